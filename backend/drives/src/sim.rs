@@ -1,0 +1,1 @@
+//! Simulated servo drive (being written).

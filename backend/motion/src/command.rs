@@ -1,0 +1,311 @@
+//! Commands into the kernel: one variant per function block, plus the "falling edge"
+//! (`Release`) and the jog dead-man renewal (`Keepalive`).
+//!
+//! A command is the rising edge of a fresh FB instance: its inputs are latched when it is
+//! submitted. All values are in the axis's engineering units and seconds.
+
+use serde::{Deserialize, Serialize};
+
+/// Identifies one command for its whole life (assigned by the caller, unique).
+pub type CommandId = u64;
+
+/// Index of an axis slot in the kernel (0-based, stable while the axis exists).
+pub type AxisSlot = u16;
+
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BufferMode {
+    /// Start at once, aborting the running command (and a buffered one).
+    #[default]
+    Aborting,
+    /// Start when the running command has finished (from standstill).
+    Buffered,
+    /// Pass the previous target at the lower of the two velocities.
+    BlendingLow,
+    /// Pass the previous target at the previous command's velocity.
+    BlendingPrevious,
+    /// Pass the previous target at this command's velocity.
+    BlendingNext,
+    /// Pass the previous target at the higher of the two velocities.
+    BlendingHigh,
+}
+
+impl BufferMode {
+    pub fn is_blending(self) -> bool {
+        !matches!(self, BufferMode::Aborting | BufferMode::Buffered)
+    }
+}
+
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    #[default]
+    Positive,
+    Negative,
+    ShortestWay,
+    CurrentDirection,
+}
+
+/// `ST_MoveOptions`.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MoveOptions {
+    /// Blend at this position instead of the previous command's target.
+    pub blending_position: Option<f64>,
+    /// Done at the logical end of positioning, without waiting for the target window.
+    pub ignore_position_monitoring: bool,
+    /// Halt/Stop: wait for the target window at the stop position before Done.
+    pub enable_stop_position_monitoring: bool,
+}
+
+/// Dynamics of a motion command; 0 means "the axis default" (#1004–#1006).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Dynamics {
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
+}
+
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JogMode {
+    /// Runs while held, with the slow manual velocity (#1001) and axis dynamics.
+    #[default]
+    StandardSlow,
+    /// Runs while held, with the fast manual velocity (#1002) and axis dynamics.
+    StandardFast,
+    /// Runs while held, with the given velocity and dynamics.
+    Continuous,
+    /// Moves by `position` per press.
+    Inching,
+    /// Moves by `position` per press and stops on a multiple of `position`.
+    InchingModulo,
+}
+
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HomingMode {
+    /// The referencing sequence configured by #1076 (cam, sync pulse …).
+    #[default]
+    Default,
+    /// Set the position without motion.
+    Direct,
+    /// Mark the axis homed without motion; position unchanged.
+    ForceCalibration,
+    /// Clear the homed flag without motion; position unchanged.
+    ResetCalibration,
+}
+
+/// `E_EncoderReferenceMode` (#1076): how the referencing sequence finds its reference.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReferenceMode {
+    /// Cam, then the encoder's sync (index) pulse — as HardwareSync.
+    #[default]
+    Default,
+    /// Reference at the falling edge of the cam.
+    PlcCam,
+    /// Cam, then the encoder index pulse latched by the drive.
+    HardwareSync,
+    /// Drive latch on the rising edge of the latch input (the cam).
+    HardwareLatchPos,
+    /// Drive latch on the falling edge of the latch input (the cam).
+    HardwareLatchNeg,
+    /// Cam, then the first zero crossing of the encoder's single-turn position.
+    SoftwareSync,
+    /// Drive-side latch, positive edge.
+    SoftDriveLatchPos,
+    /// Drive-side latch, negative edge.
+    SoftDriveLatchNeg,
+}
+
+impl ReferenceMode {
+    pub fn from_number(n: u32) -> Option<Self> {
+        use ReferenceMode::*;
+        Some(match n {
+            0 => Default,
+            1 => PlcCam,
+            2 => HardwareSync,
+            3 => HardwareLatchPos,
+            4 => HardwareLatchNeg,
+            5 => SoftwareSync,
+            6 => SoftDriveLatchPos,
+            7 => SoftDriveLatchNeg,
+            _ => return None,
+        })
+    }
+}
+
+/// `ST_HomingOptions`.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HomingOptions {
+    /// MC_Direct only: set = actual afterwards.
+    pub clear_position_lag: bool,
+    /// Overrides the cam-search direction (#1073).
+    pub search_direction: Option<Direction>,
+    /// Overrides the cam-search velocity (#1012).
+    pub search_velocity: Option<f64>,
+    /// Overrides the sync direction (#1074).
+    pub sync_direction: Option<Direction>,
+    /// Overrides the sync velocity (#1013).
+    pub sync_velocity: Option<f64>,
+    /// Overrides the reference mode (#1076).
+    pub reference_mode: Option<ReferenceMode>,
+}
+
+/// A positioning command's inputs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Positioning {
+    /// Absolute target (MoveAbsolute, MoveModulo) or distance (relative, additive).
+    pub position: f64,
+    pub velocity: f64,
+    pub dynamics: Dynamics,
+    pub buffer_mode: BufferMode,
+    pub options: MoveOptions,
+}
+
+/// One command for one axis. Validation of plain ranges (velocity > 0 …) happens in the kernel
+/// as well, so that a bad value can never move an axis, whoever submits it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CommandKind {
+    /// MC_Power. Level-type: stays busy while enabled; `Release` = Enable FALSE.
+    Power { enable: bool, enable_positive: bool, enable_negative: bool, override_percent: f64 },
+    /// MC_Reset.
+    Reset,
+    /// MC_SetPosition.
+    SetPosition { position: f64, relative: bool, clear_position_lag: bool },
+    /// MC_SetOverride (velocity factor 0..=1).
+    SetOverride { velocity_factor: f64 },
+    MoveAbsolute(Positioning),
+    MoveRelative(Positioning),
+    MoveAdditive(Positioning),
+    MoveModulo { move_: Positioning, direction: Direction },
+    MoveVelocity { velocity: f64, dynamics: Dynamics, direction: Direction, buffer_mode: BufferMode, options: MoveOptions },
+    MoveContinuousAbsolute { move_: Positioning, end_velocity: f64 },
+    MoveContinuousRelative { move_: Positioning, end_velocity: f64 },
+    /// MC_Halt; deceleration/jerk ≤ 0 mean "those of the running job".
+    Halt { deceleration: f64, jerk: f64, buffer_mode: BufferMode, options: MoveOptions },
+    /// MC_Stop; locks the axis until released or reset.
+    Stop { deceleration: f64, jerk: f64, options: MoveOptions },
+    /// MC_Jog: a rising edge of JogForward (`forward`) or JogBackwards.
+    /// `deadman` > 0: stop when not renewed (`Keepalive`) within this many seconds.
+    Jog { mode: JogMode, forward: bool, position: f64, velocity: f64, dynamics: Dynamics, deadman: f64 },
+    /// MC_Home; `position` None = the configured calibration value (#1075).
+    Home { position: Option<f64>, mode: HomingMode, options: HomingOptions },
+    /// MC_GearIn: this axis becomes the slave of `master`.
+    GearIn { master: AxisSlot, ratio_numerator: f64, ratio_denominator: u16 },
+    /// MC_GearOut.
+    GearOut,
+    /// MC_WriteParameter / MC_WriteBoolParameter at runtime (value already validated).
+    WriteParameter { number: u16, value: f64 },
+    /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
+    /// switch off a Power).
+    Release { target: CommandId },
+    /// Renews a jog's dead-man.
+    Keepalive { target: CommandId },
+}
+
+impl CommandKind {
+    /// kebab-case name as used in REST paths and the audit log.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CommandKind::Power { .. } => "power",
+            CommandKind::Reset => "reset",
+            CommandKind::SetPosition { .. } => "set-position",
+            CommandKind::SetOverride { .. } => "set-override",
+            CommandKind::MoveAbsolute(_) => "move-absolute",
+            CommandKind::MoveRelative(_) => "move-relative",
+            CommandKind::MoveAdditive(_) => "move-additive",
+            CommandKind::MoveModulo { .. } => "move-modulo",
+            CommandKind::MoveVelocity { .. } => "move-velocity",
+            CommandKind::MoveContinuousAbsolute { .. } => "move-continuous-absolute",
+            CommandKind::MoveContinuousRelative { .. } => "move-continuous-relative",
+            CommandKind::Halt { .. } => "halt",
+            CommandKind::Stop { .. } => "stop",
+            CommandKind::Jog { .. } => "jog",
+            CommandKind::Home { .. } => "home",
+            CommandKind::GearIn { .. } => "gear-in",
+            CommandKind::GearOut => "gear-out",
+            CommandKind::WriteParameter { .. } => "write-parameter",
+            CommandKind::Release { .. } => "release",
+            CommandKind::Keepalive { .. } => "keepalive",
+        }
+    }
+}
+
+/// A command addressed to one axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Command {
+    pub id: CommandId,
+    pub axis: AxisSlot,
+    pub kind: CommandKind,
+}
+
+/// The kernel's answer to a submitted command, given in the cycle it was submitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Accepted: its outputs will follow as [`crate::CommandEvent`]s.
+    Accepted,
+    /// Rejected by the axis; nothing changed.
+    Rejected(crate::ErrorId),
+}
+
+/// The outputs of a function block (`ST_McOutputs` plus the milestone flags).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FbOutputs {
+    pub busy: bool,
+    pub active: bool,
+    pub done: bool,
+    pub command_aborted: bool,
+    pub error: bool,
+    /// 0 when there is no error.
+    pub error_id: u32,
+    /// MoveVelocity, Jog continuous: commanded velocity reached.
+    pub in_velocity: bool,
+    /// GearIn: coupled.
+    pub in_gear: bool,
+    /// MoveContinuous*: target reached, running at end velocity.
+    pub in_end_velocity: bool,
+    /// Power: axis ready for operation.
+    pub status: bool,
+}
+
+impl FbOutputs {
+    /// The command has ended (Busy fell); its outputs no longer change.
+    /// (MC_Stop stays busy while it locks the axis, so its Done is not final.)
+    pub fn is_final(&self) -> bool {
+        !self.busy
+    }
+}
+
+/// A change of a command's outputs, stamped with the cycle it happened in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommandEvent {
+    pub cycle: u64,
+    pub command: CommandId,
+    pub axis: AxisSlot,
+    pub outputs: FbOutputs,
+}
+
+/// Where the kernel puts events; implemented by a Vec in tests and by a lock-free ring in
+/// the server. Must not allocate or block.
+pub trait EventSink {
+    fn push(&mut self, event: CommandEvent);
+}
+
+impl EventSink for Vec<CommandEvent> {
+    fn push(&mut self, event: CommandEvent) {
+        Vec::push(self, event)
+    }
+}

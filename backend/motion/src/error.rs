@@ -1,0 +1,118 @@
+//! Error numbers (`ErrorID`) of the kernel: the one documented table.
+//!
+//! Where TwinCAT names a number for a condition we reuse it (0x4B01 …, 0x4292, 0x4296,
+//! 0x4550); every other condition has its own number in the 0x7000 block so that an MES can
+//! tell them apart. Every number also has a stable snake_case code for problem+json.
+
+use core::fmt;
+
+/// An error number as reported in an FB's `ErrorID` output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(transparent)]
+pub struct ErrorId(pub u32);
+
+macro_rules! error_table {
+    ($( $(#[$doc:meta])* $name:ident = $num:literal, $code:literal, $text:literal; )*) => {
+        impl ErrorId {
+            $( $(#[$doc])* pub const $name: ErrorId = ErrorId($num); )*
+
+            /// Every error number the kernel can report, in table order.
+            pub const ALL: &'static [ErrorId] = &[$(ErrorId::$name),*];
+
+            /// Stable snake_case code (problem+json `code`).
+            pub fn code(self) -> &'static str {
+                match self.0 { $( $num => $code, )* _ => "unknown_error" }
+            }
+
+            /// Short English description for operators.
+            pub fn text(self) -> &'static str {
+                match self.0 { $( $num => $text, )* _ => "unknown error" }
+            }
+        }
+    };
+}
+
+error_table! {
+    /// The axis was stopped while this command travelled (reported by an aborted move).
+    AXIS_STOPPED = 0x4B00, "axis_stopped", "axis was stopped";
+    /// Command not admissible in the axis state (Disabled, ErrorStop, locked by MC_Stop, busy homing …).
+    AXIS_CANNOT_BE_STARTED = 0x4B01, "axis_cannot_be_started", "axis cannot be started in its current state";
+    /// An axis that is not moving cannot do this (e.g. GearOut on an uncoupled axis).
+    AXIS_NOT_MOVING = 0x4B03, "axis_not_moving", "axis is not in the required motion state";
+    /// Invalid mode or direction for the command.
+    INVALID_MODE = 0x4B04, "invalid_mode", "invalid mode or direction";
+    /// Command not permitted (wrong parameter type, endless motion without direction …).
+    COMMAND_NOT_PERMITTED = 0x4B05, "command_not_permitted", "command not permitted";
+    /// A command parameter is out of range (override, ratio denominator 0, velocity ≤ 0 …).
+    PARAMETER_NOT_CORRECT = 0x4B06, "parameter_not_correct", "parameter not correct";
+    /// Positioning ended but the target window was not reached within the in-target timeout.
+    IN_TARGET_TIMEOUT = 0x4B07, "in_target_timeout", "target position not reached within the in-target timeout";
+    /// A second command was to be buffered while one is already buffered.
+    BUFFER_FULL = 0x4292, "buffer_full", "command buffer full";
+    /// The optional blending position is not before the previous command's target.
+    BLENDING_POSITION_INVALID = 0x4296, "blending_position_invalid", "blending position is not before the previous target";
+    /// Following error exceeded the maximum lag for longer than the filter time.
+    FOLLOWING_ERROR = 0x4550, "following_error", "following error (position lag) too large";
+    /// Target beyond the enabled positive software limit.
+    TARGET_ABOVE_SOFT_LIMIT = 0x7001, "target_above_soft_limit", "target beyond the positive software limit";
+    /// Target beyond the enabled negative software limit.
+    TARGET_BELOW_SOFT_LIMIT = 0x7002, "target_below_soft_limit", "target beyond the negative software limit";
+    /// An endless motion was stopped at an enabled software limit.
+    SOFT_LIMIT_REACHED = 0x7003, "soft_limit_reached", "motion stopped at the software limit";
+    /// The drive reports a fault.
+    DRIVE_FAULT = 0x7010, "drive_fault", "drive fault";
+    /// The drive did not become ready after enabling.
+    DRIVE_NOT_READY = 0x7011, "drive_not_ready", "drive not ready for operation";
+    /// A hardware limit switch is active in the direction of travel.
+    LIMIT_SWITCH = 0x7012, "limit_switch", "hardware limit switch active";
+    /// The feed enable for the direction of travel is missing.
+    FEED_ENABLE_MISSING = 0x7020, "feed_enable_missing", "feed enable for this direction missing";
+    /// The trajectory planner could not solve the problem (the axis was stopped on a closed-form ramp).
+    PLANNING_FAILED = 0x7021, "planning_failed", "trajectory planning failed";
+    /// Homing could not find the reference cam or sync pulse.
+    HOMING_FAILED = 0x7030, "homing_failed", "homing sequence failed";
+    /// The master axis of a coupling does not exist or is this axis.
+    MASTER_INVALID = 0x7040, "master_invalid", "invalid master axis";
+    /// The axis is a coupled slave and motion commands to slaves are not allowed (#1065).
+    SLAVE_COMMAND_NOT_ALLOWED = 0x7041, "slave_command_not_allowed", "motion commands to a coupled slave are not allowed";
+    /// Coupling to a master that is moving is not possible with MC_GearIn.
+    MASTER_MOVING = 0x7042, "master_moving", "master axis is moving";
+    /// The master of a coupled slave went into error or was removed.
+    MASTER_LOST = 0x7043, "master_lost", "master axis lost";
+    /// Unknown parameter number or name.
+    PARAMETER_UNKNOWN = 0x7050, "parameter_unknown", "unknown parameter";
+    /// The parameter is read-only.
+    PARAMETER_READ_ONLY = 0x7051, "parameter_read_only", "parameter is read-only";
+    /// The parameter value is outside its documented range.
+    PARAMETER_OUT_OF_RANGE = 0x7052, "parameter_out_of_range", "parameter value out of range";
+    /// The command refers to a command id that does not exist or has ended.
+    COMMAND_UNKNOWN = 0x7060, "command_unknown", "unknown or finished command";
+    /// The jog dead-man timed out (no keepalive): the jog was stopped.
+    DEADMAN_TIMEOUT = 0x7061, "deadman_timeout", "jog dead-man timeout";
+    /// The axis slot does not exist.
+    AXIS_UNKNOWN = 0x7070, "axis_unknown", "unknown axis";
+}
+
+impl fmt::Display for ErrorId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "0x{:04X} {}", self.0, self.code())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_and_codes_are_unique() {
+        for (i, a) in ErrorId::ALL.iter().enumerate() {
+            for b in &ErrorId::ALL[i + 1..] {
+                assert_ne!(a.0, b.0);
+                assert_ne!(a.code(), b.code());
+            }
+            assert!(a.code().chars().all(|c| c.is_ascii_lowercase() || c == '_'));
+        }
+        assert_eq!(ErrorId::BUFFER_FULL.code(), "buffer_full");
+        assert_eq!(ErrorId(1).code(), "unknown_error");
+    }
+}

@@ -1,0 +1,150 @@
+//! The kernel: a fixed number of axis slots stepped together, masters before their slaves.
+
+use crate::axis::{Axis, MasterSample};
+use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};
+use crate::drive::{DriveFeedback, DriveSetpoint};
+use crate::error::ErrorId;
+use crate::params::AxisParameters;
+use crate::status::AxisStatus;
+
+/// All axes of one machine. Capacity is fixed at construction so that the cycle never
+/// allocates; axes are built off the cycle thread and handed in as `Box<Axis>`.
+pub struct Kernel {
+    cycle_time: f64,
+    cycle: u64,
+    axes: Vec<Option<Box<Axis>>>,
+    stepped: Vec<bool>,
+}
+
+impl Kernel {
+    /// `cycle_time` in seconds; `max_axes` slots.
+    pub fn new(cycle_time: f64, max_axes: usize) -> Self {
+        assert!(cycle_time > 0.0 && cycle_time.is_finite());
+        Kernel {
+            cycle_time,
+            cycle: 0,
+            axes: (0..max_axes).map(|_| None).collect(),
+            stepped: vec![false; max_axes],
+        }
+    }
+
+    pub fn cycle_time(&self) -> f64 {
+        self.cycle_time
+    }
+
+    /// Number of cycles stepped so far.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    pub fn capacity(&self) -> usize {
+        self.axes.len()
+    }
+
+    /// Puts a ready-built axis into a slot and returns what was there (to be freed off the
+    /// cycle thread). Does not allocate.
+    pub fn insert_axis(&mut self, slot: AxisSlot, axis: Box<Axis>) -> Result<Option<Box<Axis>>, Box<Axis>> {
+        match self.axes.get_mut(slot as usize) {
+            Some(s) => Ok(s.replace(axis)),
+            None => Err(axis),
+        }
+    }
+
+    /// Takes an axis out of its slot (to be freed off the cycle thread). Slaves coupled to
+    /// it lose their master at the next step.
+    pub fn remove_axis(&mut self, slot: AxisSlot) -> Option<Box<Axis>> {
+        self.axes.get_mut(slot as usize).and_then(|s| s.take())
+    }
+
+    pub fn axis(&self, slot: AxisSlot) -> Option<&Axis> {
+        self.axes.get(slot as usize).and_then(|a| a.as_deref())
+    }
+
+    pub fn status(&self, slot: AxisSlot) -> Option<AxisStatus> {
+        self.axis(slot).map(|a| *a.status())
+    }
+
+    pub fn parameters(&self, slot: AxisSlot) -> Option<&AxisParameters> {
+        self.axis(slot).map(|a| a.parameters())
+    }
+
+    /// Offers a command to its axis in the current cycle (before [`Kernel::step`]). The
+    /// verdict is immediate; an accepted command changes the axis state at once and its
+    /// outputs follow as events (the first one in this call).
+    pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
+        let slot = cmd.axis as usize;
+        let master = match cmd.kind {
+            CommandKind::GearIn { master, .. } => {
+                if master as usize == slot {
+                    return Verdict::Rejected(ErrorId::MASTER_INVALID);
+                }
+                match self.axis(master) {
+                    Some(m) => Some((master, MasterSample::of(m))),
+                    None => return Verdict::Rejected(ErrorId::MASTER_INVALID),
+                }
+            }
+            _ => None,
+        };
+        let cycle = self.cycle;
+        match self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
+            Some(axis) => axis.submit(cmd, master, cycle, events),
+            None => Verdict::Rejected(ErrorId::AXIS_UNKNOWN),
+        }
+    }
+
+    /// One cycle: every axis reads its feedback, advances and writes its setpoint.
+    /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
+    /// a drive that is not ready / left untouched).
+    pub fn step(&mut self, feedback: &[DriveFeedback], setpoints: &mut [DriveSetpoint], events: &mut impl EventSink) {
+        self.cycle += 1;
+        let cycle = self.cycle;
+        let dt = self.cycle_time;
+        self.stepped.iter_mut().for_each(|s| *s = false);
+        // Masters first, then slaves whose master has been stepped (chains resolve in as
+        // many passes as they are long; a loop cannot be built because GearIn rejects
+        // coupling to an axis that is itself a slave of this one's chain via the state).
+        for _pass in 0..self.axes.len().max(1) {
+            let mut progressed = false;
+            for i in 0..self.axes.len() {
+                if self.stepped[i] {
+                    continue;
+                }
+                let Some(axis) = self.axes[i].as_deref() else {
+                    self.stepped[i] = true;
+                    continue;
+                };
+                let master = match axis.master_slot() {
+                    None => None,
+                    Some(m) => match self.axes.get(m as usize).and_then(|a| a.as_deref()) {
+                        None => Some(None), // master vanished
+                        Some(ma) if self.stepped[m as usize] => Some(Some(MasterSample::of(ma))),
+                        Some(_) => continue, // wait for the master
+                    },
+                };
+                let fb = feedback.get(i).copied().unwrap_or_default();
+                let axis = self.axes[i].as_deref_mut().expect("checked above");
+                let sp = axis.step(dt, &fb, master, cycle, events);
+                if let Some(out) = setpoints.get_mut(i) {
+                    *out = sp;
+                }
+                self.stepped[i] = true;
+                progressed = true;
+            }
+            if !progressed {
+                break;
+            }
+        }
+        // Anything left is part of a coupling cycle: step it without its master.
+        for i in 0..self.axes.len() {
+            if !self.stepped[i] {
+                let fb = feedback.get(i).copied().unwrap_or_default();
+                if let Some(axis) = self.axes[i].as_deref_mut() {
+                    let sp = axis.step(dt, &fb, Some(None), cycle, events);
+                    if let Some(out) = setpoints.get_mut(i) {
+                        *out = sp;
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,493 @@
+//! The jerk-limited planner: time-optimal profiles from any state, behind our own interface.
+//!
+//! `rsruckig` (pinned) solves the 1-DoF state-to-state problem; this module maps PLCopen
+//! dynamics onto it (acceleration vs deceleration by direction of travel) and samples the
+//! trajectory cycle by cycle. When Ruckig cannot solve a problem (it never should for valid
+//! limits) the caller falls back to [`StopRamp`], a closed-form jerk-limited stop.
+
+use rsruckig::prelude::*;
+
+/// A kinematic state of the setpoint.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Kinematics {
+    pub position: f64,
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub jerk: f64,
+}
+
+/// PLCopen dynamics of one job, all > 0. `acceleration` applies while |v| rises,
+/// `deceleration` while it falls.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
+}
+
+impl Limits {
+    pub fn is_valid(&self) -> bool {
+        [self.velocity, self.acceleration, self.deceleration, self.jerk]
+            .iter()
+            .all(|x| x.is_finite() && *x > 0.0)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlanError {
+    /// A limit is not finite and positive, or the state is not finite.
+    InvalidInput,
+    /// The solver found no trajectory.
+    Infeasible,
+}
+
+/// Error handler that turns every Ruckig complaint into an `Err` without building a message
+/// string of its own (never `IgnoreErrorHandler`: it lets invalid input through).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct RejectErrors;
+
+impl RuckigErrorHandler for RejectErrors {
+    fn handle_validation_error(_message: &str) -> Result<(), RuckigError> {
+        Err(RuckigError::ValidationError(String::new()))
+    }
+    fn handle_calculator_error(_message: &str) -> Result<(), RuckigError> {
+        Err(RuckigError::CalculatorError(String::new()))
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Plan {
+    None,
+    Ruckig,
+    Fallback,
+}
+
+/// One axis's setpoint generator. Allocation-free after construction.
+pub struct Planner {
+    otg: Ruckig<1, RejectErrors>,
+    input: InputParameter<1>,
+    traj: Trajectory<1>,
+    plan: Plan,
+    time: f64,
+    duration: f64,
+    end: Kinematics,
+    fallback: StopRamp,
+}
+
+impl core::fmt::Debug for Planner {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Planner")
+            .field("plan", &self.plan)
+            .field("time", &self.time)
+            .field("duration", &self.duration)
+            .finish()
+    }
+}
+
+impl Planner {
+    pub fn new(cycle_time: f64) -> Self {
+        Planner {
+            otg: Ruckig::new(None, cycle_time),
+            input: InputParameter::new(None),
+            traj: Trajectory::new(None),
+            plan: Plan::None,
+            time: 0.0,
+            duration: 0.0,
+            end: Kinematics::default(),
+            fallback: StopRamp::default(),
+        }
+    }
+
+    /// Plans from `from` to `target` arriving with `target_velocity` (0 for a stop at the
+    /// target, ≠ 0 for blending and continuous moves). Returns the duration.
+    pub fn plan_position(
+        &mut self,
+        from: Kinematics,
+        target: f64,
+        target_velocity: f64,
+        limits: &Limits,
+    ) -> Result<f64, PlanError> {
+        check(from, limits)?;
+        if !target.is_finite() || !target_velocity.is_finite() {
+            return Err(PlanError::InvalidInput);
+        }
+        let dist = target - from.position;
+        let dir = if dist != 0.0 { dist.signum() } else { from.velocity.signum() };
+        // Will the profile have to turn around (moving away, or too fast to stop in time)?
+        let away = from.velocity * dir < 0.0;
+        let overshoot = from.velocity * dir > 0.0
+            && stop_distance(from.velocity, from.acceleration, limits.deceleration, limits.jerk)
+                > dist.abs();
+        let (max_acc, min_acc) = if away || overshoot {
+            let a = limits.acceleration.min(limits.deceleration);
+            (a, -a)
+        } else {
+            direction_limits(dir, limits)
+        };
+        self.input.control_interface = ControlInterface::Position;
+        self.input.target_position[0] = target;
+        self.input.target_velocity[0] = target_velocity;
+        self.solve(from, limits, max_acc, min_acc)
+    }
+
+    /// Plans a change to `target_velocity` (velocity interface): MoveVelocity, Halt, Stop,
+    /// jog, gear-out. Returns the duration.
+    pub fn plan_velocity(
+        &mut self,
+        from: Kinematics,
+        target_velocity: f64,
+        limits: &Limits,
+    ) -> Result<f64, PlanError> {
+        check(from, limits)?;
+        if !target_velocity.is_finite() {
+            return Err(PlanError::InvalidInput);
+        }
+        let reversing = from.velocity * target_velocity < 0.0;
+        let (max_acc, min_acc) = if reversing {
+            let a = limits.acceleration.min(limits.deceleration);
+            (a, -a)
+        } else {
+            let dir = if target_velocity != 0.0 { target_velocity.signum() } else { from.velocity.signum() };
+            direction_limits(dir, limits)
+        };
+        self.input.control_interface = ControlInterface::Velocity;
+        self.input.target_position[0] = from.position;
+        self.input.target_velocity[0] = target_velocity;
+        // The velocity interface ignores the velocity limit, but Ruckig validates it.
+        let limits = Limits { velocity: limits.velocity.max(target_velocity.abs()).max(from.velocity.abs()), ..*limits };
+        self.solve(from, &limits, max_acc, min_acc)
+    }
+
+    /// Ruckig's own problem, without the PLCopen mapping: signed acceleration limits
+    /// `max_acc` > 0 > `min_acc`. Used by the golden-file comparison with upstream Ruckig.
+    #[allow(clippy::too_many_arguments)]
+    pub fn plan_signed(
+        &mut self,
+        velocity_interface: bool,
+        from: Kinematics,
+        target_position: f64,
+        target_velocity: f64,
+        max_velocity: f64,
+        max_acc: f64,
+        min_acc: f64,
+        jerk: f64,
+    ) -> Result<f64, PlanError> {
+        let limits = Limits { velocity: max_velocity, acceleration: max_acc, deceleration: -min_acc, jerk };
+        check(from, &limits)?;
+        self.input.control_interface = if velocity_interface { ControlInterface::Velocity } else { ControlInterface::Position };
+        self.input.target_position[0] = target_position;
+        self.input.target_velocity[0] = target_velocity;
+        self.solve(from, &limits, max_acc, min_acc)
+    }
+
+    fn solve(&mut self, from: Kinematics, limits: &Limits, max_acc: f64, min_acc: f64) -> Result<f64, PlanError> {
+        let inp = &mut self.input;
+        inp.current_position[0] = from.position;
+        inp.current_velocity[0] = from.velocity;
+        inp.current_acceleration[0] = from.acceleration;
+        inp.target_acceleration[0] = 0.0;
+        inp.max_velocity[0] = limits.velocity;
+        inp.max_acceleration[0] = max_acc;
+        inp.min_acceleration = Some(rsruckig::daov_stack![min_acc]);
+        inp.max_jerk[0] = limits.jerk;
+        match self.otg.calculate(inp, &mut self.traj) {
+            Ok(RuckigResult::Working) | Ok(RuckigResult::Finished) => {
+                self.plan = Plan::Ruckig;
+                self.time = 0.0;
+                self.duration = self.traj.get_duration();
+                self.end = self.sample_at(self.duration);
+                Ok(self.duration)
+            }
+            _ => Err(PlanError::Infeasible),
+        }
+    }
+
+    /// Last resort: closed-form jerk-limited stop from `from`.
+    pub fn plan_fallback_stop(&mut self, from: Kinematics, deceleration: f64, jerk: f64) {
+        self.fallback = StopRamp::new(from, deceleration.max(1e-9), jerk.max(1e-9));
+        self.plan = Plan::Fallback;
+        self.time = 0.0;
+        self.duration = f64::INFINITY;
+    }
+
+    /// Forgets the plan (the setpoint then holds still).
+    pub fn clear(&mut self) {
+        self.plan = Plan::None;
+    }
+
+    pub fn is_planned(&self) -> bool {
+        self.plan != Plan::None
+    }
+
+    /// Advances the plan by `dt` and returns the new setpoint. After the end of a profile
+    /// the setpoint continues with the end velocity (zero for a stop).
+    pub fn step(&mut self, dt: f64) -> Option<Kinematics> {
+        match self.plan {
+            Plan::None => None,
+            Plan::Ruckig => {
+                self.time += dt;
+                Some(self.sample_at(self.time))
+            }
+            Plan::Fallback => {
+                let k = self.fallback.step(dt);
+                if self.fallback.finished() {
+                    self.duration = self.time + dt;
+                }
+                self.time += dt;
+                Some(k)
+            }
+        }
+    }
+
+    fn sample_at(&self, t: f64) -> Kinematics {
+        if t >= self.duration && self.plan == Plan::Ruckig && t > 0.0 && self.duration > 0.0 && t > self.duration {
+            // Beyond the end: constant end velocity, no acceleration.
+            let e = self.end;
+            return Kinematics { position: e.position + e.velocity * (t - self.duration), velocity: e.velocity, acceleration: 0.0, jerk: 0.0 };
+        }
+        let mut p = rsruckig::daov_stack![0.0];
+        let mut v = rsruckig::daov_stack![0.0];
+        let mut a = rsruckig::daov_stack![0.0];
+        let mut j = rsruckig::daov_stack![0.0];
+        let mut section = None;
+        self.traj.at_time(t.min(self.duration), &mut Some(&mut p), &mut Some(&mut v), &mut Some(&mut a), &mut Some(&mut j), &mut section);
+        Kinematics { position: p[0], velocity: v[0], acceleration: a[0], jerk: j[0] }
+    }
+
+    /// The profile has reached its end state.
+    pub fn finished(&self) -> bool {
+        match self.plan {
+            Plan::None => true,
+            Plan::Ruckig => self.time >= self.duration,
+            Plan::Fallback => self.fallback.finished(),
+        }
+    }
+
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    pub fn elapsed(&self) -> f64 {
+        self.time
+    }
+
+    pub fn remaining_time(&self) -> f64 {
+        (self.duration - self.time).max(0.0)
+    }
+
+    /// The end state of the current profile.
+    pub fn end_state(&self) -> Kinematics {
+        self.end
+    }
+}
+
+fn check(from: Kinematics, limits: &Limits) -> Result<(), PlanError> {
+    if !limits.is_valid() || !from.position.is_finite() || !from.velocity.is_finite() || !from.acceleration.is_finite() {
+        return Err(PlanError::InvalidInput);
+    }
+    Ok(())
+}
+
+/// Ruckig's signed acceleration limits for travel in direction `dir` (PLCopen: acceleration
+/// raises |v|, deceleration lowers it).
+fn direction_limits(dir: f64, limits: &Limits) -> (f64, f64) {
+    if dir < 0.0 {
+        (limits.deceleration, -limits.acceleration)
+    } else {
+        (limits.acceleration, -limits.deceleration)
+    }
+}
+
+/// Distance needed to stop from (v, a) with deceleration `dec` and jerk `jerk`, in the
+/// direction of v (closed form of the jerk-limited stop; ≥ 0).
+pub fn stop_distance(v: f64, a: f64, dec: f64, jerk: f64) -> f64 {
+    if v == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let mut r = StopRamp::new(Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 }, dec, jerk);
+    r.distance_to_stop().abs()
+}
+
+/// Closed-form jerk-limited stop: |a| ramps at `jerk` towards −sign(v)·`dec` and back to 0
+/// so that v and a reach zero together. Used as the fallback and to predict braking distance.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StopRamp {
+    k: Kinematics,
+    dec: f64,
+    jerk: f64,
+    done: bool,
+}
+
+impl StopRamp {
+    pub fn new(from: Kinematics, dec: f64, jerk: f64) -> Self {
+        StopRamp { k: from, dec, jerk, done: from.velocity == 0.0 && from.acceleration == 0.0 }
+    }
+
+    pub fn finished(&self) -> bool {
+        self.done
+    }
+
+    /// Integrates the ramp analytically to the end and returns the travelled distance.
+    fn distance_to_stop(&mut self) -> f64 {
+        // Work in the frame where v ≥ 0.
+        let s = if self.k.velocity != 0.0 { self.k.velocity.signum() } else { -self.k.acceleration.signum() };
+        let (mut v, mut a) = (self.k.velocity * s, self.k.acceleration * s);
+        let (d, j) = (self.dec, self.jerk);
+        let mut x = 0.0;
+        // Phase 0: positive acceleration is first ramped down to 0.
+        if a > 0.0 {
+            let t = a / j;
+            x += v * t + a * t * t / 2.0 - j * t * t * t / 6.0;
+            v += a * t - j * t * t / 2.0;
+            a = 0.0;
+        }
+        // Now a ≤ 0. Velocity lost while ramping a back to 0 from a: a²/(2j).
+        let a_neg = -a;
+        if a_neg * a_neg / (2.0 * j) >= v {
+            // Already decelerating hard enough: releasing the braking still reaches v = 0
+            // (where the ramp stops, clamping a) at the first root of v(t) = 0.
+            let t = (a_neg - (a_neg * a_neg - 2.0 * j * v).max(0.0).sqrt()) / j;
+            x += v * t - a_neg * t * t / 2.0 + j * t * t * t / 6.0;
+            return x * s;
+        }
+        // Raise |a| to a_peak ≤ d, hold, then ramp back to 0.
+        let a_peak_unlimited = ((v * j) + a_neg * a_neg / 2.0).sqrt();
+        let a_peak = a_peak_unlimited.min(d.max(a_neg));
+        // ramp up from a_neg to a_peak
+        let t1 = (a_peak - a_neg) / j;
+        x += v * t1 - a_neg * t1 * t1 / 2.0 - j * t1 * t1 * t1 / 6.0;
+        v -= a_neg * t1 + j * t1 * t1 / 2.0;
+        // ramp down from a_peak to 0 loses a_peak²/(2j)
+        let v_ramp = a_peak * a_peak / (2.0 * j);
+        let v_hold = (v - v_ramp).max(0.0);
+        let t2 = v_hold / a_peak;
+        x += v * t2 - a_peak * t2 * t2 / 2.0;
+        v -= a_peak * t2;
+        let t3 = a_peak / j;
+        x += v * t3 - a_peak * t3 * t3 / 2.0 + j * t3 * t3 * t3 / 6.0;
+        x * s
+    }
+
+    /// One cycle of the stop, choosing the jerk so that a and v reach 0 together.
+    pub fn step(&mut self, dt: f64) -> Kinematics {
+        if self.done {
+            self.k.velocity = 0.0;
+            self.k.acceleration = 0.0;
+            self.k.jerk = 0.0;
+            return self.k;
+        }
+        let s = if self.k.velocity != 0.0 { self.k.velocity.signum() } else { -self.k.acceleration.signum() };
+        let (v, a) = (self.k.velocity * s, self.k.acceleration * s);
+        let j = self.jerk;
+        // Jerk choice in the v ≥ 0 frame: braking acceleration is negative.
+        let jj = if a > -self.dec && (-a) * (-a) / (2.0 * j) < v - (-a).max(0.0) * dt {
+            -j // build up braking
+        } else if a <= 0.0 && a * a / (2.0 * j) >= v {
+            j // release braking so that a reaches 0 when v does
+        } else if a > 0.0 {
+            -j
+        } else {
+            0.0
+        };
+        let (mut nv, mut na) = (v + a * dt + jj * dt * dt / 2.0, a + jj * dt);
+        let mut np = self.k.position + s * (v * dt + a * dt * dt / 2.0 + jj * dt * dt * dt / 6.0);
+        if nv <= 0.0 || (na >= 0.0 && jj > 0.0 && nv <= 1e-12) {
+            // Stopped: clamp exactly at rest.
+            if nv < 0.0 {
+                // Undo the overshoot of the last partial cycle.
+                np -= s * nv * dt / 2.0;
+            }
+            nv = 0.0;
+            na = 0.0;
+            self.done = true;
+        }
+        self.k = Kinematics { position: np, velocity: s * nv, acceleration: s * na, jerk: s * jj };
+        self.k
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIM: Limits = Limits { velocity: 100.0, acceleration: 1000.0, deceleration: 500.0, jerk: 10000.0 };
+
+    fn run(p: &mut Planner, dt: f64) -> Vec<Kinematics> {
+        let mut out = Vec::new();
+        while !p.finished() {
+            out.push(p.step(dt).unwrap());
+            assert!(out.len() < 1_000_000);
+        }
+        out
+    }
+
+    #[test]
+    fn position_plan_reaches_target_and_uses_dec_for_braking() {
+        let mut p = Planner::new(0.001);
+        let d = p.plan_position(Kinematics::default(), 50.0, 0.0, &LIM).unwrap();
+        assert!(d > 0.5 && d < 1.0, "duration {d}");
+        let ks = run(&mut p, 0.001);
+        let last = ks.last().unwrap();
+        assert!((last.position - 50.0).abs() < 1e-9);
+        assert!(last.velocity.abs() < 1e-9);
+        let amax = ks.iter().map(|k| k.acceleration).fold(f64::MIN, f64::max);
+        let amin = ks.iter().map(|k| k.acceleration).fold(f64::MAX, f64::min);
+        assert!(amax <= 1000.0 + 1e-6 && amax > 900.0, "amax {amax}");
+        assert!(amin >= -500.0 - 1e-6 && amin < -450.0, "amin {amin}");
+    }
+
+    #[test]
+    fn negative_direction_swaps_signed_limits() {
+        let mut p = Planner::new(0.001);
+        p.plan_position(Kinematics::default(), -50.0, 0.0, &LIM).unwrap();
+        let ks = run(&mut p, 0.001);
+        let amin = ks.iter().map(|k| k.acceleration).fold(f64::MAX, f64::min);
+        let amax = ks.iter().map(|k| k.acceleration).fold(f64::MIN, f64::max);
+        assert!(amin >= -1000.0 - 1e-6 && amin < -900.0);
+        assert!(amax <= 500.0 + 1e-6 && amax > 450.0);
+    }
+
+    #[test]
+    fn velocity_plan_to_zero_stops() {
+        let mut p = Planner::new(0.001);
+        let from = Kinematics { position: 0.0, velocity: 80.0, acceleration: 300.0, jerk: 0.0 };
+        p.plan_velocity(from, 0.0, &LIM).unwrap();
+        let ks = run(&mut p, 0.001);
+        let last = ks.last().unwrap();
+        assert!(last.velocity.abs() < 1e-9 && last.acceleration.abs() < 1e-9);
+        // The prediction of the closed form stop agrees roughly (it assumes the same limits).
+        let sd = stop_distance(80.0, 300.0, 500.0, 10000.0);
+        assert!((sd - last.position).abs() / last.position < 0.05, "{sd} vs {}", last.position);
+    }
+
+    #[test]
+    fn invalid_limits_are_rejected() {
+        let mut p = Planner::new(0.001);
+        let bad = Limits { jerk: f64::NAN, ..LIM };
+        assert_eq!(p.plan_position(Kinematics::default(), 1.0, 0.0, &bad), Err(PlanError::InvalidInput));
+        let bad = Limits { velocity: 0.0, ..LIM };
+        assert_eq!(p.plan_position(Kinematics::default(), 1.0, 0.0, &bad), Err(PlanError::InvalidInput));
+    }
+
+    #[test]
+    fn fallback_stop_respects_limits_and_stops() {
+        for &(v, a) in &[(80.0, 0.0), (80.0, 400.0), (-60.0, -200.0), (5.0, -450.0), (-3.0, 100.0)] {
+            let mut r = StopRamp::new(Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 }, 500.0, 10000.0);
+            let mut prev = Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 };
+            let mut n = 0;
+            while !r.finished() {
+                let k = r.step(0.001);
+                assert!(k.acceleration.abs() <= 500.0f64.max(a.abs()) + 1e-9);
+                assert!((k.acceleration - prev.acceleration).abs() <= 10000.0 * 0.001 + 1e-9 || r.finished());
+                // never reverses
+                assert!(k.velocity * v >= -1e-12, "reversed: {k:?}");
+                prev = k;
+                n += 1;
+                assert!(n < 100_000);
+            }
+            let predicted = stop_distance(v, a, 500.0, 10000.0);
+            assert!((predicted.abs() - prev.position.abs()).abs() < 0.02 * predicted.abs().max(0.01) + 0.01, "v {v} a {a}: {predicted} vs {}", prev.position);
+        }
+    }
+}

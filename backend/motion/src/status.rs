@@ -1,0 +1,100 @@
+//! The per-axis status snapshot (NcToPlc + ST_AxisStatus, reduced to what users read).
+
+use serde::{Deserialize, Serialize};
+
+/// `MC_AxisStates`.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisState {
+    #[default]
+    Disabled,
+    Standstill,
+    Homing,
+    DiscreteMotion,
+    ContinuousMotion,
+    SynchronizedMotion,
+    Stopping,
+    ErrorStop,
+}
+
+/// Phase of a referencing sequence (`NcToPlc.HomingState`).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HomingPhase {
+    /// Not homing (READY).
+    #[default]
+    Idle,
+    /// 1: endless start towards the reference cam.
+    SearchCam,
+    /// 2: cam found, stopping.
+    StopOnCam,
+    /// 3: at standstill on the cam; leaving it towards the sync pulse.
+    LeaveCam,
+    /// 4: waiting for the falling edge of the cam.
+    WaitCamFallingEdge,
+    /// 5: latch armed, waiting for the sync pulse / latch, then stopping.
+    WaitLatch,
+    /// 6: stopping; the position is set at standstill.
+    SetPosition,
+}
+
+/// Copyable status of one axis, published every cycle.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AxisStatus {
+    pub state: AxisState,
+    /// Commanded (set) position.
+    pub set_position: f64,
+    pub set_velocity: f64,
+    pub set_acceleration: f64,
+    pub set_jerk: f64,
+    pub actual_position: f64,
+    pub actual_velocity: f64,
+    /// set − actual.
+    pub following_error: f64,
+    /// Modulo set position in [0, period) (equal to set_position on linear axes).
+    pub modulo_set_position: f64,
+    pub modulo_actual_position: f64,
+    /// Whole turns of the set position (floor(set / period)); 0 on linear axes.
+    pub modulo_set_turns: i64,
+    /// Target of the running positioning job (the set position when none).
+    pub target_position: f64,
+    pub remaining_distance: f64,
+    pub remaining_time: f64,
+    /// Effective override in percent (MC_Power override × MC_SetOverride factor).
+    pub override_percent: f64,
+    pub power_status: bool,
+    pub enable_positive: bool,
+    pub enable_negative: bool,
+    pub homed: bool,
+    pub homing_phase: HomingPhase,
+    /// A job is running (NcToPlc HasJob).
+    pub has_job: bool,
+    /// A command waits in the buffer (StateDWord bit 24).
+    pub command_buffered: bool,
+    /// MC_Stop lock (StateDWord bit 29).
+    pub motion_commands_locked: bool,
+    pub moving: bool,
+    pub moving_forward: bool,
+    pub moving_backward: bool,
+    pub constant_velocity: bool,
+    pub accelerating: bool,
+    pub decelerating: bool,
+    pub in_target_position: bool,
+    pub in_position_area: bool,
+    pub soft_limit_min_exceeded: bool,
+    pub soft_limit_max_exceeded: bool,
+    pub coupled: bool,
+    /// Slot of the master while coupled.
+    pub master: Option<u16>,
+    pub gear_ratio: f64,
+    /// 0 = no error.
+    pub error_id: u32,
+    pub drive_fault: bool,
+    /// Offset accumulated by MC_SetPosition since the last homing (#2003).
+    pub set_position_offset: f64,
+    /// Command that is executing (NcToPlc CmdNo), 0 when none.
+    pub active_command: u64,
+}
