@@ -73,6 +73,8 @@ pub struct Planner {
     duration: f64,
     end: Kinematics,
     fallback: StopRamp,
+    /// Coordinate shift applied after planning (MC_SetPosition during motion).
+    shift: f64,
 }
 
 impl core::fmt::Debug for Planner {
@@ -96,6 +98,7 @@ impl Planner {
             duration: 0.0,
             end: Kinematics::default(),
             fallback: StopRamp::default(),
+            shift: 0.0,
         }
     }
 
@@ -194,6 +197,7 @@ impl Planner {
         match self.otg.calculate(inp, &mut self.traj) {
             Ok(RuckigResult::Working) | Ok(RuckigResult::Finished) => {
                 self.plan = Plan::Ruckig;
+                self.shift = 0.0;
                 self.time = 0.0;
                 self.duration = self.traj.get_duration();
                 self.end = self.sample_at(self.duration);
@@ -209,6 +213,25 @@ impl Planner {
         self.plan = Plan::Fallback;
         self.time = 0.0;
         self.duration = f64::INFINITY;
+    }
+
+    /// Moves the planned trajectory by `delta` (the coordinate system changed, the motion
+    /// did not).
+    pub fn shift(&mut self, delta: f64) {
+        self.shift += delta;
+        self.end.position += delta;
+        self.fallback.k.position += delta;
+    }
+
+    /// Whether the current position profile passes beyond `target` in direction `dir`
+    /// (a blend or limit stop that cannot brake in time).
+    pub fn overshoots(&mut self, target: f64, dir: f64) -> bool {
+        if self.plan != Plan::Ruckig {
+            return false;
+        }
+        let ext = &self.traj.get_position_extrema()[0];
+        let tol = 1e-9 * (1.0 + target.abs());
+        if dir > 0.0 { ext.max + self.shift > target + tol } else { ext.min + self.shift < target - tol }
     }
 
     /// Forgets the plan (the setpoint then holds still).
@@ -241,7 +264,7 @@ impl Planner {
     }
 
     fn sample_at(&self, t: f64) -> Kinematics {
-        if t >= self.duration && self.plan == Plan::Ruckig && t > 0.0 && self.duration > 0.0 && t > self.duration {
+        if self.plan == Plan::Ruckig && t > self.duration {
             // Beyond the end: constant end velocity, no acceleration.
             let e = self.end;
             return Kinematics { position: e.position + e.velocity * (t - self.duration), velocity: e.velocity, acceleration: 0.0, jerk: 0.0 };
@@ -252,7 +275,7 @@ impl Planner {
         let mut j = rsruckig::daov_stack![0.0];
         let mut section = None;
         self.traj.at_time(t.min(self.duration), &mut Some(&mut p), &mut Some(&mut v), &mut Some(&mut a), &mut Some(&mut j), &mut section);
-        Kinematics { position: p[0], velocity: v[0], acceleration: a[0], jerk: j[0] }
+        Kinematics { position: p[0] + self.shift, velocity: v[0], acceleration: a[0], jerk: j[0] }
     }
 
     /// The profile has reached its end state.

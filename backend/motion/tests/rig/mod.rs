@@ -1,0 +1,360 @@
+//! Virtual-time test rig: a kernel, an ideal/PT1 plant per axis with cam, index pulse and
+//! latch, and invariant checks that run in EVERY cycle (FB protocol, state diagram,
+//! continuity, velocity/acceleration/jerk bounds).
+#![allow(dead_code)]
+
+use std::collections::{HashMap, HashSet};
+
+use motion::*;
+
+pub const DT: f64 = 0.001;
+
+/// A simple plant: actual follows the previous setpoint through an optional PT1.
+#[derive(Clone, Debug)]
+pub struct Plant {
+    pub pos: f64,
+    pub vel: f64,
+    pub tau: f64,
+    pub enabled: bool,
+    pub enable_delay_cycles: u32,
+    pending: u32,
+    pub fault: bool,
+    pub fault_code: u32,
+    pub cam: Option<(f64, f64)>,
+    pub index_period: Option<f64>,
+    pub limit_positive: bool,
+    pub limit_negative: bool,
+    /// Extra lag added to the actual position (a load that the drive cannot hold).
+    pub load_lag: f64,
+    latch_valid: bool,
+    latch_pos: f64,
+    prev_pos: f64,
+    prev_cam: bool,
+}
+
+impl Default for Plant {
+    fn default() -> Self {
+        Plant {
+            pos: 0.0,
+            vel: 0.0,
+            tau: 0.0,
+            enabled: false,
+            enable_delay_cycles: 3,
+            pending: 0,
+            fault: false,
+            fault_code: 0,
+            cam: None,
+            index_period: None,
+            limit_positive: false,
+            limit_negative: false,
+            load_lag: 0.0,
+            latch_valid: false,
+            latch_pos: 0.0,
+            prev_pos: 0.0,
+            prev_cam: false,
+        }
+    }
+}
+
+impl Plant {
+    fn cam_at(&self, p: f64) -> bool {
+        self.cam.is_some_and(|(a, b)| p >= a && p <= b)
+    }
+
+    pub fn feedback(&self) -> DriveFeedback {
+        DriveFeedback {
+            ready: !self.fault,
+            enabled: self.enabled,
+            fault: self.fault,
+            fault_code: self.fault_code,
+            actual_position: self.pos - self.load_lag,
+            actual_velocity: self.vel,
+            reference_cam: self.cam_at(self.pos),
+            limit_positive: self.limit_positive,
+            limit_negative: self.limit_negative,
+            latch_valid: self.latch_valid,
+            latch_position: self.latch_pos,
+        }
+    }
+
+    pub fn apply(&mut self, sp: &DriveSetpoint, dt: f64) {
+        if sp.fault_reset {
+            self.fault = false;
+        }
+        if sp.enable && !self.fault {
+            if !self.enabled {
+                self.pending += 1;
+                if self.pending >= self.enable_delay_cycles {
+                    self.enabled = true;
+                }
+            }
+        } else {
+            self.enabled = false;
+            self.pending = 0;
+        }
+        self.prev_pos = self.pos;
+        if self.enabled {
+            let target = sp.position;
+            let new = if self.tau > 0.0 { self.pos + (target - self.pos) * (1.0 - (-dt / self.tau).exp()) } else { target };
+            self.vel = (new - self.pos) / dt;
+            self.pos = new;
+        } else {
+            self.vel = 0.0;
+        }
+        // Latch.
+        if !sp.latch_enable {
+            self.latch_valid = false;
+        } else if !self.latch_valid {
+            let (a, b) = (self.prev_pos, self.pos);
+            let hit = match sp.latch_source {
+                LatchSource::IndexPulse => self.index_period.and_then(|per| {
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    let k = (lo / per).ceil() * per;
+                    (k <= hi && a != b && k != a).then_some(k)
+                }),
+                LatchSource::CamRising | LatchSource::CamFalling => {
+                    let (ca, cb) = (self.cam_at(a), self.cam_at(b));
+                    let want = sp.latch_source == LatchSource::CamRising;
+                    if ca != cb && cb == want {
+                        let (s, e) = self.cam.unwrap();
+                        Some(if (b > a) == want { s } else { e })
+                    } else {
+                        None
+                    }
+                }
+            };
+            if let Some(p) = hit {
+                self.latch_valid = true;
+                self.latch_pos = p;
+            }
+        }
+        self.prev_cam = self.cam_at(self.pos);
+    }
+}
+
+/// Bounds checked every cycle for one axis.
+#[derive(Clone, Copy, Debug)]
+pub struct Bounds {
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub jerk: f64,
+}
+
+pub struct Rig {
+    pub k: Kernel,
+    pub plants: Vec<Plant>,
+    pub sp: Vec<DriveSetpoint>,
+    pub events: Vec<CommandEvent>,
+    pub bounds: Vec<Bounds>,
+    pub outputs: HashMap<CommandId, FbOutputs>,
+    finals: HashSet<CommandId>,
+    next_id: CommandId,
+    prev: Vec<AxisStatus>,
+    /// Position jumps are expected (SetPosition, homing, disable) this cycle.
+    shifted: Vec<bool>,
+    pub history: Vec<Vec<AxisStatus>>,
+    pub checked_cycles: u64,
+}
+
+pub fn params() -> AxisParameters {
+    let mut p = AxisParameters::default();
+    p.axis_velo_max = 500.0;
+    p.axis_acc = 2000.0;
+    p.axis_dec = 1000.0;
+    p.axis_jerk = 20000.0;
+    p.axis_fast_dec = 5000.0;
+    p.axis_fast_acc = 5000.0;
+    p.axis_fast_jerk = 100000.0;
+    p.axis_maximum_acceleration = 5000.0;
+    p.axis_maximum_deceleration = 5000.0;
+    p.axis_target_position_window = 0.01;
+    p.axis_target_position_monitoring_time = 0.005;
+    p.axis_max_pos_lag_value = 1.0;
+    p.axis_max_pos_lag_filter_time = 0.01;
+    p
+}
+
+impl Rig {
+    pub fn new(axes: usize) -> Rig {
+        Rig::with(vec![(false, params()); axes])
+    }
+
+    pub fn with(configs: Vec<(bool, AxisParameters)>) -> Rig {
+        let n = configs.len();
+        let mut k = Kernel::new(DT, n);
+        let mut bounds = Vec::new();
+        for (i, (modulo, p)) in configs.into_iter().enumerate() {
+            bounds.push(Bounds {
+                velocity: p.axis_velo_max,
+                acceleration: p.axis_maximum_acceleration.max(p.axis_maximum_deceleration).max(p.axis_fast_dec),
+                jerk: p.axis_jerk.max(p.axis_fast_jerk),
+            });
+            k.insert_axis(i as u16, Axis::new(AxisConfig { modulo, parameters: p }, DT)).unwrap();
+        }
+        Rig {
+            k,
+            plants: vec![Plant::default(); n],
+            sp: vec![DriveSetpoint::default(); n],
+            events: Vec::new(),
+            bounds,
+            outputs: HashMap::new(),
+            finals: HashSet::new(),
+            next_id: 1,
+            prev: vec![AxisStatus::default(); n],
+            shifted: vec![true; n],
+            history: vec![Vec::new(); n],
+            checked_cycles: 0,
+        }
+    }
+
+    pub fn cmd(&mut self, axis: u16, kind: CommandKind) -> (CommandId, Verdict) {
+        let id = self.next_id;
+        self.next_id += 1;
+        let n = self.events.len();
+        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Power { enable: false, .. } | CommandKind::Reset | CommandKind::Release { .. } | CommandKind::GearIn { .. } | CommandKind::GearOut) {
+            self.shifted[axis as usize] = true;
+        }
+        let before = self.k.status(axis);
+        let v = self.k.submit(Command { id, axis, kind }, &mut self.events);
+        if let Verdict::Rejected(_) = v {
+            assert_eq!(self.events.len(), n, "a rejected command emitted events");
+            assert_eq!(self.k.status(axis), before, "a rejected command changed the axis status");
+        }
+        self.check_events(n);
+        (id, v)
+    }
+
+    /// Submits and expects acceptance.
+    pub fn ok(&mut self, axis: u16, kind: CommandKind) -> CommandId {
+        let (id, v) = self.cmd(axis, kind);
+        assert_eq!(v, Verdict::Accepted, "{kind:?} rejected");
+        id
+    }
+
+    pub fn rejected(&mut self, axis: u16, kind: CommandKind) -> ErrorId {
+        match self.cmd(axis, kind).1 {
+            Verdict::Rejected(e) => e,
+            Verdict::Accepted => panic!("{kind:?} accepted"),
+        }
+    }
+
+    pub fn out(&self, id: CommandId) -> FbOutputs {
+        self.outputs.get(&id).copied().unwrap_or_default()
+    }
+
+    pub fn st(&self, axis: u16) -> AxisStatus {
+        self.k.status(axis).unwrap()
+    }
+
+    pub fn step(&mut self) {
+        let fb: Vec<DriveFeedback> = self.plants.iter().map(|p| p.feedback()).collect();
+        let n = self.events.len();
+        self.k.step(&fb, &mut self.sp, &mut self.events);
+        for (i, p) in self.plants.iter_mut().enumerate() {
+            p.apply(&self.sp[i], DT);
+        }
+        self.check_events(n);
+        self.check_axes();
+    }
+
+    pub fn run(&mut self, seconds: f64) {
+        for _ in 0..(seconds / DT).round() as usize {
+            self.step();
+        }
+    }
+
+    /// Steps until `f` holds (at most `seconds`); returns the cycles taken.
+    pub fn until(&mut self, seconds: f64, mut f: impl FnMut(&Rig) -> bool) -> usize {
+        for i in 0..(seconds / DT).round() as usize {
+            if f(self) {
+                return i;
+            }
+            self.step();
+        }
+        panic!("condition not reached within {seconds} s; status {:?}", self.st(0));
+    }
+
+    pub fn power_on(&mut self, axis: u16) -> CommandId {
+        let id = self.ok(axis, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+        self.until(0.1, |r| r.st(axis).state == AxisState::Standstill);
+        id
+    }
+
+    fn check_events(&mut self, from: usize) {
+        for e in &self.events[from..] {
+            let o = e.outputs;
+            assert!(!self.finals.contains(&e.command), "event after the final one: {e:?}");
+            // §3.1: Busy/Done/Error/CommandAborted exclusive; Active/Done/Error/CommandAborted
+            // exclusive — except MC_Stop's Done while busy and active.
+            let stop_locked = o.done && o.busy && o.active && !o.error && !o.command_aborted;
+            let a = [o.busy, o.done, o.error, o.command_aborted].iter().filter(|x| **x).count();
+            let b = [o.active, o.done, o.error, o.command_aborted].iter().filter(|x| **x).count();
+            assert!(stop_locked || (a <= 1 && b <= 1), "exclusivity violated: {e:?}");
+            assert!(a >= 1, "no output set: {e:?}");
+            assert!(!(o.error && (o.in_velocity || o.in_gear || o.in_end_velocity)), "success flag with error: {e:?}");
+            assert_eq!(o.error, o.error_id != 0, "error and error_id disagree: {e:?}");
+            if o.active {
+                assert!(o.busy, "active without busy: {e:?}");
+            }
+            if let Some(prev) = self.outputs.get(&e.command) {
+                assert_ne!(*prev, o, "event without change: {e:?}");
+                assert!(!(prev.done && o.busy && !stop_locked && !prev.busy), "done then busy again: {e:?}");
+            }
+            assert_eq!(e.cycle, self.k.cycle(), "event stamped with a wrong cycle");
+            self.outputs.insert(e.command, o);
+            if o.is_final() {
+                self.finals.insert(e.command);
+            }
+        }
+    }
+
+    fn check_axes(&mut self) {
+        self.checked_cycles += 1;
+        for i in 0..self.prev.len() {
+            let s = self.k.status(i as u16).unwrap();
+            let p = self.prev[i];
+            let b = self.bounds[i];
+            assert!(allowed(p.state, s.state), "axis {i}: transition {:?} -> {:?} not in the diagram", p.state, s.state);
+            let tol = 1e-9;
+            assert!(s.set_velocity.abs() <= b.velocity * (1.0 + tol) + tol, "axis {i}: |v| {} > {}", s.set_velocity, b.velocity);
+            assert!(s.set_acceleration.abs() <= b.acceleration * (1.0 + tol) + tol, "axis {i}: |a| {} > {}", s.set_acceleration, b.acceleration);
+            let settled = !self.shifted[i] && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop) && !matches!(p.state, AxisState::Disabled) && p.homed == s.homed && !s.coupled && !p.coupled;
+            if settled {
+                let j = b.jerk;
+                assert!((s.set_acceleration - p.set_acceleration).abs() <= j * DT * (1.0 + 1e-6) + 1e-6, "axis {i}: jerk {} > {j} (a {} -> {})", (s.set_acceleration - p.set_acceleration) / DT, p.set_acceleration, s.set_acceleration);
+                let dv = s.set_velocity - p.set_velocity;
+                assert!((dv - (p.set_acceleration + s.set_acceleration) / 2.0 * DT).abs() <= j * DT * DT + 1e-6, "axis {i}: velocity jump {} -> {} (a {})", p.set_velocity, s.set_velocity, p.set_acceleration);
+                let dp = s.set_position - p.set_position;
+                assert!((dp - (p.set_velocity + s.set_velocity) / 2.0 * DT).abs() <= b.acceleration * DT * DT + 1e-6, "axis {i}: position jump {} -> {} (v {} -> {})", p.set_position, s.set_position, p.set_velocity, s.set_velocity);
+            }
+            self.shifted[i] = false;
+            self.prev[i] = s;
+            self.history[i].push(s);
+        }
+    }
+}
+
+/// The PLCopen state diagram (spec §2.4) with its notes; self-transitions are always fine.
+pub fn allowed(from: AxisState, to: AxisState) -> bool {
+    use AxisState::*;
+    if from == to || to == ErrorStop || to == Disabled {
+        return true;
+    }
+    match from {
+        Disabled => matches!(to, Standstill),
+        ErrorStop => matches!(to, Standstill),
+        Standstill => matches!(to, Homing | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping),
+        Homing => matches!(to, Standstill | Stopping),
+        DiscreteMotion | ContinuousMotion => matches!(to, Standstill | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping),
+        SynchronizedMotion => matches!(to, Standstill | DiscreteMotion | ContinuousMotion | Stopping),
+        Stopping => matches!(to, Standstill),
+    }
+}
+
+pub fn mv(position: f64, velocity: f64) -> Positioning {
+    Positioning { position, velocity, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }
+}
+
+pub fn mvb(position: f64, velocity: f64, buffer_mode: BufferMode) -> Positioning {
+    Positioning { buffer_mode, ..mv(position, velocity) }
+}
