@@ -120,6 +120,8 @@ struct Job {
     /// Modulo moves issued from motion are resolved when they start.
     modulo: Option<(f64, Direction)>,
     home: HomeSeq,
+    /// Error to report when this (internal stop of a) job ends: dead-man, planning failure.
+    pending_error: Option<ErrorId>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -159,6 +161,7 @@ impl Job {
             since_keepalive: 0.0,
             modulo: None,
             home: HomeSeq::default(),
+            pending_error: None,
         }
     }
 
@@ -916,14 +919,20 @@ impl Axis {
             self.disable(cycle, events);
             return Ok(());
         }
-        for j in [self.job.as_mut(), self.next.as_mut()].into_iter().flatten() {
-            if j.id == target {
-                if let JobKind::JogHeld { released } = &mut j.kind {
-                    *released = true;
-                }
-                // Other Execute-type commands run on (§3.2).
-                return Ok(());
+        if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
+            if let JobKind::JogHeld { released: false } = j.kind {
+                // Button released: ramp down now.
+                j.kind = JobKind::JogHeld { released: true };
+                self.plan_job_now();
             }
+            // Other Execute-type commands run on (§3.2).
+            return Ok(());
+        }
+        if let Some(j) = self.next.as_mut().filter(|j| j.id == target) {
+            if let JobKind::JogHeld { released } = &mut j.kind {
+                *released = true;
+            }
+            return Ok(());
         }
         Err(ErrorId::COMMAND_UNKNOWN)
     }
@@ -1148,7 +1157,7 @@ impl Axis {
                 self.planner.plan_fallback_stop(from, dec, jerk);
                 j.kind = JobKind::Halt;
                 j.options.ignore_position_monitoring = true;
-                j.out.error_id = ErrorId::PLANNING_FAILED.0;
+                j.pending_error = Some(ErrorId::PLANNING_FAILED);
                 false
             }
         }
@@ -1346,14 +1355,7 @@ impl Axis {
             job.since_keepalive += dt;
             if job.deadman > 0.0 && job.since_keepalive > job.deadman {
                 job.kind = JobKind::JogHeld { released: true };
-                job.out.error_id = ErrorId::DEADMAN_TIMEOUT.0;
-                self.job = Some(job);
-                self.plan_job_now();
-                job = self.job.expect("set above");
-            }
-        }
-        if let JobKind::JogHeld { released: true } = job.kind {
-            if job.planned_override >= 0.0 && self.planner_target_is_motion(&job) {
+                job.pending_error = Some(ErrorId::DEADMAN_TIMEOUT);
                 self.job = Some(job);
                 self.plan_job_now();
                 job = self.job.expect("set above");
@@ -1458,12 +1460,8 @@ impl Axis {
                         self.job = Some(job);
                     }
                     Some(Ok(())) => {
-                        if job.kind == (JobKind::JogHeld { released: true }) && job.out.error_id == ErrorId::DEADMAN_TIMEOUT.0 {
-                            job.out.error_id = 0;
-                            job.finish_error(ErrorId::DEADMAN_TIMEOUT, slot, cycle, events);
-                        } else if job.out.error_id == ErrorId::PLANNING_FAILED.0 {
-                            job.out.error_id = 0;
-                            job.finish_error(ErrorId::PLANNING_FAILED, slot, cycle, events);
+                        if let Some(e) = job.pending_error {
+                            job.finish_error(e, slot, cycle, events);
                         } else {
                             job.finish_done(slot, cycle, events);
                         }
@@ -1495,11 +1493,6 @@ impl Axis {
             }
             JobKind::Home | JobKind::Gear => unreachable!(),
         }
-    }
-
-    fn planner_target_is_motion(&self, _job: &Job) -> bool {
-        // A released jog is re-planned once (to zero velocity); afterwards the plan stands.
-        false
     }
 
     /// §3.11: None = still waiting; Some(Ok) = done; Some(Err) = in-target timeout.

@@ -211,7 +211,7 @@ impl Rig {
         let id = self.next_id;
         self.next_id += 1;
         let n = self.events.len();
-        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Power { enable: false, .. } | CommandKind::Reset | CommandKind::Release { .. } | CommandKind::GearIn { .. } | CommandKind::GearOut) {
+        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. }) {
             self.shifted[axis as usize] = true;
         }
         let before = self.k.status(axis);
@@ -221,6 +221,11 @@ impl Rig {
             assert_eq!(self.k.status(axis), before, "a rejected command changed the axis status");
         }
         self.check_events(n);
+        // The state changes in the cycle the command is accepted: check that transition too.
+        let now = self.k.status(axis).unwrap().state;
+        let prev = self.prev[axis as usize].state;
+        assert!(allowed(prev, now), "axis {axis}: transition {prev:?} -> {now:?} by {kind:?} not in the diagram");
+        self.prev[axis as usize].state = now;
         (id, v)
     }
 
@@ -318,7 +323,7 @@ impl Rig {
             let tol = 1e-9;
             assert!(s.set_velocity.abs() <= b.velocity * (1.0 + tol) + tol, "axis {i}: |v| {} > {}", s.set_velocity, b.velocity);
             assert!(s.set_acceleration.abs() <= b.acceleration * (1.0 + tol) + tol, "axis {i}: |a| {} > {}", s.set_acceleration, b.acceleration);
-            let settled = !self.shifted[i] && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop) && !matches!(p.state, AxisState::Disabled) && p.homed == s.homed && !s.coupled && !p.coupled;
+            let settled = !self.shifted[i] && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop) && !matches!(p.state, AxisState::Disabled | AxisState::ErrorStop) && p.homed == s.homed && !s.coupled && !p.coupled;
             if settled {
                 let j = b.jerk;
                 assert!((s.set_acceleration - p.set_acceleration).abs() <= j * DT * (1.0 + 1e-6) + 1e-6, "axis {i}: jerk {} > {j} (a {} -> {})", (s.set_acceleration - p.set_acceleration) / DT, p.set_acceleration, s.set_acceleration);

@@ -1,0 +1,118 @@
+//! Property tests: random command sequences on two coupled-capable axes never panic, never
+//! violate the per-cycle invariants of the rig (FB protocol, state diagram, continuity,
+//! velocity/acceleration/jerk bounds), and never leave the axis in an inconsistent state.
+
+mod rig;
+
+use motion::*;
+use proptest::prelude::*;
+use rig::*;
+
+fn dynamics() -> impl Strategy<Value = Dynamics> {
+    (prop_oneof![Just(0.0), 100.0..5000.0f64], prop_oneof![Just(0.0), 100.0..5000.0f64], prop_oneof![Just(0.0), 1000.0..20000.0f64])
+        .prop_map(|(acceleration, deceleration, jerk)| Dynamics { acceleration, deceleration, jerk })
+}
+
+fn buffer_mode() -> impl Strategy<Value = BufferMode> {
+    prop_oneof![
+        3 => Just(BufferMode::Aborting),
+        1 => Just(BufferMode::Buffered),
+        1 => Just(BufferMode::BlendingLow),
+        1 => Just(BufferMode::BlendingPrevious),
+        1 => Just(BufferMode::BlendingNext),
+        1 => Just(BufferMode::BlendingHigh),
+    ]
+}
+
+fn positioning() -> impl Strategy<Value = Positioning> {
+    (-500.0..500.0f64, prop_oneof![1.0..500.0f64, Just(-1.0), Just(0.0)], dynamics(), buffer_mode(), any::<bool>())
+        .prop_map(|(position, velocity, dynamics, buffer_mode, ignore)| Positioning { position, velocity, dynamics, buffer_mode, options: MoveOptions { ignore_position_monitoring: ignore, ..MoveOptions::default() } })
+}
+
+fn command() -> impl Strategy<Value = CommandKind> {
+    prop_oneof![
+        3 => (any::<bool>(), 0.0..=100.0f64).prop_map(|(enable, o)| CommandKind::Power { enable, enable_positive: true, enable_negative: true, override_percent: o }),
+        1 => Just(CommandKind::Reset),
+        4 => positioning().prop_map(CommandKind::MoveAbsolute),
+        2 => positioning().prop_map(CommandKind::MoveRelative),
+        2 => positioning().prop_map(CommandKind::MoveAdditive),
+        1 => (positioning(), prop_oneof![Just(Direction::Positive), Just(Direction::Negative), Just(Direction::ShortestWay)]).prop_map(|(mut m, direction)| { m.position = m.position.abs(); CommandKind::MoveModulo { move_: m, direction } }),
+        2 => (1.0..400.0f64, dynamics(), any::<bool>(), buffer_mode()).prop_map(|(velocity, dynamics, fwd, buffer_mode)| CommandKind::MoveVelocity { velocity, dynamics, direction: if fwd { Direction::Positive } else { Direction::Negative }, buffer_mode, options: MoveOptions::default() }),
+        1 => (positioning(), 0.0..200.0f64).prop_map(|(move_, end_velocity)| CommandKind::MoveContinuousAbsolute { move_, end_velocity }),
+        2 => (prop_oneof![Just(0.0), 100.0..5000.0f64], buffer_mode()).prop_map(|(deceleration, buffer_mode)| CommandKind::Halt { deceleration, jerk: 0.0, buffer_mode, options: MoveOptions::default() }),
+        1 => Just(CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() }),
+        2 => (0usize..5, any::<bool>(), 0.1..20.0f64).prop_map(|(m, forward, position)| CommandKind::Jog { mode: [JogMode::StandardSlow, JogMode::StandardFast, JogMode::Continuous, JogMode::Inching, JogMode::InchingModulo][m], forward, position, velocity: 100.0, dynamics: Dynamics::default(), deadman: 0.3 }),
+        1 => (-100.0..100.0f64, any::<bool>(), any::<bool>()).prop_map(|(position, relative, clear_position_lag)| CommandKind::SetPosition { position, relative, clear_position_lag }),
+        1 => (0.0..=1.0f64).prop_map(|velocity_factor| CommandKind::SetOverride { velocity_factor }),
+        1 => prop_oneof![Just(HomingMode::Direct), Just(HomingMode::ForceCalibration), Just(HomingMode::ResetCalibration), Just(HomingMode::Default)].prop_map(|mode| CommandKind::Home { position: Some(0.0), mode, options: HomingOptions::default() }),
+        1 => (-3.0..3.0f64, 1u16..4).prop_map(|(n, d)| CommandKind::GearIn { master: 0, ratio_numerator: n, ratio_denominator: d }),
+        1 => Just(CommandKind::GearOut),
+    ]
+}
+
+/// What to do between commands.
+#[derive(Clone, Debug)]
+enum Action {
+    Cmd(u16, CommandKind),
+    /// Release the n-th most recent command.
+    Release(usize),
+    Run(u16),
+    Fault(u16, bool),
+}
+
+fn action() -> impl Strategy<Value = Action> {
+    prop_oneof![
+        6 => (0u16..2, command()).prop_map(|(a, c)| Action::Cmd(a, c)),
+        1 => (0usize..4).prop_map(Action::Release),
+        5 => (0u16..400).prop_map(Action::Run),
+        1 => (0u16..2, any::<bool>()).prop_map(|(a, f)| Action::Fault(a, f)),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: std::env::var("MOTION_PROP_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(1000), ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_command_sequences_keep_every_invariant(actions in prop::collection::vec(action(), 1..40)) {
+        let mut p = params();
+        p.axis_velo_man_slow = 20.0;
+        p.axis_velo_man_fast = 100.0;
+        p.axis_en_position_lag_monitoring = true;
+        let mut r = Rig::with(vec![(false, p.clone()), (true, p)]);
+        r.plants[1].cam = Some((5.0, 8.0));
+        r.plants[1].index_period = Some(1.0);
+        // Gear slaves follow the master scaled by |ratio| < 3: widen axis 1's bounds.
+        r.bounds[1].velocity *= 3.0;
+        r.bounds[1].acceleration *= 3.0;
+        r.bounds[1].jerk *= 3.0;
+        let mut ids: Vec<(u16, CommandId)> = Vec::new();
+        for a in actions {
+            match a {
+                Action::Cmd(axis, kind) => {
+                    // Axis 0 is the only master; it never couples to itself.
+                    let axis = if matches!(kind, CommandKind::GearIn { .. }) { 1 } else { axis };
+                    let (id, _) = r.cmd(axis, kind);
+                    ids.push((axis, id));
+                }
+                Action::Release(n) => {
+                    if let Some(&(axis, id)) = ids.iter().rev().nth(n) {
+                        let _ = r.cmd(axis, CommandKind::Release { target: id });
+                    }
+                }
+                Action::Run(c) => for _ in 0..c { r.step(); },
+                Action::Fault(axis, f) => r.plants[axis as usize].fault = f,
+            }
+            for axis in 0..2u16 {
+                let s = r.st(axis);
+                prop_assert!(s.set_position.is_finite() && s.set_velocity.is_finite());
+                prop_assert_eq!(s.state == AxisState::ErrorStop, s.error_id != 0);
+                prop_assert_eq!(s.state == AxisState::SynchronizedMotion, s.coupled);
+                if s.state == AxisState::Standstill || s.state == AxisState::Disabled {
+                    prop_assert!(s.set_velocity.abs() < 1e-9, "{:?}", s);
+                }
+            }
+        }
+        // Every command that is still busy belongs to something that can be running.
+        r.run(0.5);
+    }
+}
