@@ -1,0 +1,106 @@
+//! `Kernel::step` (and submitting commands that re-plan) allocates nothing: a counting global
+//! allocator watches the cycles of steady motion, re-planning every cycle, and coupling.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use motion::*;
+
+struct Counting;
+
+thread_local! {
+    static COUNT: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        COUNT.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        COUNT.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+fn allocations() -> u64 {
+    COUNT.with(|c| c.get())
+}
+
+/// An ideal drive: actual = last setpoint.
+fn exchange(sp: &[DriveSetpoint], fb: &mut [DriveFeedback]) {
+    for (s, f) in sp.iter().zip(fb.iter_mut()) {
+        f.ready = true;
+        f.enabled = s.enable;
+        f.actual_velocity = (s.position - f.actual_position) / 0.001;
+        f.actual_position = s.position;
+    }
+}
+
+#[test]
+fn step_and_replanning_allocate_nothing() {
+    const N: usize = 8;
+    let mut k = Kernel::new(0.001, N);
+    for i in 0..N {
+        let mut p = AxisParameters::default();
+        p.axis_max_pos_lag_value = 100.0;
+        k.insert_axis(i as u16, Axis::new(AxisConfig { modulo: i % 2 == 1, parameters: p }, 0.001)).unwrap();
+    }
+    let mut fb = vec![DriveFeedback::default(); N];
+    let mut sp = vec![DriveSetpoint::default(); N];
+    let mut events: Vec<CommandEvent> = Vec::with_capacity(4096);
+    let mut id = 0;
+    let mut submit = |k: &mut Kernel, events: &mut Vec<CommandEvent>, axis: u16, kind: CommandKind| {
+        id += 1;
+        assert_eq!(k.submit(Command { id, axis, kind }, events), Verdict::Accepted, "{kind:?}");
+    };
+    for a in 0..N as u16 {
+        submit(&mut k, &mut events, a, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+    }
+    for _ in 0..20 {
+        k.step(&fb, &mut sp, &mut events);
+        exchange(&sp, &mut fb);
+    }
+    events.clear();
+    // The counter sees allocations (so the zero below means something).
+    let probe = allocations();
+    drop(std::hint::black_box(vec![1u8; 16]));
+    assert_eq!(allocations(), probe + 1);
+    // Warm-up is over: from here on nothing may allocate.
+    let before = allocations();
+    let mv = |p: f64| Positioning { position: p, velocity: 200.0, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() };
+    submit(&mut k, &mut events, 1, CommandKind::GearIn { master: 0, ratio_numerator: 2.0, ratio_denominator: 1 });
+    submit(&mut k, &mut events, 0, CommandKind::MoveAbsolute(mv(300.0)));
+    submit(&mut k, &mut events, 2, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Negative, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    submit(&mut k, &mut events, 3, CommandKind::MoveAbsolute(mv(100.0)));
+    submit(&mut k, &mut events, 3, CommandKind::MoveAbsolute(Positioning { buffer_mode: BufferMode::BlendingHigh, ..mv(200.0) }));
+    submit(&mut k, &mut events, 4, CommandKind::Jog { mode: JogMode::Continuous, forward: true, position: 0.0, velocity: 50.0, dynamics: Dynamics::default(), deadman: 0.5 });
+    for c in 0..2000 {
+        // Re-planning every cycle on axis 5 (override changes), keepalives on the jog.
+        let o = 50.0 + 50.0 * ((c as f64) * 0.01).sin().abs();
+        submit(&mut k, &mut events, 5, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: o });
+        if c == 0 {
+            submit(&mut k, &mut events, 5, CommandKind::MoveVelocity { velocity: 150.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+        }
+        if c % 100 == 0 {
+            submit(&mut k, &mut events, 4, CommandKind::Keepalive { target: 14 });
+        }
+        k.step(&fb, &mut sp, &mut events);
+        exchange(&sp, &mut fb);
+        if events.len() > 3000 {
+            events.clear();
+        }
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "the kernel allocated {} times", after - before);
+    // And the motion really happened.
+    assert!(k.status(0).unwrap().set_position > 299.0);
+    assert!((k.status(1).unwrap().set_position - 2.0 * k.status(0).unwrap().set_position).abs() < 1e-6);
+    assert!(k.status(2).unwrap().set_position < -100.0);
+}
