@@ -78,6 +78,15 @@ impl Kernel {
                 if master as usize == slot {
                     return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }
+                // A master that (through its own masters) follows this axis would close a loop.
+                let mut m = Some(master);
+                for _ in 0..self.axes.len() {
+                    match m {
+                        Some(x) if x as usize == slot => return Verdict::Rejected(ErrorId::MASTER_INVALID),
+                        Some(x) => m = self.axis(x).and_then(|a| a.master_slot()),
+                        None => break,
+                    }
+                }
                 match self.axis(master) {
                     Some(m) => Some((master, MasterSample::of(m))),
                     None => return Verdict::Rejected(ErrorId::MASTER_INVALID),
@@ -101,8 +110,7 @@ impl Kernel {
         let dt = self.cycle_time;
         self.stepped.iter_mut().for_each(|s| *s = false);
         // Masters first, then slaves whose master has been stepped (chains resolve in as
-        // many passes as they are long; a loop cannot be built because GearIn rejects
-        // coupling to an axis that is itself a slave of this one's chain via the state).
+        // many passes as they are long; submit rejects couplings that would close a loop).
         for _pass in 0..self.axes.len().max(1) {
             let mut progressed = false;
             for i in 0..self.axes.len() {

@@ -91,3 +91,8 @@ impl Default for AxisParameters {
         }
     }
 }
+
+impl AxisParameters {
+    /// TEMPORARY (kernel worktree): replaced by the full table's set_raw.
+    pub fn set_raw(&mut self, _number: u16, _value: f64) {}
+}

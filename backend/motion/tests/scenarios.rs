@@ -680,3 +680,51 @@ fn jerk_and_acceleration_limits_hold_for_an_aborting_reversal() {
     let b = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 500.0)));
     r.until(5.0, |r| r.out(b).done);
 }
+
+#[test]
+fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
+    let mut r = Rig::new(3);
+    for a in 0..3 {
+        r.power_on(a);
+    }
+    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
+    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 9, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
+    r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 });
+    r.ok(2, CommandKind::GearIn { master: 1, ratio_numerator: 1.0, ratio_denominator: 1 });
+    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 2, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
+    // A chain follows in one cycle (masters are stepped first).
+    r.ok(0, CommandKind::MoveVelocity { velocity: 10.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.run(0.2);
+    assert_eq!(r.st(2).set_position, r.st(0).set_position);
+    // The master faults: its slaves go to ErrorStop with master_lost.
+    r.plants[0].fault = true;
+    r.run(0.01);
+    assert_eq!(r.st(1).state, AxisState::ErrorStop);
+    assert_eq!(r.st(1).error_id, ErrorId::MASTER_LOST.0);
+}
+
+#[test]
+fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 50.0 });
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
+    r.until(10.0, |r| {
+        let v = r.st(0).set_velocity.abs();
+        assert!(v <= 100.0 + 1e-9, "{v} > 200 × 50 %");
+        !r.out(a).busy
+    });
+    // Second run: override changed mid-move.
+    let b = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
+    r.run(0.5);
+    r.ok(0, CommandKind::SetOverride { velocity_factor: 0.4 });
+    let v_before = r.st(0).set_velocity.abs();
+    r.step();
+    assert!((r.st(0).set_velocity.abs() - v_before).abs() < 1000.0 * DT + 1e-9, "velocity jumped on override");
+    r.run(0.3);
+    r.until(10.0, |r| {
+        assert!(r.st(0).set_velocity.abs() <= 40.0 + 1e-9);
+        !r.out(b).busy
+    });
+    assert!(r.out(b).done);
+}

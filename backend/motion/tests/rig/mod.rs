@@ -211,7 +211,7 @@ impl Rig {
         let id = self.next_id;
         self.next_id += 1;
         let n = self.events.len();
-        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. }) {
+        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Reset) {
             self.shifted[axis as usize] = true;
         }
         let before = self.k.status(axis);
