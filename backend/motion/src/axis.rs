@@ -18,6 +18,17 @@ use crate::params::AxisParameters;
 use crate::planner::{Kinematics, Limits, Planner, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
 
+/// Until the parameter table's own `set_raw` lands (an inherent method takes precedence
+/// over this trait), runtime parameter writes are accepted but not applied.
+#[allow(dead_code)]
+trait SetRawFallback {
+    fn set_raw(&mut self, number: u16, value: f64);
+}
+#[allow(dead_code)]
+impl SetRawFallback for AxisParameters {
+    fn set_raw(&mut self, _number: u16, _value: f64) {}
+}
+
 /// Static configuration of an axis (the base configuration the parameters start from).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisConfig {

@@ -91,8 +91,3 @@ impl Default for AxisParameters {
         }
     }
 }
-
-impl AxisParameters {
-    /// TEMPORARY (kernel worktree): replaced by the full table's set_raw.
-    pub fn set_raw(&mut self, _number: u16, _value: f64) {}
-}
