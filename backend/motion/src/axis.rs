@@ -45,6 +45,8 @@ pub struct MasterSample {
     pub actual_velocity: f64,
     pub moving: bool,
     pub error: bool,
+    /// The master's AxisVeloMax (GearInDyn scales its ratio-change limit with it).
+    pub max_velocity: f64,
 }
 
 impl MasterSample {
@@ -56,6 +58,7 @@ impl MasterSample {
             actual_velocity: s.actual_velocity,
             moving: s.moving,
             error: s.state == AxisState::ErrorStop,
+            max_velocity: axis.parameters().axis_velo_max,
         }
     }
 }
@@ -242,15 +245,49 @@ fn emit_once(id: CommandId, out: FbOutputs, axis: AxisSlot, cycle: u64, events: 
     events.push(CommandEvent { cycle, command: id, axis, outputs: out });
 }
 
-const DONE: FbOutputs = FbOutputs { busy: false, active: false, done: true, command_aborted: false, error: false, error_id: 0, in_velocity: false, in_gear: false, in_end_velocity: false, status: false };
+const DONE: FbOutputs = FbOutputs { busy: false, active: false, done: true, command_aborted: false, error: false, error_id: 0, in_velocity: false, in_gear: false, in_end_velocity: false, status: false, warning: false, warning_id: 0 };
 
 #[derive(Clone, Copy, Debug)]
 struct Coupling {
     master: AxisSlot,
+    /// Ratio in force (GearInDyn: ramps towards `target_ratio`).
     ratio: f64,
+    target_ratio: f64,
+    /// Max ratio change per second (GearInDyn); infinite for MC_GearIn.
+    ratio_rate: f64,
+    /// The GearInDyn command that still has Enable TRUE (0 when none).
+    dyn_command: CommandId,
     master_start: f64,
     slave_start: f64,
 }
+
+/// A running MC_MoveSuperImposed: `distance` is laid over the main motion as a quintic
+/// (C² smooth) function of the main motion's travel `u` over `length` (spec §5.2.1, §6.13).
+#[derive(Clone, Copy, Debug)]
+struct Superimposed {
+    id: CommandId,
+    out: FbOutputs,
+    /// Effective distance (signed, axis coordinates); reduced when infeasible (warning).
+    distance: f64,
+    /// Main-motion travel over which it is spread.
+    length: f64,
+    /// Main-motion travel so far.
+    travelled: f64,
+    applied: f64,
+    option: SuperpositionAbortOption,
+    last_position: f64,
+    last_direction: f64,
+}
+
+/// The superposition shape and its first two derivatives on [0, 1].
+fn smoothstep5(x: f64) -> (f64, f64, f64) {
+    let x = x.clamp(0.0, 1.0);
+    let (x2, x3) = (x * x, x * x * x);
+    (10.0 * x3 - 15.0 * x3 * x + 6.0 * x3 * x2, 30.0 * x2 - 60.0 * x3 + 30.0 * x2 * x2, 60.0 * x - 180.0 * x2 + 120.0 * x3)
+}
+/// max s' and max |s''| of [`smoothstep5`].
+const SMOOTHSTEP5_MAX_SLOPE: f64 = 1.875;
+const SMOOTHSTEP5_MAX_CURVATURE: f64 = 5.773_502_691_896_258;
 
 /// One axis. Built off the cycle thread with [`Axis::new`]; stepped by the kernel.
 #[derive(Debug)]
@@ -289,6 +326,7 @@ pub struct Axis {
     lag_timer: f64,
     in_window_timer: f64,
     coupling: Option<Coupling>,
+    superimposed: Option<Superimposed>,
     latch: Option<LatchSource>,
     prev_cam: bool,
 }
@@ -331,6 +369,7 @@ impl Axis {
             lag_timer: 0.0,
             in_window_timer: 0.0,
             coupling: None,
+            superimposed: None,
             latch: None,
             prev_cam: false,
         })
@@ -501,6 +540,17 @@ impl Axis {
                 if self.state() != AxisState::SynchronizedMotion {
                     return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
                 }
+                if self.coupling.is_some_and(|c| c.dyn_command != 0) {
+                    // GearInDyn still enabled: the slave is decoupled only for an instant and
+                    // recoupled at once with the ratio it has (spec §5.5.2).
+                    if let Some(c) = self.coupling.as_mut() {
+                        c.slave_start = self.set.position;
+                        c.master_start = f64::NAN; // rebased on the next step
+                    }
+                    emit_once(cmd.id, DONE, slot, cycle, events);
+                    return Ok(());
+                }
+                self.abort_superposition(cycle, events);
                 self.coupling = None;
                 if let Some(mut j) = self.job.take() {
                     j.finish_aborted(slot, cycle, events);
@@ -529,9 +579,13 @@ impl Axis {
                 }
                 let use_actual = self.p().axis_couple_slave_to_actual_values;
                 self.abort_all(cycle, events);
+                let ratio = ratio_numerator / ratio_denominator as f64;
                 self.coupling = Some(Coupling {
                     master: master_slot,
-                    ratio: ratio_numerator / ratio_denominator as f64,
+                    ratio,
+                    target_ratio: ratio,
+                    ratio_rate: f64::INFINITY,
+                    dyn_command: 0,
                     master_start: if use_actual { m.actual_position } else { m.set.position },
                     slave_start: self.set.position,
                 });
@@ -540,6 +594,68 @@ impl Axis {
                 let out = FbOutputs { in_gear: true, ..j.out };
                 j.emit(out, slot, cycle, events);
                 self.job = Some(j);
+                Ok(())
+            }
+            CommandKind::GearInDyn { master: master_slot, gear_ratio, acceleration } => {
+                if !gear_ratio.is_finite() || !acceleration.is_finite() || acceleration < 0.0 {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                let Some((_, m)) = master else { return Err(ErrorId::MASTER_INVALID) };
+                if m.error {
+                    return Err(ErrorId::MASTER_INVALID);
+                }
+                let acc = if acceleration > 0.0 { acceleration } else { self.p().axis_acc };
+                let rate = acc / m.max_velocity.max(EPS_V);
+                // Enable still TRUE on the same coupling: a new ratio.
+                if let Some(c) = self.coupling.as_mut().filter(|c| c.master == master_slot && c.dyn_command != 0) {
+                    c.target_ratio = gear_ratio;
+                    c.ratio_rate = rate;
+                    let old = c.dyn_command;
+                    c.dyn_command = cmd.id;
+                    if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
+                        // The earlier instance hands over to this one.
+                        let mut prev = Job { id: old, ..*j };
+                        prev.finish_done(slot, cycle, events);
+                        j.id = cmd.id;
+                        j.out = FbOutputs::default();
+                        j.activate(slot, cycle, events);
+                        let out = FbOutputs { in_gear: (c.ratio - c.target_ratio).abs() < 1e-12, ..j.out };
+                        j.emit(out, slot, cycle, events);
+                    }
+                    return Ok(());
+                }
+                match self.state() {
+                    AxisState::Standstill | AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::SynchronizedMotion => {}
+                    _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+                }
+                let use_actual = self.p().axis_couple_slave_to_actual_values;
+                let mv = if use_actual { m.actual_velocity } else { m.set.velocity };
+                // Start from the ratio the slave already has (at rest: 0) and ramp from there,
+                // so that coupling onto a moving master is acceleration-limited.
+                let start_ratio = if mv.abs() > EPS_V { self.set.velocity / mv } else if self.set.velocity.abs() <= EPS_V { gear_ratio } else {
+                    return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
+                };
+                self.abort_all(cycle, events);
+                self.coupling = Some(Coupling {
+                    master: master_slot,
+                    ratio: start_ratio,
+                    target_ratio: gear_ratio,
+                    ratio_rate: rate,
+                    dyn_command: cmd.id,
+                    master_start: if use_actual { m.actual_position } else { m.set.position },
+                    slave_start: self.set.position,
+                });
+                let mut j = Job::new(cmd.id, JobKind::Gear);
+                j.activate(slot, cycle, events);
+                let out = FbOutputs { in_gear: (start_ratio - gear_ratio).abs() < 1e-12, ..j.out };
+                j.emit(out, slot, cycle, events);
+                self.job = Some(j);
+                Ok(())
+            }
+            CommandKind::MoveSuperImposed(sp) => self.submit_superposition(cmd.id, sp, cycle, events),
+            CommandKind::AbortSuperposition => {
+                self.abort_superposition(cycle, events);
+                emit_once(cmd.id, DONE, slot, cycle, events);
                 Ok(())
             }
             CommandKind::Home { position, mode, options } => self.submit_home(cmd.id, position, mode, options, cycle, events),
@@ -921,6 +1037,7 @@ impl Axis {
 
     /// Falling edge of Execute/Enable.
     fn release(&mut self, target: CommandId, cycle: u64, events: &mut impl EventSink) -> Result<(), ErrorId> {
+        let slot = self.slot;
         if let Some(s) = self.stop.as_mut().filter(|s| s.id == target) {
             s.released = true;
             self.try_unlock(cycle, events);
@@ -928,6 +1045,17 @@ impl Axis {
         }
         if self.power.as_ref().is_some_and(|p| p.id == target) {
             self.disable(cycle, events);
+            return Ok(());
+        }
+        if let Some(c) = self.coupling.as_mut().filter(|c| c.dyn_command == target && target != 0) {
+            // Enable FALSE after coupling: the ratio freezes where it is, the slave stays coupled.
+            c.dyn_command = 0;
+            c.target_ratio = c.ratio;
+            if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
+                let out = FbOutputs { busy: false, active: false, done: true, in_gear: true, ..j.out };
+                j.emit(out, slot, cycle, events);
+                j.id = 0;
+            }
             return Ok(());
         }
         if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
@@ -980,6 +1108,7 @@ impl Axis {
     fn disable(&mut self, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
         self.enable = false;
+        self.abort_superposition(cycle, events);
         self.abort_all(cycle, events);
         if let Some(mut s) = self.stop.take() {
             s.emit(FbOutputs { busy: false, active: false, command_aborted: true, ..FbOutputs::default() }, slot, cycle, events);
@@ -997,6 +1126,7 @@ impl Axis {
     /// MC_Reset: clears ErrorStop (notes 3/4) and the MC_Stop lock; takes actual as set.
     fn reset(&mut self, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
+        self.abort_superposition(cycle, events);
         if let Some(mut s) = self.stop.take() {
             s.emit(FbOutputs { busy: false, active: false, command_aborted: true, ..FbOutputs::default() }, slot, cycle, events);
             if self.mode == Mode::Stopping && self.job.is_none() {
@@ -1024,6 +1154,10 @@ impl Axis {
             return;
         }
         self.error = e;
+        if let Some(sp) = self.superimposed.take() {
+            let out = FbOutputs { busy: false, active: false, error: true, error_id: e.0, warning: false, warning_id: 0, ..sp.out };
+            events.push(CommandEvent { cycle, command: sp.id, axis: slot, outputs: out });
+        }
         for j in [self.next.take(), self.job.take()].into_iter().flatten() {
             let mut j = j;
             j.finish_error(e, slot, cycle, events);
@@ -1265,6 +1399,7 @@ impl Axis {
             }
             self.step_feed_enables(cycle, events);
             self.step_job(dt, fb, master.flatten(), cycle, events);
+            self.step_superposition(dt, cycle, events);
             self.step_soft_limits(dt, cycle, events);
             self.step_following_error(dt, cycle, events);
         }
@@ -1374,13 +1509,31 @@ impl Axis {
         }
 
         if job.kind == JobKind::Gear {
-            if let (Some(c), Some(m)) = (self.coupling, master) {
+            if let (Some(mut c), Some(m)) = (self.coupling, master) {
                 let (mp, mv, ma, mj) = if self.p().axis_couple_slave_to_actual_values {
                     (m.actual_position, m.actual_velocity, 0.0, 0.0)
                 } else {
                     (m.set.position, m.set.velocity, m.set.acceleration, m.set.jerk)
                 };
-                self.set = Kinematics { position: c.slave_start + c.ratio * (mp - c.master_start), velocity: c.ratio * mv, acceleration: c.ratio * ma, jerk: c.ratio * mj };
+                if c.master_start.is_nan() {
+                    c.master_start = mp;
+                }
+                let mut dratio = 0.0;
+                if c.ratio != c.target_ratio {
+                    // Ratio change (GearInDyn): rate-limited, re-based so that the position
+                    // stays continuous.
+                    let step = (c.target_ratio - c.ratio).clamp(-c.ratio_rate * dt, c.ratio_rate * dt);
+                    c.slave_start += c.ratio * (mp - c.master_start);
+                    c.master_start = mp;
+                    c.ratio += step;
+                    dratio = step / dt;
+                    if c.ratio == c.target_ratio && job.id != 0 && !job.out.in_gear {
+                        let out = FbOutputs { in_gear: true, ..job.out };
+                        job.emit(out, slot, cycle, events);
+                    }
+                }
+                self.coupling = Some(c);
+                self.set = Kinematics { position: c.slave_start + c.ratio * (mp - c.master_start), velocity: c.ratio * mv, acceleration: c.ratio * ma + dratio * mv, jerk: c.ratio * mj };
             }
             self.job = Some(job);
             return;
@@ -1746,6 +1899,124 @@ impl Axis {
         }
     }
 
+    fn submit_superposition(&mut self, id: CommandId, sp: Superposition, cycle: u64, events: &mut impl EventSink) -> Result<(), ErrorId> {
+        let slot = self.slot;
+        let p = self.p();
+        let finite = [sp.distance, sp.velocity_diff, sp.acceleration, sp.deceleration, sp.velocity_process, sp.length].iter().all(|x| x.is_finite());
+        if !finite || sp.velocity_diff <= 0.0 || sp.velocity_process <= 0.0 || sp.length <= 0.0 || sp.acceleration < 0.0 || sp.deceleration < 0.0 {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        match self.state() {
+            AxisState::DiscreteMotion | AxisState::ContinuousMotion | AxisState::SynchronizedMotion => {}
+            AxisState::Standstill => return Err(ErrorId::AXIS_NOT_MOVING),
+            _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+        }
+        let dir = if self.set.velocity.abs() > EPS_V { self.set.velocity.signum() } else { return Err(ErrorId::AXIS_NOT_MOVING) };
+        let acc = if sp.acceleration > 0.0 { sp.acceleration } else { p.axis_acc };
+        let dec = if sp.deceleration > 0.0 { sp.deceleration } else { p.axis_dec };
+        let a_lim = acc.min(dec);
+        // The limits hold for the velocity the main motion really has, if that is higher.
+        let vp = sp.velocity_process.max(self.set.velocity.abs());
+        let d = sp.distance.abs();
+        // Without reversal a slow-down can take at most the process velocity; a speed-up at
+        // most what is left up to the maximum velocity.
+        let vdiff = if sp.distance < 0.0 { sp.velocity_diff.min(vp) } else { sp.velocity_diff.min((p.axis_velo_max - vp).max(0.0)) };
+        let limited = matches!(sp.mode, SuperpositionMode::VeloReductionLimitedMotion | SuperpositionMode::LengthReductionLimitedMotion | SuperpositionMode::AccReductionLimitedMotion);
+        // Main-motion travel available: "limited" lengths count this axis's own travel.
+        let l_max = if limited { sp.length - sp.distance } else { sp.length };
+        if l_max <= 0.0 {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        let need = |len: f64| (vp * d * SMOOTHSTEP5_MAX_SLOPE / len, vp * vp * d * SMOOTHSTEP5_MAX_CURVATURE / (len * len));
+        let length = match sp.mode {
+            SuperpositionMode::LengthReductionAdditiveMotion | SuperpositionMode::LengthReductionLimitedMotion => {
+                let by_v = vp * d * SMOOTHSTEP5_MAX_SLOPE / vdiff.max(EPS_V);
+                let by_a = (vp * vp * d * SMOOTHSTEP5_MAX_CURVATURE / a_lim).sqrt();
+                by_v.max(by_a).min(l_max).max(EPS_V)
+            }
+            _ => l_max,
+        };
+        let (nv, na) = need(length);
+        let scale = (vdiff / nv.max(EPS_V)).min(a_lim / na.max(EPS_V)).min(1.0);
+        let distance = dir * sp.distance.signum() * d * if d > 0.0 { scale } else { 1.0 };
+        let warning = d > 0.0 && scale < 1.0 - 1e-12;
+        // A new superposition replaces the running one (what it applied so far stays).
+        if let Some(old) = self.superimposed.take() {
+            let out = FbOutputs { busy: false, active: false, command_aborted: true, ..old.out };
+            events.push(CommandEvent { cycle, command: old.id, axis: slot, outputs: out });
+        }
+        let out = FbOutputs { busy: true, active: true, warning, warning_id: if warning { ErrorId::SUPERPOSITION_INCOMPLETE.0 } else { 0 }, ..FbOutputs::default() };
+        events.push(CommandEvent { cycle, command: id, axis: slot, outputs: out });
+        self.superimposed = Some(Superimposed { id, out, distance, length, travelled: 0.0, applied: 0.0, option: sp.abort_option, last_position: self.set.position, last_direction: dir });
+        Ok(())
+    }
+
+    fn abort_superposition(&mut self, cycle: u64, events: &mut impl EventSink) {
+        if let Some(sp) = self.superimposed.take() {
+            let out = FbOutputs { busy: false, active: false, command_aborted: true, ..sp.out };
+            events.push(CommandEvent { cycle, command: sp.id, axis: self.slot, outputs: out });
+        }
+    }
+
+    /// Lays the superposition over the setpoint the job produced this cycle: the increment is
+    /// folded into the running plan (and target, and coupling), so the main motion carries it
+    /// from now on and its target moves by the distance (spec §5.2.1).
+    fn step_superposition(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
+        let Some(mut sp) = self.superimposed else { return };
+        let base = self.set;
+        let moved = base.position - sp.last_position;
+        let travelling = self.job.as_ref().is_some_and(|j| j.kind != JobKind::Halt) && self.mode == Mode::Enabled;
+        let stopped_by_override = self.override_ratio() <= 0.0;
+        let abort = match sp.option {
+            SuperpositionAbortOption::AbortAtStandstill => {
+                !travelling || (moved == 0.0 && !stopped_by_override) || (moved != 0.0 && moved.signum() != sp.last_direction)
+            }
+            SuperpositionAbortOption::ResumeAfterStandstill => !travelling,
+            SuperpositionAbortOption::ResumeAfterMotionStop => false,
+        };
+        if abort {
+            self.abort_superposition(cycle, events);
+            return;
+        }
+        if moved != 0.0 {
+            sp.last_direction = moved.signum();
+        }
+        sp.travelled += moved.abs();
+        let x = sp.travelled / sp.length;
+        let (s, s1, s2) = smoothstep5(x);
+        let applied = sp.distance * s;
+        let delta = applied - sp.applied;
+        sp.applied = applied;
+        if delta != 0.0 {
+            if self.planner.is_planned() {
+                self.planner.shift(delta);
+            }
+            if let Some(j) = self.job.as_mut() {
+                j.target += delta;
+            }
+            if let Some(t) = self.last_target.as_mut() {
+                *t += delta;
+            }
+            if let Some(c) = self.coupling.as_mut() {
+                c.slave_start += delta;
+            }
+            self.set.position += delta;
+        }
+        if x < 1.0 {
+            // Velocity and acceleration the superposition adds (chain rule through u(t)).
+            let (v, a) = (base.velocity.abs(), base.acceleration * base.velocity.signum());
+            self.set.velocity += sp.distance * s1 / sp.length * v;
+            self.set.acceleration += sp.distance * (s2 / (sp.length * sp.length) * v * v + s1 / sp.length * a);
+            sp.last_position = self.set.position;
+            self.superimposed = Some(sp);
+        } else {
+            let out = FbOutputs { busy: false, active: false, done: true, ..sp.out };
+            events.push(CommandEvent { cycle, command: sp.id, axis: self.slot, outputs: out });
+            self.superimposed = None;
+        }
+        let _ = dt;
+    }
+
     fn update_status(&mut self) {
         let p = &self.config.parameters;
         let state = self.state();
@@ -1803,6 +2074,8 @@ impl Axis {
         s.coupled = self.coupling.is_some();
         s.master = self.coupling.map(|c| c.master);
         s.gear_ratio = self.coupling.map(|c| c.ratio).unwrap_or(0.0);
+        s.compensating = self.superimposed.is_some();
+        s.superimposed_distance = self.superimposed.map(|x| x.applied).unwrap_or(0.0);
         s.error_id = if self.mode == Mode::ErrorStop { self.error.0 } else { 0 };
         s.drive_fault = self.error == ErrorId::DRIVE_FAULT && self.mode == Mode::ErrorStop;
         s.set_position_offset = self.set_position_offset;

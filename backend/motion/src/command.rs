@@ -163,6 +163,61 @@ pub struct HomingOptions {
     pub reference_mode: Option<ReferenceMode>,
 }
 
+/// `E_SuperpositionMode`: what `length` refers to and what is minimised.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SuperpositionMode {
+    /// Length is the reference (base) travel; the whole length is used, velocity change minimal.
+    #[default]
+    VeloReductionAdditiveMotion,
+    /// Length is this axis's own travel; the whole length is used, velocity change minimal.
+    VeloReductionLimitedMotion,
+    /// Length is the reference travel; as short as the velocity difference allows.
+    LengthReductionAdditiveMotion,
+    /// Length is this axis's own travel; as short as the velocity difference allows.
+    LengthReductionLimitedMotion,
+    /// Length is the reference travel; whole length, acceleration minimal.
+    AccReductionAdditiveMotion,
+    /// Length is this axis's own travel; whole length, acceleration minimal.
+    AccReductionLimitedMotion,
+}
+
+/// `E_SuperpositionAbortOption`.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SuperpositionAbortOption {
+    /// Aborted when the main motion comes to a standstill or reverses (not for override 0).
+    #[default]
+    AbortAtStandstill,
+    /// Continues after a temporary standstill; ends when the axis reaches its target or stops.
+    ResumeAfterStandstill,
+    /// Continues even after the axis reached its target or was stopped, with the next motion.
+    ResumeAfterMotionStop,
+}
+
+/// MC_MoveSuperImposed inputs.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Superposition {
+    pub mode: SuperpositionMode,
+    /// Distance to make up (> 0: get ahead, < 0: fall back).
+    pub distance: f64,
+    /// Maximum velocity difference to the main motion (> 0).
+    pub velocity_diff: f64,
+    /// 0 = axis default.
+    pub acceleration: f64,
+    /// 0 = axis default.
+    pub deceleration: f64,
+    /// Mean velocity of the main motion during the superposition (> 0).
+    pub velocity_process: f64,
+    /// Travel available for the superposition (> 0), see `mode`.
+    pub length: f64,
+    pub abort_option: SuperpositionAbortOption,
+}
+
 /// A positioning command's inputs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Positioning {
@@ -204,8 +259,18 @@ pub enum CommandKind {
     Home { position: Option<f64>, mode: HomingMode, options: HomingOptions },
     /// MC_GearIn: this axis becomes the slave of `master`.
     GearIn { master: AxisSlot, ratio_numerator: f64, ratio_denominator: u16 },
+    /// MC_GearInDyn (Enable-type): couple with a ratio that may change every cycle; a
+    /// further GearInDyn to the same master while enabled updates the ratio. `Release` =
+    /// Enable FALSE: the ratio freezes and the slave stays coupled. `acceleration` (0 =
+    /// default #1004) limits the slave acceleration caused by ratio changes at the master's
+    /// maximum velocity.
+    GearInDyn { master: AxisSlot, gear_ratio: f64, acceleration: f64 },
     /// MC_GearOut.
     GearOut,
+    /// MC_MoveSuperImposed: a relative motion laid over the running one.
+    MoveSuperImposed(Superposition),
+    /// MC_AbortSuperposition.
+    AbortSuperposition,
     /// MC_WriteParameter / MC_WriteBoolParameter at runtime (value already validated).
     WriteParameter { number: u16, value: f64 },
     /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
@@ -235,7 +300,10 @@ impl CommandKind {
             CommandKind::Jog { .. } => "jog",
             CommandKind::Home { .. } => "home",
             CommandKind::GearIn { .. } => "gear-in",
+            CommandKind::GearInDyn { .. } => "gear-in-dyn",
             CommandKind::GearOut => "gear-out",
+            CommandKind::MoveSuperImposed(_) => "move-superimposed",
+            CommandKind::AbortSuperposition => "abort-superposition",
             CommandKind::WriteParameter { .. } => "write-parameter",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
@@ -279,6 +347,10 @@ pub struct FbOutputs {
     pub in_end_velocity: bool,
     /// Power: axis ready for operation.
     pub status: bool,
+    /// MoveSuperImposed: not completed as asked (executed as far as possible).
+    pub warning: bool,
+    /// 0x4243 with `warning`.
+    pub warning_id: u32,
 }
 
 impl FbOutputs {

@@ -51,6 +51,8 @@ error_table! {
     BUFFER_FULL = 0x4292, "buffer_full", "command buffer full";
     /// The optional blending position is not before the previous command's target.
     BLENDING_POSITION_INVALID = 0x4296, "blending_position_invalid", "blending position is not before the previous target";
+    /// MoveSuperImposed could not be completed as parameterised; done as far as possible (a warning).
+    SUPERPOSITION_INCOMPLETE = 0x4243, "superposition_incomplete", "superposition done only as far as possible";
     /// Following error exceeded the maximum lag for longer than the filter time.
     FOLLOWING_ERROR = 0x4550, "following_error", "following error (position lag) too large";
     /// Target beyond the enabled positive software limit.

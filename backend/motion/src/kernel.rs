@@ -74,7 +74,7 @@ impl Kernel {
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
         let slot = cmd.axis as usize;
         let master = match cmd.kind {
-            CommandKind::GearIn { master, .. } => {
+            CommandKind::GearIn { master, .. } | CommandKind::GearInDyn { master, .. } => {
                 if master as usize == slot {
                     return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }

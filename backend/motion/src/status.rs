@@ -90,6 +90,10 @@ pub struct AxisStatus {
     /// Slot of the master while coupled.
     pub master: Option<u16>,
     pub gear_ratio: f64,
+    /// A superposition (MC_MoveSuperImposed) is running (StateDWord bit 13 Compensating).
+    pub compensating: bool,
+    /// Distance superimposed so far by the running superposition.
+    pub superimposed_distance: f64,
     /// 0 = no error.
     pub error_id: u32,
     pub drive_fault: bool,

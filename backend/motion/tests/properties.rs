@@ -47,6 +47,13 @@ fn command() -> impl Strategy<Value = CommandKind> {
         1 => prop_oneof![Just(HomingMode::Direct), Just(HomingMode::ForceCalibration), Just(HomingMode::ResetCalibration), Just(HomingMode::Default)].prop_map(|mode| CommandKind::Home { position: Some(0.0), mode, options: HomingOptions::default() }),
         1 => (-3.0..3.0f64, 1u16..4).prop_map(|(n, d)| CommandKind::GearIn { master: 0, ratio_numerator: n, ratio_denominator: d }),
         1 => Just(CommandKind::GearOut),
+        1 => (-3.0..3.0f64, 0.0..3000.0f64).prop_map(|(gear_ratio, acceleration)| CommandKind::GearInDyn { master: 0, gear_ratio, acceleration }),
+        1 => (0usize..6, -100.0..100.0f64, 1.0..500.0f64, 1.0..500.0f64, 1.0..1000.0f64, 0usize..3).prop_map(|(m, distance, velocity_diff, velocity_process, length, o)| CommandKind::MoveSuperImposed(Superposition {
+            mode: [SuperpositionMode::VeloReductionAdditiveMotion, SuperpositionMode::VeloReductionLimitedMotion, SuperpositionMode::LengthReductionAdditiveMotion, SuperpositionMode::LengthReductionLimitedMotion, SuperpositionMode::AccReductionAdditiveMotion, SuperpositionMode::AccReductionLimitedMotion][m],
+            distance, velocity_diff, acceleration: 0.0, deceleration: 0.0, velocity_process, length,
+            abort_option: [SuperpositionAbortOption::AbortAtStandstill, SuperpositionAbortOption::ResumeAfterStandstill, SuperpositionAbortOption::ResumeAfterMotionStop][o],
+        })),
+        1 => Just(CommandKind::AbortSuperposition),
     ]
 }
 
@@ -85,12 +92,17 @@ proptest! {
         r.bounds[1].velocity *= 3.0;
         r.bounds[1].acceleration *= 3.0;
         r.bounds[1].jerk *= 3.0;
+        // Superposition and ratio ramps add acceleration-limited (not jerk-limited) motion.
+        for b in r.bounds.iter_mut() {
+            b.acceleration *= 2.0;
+            b.jerk = 1e12;
+        }
         let mut ids: Vec<(u16, CommandId)> = Vec::new();
         for a in actions {
             match a {
                 Action::Cmd(axis, kind) => {
                     // Axis 0 is the only master; it never couples to itself.
-                    let axis = if matches!(kind, CommandKind::GearIn { .. }) { 1 } else { axis };
+                    let axis = if matches!(kind, CommandKind::GearIn { .. } | CommandKind::GearInDyn { .. }) { 1 } else { axis };
                     let (id, _) = r.cmd(axis, kind);
                     ids.push((axis, id));
                 }

@@ -728,3 +728,159 @@ fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
     });
     assert!(r.out(b).done);
 }
+
+// ---------------------------------------------------------------- GearInDyn, superposition
+
+#[test]
+fn s11a_29_gear_in_dyn_release_freezes_ratio_gear_out_while_enabled_recouples() {
+    let mut r = Rig::new(2);
+    r.power_on(0);
+    r.power_on(1);
+    r.bounds[1].jerk = 1e9; // ratio ramps are acceleration-limited, not jerk-limited
+    let g = r.ok(1, CommandKind::GearInDyn { master: 0, gear_ratio: 1.0, acceleration: 0.0 });
+    assert!(r.out(g).in_gear && r.out(g).busy);
+    r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.run(0.5);
+    assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
+    // A new ratio while enabled: ramps (acceleration-limited), in_gear when reached.
+    let g2 = r.ok(1, CommandKind::GearInDyn { master: 0, gear_ratio: 1.5, acceleration: 500.0 });
+    assert!(r.out(g).done && !r.out(g).busy);
+    assert!(!r.out(g2).in_gear);
+    let mut amax: f64 = 0.0;
+    r.until(2.0, |r| {
+        amax = amax.max(r.st(1).set_acceleration.abs());
+        r.out(g2).in_gear
+    });
+    assert!((r.st(1).set_velocity - 150.0).abs() < 1e-6);
+    // 500 at the master's maximum velocity (500): 100 at its actual 100 mm/s.
+    assert!(amax <= 500.0 * 100.0 / 500.0 + 1e-6, "{amax}");
+    // GearOut while enabled: decoupled for an instant, recoupled.
+    let o = r.ok(1, CommandKind::GearOut);
+    assert!(r.out(o).done);
+    assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
+    r.run(0.1);
+    assert!((r.st(1).set_velocity - 150.0).abs() < 1e-6);
+    // Enable FALSE: command ends, ratio frozen, still coupled.
+    r.ok(1, CommandKind::Release { target: g2 });
+    let o2 = r.out(g2);
+    assert!(!o2.busy && o2.done && o2.in_gear);
+    r.run(0.2);
+    assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
+    assert!((r.st(1).gear_ratio - 1.5).abs() < 1e-12);
+    // Now GearOut really decouples.
+    r.ok(1, CommandKind::GearOut);
+    assert_eq!(r.st(1).state, AxisState::ContinuousMotion);
+}
+
+fn conveyor(velocity: f64) -> Rig {
+    let mut p = params();
+    p.axis_velo_max = 1500.0;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.bounds[0].jerk = 1e9; // the superposition profile is C² but not jerk-limited
+    r.power_on(0);
+    r.ok(0, CommandKind::MoveVelocity { velocity, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.run(1.0);
+    r
+}
+
+#[test]
+fn s11a_30_superposition_conveyor_example_and_infeasible_warning() {
+    // Spec §5.2.2 example 1: gap 1800 → 1500 mm, 300 mm to make up within 1000 mm of belt,
+    // speed reserve 500 mm/s, velocity reduction, limited motion.
+    let mut r = conveyor(500.0);
+    let start = r.st(0).set_position;
+    let sp = Superposition { mode: SuperpositionMode::VeloReductionLimitedMotion, distance: 300.0, velocity_diff: 500.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 500.0, length: 1000.0, abort_option: SuperpositionAbortOption::AbortAtStandstill };
+    let s = r.ok(0, CommandKind::MoveSuperImposed(sp));
+    assert!(r.st(0).compensating);
+    // While it runs, the axis is 300 mm ahead of the conveyor at the end, within 1000 mm.
+    let t0 = r.k.cycle();
+    r.until(5.0, |r| !r.out(s).busy);
+    let o = r.out(s);
+    assert!(o.done && !o.warning, "{o:?}");
+    let travelled = r.st(0).set_position - start;
+    let base = 500.0 * (r.k.cycle() - t0) as f64 * DT;
+    assert!((travelled - base - 300.0).abs() < 1.0, "ahead by {}", travelled - base);
+    assert!(travelled <= 1000.0 + 1.0, "used {travelled} mm");
+    assert!(r.history[0].iter().all(|h| h.set_velocity <= 500.0 + 500.0 + 1e-6));
+    assert_eq!(r.st(0).state, AxisState::ContinuousMotion);
+    assert!((r.st(0).set_velocity - 500.0).abs() < 1e-9);
+
+    // Infeasible: the same distance within 400 mm → warning 0x4243, less distance.
+    let mut r = conveyor(500.0);
+    let start = r.st(0).set_position;
+    let s = r.ok(0, CommandKind::MoveSuperImposed(Superposition { length: 400.0, ..sp }));
+    assert!(r.out(s).warning);
+    assert_eq!(r.out(s).warning_id, ErrorId::SUPERPOSITION_INCOMPLETE.0);
+    let t0 = r.k.cycle();
+    r.until(5.0, |r| !r.out(s).busy);
+    assert!(r.out(s).done && r.out(s).warning);
+    let ahead = r.st(0).set_position - start - 500.0 * (r.k.cycle() - t0) as f64 * DT;
+    assert!(ahead < 300.0 - 1.0 && ahead > 0.0, "{ahead}");
+}
+
+#[test]
+fn s11a_31_superposition_abort_options() {
+    let sp = |abort_option| Superposition { mode: SuperpositionMode::VeloReductionAdditiveMotion, distance: 50.0, velocity_diff: 200.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 200.0, length: 400.0, abort_option };
+    use SuperpositionAbortOption::*;
+    // Row 1: override 0 → continues (all options).
+    for opt in [AbortAtStandstill, ResumeAfterStandstill, ResumeAfterMotionStop] {
+        let mut r = conveyor(200.0);
+        let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
+        r.run(0.2);
+        r.ok(0, CommandKind::SetOverride { velocity_factor: 0.0 });
+        r.run(2.0);
+        assert!(r.out(s).busy, "{opt:?}: aborted by override 0");
+        r.ok(0, CommandKind::SetOverride { velocity_factor: 1.0 });
+        r.until(5.0, |r| !r.out(s).busy);
+        assert!(r.out(s).done, "{opt:?}");
+    }
+    // Row 2/4: the main motion stops (halt) → abort unless ResumeAfterMotionStop.
+    for (opt, survives) in [(AbortAtStandstill, false), (ResumeAfterStandstill, false), (ResumeAfterMotionStop, true)] {
+        let mut r = conveyor(200.0);
+        let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
+        r.run(0.2);
+        r.ok(0, CommandKind::Halt { deceleration: 0.0, jerk: 0.0, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+        r.run(1.0);
+        assert_eq!(r.out(s).busy, survives, "{opt:?}");
+        assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
+        if survives {
+            // Resumes with the next motion and completes.
+            r.ok(0, CommandKind::MoveVelocity { velocity: 200.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+            r.until(5.0, |r| !r.out(s).busy);
+            assert!(r.out(s).done);
+        }
+    }
+    // Row 3: reversal of the main motion → abort only with AbortAtStandstill.
+    for (opt, survives) in [(AbortAtStandstill, false), (ResumeAfterStandstill, true)] {
+        let mut r = conveyor(200.0);
+        let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
+        r.run(0.1);
+        r.ok(0, CommandKind::MoveVelocity { velocity: 200.0, dynamics: Dynamics::default(), direction: Direction::Negative, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+        r.run(0.6);
+        assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
+    }
+    // Row 5: reset / enable off → abort (all).
+    let mut r = conveyor(200.0);
+    let s = r.ok(0, CommandKind::MoveSuperImposed(sp(ResumeAfterMotionStop)));
+    r.run(0.1);
+    r.ok(0, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+    assert!(r.out(s).command_aborted);
+    // At standstill it is rejected (nothing to superimpose on).
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    assert_eq!(r.rejected(0, CommandKind::MoveSuperImposed(sp(AbortAtStandstill))), ErrorId::AXIS_NOT_MOVING);
+}
+
+#[test]
+fn superposition_shifts_the_target_of_the_running_move() {
+    let mut r = Rig::new(1);
+    r.bounds[0].jerk = 1e9;
+    r.power_on(0);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(400.0, 200.0)));
+    r.run(0.5);
+    let s = r.ok(0, CommandKind::MoveSuperImposed(Superposition { mode: SuperpositionMode::LengthReductionAdditiveMotion, distance: 20.0, velocity_diff: 100.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 200.0, length: 200.0, abort_option: SuperpositionAbortOption::AbortAtStandstill }));
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(s).done);
+    assert!(r.out(m).done);
+    assert!((r.st(0).set_position - 420.0).abs() < 1e-9, "{}", r.st(0).set_position);
+}
