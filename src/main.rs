@@ -1,1 +1,3 @@
-fn main() { server::run() }
+fn main() {
+    server::run()
+}
