@@ -167,8 +167,7 @@ impl AxisConfigDto {
             }
         }
         let mut p = AxisParameters::default();
-        p.axis_id = axis_id as f64;
-        p.axis_cycle_time = cycle_time;
+        params::assign_system(&mut p, axis_id, cycle_time);
         p.axis_velo_max = d.max_velocity;
         p.axis_acc = d.acceleration;
         p.axis_dec = d.deceleration;
@@ -180,8 +179,15 @@ impl AxisConfigDto {
         p.axis_fast_dec = p.axis_fast_dec.max(d.deceleration);
         p.axis_fast_acc = p.axis_fast_acc.max(d.acceleration);
         p.axis_fast_jerk = p.axis_fast_jerk.max(d.jerk);
+        // Defaults above the axis's maximum velocity would make a small axis invalid.
+        for n in [1009u16, 1012, 1013] {
+            if p.get(n).is_ok_and(|v| v.as_f64() > d.max_velocity) {
+                p.set_raw(n, d.max_velocity);
+            }
+        }
         if let Some(m) = &self.modulo {
             p.axis_encoder_modulo_value = m.period;
+            p.axis_modulo_tolerance_window = p.axis_modulo_tolerance_window.min(m.period / 4.0);
         }
         if let Some(l) = &self.soft_limits {
             p.axis_en_min_soft_pos_limit = true;
@@ -254,20 +260,11 @@ pub struct ConfigAxis {
 /// One MC_AxisParameter entry with its value on an axis.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 pub struct ParameterResource {
-    #[schema(example = 1003)]
-    pub number: u16,
-    #[schema(example = "AxisVeloMax")]
-    pub name: &'static str,
-    #[serde(rename = "type")]
-    pub ty: params::ParamType,
-    pub unit: &'static str,
-    pub group: &'static str,
-    pub read_only: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub min: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max: Option<f64>,
-    pub help: &'static str,
+    #[serde(flatten)]
+    pub info: params::ParameterInfo,
+    /// The unit for this axis (e.g. `mm/s²`).
+    #[schema(example = "mm/s")]
+    pub unit_text: String,
     pub value: ParamValue,
     /// The value of the persistent overlay, when there is one.
     #[serde(skip_serializing_if = "Option::is_none")]

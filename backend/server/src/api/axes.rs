@@ -332,17 +332,10 @@ fn parameter_resource(
     status: &AxisStatus,
 ) -> ParameterResource {
     ParameterResource {
-        number: info.number,
-        name: info.name,
-        ty: info.ty,
-        unit: info.unit,
-        group: info.group,
-        read_only: info.read_only,
-        min: info.min,
-        max: info.max,
-        help: info.help,
+        info: *info,
+        unit_text: info.unit.text(&e.config.unit),
         value: params::read(&e.params, info.number, status).unwrap_or(ParamValue::Number(f64::NAN)),
-        persistent_value: e.persistent.get(&info.number).copied(),
+        persistent_value: e.persistent.get(&info.storage).copied(),
     }
 }
 
@@ -441,7 +434,7 @@ pub async fn write_parameter(
         let mut tx = s.db.begin().await?;
         sqlx::query("INSERT INTO persistent_parameters (axis_id, number, value, updated_at) VALUES (?, ?, ?, ?) ON CONFLICT (axis_id, number) DO UPDATE SET value = excluded.value, updated_at = excluded.updated_at")
             .bind(id)
-            .bind(info.number as i64)
+            .bind(info.storage as i64)
             .bind(serde_json::to_string(&w.value).expect("value"))
             .bind(store::now_rfc3339())
             .execute(&mut *tx)
@@ -470,7 +463,7 @@ pub async fn write_parameter(
     let e = reg.axes.get_mut(&id).expect("locked by config_lock");
     e.params = p;
     if w.persistent {
-        e.persistent.insert(info.number, w.value);
+        e.persistent.insert(info.storage, w.value);
     }
     let status = s.status(slot).1.unwrap_or_default();
     Ok(Json(parameter_resource(e, info, &status)))
@@ -555,8 +548,8 @@ pub async fn import_config(
         let mut persistent = BTreeMap::new();
         for (k, v) in &a.persistent_parameters {
             match params::lookup(k) {
-                Some(info) if !info.read_only => {
-                    persistent.insert(info.number, *v);
+                Some(info) if !info.read_only && !info.is_status() => {
+                    persistent.insert(info.storage, *v);
                 }
                 _ => errs.push(FieldError {
                     field: format!("axes[{i}].persistent_parameters.{k}"),
