@@ -1,1 +1,322 @@
-pub fn run() {}
+//! motiond, the appliance: the cycle thread, the REST + websocket API and the SQLite store.
+//!
+//! Map: [`cycle`] (the real-time thread and its queues), [`app`] (the async side's state and
+//! the pump between the two), [`api`] (HTTP and websocket), [`store`] (SQLite), [`model`]
+//! (DTOs), [`sim`] / [`params`] (adapters to `drives` and `motion::params`).
+
+pub mod api;
+pub mod app;
+pub mod cycle;
+pub mod error;
+pub mod model;
+pub mod params;
+pub mod sim;
+pub mod stats;
+pub mod store;
+
+use std::collections::BTreeMap;
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::time::Instant;
+
+use clap::{Parser, Subcommand};
+
+use crate::app::{AppState, AxisEntry, SystemInfo};
+use crate::model::{AxisConfigDto, AxisDynamics, ModuloConfig, SoftLimits};
+use crate::params::ParamValue;
+use crate::sim::SimDriveConfig;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "motiond",
+    version,
+    about = "Motion controller appliance: PLCopen axes over REST and websocket"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Cmd>,
+    #[command(flatten)]
+    pub serve: ServeArgs,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Cmd {
+    /// Run the appliance (the default).
+    Serve(ServeArgs),
+    /// Print the OpenAPI document (what `openapi/openapi.json` must contain).
+    Openapi,
+}
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct ServeArgs {
+    /// Address to listen on. Only loopback addresses are allowed until authentication exists.
+    #[arg(long, default_value = "127.0.0.1:8080")]
+    pub listen: SocketAddr,
+    /// SQLite database file (`:memory:` for a throw-away one).
+    #[arg(long, default_value = "./motiond.db")]
+    pub db: String,
+    /// Cycle time in microseconds.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(250..=10_000))]
+    pub cycle_us: u32,
+    /// Do not create the demo axes on a new database.
+    #[arg(long)]
+    pub no_demo: bool,
+}
+
+/// Entry point of the `motiond` binary.
+pub fn run() {
+    let cli = Cli::parse();
+    let args = match cli.command {
+        Some(Cmd::Openapi) => {
+            print!("{}", api::openapi_json());
+            return;
+        }
+        Some(Cmd::Serve(a)) => a,
+        None => cli.serve,
+    };
+    tracing_subscriber::fmt()
+        .with_target(false)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stdout()))
+        .with_max_level(tracing::Level::INFO)
+        .init();
+    if let Err(e) = serve(args) {
+        tracing::error!("{e}");
+        eprintln!("motiond: {e}");
+        std::process::exit(1);
+    }
+}
+
+pub fn demo_axes() -> Vec<AxisConfigDto> {
+    let linear = |name: &str, limits: Option<SoftLimits>| AxisConfigDto {
+        name: name.into(),
+        unit: "mm".into(),
+        modulo: None,
+        soft_limits: limits,
+        dynamics: AxisDynamics {
+            max_velocity: 500.0,
+            acceleration: 2500.0,
+            deceleration: 2500.0,
+            jerk: 25000.0,
+            jog_velocity_slow: 10.0,
+            jog_velocity_fast: 100.0,
+        },
+        parameters: BTreeMap::from([(
+            "AxisTargetPositionWindow".to_string(),
+            ParamValue::Number(0.01),
+        )]),
+        drive: SimDriveConfig::default(),
+    };
+    vec![
+        linear(
+            "x",
+            Some(SoftLimits {
+                min: 0.0,
+                max: 1000.0,
+            }),
+        ),
+        linear("y", None),
+        AxisConfigDto {
+            name: "spindle".into(),
+            unit: "deg".into(),
+            modulo: Some(ModuloConfig { period: 360.0 }),
+            soft_limits: None,
+            dynamics: AxisDynamics {
+                max_velocity: 3600.0,
+                acceleration: 18000.0,
+                deceleration: 18000.0,
+                jerk: 180000.0,
+                jog_velocity_slow: 90.0,
+                jog_velocity_fast: 720.0,
+            },
+            parameters: BTreeMap::new(),
+            drive: SimDriveConfig::default(),
+        },
+    ]
+}
+
+fn serve(args: ServeArgs) -> Result<(), String> {
+    if !args.listen.ip().is_loopback() {
+        return Err(format!(
+            "refusing to listen on {}: binding a non-loopback address requires authentication, which motiond \
+             does not implement yet (DESIGN §6); use a loopback address such as 127.0.0.1:8080 \
+             (and a reverse proxy with authentication for remote access)",
+            args.listen
+        ));
+    }
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .thread_name("motiond-async")
+        .enable_all()
+        .build()
+        .map_err(|e| format!("cannot start the async runtime: {e}"))?;
+    rt.block_on(serve_async(args))
+}
+
+async fn serve_async(args: ServeArgs) -> Result<(), String> {
+    let db = store::open(&args.db).await?;
+    tracing::info!("database {} (WAL, synchronous=FULL)", args.db);
+
+    let cycle_time = args.cycle_us as f64 * 1e-6;
+    let shared = Arc::new(cycle::Shared::new(args.cycle_us as u64 * 1000));
+    let (input, output) = triple_buffer::triple_buffer(&cycle::Snapshot::default());
+    let (grant_tx, grant_rx) = std::sync::mpsc::channel();
+    let thread_shared = shared.clone();
+    let cycle_thread = std::thread::Builder::new()
+        .name("motiond-cycle".into())
+        .spawn(move || {
+            let ct = cycle::CycleThread::new(cycle_time, thread_shared, input);
+            let _ = grant_tx.send(cycle::request_realtime(80));
+            ct.run();
+        })
+        .map_err(|e| format!("cannot start the cycle thread: {e}"))?;
+    let realtime = grant_rx
+        .recv()
+        .map_err(|_| "the cycle thread died at start-up".to_string())?;
+    tracing::info!(
+        "cycle thread: {} µs cycle; SCHED_FIFO {}, mlockall {}, pinned to {}",
+        args.cycle_us,
+        if realtime.sched_fifo {
+            "granted"
+        } else {
+            "NOT granted"
+        },
+        if realtime.mlockall {
+            "granted"
+        } else {
+            "NOT granted"
+        },
+        realtime
+            .pinned_cpu
+            .map_or("no CPU (not granted)".to_string(), |c| format!("CPU {c}"))
+    );
+    for n in &realtime.notes {
+        tracing::warn!("real-time: {n} (running without it)");
+    }
+
+    let first_id = store::max_command_id(&db)
+        .await
+        .map_err(|e| format!("cannot read the audit log: {e}"))?
+        + 1;
+    let info = SystemInfo {
+        version: env!("CARGO_PKG_VERSION"),
+        cycle_time_s: cycle_time,
+        listen: args.listen.to_string(),
+        db: args.db.clone(),
+        realtime,
+        started: Instant::now(),
+    };
+    let (state, audit_rx) = AppState::new(shared.clone(), output, db.clone(), first_id, info);
+    tokio::spawn(app::pump(state.clone()));
+    let audit_task = tokio::spawn(app::audit_writer(db.clone(), audit_rx));
+
+    load_axes(&state, args.no_demo).await?;
+
+    let listener = tokio::net::TcpListener::bind(args.listen)
+        .await
+        .map_err(|e| format!("cannot listen on {}: {e}", args.listen))?;
+    let local = listener.local_addr().map_err(|e| e.to_string())?;
+    tracing::info!("listening on http://{local} (API /api/v1, docs /docs)");
+    let app = api::router(state.clone()).into_make_service_with_connect_info::<SocketAddr>();
+    axum::serve(listener, app)
+        .with_graceful_shutdown(shutdown_signal())
+        .await
+        .map_err(|e| format!("server error: {e}"))?;
+    tracing::info!("shutting down");
+    shared
+        .shutdown
+        .store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = cycle_thread.join();
+    drop(state);
+    audit_task.abort();
+    db.close().await;
+    Ok(())
+}
+
+async fn shutdown_signal() {
+    let ctrl_c = tokio::signal::ctrl_c();
+    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        .expect("SIGTERM handler");
+    tokio::select! {
+        _ = ctrl_c => {},
+        _ = term.recv() => {},
+    }
+}
+
+/// Loads the stored axes into the kernel, or creates the demo on a new database.
+async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
+    let db = &state.db;
+    let stored = store::load_axes(db)
+        .await
+        .map_err(|e| format!("cannot read axes: {e}"))?;
+    let initialised = store::meta(db, "initialised")
+        .await
+        .map_err(|e| e.to_string())?
+        .is_some();
+    if !initialised {
+        sqlx::query("INSERT INTO meta (key, value) VALUES ('initialised', ?)")
+            .bind(store::now_rfc3339())
+            .execute(db)
+            .await
+            .map_err(|e| format!("cannot write the database: {e}"))?;
+        if stored.is_empty() && !no_demo {
+            for config in demo_axes() {
+                let name = config.name.clone();
+                let audit = store::AuditEntry {
+                    at: store::now_rfc3339(),
+                    action: "axis.create".into(),
+                    target: Some(name.clone()),
+                    client_id: Some("demo".into()),
+                    ..Default::default()
+                };
+                api::axes::create(state, config, None, audit)
+                    .await
+                    .map_err(|e| format!("cannot create demo axis {name}: {}", e.0.detail))?;
+            }
+            tracing::info!(
+                "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°)"
+            );
+            return Ok(());
+        }
+    }
+    let mut persistent: BTreeMap<i64, BTreeMap<u16, ParamValue>> = BTreeMap::new();
+    for (axis, number, value) in store::load_persistent(db)
+        .await
+        .map_err(|e| e.to_string())?
+    {
+        match serde_json::from_str(&value) {
+            Ok(v) => {
+                persistent.entry(axis).or_default().insert(number, v);
+            }
+            Err(e) => tracing::warn!(
+                "axis {axis}: persistent parameter {number} unreadable ({e}); ignored"
+            ),
+        }
+    }
+    for (slot, a) in stored.into_iter().enumerate() {
+        let config: AxisConfigDto = serde_json::from_str(&a.config)
+            .map_err(|e| format!("axis {} in the database is unreadable: {e}", a.name))?;
+        let overlay = persistent.remove(&a.id).unwrap_or_default();
+        let (p, axis, drive) = state
+            .build_axis(a.id, &config, &overlay)
+            .map_err(|e| format!("axis {} in the database is invalid: {e:?}", a.name))?;
+        let slot = slot as u16;
+        match state.install_axis(slot, axis, drive, false).await {
+            Ok(Ok(())) => {}
+            _ => return Err(format!("cannot install axis {}", a.name)),
+        }
+        state.registry.write().unwrap().axes.insert(
+            a.id,
+            AxisEntry {
+                id: a.id,
+                name: a.name,
+                slot,
+                config,
+                params: p,
+                persistent: overlay,
+            },
+        );
+    }
+    let n = state.registry.read().unwrap().axes.len();
+    tracing::info!("{n} axes loaded from the database");
+    Ok(())
+}

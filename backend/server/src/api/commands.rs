@@ -1,0 +1,621 @@
+//! One endpoint per function block, and the command resources.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use motion::{CommandKind, Direction, JogMode, Positioning};
+use serde::Deserialize;
+use utoipa::IntoParams;
+
+use super::errors::{CommandErrors, ReadErrors};
+use super::{Client, JsonBody, Q, WaitQuery};
+use crate::app::{AppState, AxisEntry, Registry};
+use crate::error::{ApiError, ApiResult};
+use crate::model::*;
+use crate::sim::FieldError;
+
+/// Collects invalid fields of a command body.
+#[derive(Default)]
+pub struct Check(Vec<FieldError>);
+
+impl Check {
+    fn fail(&mut self, field: &str, message: &str) {
+        self.0.push(FieldError {
+            field: field.into(),
+            message: message.into(),
+        });
+    }
+    fn finite(&mut self, field: &str, v: f64) {
+        if !v.is_finite() {
+            self.fail(field, "must be a finite number");
+        }
+    }
+    fn positive(&mut self, field: &str, v: f64) {
+        if !(v.is_finite() && v > 0.0) {
+            self.fail(field, "must be > 0");
+        }
+    }
+    fn non_negative(&mut self, field: &str, v: f64) {
+        if !(v.is_finite() && v >= 0.0) {
+            self.fail(field, "must be ≥ 0 (0 = axis default)");
+        }
+    }
+    fn options(&mut self, o: &motion::MoveOptions) {
+        if let Some(b) = o.blending_position {
+            self.finite("options.blending_position", b);
+        }
+    }
+    fn done<T>(self, t: T) -> ApiResult<T> {
+        if self.0.is_empty() {
+            Ok(t)
+        } else {
+            Err(ApiError::invalid(self.0))
+        }
+    }
+}
+
+/// A function block's body: validation and translation into a kernel command.
+pub trait CommandBody: serde::de::DeserializeOwned + Send + 'static {
+    fn to_kind(&self, name: &str, reg: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind>;
+}
+
+impl CommandBody for PowerBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.override_percent.is_finite() && (0.0..=100.0).contains(&self.override_percent)) {
+            c.fail("override_percent", "must be between 0 and 100");
+        }
+        c.done(CommandKind::Power {
+            enable: self.enable,
+            enable_positive: self.enable_positive,
+            enable_negative: self.enable_negative,
+            override_percent: self.override_percent,
+        })
+    }
+}
+
+impl CommandBody for EmptyBody {
+    fn to_kind(&self, name: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        Ok(if name == "reset" {
+            CommandKind::Reset
+        } else {
+            CommandKind::GearOut
+        })
+    }
+}
+
+impl CommandBody for SetPositionBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("position", self.position);
+        c.done(CommandKind::SetPosition {
+            position: self.position,
+            relative: self.relative,
+            clear_position_lag: self.clear_position_lag,
+        })
+    }
+}
+
+impl CommandBody for SetOverrideBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.velocity_factor.is_finite() && (0.0..=1.0).contains(&self.velocity_factor)) {
+            c.fail("velocity_factor", "must be between 0 and 1");
+        }
+        c.done(CommandKind::SetOverride {
+            velocity_factor: self.velocity_factor,
+        })
+    }
+}
+
+impl CommandBody for MoveBody {
+    fn to_kind(&self, name: &str, _: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("position", self.position);
+        c.positive("velocity", self.velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        let p = Positioning {
+            position: self.position,
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        };
+        let kind = match name {
+            "move-absolute" => CommandKind::MoveAbsolute(p),
+            "move-relative" => CommandKind::MoveRelative(p),
+            "move-additive" => CommandKind::MoveAdditive(p),
+            _ => {
+                if axis.config.modulo.is_none() {
+                    c.fail("axis", "move-modulo needs a modulo axis");
+                }
+                if self.position < 0.0 {
+                    c.fail("position", "a modulo target must be ≥ 0");
+                }
+                CommandKind::MoveModulo {
+                    move_: p,
+                    direction: self.direction.unwrap_or(Direction::Positive),
+                }
+            }
+        };
+        if name != "move-modulo" && self.direction.is_some() {
+            c.fail("direction", "only move-modulo takes a direction");
+        }
+        c.done(kind)
+    }
+}
+
+impl CommandBody for MoveContinuousBody {
+    fn to_kind(&self, name: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("position", self.position);
+        c.positive("velocity", self.velocity);
+        c.finite("end_velocity", self.end_velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        let move_ = Positioning {
+            position: self.position,
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        };
+        c.done(if name == "move-continuous-absolute" {
+            CommandKind::MoveContinuousAbsolute {
+                move_,
+                end_velocity: self.end_velocity,
+            }
+        } else {
+            CommandKind::MoveContinuousRelative {
+                move_,
+                end_velocity: self.end_velocity,
+            }
+        })
+    }
+}
+
+impl CommandBody for MoveVelocityBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.positive("velocity", self.velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::MoveVelocity {
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            direction: self.direction,
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        })
+    }
+}
+
+impl CommandBody for HaltBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::Halt {
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        })
+    }
+}
+
+impl CommandBody for StopBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::Stop {
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+            options: self.options,
+        })
+    }
+}
+
+impl CommandBody for JogBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.deadman_timeout.is_finite() && (0.05..=10.0).contains(&self.deadman_timeout)) {
+            c.fail("deadman_timeout", "must be between 0.05 and 10 s");
+        }
+        c.non_negative("velocity", self.velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.non_negative("position", self.position);
+        match self.mode {
+            JogMode::Continuous if self.velocity <= 0.0 => {
+                c.fail("velocity", "continuous jog needs a velocity > 0")
+            }
+            JogMode::Inching | JogMode::InchingModulo if self.position <= 0.0 => {
+                c.fail("position", "inching needs a distance > 0")
+            }
+            _ => {}
+        }
+        c.done(CommandKind::Jog {
+            mode: self.mode,
+            forward: self.direction == JogDirection::Forward,
+            position: self.position,
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            deadman: self.deadman_timeout,
+        })
+    }
+}
+
+impl CommandBody for HomeBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        if let Some(p) = self.position {
+            c.finite("position", p);
+        }
+        for (f, v) in [
+            ("options.search_velocity", self.options.search_velocity),
+            ("options.sync_velocity", self.options.sync_velocity),
+        ] {
+            if let Some(v) = v {
+                c.positive(f, v);
+            }
+        }
+        c.done(CommandKind::Home {
+            position: self.position,
+            mode: self.mode,
+            options: self.options,
+        })
+    }
+}
+
+impl CommandBody for GearInBody {
+    fn to_kind(&self, _: &str, reg: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        let master = reg.find(&self.master);
+        match master {
+            None => c.fail("master", "no such axis"),
+            Some(m) if m.id == axis.id => c.fail("master", "an axis cannot be its own master"),
+            _ => {}
+        }
+        if !(self.ratio_numerator.is_finite() && self.ratio_numerator != 0.0) {
+            c.fail("ratio_numerator", "must be a finite number other than 0");
+        }
+        if self.ratio_denominator == 0 {
+            c.fail("ratio_denominator", "must be ≥ 1");
+        }
+        let slot = master.map_or(0, |m| m.slot);
+        c.done(CommandKind::GearIn {
+            master: slot,
+            ratio_numerator: self.ratio_numerator,
+            ratio_denominator: self.ratio_denominator,
+        })
+    }
+}
+
+/// Validates, submits and (optionally) waits: shared by all command endpoints and the websocket.
+pub async fn run_command<B: CommandBody>(
+    s: &AppState,
+    axis: &str,
+    name: &'static str,
+    body: B,
+    raw: serde_json::Value,
+    client: crate::model::ClientInfo,
+    wait: Option<Duration>,
+) -> ApiResult<CommandResource> {
+    let id = s
+        .submit(axis, name, raw, client, |reg, e| body.to_kind(name, reg, e))
+        .await?;
+    let view = match wait {
+        Some(t) => s.wait(id, t).await,
+        None => s.command(id),
+    };
+    view.ok_or_else(|| {
+        ApiError::unavailable(
+            "command_forgotten",
+            "the command left the history before it could be shown",
+        )
+    })
+}
+
+fn accepted(view: CommandResource) -> Response {
+    let loc = format!("/api/v1/commands/{}", view.id);
+    let mut r = (StatusCode::ACCEPTED, Json(view)).into_response();
+    r.headers_mut().insert(
+        header::LOCATION,
+        HeaderValue::from_str(&loc).expect("ascii"),
+    );
+    r
+}
+
+pub fn wait_duration(q: &WaitQuery) -> ApiResult<Option<Duration>> {
+    match (q.wait, q.timeout_ms) {
+        (_, Some(t)) if t > 600_000 => Err(ApiError::field("timeout_ms", "at most 600000")),
+        (true, t) => Ok(Some(Duration::from_millis(t.unwrap_or(10_000)))),
+        (false, _) => Ok(None),
+    }
+}
+
+macro_rules! command_endpoint {
+    ($fn:ident, $path:tt, $name:tt, $body:ty, $summary:tt) => {
+        #[utoipa::path(post, path = $path, tag = "commands", summary = $summary,
+            params(("axis" = String, Path, description = "axis id or name", example = "x"), WaitQuery),
+            request_body = $body,
+            responses(
+                (status = 202, description = "Accepted: the command resource (final or at its milestone when waited for)",
+                    body = CommandResource, headers(("Location" = String, description = "/api/v1/commands/{id}"))),
+                CommandErrors))]
+        pub async fn $fn(
+            State(s): State<Arc<AppState>>,
+            Path(axis): Path<String>,
+            client: Client,
+            Q(q): Q<WaitQuery>,
+            JsonBody(body, raw): JsonBody<$body>,
+        ) -> ApiResult<Response> {
+            let wait = wait_duration(&q)?;
+            Ok(accepted(run_command(&s, &axis, $name, body, raw, client.0, wait).await?))
+        }
+    };
+}
+
+command_endpoint!(
+    power,
+    "/api/v1/axes/{axis}/power",
+    "power",
+    PowerBody,
+    "MC_Power: enable (stays active until released with DELETE /commands/{id} or a power with enable=false)"
+);
+command_endpoint!(
+    reset,
+    "/api/v1/axes/{axis}/reset",
+    "reset",
+    EmptyBody,
+    "MC_Reset: clear an axis error"
+);
+command_endpoint!(
+    set_position,
+    "/api/v1/axes/{axis}/set-position",
+    "set-position",
+    SetPositionBody,
+    "MC_SetPosition"
+);
+command_endpoint!(
+    set_override,
+    "/api/v1/axes/{axis}/set-override",
+    "set-override",
+    SetOverrideBody,
+    "MC_SetOverride"
+);
+command_endpoint!(
+    move_absolute,
+    "/api/v1/axes/{axis}/move-absolute",
+    "move-absolute",
+    MoveBody,
+    "MC_MoveAbsolute"
+);
+command_endpoint!(
+    move_relative,
+    "/api/v1/axes/{axis}/move-relative",
+    "move-relative",
+    MoveBody,
+    "MC_MoveRelative (`position` is the distance)"
+);
+command_endpoint!(
+    move_additive,
+    "/api/v1/axes/{axis}/move-additive",
+    "move-additive",
+    MoveBody,
+    "MC_MoveAdditive (`position` is the distance added to the running target)"
+);
+command_endpoint!(
+    move_modulo,
+    "/api/v1/axes/{axis}/move-modulo",
+    "move-modulo",
+    MoveBody,
+    "MC_MoveModulo (modulo axes)"
+);
+command_endpoint!(
+    move_velocity,
+    "/api/v1/axes/{axis}/move-velocity",
+    "move-velocity",
+    MoveVelocityBody,
+    "MC_MoveVelocity (wait returns at in_velocity)"
+);
+command_endpoint!(
+    move_continuous_absolute,
+    "/api/v1/axes/{axis}/move-continuous-absolute",
+    "move-continuous-absolute",
+    MoveContinuousBody,
+    "MC_MoveContinuousAbsolute (wait returns at in_end_velocity)"
+);
+command_endpoint!(
+    move_continuous_relative,
+    "/api/v1/axes/{axis}/move-continuous-relative",
+    "move-continuous-relative",
+    MoveContinuousBody,
+    "MC_MoveContinuousRelative (wait returns at in_end_velocity)"
+);
+command_endpoint!(
+    halt,
+    "/api/v1/axes/{axis}/halt",
+    "halt",
+    HaltBody,
+    "MC_Halt"
+);
+command_endpoint!(
+    stop,
+    "/api/v1/axes/{axis}/stop",
+    "stop",
+    StopBody,
+    "MC_Stop: stops and locks the axis until released with DELETE /commands/{id}"
+);
+command_endpoint!(
+    jog,
+    "/api/v1/axes/{axis}/jog",
+    "jog",
+    JogBody,
+    "MC_Jog: runs while renewed with POST /commands/{id}/keepalive within deadman_timeout; DELETE releases"
+);
+command_endpoint!(
+    home,
+    "/api/v1/axes/{axis}/home",
+    "home",
+    HomeBody,
+    "MC_Home"
+);
+command_endpoint!(
+    gear_in,
+    "/api/v1/axes/{axis}/gear-in",
+    "gear-in",
+    GearInBody,
+    "MC_GearIn: couple to a master (wait returns at in_gear)"
+);
+command_endpoint!(
+    gear_out,
+    "/api/v1/axes/{axis}/gear-out",
+    "gear-out",
+    EmptyBody,
+    "MC_GearOut"
+);
+
+fn parse_id(id: &str) -> ApiResult<u64> {
+    id.parse().map_err(|_| ApiError::not_found("command", id))
+}
+
+#[utoipa::path(get, path = "/api/v1/commands/{id}", tag = "commands", summary = "A command's life",
+    params(("id" = u64, Path, description = "command id")),
+    responses((status = 200, description = "The command", body = CommandResource), ReadErrors))]
+pub async fn get_command(
+    State(s): State<Arc<AppState>>,
+    Path(id): Path<String>,
+) -> ApiResult<Json<CommandResource>> {
+    let id = parse_id(&id)?;
+    s.command(id)
+        .map(Json)
+        .ok_or_else(|| ApiError::not_found("command", &id.to_string()))
+}
+
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct ListQuery {
+    /// Only commands of this axis (id or name).
+    pub axis: Option<String>,
+    /// Only commands in this state.
+    pub state: Option<CommandState>,
+    /// At most this many (default 100, at most 2000), newest first.
+    pub limit: Option<usize>,
+}
+
+#[utoipa::path(get, path = "/api/v1/commands", tag = "commands", summary = "Recent commands, newest first",
+    params(ListQuery),
+    responses((status = 200, description = "Commands", body = Vec<CommandResource>), CommandErrors))]
+pub async fn list_commands(
+    State(s): State<Arc<AppState>>,
+    Q(q): Q<ListQuery>,
+) -> ApiResult<Json<Vec<CommandResource>>> {
+    let axis_id = match &q.axis {
+        Some(a) => Some(
+            s.registry
+                .read()
+                .unwrap()
+                .find(a)
+                .map(|e| e.id)
+                .ok_or_else(|| ApiError::not_found("axis", a))?,
+        ),
+        None => None,
+    };
+    let limit = q.limit.unwrap_or(100).min(crate::app::HISTORY);
+    let store = s.commands.lock().unwrap();
+    let out = store
+        .order
+        .iter()
+        .rev()
+        .filter_map(|id| store.map.get(id))
+        .filter(|r| r.accepted)
+        .filter(|r| axis_id.is_none_or(|a| r.axis_id == a))
+        .map(|r| r.view())
+        .filter(|v| q.state.is_none_or(|st| v.state == st))
+        .take(limit)
+        .collect();
+    Ok(Json(out))
+}
+
+fn slot_of(s: &AppState, id: u64) -> ApiResult<u16> {
+    let store = s.commands.lock().unwrap();
+    store
+        .map
+        .get(&id)
+        .filter(|r| r.accepted)
+        .map(|r| r.slot)
+        .ok_or_else(|| ApiError::not_found("command", &id.to_string()))
+}
+
+#[utoipa::path(delete, path = "/api/v1/commands/{id}", tag = "commands",
+    summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog or a power",
+    params(("id" = u64, Path, description = "command id")),
+    responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandErrors))]
+pub async fn release_command(
+    State(s): State<Arc<AppState>>,
+    Path(id): Path<String>,
+    client: Client,
+) -> ApiResult<Json<CommandResource>> {
+    let id = parse_id(&id)?;
+    let slot = slot_of(&s, id)?;
+    let result = s
+        .kernel_command(slot, motion::CommandKind::Release { target: id })
+        .await?;
+    s.audit(crate::store::AuditEntry {
+        at: crate::store::now_rfc3339(),
+        client_addr: Some(client.0.addr.clone()),
+        client_id: client.0.id.clone(),
+        action: "command.release".into(),
+        target: Some(id.to_string()),
+        command_id: Some(id),
+        detail: "{}".into(),
+        outcome: Some(match result {
+            Ok(_) => "accepted".into(),
+            Err(e) => format!("rejected:{}", e.code()),
+        }),
+    });
+    if let Err(e) = result {
+        return Err(ApiError::rejected(e));
+    }
+    // Let the release's effect (if any) reach the command's outputs before showing it.
+    tokio::time::sleep(Duration::from_millis(2)).await;
+    s.command(id)
+        .map(Json)
+        .ok_or_else(|| ApiError::not_found("command", &id.to_string()))
+}
+
+#[utoipa::path(post, path = "/api/v1/commands/{id}/keepalive", tag = "commands", summary = "Renew a jog's dead-man",
+    params(("id" = u64, Path, description = "command id")),
+    responses((status = 204, description = "Renewed"), CommandErrors))]
+pub async fn keepalive(
+    State(s): State<Arc<AppState>>,
+    Path(id): Path<String>,
+) -> ApiResult<StatusCode> {
+    let id = parse_id(&id)?;
+    let slot = slot_of(&s, id)?;
+    match s
+        .kernel_command(slot, motion::CommandKind::Keepalive { target: id })
+        .await?
+    {
+        Ok(_) => Ok(StatusCode::NO_CONTENT),
+        Err(e) => Err(ApiError::rejected(e)),
+    }
+}

@@ -1,0 +1,208 @@
+//! HTTP API (DESIGN §4): router, extractors, OpenAPI document.
+
+pub mod axes;
+pub mod commands;
+pub mod errors;
+pub mod system;
+pub mod ws;
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+
+use axum::extract::rejection::QueryRejection;
+use axum::extract::{ConnectInfo, FromRequest, FromRequestParts, Query, Request};
+use axum::http::StatusCode;
+use axum::http::request::Parts;
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use utoipa::{IntoParams, OpenApi};
+
+use crate::app::AppState;
+use crate::error::ApiError;
+use crate::model::ClientInfo;
+
+/// A JSON body whose errors are problem+json: 400 for malformed JSON, 422 for wrong types,
+/// missing or unknown fields. An empty body is read as `{}`.
+pub struct JsonBody<T>(pub T, pub serde_json::Value);
+
+impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
+    type Rejection = ApiError;
+
+    async fn from_request(req: Request, state: &S) -> Result<Self, ApiError> {
+        let bytes = axum::body::Bytes::from_request(req, state)
+            .await
+            .map_err(|e| ApiError::bad_json(format!("cannot read the body: {e}")))?;
+        let bytes: &[u8] = if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+            b"{}"
+        } else {
+            &bytes
+        };
+        let value: serde_json::Value =
+            serde_json::from_slice(bytes).map_err(|e| ApiError::bad_json(e.to_string()))?;
+        let t = T::deserialize(&value).map_err(|e| ApiError::field("body", &e.to_string()))?;
+        Ok(JsonBody(t, value))
+    }
+}
+
+/// Who sent the request: remote address and the optional `X-Client-Id` header.
+pub struct Client(pub ClientInfo);
+
+impl<S: Send + Sync> FromRequestParts<S> for Client {
+    type Rejection = std::convert::Infallible;
+
+    async fn from_request_parts(parts: &mut Parts, _: &S) -> Result<Self, Self::Rejection> {
+        let addr = parts
+            .extensions
+            .get::<ConnectInfo<SocketAddr>>()
+            .map(|c| c.0.to_string())
+            .unwrap_or_default();
+        let id = parts
+            .headers
+            .get("x-client-id")
+            .and_then(|v| v.to_str().ok())
+            .map(|s| s.chars().take(128).collect());
+        Ok(Client(ClientInfo {
+            addr,
+            id,
+            via: "rest",
+        }))
+    }
+}
+
+/// Query parameters with problem+json errors.
+pub struct Q<T>(pub T);
+
+impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for Q<T> {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &S) -> Result<Self, ApiError> {
+        let q: Result<Query<T>, QueryRejection> = Query::from_request_parts(parts, state).await;
+        q.map(|q| Q(q.0))
+            .map_err(|e| ApiError::field("query", &e.body_text()))
+    }
+}
+
+/// `?wait=true&timeout_ms=N`.
+#[derive(Debug, Default, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct WaitQuery {
+    /// Hold the response until the command is final or reaches its milestone
+    /// (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+    #[serde(default)]
+    pub wait: bool,
+    /// Longest wait (default 10000, at most 600000); then the command is returned as it stands.
+    pub timeout_ms: Option<u64>,
+}
+
+pub fn router(state: Arc<AppState>) -> Router {
+    let api = Router::new()
+        .route("/axes", get(axes::list_axes).post(axes::create_axis))
+        .route(
+            "/axes/{axis}",
+            get(axes::get_axis)
+                .put(axes::replace_axis)
+                .delete(axes::delete_axis),
+        )
+        .route("/axes/{axis}/status", get(axes::axis_status))
+        .route("/axes/{axis}/parameters", get(axes::list_parameters))
+        .route(
+            "/axes/{axis}/parameters/{parameter}",
+            get(axes::get_parameter).put(axes::write_parameter),
+        )
+        .route("/axes/{axis}/power", post(commands::power))
+        .route("/axes/{axis}/reset", post(commands::reset))
+        .route("/axes/{axis}/set-position", post(commands::set_position))
+        .route("/axes/{axis}/set-override", post(commands::set_override))
+        .route("/axes/{axis}/move-absolute", post(commands::move_absolute))
+        .route("/axes/{axis}/move-relative", post(commands::move_relative))
+        .route("/axes/{axis}/move-additive", post(commands::move_additive))
+        .route("/axes/{axis}/move-modulo", post(commands::move_modulo))
+        .route("/axes/{axis}/move-velocity", post(commands::move_velocity))
+        .route(
+            "/axes/{axis}/move-continuous-absolute",
+            post(commands::move_continuous_absolute),
+        )
+        .route(
+            "/axes/{axis}/move-continuous-relative",
+            post(commands::move_continuous_relative),
+        )
+        .route("/axes/{axis}/halt", post(commands::halt))
+        .route("/axes/{axis}/stop", post(commands::stop))
+        .route("/axes/{axis}/jog", post(commands::jog))
+        .route("/axes/{axis}/home", post(commands::home))
+        .route("/axes/{axis}/gear-in", post(commands::gear_in))
+        .route("/axes/{axis}/gear-out", post(commands::gear_out))
+        .route("/commands", get(commands::list_commands))
+        .route(
+            "/commands/{id}",
+            get(commands::get_command).delete(commands::release_command),
+        )
+        .route("/commands/{id}/keepalive", post(commands::keepalive))
+        .route("/system", get(system::system))
+        .route("/config", get(axes::export_config).put(axes::import_config))
+        .route("/ws", get(ws::upgrade))
+        .fallback(not_found);
+    Router::new()
+        .nest("/api/v1", api)
+        .route("/metrics", get(system::metrics))
+        .route("/openapi.json", get(|| async { Json(ApiDoc::openapi()) }))
+        .route("/", get(system::index))
+        .merge(
+            utoipa_swagger_ui::SwaggerUi::new("/docs")
+                .url("/openapi-swagger.json", ApiDoc::openapi()),
+        )
+        .fallback(not_found)
+        .with_state(state)
+}
+
+async fn not_found(uri: axum::http::Uri) -> Response {
+    ApiError::new(
+        StatusCode::NOT_FOUND,
+        "route_not_found",
+        "Not found",
+        format!("no route {}", uri.path()),
+    )
+    .into_response()
+}
+
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "motiond",
+        description = "Motion controller appliance: PLCopen (TwinCAT NC / Tc2_MC2) axes over REST and websocket.\n\n\
+Errors are `application/problem+json` (RFC 9457) with a stable `code` and, for errors of the motion kernel, \
+the PLCopen `error_id`. Commands are accepted with 202 and a command resource; `?wait=true` holds the response \
+until the command finishes. Authentication is not implemented yet: motiond only listens on loopback addresses.",
+        license(name = "MIT OR Apache-2.0")
+    ),
+    paths(
+        axes::list_axes, axes::create_axis, axes::get_axis, axes::replace_axis, axes::delete_axis,
+        axes::axis_status, axes::list_parameters, axes::get_parameter, axes::write_parameter,
+        commands::power, commands::reset, commands::set_position, commands::set_override,
+        commands::move_absolute, commands::move_relative, commands::move_additive, commands::move_modulo,
+        commands::move_velocity, commands::move_continuous_absolute, commands::move_continuous_relative,
+        commands::halt, commands::stop, commands::jog, commands::home, commands::gear_in, commands::gear_out,
+        commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
+        axes::export_config, axes::import_config, system::system, system::metrics, ws::upgrade,
+    ),
+    tags(
+        (name = "axes", description = "Axis configurations and live status"),
+        (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
+        (name = "commands", description = "One endpoint per function block; command resources"),
+        (name = "system", description = "Version, cycle timing, metrics, configuration export/import"),
+    )
+)]
+pub struct ApiDoc;
+
+/// The OpenAPI document as written to `openapi/openapi.json`.
+pub fn openapi_json() -> String {
+    let mut s = ApiDoc::openapi()
+        .to_pretty_json()
+        .expect("openapi serialises");
+    s.push('\n');
+    s
+}

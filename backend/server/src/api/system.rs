@@ -1,0 +1,160 @@
+//! `GET /system`, `/metrics`, `/`.
+
+use std::fmt::Write;
+use std::sync::Arc;
+use std::sync::atomic::Ordering::Relaxed;
+
+use axum::Json;
+use axum::extract::State;
+use axum::http::header;
+use axum::response::{Html, IntoResponse};
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use crate::app::AppState;
+use crate::cycle::RealtimeGrant;
+use crate::stats::Summary;
+
+/// Timing of the cycle thread, measured by itself.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+pub struct Timing {
+    /// Wake-up time minus the deadline.
+    pub wakeup_latency: Summary,
+    /// Work per cycle (drives, commands, kernel, snapshot).
+    pub compute: Summary,
+    /// Time between consecutive wake-ups.
+    pub period: Summary,
+    pub cycles: u64,
+    /// Deadlines missed because a cycle's work ended late.
+    pub overruns: u64,
+    /// Command events lost because the event ring was full.
+    pub events_dropped: u64,
+    /// Audit entries lost because the audit queue was full.
+    pub audit_dropped: u64,
+}
+
+#[derive(Clone, Debug, Serialize, ToSchema)]
+pub struct SystemResource {
+    #[schema(example = "0.1.0")]
+    pub version: &'static str,
+    /// Kernel cycle time in seconds.
+    #[schema(example = 0.001)]
+    pub cycle_time: f64,
+    /// The latest cycle.
+    pub cycle: u64,
+    pub uptime_s: f64,
+    pub listen: String,
+    pub database: String,
+    pub axes: usize,
+    /// `simulated` (EtherCAT later).
+    pub drive_bus: &'static str,
+    pub realtime: RealtimeGrant,
+    pub timing: Timing,
+}
+
+pub fn system_resource(s: &AppState) -> SystemResource {
+    let st = &s.shared.stats;
+    SystemResource {
+        version: s.info.version,
+        cycle_time: s.info.cycle_time_s,
+        cycle: s.shared.cycle.load(Relaxed),
+        uptime_s: s.info.started.elapsed().as_secs_f64(),
+        listen: s.info.listen.clone(),
+        database: s.info.db.clone(),
+        axes: s.registry.read().unwrap().axes.len(),
+        drive_bus: "simulated",
+        realtime: s.info.realtime.clone(),
+        timing: Timing {
+            wakeup_latency: st.wakeup_latency.summary(),
+            compute: st.compute.summary(),
+            period: st.period.summary(),
+            cycles: st.cycles.load(Relaxed),
+            overruns: st.overruns.load(Relaxed),
+            events_dropped: st.events_dropped.load(Relaxed),
+            audit_dropped: s.audit_dropped.load(Relaxed),
+        },
+    }
+}
+
+#[utoipa::path(get, path = "/api/v1/system", tag = "system", summary = "Version, cycle time, real-time grant and timing statistics",
+    responses((status = 200, description = "System information", body = SystemResource)))]
+pub async fn system(State(s): State<Arc<AppState>>) -> Json<SystemResource> {
+    Json(system_resource(&s))
+}
+
+#[utoipa::path(get, path = "/metrics", tag = "system", summary = "Prometheus metrics (text format 0.0.4)",
+    responses((status = 200, description = "Metrics", content_type = "text/plain", body = String)))]
+pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
+    let st = &s.shared.stats;
+    let mut out = String::with_capacity(16 * 1024);
+    st.wakeup_latency.prometheus(
+        "motiond_cycle_wakeup_latency_seconds",
+        "Wake-up time of the cycle thread minus its deadline.",
+        &mut out,
+    );
+    st.compute
+        .prometheus("motiond_cycle_compute_seconds", "Work per cycle.", &mut out);
+    st.period.prometheus(
+        "motiond_cycle_period_seconds",
+        "Time between consecutive wake-ups of the cycle thread.",
+        &mut out,
+    );
+    let counters = [
+        (
+            "motiond_cycles_total",
+            "Cycles run.",
+            st.cycles.load(Relaxed),
+        ),
+        (
+            "motiond_cycle_overruns_total",
+            "Deadlines missed.",
+            st.overruns.load(Relaxed),
+        ),
+        (
+            "motiond_events_dropped_total",
+            "Command events lost (event ring full).",
+            st.events_dropped.load(Relaxed),
+        ),
+        (
+            "motiond_commands_total",
+            "Requests taken by the cycle thread.",
+            st.commands_drained.load(Relaxed),
+        ),
+        (
+            "motiond_audit_dropped_total",
+            "Audit entries lost (queue full).",
+            s.audit_dropped.load(Relaxed),
+        ),
+    ];
+    for (name, help, v) in counters {
+        let _ = writeln!(
+            out,
+            "# HELP {name} {help}\n# TYPE {name} counter\n{name} {v}"
+        );
+    }
+    let _ = writeln!(
+        out,
+        "# HELP motiond_cycle_time_seconds Configured cycle time.\n# TYPE motiond_cycle_time_seconds gauge\nmotiond_cycle_time_seconds {}",
+        s.info.cycle_time_s
+    );
+    let _ = writeln!(
+        out,
+        "# HELP motiond_axes Configured axes.\n# TYPE motiond_axes gauge\nmotiond_axes {}",
+        s.registry.read().unwrap().axes.len()
+    );
+    let _ = writeln!(
+        out,
+        "# HELP motiond_realtime_granted SCHED_FIFO granted (1) or not (0).\n# TYPE motiond_realtime_granted gauge\nmotiond_realtime_granted {}",
+        s.info.realtime.sched_fifo as u8
+    );
+    ([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], out)
+}
+
+pub async fn index() -> Html<&'static str> {
+    Html(concat!(
+        "<!doctype html><meta charset=utf-8><title>motiond</title>",
+        "<h1>motiond</h1><p>The commissioning UI is not built yet. ",
+        "API: <a href=/docs>Swagger UI</a>, <a href=/openapi.json>openapi.json</a>, ",
+        "<a href=/api/v1/axes>/api/v1/axes</a>, <a href=/api/v1/system>/api/v1/system</a>, <a href=/metrics>/metrics</a>.</p>"
+    ))
+}

@@ -1,0 +1,447 @@
+//! Websocket `/api/v1/ws`: JSON-RPC 2.0 — subscriptions with deltas, and commands.
+//!
+//! Each connection is one task. Snapshots are taken from the latest status when a
+//! subscription is due, so a slow client simply skips intermediate snapshots; command
+//! notices come from a bounded broadcast channel (a lagging client is told how many it
+//! missed). Replies to commands are produced by spawned tasks through a bounded channel.
+//! Nothing here can block another client or the cycle thread.
+
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{ConnectInfo, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+use serde_json::{Map, Value, json};
+use tokio::sync::{broadcast, mpsc};
+use tokio::time::Instant;
+
+use super::commands::{CommandBody, run_command};
+use crate::app::AppState;
+use crate::error::ApiError;
+use crate::model::*;
+
+/// Highest subscription rate.
+pub const MAX_RATE_HZ: f64 = 100.0;
+const TICK: Duration = Duration::from_millis(10);
+const KEEPALIVE_EVERY: Duration = Duration::from_millis(100);
+
+#[utoipa::path(get, path = "/api/v1/ws", tag = "system", summary = "Websocket: JSON-RPC 2.0 subscriptions and commands",
+    description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
+(rate capped at 100 Hz; default 10); `unsubscribe` {topic}; every command endpoint by its name (`power`, \
+`move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); \
+`keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, \
+then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog sent over the \
+socket is kept alive while the socket is open and released when it closes.",
+    responses((status = 101, description = "Switching protocols")))]
+pub async fn upgrade(
+    ws: WebSocketUpgrade,
+    State(s): State<Arc<AppState>>,
+    ConnectInfo(addr): ConnectInfo<SocketAddr>,
+    headers: HeaderMap,
+) -> Response {
+    let client = ClientInfo {
+        addr: addr.to_string(),
+        id: headers
+            .get("x-client-id")
+            .and_then(|v| v.to_str().ok())
+            .map(|s| s.chars().take(128).collect()),
+        via: "websocket",
+    };
+    ws.max_message_size(256 * 1024)
+        .on_upgrade(move |socket| session(s, socket, client))
+}
+
+enum Topic {
+    Axis { slot: u16, name: String },
+    Commands,
+    System,
+}
+
+struct Sub {
+    key: String,
+    topic: Topic,
+    every: Duration,
+    due: Instant,
+    last: Option<Map<String, Value>>,
+}
+
+fn rpc_result(id: &Value, result: Value) -> String {
+    json!({"jsonrpc": "2.0", "id": id, "result": result}).to_string()
+}
+
+fn rpc_error(id: &Value, code: i64, message: &str, data: Option<Value>) -> String {
+    let mut e = json!({"code": code, "message": message});
+    if let Some(d) = data {
+        e["data"] = d;
+    }
+    json!({"jsonrpc": "2.0", "id": id, "error": e}).to_string()
+}
+
+fn api_error(id: &Value, e: ApiError) -> String {
+    let code = match e.0.status {
+        422 | 400 => -32602,
+        _ => -32000,
+    };
+    rpc_error(
+        id,
+        code,
+        &e.0.detail.clone(),
+        serde_json::to_value(&*e.0).ok(),
+    )
+}
+
+fn notify(method: &str, params: Value) -> String {
+    json!({"jsonrpc": "2.0", "method": method, "params": params}).to_string()
+}
+
+async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
+    let mut subs: Vec<Sub> = Vec::new();
+    let mut notices: Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>> = None;
+    let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
+    let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
+    let mut tick = tokio::time::interval(TICK);
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let mut next_keepalive = Instant::now() + KEEPALIVE_EVERY;
+    loop {
+        let outgoing: Vec<String> = tokio::select! {
+            msg = socket.recv() => match msg {
+                Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, t.as_str()).into_iter().collect(),
+                Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
+                Some(Ok(_)) => vec![],
+                _ => break,
+            },
+            Some(m) = out_rx.recv() => vec![m],
+            n = async { match notices.as_mut() { Some(rx) => rx.recv().await, None => std::future::pending().await } } => match n {
+                Ok(n) => vec![notify("command_event", serde_json::to_value(&*n).unwrap_or_default())],
+                Err(broadcast::error::RecvError::Lagged(k)) => vec![notify("commands_lagged", json!({"missed": k}))],
+                Err(broadcast::error::RecvError::Closed) => vec![],
+            },
+            _ = tick.tick() => {
+                let now = Instant::now();
+                if now >= next_keepalive {
+                    next_keepalive = now + KEEPALIVE_EVERY;
+                    renew_jogs(&s, &jogs);
+                }
+                updates(&s, &mut subs, now)
+            }
+        };
+        for m in outgoing {
+            if socket.send(Message::Text(m.into())).await.is_err() {
+                break;
+            }
+        }
+    }
+    // The socket is gone: release its jogs (a jog held on a socket stops when it closes).
+    let held: Vec<(u16, u64)> = std::mem::take(&mut *jogs.lock().unwrap());
+    for (slot, id) in held {
+        if s.command(id).is_some_and(|c| !c.is_final) {
+            let _ = s
+                .kernel_command(slot, motion::CommandKind::Release { target: id })
+                .await;
+        }
+    }
+}
+
+fn renew_jogs(s: &Arc<AppState>, jogs: &Arc<Mutex<Vec<(u16, u64)>>>) {
+    let mut held = jogs.lock().unwrap();
+    held.retain(|(_, id)| s.command(*id).is_some_and(|c| !c.is_final));
+    for &(slot, id) in held.iter() {
+        let s = s.clone();
+        tokio::spawn(async move {
+            let _ = s
+                .kernel_command(slot, motion::CommandKind::Keepalive { target: id })
+                .await;
+        });
+    }
+}
+
+fn updates(s: &AppState, subs: &mut [Sub], now: Instant) -> Vec<String> {
+    let mut out = Vec::new();
+    for sub in subs.iter_mut().filter(|x| now >= x.due) {
+        sub.due = now + sub.every;
+        let (cycle, value) = match &sub.topic {
+            Topic::Commands => continue,
+            Topic::Axis { slot, .. } => match s.status(*slot) {
+                (c, Some(st)) => (c, serde_json::to_value(st).unwrap_or_default()),
+                _ => continue,
+            },
+            Topic::System => {
+                let sys = super::system::system_resource(s);
+                (sys.cycle, serde_json::to_value(sys).unwrap_or_default())
+            }
+        };
+        let Value::Object(map) = value else { continue };
+        let (full, data) = match &sub.last {
+            None => (true, map.clone()),
+            Some(last) => (
+                false,
+                map.iter()
+                    .filter(|(k, v)| last.get(*k) != Some(v))
+                    .map(|(k, v)| (k.clone(), v.clone()))
+                    .collect(),
+            ),
+        };
+        if !full && data.is_empty() {
+            continue;
+        }
+        sub.last = Some(map);
+        out.push(notify(
+            "update",
+            json!({"topic": sub.key, "cycle": cycle, "full": full, "data": data}),
+        ));
+    }
+    out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn handle(
+    s: &Arc<AppState>,
+    subs: &mut Vec<Sub>,
+    notices: &mut Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>>,
+    client: &ClientInfo,
+    out_tx: &mpsc::Sender<String>,
+    jogs: &Arc<Mutex<Vec<(u16, u64)>>>,
+    text: &str,
+) -> Option<String> {
+    let req: Value = match serde_json::from_str(text) {
+        Ok(v) => v,
+        Err(e) => {
+            return Some(rpc_error(
+                &Value::Null,
+                -32700,
+                &format!("parse error: {e}"),
+                None,
+            ));
+        }
+    };
+    let id = req.get("id").cloned().unwrap_or(Value::Null);
+    let Some(method) = req
+        .get("method")
+        .and_then(|m| m.as_str())
+        .filter(|_| req.get("jsonrpc") == Some(&json!("2.0")))
+    else {
+        return Some(rpc_error(
+            &id,
+            -32600,
+            "invalid request: need jsonrpc \"2.0\" and a method",
+            None,
+        ));
+    };
+    let mut params = match req.get("params") {
+        None => Map::new(),
+        Some(Value::Object(m)) => m.clone(),
+        Some(_) => return Some(rpc_error(&id, -32602, "params must be an object", None)),
+    };
+    let method = method.to_string();
+    match method.as_str() {
+        "subscribe" => {
+            let Some(key) = params
+                .get("topic")
+                .and_then(|t| t.as_str())
+                .map(String::from)
+            else {
+                return Some(rpc_error(&id, -32602, "topic is required", None));
+            };
+            let rate = match params.get("rate_hz") {
+                None => 10.0,
+                Some(v) => match v.as_f64() {
+                    Some(r) if r > 0.0 && r.is_finite() => r.min(MAX_RATE_HZ),
+                    _ => return Some(rpc_error(&id, -32602, "rate_hz must be a number > 0", None)),
+                },
+            };
+            let topic = if key == "commands" {
+                *notices = Some(s.notices.subscribe());
+                Topic::Commands
+            } else if key == "system" {
+                Topic::System
+            } else if let Some(axis) = key
+                .strip_prefix("axes/")
+                .and_then(|r| r.strip_suffix("/status"))
+            {
+                let reg = s.registry.read().unwrap();
+                match reg.find(axis) {
+                    Some(e) => Topic::Axis {
+                        slot: e.slot,
+                        name: e.name.clone(),
+                    },
+                    None => {
+                        return Some(rpc_error(&id, -32602, &format!("no axis '{axis}'"), None));
+                    }
+                }
+            } else {
+                return Some(rpc_error(
+                    &id,
+                    -32602,
+                    "unknown topic (axes/{axis}/status, commands, system)",
+                    None,
+                ));
+            };
+            let canonical = match &topic {
+                Topic::Axis { name, .. } => format!("axes/{name}/status"),
+                _ => key.clone(),
+            };
+            subs.retain(|x| x.key != canonical && x.key != key);
+            subs.push(Sub {
+                key: key.clone(),
+                topic,
+                every: Duration::from_secs_f64(1.0 / rate),
+                due: Instant::now(),
+                last: None,
+            });
+            Some(rpc_result(&id, json!({"topic": key, "rate_hz": rate})))
+        }
+        "unsubscribe" => {
+            let key = params
+                .get("topic")
+                .and_then(|t| t.as_str())
+                .unwrap_or_default()
+                .to_string();
+            let before = subs.len();
+            subs.retain(|x| x.key != key);
+            if key == "commands" {
+                *notices = None;
+            }
+            Some(rpc_result(
+                &id,
+                json!(before != subs.len() || key == "commands"),
+            ))
+        }
+        "keepalive" | "release" => {
+            let Some(cmd) = params.get("command").and_then(|c| c.as_u64()) else {
+                return Some(rpc_error(&id, -32602, "command (id) is required", None));
+            };
+            let s = s.clone();
+            let out = out_tx.clone();
+            tokio::spawn(async move {
+                let slot = s.commands.lock().unwrap().map.get(&cmd).map(|r| r.slot);
+                let msg = match slot {
+                    None => api_error(&id, ApiError::not_found("command", &cmd.to_string())),
+                    Some(slot) => {
+                        let kind = if method == "keepalive" {
+                            motion::CommandKind::Keepalive { target: cmd }
+                        } else {
+                            motion::CommandKind::Release { target: cmd }
+                        };
+                        match s.kernel_command(slot, kind).await {
+                            Ok(Ok(cycle)) => {
+                                rpc_result(&id, json!({"command": cmd, "cycle": cycle}))
+                            }
+                            Ok(Err(e)) => api_error(&id, ApiError::rejected(e)),
+                            Err(e) => api_error(&id, e),
+                        }
+                    }
+                };
+                let _ = out.send(msg).await;
+            });
+            None
+        }
+        name => {
+            let Some(name) = COMMANDS.iter().copied().find(|c| *c == name) else {
+                return Some(rpc_error(
+                    &id,
+                    -32601,
+                    &format!("method not found: {name}"),
+                    None,
+                ));
+            };
+            let axis = match params.remove("axis") {
+                Some(Value::String(a)) => a,
+                Some(Value::Number(n)) => n.to_string(),
+                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            };
+            let wait = match (params.remove("wait"), params.remove("timeout_ms")) {
+                (Some(Value::Bool(true)), t) => Some(Duration::from_millis(
+                    t.and_then(|t| t.as_u64()).unwrap_or(10_000).min(600_000),
+                )),
+                _ => None,
+            };
+            let s = s.clone();
+            let out = out_tx.clone();
+            let client = client.clone();
+            let jogs = jogs.clone();
+            tokio::spawn(async move {
+                let raw = Value::Object(params);
+                let r = dispatch(&s, name, &axis, raw, client, wait).await;
+                let msg = match r {
+                    Ok(v) => {
+                        if name == "jog" {
+                            let slot = s.registry.read().unwrap().find(&axis).map(|e| e.slot);
+                            if let Some(slot) = slot {
+                                jogs.lock().unwrap().push((slot, v.id));
+                            }
+                        }
+                        rpc_result(&id, serde_json::to_value(v).unwrap_or_default())
+                    }
+                    Err(e) => api_error(&id, e),
+                };
+                let _ = out.send(msg).await;
+            });
+            None
+        }
+    }
+}
+
+pub const COMMANDS: &[&str] = &[
+    "power",
+    "reset",
+    "set-position",
+    "set-override",
+    "move-absolute",
+    "move-relative",
+    "move-additive",
+    "move-modulo",
+    "move-velocity",
+    "move-continuous-absolute",
+    "move-continuous-relative",
+    "halt",
+    "stop",
+    "jog",
+    "home",
+    "gear-in",
+    "gear-out",
+];
+
+async fn typed<B: CommandBody>(
+    s: &AppState,
+    name: &'static str,
+    axis: &str,
+    raw: Value,
+    client: ClientInfo,
+    wait: Option<Duration>,
+) -> Result<CommandResource, ApiError> {
+    let body: B = serde_json::from_value(raw.clone())
+        .map_err(|e| ApiError::field("params", &e.to_string()))?;
+    run_command(s, axis, name, body, raw, client, wait).await
+}
+
+async fn dispatch(
+    s: &AppState,
+    name: &'static str,
+    axis: &str,
+    raw: Value,
+    client: ClientInfo,
+    wait: Option<Duration>,
+) -> Result<CommandResource, ApiError> {
+    match name {
+        "power" => typed::<PowerBody>(s, name, axis, raw, client, wait).await,
+        "reset" | "gear-out" => typed::<EmptyBody>(s, name, axis, raw, client, wait).await,
+        "set-position" => typed::<SetPositionBody>(s, name, axis, raw, client, wait).await,
+        "set-override" => typed::<SetOverrideBody>(s, name, axis, raw, client, wait).await,
+        "move-absolute" | "move-relative" | "move-additive" | "move-modulo" => {
+            typed::<MoveBody>(s, name, axis, raw, client, wait).await
+        }
+        "move-velocity" => typed::<MoveVelocityBody>(s, name, axis, raw, client, wait).await,
+        "move-continuous-absolute" | "move-continuous-relative" => {
+            typed::<MoveContinuousBody>(s, name, axis, raw, client, wait).await
+        }
+        "halt" => typed::<HaltBody>(s, name, axis, raw, client, wait).await,
+        "stop" => typed::<StopBody>(s, name, axis, raw, client, wait).await,
+        "jog" => typed::<JogBody>(s, name, axis, raw, client, wait).await,
+        "home" => typed::<HomeBody>(s, name, axis, raw, client, wait).await,
+        "gear-in" => typed::<GearInBody>(s, name, axis, raw, client, wait).await,
+        _ => Err(ApiError::not_found("method", name)),
+    }
+}

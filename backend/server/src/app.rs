@@ -1,0 +1,566 @@
+//! The async side's shared state: axis registry, command tracking, the pump that drains the
+//! cycle thread's queues, the audit writer.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::{Arc, Mutex, RwLock};
+use std::time::{Duration, Instant};
+
+use motion::{
+    Axis, AxisConfig, AxisParameters, AxisSlot, AxisStatus, Command, CommandEvent, CommandId,
+    CommandKind, ErrorId, FbOutputs,
+};
+use serde::Serialize;
+use sqlx::SqlitePool;
+use tokio::sync::{broadcast, mpsc, oneshot};
+
+use crate::cycle::{MAX_AXES, RealtimeGrant, Reply, Request, Shared, Snapshot};
+use crate::error::{ApiError, ApiResult};
+use crate::model::{AxisConfigDto, ClientInfo, CommandEventDto, CommandResource, CommandState};
+use crate::params::{self, ParamValue};
+use crate::sim::{FieldError, SimDrive};
+use crate::store::{self, AuditEntry};
+
+/// How many commands `GET /commands` remembers.
+pub const HISTORY: usize = 2000;
+const EVENTS_PER_COMMAND: usize = 64;
+/// How long the async side waits for the cycle thread's verdict.
+const VERDICT_TIMEOUT: Duration = Duration::from_secs(2);
+
+pub struct AxisEntry {
+    pub id: i64,
+    pub name: String,
+    pub slot: AxisSlot,
+    pub config: AxisConfigDto,
+    /// Mirror of the parameters active in the kernel (base + persistent + runtime writes).
+    pub params: AxisParameters,
+    /// The persistent overlay.
+    pub persistent: BTreeMap<u16, ParamValue>,
+}
+
+#[derive(Default)]
+pub struct Registry {
+    pub axes: BTreeMap<i64, AxisEntry>,
+}
+
+impl Registry {
+    /// By id (all digits) or by name.
+    pub fn find(&self, key: &str) -> Option<&AxisEntry> {
+        match key.parse::<i64>() {
+            Ok(id) => self.axes.get(&id),
+            Err(_) => self.axes.values().find(|a| a.name == key),
+        }
+    }
+    pub fn find_mut(&mut self, key: &str) -> Option<&mut AxisEntry> {
+        match key.parse::<i64>() {
+            Ok(id) => self.axes.get_mut(&id),
+            Err(_) => self.axes.values_mut().find(|a| a.name == key),
+        }
+    }
+    pub fn by_slot(&self, slot: AxisSlot) -> Option<&AxisEntry> {
+        self.axes.values().find(|a| a.slot == slot)
+    }
+    pub fn free_slot(&self) -> Option<AxisSlot> {
+        (0..MAX_AXES as AxisSlot).find(|s| self.axes.values().all(|a| a.slot != *s))
+    }
+}
+
+pub struct CommandRecord {
+    pub id: CommandId,
+    pub axis_id: i64,
+    pub axis_name: String,
+    pub slot: AxisSlot,
+    pub name: &'static str,
+    pub parameters: serde_json::Value,
+    pub client: ClientInfo,
+    pub submitted_at: String,
+    pub accepted: bool,
+    pub accepted_cycle: u64,
+    pub outputs: FbOutputs,
+    pub last_cycle: u64,
+    pub finished_at: Option<String>,
+    pub events: VecDeque<CommandEventDto>,
+}
+
+impl CommandRecord {
+    pub fn is_final(&self) -> bool {
+        !self.outputs.busy && !self.events.is_empty()
+    }
+    pub fn view(&self) -> CommandResource {
+        let o = &self.outputs;
+        CommandResource {
+            id: self.id,
+            axis: self.axis_name.clone(),
+            axis_id: self.axis_id,
+            command: self.name,
+            parameters: self.parameters.clone(),
+            state: CommandState::of(o),
+            is_final: self.is_final(),
+            outputs: *o,
+            error_code: (o.error_id != 0).then(|| ErrorId(o.error_id).code()),
+            accepted_cycle: self.accepted_cycle,
+            last_cycle: self.last_cycle,
+            submitted_at: self.submitted_at.clone(),
+            finished_at: self.finished_at.clone(),
+            client: self.client.clone(),
+            events: self.events.iter().copied().collect(),
+        }
+    }
+}
+
+#[derive(Default)]
+pub struct CommandStore {
+    pub map: HashMap<CommandId, CommandRecord>,
+    pub order: VecDeque<CommandId>,
+}
+
+impl CommandStore {
+    fn insert(&mut self, r: CommandRecord) {
+        while self.map.len() >= HISTORY {
+            // Forget the oldest finished command (or the oldest at all if none has finished).
+            let pos = self
+                .order
+                .iter()
+                .position(|id| self.map.get(id).is_none_or(|r| r.is_final()))
+                .unwrap_or(0);
+            if let Some(id) = self.order.remove(pos) {
+                self.map.remove(&id);
+            } else {
+                break;
+            }
+        }
+        self.order.push_back(r.id);
+        self.map.insert(r.id, r);
+    }
+    fn remove(&mut self, id: CommandId) {
+        if self.map.remove(&id).is_some() {
+            self.order.retain(|x| *x != id);
+        }
+    }
+}
+
+/// A change of a command's outputs, for websocket subscribers and waiters.
+#[derive(Clone, Debug, Serialize)]
+pub struct CommandNotice {
+    pub command: CommandId,
+    pub axis: String,
+    pub name: &'static str,
+    pub cycle: u64,
+    pub state: CommandState,
+    #[serde(rename = "final")]
+    pub is_final: bool,
+    pub outputs: FbOutputs,
+}
+
+pub struct SystemInfo {
+    pub version: &'static str,
+    pub cycle_time_s: f64,
+    pub listen: String,
+    pub db: String,
+    pub realtime: RealtimeGrant,
+    pub started: Instant,
+}
+
+pub struct AppState {
+    pub shared: Arc<Shared>,
+    snapshot: Mutex<triple_buffer::Output<Snapshot>>,
+    pub registry: RwLock<Registry>,
+    /// Serialises configuration changes (axes, parameters, import).
+    pub config_lock: tokio::sync::Mutex<()>,
+    pub commands: Mutex<CommandStore>,
+    pending: Mutex<HashMap<u64, oneshot::Sender<Reply>>>,
+    pub notices: broadcast::Sender<Arc<CommandNotice>>,
+    next_id: AtomicU64,
+    pub db: SqlitePool,
+    audit_tx: mpsc::Sender<AuditEntry>,
+    pub audit_dropped: AtomicU64,
+    pub info: SystemInfo,
+}
+
+impl AppState {
+    pub fn new(
+        shared: Arc<Shared>,
+        snapshot: triple_buffer::Output<Snapshot>,
+        db: SqlitePool,
+        first_command_id: u64,
+        info: SystemInfo,
+    ) -> (Arc<AppState>, mpsc::Receiver<AuditEntry>) {
+        let (audit_tx, audit_rx) = mpsc::channel(8192);
+        let state = AppState {
+            shared,
+            snapshot: Mutex::new(snapshot),
+            registry: RwLock::new(Registry::default()),
+            config_lock: tokio::sync::Mutex::new(()),
+            commands: Mutex::new(CommandStore::default()),
+            pending: Mutex::new(HashMap::new()),
+            notices: broadcast::channel(4096).0,
+            next_id: AtomicU64::new(first_command_id.max(1)),
+            db,
+            audit_tx,
+            audit_dropped: AtomicU64::new(0),
+            info,
+        };
+        (Arc::new(state), audit_rx)
+    }
+
+    pub fn next_id(&self) -> u64 {
+        self.next_id.fetch_add(1, Relaxed)
+    }
+
+    /// The latest published snapshot: its cycle and the status of one slot.
+    pub fn status(&self, slot: AxisSlot) -> (u64, Option<AxisStatus>) {
+        let mut out = self.snapshot.lock().unwrap();
+        let s = out.read();
+        (s.cycle, s.axes.get(slot as usize).copied().flatten())
+    }
+
+    pub fn with_snapshot<R>(&self, f: impl FnOnce(&Snapshot) -> R) -> R {
+        let mut out = self.snapshot.lock().unwrap();
+        f(out.read())
+    }
+
+    /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
+    pub fn drain(&self) {
+        while let Some(r) = self.shared.replies.pop() {
+            if let Some(tx) = self.pending.lock().unwrap().remove(&r.ticket) {
+                let _ = tx.send(r);
+            }
+        }
+        let mut notices = Vec::new();
+        {
+            let mut store = self.commands.lock().unwrap();
+            while let Some(ev) = self.shared.events.pop() {
+                if let Some(n) = apply_event(&mut store, &ev) {
+                    notices.push(n);
+                }
+            }
+        }
+        for n in notices {
+            if n.is_final {
+                self.audit(AuditEntry {
+                    at: store::now_rfc3339(),
+                    action: "command.final".into(),
+                    target: Some(n.axis.clone()),
+                    command_id: Some(n.command),
+                    detail: serde_json::to_string(&n).unwrap_or_default(),
+                    outcome: Some(match n.state {
+                        CommandState::Error => {
+                            format!("error:{}", ErrorId(n.outputs.error_id).code())
+                        }
+                        s => serde_json::to_value(s)
+                            .ok()
+                            .and_then(|v| v.as_str().map(String::from))
+                            .unwrap_or_default(),
+                    }),
+                    ..Default::default()
+                });
+            }
+            let _ = self.notices.send(Arc::new(n));
+        }
+        while let Some(g) = self.shared.garbage.pop() {
+            drop(g);
+        }
+    }
+
+    /// Queues an audit entry for the batching writer (motion commands are not delayed by the
+    /// disk; configuration changes write their audit row in their own transaction instead).
+    pub fn audit(&self, e: AuditEntry) {
+        if self.audit_tx.try_send(e).is_err() {
+            self.audit_dropped.fetch_add(1, Relaxed);
+        }
+    }
+
+    async fn request(&self, ticket: u64, req: Request) -> ApiResult<Reply> {
+        let (tx, rx) = oneshot::channel();
+        self.pending.lock().unwrap().insert(ticket, tx);
+        if self.shared.requests.push(req).is_err() {
+            self.pending.lock().unwrap().remove(&ticket);
+            return Err(ApiError::unavailable(
+                "command_queue_full",
+                "the command queue to the cycle thread is full; try again",
+            ));
+        }
+        match tokio::time::timeout(VERDICT_TIMEOUT, rx).await {
+            Ok(Ok(r)) => Ok(r),
+            _ => {
+                self.pending.lock().unwrap().remove(&ticket);
+                Err(ApiError::unavailable(
+                    "cycle_unavailable",
+                    "the cycle thread did not answer",
+                ))
+            }
+        }
+    }
+
+    /// Sends a kernel command and waits for its verdict (not tracked as a command resource).
+    pub async fn kernel_command(
+        &self,
+        slot: AxisSlot,
+        kind: CommandKind,
+    ) -> ApiResult<Result<u64, ErrorId>> {
+        let id = self.next_id();
+        let r = self
+            .request(
+                id,
+                Request::Command(Command {
+                    id,
+                    axis: slot,
+                    kind,
+                }),
+            )
+            .await?;
+        Ok(r.result.map(|_| r.cycle))
+    }
+
+    /// Hands a ready axis to the cycle thread.
+    pub async fn install_axis(
+        &self,
+        slot: AxisSlot,
+        axis: Box<Axis>,
+        drive: Box<SimDrive>,
+        require_disabled: bool,
+    ) -> ApiResult<Result<(), ErrorId>> {
+        let ticket = self.next_id();
+        let r = self
+            .request(
+                ticket,
+                Request::InsertAxis {
+                    ticket,
+                    slot,
+                    axis,
+                    drive,
+                    require_disabled,
+                },
+            )
+            .await?;
+        Ok(r.result)
+    }
+
+    pub async fn uninstall_axis(
+        &self,
+        slot: AxisSlot,
+        require_disabled: bool,
+    ) -> ApiResult<Result<(), ErrorId>> {
+        let ticket = self.next_id();
+        let r = self
+            .request(
+                ticket,
+                Request::RemoveAxis {
+                    ticket,
+                    slot,
+                    require_disabled,
+                },
+            )
+            .await?;
+        Ok(r.result)
+    }
+
+    /// Builds the kernel's axis and drive for a configuration plus its persistent overlay.
+    pub fn build_axis(
+        &self,
+        id: i64,
+        config: &AxisConfigDto,
+        persistent: &BTreeMap<u16, ParamValue>,
+    ) -> Result<(AxisParameters, Box<Axis>, Box<SimDrive>), Vec<FieldError>> {
+        let ct = self.info.cycle_time_s;
+        let mut p = config.to_parameters(id, ct)?;
+        for (n, v) in persistent {
+            if let Err(e) = params::set(&mut p, *n, *v) {
+                tracing::warn!(
+                    "axis {}: persistent parameter {n} not applied: {}",
+                    config.name,
+                    e.text()
+                );
+            }
+        }
+        let axis = Axis::new(
+            AxisConfig {
+                modulo: config.modulo.is_some(),
+                parameters: p.clone(),
+            },
+            ct,
+        );
+        let drive = Box::new(SimDrive::new(config.drive.clone(), ct));
+        Ok((p, axis, drive))
+    }
+
+    /// Submits a tracked command (REST or websocket). Returns its id once accepted.
+    pub async fn submit(
+        &self,
+        axis_key: &str,
+        name: &'static str,
+        parameters: serde_json::Value,
+        client: ClientInfo,
+        build: impl FnOnce(&Registry, &AxisEntry) -> ApiResult<CommandKind>,
+    ) -> ApiResult<CommandId> {
+        let (slot, axis_id, axis_name, kind) = {
+            let reg = self.registry.read().unwrap();
+            let e = reg
+                .find(axis_key)
+                .ok_or_else(|| ApiError::not_found("axis", axis_key))?;
+            (e.slot, e.id, e.name.clone(), build(&reg, e)?)
+        };
+        let id = self.next_id();
+        let submitted_at = store::now_rfc3339();
+        let audit = AuditEntry {
+            at: submitted_at.clone(),
+            client_addr: Some(client.addr.clone()),
+            client_id: client.id.clone(),
+            action: format!("command.{name}"),
+            target: Some(axis_name.clone()),
+            command_id: Some(id),
+            detail: parameters.to_string(),
+            outcome: None,
+        };
+        self.commands.lock().unwrap().insert(CommandRecord {
+            id,
+            axis_id,
+            axis_name,
+            slot,
+            name,
+            parameters,
+            client,
+            submitted_at,
+            accepted: false,
+            accepted_cycle: 0,
+            outputs: FbOutputs::default(),
+            last_cycle: 0,
+            finished_at: None,
+            events: VecDeque::new(),
+        });
+        let reply = match self
+            .request(
+                id,
+                Request::Command(Command {
+                    id,
+                    axis: slot,
+                    kind,
+                }),
+            )
+            .await
+        {
+            Ok(r) => r,
+            Err(e) => {
+                self.commands.lock().unwrap().remove(id);
+                return Err(e);
+            }
+        };
+        match reply.result {
+            Ok(()) => {
+                if let Some(r) = self.commands.lock().unwrap().map.get_mut(&id) {
+                    r.accepted = true;
+                    r.accepted_cycle = reply.cycle;
+                    if r.finished_at.is_none() && r.is_final() {
+                        r.finished_at = Some(store::now_rfc3339());
+                    }
+                }
+                self.audit(AuditEntry {
+                    outcome: Some("accepted".into()),
+                    ..audit
+                });
+                Ok(id)
+            }
+            Err(e) => {
+                self.commands.lock().unwrap().remove(id);
+                self.audit(AuditEntry {
+                    outcome: Some(format!("rejected:{}", e.code())),
+                    ..audit
+                });
+                Err(ApiError::rejected(e))
+            }
+        }
+    }
+
+    pub fn command(&self, id: CommandId) -> Option<CommandResource> {
+        self.commands
+            .lock()
+            .unwrap()
+            .map
+            .get(&id)
+            .filter(|r| r.accepted)
+            .map(|r| r.view())
+    }
+
+    /// Waits until the command is final or reaches its milestone, or the timeout.
+    pub async fn wait(&self, id: CommandId, timeout: Duration) -> Option<CommandResource> {
+        let deadline = tokio::time::Instant::now() + timeout;
+        let mut rx = self.notices.subscribe();
+        loop {
+            let v = self.command(id)?;
+            if v.is_final || milestone(&v) {
+                return Some(v);
+            }
+            match tokio::time::timeout_at(deadline, rx.recv()).await {
+                Err(_) => return self.command(id),
+                Ok(Err(broadcast::error::RecvError::Closed)) => return self.command(id),
+                Ok(_) => {}
+            }
+        }
+    }
+}
+
+/// The point where a `?wait=true` request returns for commands that stay busy.
+fn milestone(v: &CommandResource) -> bool {
+    let o = &v.outputs;
+    o.done
+        || o.error
+        || o.command_aborted
+        || o.in_velocity
+        || o.in_gear
+        || o.in_end_velocity
+        || (v.command == "power" && o.status)
+}
+
+fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option<CommandNotice> {
+    let r = store.map.get_mut(&ev.command)?;
+    r.outputs = ev.outputs;
+    r.last_cycle = ev.cycle;
+    if r.events.len() == EVENTS_PER_COMMAND {
+        r.events.pop_front();
+    }
+    r.events.push_back(CommandEventDto {
+        cycle: ev.cycle,
+        outputs: ev.outputs,
+    });
+    if r.is_final() && r.finished_at.is_none() {
+        r.finished_at = Some(store::now_rfc3339());
+    }
+    Some(CommandNotice {
+        command: r.id,
+        axis: r.axis_name.clone(),
+        name: r.name,
+        cycle: ev.cycle,
+        state: CommandState::of(&ev.outputs),
+        is_final: !ev.outputs.busy,
+        outputs: ev.outputs,
+    })
+}
+
+/// Drains the cycle thread's queues every millisecond.
+pub async fn pump(state: Arc<AppState>) {
+    let mut tick = tokio::time::interval(Duration::from_millis(1));
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    loop {
+        tick.tick().await;
+        state.drain();
+    }
+}
+
+/// Writes queued audit entries in batches, one transaction per batch.
+pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditEntry>) {
+    let mut batch = Vec::with_capacity(256);
+    while rx.recv_many(&mut batch, 256).await > 0 {
+        let result = async {
+            let mut tx = db.begin().await?;
+            for e in &batch {
+                store::audit(&mut *tx, e).await?;
+            }
+            tx.commit().await
+        }
+        .await;
+        if let Err(e) = result {
+            tracing::error!("audit log: {} entries not written: {e}", batch.len());
+        }
+        batch.clear();
+    }
+}

@@ -1,0 +1,396 @@
+//! The cycle thread (DESIGN §2): owns the kernel and the drives; talks to the async side only
+//! through bounded lock-free queues and a triple buffer.
+//!
+//! Inside the loop there is no allocation, no lock, no logging and no syscall except the
+//! timer (`clock_nanosleep` / `clock_gettime`). Axes are built off the thread and handed in as
+//! boxes; whatever they replace is handed back through `garbage` to be freed off the thread.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
+
+use crossbeam_queue::ArrayQueue;
+use motion::{
+    Axis, AxisSlot, AxisState, AxisStatus, Command, CommandEvent, DriveFeedback, DriveSetpoint,
+    ErrorId, EventSink, Kernel, Verdict,
+};
+
+use crate::sim::SimDrive;
+use crate::stats::CycleStats;
+
+/// Number of axis slots (fixed so that the cycle never allocates).
+pub const MAX_AXES: usize = 64;
+const COMMAND_QUEUE: usize = 1024;
+const REPLY_QUEUE: usize = 2048;
+const EVENT_RING: usize = 1 << 16;
+/// Commands taken from the queue per cycle at most, so a burst cannot overrun a cycle.
+const DRAIN_PER_CYCLE: usize = 64;
+
+/// What the async side asks of the cycle thread.
+pub enum Request {
+    Command(Command),
+    /// Put an axis (and its drive) into a slot; with `require_disabled`, only if the axis
+    /// there now is disabled (else the new boxes come back as garbage and the reply is an error).
+    InsertAxis {
+        ticket: u64,
+        slot: AxisSlot,
+        axis: Box<Axis>,
+        drive: Box<SimDrive>,
+        require_disabled: bool,
+    },
+    RemoveAxis {
+        ticket: u64,
+        slot: AxisSlot,
+        require_disabled: bool,
+    },
+}
+
+/// The cycle thread's answer to a request (`ticket` = command id for commands).
+#[derive(Clone, Copy, Debug)]
+pub struct Reply {
+    pub ticket: u64,
+    pub cycle: u64,
+    pub result: Result<(), ErrorId>,
+}
+
+pub enum Garbage {
+    Axis(#[allow(dead_code)] Box<Axis>),
+    Drive(#[allow(dead_code)] Box<SimDrive>),
+}
+
+/// Status of every slot at the end of one cycle.
+#[derive(Clone)]
+pub struct Snapshot {
+    pub cycle: u64,
+    pub axes: [Option<AxisStatus>; MAX_AXES],
+}
+
+impl Default for Snapshot {
+    fn default() -> Self {
+        Snapshot {
+            cycle: 0,
+            axes: [None; MAX_AXES],
+        }
+    }
+}
+
+/// The queues and counters shared by both sides.
+pub struct Shared {
+    pub requests: ArrayQueue<Request>,
+    pub replies: ArrayQueue<Reply>,
+    pub events: ArrayQueue<CommandEvent>,
+    pub garbage: ArrayQueue<Garbage>,
+    pub stats: CycleStats,
+    pub cycle: AtomicU64,
+    pub shutdown: AtomicBool,
+    pub period_ns: u64,
+}
+
+impl Shared {
+    pub fn new(period_ns: u64) -> Self {
+        Shared {
+            requests: ArrayQueue::new(COMMAND_QUEUE),
+            replies: ArrayQueue::new(REPLY_QUEUE),
+            events: ArrayQueue::new(EVENT_RING),
+            garbage: ArrayQueue::new(4 * MAX_AXES + COMMAND_QUEUE),
+            stats: CycleStats::default(),
+            cycle: AtomicU64::new(0),
+            shutdown: AtomicBool::new(false),
+            period_ns,
+        }
+    }
+}
+
+/// What real-time facilities the OS granted.
+#[derive(Clone, Debug, Default, serde::Serialize, utoipa::ToSchema)]
+pub struct RealtimeGrant {
+    pub sched_fifo: bool,
+    pub mlockall: bool,
+    /// CPU the cycle thread is pinned to, if pinning was granted.
+    pub pinned_cpu: Option<usize>,
+    /// Why something was refused (empty when all was granted).
+    pub notes: Vec<String>,
+}
+
+struct RingSink<'a> {
+    q: &'a ArrayQueue<CommandEvent>,
+    dropped: u64,
+}
+
+impl EventSink for RingSink<'_> {
+    fn push(&mut self, event: CommandEvent) {
+        if self.q.push(event).is_err() {
+            self.dropped += 1;
+        }
+    }
+}
+
+fn now_ns() -> u64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: valid pointer to a timespec; CLOCK_MONOTONIC always exists on Linux.
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+}
+
+fn sleep_until(deadline_ns: u64) {
+    let ts = libc::timespec {
+        tv_sec: (deadline_ns / 1_000_000_000) as libc::time_t,
+        tv_nsec: (deadline_ns % 1_000_000_000) as libc::c_long,
+    };
+    // SAFETY: valid timespec; an EINTR just makes us retry until the deadline has passed.
+    while unsafe {
+        libc::clock_nanosleep(
+            libc::CLOCK_MONOTONIC,
+            libc::TIMER_ABSTIME,
+            &ts,
+            std::ptr::null_mut(),
+        )
+    } == libc::EINTR
+    {}
+}
+
+/// Tries SCHED_FIFO, mlockall and pinning for the calling thread (done once, before the loop).
+pub fn request_realtime(priority: i32) -> RealtimeGrant {
+    let mut g = RealtimeGrant::default();
+    // SAFETY: plain libc calls on the current thread with valid arguments.
+    unsafe {
+        let param = libc::sched_param {
+            sched_priority: priority,
+        };
+        if libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) == 0 {
+            g.sched_fifo = true;
+        } else {
+            g.notes.push(format!(
+                "SCHED_FIFO refused: {}",
+                std::io::Error::last_os_error()
+            ));
+        }
+        if libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) == 0 {
+            g.mlockall = true;
+        } else {
+            g.notes.push(format!(
+                "mlockall refused: {}",
+                std::io::Error::last_os_error()
+            ));
+        }
+        let ncpu = libc::sysconf(libc::_SC_NPROCESSORS_ONLN).max(1) as usize;
+        // The last CPU: the async runtime's threads are not pinned and prefer the others.
+        let cpu = ncpu - 1;
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_SET(cpu, &mut set);
+        if ncpu > 1 && libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) == 0
+        {
+            g.pinned_cpu = Some(cpu);
+        } else if ncpu > 1 {
+            g.notes.push(format!(
+                "pinning refused: {}",
+                std::io::Error::last_os_error()
+            ));
+        } else {
+            g.notes.push("pinning skipped: one CPU".into());
+        }
+    }
+    g
+}
+
+/// The state the cycle thread owns.
+pub struct CycleThread {
+    pub kernel: Kernel,
+    pub drives: Vec<Option<Box<SimDrive>>>,
+    pub shared: Arc<Shared>,
+    pub snapshot: triple_buffer::Input<Snapshot>,
+}
+
+impl CycleThread {
+    pub fn new(
+        cycle_time_s: f64,
+        shared: Arc<Shared>,
+        snapshot: triple_buffer::Input<Snapshot>,
+    ) -> Self {
+        CycleThread {
+            kernel: Kernel::new(cycle_time_s, MAX_AXES),
+            drives: (0..MAX_AXES).map(|_| None).collect(),
+            shared,
+            snapshot,
+        }
+    }
+
+    /// Runs until `shared.shutdown` is set.
+    pub fn run(mut self) {
+        let shared = self.shared.clone();
+        let period = shared.period_ns;
+        let mut feedback = vec![DriveFeedback::default(); MAX_AXES];
+        let mut setpoints = vec![DriveSetpoint::default(); MAX_AXES];
+        let mut deadline = now_ns() + period;
+        let mut last_wake = 0u64;
+        while !shared.shutdown.load(Relaxed) {
+            sleep_until(deadline);
+            let woke = now_ns();
+            let stats = &shared.stats;
+            stats.wakeup_latency.record(woke.saturating_sub(deadline));
+            if last_wake != 0 {
+                stats.period.record(woke - last_wake);
+            }
+            last_wake = woke;
+
+            self.one_cycle(&mut feedback, &mut setpoints);
+
+            let end = now_ns();
+            stats.compute.record(end - woke);
+            stats.cycles.fetch_add(1, Relaxed);
+            deadline += period;
+            if end >= deadline {
+                // Late: skip the deadlines already passed (keeping the grid) and count them.
+                let missed = (end - deadline) / period + 1;
+                deadline += missed * period;
+                stats.overruns.fetch_add(missed, Relaxed);
+            }
+        }
+    }
+
+    /// One cycle without the timing: feedback, commands, kernel step, setpoints, publish.
+    pub fn one_cycle(&mut self, feedback: &mut [DriveFeedback], setpoints: &mut [DriveSetpoint]) {
+        let shared = &*self.shared;
+        for (fb, d) in feedback.iter_mut().zip(&self.drives) {
+            *fb = match d {
+                Some(d) => d.feedback(),
+                None => DriveFeedback::default(),
+            };
+        }
+        let mut sink = RingSink {
+            q: &shared.events,
+            dropped: 0,
+        };
+        let mut drained = 0;
+        while drained < DRAIN_PER_CYCLE {
+            let Some(req) = shared.requests.pop() else {
+                break;
+            };
+            drained += 1;
+            let cycle = self.kernel.cycle();
+            let reply = match req {
+                Request::Command(cmd) => {
+                    let result = match self.kernel.submit(cmd, &mut sink) {
+                        Verdict::Accepted => Ok(()),
+                        Verdict::Rejected(e) => Err(e),
+                    };
+                    Reply {
+                        ticket: cmd.id,
+                        cycle,
+                        result,
+                    }
+                }
+                Request::InsertAxis {
+                    ticket,
+                    slot,
+                    axis,
+                    drive,
+                    require_disabled,
+                } => {
+                    if require_disabled && !self.disabled(slot) {
+                        self.discard(Garbage::Axis(axis));
+                        self.discard(Garbage::Drive(drive));
+                        Reply {
+                            ticket,
+                            cycle,
+                            result: Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+                        }
+                    } else {
+                        match self.kernel.insert_axis(slot, axis) {
+                            Ok(old) => {
+                                if let Some(old) = old {
+                                    self.discard(Garbage::Axis(old));
+                                }
+                                if let Some(old) = self.drives[slot as usize].replace(drive) {
+                                    self.discard(Garbage::Drive(old));
+                                }
+                                Reply {
+                                    ticket,
+                                    cycle,
+                                    result: Ok(()),
+                                }
+                            }
+                            Err(axis) => {
+                                self.discard(Garbage::Axis(axis));
+                                self.discard(Garbage::Drive(drive));
+                                Reply {
+                                    ticket,
+                                    cycle,
+                                    result: Err(ErrorId::AXIS_UNKNOWN),
+                                }
+                            }
+                        }
+                    }
+                }
+                Request::RemoveAxis {
+                    ticket,
+                    slot,
+                    require_disabled,
+                } => {
+                    if require_disabled && !self.disabled(slot) {
+                        Reply {
+                            ticket,
+                            cycle,
+                            result: Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+                        }
+                    } else {
+                        if let Some(old) = self.kernel.remove_axis(slot) {
+                            self.discard(Garbage::Axis(old));
+                        }
+                        if let Some(old) = self.drives.get_mut(slot as usize).and_then(|d| d.take())
+                        {
+                            self.discard(Garbage::Drive(old));
+                        }
+                        Reply {
+                            ticket,
+                            cycle,
+                            result: Ok(()),
+                        }
+                    }
+                }
+            };
+            // The async side waits on every ticket; the reply queue is larger than the request
+            // queue, so this only fails if the async side has stopped draining.
+            let _ = shared.replies.push(reply);
+        }
+        shared
+            .stats
+            .commands_drained
+            .fetch_add(drained as u64, Relaxed);
+
+        self.kernel.step(feedback, setpoints, &mut sink);
+        for (d, sp) in self.drives.iter_mut().zip(setpoints.iter()) {
+            if let Some(d) = d {
+                d.apply(sp);
+            }
+        }
+        if sink.dropped > 0 {
+            shared.stats.events_dropped.fetch_add(sink.dropped, Relaxed);
+        }
+
+        let cycle = self.kernel.cycle();
+        let snap = self.snapshot.input_buffer_mut();
+        snap.cycle = cycle;
+        for (i, s) in snap.axes.iter_mut().enumerate() {
+            *s = self.kernel.status(i as AxisSlot);
+        }
+        self.snapshot.publish();
+        shared.cycle.store(cycle, Relaxed);
+    }
+
+    fn disabled(&self, slot: AxisSlot) -> bool {
+        match self.kernel.status(slot) {
+            Some(s) => s.state == AxisState::Disabled && !s.power_status,
+            None => true,
+        }
+    }
+
+    fn discard(&self, g: Garbage) {
+        if let Err(g) = self.shared.garbage.push(g) {
+            // Never free on the cycle thread: leak instead (cannot happen with the sizes above).
+            std::mem::forget(g);
+        }
+    }
+}

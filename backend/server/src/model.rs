@@ -1,0 +1,579 @@
+//! The API's data types (DTOs). Kernel enums and structs are reused, not mirrored.
+
+use std::collections::BTreeMap;
+
+use motion::{
+    AxisParameters, AxisState, BufferMode, Direction, Dynamics, FbOutputs, HomingMode,
+    HomingOptions, JogMode, MoveOptions,
+};
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::params::{self, ParamValue};
+use crate::sim::{FieldError, SimDriveConfig};
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+
+/// Modulo (rotary) axis: positions wrap at `period`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ModuloConfig {
+    /// Modulo period in axis units (#1044), e.g. 360.
+    #[schema(example = 360.0)]
+    pub period: f64,
+}
+
+/// Software end positions (#1016–#1019); both are enabled when present.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SoftLimits {
+    #[schema(example = 0.0)]
+    pub min: f64,
+    #[schema(example = 1000.0)]
+    pub max: f64,
+}
+
+/// Default dynamics of the axis (used when a command passes 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AxisDynamics {
+    /// #1003 AxisVeloMax, units/s.
+    #[schema(example = 500.0)]
+    pub max_velocity: f64,
+    /// #1004 AxisAcc, units/s².
+    #[schema(example = 2500.0)]
+    pub acceleration: f64,
+    /// #1005 AxisDec, units/s².
+    #[schema(example = 2500.0)]
+    pub deceleration: f64,
+    /// #1006 AxisJerk, units/s³.
+    #[schema(example = 25000.0)]
+    pub jerk: f64,
+    /// #1001 AxisVeloManSlow, units/s.
+    #[schema(example = 10.0)]
+    pub jog_velocity_slow: f64,
+    /// #1002 AxisVeloManFast, units/s.
+    #[schema(example = 100.0)]
+    pub jog_velocity_fast: f64,
+}
+
+/// The configuration of one axis (its base parameter set).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "name": "x", "unit": "mm", "soft_limits": {"min": 0.0, "max": 1000.0},
+    "dynamics": {"max_velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0, "jerk": 25000.0,
+                 "jog_velocity_slow": 10.0, "jog_velocity_fast": 100.0},
+    "parameters": {"AxisTargetPositionWindow": 0.01}, "drive": {}
+}))]
+pub struct AxisConfigDto {
+    /// Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64).
+    pub name: String,
+    /// Engineering unit of positions (mm, m, um, deg, rad, rev, in, inc).
+    pub unit: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modulo: Option<ModuloConfig>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub soft_limits: Option<SoftLimits>,
+    pub dynamics: AxisDynamics,
+    /// Further base values of MC_AxisParameter entries, by name (or number).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[schema(value_type = Object)]
+    pub parameters: BTreeMap<String, ParamValue>,
+    /// Model of the simulated drive.
+    #[serde(default)]
+    pub drive: SimDriveConfig,
+}
+
+pub const UNITS: &[&str] = &["mm", "m", "um", "deg", "rad", "rev", "in", "inc"];
+
+fn finite_positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+impl AxisConfigDto {
+    /// Checks everything and builds the kernel's parameter set.
+    pub fn to_parameters(
+        &self,
+        axis_id: i64,
+        cycle_time: f64,
+    ) -> Result<AxisParameters, Vec<FieldError>> {
+        let mut errs = Vec::new();
+        let mut err = |field: &str, message: &str| {
+            errs.push(FieldError {
+                field: field.into(),
+                message: message.into(),
+            })
+        };
+        let n = &self.name;
+        let name_ok = !n.is_empty()
+            && n.len() <= 64
+            && n.chars()
+                .next()
+                .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && n.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+        if !name_ok {
+            err(
+                "name",
+                "must start with a letter or '_' and contain only letters, digits, '_' or '-' (at most 64)",
+            );
+        }
+        if !UNITS.contains(&self.unit.as_str()) {
+            err("unit", &format!("must be one of {}", UNITS.join(", ")));
+        }
+        if let Some(m) = &self.modulo {
+            if !finite_positive(m.period) {
+                err("modulo.period", "must be a finite number > 0");
+            }
+        }
+        if let Some(l) = &self.soft_limits {
+            if !l.min.is_finite() || !l.max.is_finite() {
+                err("soft_limits", "limits must be finite numbers");
+            } else if l.min >= l.max {
+                err("soft_limits.min", "must be below soft_limits.max");
+            }
+            if self.modulo.is_some() {
+                err("soft_limits", "a modulo axis has no software end positions");
+            }
+        }
+        let d = &self.dynamics;
+        for (f, v) in [
+            ("dynamics.max_velocity", d.max_velocity),
+            ("dynamics.acceleration", d.acceleration),
+            ("dynamics.deceleration", d.deceleration),
+            ("dynamics.jerk", d.jerk),
+            ("dynamics.jog_velocity_slow", d.jog_velocity_slow),
+            ("dynamics.jog_velocity_fast", d.jog_velocity_fast),
+        ] {
+            if !finite_positive(v) {
+                err(f, "must be a finite number > 0");
+            }
+        }
+        if d.jog_velocity_slow > d.max_velocity {
+            err("dynamics.jog_velocity_slow", "must not exceed max_velocity");
+        }
+        if d.jog_velocity_fast > d.max_velocity {
+            err("dynamics.jog_velocity_fast", "must not exceed max_velocity");
+        }
+        if let Err(fe) = self.drive.validate() {
+            for e in fe {
+                errs.push(FieldError {
+                    field: format!("drive.{}", e.field),
+                    message: e.message,
+                });
+            }
+        }
+        let mut p = AxisParameters::default();
+        p.axis_id = axis_id as f64;
+        p.axis_cycle_time = cycle_time;
+        p.axis_velo_max = d.max_velocity;
+        p.axis_acc = d.acceleration;
+        p.axis_dec = d.deceleration;
+        p.axis_jerk = d.jerk;
+        p.axis_velo_man_slow = d.jog_velocity_slow;
+        p.axis_velo_man_fast = d.jog_velocity_fast;
+        p.axis_maximum_acceleration = p.axis_maximum_acceleration.max(d.acceleration);
+        p.axis_maximum_deceleration = p.axis_maximum_deceleration.max(d.deceleration);
+        p.axis_fast_dec = p.axis_fast_dec.max(d.deceleration);
+        p.axis_fast_acc = p.axis_fast_acc.max(d.acceleration);
+        p.axis_fast_jerk = p.axis_fast_jerk.max(d.jerk);
+        if let Some(m) = &self.modulo {
+            p.axis_encoder_modulo_value = m.period;
+        }
+        if let Some(l) = &self.soft_limits {
+            p.axis_en_min_soft_pos_limit = true;
+            p.axis_en_max_soft_pos_limit = true;
+            p.axis_min_soft_pos_limit = l.min;
+            p.axis_max_soft_pos_limit = l.max;
+        }
+        for (key, value) in &self.parameters {
+            let field = format!("parameters.{key}");
+            match params::lookup(key) {
+                None => errs.push(FieldError {
+                    field,
+                    message: "unknown parameter".into(),
+                }),
+                Some(info) => {
+                    if let Err(e) = params::set(&mut p, info.number, *value) {
+                        errs.push(FieldError {
+                            field,
+                            message: e.text().into(),
+                        });
+                    }
+                }
+            }
+        }
+        if errs.is_empty() {
+            if let Err(issue) = params::validate(&p) {
+                let name = params::by_number(issue.number).map_or("?", |i| i.name);
+                errs.push(FieldError {
+                    field: format!("parameters.{name}"),
+                    message: issue.message,
+                });
+            }
+        }
+        if errs.is_empty() { Ok(p) } else { Err(errs) }
+    }
+}
+
+/// An axis as the API shows it.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+pub struct AxisResource {
+    #[schema(example = 1)]
+    pub id: i64,
+    /// Kernel slot (diagnostics).
+    pub slot: u16,
+    pub state: AxisState,
+    pub config: AxisConfigDto,
+}
+
+/// The whole configuration (`GET/PUT /config`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigDocument {
+    /// Format version (1).
+    #[schema(example = 1)]
+    pub version: u32,
+    pub axes: Vec<ConfigAxis>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigAxis {
+    pub id: i64,
+    pub config: AxisConfigDto,
+    /// The persistent parameter overlay, by parameter name.
+    #[serde(default)]
+    #[schema(value_type = Object)]
+    pub persistent_parameters: BTreeMap<String, ParamValue>,
+}
+
+/// One MC_AxisParameter entry with its value on an axis.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+pub struct ParameterResource {
+    #[schema(example = 1003)]
+    pub number: u16,
+    #[schema(example = "AxisVeloMax")]
+    pub name: &'static str,
+    #[serde(rename = "type")]
+    pub ty: params::ParamType,
+    pub unit: &'static str,
+    pub group: &'static str,
+    pub read_only: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+    pub help: &'static str,
+    pub value: ParamValue,
+    /// The value of the persistent overlay, when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub persistent_value: Option<ParamValue>,
+}
+
+/// `PUT /axes/{axis}/parameters/{parameter}`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"value": 800.0, "persistent": true}))]
+pub struct ParameterWrite {
+    pub value: ParamValue,
+    /// MC_WriteParameterPersistent: kept across restarts until the axis is replaced.
+    #[serde(default)]
+    pub persistent: bool,
+}
+
+/// A command's life as the API shows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CommandState {
+    Busy,
+    Active,
+    Done,
+    Aborted,
+    Error,
+}
+
+impl CommandState {
+    pub fn of(o: &FbOutputs) -> Self {
+        if o.error {
+            CommandState::Error
+        } else if o.command_aborted {
+            CommandState::Aborted
+        } else if o.done || !o.busy {
+            CommandState::Done
+        } else if o.active {
+            CommandState::Active
+        } else {
+            CommandState::Busy
+        }
+    }
+}
+
+/// A change of a command's outputs.
+#[derive(Clone, Copy, Debug, Serialize, ToSchema)]
+pub struct CommandEventDto {
+    /// The kernel cycle it happened in.
+    pub cycle: u64,
+    pub outputs: FbOutputs,
+}
+
+/// Where a command came from.
+#[derive(Clone, Debug, Default, Serialize, ToSchema)]
+pub struct ClientInfo {
+    /// Remote address.
+    pub addr: String,
+    /// The `X-Client-Id` header, if sent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
+    /// `rest` or `websocket`.
+    pub via: &'static str,
+}
+
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "id": 42, "axis": "x", "axis_id": 1, "command": "move-absolute",
+    "parameters": {"position": 100.0, "velocity": 200.0},
+    "state": "done", "final": true,
+    "outputs": {"busy": false, "active": false, "done": true, "command_aborted": false, "error": false,
+                "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false},
+    "accepted_cycle": 1200, "last_cycle": 1873,
+    "submitted_at": "2025-01-01T12:00:00.000Z", "finished_at": "2025-01-01T12:00:00.673Z",
+    "client": {"addr": "127.0.0.1:50312", "via": "rest"},
+    "events": [{"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
+                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false}}]
+}))]
+pub struct CommandResource {
+    pub id: u64,
+    pub axis: String,
+    pub axis_id: i64,
+    /// kebab-case command name (the REST endpoint).
+    pub command: &'static str,
+    /// The request body as given.
+    #[schema(value_type = Object)]
+    pub parameters: serde_json::Value,
+    pub state: CommandState,
+    /// Busy has fallen: the outputs no longer change.
+    #[serde(rename = "final")]
+    pub is_final: bool,
+    pub outputs: FbOutputs,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_code: Option<&'static str>,
+    pub accepted_cycle: u64,
+    pub last_cycle: u64,
+    pub submitted_at: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finished_at: Option<String>,
+    pub client: ClientInfo,
+    /// Output changes in order (the most recent 64).
+    pub events: Vec<CommandEventDto>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Command bodies (one per function block). Fields follow the FB inputs; 0 dynamics = axis default.
+
+/// MC_Power.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(default, deny_unknown_fields)]
+#[schema(example = json!({"enable": true}))]
+pub struct PowerBody {
+    pub enable: bool,
+    pub enable_positive: bool,
+    pub enable_negative: bool,
+    /// Velocity override in percent (0–100).
+    pub override_percent: f64,
+}
+impl Default for PowerBody {
+    fn default() -> Self {
+        PowerBody {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+        }
+    }
+}
+
+/// MC_Reset (no inputs).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EmptyBody {}
+
+/// MC_SetPosition.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 0.0}))]
+pub struct SetPositionBody {
+    pub position: f64,
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub relative: bool,
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub clear_position_lag: bool,
+}
+
+/// MC_SetOverride.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"velocity_factor": 0.5}))]
+pub struct SetOverrideBody {
+    /// 0.0–1.0.
+    pub velocity_factor: f64,
+}
+
+/// MC_MoveAbsolute / MC_MoveModulo target, or MC_MoveRelative / MC_MoveAdditive distance.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 250.0, "velocity": 200.0}))]
+pub struct MoveBody {
+    /// Target position (absolute, modulo) or distance (relative, additive).
+    pub position: f64,
+    /// > 0, units/s.
+    pub velocity: f64,
+    #[serde(default)]
+    pub acceleration: f64,
+    #[serde(default)]
+    pub deceleration: f64,
+    #[serde(default)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+    /// MC_MoveModulo only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<Direction>,
+}
+
+/// MC_MoveContinuousAbsolute / MC_MoveContinuousRelative.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 500.0, "velocity": 200.0, "end_velocity": 50.0}))]
+pub struct MoveContinuousBody {
+    pub position: f64,
+    pub velocity: f64,
+    /// Velocity kept after the target (signed).
+    pub end_velocity: f64,
+    #[serde(default)]
+    pub acceleration: f64,
+    #[serde(default)]
+    pub deceleration: f64,
+    #[serde(default)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+}
+
+/// MC_MoveVelocity.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"velocity": 100.0, "direction": "positive"}))]
+pub struct MoveVelocityBody {
+    pub velocity: f64,
+    #[serde(default)]
+    pub acceleration: f64,
+    #[serde(default)]
+    pub deceleration: f64,
+    #[serde(default)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub direction: Direction,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+}
+
+/// MC_Halt.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct HaltBody {
+    /// 0 = that of the running job.
+    pub deceleration: f64,
+    pub jerk: f64,
+    pub buffer_mode: BufferMode,
+    pub options: MoveOptions,
+}
+
+/// MC_Stop.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct StopBody {
+    pub deceleration: f64,
+    pub jerk: f64,
+    pub options: MoveOptions,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum JogDirection {
+    #[default]
+    Forward,
+    Backward,
+}
+
+/// MC_Jog: a press of JogForward / JogBackwards; held by keepalives (dead-man).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(default, deny_unknown_fields)]
+#[schema(example = json!({"direction": "forward", "mode": "standard_slow", "deadman_timeout": 0.5}))]
+pub struct JogBody {
+    pub direction: JogDirection,
+    pub mode: JogMode,
+    /// Inching distance (inching modes).
+    pub position: f64,
+    /// Continuous mode velocity.
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
+    /// Seconds without keepalive after which the jog stops (0.05–10; default 0.5).
+    pub deadman_timeout: f64,
+}
+impl Default for JogBody {
+    fn default() -> Self {
+        JogBody {
+            direction: JogDirection::Forward,
+            mode: JogMode::StandardSlow,
+            position: 0.0,
+            velocity: 0.0,
+            acceleration: 0.0,
+            deceleration: 0.0,
+            jerk: 0.0,
+            deadman_timeout: 0.5,
+        }
+    }
+}
+
+/// MC_Home.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
+#[serde(default, deny_unknown_fields)]
+#[schema(example = json!({"mode": "direct", "position": 0.0}))]
+pub struct HomeBody {
+    /// None = the calibration value (#1075).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<f64>,
+    pub mode: HomingMode,
+    pub options: HomingOptions,
+}
+
+/// MC_GearIn.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "ratio_numerator": 1.0, "ratio_denominator": 1}))]
+pub struct GearInBody {
+    /// Master axis id or name.
+    pub master: String,
+    pub ratio_numerator: f64,
+    pub ratio_denominator: u16,
+}
+
+pub fn dynamics(acceleration: f64, deceleration: f64, jerk: f64) -> Dynamics {
+    Dynamics {
+        acceleration,
+        deceleration,
+        jerk,
+    }
+}

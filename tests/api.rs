@@ -1,0 +1,675 @@
+//! End-to-end tests of the `motiond` binary over HTTP (issue 3, "How we will know").
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+use serde_json::{Value, json};
+
+const AXIS_CANNOT_BE_STARTED: u64 = 0x4B01;
+
+#[tokio::test(flavor = "multi_thread")]
+async fn demo_axes_exist() {
+    let s = Server::start();
+    let r = get(&s, "/api/v1/axes").await;
+    assert_eq!(r.status, 200);
+    let axes = r.json.as_array().unwrap();
+    let names: Vec<&str> = axes
+        .iter()
+        .map(|a| a["config"]["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["x", "y", "spindle"]);
+    let x = &axes[0]["config"];
+    assert_eq!(x["unit"], "mm");
+    assert_eq!(x["soft_limits"], json!({"min": 0.0, "max": 1000.0}));
+    assert_eq!(axes[2]["config"]["modulo"]["period"], 360.0);
+    assert_eq!(axes[0]["state"], "disabled");
+    // by id and by name
+    let id = axes[1]["id"].as_i64().unwrap();
+    assert_eq!(
+        get(&s, &format!("/api/v1/axes/{id}")).await.json["config"]["name"],
+        "y"
+    );
+    assert_eq!(
+        get(&s, "/api/v1/axes/spindle").await.json["id"],
+        axes[2]["id"]
+    );
+    assert_problem(&get(&s, "/api/v1/axes/nope").await, 404, "axis_not_found");
+    let st = status(&s, "x").await;
+    assert_eq!(st["status"]["state"], "disabled");
+    assert!(st["cycle"].as_u64().unwrap() > 0);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn no_demo_gives_an_empty_machine() {
+    let s = Server::start_with(":memory:", &["--no-demo", "--cycle-us", "2000"]);
+    assert_eq!(get(&s, "/api/v1/axes").await.json, json!([]));
+    assert_eq!(get(&s, "/api/v1/system").await.json["cycle_time"], 0.002);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn power_and_move_absolute_with_wait_reaches_the_target() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 120.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let loc = r.location.clone().expect("Location header");
+    assert_eq!(loc, format!("/api/v1/commands/{}", r.json["id"]));
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(r.json["final"], true);
+    assert_eq!(r.json["outputs"]["done"], true);
+    let window = get(&s, "/api/v1/axes/x/parameters/AxisTargetPositionWindow")
+        .await
+        .json["value"]
+        .as_f64()
+        .unwrap();
+    let st = status(&s, "x").await;
+    let actual = st["status"]["actual_position"].as_f64().unwrap();
+    assert!(
+        (actual - 120.0).abs() <= window,
+        "actual {actual} not within {window} of 120"
+    );
+    assert_eq!(st["status"]["state"], "standstill");
+    // the resource is kept and listed
+    let c = get(&s, &loc).await;
+    assert_eq!(c.json["state"], "done");
+    let list = get(&s, "/api/v1/commands?axis=x&state=done").await;
+    assert!(
+        list.json
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c["id"] == r.json["id"]),
+        "{}",
+        list.text
+    );
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn move_on_a_disabled_axis_is_409_with_the_plcopen_error_id() {
+    let s = Server::start();
+    let r = post(
+        &s,
+        "/api/v1/axes/y/move-absolute",
+        json!({"position": 10.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    assert_eq!(r.json["error_id"].as_u64(), Some(AXIS_CANNOT_BE_STARTED));
+    // a rejected command leaves no resource
+    assert_eq!(get(&s, "/api/v1/commands?axis=y").await.json, json!([]));
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn invalid_requests_are_problems_and_keep_no_command() {
+    let s = Server::start();
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 10.0, "velocity": -5.0}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "velocity");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": "far", "velocity": 5.0}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 1.0, "velocity": 5.0, "speed": 3}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("speed"),
+        "{}",
+        r.text
+    );
+    let r = post(&s, "/api/v1/axes/x/move-absolute", json!({"velocity": 5.0})).await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = req(
+        reqwest::Method::POST,
+        &s.url("/api/v1/axes/x/move-absolute"),
+        None,
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    let client = reqwest::Client::new();
+    let raw = client
+        .post(s.url("/api/v1/axes/x/move-absolute"))
+        .body("{\"position\": 1,")
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(raw.status().as_u16(), 400);
+    assert_eq!(raw.headers()["content-type"], "application/problem+json");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=maybe",
+        json!({"position": 1.0, "velocity": 5.0}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = post(&s, "/api/v1/axes/x/jog", json!({"deadman_timeout": 0.0})).await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/gear-in",
+        json!({"master": "nobody", "ratio_numerator": 1.0, "ratio_denominator": 1}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = post(
+        &s,
+        "/api/v1/axes/z/move-absolute",
+        json!({"position": 1.0, "velocity": 5.0}),
+    )
+    .await;
+    assert_problem(&r, 404, "axis_not_found");
+    assert_problem(
+        &get(&s, "/api/v1/commands/12345").await,
+        404,
+        "command_not_found",
+    );
+    assert_problem(
+        &get(&s, "/api/v1/nothing-here").await,
+        404,
+        "route_not_found",
+    );
+    assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
+    // the server is still fine
+    assert_eq!(get(&s, "/api/v1/system").await.status, 200);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn stop_locks_the_axis_until_released() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let mv = post(
+        &s,
+        "/api/v1/axes/y/move-velocity",
+        json!({"velocity": 50.0}),
+    )
+    .await;
+    assert_eq!(mv.status, 202, "{}", mv.text);
+    let stop = post(
+        &s,
+        "/api/v1/axes/y/stop?wait=true&timeout_ms=10000",
+        json!({}),
+    )
+    .await;
+    assert_eq!(stop.status, 202, "{}", stop.text);
+    assert_eq!(stop.json["outputs"]["done"], true, "{}", stop.text);
+    assert_eq!(
+        stop.json["outputs"]["busy"], true,
+        "a stop holds the lock: {}",
+        stop.text
+    );
+    let mv_after = get(&s, &format!("/api/v1/commands/{}", mv.json["id"])).await;
+    assert_eq!(mv_after.json["state"], "aborted", "{}", mv_after.text);
+    assert_eq!(
+        status(&s, "y").await["status"]["motion_commands_locked"],
+        true
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/y/move-relative",
+        json!({"position": 5.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    assert_eq!(r.json["error_id"].as_u64(), Some(AXIS_CANNOT_BE_STARTED));
+    let rel = delete(&s, &format!("/api/v1/commands/{}", stop.json["id"])).await;
+    assert_eq!(rel.status, 200, "{}", rel.text);
+    let stop_final = until_final(&s, stop.json["id"].as_u64().unwrap(), 5).await;
+    assert_eq!(stop_final["outputs"]["busy"], false);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/move-relative?wait=true",
+        json!({"position": 5.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+}
+
+/// The first event (after acceptance) where the jog no longer runs: stopped by the kernel.
+fn jog_end_cycle(cmd: &Value) -> u64 {
+    let accepted = cmd["accepted_cycle"].as_u64().unwrap();
+    cmd["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| {
+            e["cycle"].as_u64().unwrap() > accepted
+                && (e["outputs"]["error"] == true
+                    || e["outputs"]["active"] == false
+                    || e["outputs"]["busy"] == false)
+        })
+        .map(|e| e["cycle"].as_u64().unwrap())
+        .unwrap_or_else(|| panic!("no end event: {cmd}"))
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_jog_without_keepalive_stops_within_deadman_plus_one_cycle() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let deadman = 0.2; // s; cycle 1 ms → 200 cycles
+    let jog = post(
+        &s,
+        "/api/v1/axes/y/jog",
+        json!({"direction": "forward", "mode": "standard_fast", "deadman_timeout": deadman}),
+    )
+    .await;
+    assert_eq!(jog.status, 202, "{}", jog.text);
+    let id = jog.json["id"].as_u64().unwrap();
+    let fin = until_final(&s, id, 10).await;
+    let accepted = fin["accepted_cycle"].as_u64().unwrap();
+    let end = jog_end_cycle(&fin);
+    let limit = accepted + (deadman / 0.001).round() as u64 + 1;
+    assert!(
+        end <= limit,
+        "jog ended at cycle {end}, accepted at {accepted}, limit {limit}: {fin}"
+    );
+    assert!(
+        end + 5 >= accepted + (deadman / 0.001).round() as u64,
+        "jog ended too early ({end}): {fin}"
+    );
+    // and the axis comes to rest
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    loop {
+        let st = status(&s, "y").await;
+        if st["status"]["moving"] == false {
+            break;
+        }
+        assert!(std::time::Instant::now() < deadline, "y still moving: {st}");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_jog_with_keepalives_keeps_running_until_released() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let jog = post(
+        &s,
+        "/api/v1/axes/y/jog",
+        json!({"direction": "backward", "deadman_timeout": 0.5}),
+    )
+    .await;
+    assert_eq!(jog.status, 202, "{}", jog.text);
+    let id = jog.json["id"].as_u64().unwrap();
+    for _ in 0..25 {
+        let k = post(&s, &format!("/api/v1/commands/{id}/keepalive"), json!({})).await;
+        assert_eq!(k.status, 204, "{}", k.text);
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let c = get(&s, &format!("/api/v1/commands/{id}")).await;
+    assert_eq!(c.json["final"], false, "renewed jog stopped: {}", c.text);
+    assert!(
+        status(&s, "y").await["status"]["actual_position"]
+            .as_f64()
+            .unwrap()
+            < 0.0
+    );
+    assert_eq!(
+        delete(&s, &format!("/api/v1/commands/{id}")).await.status,
+        200
+    );
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["outputs"]["error"], false, "{fin}");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn persistent_parameters_survive_a_restart_and_others_do_not() {
+    let dir = temp_dir();
+    let db = dir.join("m.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    let r = put(
+        &s,
+        "/api/v1/axes/x/parameters/AxisVeloMax",
+        json!({"value": 800.0, "persistent": true}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["value"], 800.0);
+    assert_eq!(r.json["persistent_value"], 800.0);
+    let r = put(
+        &s,
+        "/api/v1/axes/y/parameters/1004",
+        json!({"value": 3000.0}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(
+        get(&s, "/api/v1/axes/y/parameters/AxisAcc").await.json["value"],
+        3000.0
+    );
+    let r = put(
+        &s,
+        "/api/v1/axes/y/parameters/AxisAcc",
+        json!({"value": -1.0}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = put(
+        &s,
+        "/api/v1/axes/y/parameters/AxisAcc",
+        json!({"value": true}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert_problem(
+        &put(
+            &s,
+            "/api/v1/axes/y/parameters/NoSuchThing",
+            json!({"value": 1.0}),
+        )
+        .await,
+        404,
+        "parameter_not_found",
+    );
+    let list = get(&s, "/api/v1/axes/x/parameters").await;
+    assert!(
+        list.json
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p["number"] == 1003 && p["value"] == 800.0)
+    );
+    s.stop(); // SIGKILL: what was reported as written must be on disk
+
+    let s = Server::start_with(db, &[]);
+    assert!(
+        !s.log.lock().unwrap().iter().any(|l| l.contains("demo")),
+        "demo created again"
+    );
+    let v = get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await;
+    assert_eq!(v.json["value"], 800.0, "{}", v.text);
+    assert_eq!(v.json["persistent_value"], 800.0);
+    assert_eq!(
+        get(&s, "/api/v1/axes/y/parameters/AxisAcc").await.json["value"],
+        2500.0
+    );
+    // replacing the axis configuration drops the persistent overlay
+    let cfg = get(&s, "/api/v1/axes/x").await.json["config"].clone();
+    let r = put(&s, "/api/v1/axes/x", cfg).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let v = get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await;
+    assert_eq!(v.json["value"], 500.0, "{}", v.text);
+    assert!(v.json.get("persistent_value").is_none());
+    s.stop();
+    let s = Server::start_with(db, &[]);
+    assert_eq!(
+        get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await.json["value"],
+        500.0
+    );
+    drop(s);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn export_import_round_trips() {
+    let s = Server::start();
+    assert_eq!(
+        put(
+            &s,
+            "/api/v1/axes/spindle/parameters/AxisVeloManFast",
+            json!({"value": 360.0, "persistent": true})
+        )
+        .await
+        .status,
+        200
+    );
+    let a = get(&s, "/api/v1/config").await;
+    assert_eq!(a.status, 200);
+    assert_eq!(
+        a.json["axes"][2]["persistent_parameters"],
+        json!({"AxisVeloManFast": 360.0})
+    );
+    let r = put(&s, "/api/v1/config", a.json.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let b = get(&s, "/api/v1/config").await;
+    assert_eq!(a.text, b.text, "export → import → export differs");
+    assert_eq!(
+        get(&s, "/api/v1/axes/spindle/parameters/AxisVeloManFast")
+            .await
+            .json["value"],
+        360.0
+    );
+
+    // an invalid document changes nothing
+    let mut bad = a.json.clone();
+    bad["axes"][1]["config"]["name"] = json!("x");
+    bad["axes"][0]["config"]["dynamics"]["jerk"] = json!(0.0);
+    let r = put(&s, "/api/v1/config", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert!(
+        r.json["errors"].as_array().unwrap().len() >= 2,
+        "{}",
+        r.text
+    );
+    assert_eq!(get(&s, "/api/v1/config").await.text, a.text);
+
+    // a different document replaces the machine
+    let mut two = a.json.clone();
+    two["axes"].as_array_mut().unwrap().truncate(1);
+    two["axes"][0]["config"]["name"] = json!("portal");
+    let r = put(&s, "/api/v1/config", two).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let axes = get(&s, "/api/v1/axes").await.json;
+    assert_eq!(axes.as_array().unwrap().len(), 1);
+    assert_eq!(axes[0]["config"]["name"], "portal");
+
+    // not while an axis is enabled
+    power_on(&s, "portal").await;
+    let r = put(&s, "/api/v1/config", a.json.clone()).await;
+    assert_problem(&r, 409, "axis_not_disabled");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn axis_crud_with_validation_and_enabled_axes_protected() {
+    let s = Server::start();
+    let cfg = json!({"name": "z", "unit": "mm", "soft_limits": {"min": -10.0, "max": 200.0},
+        "dynamics": {"max_velocity": 100.0, "acceleration": 1000.0, "deceleration": 1000.0, "jerk": 10000.0,
+                     "jog_velocity_slow": 5.0, "jog_velocity_fast": 50.0}});
+    let r = post(&s, "/api/v1/axes", cfg.clone()).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(
+        r.location.as_deref(),
+        Some(format!("/api/v1/axes/{}", r.json["id"]).as_str())
+    );
+    assert_problem(
+        &post(&s, "/api/v1/axes", cfg.clone()).await,
+        409,
+        "axis_name_taken",
+    );
+    let mut bad = cfg.clone();
+    bad["name"] = json!("1bad name");
+    bad["unit"] = json!("furlong");
+    bad["modulo"] = json!({"period": -1.0});
+    bad["dynamics"]["jog_velocity_fast"] = json!(500.0);
+    bad["drive"] = json!({"lag_time_constant": -1.0});
+    let r = post(&s, "/api/v1/axes", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    let fields: Vec<&str> = r.json["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["field"].as_str().unwrap())
+        .collect();
+    for f in [
+        "name",
+        "unit",
+        "modulo.period",
+        "dynamics.jog_velocity_fast",
+    ] {
+        assert!(fields.contains(&f), "{f} not reported: {fields:?}");
+    }
+    assert!(fields.iter().any(|f| f.starts_with("drive.")), "{fields:?}");
+    let mut unknown = cfg.clone();
+    unknown["colour"] = json!("red");
+    assert_problem(
+        &post(&s, "/api/v1/axes", unknown).await,
+        422,
+        "validation_failed",
+    );
+    assert_eq!(
+        get(&s, "/api/v1/axes").await.json.as_array().unwrap().len(),
+        4
+    );
+
+    power_on(&s, "z").await;
+    let mut changed = cfg.clone();
+    changed["dynamics"]["max_velocity"] = json!(150.0);
+    assert_problem(
+        &put(&s, "/api/v1/axes/z", changed.clone()).await,
+        409,
+        "axis_not_disabled",
+    );
+    assert_problem(
+        &delete(&s, "/api/v1/axes/z").await,
+        409,
+        "axis_not_disabled",
+    );
+    let off = post(
+        &s,
+        "/api/v1/axes/z/power?wait=true",
+        json!({"enable": false}),
+    )
+    .await;
+    assert_eq!(off.status, 202, "{}", off.text);
+    let deadline = std::time::Instant::now() + Duration::from_secs(5);
+    while status(&s, "z").await["status"]["state"] != "disabled" {
+        assert!(std::time::Instant::now() < deadline);
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    let r = put(&s, "/api/v1/axes/z", changed).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["config"]["dynamics"]["max_velocity"], 150.0);
+    assert_eq!(
+        get(&s, "/api/v1/axes/z/parameters/1003").await.json["value"],
+        150.0
+    );
+    assert_eq!(delete(&s, "/api/v1/axes/z").await.status, 204);
+    assert_problem(&get(&s, "/api/v1/axes/z").await, 404, "axis_not_found");
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn system_and_metrics_report_cycle_timing() {
+    let s = Server::start();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let r = get(&s, "/api/v1/system").await;
+    assert_eq!(r.status, 200);
+    assert_eq!(r.json["cycle_time"], 0.001);
+    assert!(
+        r.json["timing"]["cycles"].as_u64().unwrap() > 100,
+        "{}",
+        r.text
+    );
+    assert!(
+        r.json["timing"]["wakeup_latency"]["count"]
+            .as_u64()
+            .unwrap()
+            > 100
+    );
+    assert!(r.json["realtime"]["sched_fifo"].is_boolean());
+    let m = get(&s, "/metrics").await;
+    assert_eq!(m.status, 200);
+    assert!(m.content_type.starts_with("text/plain"));
+    for name in [
+        "motiond_cycle_wakeup_latency_seconds_bucket",
+        "motiond_cycle_compute_seconds_count",
+        "motiond_cycle_overruns_total",
+        "motiond_cycles_total",
+    ] {
+        assert!(m.text.contains(name), "{name} missing");
+    }
+    let docs = get(&s, "/docs/").await;
+    assert_eq!(docs.status, 200);
+    assert!(docs.text.contains("swagger"), "{}", docs.text);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn start_up_refuses_what_it_cannot_do_safely() {
+    let out = bin()
+        .args(["--listen", "0.0.0.0:0", "--db", ":memory:"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(text.contains("authentication"), "{text}");
+
+    let out = bin()
+        .args(["--cycle-us", "100", "--db", ":memory:"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+
+    let dir = temp_dir();
+    let corrupt = dir.join("corrupt.db");
+    std::fs::write(&corrupt, vec![0x42u8; 8192]).unwrap();
+    let out = bin()
+        .args(["--listen", "127.0.0.1:0", "--db", corrupt.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(text.contains("corrupt.db"), "{text}");
+
+    let db = dir.join("locked.db");
+    let first = Server::start_with(db.to_str().unwrap(), &[]);
+    let out = bin()
+        .args(["--listen", "127.0.0.1:0", "--db", db.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(text.contains("locked"), "{text}");
+    drop(first);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn openapi_json_is_current() {
+    let out = bin().arg("openapi").output().unwrap();
+    assert!(out.status.success());
+    let generated = String::from_utf8(out.stdout).unwrap();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/openapi/openapi.json");
+    if std::env::var_os("UPDATE_OPENAPI").is_some() {
+        std::fs::write(path, &generated).unwrap();
+    }
+    let stored = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        stored == generated,
+        "openapi/openapi.json is stale: regenerate with `cargo run -- openapi > openapi/openapi.json` (or UPDATE_OPENAPI=1 cargo test --test api openapi)"
+    );
+    let doc: Value = serde_json::from_str(&generated).unwrap();
+    let paths = doc["paths"].as_object().unwrap();
+    for p in [
+        "/api/v1/axes",
+        "/api/v1/axes/{axis}/move-absolute",
+        "/api/v1/axes/{axis}/gear-out",
+        "/api/v1/commands/{id}/keepalive",
+        "/api/v1/config",
+        "/metrics",
+        "/api/v1/ws",
+    ] {
+        assert!(paths.contains_key(p), "{p} not documented");
+    }
+    assert_eq!(paths.len(), 29, "{:?}", paths.keys().collect::<Vec<_>>());
+    let s = Server::start();
+    assert_eq!(get(&s, "/openapi.json").await.json, doc);
+}

@@ -1,0 +1,215 @@
+//! Starts the real `motiond` binary on a free port with its own database.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use serde_json::{Value, json};
+
+pub struct Server {
+    pub child: Child,
+    pub base: String,
+    pub addr: String,
+    pub log: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+}
+
+static N: AtomicUsize = AtomicUsize::new(0);
+
+/// A fresh directory for one test's database files.
+pub fn temp_dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "motiond-test-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_motiond"))
+}
+
+impl Server {
+    /// Starts motiond with `--db db` (`:memory:` by default) on 127.0.0.1:0 and waits until it listens.
+    pub fn start_with(db: &str, extra: &[&str]) -> Server {
+        let mut cmd = bin();
+        cmd.args(["serve", "--listen", "127.0.0.1:0", "--db", db])
+            .args(extra);
+        cmd.stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .env("NO_COLOR", "1");
+        let mut child = cmd.spawn().expect("motiond starts");
+        let stdout = child.stdout.take().unwrap();
+        let stderr = child.stderr.take().unwrap();
+        let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let (tx, rx) = mpsc::channel();
+        let l = log.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if let Some(i) = line.find("listening on http://") {
+                    let rest = &line[i + "listening on http://".len()..];
+                    let addr = rest
+                        .split_whitespace()
+                        .next()
+                        .unwrap_or_default()
+                        .to_string();
+                    let _ = tx.send(addr);
+                }
+                l.lock().unwrap().push(line);
+            }
+        });
+        let l = log.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                l.lock().unwrap().push(line);
+            }
+        });
+        let addr = match rx.recv_timeout(Duration::from_secs(60)) {
+            Ok(a) => a,
+            Err(_) => {
+                let _ = child.kill();
+                panic!("motiond did not start:\n{}", log.lock().unwrap().join("\n"));
+            }
+        };
+        Server {
+            child,
+            base: format!("http://{addr}"),
+            addr,
+            log,
+        }
+    }
+
+    pub fn start() -> Server {
+        Self::start_with(":memory:", &[])
+    }
+
+    pub fn url(&self, path: &str) -> String {
+        format!("{}{}", self.base, path)
+    }
+
+    pub fn stop(mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+pub struct Resp {
+    pub status: u16,
+    pub content_type: String,
+    pub location: Option<String>,
+    pub text: String,
+    pub json: Value,
+}
+
+pub async fn req(method: reqwest::Method, url: &str, body: Option<Value>) -> Resp {
+    let client = reqwest::Client::new();
+    let mut r = client
+        .request(method, url)
+        .header("x-client-id", "integration-test");
+    if let Some(b) = body {
+        r = r
+            .header("content-type", "application/json")
+            .body(b.to_string());
+    }
+    let resp = r.send().await.expect("request sent");
+    let status = resp.status().as_u16();
+    let content_type = resp
+        .headers()
+        .get("content-type")
+        .and_then(|v| v.to_str().ok())
+        .unwrap_or_default()
+        .to_string();
+    let location = resp
+        .headers()
+        .get("location")
+        .and_then(|v| v.to_str().ok())
+        .map(String::from);
+    let text = resp.text().await.unwrap_or_default();
+    let json = serde_json::from_str(&text).unwrap_or(Value::Null);
+    Resp {
+        status,
+        content_type,
+        location,
+        text,
+        json,
+    }
+}
+
+pub async fn get(s: &Server, path: &str) -> Resp {
+    req(reqwest::Method::GET, &s.url(path), None).await
+}
+pub async fn post(s: &Server, path: &str, body: Value) -> Resp {
+    req(reqwest::Method::POST, &s.url(path), Some(body)).await
+}
+pub async fn put(s: &Server, path: &str, body: Value) -> Resp {
+    req(reqwest::Method::PUT, &s.url(path), Some(body)).await
+}
+pub async fn delete(s: &Server, path: &str) -> Resp {
+    req(reqwest::Method::DELETE, &s.url(path), None).await
+}
+
+/// Enables an axis and waits until it is ready; returns the power command.
+pub async fn power_on(s: &Server, axis: &str) -> Value {
+    let r = post(
+        s,
+        &format!("/api/v1/axes/{axis}/power?wait=true&timeout_ms=5000"),
+        json!({"enable": true}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "power on {axis}: {}", r.text);
+    assert_eq!(
+        r.json["outputs"]["status"], true,
+        "power status of {axis}: {}",
+        r.text
+    );
+    r.json
+}
+
+pub async fn status(s: &Server, axis: &str) -> Value {
+    let r = get(s, &format!("/api/v1/axes/{axis}/status")).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    r.json
+}
+
+/// Polls a command until it is final (or panics after `secs`).
+pub async fn until_final(s: &Server, id: u64, secs: u64) -> Value {
+    let deadline = std::time::Instant::now() + Duration::from_secs(secs);
+    loop {
+        let r = get(s, &format!("/api/v1/commands/{id}")).await;
+        assert_eq!(r.status, 200, "{}", r.text);
+        if r.json["final"] == true {
+            return r.json;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "command {id} not final: {}",
+            r.text
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+pub fn assert_problem(r: &Resp, status: u16, code: &str) {
+    assert_eq!(r.status, status, "{}", r.text);
+    assert_eq!(r.content_type, "application/problem+json", "{}", r.text);
+    assert_eq!(r.json["status"], status, "{}", r.text);
+    assert_eq!(r.json["code"], code, "{}", r.text);
+    assert!(
+        r.json["type"].is_string() && r.json["title"].is_string() && r.json["detail"].is_string(),
+        "{}",
+        r.text
+    );
+}
