@@ -18,17 +18,6 @@ use crate::params::AxisParameters;
 use crate::planner::{Kinematics, Limits, Planner, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
 
-/// Until the parameter table's own `set_raw` lands (an inherent method takes precedence
-/// over this trait), runtime parameter writes are accepted but not applied.
-#[allow(dead_code)]
-trait SetRawFallback {
-    fn set_raw(&mut self, number: u16, value: f64);
-}
-#[allow(dead_code)]
-impl SetRawFallback for AxisParameters {
-    fn set_raw(&mut self, _number: u16, _value: f64) {}
-}
-
 /// Static configuration of an axis (the base configuration the parameters start from).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisConfig {
@@ -494,6 +483,17 @@ impl Axis {
                 Ok(())
             }
             CommandKind::WriteParameter { number, value } => {
+                if number == 3000 {
+                    // AxisGearRatio: only while coupled; takes effect without a position jump.
+                    let Some(c) = self.coupling.as_mut() else { return Err(ErrorId::COMMAND_NOT_PERMITTED) };
+                    if !value.is_finite() {
+                        return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                    }
+                    c.slave_start = self.set.position;
+                    c.master_start = f64::NAN; // re-based on the next step
+                    c.ratio = value;
+                    c.target_ratio = value;
+                }
                 self.config.parameters.set_raw(number, value);
                 self.config.parameters.axis_cycle_time = self.cycle_time;
                 emit_once(cmd.id, DONE, slot, cycle, events);

@@ -33,8 +33,6 @@ macro_rules! error_table {
 }
 
 error_table! {
-    /// The axis was stopped while this command travelled (reported by an aborted move).
-    AXIS_STOPPED = 0x4B00, "axis_stopped", "axis was stopped";
     /// Command not admissible in the axis state (Disabled, ErrorStop, locked by MC_Stop, busy homing …).
     AXIS_CANNOT_BE_STARTED = 0x4B01, "axis_cannot_be_started", "axis cannot be started in its current state";
     /// An axis that is not moving cannot do this (e.g. GearOut on an uncoupled axis).

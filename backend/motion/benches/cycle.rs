@@ -1,0 +1,105 @@
+//! One kernel cycle for 1, 8 and 64 axes under mixed load: a quarter positioning back and
+//! forth, a quarter velocity moves re-planned every cycle by an override ramp, a quarter
+//! gear slaves of moving masters, a quarter jogging. Figures: docs/benchmarks.md.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use motion::*;
+
+struct Machine {
+    k: Kernel,
+    fb: Vec<DriveFeedback>,
+    sp: Vec<DriveSetpoint>,
+    events: Vec<CommandEvent>,
+    n: usize,
+    next_id: u64,
+    cycle: u64,
+}
+
+fn mv(position: f64) -> Positioning {
+    Positioning { position, velocity: 400.0, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }
+}
+
+impl Machine {
+    fn new(n: usize) -> Machine {
+        let mut k = Kernel::new(0.001, n);
+        for i in 0..n {
+            let mut p = AxisParameters::default();
+            p.axis_max_pos_lag_value = 1e6;
+            k.insert_axis(i as u16, Axis::new(AxisConfig { modulo: false, parameters: p }, 0.001)).unwrap();
+        }
+        let mut m = Machine { k, fb: vec![DriveFeedback::default(); n], sp: vec![DriveSetpoint::default(); n], events: Vec::with_capacity(1 << 16), n, next_id: 0, cycle: 0 };
+        for a in 0..n as u16 {
+            m.submit(a, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+        }
+        for _ in 0..10 {
+            m.cycle_once();
+        }
+        for a in 0..n {
+            let axis = a as u16;
+            match a % 4 {
+                0 => m.submit(axis, CommandKind::MoveAbsolute(mv(200.0))),
+                1 => m.submit(axis, CommandKind::MoveVelocity { velocity: 300.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }),
+                2 => m.submit(axis, CommandKind::GearIn { master: (a - 2) as u16, ratio_numerator: 0.5, ratio_denominator: 1 }),
+                _ => m.submit(axis, CommandKind::Jog { mode: JogMode::Continuous, forward: true, position: 0.0, velocity: 50.0, dynamics: Dynamics::default(), deadman: 0.0 }),
+            };
+        }
+        m
+    }
+
+    fn submit(&mut self, axis: u16, kind: CommandKind) -> Verdict {
+        self.next_id += 1;
+        self.k.submit(Command { id: self.next_id, axis, kind }, &mut self.events)
+    }
+
+    fn cycle_once(&mut self) {
+        self.cycle += 1;
+        // Load: re-plan the velocity axes every cycle, restart finished moves.
+        let o = 60.0 + 40.0 * ((self.cycle as f64) * 0.003).sin();
+        for a in 0..self.n {
+            let axis = a as u16;
+            match a % 4 {
+                1 => {
+                    self.submit(axis, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: o });
+                }
+                0 if !self.k.status(axis).unwrap().has_job => {
+                    let to = if self.k.status(axis).unwrap().set_position > 100.0 { 0.0 } else { 200.0 };
+                    self.submit(axis, CommandKind::MoveAbsolute(mv(to)));
+                }
+                _ => {}
+            }
+        }
+        self.k.step(&self.fb, &mut self.sp, &mut self.events);
+        for (s, f) in self.sp.iter().zip(self.fb.iter_mut()) {
+            f.ready = true;
+            f.enabled = s.enable;
+            f.actual_position = s.position;
+            f.actual_velocity = s.velocity;
+        }
+        if self.events.len() > 60000 {
+            self.events.clear();
+        }
+    }
+}
+
+fn cycle(c: &mut Criterion) {
+    let mut g = c.benchmark_group("cycle_mixed_load");
+    for n in [1usize, 8, 64] {
+        // With one axis it is a positioning axis moving back and forth.
+        let mut m = Machine::new(n);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| b.iter(|| m.cycle_once()));
+    }
+    g.finish();
+    // The step alone, without the benchmark's own command traffic, at 64 axes.
+    let mut m = Machine::new(64);
+    c.bench_function("step_only_64_axes", |b| {
+        b.iter(|| {
+            m.k.step(&m.fb, &mut m.sp, &mut m.events);
+            if m.events.len() > 60000 {
+                m.events.clear();
+            }
+        })
+    });
+}
+
+criterion_group!(benches, cycle);
+criterion_main!(benches);
