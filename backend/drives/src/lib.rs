@@ -2,3 +2,5 @@
 //! on EtherCAT.
 
 pub mod sim;
+
+pub use sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
