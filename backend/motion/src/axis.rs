@@ -266,6 +266,11 @@ struct Superimposed {
     option: SuperpositionAbortOption,
     last_position: f64,
     last_direction: f64,
+    /// Largest velocity the superposition may add (the main motion may run faster than
+    /// `velocity_process`; progress is then rate-limited instead of exceeding it).
+    velocity_diff: f64,
+    /// Velocity and acceleration it added in the last cycle.
+    added: (f64, f64),
 }
 
 /// The superposition shape and its first two derivatives on [0, 1].
@@ -298,6 +303,9 @@ pub struct Axis {
     override_factor: f64,
     power_on_timer: f64,
     set: Kinematics,
+    /// The setpoint position sent last cycle: the actual position read now answers it, so
+    /// the following error compares the two (comparing with the new setpoint would add v·dt).
+    sent_position: f64,
     act_pos: f64,
     act_vel: f64,
     /// axis position = drive position + offset (MC_SetPosition, homing).
@@ -344,6 +352,7 @@ impl Axis {
             override_factor: 1.0,
             power_on_timer: 0.0,
             set: Kinematics::default(),
+            sent_position: 0.0,
             act_pos: 0.0,
             act_vel: 0.0,
             offset: 0.0,
@@ -1210,6 +1219,7 @@ impl Axis {
     fn shift_coordinates(&mut self, shift: f64) {
         self.offset += shift;
         self.act_pos += shift;
+        self.sent_position += shift;
         self.set.position += shift;
         for j in [self.job.as_mut(), self.next.as_mut()].into_iter().flatten() {
             j.target += shift;
@@ -1267,9 +1277,20 @@ impl Axis {
     /// stops on the closed-form ramp and the job reports PLANNING_FAILED.
     fn plan_job_now(&mut self) -> bool {
         let ovr = self.override_ratio();
-        let from = self.set;
+        let from = self.plan_origin();
+        let velo_max = self.config.parameters.axis_velo_max;
         let Some(j) = self.job.as_mut() else { return true };
         j.planned_override = ovr;
+        // Taking over an accelerating axis with a weak jerk would let the velocity run on
+        // past the axis maximum while the acceleration is ramped down: use at least the jerk
+        // that keeps it within AxisVeloMax.
+        if from.acceleration * from.velocity > 0.0 {
+            let room = (velo_max - from.velocity.abs()).max(velo_max * 1e-6);
+            let needed = from.acceleration * from.acceleration / (2.0 * room);
+            if needed > j.jerk {
+                j.jerk = needed;
+            }
+        }
         let res = match j.kind {
             JobKind::Positioning { .. } => {
                 if ovr <= 0.0 {
@@ -1405,6 +1426,7 @@ impl Axis {
         }
         self.try_unlock(cycle, events);
         self.update_status();
+        self.sent_position = self.set.position;
         self.prev_cam = fb.reference_cam;
         let _ = slot;
         DriveSetpoint {
@@ -1769,7 +1791,7 @@ impl Axis {
             self.lag_timer = 0.0;
             return;
         }
-        let lag = (self.set.position - self.act_pos).abs();
+        let lag = (self.sent_position - self.act_pos).abs();
         if lag > max_lag {
             self.lag_timer += dt;
             if self.lag_timer > filter + 1e-12 {
@@ -1941,20 +1963,33 @@ impl Axis {
         let distance = dir * sp.distance.signum() * d * if d > 0.0 { scale } else { 1.0 };
         let warning = d > 0.0 && scale < 1.0 - 1e-12;
         // A new superposition replaces the running one (what it applied so far stays).
-        if let Some(old) = self.superimposed.take() {
-            let out = FbOutputs { busy: false, active: false, command_aborted: true, ..old.out };
-            events.push(CommandEvent { cycle, command: old.id, axis: slot, outputs: out });
-        }
+        self.abort_superposition(cycle, events);
         let out = FbOutputs { busy: true, active: true, warning, warning_id: if warning { ErrorId::SUPERPOSITION_INCOMPLETE.0 } else { 0 }, ..FbOutputs::default() };
         events.push(CommandEvent { cycle, command: id, axis: slot, outputs: out });
-        self.superimposed = Some(Superimposed { id, out, distance, length, travelled: 0.0, applied: 0.0, option: sp.abort_option, last_position: self.set.position, last_direction: dir });
+        self.superimposed = Some(Superimposed { id, out, distance, length, travelled: 0.0, applied: 0.0, option: sp.abort_option, last_position: self.set.position, last_direction: dir, velocity_diff: vdiff.max(EPS_V), added: (0.0, 0.0) });
         Ok(())
     }
 
+    /// Ends a superposition with CommandAborted; what it applied stays. The velocity it was
+    /// adding is handed to the main motion's planner, which takes it away smoothly.
     fn abort_superposition(&mut self, cycle: u64, events: &mut impl EventSink) {
         if let Some(sp) = self.superimposed.take() {
             let out = FbOutputs { busy: false, active: false, command_aborted: true, ..sp.out };
             events.push(CommandEvent { cycle, command: sp.id, axis: self.slot, outputs: out });
+            if sp.added != (0.0, 0.0) && self.mode != Mode::Disabled {
+                if self.job.as_ref().is_some_and(|j| j.kind != JobKind::Gear && j.kind != JobKind::Home) {
+                    self.plan_job_now();
+                }
+            }
+        }
+    }
+
+    /// The state plans start from: the setpoint without what a running superposition adds
+    /// (it keeps adding it on top of the new plan).
+    fn plan_origin(&self) -> Kinematics {
+        match self.superimposed {
+            Some(sp) => Kinematics { velocity: self.set.velocity - sp.added.0, acceleration: self.set.acceleration - sp.added.1, ..self.set },
+            None => self.set,
         }
     }
 
@@ -1964,7 +1999,10 @@ impl Axis {
     fn step_superposition(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
         let Some(mut sp) = self.superimposed else { return };
         let base = self.set;
-        let moved = base.position - sp.last_position;
+        let mut moved = base.position - sp.last_position;
+        if moved.abs() < 1e-12 {
+            moved = 0.0; // float noise of a standing main motion is no reversal
+        }
         let travelling = self.job.as_ref().is_some_and(|j| j.kind != JobKind::Halt) && self.mode == Mode::Enabled;
         let stopped_by_override = self.override_ratio() <= 0.0;
         let abort = match sp.option {
@@ -1975,13 +2013,31 @@ impl Axis {
             SuperpositionAbortOption::ResumeAfterMotionStop => false,
         };
         if abort {
+            // This cycle's sample is the bare main motion: keep last cycle's contribution in
+            // it so that the planner takes over from a continuous state.
+            self.set.position += sp.added.0 * dt;
+            self.set.velocity += sp.added.0;
+            self.set.acceleration += sp.added.1;
+            if self.planner.is_planned() {
+                self.planner.shift(sp.added.0 * dt);
+            }
+            self.superimposed = Some(Superimposed { added: (0.0, 0.0), ..sp });
             self.abort_superposition(cycle, events);
             return;
         }
         if moved != 0.0 {
             sp.last_direction = moved.signum();
         }
-        sp.travelled += moved.abs();
+        // Progress along the main travel, limited so that the added velocity stays within
+        // velocity_diff even when the main motion runs faster than velocity_process.
+        // Steepest slope within this step (s' changes along the step).
+        let slope = smoothstep5(sp.travelled / sp.length).1.max(smoothstep5((sp.travelled + moved.abs()) / sp.length).1);
+        let v_base = base.velocity.abs();
+        let adds_speed = sp.distance * moved.signum() > 0.0;
+        let room = if adds_speed { (self.p().axis_velo_max - v_base).max(0.0) } else { v_base };
+        let allowed = sp.velocity_diff.min(room);
+        let max_step = if slope > 0.0 { allowed * dt * sp.length / (sp.distance.abs() * slope).max(EPS_V) } else { f64::INFINITY };
+        sp.travelled += moved.abs().min(max_step);
         let x = sp.travelled / sp.length;
         let (s, s1, s2) = smoothstep5(x);
         let applied = sp.distance * s;
@@ -2003,10 +2059,14 @@ impl Axis {
             self.set.position += delta;
         }
         if x < 1.0 {
-            // Velocity and acceleration the superposition adds (chain rule through u(t)).
-            let (v, a) = (base.velocity.abs(), base.acceleration * base.velocity.signum());
-            self.set.velocity += sp.distance * s1 / sp.length * v;
-            self.set.acceleration += sp.distance * (s2 / (sp.length * sp.length) * v * v + s1 / sp.length * a);
+            // Velocity the superposition adds: its increment per cycle (consistent with the
+            // position by construction); acceleration: the change of that velocity.
+            let _ = (s1, s2);
+            let v_add = delta / dt;
+            let a_add = (v_add - sp.added.0) / dt;
+            self.set.velocity += v_add;
+            self.set.acceleration += a_add;
+            sp.added = (v_add, a_add);
             sp.last_position = self.set.position;
             self.superimposed = Some(sp);
         } else {
@@ -2029,7 +2089,7 @@ impl Axis {
         s.set_jerk = set.jerk;
         s.actual_position = self.act_pos;
         s.actual_velocity = self.act_vel;
-        s.following_error = set.position - self.act_pos;
+        s.following_error = self.sent_position - self.act_pos;
         let period = p.axis_encoder_modulo_value;
         if self.config.modulo && period > 0.0 {
             s.modulo_set_position = set.position.rem_euclid(period);

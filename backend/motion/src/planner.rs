@@ -200,7 +200,15 @@ impl Planner {
                 self.shift = 0.0;
                 self.time = 0.0;
                 self.duration = self.traj.get_duration();
-                self.end = self.sample_at(self.duration);
+                // The end state is the target itself, not a float-noisy sample of it.
+                let mut end = self.sample_at(self.duration);
+                end.velocity = self.input.target_velocity[0];
+                end.acceleration = 0.0;
+                end.jerk = 0.0;
+                if self.input.control_interface == ControlInterface::Position {
+                    end.position = self.input.target_position[0];
+                }
+                self.end = end;
                 Ok(self.duration)
             }
             _ => Err(PlanError::Infeasible),
