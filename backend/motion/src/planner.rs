@@ -201,7 +201,7 @@ impl Planner {
                 self.time = 0.0;
                 self.duration = self.traj.get_duration();
                 // The end state is the target itself, not a float-noisy sample of it.
-                let mut end = self.sample_at(self.duration);
+                let mut end = self.sample_raw(self.duration);
                 end.velocity = self.input.target_velocity[0];
                 end.acceleration = 0.0;
                 end.jerk = 0.0;
@@ -272,11 +272,15 @@ impl Planner {
     }
 
     fn sample_at(&self, t: f64) -> Kinematics {
-        if self.plan == Plan::Ruckig && t > self.duration {
-            // Beyond the end: constant end velocity, no acceleration.
+        if self.plan == Plan::Ruckig && t >= self.duration {
+            // At and beyond the end: the exact end state, then constant end velocity.
             let e = self.end;
             return Kinematics { position: e.position + e.velocity * (t - self.duration), velocity: e.velocity, acceleration: 0.0, jerk: 0.0 };
         }
+        self.sample_raw(t)
+    }
+
+    fn sample_raw(&self, t: f64) -> Kinematics {
         let mut p = rsruckig::daov_stack![0.0];
         let mut v = rsruckig::daov_stack![0.0];
         let mut a = rsruckig::daov_stack![0.0];
