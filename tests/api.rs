@@ -472,7 +472,7 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
     bad["unit"] = json!("furlong");
     bad["modulo"] = json!({"period": -1.0});
     bad["dynamics"]["jog_velocity_fast"] = json!(500.0);
-    bad["drive"] = json!({"lag_time_constant": -1.0});
+    bad["drive"] = json!({"dead_time": 5.0});
     let r = post(&s, "/api/v1/axes", bad).await;
     assert_problem(&r, 422, "validation_failed");
     let fields: Vec<&str> = r.json["errors"]

@@ -217,10 +217,19 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let local = listener.local_addr().map_err(|e| e.to_string())?;
     tracing::info!("listening on http://{local} (API /api/v1, docs /docs)");
     let app = api::router(state.clone()).into_make_service_with_connect_info::<SocketAddr>();
-    axum::serve(listener, app)
-        .with_graceful_shutdown(shutdown_signal())
-        .await
-        .map_err(|e| format!("server error: {e}"))?;
+    let (stopping_tx, mut stopping) = tokio::sync::watch::channel(false);
+    let server = axum::serve(listener, app).with_graceful_shutdown(async move {
+        shutdown_signal().await;
+        let _ = stopping_tx.send(true);
+    });
+    // Open websockets would hold a graceful shutdown forever: give them 2 s.
+    tokio::select! {
+        r = std::future::IntoFuture::into_future(server) => r.map_err(|e| format!("server error: {e}"))?,
+        _ = async {
+            let _ = stopping.wait_for(|s| *s).await;
+            tokio::time::sleep(std::time::Duration::from_secs(2)).await;
+        } => tracing::warn!("closing the connections still open"),
+    }
     tracing::info!("shutting down");
     shared
         .shutdown

@@ -114,25 +114,22 @@ impl Histogram {
         }
     }
 
-    /// Prometheus histogram lines (seconds), cumulative at a fixed set of bucket bounds.
+    /// Prometheus histogram lines (seconds), cumulative at the fixed bucket bounds.
     pub fn prometheus(&self, name: &str, help: &str, out: &mut String) {
         use std::fmt::Write;
         let counts = self.counts();
         let _ = writeln!(out, "# HELP {name} {help}\n# TYPE {name} histogram");
+        // Every bucket bound (≈6 % steps) so that windowed quantiles can be computed from two
+        // scrapes; the set of bounds is fixed, as Prometheus requires.
         let mut cumulative = 0u64;
-        let mut next = 0usize;
-        // Report every 4th bucket bound (≈25 % steps) plus +Inf to keep the output short.
         for (i, c) in counts.iter().enumerate() {
             cumulative += c;
-            if i == next || i == BUCKETS - 1 {
-                let le = upper(i) as f64 / 1e9;
-                let _ = writeln!(out, "{name}_bucket{{le=\"{le:e}\"}} {cumulative}");
-                next = if i == 0 { 1 } else { i + 4 };
-            }
+            let le = upper(i) as f64 / 1e9;
+            let _ = writeln!(out, "{name}_bucket{{le=\"{le:e}\"}} {cumulative}");
         }
         let _ = writeln!(out, "{name}_bucket{{le=\"+Inf\"}} {cumulative}");
         let _ = writeln!(out, "{name}_sum {}", self.sum.load(Relaxed) as f64 / 1e9);
-        let _ = writeln!(out, "{name}_count {}", self.count.load(Relaxed));
+        let _ = writeln!(out, "{name}_count {cumulative}");
     }
 }
 

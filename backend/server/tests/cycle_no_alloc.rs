@@ -1,0 +1,163 @@
+//! The cycle thread's work (drain requests, step, publish) allocates nothing and frees nothing,
+//! including while commands and axis hand-overs arrive.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::Arc;
+
+use motion::{
+    Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint,
+    Positioning,
+};
+use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
+use server::sim::{SimDrive, SimDriveConfig};
+
+struct Counting;
+
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static COUNT: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        if COUNTING.with(|c| c.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        if COUNTING.with(|c| c.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        if COUNTING.with(|c| c.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+fn counted<R>(f: impl FnOnce() -> R) -> (R, usize) {
+    COUNT.with(|c| c.set(0));
+    COUNTING.with(|c| c.set(true));
+    let r = f();
+    COUNTING.with(|c| c.set(false));
+    (r, COUNT.with(|c| c.get()))
+}
+
+#[test]
+fn a_cycle_allocates_nothing() {
+    let ct = 0.001;
+    let shared = Arc::new(Shared::new(1_000_000));
+    let (input, mut output) = triple_buffer::triple_buffer(&Snapshot::default());
+    let mut cycle = CycleThread::new(ct, shared.clone(), input);
+    let mut fb = vec![DriveFeedback::default(); MAX_AXES];
+    let mut sp = vec![DriveSetpoint::default(); MAX_AXES];
+    let axis = || {
+        Axis::new(
+            AxisConfig {
+                modulo: false,
+                parameters: AxisParameters::default(),
+            },
+            ct,
+        )
+    };
+    let drive = || Box::new(SimDrive::new(SimDriveConfig::default(), ct));
+    for slot in 0..3u16 {
+        assert!(
+            shared
+                .requests
+                .push(Request::InsertAxis {
+                    ticket: slot as u64,
+                    slot,
+                    axis: axis(),
+                    drive: drive(),
+                    require_disabled: false
+                })
+                .is_ok()
+        );
+    }
+    let mut total = 0;
+    let mut id = 100;
+    for i in 0..3000u64 {
+        // Commands arrive now and then: power, moves back and forth, a replacement axis.
+        match i {
+            5 => {
+                for slot in 0..3u16 {
+                    id += 1;
+                    let kind = CommandKind::Power {
+                        enable: true,
+                        enable_positive: true,
+                        enable_negative: true,
+                        override_percent: 100.0,
+                    };
+                    assert!(
+                        shared
+                            .requests
+                            .push(Request::Command(Command {
+                                id,
+                                axis: slot,
+                                kind
+                            }))
+                            .is_ok()
+                    );
+                }
+            }
+            i if i > 100 && i % 250 == 0 => {
+                id += 1;
+                let p = Positioning {
+                    position: (i % 500) as f64,
+                    velocity: 300.0,
+                    dynamics: Default::default(),
+                    buffer_mode: Default::default(),
+                    options: Default::default(),
+                };
+                assert!(
+                    shared
+                        .requests
+                        .push(Request::Command(Command {
+                            id,
+                            axis: 0,
+                            kind: CommandKind::MoveAbsolute(p)
+                        }))
+                        .is_ok()
+                );
+            }
+            1500 => {
+                assert!(
+                    shared
+                        .requests
+                        .push(Request::InsertAxis {
+                            ticket: 9,
+                            slot: 2,
+                            axis: axis(),
+                            drive: drive(),
+                            require_disabled: false
+                        })
+                        .is_ok()
+                );
+            }
+            _ => {}
+        }
+        let ((), n) = counted(|| cycle.one_cycle(&mut fb, &mut sp));
+        total += n;
+        // The async side drains (and frees) outside the counted region.
+        while shared.replies.pop().is_some() {}
+        while shared.events.pop().is_some() {}
+        while shared.garbage.pop().is_some() {}
+    }
+    assert_eq!(total, 0, "the cycle allocated or freed {total} times");
+    let snap = output.read();
+    assert_eq!(snap.cycle, 3000);
+    assert!(
+        snap.axes[0].unwrap().set_position != 0.0,
+        "axis 0 never moved: {:?}",
+        snap.axes[0]
+    );
+}

@@ -1,0 +1,106 @@
+//! Load generator for the service benchmarks (scripts/bench/run.sh).
+//!
+//! `bench rtt BASE N`: N sequential POST move-absolute on one keep-alive connection
+//! (alternating targets, aborting), prints p50/p99/max of POST → 202 in µs.
+//! `bench ws ADDR CLIENTS RATE SECONDS AXIS...`: CLIENTS websocket clients, each subscribed to
+//! every AXIS status at RATE Hz, for SECONDS; prints messages received and gaps.
+
+use std::time::{Duration, Instant};
+
+use futures_util::{SinkExt, StreamExt};
+use serde_json::json;
+use tokio_tungstenite::tungstenite::Message;
+
+fn pct(sorted: &[u64], q: f64) -> u64 {
+    if sorted.is_empty() {
+        return 0;
+    }
+    sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1]
+}
+
+async fn rtt(base: &str, n: usize) {
+    let client = reqwest::Client::new();
+    let url = format!("{base}/api/v1/axes/y/move-absolute");
+    let mut lat = Vec::with_capacity(n);
+    for i in 0..n + 100 {
+        let body =
+            json!({"position": if i % 2 == 0 { 50.0 } else { 0.0 }, "velocity": 100.0}).to_string();
+        let t = Instant::now();
+        let r = client.post(&url).body(body).send().await.expect("POST");
+        let status = r.status().as_u16();
+        let _ = r.bytes().await;
+        let us = t.elapsed().as_micros() as u64;
+        assert_eq!(status, 202, "POST move-absolute answered {status}");
+        if i >= 100 {
+            lat.push(us); // the first 100 warm up the connection and caches
+        }
+    }
+    lat.sort_unstable();
+    println!(
+        "{{\"requests\": {}, \"p50_us\": {}, \"p90_us\": {}, \"p99_us\": {}, \"max_us\": {}}}",
+        lat.len(),
+        pct(&lat, 0.5),
+        pct(&lat, 0.9),
+        pct(&lat, 0.99),
+        lat.last().unwrap()
+    );
+}
+
+async fn ws_client(addr: String, axes: Vec<String>, rate: f64, secs: f64) -> (u64, u64) {
+    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/api/v1/ws"))
+        .await
+        .expect("ws connect");
+    for (i, a) in axes.iter().enumerate() {
+        let m = json!({"jsonrpc": "2.0", "id": i, "method": "subscribe", "params": {"topic": format!("axes/{a}/status"), "rate_hz": rate}});
+        ws.send(Message::Text(m.to_string().into())).await.unwrap();
+    }
+    let end = Instant::now() + Duration::from_secs_f64(secs);
+    let (mut updates, mut bytes) = (0u64, 0u64);
+    while let Ok(Some(Ok(m))) = tokio::time::timeout_at(end.into(), ws.next()).await {
+        if let Message::Text(t) = m {
+            bytes += t.len() as u64;
+            if t.contains("\"update\"") {
+                updates += 1;
+            }
+        }
+    }
+    let _ = ws.close(None).await;
+    (updates, bytes)
+}
+
+#[tokio::main]
+async fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    match args.get(1).map(String::as_str) {
+        Some("rtt") => rtt(&args[2], args[3].parse().unwrap()).await,
+        Some("ws") => {
+            let addr = args[2].clone();
+            let clients: usize = args[3].parse().unwrap();
+            let rate: f64 = args[4].parse().unwrap();
+            let secs: f64 = args[5].parse().unwrap();
+            let axes: Vec<String> = args[6..].to_vec();
+            let tasks: Vec<_> = (0..clients)
+                .map(|_| tokio::spawn(ws_client(addr.clone(), axes.clone(), rate, secs)))
+                .collect();
+            let mut per_client = Vec::new();
+            let mut bytes = 0;
+            for t in tasks {
+                let (u, b) = t.await.unwrap();
+                per_client.push(u);
+                bytes += b;
+            }
+            per_client.sort_unstable();
+            let total: u64 = per_client.iter().sum();
+            let expected = rate * secs * axes.len() as f64;
+            println!(
+                "{{\"clients\": {clients}, \"axes\": {}, \"rate_hz\": {rate}, \"seconds\": {secs}, \"updates_total\": {total}, \"updates_per_s\": {:.0}, \"mb_per_s\": {:.2}, \"per_client_min\": {}, \"per_client_max\": {}, \"expected_per_client_max\": {expected:.0}}}",
+                axes.len(),
+                total as f64 / secs,
+                bytes as f64 / secs / 1e6,
+                per_client[0],
+                per_client[per_client.len() - 1]
+            );
+        }
+        _ => eprintln!("usage: bench rtt BASE N | bench ws ADDR CLIENTS RATE SECONDS AXIS..."),
+    }
+}

@@ -1,0 +1,174 @@
+#!/usr/bin/env python3
+"""Service benchmarks of motiond (figures for docs/benchmarks.md, section "Service").
+
+1. Wake-up latency of the idle cycle thread over a window (from /metrics deltas).
+2. POST move-absolute -> 202 round trip at 1 kHz cycle (examples/bench.rs rtt).
+3. 100 websocket clients x 16 axes at 50 Hz while all axes move: overruns and CPU.
+4. cyclictest (Debian rt-tests) on the same CPU, priority and interval, same run.
+
+Usage: service.py MOTIOND BENCH OUTDIR [--quick]
+"""
+import json, os, re, subprocess, sys, time, urllib.request
+
+MOTIOND, BENCH, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
+QUICK = "--quick" in sys.argv
+WINDOW = 10 if QUICK else 30
+PORT = 18181
+BASE = f"http://127.0.0.1:{PORT}"
+TICK = os.sysconf("SC_CLK_TCK")
+
+
+def http(method, path, body=None):
+    data = None if body is None else json.dumps(body).encode()
+    req = urllib.request.Request(BASE + path, data=data, method=method, headers={"content-type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=30) as r:
+            return r.status, r.read().decode()
+    except urllib.error.HTTPError as e:
+        return e.code, e.read().decode()
+
+
+def metrics():
+    _, text = http("GET", "/metrics")
+    hist, counters = {}, {}
+    for line in text.splitlines():
+        m = re.match(r'(\w+)_bucket\{le="([^"]+)"\} (\d+)', line)
+        if m:
+            hist.setdefault(m.group(1), []).append((float("inf") if m.group(2) == "+Inf" else float(m.group(2)), int(m.group(3))))
+            continue
+        m = re.match(r"(\w+) ([0-9.e+-]+)$", line)
+        if m:
+            counters[m.group(1)] = float(m.group(2))
+    return hist, counters
+
+
+def window_quantiles(before, after, name):
+    """p50/p99/max (µs, bucket upper bounds) of the samples between two scrapes."""
+    b = dict(before[0][name]); a = after[0][name]
+    cum = [(le, n - b.get(le, 0)) for le, n in a]
+    total = cum[-1][1]
+    res = {"count": total}
+    for q, key in ((0.5, "p50_us"), (0.99, "p99_us"), (0.999, "p999_us")):
+        rank = max(1, int(q * total + 0.999999))
+        res[key] = next(round(le * 1e6, 1) for le, n in cum if n >= rank)
+    prev = 0
+    mx = 0
+    for le, n in cum:
+        if n > prev and le != float("inf"):
+            mx = le
+        prev = n
+    res["max_us_bucket_upper"] = round(mx * 1e6, 1)
+    return res
+
+
+def cpu_ticks(pid):
+    """(process utime+stime, {thread name: ticks})."""
+    def ticks(path):
+        f = open(path).read().rsplit(")", 1)[1].split()
+        return int(f[11]) + int(f[12])
+    threads = {}
+    for t in os.listdir(f"/proc/{pid}/task"):
+        name = open(f"/proc/{pid}/task/{t}/comm").read().strip()
+        threads[name] = threads.get(name, 0) + ticks(f"/proc/{pid}/task/{t}/stat")
+    return ticks(f"/proc/{pid}/stat"), threads
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    log = open(os.path.join(OUT, "motiond.log"), "w")
+    proc = subprocess.Popen([MOTIOND, "--db", ":memory:", "--listen", f"127.0.0.1:{PORT}"], stdout=log, stderr=subprocess.STDOUT)
+    results = {"machine": {"cpus": os.cpu_count(), "kernel": os.uname().release}}
+    try:
+        for _ in range(200):
+            try:
+                if http("GET", "/api/v1/system")[0] == 200:
+                    break
+            except Exception:
+                time.sleep(0.05)
+        system = json.loads(http("GET", "/api/v1/system")[1])
+        results["realtime"] = system["realtime"]
+        time.sleep(2)  # start-up done
+
+        # 1. idle wake-up latency
+        m0 = metrics(); time.sleep(WINDOW); m1 = metrics()
+        results["idle"] = {
+            "seconds": WINDOW,
+            "wakeup_latency": window_quantiles(m0, m1, "motiond_cycle_wakeup_latency_seconds"),
+            "compute": window_quantiles(m0, m1, "motiond_cycle_compute_seconds"),
+            "overruns": m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"],
+        }
+        print("idle", json.dumps(results["idle"]), flush=True)
+
+        # 2. POST -> 202 round trip
+        st, body = http("POST", "/api/v1/axes/y/power?wait=true", {})
+        assert st == 202, body
+        m0 = metrics()
+        out = subprocess.run([BENCH, "rtt", BASE, "2000" if QUICK else "10000"], capture_output=True, text=True, check=True).stdout
+        m1 = metrics()
+        results["rtt"] = json.loads(out)
+        results["rtt"]["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
+        print("rtt", json.dumps(results["rtt"]), flush=True)
+
+        # 3. 16 moving axes, 100 websocket clients at 50 Hz each on all 16
+        axes = ["x", "y", "spindle"]
+        cfg = {"unit": "mm", "dynamics": {"max_velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0, "jerk": 25000.0, "jog_velocity_slow": 10.0, "jog_velocity_fast": 100.0}}
+        for i in range(13):
+            st, body = http("POST", "/api/v1/axes", dict(cfg, name=f"a{i}"))
+            assert st == 201, body
+            axes.append(f"a{i}")
+        for a in axes:
+            st, body = http("POST", f"/api/v1/axes/{a}/power?wait=true", {})
+            assert st == 202, body
+            st, body = http("POST", f"/api/v1/axes/{a}/move-velocity", {"velocity": 20.0 if a != "spindle" else 360.0})
+            assert st == 202, body
+        time.sleep(1)
+        secs = WINDOW
+        m0 = metrics(); c0 = cpu_ticks(proc.pid); t0 = time.time(); ch0 = os.times()
+        out = subprocess.run([BENCH, "ws", f"127.0.0.1:{PORT}", "100", "50", str(secs)] + axes, capture_output=True, text=True, check=True).stdout
+        ch1 = os.times(); t1 = time.time(); c1 = cpu_ticks(proc.pid); m1 = metrics()
+        el = t1 - t0
+        ws = json.loads(out)
+        ws["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
+        ws["wakeup_latency"] = window_quantiles(m0, m1, "motiond_cycle_wakeup_latency_seconds")
+        ws["compute"] = window_quantiles(m0, m1, "motiond_cycle_compute_seconds")
+        ws["motiond_cpu_percent"] = round(100 * (c1[0] - c0[0]) / TICK / el, 1)
+        ws["motiond_cpu_percent_by_thread"] = {k: round(100 * (v - c0[1].get(k, 0)) / TICK / el, 1) for k, v in c1[1].items()}
+        ws["load_generator_cpu_percent"] = round(100 * ((ch1.children_user - ch0.children_user) + (ch1.children_system - ch0.children_system)) / el, 1)
+        results["ws"] = ws
+        print("ws", json.dumps(ws), flush=True)
+    finally:
+        proc.terminate()
+        proc.wait()
+
+    # 4. cyclictest, same CPU / priority / interval, after motiond has stopped
+    cpu = results["realtime"].get("pinned_cpu")
+    loops = WINDOW * 1000
+    hist = os.path.join(OUT, "cyclictest.hist")
+    cmd = ["cyclictest", "-m", "-q", "-p", "80", "-t", "1", "-i", "1000", "-l", str(loops), "-h", "20000", f"--histfile={hist}"]
+    if cpu is not None:
+        cmd += ["-a", str(cpu)]
+    subprocess.run(cmd, check=True, capture_output=True)
+    counts = []
+    for line in open(hist):
+        if line.startswith("#"):
+            continue
+        parts = line.split()
+        if len(parts) >= 2:
+            counts.append((int(parts[0]), int(parts[1])))
+    total = sum(n for _, n in counts)
+    mx = max(v for v, n in counts if n > 0)
+    overflow = re.search(r"# Histogram Overflows: (\d+)", open(hist).read())
+    def q(p):
+        rank = max(1, int(p * total + 0.999999)); acc = 0
+        for v, n in counts:
+            acc += n
+            if acc >= rank:
+                return v + 1  # bucket [v, v+1) µs: upper bound, as for motiond
+        return mx
+    results["cyclictest"] = {"count": total, "p50_us": q(0.5), "p99_us": q(0.99), "p999_us": q(0.999), "max_us": mx,
+                             "overflows": int(overflow.group(1)) if overflow else 0, "command": " ".join(cmd)}
+    print("cyclictest", json.dumps(results["cyclictest"]), flush=True)
+    json.dump(results, open(os.path.join(OUT, "results.json"), "w"), indent=2)
+
+
+main()
