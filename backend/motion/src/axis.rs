@@ -52,6 +52,17 @@ impl MasterSample {
     }
 }
 
+/// -1, 0 or 1 (unlike `f64::signum`, which gives ±1 for ±0).
+fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
 /// Velocities below this are "at rest" (units/s); far below any real resolution.
 const EPS_V: f64 = 1e-9;
 /// How long a drive may take to report "operation enabled" after MC_Power.
@@ -908,7 +919,7 @@ impl Axis {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
                 if let Some(prev) = self.predecessor().filter(|p| p.is_positioning() && !p.is_endless()) {
-                    let dir = (prev.target - self.set.position).signum();
+                    let dir = sign(prev.target - self.set.position);
                     if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
                         return Err(ErrorId::BLENDING_POSITION_INVALID);
                     }
@@ -1353,11 +1364,11 @@ impl Axis {
         }
         // Direction of the successor's travel from A's target.
         let b_dir = match b.kind {
-            JobKind::Positioning { .. } => (b.target - a.target).signum(),
+            JobKind::Positioning { .. } => sign(b.target - a.target),
             JobKind::Velocity | JobKind::JogHeld { .. } => b.direction,
             _ => 0.0,
         };
-        let a_dir = (a.target - self.set.position).signum();
+        let a_dir = sign(a.target - self.set.position);
         if b_dir == 0.0 || a_dir == 0.0 || b_dir != a_dir {
             return; // a reversal blends at rest, as Buffered
         }
