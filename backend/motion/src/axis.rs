@@ -335,6 +335,9 @@ pub struct Axis {
     in_window_timer: f64,
     coupling: Option<Coupling>,
     superimposed: Option<Superimposed>,
+    /// `set` includes what the superposition added (true between its step and the next
+    /// sample of the main motion).
+    set_has_superposition: bool,
     latch: Option<LatchSource>,
     prev_cam: bool,
 }
@@ -379,6 +382,7 @@ impl Axis {
             in_window_timer: 0.0,
             coupling: None,
             superimposed: None,
+            set_has_superposition: false,
             latch: None,
             prev_cam: false,
         })
@@ -1567,6 +1571,7 @@ impl Axis {
                 }
                 self.coupling = Some(c);
                 self.set = Kinematics { position: c.slave_start + c.ratio * (mp - c.master_start), velocity: c.ratio * mv, acceleration: c.ratio * ma + dratio * mv, jerk: c.ratio * mj };
+                self.set_has_superposition = false;
             }
             self.job = Some(job);
             return;
@@ -1606,6 +1611,7 @@ impl Axis {
 
         if let Some(k) = self.planner.step(dt) {
             self.set = k;
+            self.set_has_superposition = false;
         }
         let finished = self.planner.finished();
 
@@ -1826,6 +1832,7 @@ impl Axis {
         let mut fail = None;
         if let Some(k) = self.planner.step(dt) {
             self.set = k;
+            self.set_has_superposition = false;
         }
         let stopped = self.planner.finished() && self.set.velocity.abs() <= EPS_V;
         let limit_hit = (h.search_dir > 0.0 && fb.limit_positive) || (h.search_dir < 0.0 && fb.limit_negative);
@@ -1998,7 +2005,7 @@ impl Axis {
     /// The state plans start from: the setpoint without what a running superposition adds
     /// (it keeps adding it on top of the new plan).
     fn plan_origin(&self) -> Kinematics {
-        match self.superimposed {
+        match self.superimposed.filter(|_| self.set_has_superposition) {
             Some(sp) => Kinematics { velocity: self.set.velocity - sp.added.0, acceleration: self.set.acceleration - sp.added.1, ..self.set },
             None => self.set,
         }
@@ -2077,6 +2084,7 @@ impl Axis {
             let a_add = (v_add - sp.added.0) / dt;
             self.set.velocity += v_add;
             self.set.acceleration += a_add;
+            self.set_has_superposition = true;
             sp.added = (v_add, a_add);
             sp.last_position = self.set.position;
             self.superimposed = Some(sp);

@@ -884,3 +884,20 @@ fn superposition_shifts_the_target_of_the_running_move() {
     assert!(r.out(m).done);
     assert!((r.st(0).set_position - 420.0).abs() < 1e-9, "{}", r.st(0).set_position);
 }
+
+#[test]
+fn superposition_across_a_blend_handoff_stays_continuous() {
+    // Found by the property test: a blending successor must plan from the main motion alone,
+    // not from the main motion minus the superposition twice.
+    let mut r = Rig::new(1);
+    r.bounds[0].jerk = 1e12;
+    r.bounds[0].acceleration *= 2.0;
+    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 65.0 });
+    r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
+    r.ok(0, CommandKind::MoveRelative(mv(173.0, 467.0)));
+    let b = r.ok(0, CommandKind::MoveVelocity { velocity: 1.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::BlendingPrevious, options: MoveOptions::default() });
+    r.run(0.078);
+    r.ok(0, CommandKind::MoveSuperImposed(Superposition { mode: SuperpositionMode::LengthReductionAdditiveMotion, distance: -77.0, velocity_diff: 215.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 1.0, length: 788.0, abort_option: SuperpositionAbortOption::AbortAtStandstill }));
+    r.until(3.0, |r| r.out(b).active);
+    r.run(0.5);
+}
