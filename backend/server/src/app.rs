@@ -161,9 +161,14 @@ pub struct SystemInfo {
     pub started: Instant,
 }
 
+/// A status as a JSON object, shared by every websocket subscriber of that cycle.
+pub type StatusJson = Arc<serde_json::Map<String, serde_json::Value>>;
+
 pub struct AppState {
     pub shared: Arc<Shared>,
     snapshot: Mutex<triple_buffer::Output<Snapshot>>,
+    /// Per slot: the status of the latest cycle already turned into JSON.
+    status_json: Mutex<Vec<Option<(u64, StatusJson)>>>,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -189,6 +194,7 @@ impl AppState {
         let state = AppState {
             shared,
             snapshot: Mutex::new(snapshot),
+            status_json: Mutex::new(vec![None; MAX_AXES]),
             registry: RwLock::new(Registry::default()),
             config_lock: tokio::sync::Mutex::new(()),
             commands: Mutex::new(CommandStore::default()),
@@ -212,6 +218,25 @@ impl AppState {
         let mut out = self.snapshot.lock().unwrap();
         let s = out.read();
         (s.cycle, s.axes.get(slot as usize).copied().flatten())
+    }
+
+    /// The latest status of a slot as JSON, serialised once per cycle whoever asks.
+    pub fn status_json(&self, slot: AxisSlot) -> Option<(u64, StatusJson)> {
+        let (cycle, status) = self.status(slot);
+        let status = status?;
+        let mut cache = self.status_json.lock().unwrap();
+        let entry = cache.get_mut(slot as usize)?;
+        if let Some((c, j)) = entry {
+            if *c == cycle {
+                return Some((cycle, j.clone()));
+            }
+        }
+        let serde_json::Value::Object(map) = serde_json::to_value(status).ok()? else {
+            return None;
+        };
+        let j = Arc::new(map);
+        *entry = Some((cycle, j.clone()));
+        Some((cycle, j))
     }
 
     pub fn with_snapshot<R>(&self, f: impl FnOnce(&Snapshot) -> R) -> R {

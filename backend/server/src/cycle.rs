@@ -107,6 +107,8 @@ pub struct RealtimeGrant {
     pub mlockall: bool,
     /// CPU the cycle thread is pinned to, if pinning was granted.
     pub pinned_cpu: Option<usize>,
+    /// `/dev/cpu_dma_latency` held at 0 (no deep C-states that slow wake-ups).
+    pub cpu_dma_latency_zero: bool,
     /// Why something was refused (empty when all was granted).
     pub notes: Vec<String>,
 }
@@ -174,6 +176,20 @@ pub fn request_realtime(priority: i32) -> RealtimeGrant {
                 "mlockall refused: {}",
                 std::io::Error::last_os_error()
             ));
+        }
+        // As cyclictest does: keep the CPUs out of deep idle states for the process's life.
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/cpu_dma_latency")
+        {
+            Ok(mut f) => {
+                use std::io::Write;
+                if f.write_all(&0i32.to_ne_bytes()).is_ok() {
+                    g.cpu_dma_latency_zero = true;
+                    std::mem::forget(f); // the request holds while the file is open
+                }
+            }
+            Err(e) => g.notes.push(format!("/dev/cpu_dma_latency not set: {e}")),
         }
         let ncpu = libc::sysconf(libc::_SC_NPROCESSORS_ONLN).max(1) as usize;
         // The last CPU: the async runtime's threads are not pinned and prefer the others.

@@ -25,7 +25,7 @@ use crate::model::*;
 
 /// Highest subscription rate.
 pub const MAX_RATE_HZ: f64 = 100.0;
-const TICK: Duration = Duration::from_millis(10);
+const TICK: Duration = Duration::from_millis(5);
 const KEEPALIVE_EVERY: Duration = Duration::from_millis(100);
 
 #[utoipa::path(get, path = "/api/v1/ws", tag = "system", summary = "Websocket: JSON-RPC 2.0 subscriptions and commands",
@@ -65,7 +65,7 @@ struct Sub {
     topic: Topic,
     every: Duration,
     due: Instant,
-    last: Option<Map<String, Value>>,
+    last: Option<crate::app::StatusJson>,
 }
 
 fn rpc_result(id: &Value, result: Value) -> String {
@@ -161,29 +161,34 @@ fn renew_jogs(s: &Arc<AppState>, jogs: &Arc<Mutex<Vec<(u16, u64)>>>) {
 fn updates(s: &AppState, subs: &mut [Sub], now: Instant) -> Vec<String> {
     let mut out = Vec::new();
     for sub in subs.iter_mut().filter(|x| now >= x.due) {
-        sub.due = now + sub.every;
-        let (cycle, value) = match &sub.topic {
+        // Keep the rate's grid; a client that fell behind skips what it missed.
+        sub.due += sub.every;
+        if sub.due <= now {
+            sub.due = now + sub.every;
+        }
+        let (cycle, map) = match &sub.topic {
             Topic::Commands => continue,
-            Topic::Axis { slot, .. } => match s.status(*slot) {
-                (c, Some(st)) => (c, serde_json::to_value(st).unwrap_or_default()),
-                _ => continue,
+            Topic::Axis { slot, .. } => match s.status_json(*slot) {
+                Some(x) => x,
+                None => continue,
             },
             Topic::System => {
                 let sys = super::system::system_resource(s);
-                (sys.cycle, serde_json::to_value(sys).unwrap_or_default())
+                let Ok(Value::Object(m)) = serde_json::to_value(&sys) else {
+                    continue;
+                };
+                (sys.cycle, Arc::new(m))
             }
         };
-        let Value::Object(map) = value else { continue };
-        let (full, data) = match &sub.last {
-            None => (true, map.clone()),
-            Some(last) => (
-                false,
-                map.iter()
-                    .filter(|(k, v)| last.get(*k) != Some(v))
-                    .map(|(k, v)| (k.clone(), v.clone()))
-                    .collect(),
-            ),
+        let data: Map<String, Value> = match &sub.last {
+            None => (*map).clone(),
+            Some(last) => map
+                .iter()
+                .filter(|(k, v)| last.get(*k) != Some(v))
+                .map(|(k, v)| (k.clone(), v.clone()))
+                .collect(),
         };
+        let full = sub.last.is_none();
         if !full && data.is_empty() {
             continue;
         }
