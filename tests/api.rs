@@ -644,3 +644,76 @@ async fn openapi_json_is_current() {
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
+
+/// A full disk at run time: the write that does not fit is a 503 and leaves nothing behind;
+/// every write that was reported as done is there after a restart.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_full_disk_is_a_503_and_never_a_lost_write() {
+    let dir = temp_dir();
+    let db = dir.join("full.db");
+    let db = db.to_str().unwrap().to_string();
+    // Create the database first, then restart with a file-size limit just above its size.
+    drop(Server::start_with(&db, &[]));
+    let size = |p: &str| std::fs::metadata(p).map_or(0, |m| m.len());
+    let limit_kb = (size(&db) + size(&format!("{db}-wal"))) / 1024 + 96;
+    let script = format!("ulimit -f {limit_kb}; exec \"$0\" \"$@\"");
+    let mut cmd = std::process::Command::new("bash");
+    cmd.args([
+        "-c",
+        &script,
+        env!("CARGO_BIN_EXE_motiond"),
+        "--listen",
+        "127.0.0.1:0",
+        "--db",
+        &db,
+    ]);
+    let s = Server::spawn(cmd);
+    let mut created = Vec::new();
+    let mut failure = None;
+    for i in 0..60 {
+        let name = format!("filler{i}");
+        let cfg = json!({"name": name, "unit": "mm",
+            "dynamics": {"max_velocity": 100.0, "acceleration": 1000.0, "deceleration": 1000.0, "jerk": 10000.0,
+                         "jog_velocity_slow": 5.0, "jog_velocity_fast": 50.0}});
+        let r = post(&s, "/api/v1/axes", cfg).await;
+        match r.status {
+            201 => created.push(name),
+            _ => {
+                failure = Some((name, r));
+                break;
+            }
+        }
+    }
+    let (failed_name, r) = failure.expect("the file-size limit was never reached");
+    assert_problem(&r, 503, "storage_unavailable");
+    assert!(!created.is_empty(), "the limit left no room at all");
+    let names = |axes: &Value| {
+        axes.as_array()
+            .unwrap()
+            .iter()
+            .map(|a| a["config"]["name"].as_str().unwrap().to_string())
+            .collect::<Vec<_>>()
+    };
+    let live = names(&get(&s, "/api/v1/axes").await.json);
+    assert!(
+        !live.contains(&failed_name),
+        "{failed_name} half-created: {live:?}"
+    );
+    assert_eq!(
+        get(&s, "/api/v1/system").await.status,
+        200,
+        "server unwell after the full disk"
+    );
+    s.stop();
+    let s = Server::start_with(&db, &[]);
+    let after = names(&get(&s, "/api/v1/axes").await.json);
+    assert_eq!(
+        after, live,
+        "what the server showed differs from what was stored"
+    );
+    for n in &created {
+        assert!(after.contains(n), "{n} was reported created but is lost");
+    }
+    drop(s);
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -41,6 +41,11 @@ impl Server {
         let mut cmd = bin();
         cmd.args(["serve", "--listen", "127.0.0.1:0", "--db", db])
             .args(extra);
+        Self::spawn(cmd)
+    }
+
+    /// Starts a prepared command that runs motiond (which must listen on a free port).
+    pub fn spawn(mut cmd: Command) -> Server {
         cmd.stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .env("NO_COLOR", "1");

@@ -143,6 +143,10 @@ fn serve(args: ServeArgs) -> Result<(), String> {
             args.listen
         ));
     }
+    // A file-size limit must fail the write (SQLite reports it, the request gets 503), not
+    // kill the process.
+    // SAFETY: setting a signal disposition to SIG_IGN before any thread is started.
+    unsafe { libc::signal(libc::SIGXFSZ, libc::SIG_IGN) };
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .thread_name("motiond-async")
