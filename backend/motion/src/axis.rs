@@ -129,8 +129,9 @@ struct Job {
     /// Override the current plan was made with.
     planned_override: f64,
     /// Jog dead-man (s); 0 = none.
-    deadman: f64,
-    since_keepalive: f64,
+    /// Jog dead-man in whole cycles (0 = none) and cycles since the last keepalive.
+    deadman_cycles: u32,
+    since_keepalive: u32,
     /// Modulo moves issued from motion are resolved when they start.
     modulo: Option<(f64, Direction)>,
     home: HomeSeq,
@@ -171,8 +172,8 @@ impl Job {
             buffer_mode: BufferMode::Aborting,
             options: MoveOptions::default(),
             planned_override: -1.0,
-            deadman: 0.0,
-            since_keepalive: 0.0,
+            deadman_cycles: 0,
+            since_keepalive: 0,
             modulo: None,
             home: HomeSeq::default(),
             pending_error: None,
@@ -219,7 +220,7 @@ impl Job {
     }
 
     fn finish_error(&mut self, e: ErrorId, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        let out = FbOutputs { busy: false, active: false, error: true, error_id: e.0, in_velocity: false, in_gear: false, in_end_velocity: false, ..self.out };
+        let out = FbOutputs { busy: false, active: false, error: true, error_id: e.0, in_velocity: false, in_gear: false, in_end_velocity: false, warning: false, warning_id: 0, ..self.out };
         self.emit(out, axis, cycle, events);
     }
 }
@@ -280,6 +281,8 @@ struct Superimposed {
     /// Largest velocity the superposition may add (the main motion may run faster than
     /// `velocity_process`; progress is then rate-limited instead of exceeding it).
     velocity_diff: f64,
+    /// Acceleration limit of the superimposed motion.
+    acc_limit: f64,
     /// Velocity and acceleration it added in the last cycle.
     added: (f64, f64),
 }
@@ -398,6 +401,11 @@ impl Axis {
 
     pub fn config(&self) -> &AxisConfig {
         &self.config
+    }
+
+    /// Disabled with no enable requested: the axis may be replaced or removed.
+    pub fn is_disabled(&self) -> bool {
+        self.mode == Mode::Disabled && !self.enable
     }
 
     pub fn master_slot(&self) -> Option<AxisSlot> {
@@ -527,7 +535,7 @@ impl Axis {
             CommandKind::Keepalive { target } => {
                 for j in [self.job.as_mut(), self.next.as_mut()].into_iter().flatten() {
                     if j.id == target {
-                        j.since_keepalive = 0.0;
+                        j.since_keepalive = 0;
                         return Ok(());
                     }
                 }
@@ -902,7 +910,9 @@ impl Axis {
                     }
                     _ => {
                         job = Job::new(cmd.id, JobKind::JogHeld { released: false });
-                        job.deadman = deadman;
+                        // Counted in whole cycles so that it fires exactly `deadman` after
+                        // the last keepalive (a float sum would drift by a cycle).
+                        job.deadman_cycles = if deadman > 0.0 { ((deadman / self.cycle_time) - 1e-9).ceil().max(1.0) as u32 } else { 0 };
                     }
                 }
                 job.velocity = v;
@@ -1086,6 +1096,8 @@ impl Axis {
             if let JobKind::JogHeld { released: false } = j.kind {
                 // Button released: ramp down now.
                 j.kind = JobKind::JogHeld { released: true };
+                let out = FbOutputs { in_velocity: false, ..j.out };
+                j.emit(out, slot, cycle, events);
                 self.plan_job_now();
             }
             // Other Execute-type commands run on (§3.2).
@@ -1250,7 +1262,7 @@ impl Axis {
     fn start_job(&mut self, mut job: Job, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
         job.activate(slot, cycle, events);
-        job.since_keepalive = 0.0;
+        job.since_keepalive = 0;
         self.in_window_timer = 0.0;
         self.job = Some(job);
         self.resolve_modulo_from_motion();
@@ -1535,10 +1547,13 @@ impl Axis {
 
         // Jog dead-man.
         if let JobKind::JogHeld { released: false } = job.kind {
-            job.since_keepalive += dt;
-            if job.deadman > 0.0 && job.since_keepalive > job.deadman {
+            job.since_keepalive = job.since_keepalive.saturating_add(1);
+            if job.deadman_cycles > 0 && job.since_keepalive >= job.deadman_cycles {
                 job.kind = JobKind::JogHeld { released: true };
                 job.pending_error = Some(ErrorId::DEADMAN_TIMEOUT);
+                // Reported in the cycle it fires (the command ends with the error at rest).
+                let out = FbOutputs { in_velocity: false, warning: true, warning_id: ErrorId::DEADMAN_TIMEOUT.0, ..job.out };
+                job.emit(out, slot, cycle, events);
                 self.job = Some(job);
                 self.plan_job_now();
                 job = self.job.expect("set above");
@@ -1750,7 +1765,7 @@ impl Axis {
                     return;
                 }
             }
-            n.since_keepalive = 0.0;
+            n.since_keepalive = 0;
             self.start_job(n, cycle, events);
         }
     }
@@ -1984,7 +1999,7 @@ impl Axis {
         self.abort_superposition(cycle, events);
         let out = FbOutputs { busy: true, active: true, warning, warning_id: if warning { ErrorId::SUPERPOSITION_INCOMPLETE.0 } else { 0 }, ..FbOutputs::default() };
         events.push(CommandEvent { cycle, command: id, axis: slot, outputs: out });
-        self.superimposed = Some(Superimposed { id, out, distance, length, travelled: 0.0, applied: 0.0, option: sp.abort_option, last_position: self.set.position, last_direction: dir, velocity_diff: vdiff.max(EPS_V), added: (0.0, 0.0) });
+        self.superimposed = Some(Superimposed { id, out, distance, length, travelled: 0.0, applied: 0.0, option: sp.abort_option, last_position: self.set.position, last_direction: dir, velocity_diff: vdiff.max(EPS_V), acc_limit: a_lim, added: (0.0, 0.0) });
         Ok(())
     }
 
@@ -2046,21 +2061,30 @@ impl Axis {
         if moved != 0.0 {
             sp.last_direction = moved.signum();
         }
-        // Progress along the main travel, limited so that the added velocity stays within
-        // velocity_diff even when the main motion runs faster than velocity_process.
-        // Steepest slope within this step (s' changes along the step).
-        let slope = smoothstep5(sp.travelled / sp.length).1.max(smoothstep5((sp.travelled + moved.abs()) / sp.length).1);
+        // Where the profile wants the superposition to be, as a function of the main travel.
+        sp.travelled += moved.abs();
+        let x = (sp.travelled / sp.length).min(1.0);
+        let desired = sp.distance * smoothstep5(x).0;
+        // Follow it within the limits of the superimposed motion: never against the distance,
+        // at most velocity_diff (and never beyond AxisVeloMax or a reversal of the main
+        // motion), acceleration within its limit, braking in time for the full distance.
+        // When the main motion runs faster than velocity_process the superposition lags the
+        // profile and catches up; it is acceleration-limited, not jerk-limited (TwinCAT:
+        // "Jerk not implemented").
+        let dir = sign(sp.distance);
         let v_base = base.velocity.abs();
-        let adds_speed = sp.distance * moved.signum() > 0.0;
+        let adds_speed = sp.distance * sp.last_direction > 0.0;
         let room = if adds_speed { (self.p().axis_velo_max - v_base).max(0.0) } else { v_base };
-        let allowed = sp.velocity_diff.min(room);
-        let max_step = if slope > 0.0 { allowed * dt * sp.length / (sp.distance.abs() * slope).max(EPS_V) } else { f64::INFINITY };
-        sp.travelled += moved.abs().min(max_step);
-        let x = sp.travelled / sp.length;
-        let (s, s1, s2) = smoothstep5(x);
-        let applied = sp.distance * s;
-        let delta = applied - sp.applied;
-        sp.applied = applied;
+        let v_max = sp.velocity_diff.min(room);
+        let prev = sp.added.0 * dir; // ≥ 0 in the direction of the distance
+        let to_desired = (desired - sp.applied) * dir;
+        let to_end = (sp.distance - sp.applied) * dir;
+        let a = sp.acc_limit;
+        let mut v = (to_desired / dt).min(v_max);
+        v = v.clamp(prev - a * dt, prev + a * dt);
+        v = v.min((2.0 * a * to_end.max(0.0)).sqrt()).min(to_end.max(0.0) / dt).max(0.0);
+        let delta = dir * v * dt;
+        sp.applied += delta;
         if delta != 0.0 {
             if self.planner.is_planned() {
                 self.planner.shift(delta);
@@ -2076,10 +2100,10 @@ impl Axis {
             }
             self.set.position += delta;
         }
-        if x < 1.0 {
-            // Velocity the superposition adds: its increment per cycle (consistent with the
-            // position by construction); acceleration: the change of that velocity.
-            let _ = (s1, s2);
+        let complete = x >= 1.0 && (sp.distance - sp.applied).abs() <= 1e-9 * (1.0 + sp.distance.abs());
+        if !complete {
+            // Velocity the superposition adds (its increment per cycle, consistent with the
+            // position by construction) and its acceleration (the change of that velocity).
             let v_add = delta / dt;
             let a_add = (v_add - sp.added.0) / dt;
             self.set.velocity += v_add;
@@ -2093,7 +2117,6 @@ impl Axis {
             events.push(CommandEvent { cycle, command: sp.id, axis: self.slot, outputs: out });
             self.superimposed = None;
         }
-        let _ = dt;
     }
 
     fn update_status(&mut self) {

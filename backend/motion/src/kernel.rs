@@ -64,6 +64,11 @@ impl Kernel {
         self.axis(slot).map(|a| *a.status())
     }
 
+    /// No axis in the slot, or one that is disabled with no enable requested.
+    pub fn is_disabled(&self, slot: AxisSlot) -> bool {
+        self.axis(slot).is_none_or(|a| a.is_disabled())
+    }
+
     pub fn parameters(&self, slot: AxisSlot) -> Option<&AxisParameters> {
         self.axis(slot).map(|a| a.parameters())
     }
@@ -94,7 +99,8 @@ impl Kernel {
             }
             _ => None,
         };
-        let cycle = self.cycle;
+        // Stamped with the cycle the command takes effect in (the next step).
+        let cycle = self.cycle + 1;
         match self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
             Some(axis) => axis.submit(cmd, master, cycle, events),
             None => Verdict::Rejected(ErrorId::AXIS_UNKNOWN),

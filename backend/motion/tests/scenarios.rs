@@ -552,10 +552,14 @@ fn jog_dead_man_stops_the_axis_when_not_renewed() {
         r.ok(0, CommandKind::Keepalive { target: j });
     }
     assert!(r.st(0).set_velocity > 49.0);
-    let c0 = r.k.cycle();
-    r.until(1.0, |r| r.st(0).decelerating);
-    // Deceleration begins at the first cycle after the dead-man time.
-    assert!(r.k.cycle() - c0 <= 201 + 1, "{}", r.k.cycle() - c0);
+    // The last keepalive takes effect in cycle c0; the dead-man fires exactly 200 cycles
+    // (0.2 s) later, reports it at once and starts braking in that cycle.
+    let c0 = r.k.cycle() + 1;
+    r.until(1.0, |r| r.out(j).warning);
+    let fired = r.events.iter().find(|e| e.command == j && e.outputs.warning).unwrap().cycle;
+    assert_eq!(fired - c0, 199, "fired {} cycles after the keepalive", fired - c0);
+    assert_eq!(r.out(j).warning_id, ErrorId::DEADMAN_TIMEOUT.0);
+    assert!(!r.out(j).in_velocity && r.st(0).decelerating);
     r.until(1.0, |r| !r.out(j).busy);
     assert_eq!(r.out(j).error_id, ErrorId::DEADMAN_TIMEOUT.0);
 }

@@ -220,7 +220,8 @@ impl Rig {
             assert_eq!(self.events.len(), n, "a rejected command emitted events");
             assert_eq!(self.k.status(axis), before, "a rejected command changed the axis status");
         }
-        self.check_events(n);
+        // Events of a submit are stamped with the cycle the command takes effect in.
+        self.check_events_at(n, self.k.cycle() + 1);
         // The state changes in the cycle the command is accepted: check that transition too.
         let now = self.k.status(axis).unwrap().state;
         let prev = self.prev[axis as usize].state;
@@ -286,6 +287,10 @@ impl Rig {
     }
 
     fn check_events(&mut self, from: usize) {
+        self.check_events_at(from, self.k.cycle());
+    }
+
+    fn check_events_at(&mut self, from: usize, cycle: u64) {
         for e in &self.events[from..] {
             let o = e.outputs;
             assert!(!self.finals.contains(&e.command), "event after the final one: {e:?}");
@@ -305,7 +310,7 @@ impl Rig {
                 assert_ne!(*prev, o, "event without change: {e:?}");
                 assert!(!(prev.done && o.busy && !stop_locked && !prev.busy), "done then busy again: {e:?}");
             }
-            assert_eq!(e.cycle, self.k.cycle(), "event stamped with a wrong cycle");
+            assert_eq!(e.cycle, cycle, "event stamped with a wrong cycle");
             self.outputs.insert(e.command, o);
             if o.is_final() {
                 self.finals.insert(e.command);
