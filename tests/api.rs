@@ -8,6 +8,7 @@ use common::*;
 use serde_json::{Value, json};
 
 const AXIS_CANNOT_BE_STARTED: u64 = 0x4B01;
+const DEADMAN_TIMEOUT: u64 = 0x7061;
 
 #[tokio::test(flavor = "multi_thread")]
 async fn demo_axes_exist() {
@@ -244,11 +245,16 @@ async fn stop_locks_the_axis_until_released() {
     assert_eq!(r.json["state"], "done", "{}", r.text);
 }
 
+/// Issue 3: "a jog whose keepalives stop halts within dead-man time + one cycle". Without
+/// keepalives the dead-man counts from the cycle the jog took effect in (its first event); the
+/// kernel reports the expiry in the cycle it fires (in_velocity falls, warning 0x7061) and ends
+/// the command with error 0x7061 once the axis is at rest.
 #[tokio::test(flavor = "multi_thread")]
 async fn a_jog_without_keepalive_is_stopped_by_its_deadman() {
     let s = Server::start();
     power_on(&s, "y").await;
-    let deadman: f64 = 0.2; // s; cycle 1 ms → 200 cycles
+    let deadman: f64 = 0.2; // s; cycle 1 ms
+    let deadman_cycles = (deadman / 0.001).round() as u64;
     let jog = post(
         &s,
         "/api/v1/axes/y/jog",
@@ -260,13 +266,48 @@ async fn a_jog_without_keepalive_is_stopped_by_its_deadman() {
     let fin = until_final(&s, id, 10).await;
     assert_eq!(fin["state"], "error", "{fin}");
     assert_eq!(fin["error_code"], "deadman_timeout", "{fin}");
-    let accepted = fin["accepted_cycle"].as_u64().unwrap();
+    assert_eq!(
+        fin["outputs"]["error_id"].as_u64(),
+        Some(DEADMAN_TIMEOUT),
+        "{fin}"
+    );
+    let events = fin["events"].as_array().unwrap();
+    let start = events[0]["cycle"].as_u64().unwrap();
+    assert_eq!(fin["accepted_cycle"].as_u64(), Some(start), "{fin}");
+    let fired = events
+        .iter()
+        .position(|e| e["outputs"]["warning_id"].as_u64() == Some(DEADMAN_TIMEOUT))
+        .unwrap_or_else(|| panic!("no dead-man event: {fin}"));
+    let f = &events[fired]["outputs"];
+    assert_eq!(f["warning"], true, "{fin}");
+    assert_eq!(f["in_velocity"], false, "{fin}");
+    assert_eq!(f["busy"], true, "{fin}");
+    assert_eq!(f["error"], false, "{fin}");
+    assert_eq!(
+        events[fired - 1]["outputs"]["in_velocity"],
+        true,
+        "the jog never reached its velocity before the dead-man: {fin}"
+    );
+    let fired_cycle = events[fired]["cycle"].as_u64().unwrap();
+    assert!(
+        fired_cycle - start <= deadman_cycles + 1,
+        "dead-man fired at cycle {fired_cycle}, {} cycles after the jog took effect (limit {}): {fin}",
+        fired_cycle - start,
+        deadman_cycles + 1
+    );
+    assert!(
+        fired_cycle - start + 1 >= deadman_cycles,
+        "dead-man fired early, {} cycles after the jog took effect: {fin}",
+        fired_cycle - start
+    );
     let end = fin["last_cycle"].as_u64().unwrap();
     assert!(
-        end > accepted + (deadman / 0.001) as u64,
-        "stopped before its dead-man time: {fin}"
+        end > fired_cycle,
+        "ended in the cycle the dead-man fired: {fin}"
     );
-    assert_eq!(status(&s, "y").await["status"]["moving"], false);
+    let st = status(&s, "y").await["status"].clone();
+    assert_eq!(st["moving"], false, "{st}");
+    assert_eq!(st["state"], "standstill", "{st}");
 }
 
 #[tokio::test(flavor = "multi_thread")]

@@ -10,8 +10,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
 
 use crossbeam_queue::ArrayQueue;
 use motion::{
-    Axis, AxisSlot, AxisState, AxisStatus, Command, CommandEvent, DriveFeedback, DriveSetpoint,
-    ErrorId, EventSink, Kernel, Verdict,
+    Axis, AxisSlot, AxisStatus, Command, CommandEvent, DriveFeedback, DriveSetpoint, ErrorId,
+    EventSink, Kernel, Verdict,
 };
 
 use crate::sim::SimDrive;
@@ -48,6 +48,9 @@ pub enum Request {
 #[derive(Clone, Copy, Debug)]
 pub struct Reply {
     pub ticket: u64,
+    /// The cycle the request takes effect in: the step that follows the drain. The kernel
+    /// stamps the events of an accepted command's submit with this number too, and the
+    /// snapshot of that step carries it.
     pub cycle: u64,
     pub result: Result<(), ErrorId>,
 }
@@ -285,7 +288,7 @@ impl CycleThread {
                 break;
             };
             drained += 1;
-            let cycle = self.kernel.cycle();
+            let cycle = self.kernel.cycle() + 1;
             let reply = match req {
                 Request::Command(cmd) => {
                     let result = match self.kernel.submit(cmd, &mut sink) {
@@ -305,7 +308,7 @@ impl CycleThread {
                     drive,
                     require_disabled,
                 } => {
-                    if require_disabled && !self.disabled(slot) {
+                    if require_disabled && !self.kernel.is_disabled(slot) {
                         self.discard(Garbage::Axis(axis));
                         self.discard(Garbage::Drive(drive));
                         Reply {
@@ -345,7 +348,7 @@ impl CycleThread {
                     slot,
                     require_disabled,
                 } => {
-                    if require_disabled && !self.disabled(slot) {
+                    if require_disabled && !self.kernel.is_disabled(slot) {
                         Reply {
                             ticket,
                             cycle,
@@ -394,13 +397,6 @@ impl CycleThread {
         }
         self.snapshot.publish();
         shared.cycle.store(cycle, Relaxed);
-    }
-
-    fn disabled(&self, slot: AxisSlot) -> bool {
-        match self.kernel.status(slot) {
-            Some(s) => s.state == AxisState::Disabled && !s.power_status,
-            None => true,
-        }
     }
 
     fn discard(&self, g: Garbage) {

@@ -335,12 +335,14 @@ pub struct ClientInfo {
     "parameters": {"position": 100.0, "velocity": 200.0},
     "state": "done", "final": true,
     "outputs": {"busy": false, "active": false, "done": true, "command_aborted": false, "error": false,
-                "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false},
+                "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+                "warning": false, "warning_id": 0},
     "accepted_cycle": 1200, "last_cycle": 1873,
     "submitted_at": "2025-01-01T12:00:00.000Z", "finished_at": "2025-01-01T12:00:00.673Z",
     "client": {"addr": "127.0.0.1:50312", "via": "rest"},
     "events": [{"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
-                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false}}]
+                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+                "warning": false, "warning_id": 0}}]
 }))]
 pub struct CommandResource {
     pub id: u64,
@@ -358,7 +360,9 @@ pub struct CommandResource {
     pub outputs: FbOutputs,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error_code: Option<&'static str>,
+    /// The cycle the command took effect in (the cycle of its first event).
     pub accepted_cycle: u64,
+    /// The cycle of its latest output change.
     pub last_cycle: u64,
     pub submitted_at: String,
     #[serde(skip_serializing_if = "Option::is_none")]
