@@ -164,6 +164,31 @@ async fn rpc_errors_and_unsubscribe() {
     .await;
     let (r, _) = response(&mut ws, 3).await;
     assert_eq!(r["error"]["data"]["error_id"], 0x4B01, "{r}");
+    // The newer function blocks are methods too, validated like their REST endpoints.
+    send(
+        &mut ws,
+        30,
+        "move-superimposed",
+        json!({"axis": "x", "distance": 1.0, "velocity_diff": 0.0, "velocity_process": 10.0, "length": 10.0}),
+    )
+    .await;
+    let (r, _) = response(&mut ws, 30).await;
+    assert_eq!(
+        r["error"]["data"]["errors"][0]["field"], "velocity_diff",
+        "{r}"
+    );
+    send(
+        &mut ws,
+        31,
+        "gear-in-dyn",
+        json!({"axis": "y", "master": "nobody", "gear_ratio": 1.0}),
+    )
+    .await;
+    let (r, _) = response(&mut ws, 31).await;
+    assert_eq!(r["error"]["data"]["errors"][0]["field"], "master", "{r}");
+    send(&mut ws, 32, "abort-superposition", json!({"axis": "x"})).await;
+    let (r, _) = response(&mut ws, 32).await;
+    assert_eq!(r["result"]["command"], "abort-superposition", "{r}");
     send(
         &mut ws,
         4,

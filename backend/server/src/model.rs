@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use motion::{
     AxisParameters, AxisState, BufferMode, Direction, Dynamics, FbOutputs, HomingMode,
-    HomingOptions, JogMode, MoveOptions,
+    HomingOptions, JogMode, MoveOptions, SuperpositionAbortOption, SuperpositionMode,
 };
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
@@ -569,6 +569,49 @@ pub struct GearInBody {
     pub master: String,
     pub ratio_numerator: f64,
     pub ratio_denominator: u16,
+}
+
+/// MC_GearInDyn (Enable-type): stays active until released with `DELETE /commands/{id}`
+/// (Enable FALSE: the ratio freezes, the slave stays coupled). A further gear-in-dyn to the
+/// same master while this one is enabled takes over and changes the ratio.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "gear_ratio": 1.5, "acceleration": 500.0}))]
+pub struct GearInDynBody {
+    /// Master axis id or name.
+    pub master: String,
+    /// Slave travel per master travel (signed).
+    pub gear_ratio: f64,
+    /// Slave acceleration that a ratio change may cause at the master's maximum velocity,
+    /// units/s² (0 = the slave's AxisAcc #1004).
+    #[serde(default)]
+    pub acceleration: f64,
+}
+
+/// MC_MoveSuperImposed: a relative motion laid over the running one.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"distance": 10.0, "velocity_diff": 50.0, "velocity_process": 200.0, "length": 200.0}))]
+pub struct MoveSuperImposedBody {
+    /// What `length` refers to and what is minimised.
+    #[serde(default)]
+    pub mode: SuperpositionMode,
+    /// Distance to make up (> 0: get ahead, < 0: fall back), units.
+    pub distance: f64,
+    /// Largest velocity difference to the main motion (> 0), units/s.
+    pub velocity_diff: f64,
+    /// 0 = the axis default.
+    #[serde(default)]
+    pub acceleration: f64,
+    /// 0 = the axis default.
+    #[serde(default)]
+    pub deceleration: f64,
+    /// Mean velocity of the main motion while the superposition runs (> 0), units/s.
+    pub velocity_process: f64,
+    /// Travel available for the superposition (> 0), units; see `mode`.
+    pub length: f64,
+    #[serde(default)]
+    pub abort_option: SuperpositionAbortOption,
 }
 
 pub fn dynamics(acceleration: f64, deceleration: f64, jerk: f64) -> Dynamics {

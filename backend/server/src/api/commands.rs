@@ -7,7 +7,7 @@ use axum::Json;
 use axum::extract::{Path, State};
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use motion::{CommandKind, Direction, JogMode, Positioning};
+use motion::{AxisSlot, CommandKind, Direction, JogMode, Positioning, Superposition};
 use serde::Deserialize;
 use utoipa::IntoParams;
 
@@ -80,11 +80,12 @@ impl CommandBody for PowerBody {
 
 impl CommandBody for EmptyBody {
     fn to_kind(&self, name: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
-        Ok(if name == "reset" {
-            CommandKind::Reset
-        } else {
-            CommandKind::GearOut
-        })
+        match name {
+            "reset" => Ok(CommandKind::Reset),
+            "gear-out" => Ok(CommandKind::GearOut),
+            "abort-superposition" => Ok(CommandKind::AbortSuperposition),
+            _ => Err(ApiError::not_found("command", name)),
+        }
     }
 }
 
@@ -283,27 +284,72 @@ impl CommandBody for HomeBody {
     }
 }
 
+/// The master of a coupling: an axis other than the slave.
+fn master_slot(c: &mut Check, reg: &Registry, axis: &AxisEntry, master: &str) -> AxisSlot {
+    match reg.find(master) {
+        None => {
+            c.fail("master", "no such axis");
+            0
+        }
+        Some(m) if m.id == axis.id => {
+            c.fail("master", "an axis cannot be its own master");
+            0
+        }
+        Some(m) => m.slot,
+    }
+}
+
 impl CommandBody for GearInBody {
     fn to_kind(&self, _: &str, reg: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind> {
         let mut c = Check::default();
-        let master = reg.find(&self.master);
-        match master {
-            None => c.fail("master", "no such axis"),
-            Some(m) if m.id == axis.id => c.fail("master", "an axis cannot be its own master"),
-            _ => {}
-        }
+        let master = master_slot(&mut c, reg, axis, &self.master);
         if !(self.ratio_numerator.is_finite() && self.ratio_numerator != 0.0) {
             c.fail("ratio_numerator", "must be a finite number other than 0");
         }
         if self.ratio_denominator == 0 {
             c.fail("ratio_denominator", "must be ≥ 1");
         }
-        let slot = master.map_or(0, |m| m.slot);
         c.done(CommandKind::GearIn {
-            master: slot,
+            master,
             ratio_numerator: self.ratio_numerator,
             ratio_denominator: self.ratio_denominator,
         })
+    }
+}
+
+impl CommandBody for GearInDynBody {
+    fn to_kind(&self, _: &str, reg: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        c.finite("gear_ratio", self.gear_ratio);
+        c.non_negative("acceleration", self.acceleration);
+        c.done(CommandKind::GearInDyn {
+            master,
+            gear_ratio: self.gear_ratio,
+            acceleration: self.acceleration,
+        })
+    }
+}
+
+impl CommandBody for MoveSuperImposedBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("distance", self.distance);
+        c.positive("velocity_diff", self.velocity_diff);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.positive("velocity_process", self.velocity_process);
+        c.positive("length", self.length);
+        c.done(CommandKind::MoveSuperImposed(Superposition {
+            mode: self.mode,
+            distance: self.distance,
+            velocity_diff: self.velocity_diff,
+            acceleration: self.acceleration,
+            deceleration: self.deceleration,
+            velocity_process: self.velocity_process,
+            length: self.length,
+            abort_option: self.abort_option,
+        }))
     }
 }
 
@@ -485,11 +531,32 @@ command_endpoint!(
     "MC_GearIn: couple to a master (wait returns at in_gear)"
 );
 command_endpoint!(
+    gear_in_dyn,
+    "/api/v1/axes/{axis}/gear-in-dyn",
+    "gear-in-dyn",
+    GearInDynBody,
+    "MC_GearInDyn: couple with a ratio that may change while enabled (a further gear-in-dyn to the same master changes it; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratio frozen, still coupled)"
+);
+command_endpoint!(
     gear_out,
     "/api/v1/axes/{axis}/gear-out",
     "gear-out",
     EmptyBody,
     "MC_GearOut"
+);
+command_endpoint!(
+    move_superimposed,
+    "/api/v1/axes/{axis}/move-superimposed",
+    "move-superimposed",
+    MoveSuperImposedBody,
+    "MC_MoveSuperImposed: lay a relative distance over the running motion (409 axis_not_moving at standstill; warning 0x4243 when it can only be done in part)"
+);
+command_endpoint!(
+    abort_superposition,
+    "/api/v1/axes/{axis}/abort-superposition",
+    "abort-superposition",
+    EmptyBody,
+    "MC_AbortSuperposition: end a running superposition (what it applied so far stays)"
 );
 
 fn parse_id(id: &str) -> ApiResult<u64> {
@@ -566,7 +633,7 @@ fn slot_of(s: &AppState, id: u64) -> ApiResult<u16> {
 }
 
 #[utoipa::path(delete, path = "/api/v1/commands/{id}", tag = "commands",
-    summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog or a power",
+    summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog, a power or a gear-in-dyn",
     params(("id" = u64, Path, description = "command id")),
     responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandErrors))]
 pub async fn release_command(

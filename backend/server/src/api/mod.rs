@@ -135,7 +135,16 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/axes/{axis}/jog", post(commands::jog))
         .route("/axes/{axis}/home", post(commands::home))
         .route("/axes/{axis}/gear-in", post(commands::gear_in))
+        .route("/axes/{axis}/gear-in-dyn", post(commands::gear_in_dyn))
         .route("/axes/{axis}/gear-out", post(commands::gear_out))
+        .route(
+            "/axes/{axis}/move-superimposed",
+            post(commands::move_superimposed),
+        )
+        .route(
+            "/axes/{axis}/abort-superposition",
+            post(commands::abort_superposition),
+        )
         .route("/commands", get(commands::list_commands))
         .route(
             "/commands/{id}",
@@ -181,7 +190,8 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         commands::power, commands::reset, commands::set_position, commands::set_override,
         commands::move_absolute, commands::move_relative, commands::move_additive, commands::move_modulo,
         commands::move_velocity, commands::move_continuous_absolute, commands::move_continuous_relative,
-        commands::halt, commands::stop, commands::jog, commands::home, commands::gear_in, commands::gear_out,
+        commands::halt, commands::stop, commands::jog, commands::home, commands::gear_in, commands::gear_in_dyn, commands::gear_out,
+        commands::move_superimposed, commands::abort_superposition,
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
         axes::export_config, axes::import_config, system::system, system::metrics, ws::upgrade,
     ),

@@ -406,7 +406,10 @@ pub const COMMANDS: &[&str] = &[
     "jog",
     "home",
     "gear-in",
+    "gear-in-dyn",
     "gear-out",
+    "move-superimposed",
+    "abort-superposition",
 ];
 
 async fn typed<B: CommandBody>(
@@ -432,7 +435,9 @@ async fn dispatch(
 ) -> Result<CommandResource, ApiError> {
     match name {
         "power" => typed::<PowerBody>(s, name, axis, raw, client, wait).await,
-        "reset" | "gear-out" => typed::<EmptyBody>(s, name, axis, raw, client, wait).await,
+        "reset" | "gear-out" | "abort-superposition" => {
+            typed::<EmptyBody>(s, name, axis, raw, client, wait).await
+        }
         "set-position" => typed::<SetPositionBody>(s, name, axis, raw, client, wait).await,
         "set-override" => typed::<SetOverrideBody>(s, name, axis, raw, client, wait).await,
         "move-absolute" | "move-relative" | "move-additive" | "move-modulo" => {
@@ -447,6 +452,10 @@ async fn dispatch(
         "jog" => typed::<JogBody>(s, name, axis, raw, client, wait).await,
         "home" => typed::<HomeBody>(s, name, axis, raw, client, wait).await,
         "gear-in" => typed::<GearInBody>(s, name, axis, raw, client, wait).await,
+        "gear-in-dyn" => typed::<GearInDynBody>(s, name, axis, raw, client, wait).await,
+        "move-superimposed" => {
+            typed::<MoveSuperImposedBody>(s, name, axis, raw, client, wait).await
+        }
         _ => Err(ApiError::not_found("method", name)),
     }
 }
