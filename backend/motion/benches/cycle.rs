@@ -16,7 +16,13 @@ struct Machine {
 }
 
 fn mv(position: f64) -> Positioning {
-    Positioning { position, velocity: 400.0, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }
+    Positioning {
+        position,
+        velocity: 400.0,
+        dynamics: Dynamics::default(),
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
 }
 
 impl Machine {
@@ -25,11 +31,37 @@ impl Machine {
         for i in 0..n {
             let mut p = AxisParameters::default();
             p.axis_max_pos_lag_value = 1e6;
-            k.insert_axis(i as u16, Axis::new(AxisConfig { modulo: false, parameters: p }, 0.001)).unwrap();
+            k.insert_axis(
+                i as u16,
+                Axis::new(
+                    AxisConfig {
+                        modulo: false,
+                        parameters: p,
+                    },
+                    0.001,
+                ),
+            )
+            .unwrap();
         }
-        let mut m = Machine { k, fb: vec![DriveFeedback::default(); n], sp: vec![DriveSetpoint::default(); n], events: Vec::with_capacity(1 << 16), n, next_id: 0, cycle: 0 };
+        let mut m = Machine {
+            k,
+            fb: vec![DriveFeedback::default(); n],
+            sp: vec![DriveSetpoint::default(); n],
+            events: Vec::with_capacity(1 << 16),
+            n,
+            next_id: 0,
+            cycle: 0,
+        };
         for a in 0..n as u16 {
-            m.submit(a, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+            m.submit(
+                a,
+                CommandKind::Power {
+                    enable: true,
+                    enable_positive: true,
+                    enable_negative: true,
+                    override_percent: 100.0,
+                },
+            );
         }
         for _ in 0..10 {
             m.cycle_once();
@@ -38,9 +70,35 @@ impl Machine {
             let axis = a as u16;
             match a % 4 {
                 0 => m.submit(axis, CommandKind::MoveAbsolute(mv(200.0))),
-                1 => m.submit(axis, CommandKind::MoveVelocity { velocity: 300.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }),
-                2 => m.submit(axis, CommandKind::GearIn { master: (a - 2) as u16, ratio_numerator: 0.5, ratio_denominator: 1 }),
-                _ => m.submit(axis, CommandKind::Jog { mode: JogMode::Continuous, forward: true, position: 0.0, velocity: 50.0, dynamics: Dynamics::default(), deadman: 0.0 }),
+                1 => m.submit(
+                    axis,
+                    CommandKind::MoveVelocity {
+                        velocity: 300.0,
+                        dynamics: Dynamics::default(),
+                        direction: Direction::Positive,
+                        buffer_mode: BufferMode::Aborting,
+                        options: MoveOptions::default(),
+                    },
+                ),
+                2 => m.submit(
+                    axis,
+                    CommandKind::GearIn {
+                        master: (a - 2) as u16,
+                        ratio_numerator: 0.5,
+                        ratio_denominator: 1,
+                    },
+                ),
+                _ => m.submit(
+                    axis,
+                    CommandKind::Jog {
+                        mode: JogMode::Continuous,
+                        forward: true,
+                        position: 0.0,
+                        velocity: 50.0,
+                        dynamics: Dynamics::default(),
+                        deadman: 0.0,
+                    },
+                ),
             };
         }
         m
@@ -48,7 +106,14 @@ impl Machine {
 
     fn submit(&mut self, axis: u16, kind: CommandKind) -> Verdict {
         self.next_id += 1;
-        self.k.submit(Command { id: self.next_id, axis, kind }, &mut self.events)
+        self.k.submit(
+            Command {
+                id: self.next_id,
+                axis,
+                kind,
+            },
+            &mut self.events,
+        )
     }
 
     fn cycle_once(&mut self) {
@@ -59,10 +124,22 @@ impl Machine {
             let axis = a as u16;
             match a % 4 {
                 1 => {
-                    self.submit(axis, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: o });
+                    self.submit(
+                        axis,
+                        CommandKind::Power {
+                            enable: true,
+                            enable_positive: true,
+                            enable_negative: true,
+                            override_percent: o,
+                        },
+                    );
                 }
                 0 if !self.k.status(axis).unwrap().has_job => {
-                    let to = if self.k.status(axis).unwrap().set_position > 100.0 { 0.0 } else { 200.0 };
+                    let to = if self.k.status(axis).unwrap().set_position > 100.0 {
+                        0.0
+                    } else {
+                        200.0
+                    };
                     self.submit(axis, CommandKind::MoveAbsolute(mv(to)));
                 }
                 _ => {}
@@ -86,7 +163,9 @@ fn cycle(c: &mut Criterion) {
     for n in [1usize, 8, 64] {
         // With one axis it is a positioning axis moving back and forth.
         let mut m = Machine::new(n);
-        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| b.iter(|| m.cycle_once()));
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            b.iter(|| m.cycle_once())
+        });
     }
     g.finish();
     // The step alone, without the benchmark's own command traffic, at 64 axes.

@@ -234,37 +234,91 @@ pub struct Positioning {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CommandKind {
     /// MC_Power. Level-type: stays busy while enabled; `Release` = Enable FALSE.
-    Power { enable: bool, enable_positive: bool, enable_negative: bool, override_percent: f64 },
+    Power {
+        enable: bool,
+        enable_positive: bool,
+        enable_negative: bool,
+        override_percent: f64,
+    },
     /// MC_Reset.
     Reset,
     /// MC_SetPosition.
-    SetPosition { position: f64, relative: bool, clear_position_lag: bool },
+    SetPosition {
+        position: f64,
+        relative: bool,
+        clear_position_lag: bool,
+    },
     /// MC_SetOverride (velocity factor 0..=1).
-    SetOverride { velocity_factor: f64 },
+    SetOverride {
+        velocity_factor: f64,
+    },
     MoveAbsolute(Positioning),
     MoveRelative(Positioning),
     MoveAdditive(Positioning),
-    MoveModulo { move_: Positioning, direction: Direction },
-    MoveVelocity { velocity: f64, dynamics: Dynamics, direction: Direction, buffer_mode: BufferMode, options: MoveOptions },
-    MoveContinuousAbsolute { move_: Positioning, end_velocity: f64 },
-    MoveContinuousRelative { move_: Positioning, end_velocity: f64 },
+    MoveModulo {
+        move_: Positioning,
+        direction: Direction,
+    },
+    MoveVelocity {
+        velocity: f64,
+        dynamics: Dynamics,
+        direction: Direction,
+        buffer_mode: BufferMode,
+        options: MoveOptions,
+    },
+    MoveContinuousAbsolute {
+        move_: Positioning,
+        end_velocity: f64,
+    },
+    MoveContinuousRelative {
+        move_: Positioning,
+        end_velocity: f64,
+    },
     /// MC_Halt; deceleration/jerk ≤ 0 mean "those of the running job".
-    Halt { deceleration: f64, jerk: f64, buffer_mode: BufferMode, options: MoveOptions },
+    Halt {
+        deceleration: f64,
+        jerk: f64,
+        buffer_mode: BufferMode,
+        options: MoveOptions,
+    },
     /// MC_Stop; locks the axis until released or reset.
-    Stop { deceleration: f64, jerk: f64, options: MoveOptions },
+    Stop {
+        deceleration: f64,
+        jerk: f64,
+        options: MoveOptions,
+    },
     /// MC_Jog: a rising edge of JogForward (`forward`) or JogBackwards.
     /// `deadman` > 0: stop when not renewed (`Keepalive`) within this many seconds.
-    Jog { mode: JogMode, forward: bool, position: f64, velocity: f64, dynamics: Dynamics, deadman: f64 },
+    Jog {
+        mode: JogMode,
+        forward: bool,
+        position: f64,
+        velocity: f64,
+        dynamics: Dynamics,
+        deadman: f64,
+    },
     /// MC_Home; `position` None = the configured calibration value (#1075).
-    Home { position: Option<f64>, mode: HomingMode, options: HomingOptions },
+    Home {
+        position: Option<f64>,
+        mode: HomingMode,
+        options: HomingOptions,
+    },
     /// MC_GearIn: this axis becomes the slave of `master`.
-    GearIn { master: AxisSlot, ratio_numerator: f64, ratio_denominator: u16 },
+    GearIn {
+        master: AxisSlot,
+        ratio_numerator: f64,
+        ratio_denominator: u16,
+    },
     /// MC_GearInDyn (Enable-type): couple with a ratio that may change every cycle; a
     /// further GearInDyn to the same master while enabled updates the ratio. `Release` =
     /// Enable FALSE: the ratio freezes and the slave stays coupled. `acceleration` (0 =
     /// default #1004) limits the slave acceleration caused by ratio changes at the master's
     /// maximum velocity.
-    GearInDyn { master: AxisSlot, gear_ratio: f64, acceleration: f64 },
+    GearInDyn {
+        master: AxisSlot,
+        gear_ratio: f64,
+        acceleration: f64,
+    },
     /// MC_GearOut.
     GearOut,
     /// MC_MoveSuperImposed: a relative motion laid over the running one.
@@ -272,12 +326,19 @@ pub enum CommandKind {
     /// MC_AbortSuperposition.
     AbortSuperposition,
     /// MC_WriteParameter / MC_WriteBoolParameter at runtime (value already validated).
-    WriteParameter { number: u16, value: f64 },
+    WriteParameter {
+        number: u16,
+        value: f64,
+    },
     /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
     /// switch off a Power).
-    Release { target: CommandId },
+    Release {
+        target: CommandId,
+    },
     /// Renews a jog's dead-man.
-    Keepalive { target: CommandId },
+    Keepalive {
+        target: CommandId,
+    },
 }
 
 impl CommandKind {

@@ -43,7 +43,11 @@ impl Kernel {
 
     /// Puts a ready-built axis into a slot and returns what was there (to be freed off the
     /// cycle thread). Does not allocate.
-    pub fn insert_axis(&mut self, slot: AxisSlot, axis: Box<Axis>) -> Result<Option<Box<Axis>>, Box<Axis>> {
+    pub fn insert_axis(
+        &mut self,
+        slot: AxisSlot,
+        axis: Box<Axis>,
+    ) -> Result<Option<Box<Axis>>, Box<Axis>> {
         match self.axes.get_mut(slot as usize) {
             Some(s) => Ok(s.replace(axis)),
             None => Err(axis),
@@ -87,7 +91,9 @@ impl Kernel {
                 let mut m = Some(master);
                 for _ in 0..self.axes.len() {
                     match m {
-                        Some(x) if x as usize == slot => return Verdict::Rejected(ErrorId::MASTER_INVALID),
+                        Some(x) if x as usize == slot => {
+                            return Verdict::Rejected(ErrorId::MASTER_INVALID);
+                        }
                         Some(x) => m = self.axis(x).and_then(|a| a.master_slot()),
                         None => break,
                     }
@@ -110,7 +116,12 @@ impl Kernel {
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
     /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
     /// a drive that is not ready / left untouched).
-    pub fn step(&mut self, feedback: &[DriveFeedback], setpoints: &mut [DriveSetpoint], events: &mut impl EventSink) {
+    pub fn step(
+        &mut self,
+        feedback: &[DriveFeedback],
+        setpoints: &mut [DriveSetpoint],
+        events: &mut impl EventSink,
+    ) {
         self.cycle += 1;
         let cycle = self.cycle;
         let dt = self.cycle_time;

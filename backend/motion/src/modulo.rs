@@ -8,7 +8,14 @@ use crate::error::ErrorId;
 /// with period `period` and tolerance window half width `tf`. `from_standstill`: targets
 /// ≥ period add full turns; in motion the extra turns are ignored (the shortest path in the
 /// given direction is taken).
-pub fn modulo_end_position(s: f64, t: f64, period: f64, tf: f64, direction: Direction, from_standstill: bool) -> Result<f64, ErrorId> {
+pub fn modulo_end_position(
+    s: f64,
+    t: f64,
+    period: f64,
+    tf: f64,
+    direction: Direction,
+    from_standstill: bool,
+) -> Result<f64, ErrorId> {
     if !(period > 0.0) || !period.is_finite() {
         return Err(ErrorId::PARAMETER_NOT_CORRECT);
     }
@@ -17,7 +24,11 @@ pub fn modulo_end_position(s: f64, t: f64, period: f64, tf: f64, direction: Dire
     }
     let base_turn = (s / period).floor() * period;
     let t0 = t.rem_euclid(period);
-    let extra_turns = if from_standstill { (t / period).floor() } else { 0.0 };
+    let extra_turns = if from_standstill {
+        (t / period).floor()
+    } else {
+        0.0
+    };
     let mut c = base_turn + t0;
     match direction {
         Direction::Positive => {
@@ -116,21 +127,40 @@ mod tests {
         for (dir, start, target, travel, end) in rows {
             let e = modulo_end_position(start, target, 360.0, 1.0, dir, true).unwrap();
             assert!(close(e, end), "{dir:?} {start} {target}: {e} != {end}");
-            assert!(close(e - start, travel), "{dir:?} {start} {target}: travel {}", e - start);
+            assert!(
+                close(e - start, travel),
+                "{dir:?} {start} {target}: travel {}",
+                e - start
+            );
             assert!(close(e.rem_euclid(360.0), 90.0));
         }
     }
 
     #[test]
     fn shortest_way_rejects_targets_beyond_one_period_and_negative_targets() {
-        assert_eq!(modulo_end_position(90.0, 360.0, 360.0, 1.0, ShortestWay, true), Err(ErrorId::INVALID_MODE));
-        assert_eq!(modulo_end_position(90.0, -1.0, 360.0, 1.0, Positive, true), Err(ErrorId::PARAMETER_NOT_CORRECT));
-        assert!(close(modulo_end_position(350.0, 10.0, 360.0, 1.0, ShortestWay, true).unwrap(), 370.0));
+        assert_eq!(
+            modulo_end_position(90.0, 360.0, 360.0, 1.0, ShortestWay, true),
+            Err(ErrorId::INVALID_MODE)
+        );
+        assert_eq!(
+            modulo_end_position(90.0, -1.0, 360.0, 1.0, Positive, true),
+            Err(ErrorId::PARAMETER_NOT_CORRECT)
+        );
+        assert!(close(
+            modulo_end_position(350.0, 10.0, 360.0, 1.0, ShortestWay, true).unwrap(),
+            370.0
+        ));
     }
 
     #[test]
     fn from_motion_extra_turns_are_ignored() {
-        assert!(close(modulo_end_position(90.0, 450.0, 360.0, 1.0, Positive, false).unwrap(), 90.0));
-        assert!(close(modulo_end_position(100.0, 450.0, 360.0, 1.0, Positive, false).unwrap(), 450.0));
+        assert!(close(
+            modulo_end_position(90.0, 450.0, 360.0, 1.0, Positive, false).unwrap(),
+            90.0
+        ));
+        assert!(close(
+            modulo_end_position(100.0, 450.0, 360.0, 1.0, Positive, false).unwrap(),
+            450.0
+        ));
     }
 }

@@ -28,9 +28,14 @@ pub struct Limits {
 
 impl Limits {
     pub fn is_valid(&self) -> bool {
-        [self.velocity, self.acceleration, self.deceleration, self.jerk]
-            .iter()
-            .all(|x| x.is_finite() && *x > 0.0)
+        [
+            self.velocity,
+            self.acceleration,
+            self.deceleration,
+            self.jerk,
+        ]
+        .iter()
+        .all(|x| x.is_finite() && *x > 0.0)
     }
 }
 
@@ -116,12 +121,20 @@ impl Planner {
             return Err(PlanError::InvalidInput);
         }
         let dist = target - from.position;
-        let dir = if dist != 0.0 { dist.signum() } else { from.velocity.signum() };
+        let dir = if dist != 0.0 {
+            dist.signum()
+        } else {
+            from.velocity.signum()
+        };
         // Will the profile have to turn around (moving away, or too fast to stop in time)?
         let away = from.velocity * dir < 0.0;
         let overshoot = from.velocity * dir > 0.0
-            && stop_distance(from.velocity, from.acceleration, limits.deceleration, limits.jerk)
-                > dist.abs();
+            && stop_distance(
+                from.velocity,
+                from.acceleration,
+                limits.deceleration,
+                limits.jerk,
+            ) > dist.abs();
         let (max_acc, min_acc) = if away || overshoot {
             let a = limits.acceleration.min(limits.deceleration);
             (a, -a)
@@ -151,14 +164,24 @@ impl Planner {
             let a = limits.acceleration.min(limits.deceleration);
             (a, -a)
         } else {
-            let dir = if target_velocity != 0.0 { target_velocity.signum() } else { from.velocity.signum() };
+            let dir = if target_velocity != 0.0 {
+                target_velocity.signum()
+            } else {
+                from.velocity.signum()
+            };
             direction_limits(dir, limits)
         };
         self.input.control_interface = ControlInterface::Velocity;
         self.input.target_position[0] = from.position;
         self.input.target_velocity[0] = target_velocity;
         // The velocity interface ignores the velocity limit, but Ruckig validates it.
-        let limits = Limits { velocity: limits.velocity.max(target_velocity.abs()).max(from.velocity.abs()), ..*limits };
+        let limits = Limits {
+            velocity: limits
+                .velocity
+                .max(target_velocity.abs())
+                .max(from.velocity.abs()),
+            ..*limits
+        };
         self.solve(from, &limits, max_acc, min_acc)
     }
 
@@ -176,15 +199,30 @@ impl Planner {
         min_acc: f64,
         jerk: f64,
     ) -> Result<f64, PlanError> {
-        let limits = Limits { velocity: max_velocity, acceleration: max_acc, deceleration: -min_acc, jerk };
+        let limits = Limits {
+            velocity: max_velocity,
+            acceleration: max_acc,
+            deceleration: -min_acc,
+            jerk,
+        };
         check(from, &limits)?;
-        self.input.control_interface = if velocity_interface { ControlInterface::Velocity } else { ControlInterface::Position };
+        self.input.control_interface = if velocity_interface {
+            ControlInterface::Velocity
+        } else {
+            ControlInterface::Position
+        };
         self.input.target_position[0] = target_position;
         self.input.target_velocity[0] = target_velocity;
         self.solve(from, &limits, max_acc, min_acc)
     }
 
-    fn solve(&mut self, from: Kinematics, limits: &Limits, max_acc: f64, min_acc: f64) -> Result<f64, PlanError> {
+    fn solve(
+        &mut self,
+        from: Kinematics,
+        limits: &Limits,
+        max_acc: f64,
+        min_acc: f64,
+    ) -> Result<f64, PlanError> {
         let inp = &mut self.input;
         inp.current_position[0] = from.position;
         inp.current_velocity[0] = from.velocity;
@@ -194,7 +232,10 @@ impl Planner {
         inp.max_acceleration[0] = max_acc;
         inp.min_acceleration = Some(rsruckig::daov_stack![min_acc]);
         inp.max_jerk[0] = limits.jerk;
-        let mut solved = matches!(self.otg.calculate(inp, &mut self.traj), Ok(RuckigResult::Working | RuckigResult::Finished));
+        let mut solved = matches!(
+            self.otg.calculate(inp, &mut self.traj),
+            Ok(RuckigResult::Working | RuckigResult::Finished)
+        );
         // rsruckig 3.0.1 fails on about 0.2 % of valid position problems in narrow
         // numerical bands that upstream Ruckig solves (backend/motion/tests/ruckig_golden.rs):
         // the same problem with limits a hair tighter lies outside the band. Tighter limits
@@ -209,7 +250,10 @@ impl Planner {
             inp.max_acceleration[0] = max_acc * k;
             inp.min_acceleration = Some(rsruckig::daov_stack![min_acc * k]);
             inp.max_jerk[0] = limits.jerk * k;
-            solved = matches!(self.otg.calculate(inp, &mut self.traj), Ok(RuckigResult::Working | RuckigResult::Finished));
+            solved = matches!(
+                self.otg.calculate(inp, &mut self.traj),
+                Ok(RuckigResult::Working | RuckigResult::Finished)
+            );
         }
         match solved {
             true => {
@@ -256,7 +300,11 @@ impl Planner {
         }
         let ext = &self.traj.get_position_extrema()[0];
         let tol = 1e-9 * (1.0 + target.abs());
-        if dir > 0.0 { ext.max + self.shift > target + tol } else { ext.min + self.shift < target - tol }
+        if dir > 0.0 {
+            ext.max + self.shift > target + tol
+        } else {
+            ext.min + self.shift < target - tol
+        }
     }
 
     /// Forgets the plan (the setpoint then holds still).
@@ -292,7 +340,12 @@ impl Planner {
         if self.plan == Plan::Ruckig && t >= self.duration {
             // At and beyond the end: the exact end state, then constant end velocity.
             let e = self.end;
-            return Kinematics { position: e.position + e.velocity * (t - self.duration), velocity: e.velocity, acceleration: 0.0, jerk: 0.0 };
+            return Kinematics {
+                position: e.position + e.velocity * (t - self.duration),
+                velocity: e.velocity,
+                acceleration: 0.0,
+                jerk: 0.0,
+            };
         }
         self.sample_raw(t)
     }
@@ -303,8 +356,20 @@ impl Planner {
         let mut a = rsruckig::daov_stack![0.0];
         let mut j = rsruckig::daov_stack![0.0];
         let mut section = None;
-        self.traj.at_time(t.min(self.duration), &mut Some(&mut p), &mut Some(&mut v), &mut Some(&mut a), &mut Some(&mut j), &mut section);
-        Kinematics { position: p[0] + self.shift, velocity: v[0], acceleration: a[0], jerk: j[0] }
+        self.traj.at_time(
+            t.min(self.duration),
+            &mut Some(&mut p),
+            &mut Some(&mut v),
+            &mut Some(&mut a),
+            &mut Some(&mut j),
+            &mut section,
+        );
+        Kinematics {
+            position: p[0] + self.shift,
+            velocity: v[0],
+            acceleration: a[0],
+            jerk: j[0],
+        }
     }
 
     /// The profile has reached its end state.
@@ -335,7 +400,11 @@ impl Planner {
 }
 
 fn check(from: Kinematics, limits: &Limits) -> Result<(), PlanError> {
-    if !limits.is_valid() || !from.position.is_finite() || !from.velocity.is_finite() || !from.acceleration.is_finite() {
+    if !limits.is_valid()
+        || !from.position.is_finite()
+        || !from.velocity.is_finite()
+        || !from.acceleration.is_finite()
+    {
         return Err(PlanError::InvalidInput);
     }
     Ok(())
@@ -357,7 +426,16 @@ pub fn stop_distance(v: f64, a: f64, dec: f64, jerk: f64) -> f64 {
     if v == 0.0 && a == 0.0 {
         return 0.0;
     }
-    let mut r = StopRamp::new(Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 }, dec, jerk);
+    let mut r = StopRamp::new(
+        Kinematics {
+            position: 0.0,
+            velocity: v,
+            acceleration: a,
+            jerk: 0.0,
+        },
+        dec,
+        jerk,
+    );
     r.distance_to_stop().abs()
 }
 
@@ -373,7 +451,12 @@ pub struct StopRamp {
 
 impl StopRamp {
     pub fn new(from: Kinematics, dec: f64, jerk: f64) -> Self {
-        StopRamp { k: from, dec, jerk, done: from.velocity == 0.0 && from.acceleration == 0.0 }
+        StopRamp {
+            k: from,
+            dec,
+            jerk,
+            done: from.velocity == 0.0 && from.acceleration == 0.0,
+        }
     }
 
     pub fn finished(&self) -> bool {
@@ -383,7 +466,11 @@ impl StopRamp {
     /// Integrates the ramp analytically to the end and returns the travelled distance.
     fn distance_to_stop(&mut self) -> f64 {
         // Work in the frame where v ≥ 0.
-        let s = if self.k.velocity != 0.0 { self.k.velocity.signum() } else { -self.k.acceleration.signum() };
+        let s = if self.k.velocity != 0.0 {
+            self.k.velocity.signum()
+        } else {
+            -self.k.acceleration.signum()
+        };
         let (mut v, mut a) = (self.k.velocity * s, self.k.acceleration * s);
         let (d, j) = (self.dec, self.jerk);
         let mut x = 0.0;
@@ -429,7 +516,11 @@ impl StopRamp {
             self.k.jerk = 0.0;
             return self.k;
         }
-        let s = if self.k.velocity != 0.0 { self.k.velocity.signum() } else { -self.k.acceleration.signum() };
+        let s = if self.k.velocity != 0.0 {
+            self.k.velocity.signum()
+        } else {
+            -self.k.acceleration.signum()
+        };
         let (v, a) = (self.k.velocity * s, self.k.acceleration * s);
         let j = self.jerk;
         // Jerk choice in the v ≥ 0 frame: braking acceleration is negative.
@@ -454,7 +545,12 @@ impl StopRamp {
             na = 0.0;
             self.done = true;
         }
-        self.k = Kinematics { position: np, velocity: s * nv, acceleration: s * na, jerk: s * jj };
+        self.k = Kinematics {
+            position: np,
+            velocity: s * nv,
+            acceleration: s * na,
+            jerk: s * jj,
+        };
         self.k
     }
 }
@@ -463,7 +559,12 @@ impl StopRamp {
 mod tests {
     use super::*;
 
-    const LIM: Limits = Limits { velocity: 100.0, acceleration: 1000.0, deceleration: 500.0, jerk: 10000.0 };
+    const LIM: Limits = Limits {
+        velocity: 100.0,
+        acceleration: 1000.0,
+        deceleration: 500.0,
+        jerk: 10000.0,
+    };
 
     fn run(p: &mut Planner, dt: f64) -> Vec<Kinematics> {
         let mut out = Vec::new();
@@ -477,7 +578,9 @@ mod tests {
     #[test]
     fn position_plan_reaches_target_and_uses_dec_for_braking() {
         let mut p = Planner::new(0.001);
-        let d = p.plan_position(Kinematics::default(), 50.0, 0.0, &LIM).unwrap();
+        let d = p
+            .plan_position(Kinematics::default(), 50.0, 0.0, &LIM)
+            .unwrap();
         assert!(d > 0.5 && d < 1.0, "duration {d}");
         let ks = run(&mut p, 0.001);
         let last = ks.last().unwrap();
@@ -492,7 +595,8 @@ mod tests {
     #[test]
     fn negative_direction_swaps_signed_limits() {
         let mut p = Planner::new(0.001);
-        p.plan_position(Kinematics::default(), -50.0, 0.0, &LIM).unwrap();
+        p.plan_position(Kinematics::default(), -50.0, 0.0, &LIM)
+            .unwrap();
         let ks = run(&mut p, 0.001);
         let amin = ks.iter().map(|k| k.acceleration).fold(f64::MAX, f64::min);
         let amax = ks.iter().map(|k| k.acceleration).fold(f64::MIN, f64::max);
@@ -503,35 +607,79 @@ mod tests {
     #[test]
     fn velocity_plan_to_zero_stops() {
         let mut p = Planner::new(0.001);
-        let from = Kinematics { position: 0.0, velocity: 80.0, acceleration: 300.0, jerk: 0.0 };
+        let from = Kinematics {
+            position: 0.0,
+            velocity: 80.0,
+            acceleration: 300.0,
+            jerk: 0.0,
+        };
         p.plan_velocity(from, 0.0, &LIM).unwrap();
         let ks = run(&mut p, 0.001);
         let last = ks.last().unwrap();
         assert!(last.velocity.abs() < 1e-9 && last.acceleration.abs() < 1e-9);
         // The prediction of the closed form stop agrees roughly (it assumes the same limits).
         let sd = stop_distance(80.0, 300.0, 500.0, 10000.0);
-        assert!((sd - last.position).abs() / last.position < 0.05, "{sd} vs {}", last.position);
+        assert!(
+            (sd - last.position).abs() / last.position < 0.05,
+            "{sd} vs {}",
+            last.position
+        );
     }
 
     #[test]
     fn invalid_limits_are_rejected() {
         let mut p = Planner::new(0.001);
-        let bad = Limits { jerk: f64::NAN, ..LIM };
-        assert_eq!(p.plan_position(Kinematics::default(), 1.0, 0.0, &bad), Err(PlanError::InvalidInput));
-        let bad = Limits { velocity: 0.0, ..LIM };
-        assert_eq!(p.plan_position(Kinematics::default(), 1.0, 0.0, &bad), Err(PlanError::InvalidInput));
+        let bad = Limits {
+            jerk: f64::NAN,
+            ..LIM
+        };
+        assert_eq!(
+            p.plan_position(Kinematics::default(), 1.0, 0.0, &bad),
+            Err(PlanError::InvalidInput)
+        );
+        let bad = Limits {
+            velocity: 0.0,
+            ..LIM
+        };
+        assert_eq!(
+            p.plan_position(Kinematics::default(), 1.0, 0.0, &bad),
+            Err(PlanError::InvalidInput)
+        );
     }
 
     #[test]
     fn fallback_stop_respects_limits_and_stops() {
-        for &(v, a) in &[(80.0, 0.0), (80.0, 400.0), (-60.0, -200.0), (5.0, -450.0), (-3.0, 100.0)] {
-            let mut r = StopRamp::new(Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 }, 500.0, 10000.0);
-            let mut prev = Kinematics { position: 0.0, velocity: v, acceleration: a, jerk: 0.0 };
+        for &(v, a) in &[
+            (80.0, 0.0),
+            (80.0, 400.0),
+            (-60.0, -200.0),
+            (5.0, -450.0),
+            (-3.0, 100.0),
+        ] {
+            let mut r = StopRamp::new(
+                Kinematics {
+                    position: 0.0,
+                    velocity: v,
+                    acceleration: a,
+                    jerk: 0.0,
+                },
+                500.0,
+                10000.0,
+            );
+            let mut prev = Kinematics {
+                position: 0.0,
+                velocity: v,
+                acceleration: a,
+                jerk: 0.0,
+            };
             let mut n = 0;
             while !r.finished() {
                 let k = r.step(0.001);
                 assert!(k.acceleration.abs() <= 500.0f64.max(a.abs()) + 1e-9);
-                assert!((k.acceleration - prev.acceleration).abs() <= 10000.0 * 0.001 + 1e-9 || r.finished());
+                assert!(
+                    (k.acceleration - prev.acceleration).abs() <= 10000.0 * 0.001 + 1e-9
+                        || r.finished()
+                );
                 // never reverses
                 assert!(k.velocity * v >= -1e-12, "reversed: {k:?}");
                 prev = k;
@@ -539,7 +687,12 @@ mod tests {
                 assert!(n < 100_000);
             }
             let predicted = stop_distance(v, a, 500.0, 10000.0);
-            assert!((predicted.abs() - prev.position.abs()).abs() < 0.02 * predicted.abs().max(0.01) + 0.01, "v {v} a {a}: {predicted} vs {}", prev.position);
+            assert!(
+                (predicted.abs() - prev.position.abs()).abs()
+                    < 0.02 * predicted.abs().max(0.01) + 0.01,
+                "v {v} a {a}: {predicted} vs {}",
+                prev.position
+            );
         }
     }
 }

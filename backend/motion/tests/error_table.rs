@@ -13,7 +13,13 @@ fn table() -> String {
          | error_id | hex | code | meaning |\n|---:|---|---|---|\n",
     );
     for e in ErrorId::ALL {
-        s.push_str(&format!("| {} | 0x{:04X} | `{}` | {} |\n", e.0, e.0, e.code(), e.text()));
+        s.push_str(&format!(
+            "| {} | 0x{:04X} | `{}` | {} |\n",
+            e.0,
+            e.0,
+            e.code(),
+            e.text()
+        ));
     }
     s
 }
@@ -26,5 +32,8 @@ fn docs_errors_md_lists_every_error_number() {
         std::fs::write(path, &want).unwrap();
     }
     let have = std::fs::read_to_string(path).unwrap_or_default();
-    assert!(have == want, "docs/errors.md is stale: run MOTION_WRITE_DOCS=1 cargo test -p motion --test error_table");
+    assert!(
+        have == want,
+        "docs/errors.md is stale: run MOTION_WRITE_DOCS=1 cargo test -p motion --test error_table"
+    );
 }

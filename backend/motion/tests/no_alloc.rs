@@ -50,18 +50,43 @@ fn step_and_replanning_allocate_nothing() {
     for i in 0..N {
         let mut p = AxisParameters::default();
         p.axis_max_pos_lag_value = 100.0;
-        k.insert_axis(i as u16, Axis::new(AxisConfig { modulo: i % 2 == 1, parameters: p }, 0.001)).unwrap();
+        k.insert_axis(
+            i as u16,
+            Axis::new(
+                AxisConfig {
+                    modulo: i % 2 == 1,
+                    parameters: p,
+                },
+                0.001,
+            ),
+        )
+        .unwrap();
     }
     let mut fb = vec![DriveFeedback::default(); N];
     let mut sp = vec![DriveSetpoint::default(); N];
     let mut events: Vec<CommandEvent> = Vec::with_capacity(4096);
     let mut id = 0;
-    let mut submit = |k: &mut Kernel, events: &mut Vec<CommandEvent>, axis: u16, kind: CommandKind| {
-        id += 1;
-        assert_eq!(k.submit(Command { id, axis, kind }, events), Verdict::Accepted, "{kind:?}");
-    };
+    let mut submit =
+        |k: &mut Kernel, events: &mut Vec<CommandEvent>, axis: u16, kind: CommandKind| {
+            id += 1;
+            assert_eq!(
+                k.submit(Command { id, axis, kind }, events),
+                Verdict::Accepted,
+                "{kind:?}"
+            );
+        };
     for a in 0..N as u16 {
-        submit(&mut k, &mut events, a, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+        submit(
+            &mut k,
+            &mut events,
+            a,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+            },
+        );
     }
     for _ in 0..20 {
         k.step(&fb, &mut sp, &mut events);
@@ -74,22 +99,94 @@ fn step_and_replanning_allocate_nothing() {
     assert_eq!(allocations(), probe + 1);
     // Warm-up is over: from here on nothing may allocate.
     let before = allocations();
-    let mv = |p: f64| Positioning { position: p, velocity: 200.0, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() };
-    submit(&mut k, &mut events, 1, CommandKind::GearIn { master: 0, ratio_numerator: 2.0, ratio_denominator: 1 });
+    let mv = |p: f64| Positioning {
+        position: p,
+        velocity: 200.0,
+        dynamics: Dynamics::default(),
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    };
+    submit(
+        &mut k,
+        &mut events,
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 2.0,
+            ratio_denominator: 1,
+        },
+    );
     submit(&mut k, &mut events, 0, CommandKind::MoveAbsolute(mv(300.0)));
-    submit(&mut k, &mut events, 2, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Negative, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    submit(
+        &mut k,
+        &mut events,
+        2,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Negative,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     submit(&mut k, &mut events, 3, CommandKind::MoveAbsolute(mv(100.0)));
-    submit(&mut k, &mut events, 3, CommandKind::MoveAbsolute(Positioning { buffer_mode: BufferMode::BlendingHigh, ..mv(200.0) }));
-    submit(&mut k, &mut events, 4, CommandKind::Jog { mode: JogMode::Continuous, forward: true, position: 0.0, velocity: 50.0, dynamics: Dynamics::default(), deadman: 0.5 });
+    submit(
+        &mut k,
+        &mut events,
+        3,
+        CommandKind::MoveAbsolute(Positioning {
+            buffer_mode: BufferMode::BlendingHigh,
+            ..mv(200.0)
+        }),
+    );
+    submit(
+        &mut k,
+        &mut events,
+        4,
+        CommandKind::Jog {
+            mode: JogMode::Continuous,
+            forward: true,
+            position: 0.0,
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            deadman: 0.5,
+        },
+    );
     for c in 0..2000 {
         // Re-planning every cycle on axis 5 (override changes), keepalives on the jog.
         let o = 50.0 + 50.0 * ((c as f64) * 0.01).sin().abs();
-        submit(&mut k, &mut events, 5, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: o });
+        submit(
+            &mut k,
+            &mut events,
+            5,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: o,
+            },
+        );
         if c == 0 {
-            submit(&mut k, &mut events, 5, CommandKind::MoveVelocity { velocity: 150.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+            submit(
+                &mut k,
+                &mut events,
+                5,
+                CommandKind::MoveVelocity {
+                    velocity: 150.0,
+                    dynamics: Dynamics::default(),
+                    direction: Direction::Positive,
+                    buffer_mode: BufferMode::Aborting,
+                    options: MoveOptions::default(),
+                },
+            );
         }
         if c % 100 == 0 {
-            submit(&mut k, &mut events, 4, CommandKind::Keepalive { target: 14 });
+            submit(
+                &mut k,
+                &mut events,
+                4,
+                CommandKind::Keepalive { target: 14 },
+            );
         }
         k.step(&fb, &mut sp, &mut events);
         exchange(&sp, &mut fb);
@@ -98,9 +195,16 @@ fn step_and_replanning_allocate_nothing() {
         }
     }
     let after = allocations();
-    assert_eq!(after - before, 0, "the kernel allocated {} times", after - before);
+    assert_eq!(
+        after - before,
+        0,
+        "the kernel allocated {} times",
+        after - before
+    );
     // And the motion really happened.
     assert!(k.status(0).unwrap().set_position > 299.0);
-    assert!((k.status(1).unwrap().set_position - 2.0 * k.status(0).unwrap().set_position).abs() < 1e-6);
+    assert!(
+        (k.status(1).unwrap().set_position - 2.0 * k.status(0).unwrap().set_position).abs() < 1e-6
+    );
     assert!(k.status(2).unwrap().set_position < -100.0);
 }

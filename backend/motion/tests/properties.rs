@@ -9,8 +9,16 @@ use proptest::prelude::*;
 use rig::*;
 
 fn dynamics() -> impl Strategy<Value = Dynamics> {
-    (prop_oneof![Just(0.0), 100.0..5000.0f64], prop_oneof![Just(0.0), 100.0..5000.0f64], prop_oneof![Just(0.0), 1000.0..20000.0f64])
-        .prop_map(|(acceleration, deceleration, jerk)| Dynamics { acceleration, deceleration, jerk })
+    (
+        prop_oneof![Just(0.0), 100.0..5000.0f64],
+        prop_oneof![Just(0.0), 100.0..5000.0f64],
+        prop_oneof![Just(0.0), 1000.0..20000.0f64],
+    )
+        .prop_map(|(acceleration, deceleration, jerk)| Dynamics {
+            acceleration,
+            deceleration,
+            jerk,
+        })
 }
 
 fn buffer_mode() -> impl Strategy<Value = BufferMode> {
@@ -25,8 +33,25 @@ fn buffer_mode() -> impl Strategy<Value = BufferMode> {
 }
 
 fn positioning() -> impl Strategy<Value = Positioning> {
-    (-500.0..500.0f64, prop_oneof![1.0..500.0f64, Just(-1.0), Just(0.0)], dynamics(), buffer_mode(), any::<bool>())
-        .prop_map(|(position, velocity, dynamics, buffer_mode, ignore)| Positioning { position, velocity, dynamics, buffer_mode, options: MoveOptions { ignore_position_monitoring: ignore, ..MoveOptions::default() } })
+    (
+        -500.0..500.0f64,
+        prop_oneof![1.0..500.0f64, Just(-1.0), Just(0.0)],
+        dynamics(),
+        buffer_mode(),
+        any::<bool>(),
+    )
+        .prop_map(
+            |(position, velocity, dynamics, buffer_mode, ignore)| Positioning {
+                position,
+                velocity,
+                dynamics,
+                buffer_mode,
+                options: MoveOptions {
+                    ignore_position_monitoring: ignore,
+                    ..MoveOptions::default()
+                },
+            },
+        )
 }
 
 fn command() -> impl Strategy<Value = CommandKind> {

@@ -42,8 +42,8 @@ enum Defect {
 /// nearby inputs agree. About 0.2 % of such random problems, position interface only.
 const KNOWN_RSRUCKIG_DEFECTS: &[(usize, Defect)] = &[
     (389, Defect::Slower), // 0.2973 s instead of 0.1026 s (rest, a0 > 0)
-    // #429, 780, 1054, 1790, 1878, 2181: rejected by a bare rsruckig 3.0.1; the planner's
-    // retry with limits tightened by 1e-12…1e-6 solves them within 1e-9 s of upstream.
+                           // #429, 780, 1054, 1790, 1878, 2181: rejected by a bare rsruckig 3.0.1; the planner's
+                           // retry with limits tightened by 1e-12…1e-6 solves them within 1e-9 s of upstream.
 ];
 
 #[derive(Deserialize)]

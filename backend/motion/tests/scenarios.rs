@@ -17,7 +17,10 @@ fn s11a_01_fresh_axis_is_disabled_and_rejects_moves() {
     let mut r = Rig::new(1);
     r.step();
     assert_eq!(r.st(0).state, AxisState::Disabled);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, 100.0))), ErrorId::AXIS_CANNOT_BE_STARTED);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, 100.0))),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
     r.run(0.05);
     assert_eq!(r.st(0).set_position, 0.0);
     assert_eq!(r.plants[0].pos, 0.0);
@@ -26,7 +29,15 @@ fn s11a_01_fresh_axis_is_disabled_and_rejects_moves() {
 #[test]
 fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error() {
     let mut r = Rig::new(1);
-    let p = r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+    let p = r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+        },
+    );
     assert!(r.out(p).busy && !r.out(p).status);
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
     assert!(r.out(p).status && r.out(p).busy && r.out(p).active);
@@ -35,7 +46,15 @@ fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error()
     // With a drive fault pending: ErrorStop.
     let mut r = Rig::new(1);
     r.plants[0].fault = true;
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+        },
+    );
     r.step();
     assert_eq!(r.st(0).state, AxisState::ErrorStop);
     assert_eq!(r.st(0).error_id, ErrorId::DRIVE_FAULT.0);
@@ -45,9 +64,26 @@ fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error()
 fn s11a_03_power_off_from_motion_disables_and_aborts() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let m = r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let m = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.1);
-    r.ok(0, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: false,
+            enable_positive: false,
+            enable_negative: false,
+            override_percent: 100.0,
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::Disabled);
     assert!(r.out(m).command_aborted);
     r.step();
@@ -62,7 +98,19 @@ fn s11a_04_errorstop_rejects_everything_until_reset() {
     r.plants[0].fault_code = 7;
     r.step();
     assert_eq!(r.st(0).state, AxisState::ErrorStop);
-    for k in [CommandKind::MoveAbsolute(mv(1.0, 10.0)), CommandKind::Home { position: None, mode: HomingMode::Default, options: HomingOptions::default() }, CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() }] {
+    for k in [
+        CommandKind::MoveAbsolute(mv(1.0, 10.0)),
+        CommandKind::Home {
+            position: None,
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    ] {
         assert_eq!(r.rejected(0, k), ErrorId::AXIS_CANNOT_BE_STARTED);
     }
     // Reset with power still enabled → Standstill (note 4) once the drive recovers.
@@ -73,7 +121,15 @@ fn s11a_04_errorstop_rejects_everything_until_reset() {
     r.plants[0].fault = true;
     r.step();
     assert_eq!(r.st(0).state, AxisState::ErrorStop);
-    r.ok(0, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: false,
+            enable_positive: false,
+            enable_negative: false,
+            override_percent: 100.0,
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::ErrorStop);
     r.ok(0, CommandKind::Reset);
     assert_eq!(r.st(0).state, AxisState::Disabled);
@@ -85,9 +141,25 @@ fn s11a_05_state_changes_in_the_cycle_the_command_is_accepted() {
     power(&mut r);
     r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
-    r.ok(0, CommandKind::MoveVelocity { velocity: 10.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 10.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::ContinuousMotion);
-    r.ok(0, CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::Stopping);
 }
 
@@ -95,10 +167,22 @@ fn s11a_05_state_changes_in_the_cycle_the_command_is_accepted() {
 fn s11a_06_parameter_writes_do_not_change_the_state() {
     let mut r = Rig::new(1);
     power(&mut r);
-    r.ok(0, CommandKind::WriteParameter { number: 1026, value: 0.05 });
+    r.ok(
+        0,
+        CommandKind::WriteParameter {
+            number: 1026,
+            value: 0.05,
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::Standstill);
     r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
-    r.ok(0, CommandKind::WriteParameter { number: 1026, value: 0.02 });
+    r.ok(
+        0,
+        CommandKind::WriteParameter {
+            number: 1026,
+            value: 0.02,
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
 }
 
@@ -122,7 +206,10 @@ fn s11a_08_09_inputs_latched_a_new_command_is_a_new_instance() {
     power(&mut r);
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(20.0, 200.0)));
     r.run(0.05);
-    let b = r.ok(0, CommandKind::MoveAbsolute(mvb(30.0, 200.0, BufferMode::Buffered)));
+    let b = r.ok(
+        0,
+        CommandKind::MoveAbsolute(mvb(30.0, 200.0, BufferMode::Buffered)),
+    );
     r.until(2.0, |r| r.out(b).done);
     assert!(r.out(a).done);
     assert!((r.st(0).set_position - 30.0).abs() < 1e-9);
@@ -147,7 +234,10 @@ fn s11a_11_parameter_errors_are_fb_errors_axis_errors_need_reset() {
     let mut r = Rig::new(1);
     power(&mut r);
     // FB error: rejected, axis unaffected.
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, -1.0))), ErrorId::PARAMETER_NOT_CORRECT);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, -1.0))),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
     assert_eq!(r.st(0).state, AxisState::Standstill);
     r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     // Axis error: following error → ErrorStop until reset.
@@ -169,13 +259,19 @@ fn s11a_12_buffered_successor_starts_from_standstill() {
     let mut r = Rig::new(1);
     power(&mut r);
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
-    let b = r.ok(0, CommandKind::MoveAbsolute(mvb(20.0, 100.0, BufferMode::Buffered)));
+    let b = r.ok(
+        0,
+        CommandKind::MoveAbsolute(mvb(20.0, 100.0, BufferMode::Buffered)),
+    );
     assert!(r.out(b).busy && !r.out(b).active);
     r.until(2.0, |r| r.out(a).done);
     // The predecessor was Done (target window) before the successor became active; at that
     // moment the axis was at rest at P1.
     let h = &r.history[0];
-    let i = h.iter().position(|s| (s.target_position - 20.0).abs() < 1e-12).unwrap();
+    let i = h
+        .iter()
+        .position(|s| (s.target_position - 20.0).abs() < 1e-12)
+        .unwrap();
     assert!(h[i - 1].set_velocity.abs() < 1e-9 && (h[i - 1].set_position - 10.0).abs() < 1e-9);
     r.until(2.0, |r| r.out(b).done);
 }
@@ -198,16 +294,40 @@ fn s11a_12_blending_modes_pass_p1_at_the_specified_velocity() {
     // v1 < v2
     let (v1, v2) = (100.0, 300.0);
     let near = |a: f64, b: f64| (a - b).abs() < 2.0; // within a cycle of acceleration
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingLow, v1, v2), v1));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingPrevious, v1, v2), v1));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingNext, v1, v2), v2));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingHigh, v1, v2), v2));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingLow, v1, v2),
+        v1
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingPrevious, v1, v2),
+        v1
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingNext, v1, v2),
+        v2
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingHigh, v1, v2),
+        v2
+    ));
     // v2 < v1
     let (v1, v2) = (300.0, 100.0);
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingLow, v1, v2), v2));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingPrevious, v1, v2), v1));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingNext, v1, v2), v2));
-    assert!(near(blend_velocity_at_p1(BufferMode::BlendingHigh, v1, v2), v1));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingLow, v1, v2),
+        v2
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingPrevious, v1, v2),
+        v1
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingNext, v1, v2),
+        v2
+    ));
+    assert!(near(
+        blend_velocity_at_p1(BufferMode::BlendingHigh, v1, v2),
+        v1
+    ));
     // Buffered passes at rest.
     assert!(blend_velocity_at_p1(BufferMode::Buffered, v1, v2).abs() < 1e-9);
 }
@@ -217,8 +337,17 @@ fn s11a_13_second_buffered_command_is_buffer_full_aborting_still_wins() {
     let mut r = Rig::new(1);
     power(&mut r);
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(50.0, 100.0)));
-    let b = r.ok(0, CommandKind::MoveAbsolute(mvb(60.0, 100.0, BufferMode::Buffered)));
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mvb(70.0, 100.0, BufferMode::BlendingLow))), ErrorId::BUFFER_FULL);
+    let b = r.ok(
+        0,
+        CommandKind::MoveAbsolute(mvb(60.0, 100.0, BufferMode::Buffered)),
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::MoveAbsolute(mvb(70.0, 100.0, BufferMode::BlendingLow))
+        ),
+        ErrorId::BUFFER_FULL
+    );
     let c = r.ok(0, CommandKind::MoveAbsolute(mv(5.0, 100.0)));
     assert!(r.out(a).command_aborted && r.out(b).command_aborted);
     r.until(3.0, |r| r.out(c).done);
@@ -228,9 +357,21 @@ fn s11a_13_second_buffered_command_is_buffer_full_aborting_still_wins() {
 fn s11a_14_buffered_command_after_endless_motion_acts_at_once() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let v = r.ok(0, CommandKind::MoveVelocity { velocity: 50.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.2);
-    let b = r.ok(0, CommandKind::MoveAbsolute(mvb(100.0, 100.0, BufferMode::Buffered)));
+    let b = r.ok(
+        0,
+        CommandKind::MoveAbsolute(mvb(100.0, 100.0, BufferMode::Buffered)),
+    );
     assert!(r.out(v).command_aborted);
     assert!(r.out(b).active);
 }
@@ -243,7 +384,10 @@ fn s11a_15_blending_position_rules() {
     r.run(0.05);
     let mut m = mvb(150.0, 100.0, BufferMode::BlendingLow);
     m.options.blending_position = Some(120.0);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(m)), ErrorId::BLENDING_POSITION_INVALID);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(m)),
+        ErrorId::BLENDING_POSITION_INVALID
+    );
     // Already passed → acts like Aborting.
     let pos = r.st(0).set_position;
     m.options.blending_position = Some(pos - 1.0);
@@ -259,10 +403,33 @@ fn s11a_16_slave_motion_commands_decouple_only_when_allowed_and_aborting() {
     r.power_on(0);
     r.power_on(1);
     r.power_on(2);
-    r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 });
-    r.ok(2, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 });
-    assert_eq!(r.rejected(1, CommandKind::MoveAbsolute(mv(10.0, 10.0))), ErrorId::SLAVE_COMMAND_NOT_ALLOWED);
-    assert_eq!(r.rejected(2, CommandKind::MoveAbsolute(mvb(10.0, 10.0, BufferMode::Buffered))), ErrorId::INVALID_MODE);
+    r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        },
+    );
+    r.ok(
+        2,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        },
+    );
+    assert_eq!(
+        r.rejected(1, CommandKind::MoveAbsolute(mv(10.0, 10.0))),
+        ErrorId::SLAVE_COMMAND_NOT_ALLOWED
+    );
+    assert_eq!(
+        r.rejected(
+            2,
+            CommandKind::MoveAbsolute(mvb(10.0, 10.0, BufferMode::Buffered))
+        ),
+        ErrorId::INVALID_MODE
+    );
     let m = r.ok(2, CommandKind::MoveAbsolute(mv(10.0, 10.0)));
     assert_eq!(r.st(2).state, AxisState::DiscreteMotion);
     assert!(!r.st(2).coupled);
@@ -291,8 +458,14 @@ fn s11a_17_relative_from_set_additive_from_last_target() {
 fn s11a_18_zero_dynamics_use_axis_defaults_velocity_must_be_positive() {
     let mut r = Rig::new(1);
     power(&mut r);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, 0.0))), ErrorId::PARAMETER_NOT_CORRECT);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, f64::NAN))), ErrorId::PARAMETER_NOT_CORRECT);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, 0.0))),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(10.0, f64::NAN))),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 500.0)));
     r.until(3.0, |r| r.out(a).done);
     let h = &r.history[0];
@@ -310,7 +483,10 @@ fn s11a_19_done_waits_for_the_target_window_unless_ignored() {
     power(&mut r);
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     r.until(2.0, |r| !r.st(0).moving && r.st(0).set_position == 10.0);
-    assert!(!r.out(a).done, "done before the actual position is in the window");
+    assert!(
+        !r.out(a).done,
+        "done before the actual position is in the window"
+    );
     r.until(1.0, |r| r.out(a).done);
     assert!((r.plants[0].pos - 10.0).abs() <= 0.01);
 
@@ -340,14 +516,28 @@ fn in_target_timeout_reports_0x4b07() {
 fn s11a_20_move_velocity_in_velocity_and_stays_busy() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let v = r.ok(0, CommandKind::MoveVelocity { velocity: 120.0, dynamics: Dynamics::default(), direction: Direction::Negative, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 120.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Negative,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.until(1.0, |r| r.out(v).in_velocity);
     assert!((r.st(0).set_velocity + 120.0).abs() < 1e-9);
     r.run(0.5);
     let o = r.out(v);
     assert!(o.busy && o.active && o.in_velocity && !o.done);
     // Override change: in_velocity drops, re-plans without a jump, comes back.
-    r.ok(0, CommandKind::SetOverride { velocity_factor: 0.5 });
+    r.ok(
+        0,
+        CommandKind::SetOverride {
+            velocity_factor: 0.5,
+        },
+    );
     r.step();
     assert!(!r.out(v).in_velocity);
     r.until(1.0, |r| r.out(v).in_velocity);
@@ -358,7 +548,13 @@ fn s11a_20_move_velocity_in_velocity_and_stays_busy() {
 fn s11a_21_move_continuous_reaches_target_then_keeps_end_velocity() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let c = r.ok(0, CommandKind::MoveContinuousAbsolute { move_: mv(100.0, 200.0), end_velocity: 50.0 });
+    let c = r.ok(
+        0,
+        CommandKind::MoveContinuousAbsolute {
+            move_: mv(100.0, 200.0),
+            end_velocity: 50.0,
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::ContinuousMotion);
     r.until(3.0, |r| r.out(c).in_end_velocity);
     assert!((r.st(0).set_position - 100.0).abs() < 0.1);
@@ -373,29 +569,78 @@ fn s11a_22_move_modulo_from_standstill_uses_the_table_algorithm() {
     p.axis_modulo_tolerance_window = 1.0;
     let mut r = Rig::with(vec![(true, p)]);
     power(&mut r);
-    r.ok(0, CommandKind::SetPosition { position: 90.9, relative: false, clear_position_lag: true });
-    let m = r.ok(0, CommandKind::MoveModulo { move_: mv(450.0, 300.0), direction: Direction::Positive });
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 90.9,
+            relative: false,
+            clear_position_lag: true,
+        },
+    );
+    let m = r.ok(
+        0,
+        CommandKind::MoveModulo {
+            move_: mv(450.0, 300.0),
+            direction: Direction::Positive,
+        },
+    );
     assert!((r.st(0).target_position - 450.0).abs() < 1e-9);
     r.until(5.0, |r| r.out(m).done);
     assert!((r.st(0).modulo_set_position - 90.0).abs() < 1e-9);
     assert_eq!(r.st(0).modulo_set_turns, 1);
-    assert_eq!(r.rejected(0, CommandKind::MoveModulo { move_: mv(400.0, 100.0), direction: Direction::ShortestWay }), ErrorId::INVALID_MODE);
-    assert_eq!(r.rejected(0, CommandKind::MoveModulo { move_: mv(-1.0, 100.0), direction: Direction::Positive }), ErrorId::PARAMETER_NOT_CORRECT);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::MoveModulo {
+                move_: mv(400.0, 100.0),
+                direction: Direction::ShortestWay
+            }
+        ),
+        ErrorId::INVALID_MODE
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::MoveModulo {
+                move_: mv(-1.0, 100.0),
+                direction: Direction::Positive
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
 }
 
 #[test]
 fn move_modulo_from_motion_keeps_direction_and_ignores_extra_turns() {
     let mut r = Rig::with(vec![(true, params())]);
     power(&mut r);
-    r.ok(0, CommandKind::MoveVelocity { velocity: 200.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 200.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.5);
-    let m = r.ok(0, CommandKind::MoveModulo { move_: mv(370.0, 200.0), direction: Direction::Positive });
+    let m = r.ok(
+        0,
+        CommandKind::MoveModulo {
+            move_: mv(370.0, 200.0),
+            direction: Direction::Positive,
+        },
+    );
     let start = r.st(0).set_position;
     r.until(5.0, |r| r.out(m).done);
     let s = r.st(0);
     assert!((s.modulo_set_position - 10.0).abs() < 1e-9);
     assert!(s.set_position > start && s.set_position - start < 360.0 + 100.0);
-    assert!(r.history[0].iter().all(|h| h.set_velocity >= -1e-9), "reversed");
+    assert!(
+        r.history[0].iter().all(|h| h.set_velocity >= -1e-9),
+        "reversed"
+    );
 }
 
 #[test]
@@ -407,10 +652,23 @@ fn s11a_23_halt_has_no_lock_and_never_weaker_dynamics() {
     r.ok(0, CommandKind::MoveAbsolute(m));
     r.run(0.3);
     // Weaker deceleration asked: the move's 3000 is used.
-    let h = r.ok(0, CommandKind::Halt { deceleration: 100.0, jerk: 0.0, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let h = r.ok(
+        0,
+        CommandKind::Halt {
+            deceleration: 100.0,
+            jerk: 0.0,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
     r.run(0.05);
-    let amin = r.history[0].iter().rev().take(50).map(|s| s.set_acceleration).fold(0.0, f64::min);
+    let amin = r.history[0]
+        .iter()
+        .rev()
+        .take(50)
+        .map(|s| s.set_acceleration)
+        .fold(0.0, f64::min);
     assert!(amin < -1000.0, "halt used a weaker deceleration: {amin}");
     // No lock: a new move during the ramp is accepted.
     let b = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 100.0)));
@@ -422,26 +680,55 @@ fn s11a_23_halt_has_no_lock_and_never_weaker_dynamics() {
 fn s11a_24_stop_locks_until_released_done_while_busy() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let a = r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let a = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.2);
-    let s = r.ok(0, CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() });
+    let s = r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    );
     assert!(r.out(a).command_aborted);
     assert_eq!(r.st(0).state, AxisState::Stopping);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(0.0, 10.0))), ErrorId::AXIS_CANNOT_BE_STARTED);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(0.0, 10.0))),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
     r.until(2.0, |r| r.out(s).done);
     let o = r.out(s);
     assert!(o.done && o.busy && o.active, "{o:?}");
     assert_eq!(r.st(0).state, AxisState::Stopping);
     assert!(r.st(0).motion_commands_locked);
     r.run(0.1);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(0.0, 10.0))), ErrorId::AXIS_CANNOT_BE_STARTED);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(0.0, 10.0))),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
     r.ok(0, CommandKind::Release { target: s });
     assert_eq!(r.st(0).state, AxisState::Standstill);
     assert!(!r.out(s).busy && r.out(s).done);
     r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 10.0)));
 
     // MC_Reset also removes the lock.
-    let s2 = r.ok(0, CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() });
+    let s2 = r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    );
     r.until(2.0, |r| r.out(s2).done);
     r.ok(0, CommandKind::Reset);
     r.step();
@@ -454,17 +741,45 @@ fn s11a_24_stop_locks_until_released_done_while_busy() {
 fn s11a_25_home_direct_force_reset_calibration() {
     let mut r = Rig::new(1);
     power(&mut r);
-    r.ok(0, CommandKind::SetPosition { position: 5.0, relative: true, clear_position_lag: false });
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 5.0,
+            relative: true,
+            clear_position_lag: false,
+        },
+    );
     assert_eq!(r.st(0).set_position_offset, 5.0);
-    r.ok(0, CommandKind::Home { position: Some(42.0), mode: HomingMode::Direct, options: HomingOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(42.0),
+            mode: HomingMode::Direct,
+            options: HomingOptions::default(),
+        },
+    );
     assert!(r.st(0).homed);
     assert!((r.st(0).set_position - 42.0).abs() < 1e-9);
     assert_eq!(r.st(0).set_position_offset, 0.0);
     r.run(0.01);
     assert_eq!(r.plants[0].pos, 0.0, "direct homing moved the axis");
-    r.ok(0, CommandKind::Home { position: None, mode: HomingMode::ResetCalibration, options: HomingOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Home {
+            position: None,
+            mode: HomingMode::ResetCalibration,
+            options: HomingOptions::default(),
+        },
+    );
     assert!(!r.st(0).homed);
-    r.ok(0, CommandKind::Home { position: None, mode: HomingMode::ForceCalibration, options: HomingOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Home {
+            position: None,
+            mode: HomingMode::ForceCalibration,
+            options: HomingOptions::default(),
+        },
+    );
     assert!(r.st(0).homed);
     assert!((r.st(0).set_position - 42.0).abs() < 1e-9);
 }
@@ -475,7 +790,14 @@ fn homing_sequence_cam_then_index_pulse_references_exactly() {
     r.plants[0].cam = Some((50.0, 55.0));
     r.plants[0].index_period = Some(8.0); // pulses at …, 40, 48, 56 …
     power(&mut r);
-    let h = r.ok(0, CommandKind::Home { position: Some(100.0), mode: HomingMode::Default, options: HomingOptions::default() });
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(100.0),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
     assert_eq!(r.st(0).state, AxisState::Homing);
     let mut phases = vec![];
     r.until(20.0, |r| {
@@ -488,19 +810,41 @@ fn homing_sequence_cam_then_index_pulse_references_exactly() {
     assert!(r.out(h).done, "{:?}", r.out(h));
     r.run(0.01); // the drive follows the last setpoint
     use HomingPhase::*;
-    assert_eq!(phases, vec![SearchCam, StopOnCam, LeaveCam, WaitCamFallingEdge, WaitLatch, SetPosition, Idle]);
+    assert_eq!(
+        phases,
+        vec![
+            SearchCam,
+            StopOnCam,
+            LeaveCam,
+            WaitCamFallingEdge,
+            WaitLatch,
+            SetPosition,
+            Idle
+        ]
+    );
     // Leaving the cam backwards (falling edge at 50), the first index pulse is at 48: the
     // drive position 48 is now the reference 100.
     let s = r.st(0);
     assert!(s.homed && s.state == AxisState::Standstill);
-    assert!((s.actual_position - (100.0 + (r.plants[0].pos - 48.0))).abs() < 1e-9, "{s:?} plant {}", r.plants[0].pos);
+    assert!(
+        (s.actual_position - (100.0 + (r.plants[0].pos - 48.0))).abs() < 1e-9,
+        "{s:?} plant {}",
+        r.plants[0].pos
+    );
 }
 
 #[test]
 fn homing_fails_cleanly_when_the_cam_is_never_found() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let h = r.ok(0, CommandKind::Home { position: None, mode: HomingMode::Default, options: HomingOptions::default() });
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: None,
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
     r.run(0.5);
     r.plants[0].limit_positive = true;
     r.until(2.0, |r| !r.out(h).busy);
@@ -516,7 +860,14 @@ fn s11a_26_jog_modes() {
     p.axis_velo_man_fast = 70.0;
     let mut r = Rig::with(vec![(false, p)]);
     power(&mut r);
-    let jog = |mode, forward, position| CommandKind::Jog { mode, forward, position, velocity: 33.0, dynamics: Dynamics::default(), deadman: 0.0 };
+    let jog = |mode, forward, position| CommandKind::Jog {
+        mode,
+        forward,
+        position,
+        velocity: 33.0,
+        dynamics: Dynamics::default(),
+        deadman: 0.0,
+    };
     let j = r.ok(0, jog(JogMode::StandardSlow, true, 0.0));
     r.run(0.5);
     assert!((r.st(0).set_velocity - 7.0).abs() < 1e-9);
@@ -546,7 +897,17 @@ fn s11a_26_jog_modes() {
 fn jog_dead_man_stops_the_axis_when_not_renewed() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let j = r.ok(0, CommandKind::Jog { mode: JogMode::Continuous, forward: true, position: 0.0, velocity: 50.0, dynamics: Dynamics::default(), deadman: 0.2 });
+    let j = r.ok(
+        0,
+        CommandKind::Jog {
+            mode: JogMode::Continuous,
+            forward: true,
+            position: 0.0,
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            deadman: 0.2,
+        },
+    );
     for _ in 0..5 {
         r.run(0.1);
         r.ok(0, CommandKind::Keepalive { target: j });
@@ -556,8 +917,18 @@ fn jog_dead_man_stops_the_axis_when_not_renewed() {
     // (0.2 s) later, reports it at once and starts braking in that cycle.
     let c0 = r.k.cycle() + 1;
     r.until(1.0, |r| r.out(j).warning);
-    let fired = r.events.iter().find(|e| e.command == j && e.outputs.warning).unwrap().cycle;
-    assert_eq!(fired - c0, 199, "fired {} cycles after the keepalive", fired - c0);
+    let fired = r
+        .events
+        .iter()
+        .find(|e| e.command == j && e.outputs.warning)
+        .unwrap()
+        .cycle;
+    assert_eq!(
+        fired - c0,
+        199,
+        "fired {} cycles after the keepalive",
+        fired - c0
+    );
     assert_eq!(r.out(j).warning_id, ErrorId::DEADMAN_TIMEOUT.0);
     assert!(!r.out(j).in_velocity && r.st(0).decelerating);
     r.until(1.0, |r| !r.out(j).busy);
@@ -570,9 +941,33 @@ fn s11a_27_gear_ratio_forms_give_identical_slaves_denominator_zero_rejected() {
     for a in 0..3 {
         r.power_on(a);
     }
-    assert_eq!(r.rejected(1, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 0 }), ErrorId::PARAMETER_NOT_CORRECT);
-    let g1 = r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 4 });
-    let g2 = r.ok(2, CommandKind::GearIn { master: 0, ratio_numerator: 0.25, ratio_denominator: 1 });
+    assert_eq!(
+        r.rejected(
+            1,
+            CommandKind::GearIn {
+                master: 0,
+                ratio_numerator: 1.0,
+                ratio_denominator: 0
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    let g1 = r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 1.0,
+            ratio_denominator: 4,
+        },
+    );
+    let g2 = r.ok(
+        2,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 0.25,
+            ratio_denominator: 1,
+        },
+    );
     assert!(r.out(g1).in_gear && r.out(g2).in_gear);
     assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 200.0)));
@@ -583,7 +978,14 @@ fn s11a_27_gear_ratio_forms_give_identical_slaves_denominator_zero_rejected() {
     let mut r = Rig::new(2);
     r.power_on(0);
     r.power_on(1);
-    r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: -2.0, ratio_denominator: 1 });
+    r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: -2.0,
+            ratio_denominator: 1,
+        },
+    );
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     r.until(3.0, |r| r.out(m).done);
     assert!((r.st(1).set_position + 20.0).abs() < 1e-9);
@@ -594,31 +996,106 @@ fn s11a_28_gear_out_in_motion_keeps_constant_velocity() {
     let mut r = Rig::new(2);
     r.power_on(0);
     r.power_on(1);
-    let g = r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: 2.0, ratio_denominator: 1 });
-    r.ok(0, CommandKind::MoveVelocity { velocity: 50.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    let g = r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 2.0,
+            ratio_denominator: 1,
+        },
+    );
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(1.0);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
     r.ok(1, CommandKind::GearOut);
     assert!(r.out(g).command_aborted);
     assert_eq!(r.st(1).state, AxisState::ContinuousMotion);
-    r.ok(0, CommandKind::Halt { deceleration: 0.0, jerk: 0.0, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Halt {
+            deceleration: 0.0,
+            jerk: 0.0,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(1.0);
-    assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6, "{}", r.st(1).set_velocity);
+    assert!(
+        (r.st(1).set_velocity - 100.0).abs() < 1e-6,
+        "{}",
+        r.st(1).set_velocity
+    );
     assert!(r.st(0).set_velocity.abs() < 1e-9);
 }
 
 #[test]
 fn s11a_34_override_range() {
     let mut r = Rig::new(1);
-    assert_eq!(r.rejected(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.5 }), ErrorId::PARAMETER_NOT_CORRECT);
-    assert_eq!(r.rejected(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: -0.1 }), ErrorId::PARAMETER_NOT_CORRECT);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.5
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: -0.1
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
     power(&mut r);
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 50.0 });
-    let v = r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+        },
+    );
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.until(1.0, |r| r.out(v).in_velocity);
     assert!((r.st(0).set_velocity - 50.0).abs() < 1e-9);
     // Override 0 stops the axis without aborting the command.
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 0.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 0.0,
+        },
+    );
     r.run(1.0);
     assert!(r.st(0).set_velocity.abs() < 1e-9);
     assert!(r.out(v).busy && !r.out(v).command_aborted);
@@ -635,26 +1112,73 @@ fn soft_limits_reject_targets_and_stop_endless_motion_at_the_limit() {
     p.axis_min_soft_pos_limit = -10.0;
     let mut r = Rig::with(vec![(false, p)]);
     power(&mut r);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(100.5, 10.0))), ErrorId::TARGET_ABOVE_SOFT_LIMIT);
-    assert_eq!(r.rejected(0, CommandKind::MoveRelative(mv(-11.0, 10.0))), ErrorId::TARGET_BELOW_SOFT_LIMIT);
-    let v = r.ok(0, CommandKind::MoveVelocity { velocity: 300.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(100.5, 10.0))),
+        ErrorId::TARGET_ABOVE_SOFT_LIMIT
+    );
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveRelative(mv(-11.0, 10.0))),
+        ErrorId::TARGET_BELOW_SOFT_LIMIT
+    );
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 300.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.until(3.0, |r| !r.out(v).busy);
     assert_eq!(r.out(v).error_id, ErrorId::SOFT_LIMIT_REACHED.0);
     r.until(3.0, |r| r.st(0).state == AxisState::Standstill);
     let s = r.st(0);
-    assert!(s.set_position <= 100.0 + 1e-9 && s.set_position > 99.0, "{}", s.set_position);
+    assert!(
+        s.set_position <= 100.0 + 1e-9 && s.set_position > 99.0,
+        "{}",
+        s.set_position
+    );
     assert!(r.history[0].iter().all(|h| h.set_position <= 100.0 + 1e-9));
 }
 
 #[test]
 fn feed_enable_missing_rejects_and_stops() {
     let mut r = Rig::new(1);
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: false, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: false,
+            override_percent: 100.0,
+        },
+    );
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
-    assert_eq!(r.rejected(0, CommandKind::MoveAbsolute(mv(-5.0, 10.0))), ErrorId::FEED_ENABLE_MISSING);
-    let v = r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(-5.0, 10.0))),
+        ErrorId::FEED_ENABLE_MISSING
+    );
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.3);
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: false,
+            enable_negative: false,
+            override_percent: 100.0,
+        },
+    );
     r.step();
     assert_eq!(r.out(v).error_id, ErrorId::FEED_ENABLE_MISSING.0);
     r.until(2.0, |r| r.st(0).state == AxisState::Standstill);
@@ -666,8 +1190,25 @@ fn set_position_during_motion_shifts_coordinates_not_the_motion() {
     power(&mut r);
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 100.0)));
     r.run(0.3);
-    assert_eq!(r.rejected(0, CommandKind::SetPosition { position: 0.0, relative: false, clear_position_lag: false }), ErrorId::AXIS_CANNOT_BE_STARTED);
-    r.ok(0, CommandKind::SetPosition { position: 1000.0, relative: true, clear_position_lag: false });
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::SetPosition {
+                position: 0.0,
+                relative: false,
+                clear_position_lag: false
+            }
+        ),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 1000.0,
+            relative: true,
+            clear_position_lag: false,
+        },
+    );
     r.until(5.0, |r| r.out(m).done);
     assert!((r.st(0).set_position - 1100.0).abs() < 1e-9);
     assert!((r.plants[0].pos - 100.0).abs() < 0.01);
@@ -691,13 +1232,66 @@ fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
     for a in 0..3 {
         r.power_on(a);
     }
-    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
-    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 9, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
-    r.ok(1, CommandKind::GearIn { master: 0, ratio_numerator: 1.0, ratio_denominator: 1 });
-    r.ok(2, CommandKind::GearIn { master: 1, ratio_numerator: 1.0, ratio_denominator: 1 });
-    assert_eq!(r.rejected(0, CommandKind::GearIn { master: 2, ratio_numerator: 1.0, ratio_denominator: 1 }), ErrorId::MASTER_INVALID);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::GearIn {
+                master: 0,
+                ratio_numerator: 1.0,
+                ratio_denominator: 1
+            }
+        ),
+        ErrorId::MASTER_INVALID
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::GearIn {
+                master: 9,
+                ratio_numerator: 1.0,
+                ratio_denominator: 1
+            }
+        ),
+        ErrorId::MASTER_INVALID
+    );
+    r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        },
+    );
+    r.ok(
+        2,
+        CommandKind::GearIn {
+            master: 1,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        },
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::GearIn {
+                master: 2,
+                ratio_numerator: 1.0,
+                ratio_denominator: 1
+            }
+        ),
+        ErrorId::MASTER_INVALID
+    );
     // A chain follows in one cycle (masters are stepped first).
-    r.ok(0, CommandKind::MoveVelocity { velocity: 10.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 10.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.2);
     assert_eq!(r.st(2).set_position, r.st(0).set_position);
     // The master faults: its slaves go to ErrorStop with master_lost.
@@ -711,7 +1305,15 @@ fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
 fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
     let mut r = Rig::new(1);
     power(&mut r);
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 50.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+        },
+    );
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
     r.until(10.0, |r| {
         let v = r.st(0).set_velocity.abs();
@@ -721,10 +1323,18 @@ fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
     // Second run: override changed mid-move.
     let b = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
     r.run(0.5);
-    r.ok(0, CommandKind::SetOverride { velocity_factor: 0.4 });
+    r.ok(
+        0,
+        CommandKind::SetOverride {
+            velocity_factor: 0.4,
+        },
+    );
     let v_before = r.st(0).set_velocity.abs();
     r.step();
-    assert!((r.st(0).set_velocity.abs() - v_before).abs() < 1000.0 * DT + 1e-9, "velocity jumped on override");
+    assert!(
+        (r.st(0).set_velocity.abs() - v_before).abs() < 1000.0 * DT + 1e-9,
+        "velocity jumped on override"
+    );
     r.run(0.3);
     r.until(10.0, |r| {
         assert!(r.st(0).set_velocity.abs() <= 40.0 + 1e-9);
@@ -741,13 +1351,36 @@ fn s11a_29_gear_in_dyn_release_freezes_ratio_gear_out_while_enabled_recouples() 
     r.power_on(0);
     r.power_on(1);
     r.bounds[1].jerk = 1e9; // ratio ramps are acceleration-limited, not jerk-limited
-    let g = r.ok(1, CommandKind::GearInDyn { master: 0, gear_ratio: 1.0, acceleration: 0.0 });
+    let g = r.ok(
+        1,
+        CommandKind::GearInDyn {
+            master: 0,
+            gear_ratio: 1.0,
+            acceleration: 0.0,
+        },
+    );
     assert!(r.out(g).in_gear && r.out(g).busy);
-    r.ok(0, CommandKind::MoveVelocity { velocity: 100.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.5);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
     // A new ratio while enabled: ramps (acceleration-limited), in_gear when reached.
-    let g2 = r.ok(1, CommandKind::GearInDyn { master: 0, gear_ratio: 1.5, acceleration: 500.0 });
+    let g2 = r.ok(
+        1,
+        CommandKind::GearInDyn {
+            master: 0,
+            gear_ratio: 1.5,
+            acceleration: 500.0,
+        },
+    );
     assert!(r.out(g).done && !r.out(g).busy);
     assert!(!r.out(g2).in_gear);
     let mut amax: f64 = 0.0;
@@ -782,7 +1415,16 @@ fn conveyor(velocity: f64) -> Rig {
     let mut r = Rig::with(vec![(false, p)]);
     r.bounds[0].jerk = 1e9; // the superposition profile is C² but not jerk-limited
     r.power_on(0);
-    r.ok(0, CommandKind::MoveVelocity { velocity, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(1.0);
     r
 }
@@ -793,7 +1435,16 @@ fn s11a_30_superposition_conveyor_example_and_infeasible_warning() {
     // speed reserve 500 mm/s, velocity reduction, limited motion.
     let mut r = conveyor(500.0);
     let start = r.st(0).set_position;
-    let sp = Superposition { mode: SuperpositionMode::VeloReductionLimitedMotion, distance: 300.0, velocity_diff: 500.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 500.0, length: 1000.0, abort_option: SuperpositionAbortOption::AbortAtStandstill };
+    let sp = Superposition {
+        mode: SuperpositionMode::VeloReductionLimitedMotion,
+        distance: 300.0,
+        velocity_diff: 500.0,
+        acceleration: 0.0,
+        deceleration: 0.0,
+        velocity_process: 500.0,
+        length: 1000.0,
+        abort_option: SuperpositionAbortOption::AbortAtStandstill,
+    };
     let s = r.ok(0, CommandKind::MoveSuperImposed(sp));
     assert!(r.st(0).compensating);
     // While it runs, the axis is 300 mm ahead of the conveyor at the end, within 1000 mm.
@@ -803,16 +1454,30 @@ fn s11a_30_superposition_conveyor_example_and_infeasible_warning() {
     assert!(o.done && !o.warning, "{o:?}");
     let travelled = r.st(0).set_position - start;
     let base = 500.0 * (r.k.cycle() - t0) as f64 * DT;
-    assert!((travelled - base - 300.0).abs() < 1.0, "ahead by {}", travelled - base);
+    assert!(
+        (travelled - base - 300.0).abs() < 1.0,
+        "ahead by {}",
+        travelled - base
+    );
     assert!(travelled <= 1000.0 + 1.0, "used {travelled} mm");
-    assert!(r.history[0].iter().all(|h| h.set_velocity <= 500.0 + 500.0 + 1e-6));
+    assert!(
+        r.history[0]
+            .iter()
+            .all(|h| h.set_velocity <= 500.0 + 500.0 + 1e-6)
+    );
     assert_eq!(r.st(0).state, AxisState::ContinuousMotion);
     assert!((r.st(0).set_velocity - 500.0).abs() < 1e-9);
 
     // Infeasible: the same distance within 400 mm → warning 0x4243, less distance.
     let mut r = conveyor(500.0);
     let start = r.st(0).set_position;
-    let s = r.ok(0, CommandKind::MoveSuperImposed(Superposition { length: 400.0, ..sp }));
+    let s = r.ok(
+        0,
+        CommandKind::MoveSuperImposed(Superposition {
+            length: 400.0,
+            ..sp
+        }),
+    );
     assert!(r.out(s).warning);
     assert_eq!(r.out(s).warning_id, ErrorId::SUPERPOSITION_INCOMPLETE.0);
     let t0 = r.k.cycle();
@@ -824,32 +1489,76 @@ fn s11a_30_superposition_conveyor_example_and_infeasible_warning() {
 
 #[test]
 fn s11a_31_superposition_abort_options() {
-    let sp = |abort_option| Superposition { mode: SuperpositionMode::VeloReductionAdditiveMotion, distance: 50.0, velocity_diff: 200.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 200.0, length: 400.0, abort_option };
+    let sp = |abort_option| Superposition {
+        mode: SuperpositionMode::VeloReductionAdditiveMotion,
+        distance: 50.0,
+        velocity_diff: 200.0,
+        acceleration: 0.0,
+        deceleration: 0.0,
+        velocity_process: 200.0,
+        length: 400.0,
+        abort_option,
+    };
     use SuperpositionAbortOption::*;
     // Row 1: override 0 → continues (all options).
-    for opt in [AbortAtStandstill, ResumeAfterStandstill, ResumeAfterMotionStop] {
+    for opt in [
+        AbortAtStandstill,
+        ResumeAfterStandstill,
+        ResumeAfterMotionStop,
+    ] {
         let mut r = conveyor(200.0);
         let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
         r.run(0.2);
-        r.ok(0, CommandKind::SetOverride { velocity_factor: 0.0 });
+        r.ok(
+            0,
+            CommandKind::SetOverride {
+                velocity_factor: 0.0,
+            },
+        );
         r.run(2.0);
         assert!(r.out(s).busy, "{opt:?}: aborted by override 0");
-        r.ok(0, CommandKind::SetOverride { velocity_factor: 1.0 });
+        r.ok(
+            0,
+            CommandKind::SetOverride {
+                velocity_factor: 1.0,
+            },
+        );
         r.until(5.0, |r| !r.out(s).busy);
         assert!(r.out(s).done, "{opt:?}");
     }
     // Row 2/4: the main motion stops (halt) → abort unless ResumeAfterMotionStop.
-    for (opt, survives) in [(AbortAtStandstill, false), (ResumeAfterStandstill, false), (ResumeAfterMotionStop, true)] {
+    for (opt, survives) in [
+        (AbortAtStandstill, false),
+        (ResumeAfterStandstill, false),
+        (ResumeAfterMotionStop, true),
+    ] {
         let mut r = conveyor(200.0);
         let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
         r.run(0.2);
-        r.ok(0, CommandKind::Halt { deceleration: 0.0, jerk: 0.0, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+        r.ok(
+            0,
+            CommandKind::Halt {
+                deceleration: 0.0,
+                jerk: 0.0,
+                buffer_mode: BufferMode::Aborting,
+                options: MoveOptions::default(),
+            },
+        );
         r.run(1.0);
         assert_eq!(r.out(s).busy, survives, "{opt:?}");
         assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
         if survives {
             // Resumes with the next motion and completes.
-            r.ok(0, CommandKind::MoveVelocity { velocity: 200.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+            r.ok(
+                0,
+                CommandKind::MoveVelocity {
+                    velocity: 200.0,
+                    dynamics: Dynamics::default(),
+                    direction: Direction::Positive,
+                    buffer_mode: BufferMode::Aborting,
+                    options: MoveOptions::default(),
+                },
+            );
             r.until(5.0, |r| !r.out(s).busy);
             assert!(r.out(s).done);
         }
@@ -859,7 +1568,16 @@ fn s11a_31_superposition_abort_options() {
         let mut r = conveyor(200.0);
         let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
         r.run(0.1);
-        r.ok(0, CommandKind::MoveVelocity { velocity: 200.0, dynamics: Dynamics::default(), direction: Direction::Negative, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() });
+        r.ok(
+            0,
+            CommandKind::MoveVelocity {
+                velocity: 200.0,
+                dynamics: Dynamics::default(),
+                direction: Direction::Negative,
+                buffer_mode: BufferMode::Aborting,
+                options: MoveOptions::default(),
+            },
+        );
         r.run(0.6);
         assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
     }
@@ -867,12 +1585,23 @@ fn s11a_31_superposition_abort_options() {
     let mut r = conveyor(200.0);
     let s = r.ok(0, CommandKind::MoveSuperImposed(sp(ResumeAfterMotionStop)));
     r.run(0.1);
-    r.ok(0, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: false,
+            enable_positive: false,
+            enable_negative: false,
+            override_percent: 100.0,
+        },
+    );
     assert!(r.out(s).command_aborted);
     // At standstill it is rejected (nothing to superimpose on).
     let mut r = Rig::new(1);
     r.power_on(0);
-    assert_eq!(r.rejected(0, CommandKind::MoveSuperImposed(sp(AbortAtStandstill))), ErrorId::AXIS_NOT_MOVING);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveSuperImposed(sp(AbortAtStandstill))),
+        ErrorId::AXIS_NOT_MOVING
+    );
 }
 
 #[test]
@@ -882,11 +1611,27 @@ fn superposition_shifts_the_target_of_the_running_move() {
     r.power_on(0);
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(400.0, 200.0)));
     r.run(0.5);
-    let s = r.ok(0, CommandKind::MoveSuperImposed(Superposition { mode: SuperpositionMode::LengthReductionAdditiveMotion, distance: 20.0, velocity_diff: 100.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 200.0, length: 200.0, abort_option: SuperpositionAbortOption::AbortAtStandstill }));
+    let s = r.ok(
+        0,
+        CommandKind::MoveSuperImposed(Superposition {
+            mode: SuperpositionMode::LengthReductionAdditiveMotion,
+            distance: 20.0,
+            velocity_diff: 100.0,
+            acceleration: 0.0,
+            deceleration: 0.0,
+            velocity_process: 200.0,
+            length: 200.0,
+            abort_option: SuperpositionAbortOption::AbortAtStandstill,
+        }),
+    );
     r.until(5.0, |r| !r.out(m).busy);
     assert!(r.out(s).done);
     assert!(r.out(m).done);
-    assert!((r.st(0).set_position - 420.0).abs() < 1e-9, "{}", r.st(0).set_position);
+    assert!(
+        (r.st(0).set_position - 420.0).abs() < 1e-9,
+        "{}",
+        r.st(0).set_position
+    );
 }
 
 #[test]
@@ -896,12 +1641,41 @@ fn superposition_across_a_blend_handoff_stays_continuous() {
     let mut r = Rig::new(1);
     r.bounds[0].jerk = 1e12;
     r.bounds[0].acceleration *= 2.0;
-    r.ok(0, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 65.0 });
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 65.0,
+        },
+    );
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
     r.ok(0, CommandKind::MoveRelative(mv(173.0, 467.0)));
-    let b = r.ok(0, CommandKind::MoveVelocity { velocity: 1.0, dynamics: Dynamics::default(), direction: Direction::Positive, buffer_mode: BufferMode::BlendingPrevious, options: MoveOptions::default() });
+    let b = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 1.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::BlendingPrevious,
+            options: MoveOptions::default(),
+        },
+    );
     r.run(0.078);
-    r.ok(0, CommandKind::MoveSuperImposed(Superposition { mode: SuperpositionMode::LengthReductionAdditiveMotion, distance: -77.0, velocity_diff: 215.0, acceleration: 0.0, deceleration: 0.0, velocity_process: 1.0, length: 788.0, abort_option: SuperpositionAbortOption::AbortAtStandstill }));
+    r.ok(
+        0,
+        CommandKind::MoveSuperImposed(Superposition {
+            mode: SuperpositionMode::LengthReductionAdditiveMotion,
+            distance: -77.0,
+            velocity_diff: 215.0,
+            acceleration: 0.0,
+            deceleration: 0.0,
+            velocity_process: 1.0,
+            length: 788.0,
+            abort_option: SuperpositionAbortOption::AbortAtStandstill,
+        }),
+    );
     r.until(3.0, |r| r.out(b).active);
     r.run(0.5);
 }

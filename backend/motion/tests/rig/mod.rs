@@ -95,7 +95,11 @@ impl Plant {
         self.prev_pos = self.pos;
         if self.enabled {
             let target = sp.position;
-            let new = if self.tau > 0.0 { self.pos + (target - self.pos) * (1.0 - (-dt / self.tau).exp()) } else { target };
+            let new = if self.tau > 0.0 {
+                self.pos + (target - self.pos) * (1.0 - (-dt / self.tau).exp())
+            } else {
+                target
+            };
             self.vel = (new - self.pos) / dt;
             self.pos = new;
         } else {
@@ -186,10 +190,23 @@ impl Rig {
         for (i, (modulo, p)) in configs.into_iter().enumerate() {
             bounds.push(Bounds {
                 velocity: p.axis_velo_max,
-                acceleration: p.axis_maximum_acceleration.max(p.axis_maximum_deceleration).max(p.axis_fast_dec),
+                acceleration: p
+                    .axis_maximum_acceleration
+                    .max(p.axis_maximum_deceleration)
+                    .max(p.axis_fast_dec),
                 jerk: p.axis_jerk.max(p.axis_fast_jerk),
             });
-            k.insert_axis(i as u16, Axis::new(AxisConfig { modulo, parameters: p }, DT)).unwrap();
+            k.insert_axis(
+                i as u16,
+                Axis::new(
+                    AxisConfig {
+                        modulo,
+                        parameters: p,
+                    },
+                    DT,
+                ),
+            )
+            .unwrap();
         }
         Rig {
             k,
@@ -211,21 +228,31 @@ impl Rig {
         let id = self.next_id;
         self.next_id += 1;
         let n = self.events.len();
-        if matches!(kind, CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Reset) {
+        if matches!(
+            kind,
+            CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Reset
+        ) {
             self.shifted[axis as usize] = true;
         }
         let before = self.k.status(axis);
         let v = self.k.submit(Command { id, axis, kind }, &mut self.events);
         if let Verdict::Rejected(_) = v {
             assert_eq!(self.events.len(), n, "a rejected command emitted events");
-            assert_eq!(self.k.status(axis), before, "a rejected command changed the axis status");
+            assert_eq!(
+                self.k.status(axis),
+                before,
+                "a rejected command changed the axis status"
+            );
         }
         // Events of a submit are stamped with the cycle the command takes effect in.
         self.check_events_at(n, self.k.cycle() + 1);
         // The state changes in the cycle the command is accepted: check that transition too.
         let now = self.k.status(axis).unwrap().state;
         let prev = self.prev[axis as usize].state;
-        assert!(allowed(prev, now), "axis {axis}: transition {prev:?} -> {now:?} by {kind:?} not in the diagram");
+        assert!(
+            allowed(prev, now),
+            "axis {axis}: transition {prev:?} -> {now:?} by {kind:?} not in the diagram"
+        );
         self.prev[axis as usize].state = now;
         (id, v)
     }
@@ -277,11 +304,22 @@ impl Rig {
             }
             self.step();
         }
-        panic!("condition not reached within {seconds} s; status {:?}", self.st(0));
+        panic!(
+            "condition not reached within {seconds} s; status {:?}",
+            self.st(0)
+        );
     }
 
     pub fn power_on(&mut self, axis: u16) -> CommandId {
-        let id = self.ok(axis, CommandKind::Power { enable: true, enable_positive: true, enable_negative: true, override_percent: 100.0 });
+        let id = self.ok(
+            axis,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+            },
+        );
         self.until(0.1, |r| r.st(axis).state == AxisState::Standstill);
         id
     }
@@ -293,22 +331,44 @@ impl Rig {
     fn check_events_at(&mut self, from: usize, cycle: u64) {
         for e in &self.events[from..] {
             let o = e.outputs;
-            assert!(!self.finals.contains(&e.command), "event after the final one: {e:?}");
+            assert!(
+                !self.finals.contains(&e.command),
+                "event after the final one: {e:?}"
+            );
             // §3.1: Busy/Done/Error/CommandAborted exclusive; Active/Done/Error/CommandAborted
             // exclusive — except MC_Stop's Done while busy and active.
             let stop_locked = o.done && o.busy && o.active && !o.error && !o.command_aborted;
-            let a = [o.busy, o.done, o.error, o.command_aborted].iter().filter(|x| **x).count();
-            let b = [o.active, o.done, o.error, o.command_aborted].iter().filter(|x| **x).count();
-            assert!(stop_locked || (a <= 1 && b <= 1), "exclusivity violated: {e:?}");
+            let a = [o.busy, o.done, o.error, o.command_aborted]
+                .iter()
+                .filter(|x| **x)
+                .count();
+            let b = [o.active, o.done, o.error, o.command_aborted]
+                .iter()
+                .filter(|x| **x)
+                .count();
+            assert!(
+                stop_locked || (a <= 1 && b <= 1),
+                "exclusivity violated: {e:?}"
+            );
             assert!(a >= 1, "no output set: {e:?}");
-            assert!(!(o.error && (o.in_velocity || o.in_gear || o.in_end_velocity)), "success flag with error: {e:?}");
-            assert_eq!(o.error, o.error_id != 0, "error and error_id disagree: {e:?}");
+            assert!(
+                !(o.error && (o.in_velocity || o.in_gear || o.in_end_velocity)),
+                "success flag with error: {e:?}"
+            );
+            assert_eq!(
+                o.error,
+                o.error_id != 0,
+                "error and error_id disagree: {e:?}"
+            );
             if o.active {
                 assert!(o.busy, "active without busy: {e:?}");
             }
             if let Some(prev) = self.outputs.get(&e.command) {
                 assert_ne!(*prev, o, "event without change: {e:?}");
-                assert!(!(prev.done && o.busy && !stop_locked && !prev.busy), "done then busy again: {e:?}");
+                assert!(
+                    !(prev.done && o.busy && !stop_locked && !prev.busy),
+                    "done then busy again: {e:?}"
+                );
             }
             assert_eq!(e.cycle, cycle, "event stamped with a wrong cycle");
             self.outputs.insert(e.command, o);
@@ -324,18 +384,59 @@ impl Rig {
             let s = self.k.status(i as u16).unwrap();
             let p = self.prev[i];
             let b = self.bounds[i];
-            assert!(allowed(p.state, s.state), "axis {i}: transition {:?} -> {:?} not in the diagram", p.state, s.state);
+            assert!(
+                allowed(p.state, s.state),
+                "axis {i}: transition {:?} -> {:?} not in the diagram",
+                p.state,
+                s.state
+            );
             let tol = 1e-9;
-            assert!(s.set_velocity.abs() <= b.velocity * (1.0 + tol) + tol, "axis {i}: |v| {} > {}", s.set_velocity, b.velocity);
-            assert!(s.set_acceleration.abs() <= b.acceleration * (1.0 + tol) + tol, "axis {i}: |a| {} > {}", s.set_acceleration, b.acceleration);
-            let settled = !self.shifted[i] && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop) && !matches!(p.state, AxisState::Disabled | AxisState::ErrorStop) && p.homed == s.homed && !s.coupled && !p.coupled;
+            assert!(
+                s.set_velocity.abs() <= b.velocity * (1.0 + tol) + tol,
+                "axis {i}: |v| {} > {}",
+                s.set_velocity,
+                b.velocity
+            );
+            assert!(
+                s.set_acceleration.abs() <= b.acceleration * (1.0 + tol) + tol,
+                "axis {i}: |a| {} > {}",
+                s.set_acceleration,
+                b.acceleration
+            );
+            let settled = !self.shifted[i]
+                && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop)
+                && !matches!(p.state, AxisState::Disabled | AxisState::ErrorStop)
+                && p.homed == s.homed
+                && !s.coupled
+                && !p.coupled;
             if settled {
                 let j = b.jerk;
-                assert!((s.set_acceleration - p.set_acceleration).abs() <= j * DT * (1.0 + 1e-6) + 1e-6, "axis {i}: jerk {} > {j} (a {} -> {})", (s.set_acceleration - p.set_acceleration) / DT, p.set_acceleration, s.set_acceleration);
+                assert!(
+                    (s.set_acceleration - p.set_acceleration).abs() <= j * DT * (1.0 + 1e-6) + 1e-6,
+                    "axis {i}: jerk {} > {j} (a {} -> {})",
+                    (s.set_acceleration - p.set_acceleration) / DT,
+                    p.set_acceleration,
+                    s.set_acceleration
+                );
                 let dv = s.set_velocity - p.set_velocity;
-                assert!((dv - (p.set_acceleration + s.set_acceleration) / 2.0 * DT).abs() <= j * DT * DT + 1e-6, "axis {i}: velocity jump {} -> {} (a {})", p.set_velocity, s.set_velocity, p.set_acceleration);
+                assert!(
+                    (dv - (p.set_acceleration + s.set_acceleration) / 2.0 * DT).abs()
+                        <= j * DT * DT + 1e-6,
+                    "axis {i}: velocity jump {} -> {} (a {})",
+                    p.set_velocity,
+                    s.set_velocity,
+                    p.set_acceleration
+                );
                 let dp = s.set_position - p.set_position;
-                assert!((dp - (p.set_velocity + s.set_velocity) / 2.0 * DT).abs() <= b.acceleration * DT * DT + 1e-6, "axis {i}: position jump {} -> {} (v {} -> {})", p.set_position, s.set_position, p.set_velocity, s.set_velocity);
+                assert!(
+                    (dp - (p.set_velocity + s.set_velocity) / 2.0 * DT).abs()
+                        <= b.acceleration * DT * DT + 1e-6,
+                    "axis {i}: position jump {} -> {} (v {} -> {})",
+                    p.set_position,
+                    s.set_position,
+                    p.set_velocity,
+                    s.set_velocity
+                );
             }
             self.shifted[i] = false;
             self.prev[i] = s;
@@ -353,18 +454,36 @@ pub fn allowed(from: AxisState, to: AxisState) -> bool {
     match from {
         Disabled => matches!(to, Standstill),
         ErrorStop => matches!(to, Standstill),
-        Standstill => matches!(to, Homing | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping),
+        Standstill => matches!(
+            to,
+            Homing | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping
+        ),
         Homing => matches!(to, Standstill | Stopping),
-        DiscreteMotion | ContinuousMotion => matches!(to, Standstill | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping),
-        SynchronizedMotion => matches!(to, Standstill | DiscreteMotion | ContinuousMotion | Stopping),
+        DiscreteMotion | ContinuousMotion => matches!(
+            to,
+            Standstill | DiscreteMotion | ContinuousMotion | SynchronizedMotion | Stopping
+        ),
+        SynchronizedMotion => matches!(
+            to,
+            Standstill | DiscreteMotion | ContinuousMotion | Stopping
+        ),
         Stopping => matches!(to, Standstill),
     }
 }
 
 pub fn mv(position: f64, velocity: f64) -> Positioning {
-    Positioning { position, velocity, dynamics: Dynamics::default(), buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }
+    Positioning {
+        position,
+        velocity,
+        dynamics: Dynamics::default(),
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
 }
 
 pub fn mvb(position: f64, velocity: f64, buffer_mode: BufferMode) -> Positioning {
-    Positioning { buffer_mode, ..mv(position, velocity) }
+    Positioning {
+        buffer_mode,
+        ..mv(position, velocity)
+    }
 }

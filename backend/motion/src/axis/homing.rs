@@ -1,0 +1,255 @@
+//! MC_Home: direct, force/reset calibration, and the referencing sequence of spec §5.3
+//! against the drive's reference cam and latch.
+
+use super::*;
+
+impl Axis {
+    pub(super) fn submit_home(
+        &mut self,
+        id: CommandId,
+        position: Option<f64>,
+        mode: HomingMode,
+        options: HomingOptions,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<(), ErrorId> {
+        let slot = self.slot;
+        if self.state() != AxisState::Standstill {
+            return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
+        }
+        let reference = position.unwrap_or(self.p().axis_encoder_homing_calib_value);
+        if !reference.is_finite() {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        match mode {
+            HomingMode::Direct => {
+                let shift = reference - self.set.position;
+                self.shift_coordinates(shift);
+                if options.clear_position_lag {
+                    self.set.position = self.act_pos;
+                }
+                self.set_position_offset = 0.0;
+                self.homed = true;
+                emit_once(id, DONE, slot, cycle, events);
+                Ok(())
+            }
+            HomingMode::ForceCalibration => {
+                self.homed = true;
+                emit_once(id, DONE, slot, cycle, events);
+                Ok(())
+            }
+            HomingMode::ResetCalibration => {
+                self.homed = false;
+                emit_once(id, DONE, slot, cycle, events);
+                Ok(())
+            }
+            HomingMode::Default => {
+                let p = self.p();
+                let dir_of =
+                    |d: Option<Direction>, inv: bool, default: f64| -> Result<f64, ErrorId> {
+                        match d {
+                            None => Ok(if inv { -default } else { default }),
+                            Some(Direction::Positive) => Ok(1.0),
+                            Some(Direction::Negative) => Ok(-1.0),
+                            Some(_) => Err(ErrorId::INVALID_MODE),
+                        }
+                    };
+                let search_dir = dir_of(
+                    options.search_direction,
+                    p.axis_encoder_homing_inv_dir_cam_search,
+                    1.0,
+                )?;
+                let sync_dir = dir_of(
+                    options.sync_direction,
+                    p.axis_encoder_homing_inv_dir_sync_search,
+                    -1.0,
+                )?;
+                let search_velocity = self.check_velocity(
+                    options
+                        .search_velocity
+                        .unwrap_or(p.axis_calibration_velocity_forward),
+                )?;
+                let sync_velocity = self.check_velocity(
+                    options
+                        .sync_velocity
+                        .unwrap_or(p.axis_calibration_velocity_backward),
+                )?;
+                let rm = match options.reference_mode {
+                    Some(m) => m,
+                    None => ReferenceMode::from_number(p.axis_encoder_reference_mode)
+                        .ok_or(ErrorId::INVALID_MODE)?,
+                };
+                self.check_feed_enable(search_dir)?;
+                self.check_feed_enable(sync_dir)?;
+                let mut j = Job::new(id, JobKind::Home);
+                j.acc = p.axis_acc;
+                j.dec = p.axis_dec;
+                j.jerk = p.axis_jerk;
+                j.home = HomeSeq {
+                    phase: HomingPhase::SearchCam,
+                    reference,
+                    mode: rm,
+                    search_dir,
+                    search_velocity,
+                    sync_dir,
+                    sync_velocity,
+                    latched: None,
+                    cam_seen: false,
+                    failed: None,
+                };
+                self.homed = false;
+                self.start_job(j, cycle, events);
+                Ok(())
+            }
+        }
+    }
+
+    /// The referencing sequence of spec §5.3 against the drive's cam and latch.
+    pub(super) fn step_home(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let slot = self.slot;
+        let Some(mut job) = self.job else { return };
+        let mut h = job.home;
+        let cam = fb.reference_cam;
+        let cam_rise = cam && !self.prev_cam;
+        let cam_fall = !cam && self.prev_cam;
+        let drive_latch = matches!(
+            h.mode,
+            ReferenceMode::HardwareLatchPos
+                | ReferenceMode::HardwareLatchNeg
+                | ReferenceMode::SoftDriveLatchPos
+                | ReferenceMode::SoftDriveLatchNeg
+        );
+        let mut replan = false;
+        let mut fail = None;
+        if let Some(k) = self.planner.step(dt) {
+            self.set = k;
+            self.set_has_superposition = false;
+        }
+        let stopped = self.planner.finished() && self.set.velocity.abs() <= EPS_V;
+        let limit_hit =
+            (h.search_dir > 0.0 && fb.limit_positive) || (h.search_dir < 0.0 && fb.limit_negative);
+        if let Some(e) = h.failed {
+            if stopped {
+                job.home = HomeSeq {
+                    phase: HomingPhase::Idle,
+                    ..h
+                };
+                job.finish_error(e, slot, cycle, events);
+                self.job = None;
+                self.planner.clear();
+                self.set.velocity = 0.0;
+                self.set.acceleration = 0.0;
+            }
+            return;
+        }
+        match h.phase {
+            HomingPhase::SearchCam => {
+                if drive_latch {
+                    self.latch = Some(
+                        if matches!(
+                            h.mode,
+                            ReferenceMode::HardwareLatchPos | ReferenceMode::SoftDriveLatchPos
+                        ) {
+                            LatchSource::CamRising
+                        } else {
+                            LatchSource::CamFalling
+                        },
+                    );
+                    if fb.latch_valid {
+                        h.latched = Some(fb.latch_position + self.offset);
+                        self.latch = None;
+                        h.phase = HomingPhase::SetPosition;
+                        replan = true;
+                    }
+                } else if cam && (!h.cam_seen || cam_rise) {
+                    h.cam_seen = true;
+                    // Cam already active at the start: directly to phase 3.
+                    h.phase = if self.set.velocity.abs() <= EPS_V {
+                        HomingPhase::LeaveCam
+                    } else {
+                        HomingPhase::StopOnCam
+                    };
+                    replan = true;
+                }
+                if limit_hit && h.phase == HomingPhase::SearchCam {
+                    fail = Some(ErrorId::HOMING_FAILED);
+                }
+            }
+            HomingPhase::StopOnCam => {
+                if stopped {
+                    if !cam {
+                        fail = Some(ErrorId::HOMING_FAILED);
+                    } else {
+                        h.phase = HomingPhase::LeaveCam;
+                        replan = true;
+                    }
+                }
+            }
+            HomingPhase::LeaveCam => {
+                h.phase = HomingPhase::WaitCamFallingEdge;
+            }
+            HomingPhase::WaitCamFallingEdge => {
+                if cam_fall || !cam {
+                    match h.mode {
+                        ReferenceMode::PlcCam => {
+                            h.latched = Some(self.act_pos);
+                            h.phase = HomingPhase::SetPosition;
+                            replan = true;
+                        }
+                        _ => {
+                            self.latch = Some(LatchSource::IndexPulse);
+                            h.phase = HomingPhase::WaitLatch;
+                        }
+                    }
+                }
+            }
+            HomingPhase::WaitLatch => {
+                if fb.latch_valid {
+                    h.latched = Some(fb.latch_position + self.offset);
+                    self.latch = None;
+                    h.phase = HomingPhase::SetPosition;
+                    replan = true;
+                }
+            }
+            HomingPhase::SetPosition => {
+                if stopped {
+                    let latched = h.latched.unwrap_or(self.act_pos);
+                    // actual = reference + distance travelled since the latch.
+                    let shift = h.reference - latched;
+                    self.shift_coordinates(shift);
+                    self.set_position_offset = 0.0;
+                    self.homed = true;
+                    h.phase = HomingPhase::Idle;
+                    job.home = h;
+                    job.finish_done(slot, cycle, events);
+                    self.job = None;
+                    self.planner.clear();
+                    self.set.velocity = 0.0;
+                    self.set.acceleration = 0.0;
+                    return;
+                }
+            }
+            HomingPhase::Idle => {}
+        }
+        if let Some(e) = fail {
+            self.latch = None;
+            h.failed = Some(e);
+            h.phase = HomingPhase::SetPosition;
+            job.home = h;
+            self.job = Some(job);
+            self.plan_job_now();
+            return;
+        }
+        job.home = h;
+        self.job = Some(job);
+        if replan {
+            self.plan_job_now();
+        }
+    }
+}

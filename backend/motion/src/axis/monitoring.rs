@@ -1,0 +1,336 @@
+//! Power, errors and monitoring: MC_Power/notes 1–5, MC_Reset, ErrorStop, feed enables,
+//! software limits for endless motion and following-error monitoring.
+
+use super::*;
+
+impl Axis {
+    /// Note 2: Enable FALSE → Disabled (ErrorStop stays ErrorStop).
+    pub(super) fn disable(&mut self, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        self.enable = false;
+        self.abort_superposition(cycle, events);
+        self.abort_all(cycle, events);
+        if let Some(mut s) = self.stop.take() {
+            s.emit(
+                FbOutputs {
+                    busy: false,
+                    active: false,
+                    command_aborted: true,
+                    ..FbOutputs::default()
+                },
+                slot,
+                cycle,
+                events,
+            );
+        }
+        if let Some(mut p) = self.power.take() {
+            p.emit(
+                FbOutputs {
+                    busy: false,
+                    active: false,
+                    done: true,
+                    status: false,
+                    ..FbOutputs::default()
+                },
+                slot,
+                cycle,
+                events,
+            );
+        }
+        self.planner.clear();
+        if self.mode != Mode::ErrorStop {
+            self.mode = Mode::Disabled;
+        }
+        self.set = Kinematics {
+            position: self.act_pos,
+            ..Kinematics::default()
+        };
+    }
+
+    /// MC_Reset: clears ErrorStop (notes 3/4) and the MC_Stop lock; takes actual as set.
+    pub(super) fn reset(&mut self, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        self.abort_superposition(cycle, events);
+        if let Some(mut s) = self.stop.take() {
+            s.emit(
+                FbOutputs {
+                    busy: false,
+                    active: false,
+                    command_aborted: true,
+                    ..FbOutputs::default()
+                },
+                slot,
+                cycle,
+                events,
+            );
+            if self.mode == Mode::Stopping && self.job.is_none() {
+                self.mode = Mode::Enabled;
+            }
+            // Otherwise the ramp ends in Standstill without the lock (see step_job).
+        }
+        if self.mode == Mode::ErrorStop {
+            self.fault_reset = true;
+            self.reset_grace = 3;
+            self.error = ErrorId(0);
+            self.lag_timer = 0.0;
+            self.abort_all(cycle, events);
+            self.planner.clear();
+            self.set = Kinematics {
+                position: self.act_pos,
+                ..Kinematics::default()
+            };
+            self.mode = if self.enable && self.status.power_status {
+                Mode::Enabled
+            } else {
+                Mode::Disabled
+            };
+        }
+    }
+
+    /// Note 1: axis error → ErrorStop; every command reports the error; the setpoint stops
+    /// on a fast ramp (or follows the actual position when the drive is off).
+    pub(super) fn enter_error(&mut self, e: ErrorId, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        if self.mode == Mode::ErrorStop {
+            return;
+        }
+        self.error = e;
+        if let Some(sp) = self.superimposed.take() {
+            let out = FbOutputs {
+                busy: false,
+                active: false,
+                error: true,
+                error_id: e.0,
+                warning: false,
+                warning_id: 0,
+                ..sp.out
+            };
+            events.push(CommandEvent {
+                cycle,
+                command: sp.id,
+                axis: slot,
+                outputs: out,
+            });
+        }
+        for j in [self.next.take(), self.job.take()].into_iter().flatten() {
+            let mut j = j;
+            j.finish_error(e, slot, cycle, events);
+        }
+        if let Some(mut s) = self.stop.take() {
+            s.emit(
+                FbOutputs {
+                    busy: false,
+                    active: false,
+                    error: true,
+                    error_id: e.0,
+                    ..FbOutputs::default()
+                },
+                slot,
+                cycle,
+                events,
+            );
+        }
+        self.coupling = None;
+        self.mode = Mode::ErrorStop;
+        let p = self.p();
+        let (dec, jerk) = (
+            p.axis_fast_dec.max(p.axis_dec),
+            p.axis_fast_jerk.max(p.axis_jerk),
+        );
+        let mut j = Job::new(0, JobKind::Halt);
+        j.dec = dec;
+        j.acc = dec;
+        j.jerk = jerk;
+        j.velocity = self.set.velocity.abs().max(EPS_V);
+        self.job = Some(j);
+        self.plan_job_now();
+        if let Some(j) = self.job.as_mut() {
+            j.phase = Phase::Moving;
+        }
+    }
+
+    pub(super) fn step_power(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let slot = self.slot;
+        self.reset_grace = self.reset_grace.saturating_sub(1);
+        if fb.fault
+            && self.reset_grace == 0
+            && self.mode != Mode::ErrorStop
+            && (self.enable || self.mode != Mode::Disabled)
+        {
+            self.enter_error(ErrorId::DRIVE_FAULT, cycle, events);
+        }
+        let status = self.enable && fb.enabled && fb.ready && !fb.fault;
+        if self.enable && !status && self.mode == Mode::Disabled {
+            self.power_on_timer += dt;
+            if self.power_on_timer > POWER_ON_TIMEOUT {
+                if let Some(mut p) = self.power.take() {
+                    p.emit(
+                        FbOutputs {
+                            busy: false,
+                            active: false,
+                            error: true,
+                            error_id: ErrorId::DRIVE_NOT_READY.0,
+                            ..FbOutputs::default()
+                        },
+                        slot,
+                        cycle,
+                        events,
+                    );
+                }
+                self.enable = false;
+            }
+        }
+        if self.enable && status && self.mode == Mode::Disabled {
+            // Note 5: the axis takes the actual position as set position.
+            self.set = Kinematics {
+                position: self.act_pos,
+                ..Kinematics::default()
+            };
+            self.mode = Mode::Enabled;
+            self.lag_timer = 0.0;
+        }
+        if self.enable
+            && !fb.enabled
+            && self.status.power_status
+            && !fb.fault
+            && matches!(self.mode, Mode::Enabled | Mode::Stopping)
+        {
+            // The drive dropped out by itself.
+            self.enter_error(ErrorId::DRIVE_NOT_READY, cycle, events);
+        }
+        self.status.power_status = status;
+        if let Some(mut p) = self.power {
+            p.emit(
+                FbOutputs {
+                    busy: true,
+                    active: true,
+                    status,
+                    ..FbOutputs::default()
+                },
+                slot,
+                cycle,
+                events,
+            );
+            self.power = Some(p);
+        }
+    }
+
+    /// A feed enable dropping while moving in its direction stops the axis (controlled).
+    pub(super) fn step_feed_enables(&mut self, cycle: u64, events: &mut impl EventSink) {
+        if self.mode != Mode::Enabled {
+            return;
+        }
+        let v = self.set.velocity;
+        let blocked = (v > EPS_V && !self.enable_positive) || (v < -EPS_V && !self.enable_negative);
+        if blocked
+            && self
+                .job
+                .as_ref()
+                .is_some_and(|j| j.id != 0 || j.kind != JobKind::Halt)
+        {
+            self.stop_internally(ErrorId::FEED_ENABLE_MISSING, cycle, events);
+        }
+    }
+
+    /// Ends the running command with `e` and stops the axis on an internal halt (not an
+    /// axis error: the axis ends in Standstill).
+    pub(super) fn stop_internally(&mut self, e: ErrorId, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        let (mut dec, mut jerk) = (self.p().axis_dec, self.p().axis_jerk);
+        if let Some(mut n) = self.next.take() {
+            n.finish_error(e, slot, cycle, events);
+        }
+        if let Some(mut j) = self.job.take() {
+            dec = dec.max(j.dec);
+            jerk = jerk.max(j.jerk);
+            j.finish_error(e, slot, cycle, events);
+        }
+        self.coupling = None;
+        let mut h = Job::new(0, JobKind::Halt);
+        h.dec = dec;
+        h.acc = dec;
+        h.jerk = jerk;
+        h.velocity = self.set.velocity.abs().max(EPS_V);
+        h.options.ignore_position_monitoring = true;
+        self.start_job(h, cycle, events);
+    }
+
+    /// Endless motion stops at an enabled software limit with its deceleration.
+    pub(super) fn step_soft_limits(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        let p = self.p();
+        let Some(job) = self.job else { return };
+        let endless = job.is_endless() && job.kind != JobKind::Gear;
+        let v = self.set.velocity;
+        if !endless && !(job.id == 0 && job.kind == JobKind::Velocity) || v.abs() <= EPS_V {
+            return;
+        }
+        let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {
+            p.axis_max_soft_pos_limit
+        } else if v < 0.0 && p.axis_en_min_soft_pos_limit {
+            p.axis_min_soft_pos_limit
+        } else {
+            return;
+        };
+        let (dec, jerk) = (job.dec.max(1e-9), job.jerk.max(1e-9));
+        let sd = stop_distance(v, self.set.acceleration, dec, jerk);
+        let margin = 2.0 * v.abs() * dt;
+        if (limit - self.set.position) * v.signum() > sd + margin {
+            return;
+        }
+        let mut j = job;
+        j.finish_error(ErrorId::SOFT_LIMIT_REACHED, slot, cycle, events);
+        if let Some(mut n) = self.next.take() {
+            n.finish_aborted(slot, cycle, events);
+        }
+        let mut h = Job::new(0, JobKind::Positioning { continuous: false });
+        h.velocity = v.abs();
+        h.acc = job.acc;
+        h.dec = dec;
+        h.jerk = jerk;
+        h.target = limit;
+        h.options.ignore_position_monitoring = true;
+        self.job = None;
+        self.start_job(h, cycle, events);
+        // If the limit cannot be reached without overshoot, stop as hard as allowed.
+        if self.planner.overshoots(limit, v.signum()) {
+            if let Some(h) = self.job.as_mut() {
+                h.kind = JobKind::Halt;
+            }
+            self.plan_job_now();
+        }
+    }
+
+    pub(super) fn step_following_error(
+        &mut self,
+        dt: f64,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let p = self.p();
+        let (enabled, max_lag, filter) = (
+            p.axis_en_position_lag_monitoring,
+            p.axis_max_pos_lag_value,
+            p.axis_max_pos_lag_filter_time,
+        );
+        if !enabled || self.mode == Mode::ErrorStop || self.mode == Mode::Disabled {
+            self.lag_timer = 0.0;
+            return;
+        }
+        let lag = (self.sent_position - self.act_pos).abs();
+        if lag > max_lag {
+            self.lag_timer += dt;
+            if self.lag_timer > filter + 1e-12 {
+                self.enter_error(ErrorId::FOLLOWING_ERROR, cycle, events);
+            }
+        } else {
+            self.lag_timer = 0.0;
+        }
+    }
+}

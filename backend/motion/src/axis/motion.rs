@@ -1,0 +1,947 @@
+//! Motion jobs: admission and resolution of move/halt/jog commands, the buffer and blending
+//! (spec §3.8), planning from the current state, the per-cycle job step and the done criterion
+//! (§3.11).
+
+use super::*;
+
+impl Axis {
+    /// Checks shared by every motion command: state, lock, slave rule. Returns whether the
+    /// axis is a slave that the command will decouple.
+    pub(super) fn admit_motion(&self, buffer_mode: BufferMode) -> Result<(), ErrorId> {
+        match self.state() {
+            AxisState::Standstill | AxisState::DiscreteMotion | AxisState::ContinuousMotion => {
+                Ok(())
+            }
+            AxisState::SynchronizedMotion => {
+                if !self.p().axis_allow_motion_cmd_to_slave_axis {
+                    Err(ErrorId::SLAVE_COMMAND_NOT_ALLOWED)
+                } else if buffer_mode != BufferMode::Aborting {
+                    Err(ErrorId::INVALID_MODE)
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+        }
+    }
+
+    /// Resolves 0 → axis default and checks the dynamics of a move.
+    pub(super) fn dynamics(&self, d: Dynamics) -> Result<(f64, f64, f64), ErrorId> {
+        let p = self.p();
+        let pick = |v: f64, default: f64| {
+            if v == 0.0 {
+                Ok(default)
+            } else if v > 0.0 && v.is_finite() {
+                Ok(v)
+            } else {
+                Err(ErrorId::PARAMETER_NOT_CORRECT)
+            }
+        };
+        let acc = pick(d.acceleration, p.axis_acc)?;
+        let dec = pick(d.deceleration, p.axis_dec)?;
+        let jerk = pick(d.jerk, p.axis_jerk)?;
+        if acc > p.axis_maximum_acceleration * (1.0 + 1e-12)
+            || dec > p.axis_maximum_deceleration * (1.0 + 1e-12)
+        {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        Ok((acc, dec, jerk))
+    }
+
+    pub(super) fn check_velocity(&self, v: f64) -> Result<f64, ErrorId> {
+        if !(v > 0.0) || !v.is_finite() || v > self.p().axis_velo_max * (1.0 + 1e-12) {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        Ok(v)
+    }
+
+    pub(super) fn check_soft_limits(&self, target: f64) -> Result<(), ErrorId> {
+        let p = self.p();
+        if p.axis_en_max_soft_pos_limit && target > p.axis_max_soft_pos_limit {
+            return Err(ErrorId::TARGET_ABOVE_SOFT_LIMIT);
+        }
+        if p.axis_en_min_soft_pos_limit && target < p.axis_min_soft_pos_limit {
+            return Err(ErrorId::TARGET_BELOW_SOFT_LIMIT);
+        }
+        Ok(())
+    }
+
+    pub(super) fn check_feed_enable(&self, direction: f64) -> Result<(), ErrorId> {
+        if (direction > 0.0 && !self.enable_positive) || (direction < 0.0 && !self.enable_negative)
+        {
+            return Err(ErrorId::FEED_ENABLE_MISSING);
+        }
+        Ok(())
+    }
+
+    /// The job that a new buffered command would follow (the buffered one if any, else the
+    /// running one), if it is a job that can be followed.
+    pub(super) fn predecessor(&self) -> Option<&Job> {
+        self.next.as_ref().or(self.job.as_ref())
+    }
+
+    /// Where a command issued now starts from: the previous target when it is buffered
+    /// behind a positioning job, else the current set position.
+    pub(super) fn start_position(&self, buffer_mode: BufferMode) -> f64 {
+        if buffer_mode != BufferMode::Aborting {
+            if let Some(p) = self.predecessor() {
+                if p.is_positioning() && !p.is_endless() {
+                    return p.target;
+                }
+            }
+        }
+        self.set.position
+    }
+
+    pub(super) fn submit_motion(
+        &mut self,
+        cmd: Command,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<(), ErrorId> {
+        let slot = self.slot;
+        let mut job;
+        match cmd.kind {
+            CommandKind::MoveAbsolute(m)
+            | CommandKind::MoveRelative(m)
+            | CommandKind::MoveAdditive(m)
+            | CommandKind::MoveModulo { move_: m, .. }
+            | CommandKind::MoveContinuousAbsolute { move_: m, .. }
+            | CommandKind::MoveContinuousRelative { move_: m, .. } => {
+                self.admit_motion(m.buffer_mode)?;
+                let v = self.check_velocity(m.velocity)?;
+                let (acc, dec, jerk) = self.dynamics(m.dynamics)?;
+                if !m.position.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                let start = self.start_position(m.buffer_mode);
+                let mut continuous = false;
+                let mut end_v = 0.0;
+                let mut modulo = None;
+                let target = match cmd.kind {
+                    CommandKind::MoveAbsolute(_) => m.position,
+                    CommandKind::MoveRelative(_) => start + m.position,
+                    CommandKind::MoveAdditive(_) => {
+                        let base = match self.predecessor() {
+                            Some(p) if p.is_endless() => self.set.position,
+                            _ => self.last_target.unwrap_or(self.set.position),
+                        };
+                        base + m.position
+                    }
+                    CommandKind::MoveModulo { direction, .. } => {
+                        let period = self.period();
+                        let tf = self.p().axis_modulo_tolerance_window;
+                        let from_standstill = self.state() == AxisState::Standstill
+                            || m.buffer_mode == BufferMode::Buffered;
+                        // Validate now (errors are the command's verdict); moves from motion
+                        // are resolved against the state at their start.
+                        let end = modulo_end_position(
+                            start,
+                            m.position,
+                            period,
+                            tf,
+                            direction,
+                            from_standstill,
+                        )?;
+                        if !from_standstill {
+                            if direction == Direction::ShortestWay
+                                || direction == Direction::CurrentDirection
+                            {
+                                // Must not reverse: keep the direction of travel.
+                            }
+                            modulo = Some((m.position, direction));
+                        }
+                        end
+                    }
+                    CommandKind::MoveContinuousAbsolute { end_velocity, .. }
+                    | CommandKind::MoveContinuousRelative { end_velocity, .. } => {
+                        if !(end_velocity >= 0.0)
+                            || !end_velocity.is_finite()
+                            || end_velocity > self.p().axis_velo_max
+                        {
+                            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                        }
+                        continuous = true;
+                        let t = if matches!(cmd.kind, CommandKind::MoveContinuousAbsolute { .. }) {
+                            m.position
+                        } else {
+                            start + m.position
+                        };
+                        let dir = if t >= start { 1.0 } else { -1.0 };
+                        end_v = dir * end_velocity;
+                        t
+                    }
+                    _ => unreachable!(),
+                };
+                self.check_soft_limits(target)?;
+                let dir = (target - start).signum();
+                if target != start {
+                    self.check_feed_enable(dir)?;
+                }
+                job = Job::new(cmd.id, JobKind::Positioning { continuous });
+                job.velocity = v;
+                job.acc = acc;
+                job.dec = dec;
+                job.jerk = jerk;
+                job.target = target;
+                job.end_velocity = end_v;
+                job.continuous_velocity = end_v.abs();
+                job.buffer_mode = m.buffer_mode;
+                job.options = m.options;
+                job.modulo = modulo;
+            }
+            CommandKind::MoveVelocity {
+                velocity,
+                dynamics,
+                direction,
+                buffer_mode,
+                options,
+            } => {
+                self.admit_motion(buffer_mode)?;
+                let v = self.check_velocity(velocity)?;
+                let (acc, dec, jerk) = self.dynamics(dynamics)?;
+                let dir = match direction {
+                    Direction::Positive => 1.0,
+                    Direction::Negative => -1.0,
+                    _ => return Err(ErrorId::COMMAND_NOT_PERMITTED),
+                };
+                self.check_feed_enable(dir)?;
+                job = Job::new(cmd.id, JobKind::Velocity);
+                job.velocity = v;
+                job.direction = dir;
+                job.acc = acc;
+                job.dec = dec;
+                job.jerk = jerk;
+                job.buffer_mode = buffer_mode;
+                job.options = options;
+            }
+            CommandKind::Halt {
+                deceleration,
+                jerk,
+                buffer_mode,
+                options,
+            } => {
+                self.admit_motion(buffer_mode)?;
+                if !deceleration.is_finite() || !jerk.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                let (dec, jk) = self.stop_dynamics(deceleration, jerk);
+                job = Job::new(cmd.id, JobKind::Halt);
+                job.dec = dec;
+                job.acc = dec.max(self.p().axis_acc);
+                job.jerk = jk;
+                job.velocity = self.p().axis_velo_max;
+                job.buffer_mode = buffer_mode;
+                job.options = options;
+            }
+            CommandKind::Jog {
+                mode,
+                forward,
+                position,
+                velocity,
+                dynamics,
+                deadman,
+            } => {
+                self.admit_motion(BufferMode::Aborting)?;
+                if !deadman.is_finite() || deadman < 0.0 {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                let dir = if forward { 1.0 } else { -1.0 };
+                let p = self.p();
+                let (v, acc, dec, jerk) = match mode {
+                    JogMode::StandardSlow => {
+                        (p.axis_velo_man_slow, p.axis_acc, p.axis_dec, p.axis_jerk)
+                    }
+                    JogMode::StandardFast => {
+                        (p.axis_velo_man_fast, p.axis_acc, p.axis_dec, p.axis_jerk)
+                    }
+                    _ => {
+                        let v = self.check_velocity(velocity)?;
+                        let (a, d, j) = self.dynamics(dynamics)?;
+                        (v, a, d, j)
+                    }
+                };
+                let v = self.check_velocity(v)?;
+                self.check_feed_enable(dir)?;
+                match mode {
+                    JogMode::Inching | JogMode::InchingModulo => {
+                        if !(position > 0.0) || !position.is_finite() {
+                            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                        }
+                        let s = self.set.position;
+                        let target = if mode == JogMode::Inching {
+                            s + dir * position
+                        } else {
+                            // Snap to the next multiple of the step in the direction of travel.
+                            let n = s / position;
+                            let k = if forward {
+                                (n + 1e-9).floor() + 1.0
+                            } else {
+                                (n - 1e-9).ceil() - 1.0
+                            };
+                            k * position
+                        };
+                        self.check_soft_limits(target)?;
+                        job = Job::new(cmd.id, JobKind::Positioning { continuous: false });
+                        job.target = target;
+                    }
+                    _ => {
+                        job = Job::new(cmd.id, JobKind::JogHeld { released: false });
+                        // Counted in whole cycles so that it fires exactly `deadman` after
+                        // the last keepalive (a float sum would drift by a cycle).
+                        job.deadman_cycles = if deadman > 0.0 {
+                            ((deadman / self.cycle_time) - 1e-9).ceil().max(1.0) as u32
+                        } else {
+                            0
+                        };
+                    }
+                }
+                job.velocity = v;
+                job.direction = dir;
+                job.acc = acc;
+                job.dec = dec;
+                job.jerk = jerk;
+            }
+            _ => return Err(ErrorId::COMMAND_NOT_PERMITTED),
+        }
+
+        // Blending position (optional): must lie before the previous target; already passed
+        // → the command acts at once (Aborting).
+        let mut mode = job.buffer_mode;
+        if let Some(bp) = job.options.blending_position {
+            if mode != BufferMode::Aborting {
+                if !bp.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                if let Some(prev) = self
+                    .predecessor()
+                    .filter(|p| p.is_positioning() && !p.is_endless())
+                {
+                    let dir = sign(prev.target - self.set.position);
+                    if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
+                        return Err(ErrorId::BLENDING_POSITION_INVALID);
+                    }
+                    if (self.set.position - bp) * dir >= 0.0 {
+                        mode = BufferMode::Aborting;
+                    }
+                }
+            }
+        }
+
+        // Buffer modes (§3.8): an endless job takes no successor; the queue holds one.
+        let running_endless = self.job.as_ref().is_some_and(|j| j.is_endless())
+            || self
+                .job
+                .as_ref()
+                .is_some_and(|j| j.kind == JobKind::Halt && j.id == 0);
+        if mode != BufferMode::Aborting && (self.job.is_none() || running_endless) {
+            mode = BufferMode::Aborting;
+        }
+        if mode != BufferMode::Aborting && self.next.is_some() {
+            return Err(ErrorId::BUFFER_FULL);
+        }
+
+        // Accepted from here on.
+        if self.coupling.is_some() {
+            self.coupling = None;
+        }
+        if job.is_positioning() {
+            self.last_target = Some(job.target);
+        }
+        if job.kind != JobKind::Halt {
+            self.last_dec = job.dec;
+            self.last_jerk = job.jerk;
+        }
+        job.buffer_mode = mode;
+        if mode == BufferMode::Aborting {
+            if let Some(mut n) = self.next.take() {
+                n.finish_aborted(slot, cycle, events);
+            }
+            if let Some(mut j) = self.job.take() {
+                if j.kind == JobKind::Halt && job.kind == JobKind::Halt {
+                    // A halt on a halting axis keeps the stronger ramp.
+                    job.dec = job.dec.max(j.dec);
+                    job.jerk = job.jerk.max(j.jerk);
+                }
+                j.finish_aborted(slot, cycle, events);
+            }
+            self.start_job(job, cycle, events);
+        } else {
+            // Queued: busy, not active.
+            let out = job.out;
+            if job.id != 0 {
+                events.push(CommandEvent {
+                    cycle,
+                    command: job.id,
+                    axis: slot,
+                    outputs: out,
+                });
+            }
+            job.phase = Phase::Queued;
+            self.next = Some(job);
+            self.prepare_blend(cycle, events);
+        }
+        Ok(())
+    }
+
+    /// MC_Halt/MC_Stop dynamics: ≤ 0 means the last move's; never weaker than the running job.
+    pub(super) fn stop_dynamics(&self, dec: f64, jerk: f64) -> (f64, f64) {
+        let mut d = if dec > 0.0 { dec } else { self.last_dec };
+        let mut j = if jerk > 0.0 { jerk } else { self.last_jerk };
+        if let Some(job) = &self.job {
+            if job.dec > 0.0 {
+                d = d.max(job.dec);
+            }
+            if job.jerk > 0.0 {
+                j = j.max(job.jerk);
+            }
+        }
+        (d, j)
+    }
+
+    pub(super) fn start_job(&mut self, mut job: Job, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        job.activate(slot, cycle, events);
+        job.since_keepalive = 0;
+        self.in_window_timer = 0.0;
+        self.job = Some(job);
+        self.resolve_modulo_from_motion();
+        self.plan_job_now();
+        self.prepare_blend(cycle, events);
+    }
+
+    /// A modulo move started from motion takes the shortest path in the direction of travel
+    /// that it can still brake for (extra turns are ignored, no reversal).
+    pub(super) fn resolve_modulo_from_motion(&mut self) {
+        let period = self.period();
+        let tf = self.p().axis_modulo_tolerance_window;
+        let set = self.set;
+        if let Some(j) = self.job.as_mut() {
+            if let Some((t, dir)) = j.modulo.take() {
+                let travel_dir = if set.velocity.abs() > EPS_V {
+                    set.velocity.signum()
+                } else {
+                    match dir {
+                        Direction::Negative => -1.0,
+                        _ => 1.0,
+                    }
+                };
+                let d = if travel_dir > 0.0 {
+                    Direction::Positive
+                } else {
+                    Direction::Negative
+                };
+                let sd = stop_distance(set.velocity, set.acceleration, j.dec, j.jerk);
+                let brake_point = set.position + travel_dir * sd;
+                if let Ok(mut end) = modulo_end_position(
+                    brake_point,
+                    t.rem_euclid(period),
+                    period,
+                    tf.min(0.0),
+                    d,
+                    false,
+                ) {
+                    // Past the brake point in the travel direction.
+                    while (end - brake_point) * travel_dir < 0.0 {
+                        end += travel_dir * period;
+                    }
+                    j.target = end;
+                }
+            }
+        }
+    }
+
+    /// (Re)plans the active job from the current set state. On a planner failure the axis
+    /// stops on the closed-form ramp and the job reports PLANNING_FAILED.
+    pub(super) fn plan_job_now(&mut self) -> bool {
+        let ovr = self.override_ratio();
+        let from = self.plan_origin();
+        let velo_max = self.config.parameters.axis_velo_max;
+        let Some(j) = self.job.as_mut() else {
+            return true;
+        };
+        j.planned_override = ovr;
+        // Taking over an accelerating axis with a weak jerk would let the velocity run on
+        // past the axis maximum while the acceleration is ramped down: use at least the jerk
+        // that keeps it within AxisVeloMax.
+        if from.acceleration * from.velocity > 0.0 {
+            let room = (velo_max - from.velocity.abs()).max(velo_max * 1e-6);
+            let needed = from.acceleration * from.acceleration / (2.0 * room);
+            if needed > j.jerk {
+                j.jerk = needed;
+            }
+        }
+        let res = match j.kind {
+            JobKind::Positioning { .. } => {
+                if ovr <= 0.0 {
+                    self.planner.plan_velocity(from, 0.0, &j.limits(1.0))
+                } else {
+                    let mut lim = j.limits(ovr);
+                    if j.end_velocity.abs() > lim.velocity {
+                        lim.velocity = j.end_velocity.abs();
+                    }
+                    self.planner.plan_position(
+                        from,
+                        j.target,
+                        j.end_velocity * if j.is_endless() { ovr } else { 1.0 },
+                        &lim,
+                    )
+                }
+            }
+            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+                self.planner
+                    .plan_velocity(from, j.direction * j.velocity * ovr, &j.limits(1.0))
+            }
+            JobKind::JogHeld { released: true } | JobKind::Halt => {
+                self.planner.plan_velocity(from, 0.0, &j.limits(1.0))
+            }
+            JobKind::Home => {
+                let h = j.home;
+                let v = match h.phase {
+                    HomingPhase::SearchCam => h.search_dir * h.search_velocity * ovr,
+                    HomingPhase::LeaveCam | HomingPhase::WaitCamFallingEdge => {
+                        h.sync_dir * h.sync_velocity * ovr
+                    }
+                    _ => 0.0,
+                };
+                self.planner.plan_velocity(
+                    from,
+                    v,
+                    &Limits {
+                        velocity: h.search_velocity.max(h.sync_velocity),
+                        acceleration: j.acc,
+                        deceleration: j.dec,
+                        jerk: j.jerk,
+                    },
+                )
+            }
+            JobKind::Gear => return true,
+        };
+        match res {
+            Ok(_) => true,
+            Err(_) => {
+                let (dec, jerk) = (
+                    j.dec.max(self.config.parameters.axis_dec),
+                    j.jerk.max(self.config.parameters.axis_jerk),
+                );
+                self.planner.plan_fallback_stop(from, dec, jerk);
+                j.kind = JobKind::Halt;
+                j.options.ignore_position_monitoring = true;
+                j.pending_error = Some(ErrorId::PLANNING_FAILED);
+                false
+            }
+        }
+    }
+
+    /// When a blending successor is queued behind a positioning job, the running job is
+    /// re-planned to pass its target at the blending velocity (§3.8), as well as possible.
+    pub(super) fn prepare_blend(&mut self, _cycle: u64, _events: &mut impl EventSink) {
+        let ovr = self.override_ratio();
+        let (Some(a), Some(b)) = (self.job.as_ref(), self.next.as_ref()) else {
+            return;
+        };
+        if !a.is_positioning() || a.is_endless() || a.phase != Phase::Moving {
+            return;
+        }
+        if b.kind == JobKind::Halt {
+            // Halt buffered with BlendingNext/Low may only strengthen the final ramp.
+            if matches!(
+                b.buffer_mode,
+                BufferMode::BlendingNext | BufferMode::BlendingLow
+            ) && b.dec > a.dec
+            {
+                let dec = b.dec;
+                if let Some(a) = self.job.as_mut() {
+                    a.dec = dec;
+                }
+                self.plan_job_now();
+            }
+            return;
+        }
+        if !b.buffer_mode.is_blending() {
+            return;
+        }
+        // Direction of the successor's travel from A's target.
+        let b_dir = match b.kind {
+            JobKind::Positioning { .. } => sign(b.target - a.target),
+            JobKind::Velocity | JobKind::JogHeld { .. } => b.direction,
+            _ => 0.0,
+        };
+        let a_dir = sign(a.target - self.set.position);
+        if b_dir == 0.0 || a_dir == 0.0 || b_dir != a_dir {
+            return; // a reversal blends at rest, as Buffered
+        }
+        let (v1, v2) = (a.velocity, b.velocity);
+        let vb = match b.buffer_mode {
+            BufferMode::BlendingLow => v1.min(v2),
+            BufferMode::BlendingPrevious => v1,
+            BufferMode::BlendingNext => v2,
+            BufferMode::BlendingHigh => v1.max(v2),
+            _ => 0.0,
+        } * ovr;
+        let from = self.set;
+        let target = a.target;
+        let mut lim = a.limits(ovr);
+        lim.velocity = lim.velocity.max(vb);
+        // Try the blending velocity; if it cannot be reached without overshooting the
+        // target, pass the target as fast as we can brake to, else stop there.
+        for cand in [vb, from.velocity.abs().min(vb), 0.0] {
+            let ok = self
+                .planner
+                .plan_position(from, target, a_dir * cand, &lim)
+                .is_ok()
+                && !self.planner.overshoots(target, a_dir);
+            if ok {
+                if let Some(a) = self.job.as_mut() {
+                    a.end_velocity = a_dir * cand;
+                }
+                return;
+            }
+        }
+        self.plan_job_now();
+    }
+
+    pub(super) fn step_job(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        master: Option<MasterSample>,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let slot = self.slot;
+        let ovr = self.override_ratio();
+        let Some(mut job) = self.job else {
+            self.set.velocity = 0.0;
+            self.set.acceleration = 0.0;
+            self.set.jerk = 0.0;
+            return;
+        };
+
+        // Jog dead-man.
+        if let JobKind::JogHeld { released: false } = job.kind {
+            job.since_keepalive = job.since_keepalive.saturating_add(1);
+            if job.deadman_cycles > 0 && job.since_keepalive >= job.deadman_cycles {
+                job.kind = JobKind::JogHeld { released: true };
+                job.pending_error = Some(ErrorId::DEADMAN_TIMEOUT);
+                // Reported in the cycle it fires (the command ends with the error at rest).
+                let out = FbOutputs {
+                    in_velocity: false,
+                    warning: true,
+                    warning_id: ErrorId::DEADMAN_TIMEOUT.0,
+                    ..job.out
+                };
+                job.emit(out, slot, cycle, events);
+                self.job = Some(job);
+                self.plan_job_now();
+                job = self.job.expect("set above");
+            }
+        }
+
+        if job.kind == JobKind::Gear {
+            if let (Some(mut c), Some(m)) = (self.coupling, master) {
+                let (mp, mv, ma, mj) = if self.p().axis_couple_slave_to_actual_values {
+                    (m.actual_position, m.actual_velocity, 0.0, 0.0)
+                } else {
+                    (
+                        m.set.position,
+                        m.set.velocity,
+                        m.set.acceleration,
+                        m.set.jerk,
+                    )
+                };
+                if c.master_start.is_nan() {
+                    c.master_start = mp;
+                }
+                let mut dratio = 0.0;
+                if c.ratio != c.target_ratio {
+                    // Ratio change (GearInDyn): rate-limited, re-based so that the position
+                    // stays continuous.
+                    let step =
+                        (c.target_ratio - c.ratio).clamp(-c.ratio_rate * dt, c.ratio_rate * dt);
+                    c.slave_start += c.ratio * (mp - c.master_start);
+                    c.master_start = mp;
+                    c.ratio += step;
+                    dratio = step / dt;
+                    if c.ratio == c.target_ratio && job.id != 0 && !job.out.in_gear {
+                        let out = FbOutputs {
+                            in_gear: true,
+                            ..job.out
+                        };
+                        job.emit(out, slot, cycle, events);
+                    }
+                }
+                self.coupling = Some(c);
+                self.set = Kinematics {
+                    position: c.slave_start + c.ratio * (mp - c.master_start),
+                    velocity: c.ratio * mv,
+                    acceleration: c.ratio * ma + dratio * mv,
+                    jerk: c.ratio * mj,
+                };
+                self.set_has_superposition = false;
+            }
+            self.job = Some(job);
+            return;
+        }
+
+        // Override changes re-plan (never a velocity jump).
+        let endless_holding =
+            job.phase == Phase::Holding && job.kind == JobKind::Positioning { continuous: true };
+        if job.planned_override != ovr
+            && job.phase != Phase::Queued
+            && !matches!(
+                job.kind,
+                JobKind::Halt | JobKind::JogHeld { released: true }
+            )
+            && !matches!(job.phase, Phase::Settling { .. })
+        {
+            self.job = Some(job);
+            if endless_holding {
+                // Continue at end velocity × override.
+                let j = self.job.as_mut().expect("set");
+                j.planned_override = ovr;
+                let v = j.end_velocity * ovr;
+                let lim = j.limits(1.0);
+                let _ = self.planner.plan_velocity(
+                    self.set,
+                    v,
+                    &Limits {
+                        velocity: lim.velocity.max(v.abs()),
+                        ..lim
+                    },
+                );
+            } else {
+                self.plan_job_now();
+                // Re-planning restarts the milestone.
+                let j = self.job.as_mut().expect("set");
+                if j.phase == Phase::Holding {
+                    j.phase = Phase::Moving;
+                }
+            }
+            job = self.job.expect("set above");
+            if job.out.in_velocity {
+                let out = FbOutputs {
+                    in_velocity: false,
+                    ..job.out
+                };
+                job.emit(out, slot, cycle, events);
+            }
+        }
+
+        if job.kind == JobKind::Home {
+            self.job = Some(job);
+            self.step_home(dt, fb, cycle, events);
+            return;
+        }
+
+        if let Some(k) = self.planner.step(dt) {
+            self.set = k;
+            self.set_has_superposition = false;
+        }
+        let finished = self.planner.finished();
+
+        match job.kind {
+            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+                let reached = finished && ovr > 0.0 && job.planned_override == ovr;
+                if reached != job.out.in_velocity {
+                    let out = FbOutputs {
+                        in_velocity: reached,
+                        ..job.out
+                    };
+                    job.emit(out, slot, cycle, events);
+                }
+                job.phase = if reached {
+                    Phase::Holding
+                } else {
+                    Phase::Moving
+                };
+                self.job = Some(job);
+            }
+            JobKind::Positioning { continuous: true } => {
+                if finished && job.phase == Phase::Moving && job.planned_override > 0.0 {
+                    job.phase = Phase::Holding;
+                    let out = FbOutputs {
+                        in_end_velocity: true,
+                        ..job.out
+                    };
+                    job.emit(out, slot, cycle, events);
+                    if job.end_velocity == 0.0 {
+                        // End velocity 0: the target is an end; done at rest.
+                        job.finish_done(slot, cycle, events);
+                        self.job = None;
+                        self.planner.clear();
+                        self.start_next(cycle, events);
+                        return;
+                    }
+                }
+                self.job = Some(job);
+            }
+            JobKind::Positioning { continuous: false }
+            | JobKind::Halt
+            | JobKind::JogHeld { released: true } => {
+                if !finished
+                    || (job.kind == JobKind::Positioning { continuous: false }
+                        && job.planned_override <= 0.0)
+                {
+                    self.job = Some(job);
+                    return;
+                }
+                // Logical end of positioning: the setpoint stands exactly on the target.
+                if job.kind == (JobKind::Positioning { continuous: false })
+                    && job.end_velocity == 0.0
+                {
+                    self.set.position = job.target;
+                }
+                let blending_successor = self
+                    .next
+                    .as_ref()
+                    .is_some_and(|n| n.buffer_mode.is_blending())
+                    && job.end_velocity != 0.0;
+                if blending_successor {
+                    job.finish_done(slot, cycle, events);
+                    self.job = None;
+                    self.start_next(cycle, events);
+                    return;
+                }
+                let done = self.done_criterion(&mut job, dt);
+                match done {
+                    None => {
+                        self.job = Some(job);
+                    }
+                    Some(Ok(())) => {
+                        if let Some(e) = job.pending_error {
+                            job.finish_error(e, slot, cycle, events);
+                        } else {
+                            job.finish_done(slot, cycle, events);
+                        }
+                        self.job = None;
+                        self.planner.clear();
+                        self.set.velocity = 0.0;
+                        self.set.acceleration = 0.0;
+                        self.set.jerk = 0.0;
+                        if self.mode == Mode::Stopping {
+                            if let Some(mut s) = self.stop {
+                                s.emit(
+                                    FbOutputs {
+                                        busy: true,
+                                        active: true,
+                                        done: true,
+                                        ..FbOutputs::default()
+                                    },
+                                    slot,
+                                    cycle,
+                                    events,
+                                );
+                                self.stop = Some(s);
+                            } else {
+                                // The lock was removed by MC_Reset during the ramp.
+                                self.mode = Mode::Enabled;
+                            }
+                        }
+                        self.start_next(cycle, events);
+                    }
+                    Some(Err(e)) => {
+                        job.finish_error(e, slot, cycle, events);
+                        self.job = None;
+                        self.planner.clear();
+                        if let Some(mut n) = self.next.take() {
+                            n.finish_aborted(slot, cycle, events);
+                        }
+                    }
+                }
+            }
+            JobKind::Home | JobKind::Gear => unreachable!(),
+        }
+    }
+
+    /// §3.11: None = still waiting; Some(Ok) = done; Some(Err) = in-target timeout.
+    pub(super) fn done_criterion(&mut self, job: &mut Job, dt: f64) -> Option<Result<(), ErrorId>> {
+        let p = self.p();
+        let stop_like = job.kind != (JobKind::Positioning { continuous: false });
+        let monitor = if stop_like {
+            job.options.enable_stop_position_monitoring
+        } else {
+            !job.options.ignore_position_monitoring
+        };
+        if !monitor || self.mode == Mode::ErrorStop {
+            return Some(Ok(()));
+        }
+        let target = if stop_like {
+            self.set.position
+        } else {
+            job.target
+        };
+        let dev = (self.act_pos - target).abs();
+        let (mut in_window, mut total) = match job.phase {
+            Phase::Settling { in_window, total } => (in_window, total),
+            _ => (0.0, 0.0),
+        };
+        total += dt;
+        let reached = if p.axis_en_target_position_monitoring {
+            if dev <= p.axis_target_position_window {
+                in_window += dt;
+            } else {
+                in_window = 0.0;
+            }
+            in_window + 1e-12 >= p.axis_target_position_monitoring_time
+        } else if p.axis_en_position_range_monitoring {
+            dev <= p.axis_position_range_window
+        } else {
+            true
+        };
+        job.phase = Phase::Settling { in_window, total };
+        if reached {
+            return Some(Ok(()));
+        }
+        if p.axis_en_in_target_timeout && total > p.axis_in_target_timeout {
+            return Some(Err(ErrorId::IN_TARGET_TIMEOUT));
+        }
+        None
+    }
+
+    /// Activates the buffered job when the running one has ended.
+    pub(super) fn start_next(&mut self, cycle: u64, events: &mut impl EventSink) {
+        if self.job.is_some() || self.mode != Mode::Enabled {
+            return;
+        }
+        if let Some(mut n) = self.next.take() {
+            if n.kind == JobKind::Halt {
+                // Buffered halt at standstill: nothing to stop.
+                let slot = self.slot;
+                n.activate(slot, cycle, events);
+                if self.set.velocity.abs() <= EPS_V {
+                    n.finish_done(slot, cycle, events);
+                    return;
+                }
+            }
+            n.since_keepalive = 0;
+            self.start_job(n, cycle, events);
+        }
+    }
+
+    /// After GearOut (or when a slave loses its master while moving): keep the current
+    /// velocity as an endless motion that no command owns.
+    pub(super) fn continue_at_current_velocity(&mut self, cycle: u64, events: &mut impl EventSink) {
+        if self.set.velocity.abs() <= EPS_V && self.set.acceleration == 0.0 {
+            self.set.velocity = 0.0;
+            return;
+        }
+        let p = self.p();
+        let mut j = Job::new(0, JobKind::Velocity);
+        j.velocity = self.set.velocity.abs().min(p.axis_velo_max).max(EPS_V);
+        j.direction = self.set.velocity.signum();
+        j.acc = p.axis_acc;
+        j.dec = p.axis_dec;
+        j.jerk = p.axis_jerk;
+        // Not scaled by the override: it continues the master's speed.
+        j.planned_override = 1.0;
+        self.start_job(j, cycle, events);
+        let ovr = self.override_ratio();
+        if let Some(j) = self.job.as_mut() {
+            let _ = self
+                .planner
+                .plan_velocity(self.set, j.direction * j.velocity, &j.limits(1.0));
+            j.planned_override = ovr;
+        }
+    }
+}
