@@ -18,6 +18,7 @@ use crate::params::AxisParameters;
 use crate::planner::{Kinematics, Limits, Planner, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
 
+mod coupling;
 mod homing;
 mod monitoring;
 mod motion;
@@ -241,24 +242,11 @@ impl Job {
     }
 
     fn finish_done(&mut self, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        let out = FbOutputs {
-            busy: false,
-            active: false,
-            done: true,
-            ..self.out
-        };
-        self.emit(out, axis, cycle, events);
+        self.emit(ended(self.out, End::Done), axis, cycle, events);
     }
 
     fn finish_aborted(&mut self, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        let out = FbOutputs {
-            busy: false,
-            active: false,
-            command_aborted: true,
-            in_velocity: false,
-            ..self.out
-        };
-        self.emit(out, axis, cycle, events);
+        self.emit(ended(self.out, End::Aborted), axis, cycle, events);
     }
 
     fn finish_error(
@@ -268,19 +256,7 @@ impl Job {
         cycle: u64,
         events: &mut impl EventSink,
     ) {
-        let out = FbOutputs {
-            busy: false,
-            active: false,
-            error: true,
-            error_id: e.0,
-            in_velocity: false,
-            in_gear: false,
-            in_end_velocity: false,
-            warning: false,
-            warning_id: 0,
-            ..self.out
-        };
-        self.emit(out, axis, cycle, events);
+        self.emit(ended(self.out, End::Error(e)), axis, cycle, events);
     }
 }
 
@@ -293,6 +269,10 @@ struct Held {
 }
 
 impl Held {
+    fn end(&mut self, end: End, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+        self.emit(ended(self.out, end), axis, cycle, events);
+    }
+
     fn emit(&mut self, out: FbOutputs, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
         if out != self.out {
             events.push(CommandEvent {
@@ -303,6 +283,38 @@ impl Held {
             });
         }
         self.out = out;
+    }
+}
+
+/// How a command ended (exactly one of Done, CommandAborted, Error; Busy and Active fall).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum End {
+    Done,
+    Aborted,
+    Error(ErrorId),
+}
+
+/// The outputs of a command that ends now: success flags survive only a Done; an error
+/// clears every success flag and the warning (§3.5).
+fn ended(out: FbOutputs, end: End) -> FbOutputs {
+    let error = match end {
+        End::Error(e) => e.0,
+        _ => 0,
+    };
+    let ok = end == End::Done;
+    FbOutputs {
+        busy: false,
+        active: false,
+        done: ok,
+        command_aborted: end == End::Aborted,
+        error: error != 0,
+        error_id: error,
+        in_velocity: out.in_velocity && ok,
+        in_gear: out.in_gear && error == 0,
+        in_end_velocity: out.in_end_velocity && error == 0,
+        status: false,
+        warning: out.warning && error == 0,
+        warning_id: if error == 0 { out.warning_id } else { 0 },
     }
 }
 
@@ -354,8 +366,7 @@ struct Coupling {
 /// (C² smooth) function of the main motion's travel `u` over `length` (spec §5.2.1, §6.13).
 #[derive(Clone, Copy, Debug)]
 struct Superimposed {
-    id: CommandId,
-    out: FbOutputs,
+    cmd: Held,
     /// Effective distance (signed, axis coordinates); reduced when infeasible (warning).
     distance: f64,
     /// Main-motion travel over which it is spread.
@@ -573,17 +584,7 @@ impl Axis {
                 self.enable_positive = enable_positive;
                 self.enable_negative = enable_negative;
                 if let Some(mut old) = self.power.take() {
-                    old.emit(
-                        FbOutputs {
-                            busy: false,
-                            active: false,
-                            command_aborted: true,
-                            ..old.out
-                        },
-                        slot,
-                        cycle,
-                        events,
-                    );
+                    old.end(End::Aborted, slot, cycle, events);
                 }
                 if enable {
                     if !self.enable {
@@ -701,18 +702,7 @@ impl Axis {
                 let (dec, jk) = self.stop_dynamics(deceleration, jerk);
                 self.abort_all(cycle, events);
                 if let Some(mut old) = self.stop.take() {
-                    old.emit(
-                        FbOutputs {
-                            busy: false,
-                            active: false,
-                            done: false,
-                            command_aborted: true,
-                            ..old.out
-                        },
-                        slot,
-                        cycle,
-                        events,
-                    );
+                    old.end(End::Aborted, slot, cycle, events);
                 }
                 self.coupling = None;
                 self.mode = Mode::Stopping;
@@ -741,173 +731,33 @@ impl Axis {
                 self.start_job(j, cycle, events);
                 Ok(())
             }
-            CommandKind::GearOut => {
-                if self.state() != AxisState::SynchronizedMotion {
-                    return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
-                }
-                if self.coupling.is_some_and(|c| c.dyn_command != 0) {
-                    // GearInDyn still enabled: the slave is decoupled only for an instant and
-                    // recoupled at once with the ratio it has (spec §5.5.2).
-                    if let Some(c) = self.coupling.as_mut() {
-                        c.slave_start = self.set.position;
-                        c.master_start = f64::NAN; // rebased on the next step
-                    }
-                    emit_once(cmd.id, DONE, slot, cycle, events);
-                    return Ok(());
-                }
-                self.abort_superposition(cycle, events);
-                self.coupling = None;
-                if let Some(mut j) = self.job.take() {
-                    j.finish_aborted(slot, cycle, events);
-                }
-                self.continue_at_current_velocity(cycle, events);
-                emit_once(cmd.id, DONE, slot, cycle, events);
-                Ok(())
-            }
+            CommandKind::GearOut => self.submit_gear_out(cmd.id, cycle, events),
             CommandKind::GearIn {
                 master: master_slot,
                 ratio_numerator,
                 ratio_denominator,
-            } => {
-                if ratio_denominator == 0 || !ratio_numerator.is_finite() {
-                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
-                }
-                let Some((_, m)) = master else {
-                    return Err(ErrorId::MASTER_INVALID);
-                };
-                match self.state() {
-                    AxisState::Standstill
-                    | AxisState::DiscreteMotion
-                    | AxisState::ContinuousMotion
-                    | AxisState::SynchronizedMotion => {}
-                    _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
-                }
-                if m.error {
-                    return Err(ErrorId::MASTER_INVALID);
-                }
-                if m.moving || m.set.velocity.abs() > EPS_V {
-                    return Err(ErrorId::MASTER_MOVING);
-                }
-                if self.set.velocity.abs() > EPS_V {
-                    return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
-                }
-                let use_actual = self.p().axis_couple_slave_to_actual_values;
-                self.abort_all(cycle, events);
-                let ratio = ratio_numerator / ratio_denominator as f64;
-                self.coupling = Some(Coupling {
-                    master: master_slot,
-                    ratio,
-                    target_ratio: ratio,
-                    ratio_rate: f64::INFINITY,
-                    dyn_command: 0,
-                    master_start: if use_actual {
-                        m.actual_position
-                    } else {
-                        m.set.position
-                    },
-                    slave_start: self.set.position,
-                });
-                let mut j = Job::new(cmd.id, JobKind::Gear);
-                j.activate(slot, cycle, events);
-                let out = FbOutputs {
-                    in_gear: true,
-                    ..j.out
-                };
-                j.emit(out, slot, cycle, events);
-                self.job = Some(j);
-                Ok(())
-            }
+            } => self.submit_gear_in(
+                cmd.id,
+                master_slot,
+                master,
+                ratio_numerator,
+                ratio_denominator,
+                cycle,
+                events,
+            ),
             CommandKind::GearInDyn {
                 master: master_slot,
                 gear_ratio,
                 acceleration,
-            } => {
-                if !gear_ratio.is_finite() || !acceleration.is_finite() || acceleration < 0.0 {
-                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
-                }
-                let Some((_, m)) = master else {
-                    return Err(ErrorId::MASTER_INVALID);
-                };
-                if m.error {
-                    return Err(ErrorId::MASTER_INVALID);
-                }
-                let acc = if acceleration > 0.0 {
-                    acceleration
-                } else {
-                    self.p().axis_acc
-                };
-                let rate = acc / m.max_velocity.max(EPS_V);
-                // Enable still TRUE on the same coupling: a new ratio.
-                if let Some(c) = self
-                    .coupling
-                    .as_mut()
-                    .filter(|c| c.master == master_slot && c.dyn_command != 0)
-                {
-                    c.target_ratio = gear_ratio;
-                    c.ratio_rate = rate;
-                    let old = c.dyn_command;
-                    c.dyn_command = cmd.id;
-                    if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
-                        // The earlier instance hands over to this one.
-                        let mut prev = Job { id: old, ..*j };
-                        prev.finish_done(slot, cycle, events);
-                        j.id = cmd.id;
-                        j.out = FbOutputs::default();
-                        j.activate(slot, cycle, events);
-                        let out = FbOutputs {
-                            in_gear: (c.ratio - c.target_ratio).abs() < 1e-12,
-                            ..j.out
-                        };
-                        j.emit(out, slot, cycle, events);
-                    }
-                    return Ok(());
-                }
-                match self.state() {
-                    AxisState::Standstill
-                    | AxisState::DiscreteMotion
-                    | AxisState::ContinuousMotion
-                    | AxisState::SynchronizedMotion => {}
-                    _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
-                }
-                let use_actual = self.p().axis_couple_slave_to_actual_values;
-                let mv = if use_actual {
-                    m.actual_velocity
-                } else {
-                    m.set.velocity
-                };
-                // Start from the ratio the slave already has (at rest: 0) and ramp from there,
-                // so that coupling onto a moving master is acceleration-limited.
-                let start_ratio = if mv.abs() > EPS_V {
-                    self.set.velocity / mv
-                } else if self.set.velocity.abs() <= EPS_V {
-                    gear_ratio
-                } else {
-                    return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
-                };
-                self.abort_all(cycle, events);
-                self.coupling = Some(Coupling {
-                    master: master_slot,
-                    ratio: start_ratio,
-                    target_ratio: gear_ratio,
-                    ratio_rate: rate,
-                    dyn_command: cmd.id,
-                    master_start: if use_actual {
-                        m.actual_position
-                    } else {
-                        m.set.position
-                    },
-                    slave_start: self.set.position,
-                });
-                let mut j = Job::new(cmd.id, JobKind::Gear);
-                j.activate(slot, cycle, events);
-                let out = FbOutputs {
-                    in_gear: (start_ratio - gear_ratio).abs() < 1e-12,
-                    ..j.out
-                };
-                j.emit(out, slot, cycle, events);
-                self.job = Some(j);
-                Ok(())
-            }
+            } => self.submit_gear_in_dyn(
+                cmd.id,
+                master_slot,
+                master,
+                gear_ratio,
+                acceleration,
+                cycle,
+                events,
+            ),
             CommandKind::MoveSuperImposed(sp) => {
                 self.submit_superposition(cmd.id, sp, cycle, events)
             }
@@ -991,17 +841,7 @@ impl Axis {
         let slot = self.slot;
         if let Some(mut s) = self.stop {
             if s.released && s.out.done && self.job.is_none() {
-                s.emit(
-                    FbOutputs {
-                        busy: false,
-                        active: false,
-                        done: true,
-                        ..FbOutputs::default()
-                    },
-                    slot,
-                    cycle,
-                    events,
-                );
+                s.end(End::Done, slot, cycle, events);
                 self.stop = None;
                 if self.mode == Mode::Stopping {
                     self.mode = Mode::Enabled;

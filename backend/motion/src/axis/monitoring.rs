@@ -11,31 +11,10 @@ impl Axis {
         self.abort_superposition(cycle, events);
         self.abort_all(cycle, events);
         if let Some(mut s) = self.stop.take() {
-            s.emit(
-                FbOutputs {
-                    busy: false,
-                    active: false,
-                    command_aborted: true,
-                    ..FbOutputs::default()
-                },
-                slot,
-                cycle,
-                events,
-            );
+            s.end(End::Aborted, slot, cycle, events);
         }
         if let Some(mut p) = self.power.take() {
-            p.emit(
-                FbOutputs {
-                    busy: false,
-                    active: false,
-                    done: true,
-                    status: false,
-                    ..FbOutputs::default()
-                },
-                slot,
-                cycle,
-                events,
-            );
+            p.end(End::Done, slot, cycle, events);
         }
         self.planner.clear();
         if self.mode != Mode::ErrorStop {
@@ -52,17 +31,7 @@ impl Axis {
         let slot = self.slot;
         self.abort_superposition(cycle, events);
         if let Some(mut s) = self.stop.take() {
-            s.emit(
-                FbOutputs {
-                    busy: false,
-                    active: false,
-                    command_aborted: true,
-                    ..FbOutputs::default()
-                },
-                slot,
-                cycle,
-                events,
-            );
+            s.end(End::Aborted, slot, cycle, events);
             if self.mode == Mode::Stopping && self.job.is_none() {
                 self.mode = Mode::Enabled;
             }
@@ -95,40 +64,15 @@ impl Axis {
             return;
         }
         self.error = e;
-        if let Some(sp) = self.superimposed.take() {
-            let out = FbOutputs {
-                busy: false,
-                active: false,
-                error: true,
-                error_id: e.0,
-                warning: false,
-                warning_id: 0,
-                ..sp.out
-            };
-            events.push(CommandEvent {
-                cycle,
-                command: sp.id,
-                axis: slot,
-                outputs: out,
-            });
+        if let Some(mut sp) = self.superimposed.take() {
+            sp.cmd.end(End::Error(e), slot, cycle, events);
         }
         for j in [self.next.take(), self.job.take()].into_iter().flatten() {
             let mut j = j;
             j.finish_error(e, slot, cycle, events);
         }
         if let Some(mut s) = self.stop.take() {
-            s.emit(
-                FbOutputs {
-                    busy: false,
-                    active: false,
-                    error: true,
-                    error_id: e.0,
-                    ..FbOutputs::default()
-                },
-                slot,
-                cycle,
-                events,
-            );
+            s.end(End::Error(e), slot, cycle, events);
         }
         self.coupling = None;
         self.mode = Mode::ErrorStop;
@@ -170,18 +114,7 @@ impl Axis {
             self.power_on_timer += dt;
             if self.power_on_timer > POWER_ON_TIMEOUT {
                 if let Some(mut p) = self.power.take() {
-                    p.emit(
-                        FbOutputs {
-                            busy: false,
-                            active: false,
-                            error: true,
-                            error_id: ErrorId::DRIVE_NOT_READY.0,
-                            ..FbOutputs::default()
-                        },
-                        slot,
-                        cycle,
-                        events,
-                    );
+                    p.end(End::Error(ErrorId::DRIVE_NOT_READY), slot, cycle, events);
                 }
                 self.enable = false;
             }

@@ -126,15 +126,14 @@ impl Axis {
             },
             ..FbOutputs::default()
         };
-        events.push(CommandEvent {
-            cycle,
-            command: id,
-            axis: slot,
-            outputs: out,
-        });
-        self.superimposed = Some(Superimposed {
+        let mut cmd = Held {
             id,
-            out,
+            out: FbOutputs::default(),
+            released: false,
+        };
+        cmd.emit(out, slot, cycle, events);
+        self.superimposed = Some(Superimposed {
+            cmd,
             distance,
             length,
             travelled: 0.0,
@@ -152,19 +151,8 @@ impl Axis {
     /// Ends a superposition with CommandAborted; what it applied stays. The velocity it was
     /// adding is handed to the main motion's planner, which takes it away smoothly.
     pub(super) fn abort_superposition(&mut self, cycle: u64, events: &mut impl EventSink) {
-        if let Some(sp) = self.superimposed.take() {
-            let out = FbOutputs {
-                busy: false,
-                active: false,
-                command_aborted: true,
-                ..sp.out
-            };
-            events.push(CommandEvent {
-                cycle,
-                command: sp.id,
-                axis: self.slot,
-                outputs: out,
-            });
+        if let Some(mut sp) = self.superimposed.take() {
+            sp.cmd.end(End::Aborted, self.slot, cycle, events);
             if sp.added != (0.0, 0.0) && self.mode != Mode::Disabled {
                 if self
                     .job
@@ -293,18 +281,7 @@ impl Axis {
             sp.last_position = self.set.position;
             self.superimposed = Some(sp);
         } else {
-            let out = FbOutputs {
-                busy: false,
-                active: false,
-                done: true,
-                ..sp.out
-            };
-            events.push(CommandEvent {
-                cycle,
-                command: sp.id,
-                axis: self.slot,
-                outputs: out,
-            });
+            sp.cmd.end(End::Done, self.slot, cycle, events);
             self.superimposed = None;
         }
     }
