@@ -90,6 +90,8 @@ enum Action {
     Release(usize),
     Run(u16),
     Fault(u16, bool),
+    /// A hardware limit switch (positive or negative) goes on or off.
+    Limit(u16, bool, bool),
 }
 
 fn action() -> impl Strategy<Value = Action> {
@@ -98,6 +100,7 @@ fn action() -> impl Strategy<Value = Action> {
         1 => (0usize..4).prop_map(Action::Release),
         5 => (0u16..400).prop_map(Action::Run),
         1 => (0u16..2, any::<bool>()).prop_map(|(a, f)| Action::Fault(a, f)),
+        1 => (0u16..2, any::<bool>(), any::<bool>()).prop_map(|(a, p, on)| Action::Limit(a, p, on)),
     ]
 }
 
@@ -138,6 +141,10 @@ proptest! {
                 }
                 Action::Run(c) => for _ in 0..c { r.step(); },
                 Action::Fault(axis, f) => r.plants[axis as usize].fault = f,
+                Action::Limit(axis, positive, on) => {
+                    let p = &mut r.plants[axis as usize];
+                    if positive { p.limit_positive = on } else { p.limit_negative = on }
+                }
             }
             for axis in 0..2u16 {
                 let s = r.st(axis);

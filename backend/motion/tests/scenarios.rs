@@ -1679,3 +1679,39 @@ fn superposition_across_a_blend_handoff_stays_continuous() {
     r.until(3.0, |r| r.out(b).active);
     r.run(0.5);
 }
+
+#[test]
+fn hardware_limit_switch_stops_fast_and_blocks_that_direction_only() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 200.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(0.5);
+    r.plants[0].limit_positive = true;
+    r.step();
+    r.step();
+    assert_eq!(r.out(v).error_id, ErrorId::LIMIT_SWITCH.0);
+    assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
+    r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+    // Braked with the fast-stop deceleration (5000), not the axis default (1000).
+    let amin = r.history[0]
+        .iter()
+        .map(|s| s.set_acceleration)
+        .fold(0.0, f64::min);
+    assert!(amin < -1000.0 - 1.0, "{amin}");
+    // Moving further into the switch is refused; moving off it is fine.
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveRelative(mv(1.0, 10.0))),
+        ErrorId::LIMIT_SWITCH
+    );
+    let back = r.ok(0, CommandKind::MoveRelative(mv(-5.0, 10.0)));
+    r.until(2.0, |r| r.out(back).done);
+}

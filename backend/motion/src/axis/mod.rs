@@ -402,6 +402,9 @@ pub struct Axis {
     enable: bool,
     enable_positive: bool,
     enable_negative: bool,
+    /// Hardware limit switches as last reported by the drive.
+    limit_positive: bool,
+    limit_negative: bool,
     power_override: f64,
     override_factor: f64,
     power_on_timer: f64,
@@ -461,6 +464,8 @@ impl Axis {
             enable: false,
             enable_positive: false,
             enable_negative: false,
+            limit_positive: false,
+            limit_negative: false,
             power_override: 100.0,
             override_factor: 1.0,
             power_on_timer: 0.0,
@@ -898,6 +903,8 @@ impl Axis {
     ) -> DriveSetpoint {
         let slot = self.slot;
         self.act_pos = fb.actual_position + self.offset;
+        self.limit_positive = fb.limit_positive;
+        self.limit_negative = fb.limit_negative;
         self.act_vel = fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 

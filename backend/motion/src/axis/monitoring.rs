@@ -160,22 +160,42 @@ impl Axis {
             return;
         }
         let v = self.set.velocity;
-        let blocked = (v > EPS_V && !self.enable_positive) || (v < -EPS_V && !self.enable_negative);
-        if blocked
-            && self
-                .job
-                .as_ref()
-                .is_some_and(|j| j.id != 0 || j.kind != JobKind::Halt)
-        {
-            self.stop_internally(ErrorId::FEED_ENABLE_MISSING, cycle, events);
+        // A stop of our own is already under way; homing handles limit switches itself.
+        let stoppable = self
+            .job
+            .as_ref()
+            .is_some_and(|j| (j.id != 0 || j.kind != JobKind::Halt) && j.kind != JobKind::Home);
+        if !stoppable {
+            return;
+        }
+        if (v > EPS_V && self.limit_positive) || (v < -EPS_V && self.limit_negative) {
+            // A hardware limit switch in the direction of travel: stop with the fast-stop
+            // dynamics (#1053/#1054).
+            self.stop_internally(ErrorId::LIMIT_SWITCH, true, cycle, events);
+        } else if (v > EPS_V && !self.enable_positive) || (v < -EPS_V && !self.enable_negative) {
+            self.stop_internally(ErrorId::FEED_ENABLE_MISSING, false, cycle, events);
         }
     }
 
     /// Ends the running command with `e` and stops the axis on an internal halt (not an
     /// axis error: the axis ends in Standstill).
-    pub(super) fn stop_internally(&mut self, e: ErrorId, cycle: u64, events: &mut impl EventSink) {
+    pub(super) fn stop_internally(
+        &mut self,
+        e: ErrorId,
+        fast: bool,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
         let slot = self.slot;
-        let (mut dec, mut jerk) = (self.p().axis_dec, self.p().axis_jerk);
+        let p = self.p();
+        let (mut dec, mut jerk) = if fast {
+            (
+                p.axis_fast_dec.max(p.axis_dec),
+                p.axis_fast_jerk.max(p.axis_jerk),
+            )
+        } else {
+            (p.axis_dec, p.axis_jerk)
+        };
         if let Some(mut n) = self.next.take() {
             n.finish_error(e, slot, cycle, events);
         }

@@ -66,10 +66,14 @@ impl Axis {
         Ok(())
     }
 
+    /// Feed enable and hardware limit switch of the direction of travel.
     pub(super) fn check_feed_enable(&self, direction: f64) -> Result<(), ErrorId> {
         if (direction > 0.0 && !self.enable_positive) || (direction < 0.0 && !self.enable_negative)
         {
             return Err(ErrorId::FEED_ENABLE_MISSING);
+        }
+        if (direction > 0.0 && self.limit_positive) || (direction < 0.0 && self.limit_negative) {
+            return Err(ErrorId::LIMIT_SWITCH);
         }
         Ok(())
     }
