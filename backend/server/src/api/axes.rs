@@ -501,6 +501,9 @@ pub async fn export_config(State(s): State<Arc<AppState>>) -> Json<ConfigDocumen
     Json(export(&s))
 }
 
+/// An axis as installed before an import: id, slot, name, configuration, persistent overlay.
+type InstalledAxis = (i64, u16, String, AxisConfigDto, BTreeMap<u16, ParamValue>);
+
 #[utoipa::path(put, path = "/api/v1/config", tag = "system",
     summary = "Import a whole configuration (replaces every axis; all axes must be disabled)",
     request_body = ConfigDocument,
@@ -584,7 +587,7 @@ pub async fn import_config(
     if !errs.is_empty() {
         return Err(ApiError::invalid(errs));
     }
-    let old: Vec<(i64, u16, String, AxisConfigDto, BTreeMap<u16, ParamValue>)> = {
+    let old: Vec<InstalledAxis> = {
         let reg = s.registry.read().unwrap();
         reg.axes
             .values()
