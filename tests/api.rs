@@ -676,6 +676,8 @@ async fn openapi_json_is_current() {
         "/api/v1/axes/{axis}/gear-in-dyn",
         "/api/v1/axes/{axis}/move-superimposed",
         "/api/v1/axes/{axis}/abort-superposition",
+        "/api/v1/axes/{axis}/simulation/fault",
+        "/api/v1/audit",
         "/api/v1/commands/{id}/keepalive",
         "/api/v1/config",
         "/metrics",
@@ -683,7 +685,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 32, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 34, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -955,4 +957,217 @@ async fn gear_in_dyn_couples_y_to_x_and_a_second_call_changes_the_ratio() {
     let out = post(&s, "/api/v1/axes/y/gear-out?wait=true", json!({})).await;
     assert_eq!(out.json["state"], "done", "{}", out.text);
     until_status(&s, "y", 5, |st| st["coupled"] == false).await;
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn an_injected_drive_fault_stops_the_axis_until_cleared_and_reset() {
+    const DRIVE_FAULT: u64 = 0x7010;
+    let s = Server::start();
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let fault = "/api/v1/axes/x/simulation/fault";
+    for bad in [
+        json!({"kind": "meltdown"}),
+        json!({"kind": "load"}),
+        json!({"kind": "drive_fault", "code": -1}),
+        json!({"kind": "limit_switch", "positive": true}),
+        json!({"kind": "clear", "now": true}),
+    ] {
+        assert_problem(&post(&s, fault, bad).await, 422, "validation_failed");
+    }
+    assert_problem(
+        &post(
+            &s,
+            "/api/v1/axes/nope/simulation/fault",
+            json!({"kind": "clear"}),
+        )
+        .await,
+        404,
+        "axis_not_found",
+    );
+    assert_eq!(status(&s, "x").await["status"]["state"], "standstill");
+
+    let r = post(&s, fault, json!({"kind": "drive_fault", "code": 0x2310})).await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    assert!(r.text.is_empty(), "{}", r.text);
+    let st = until_status(&s, "x", 5, |st| st["state"] == "error_stop").await;
+    assert_eq!(st["error_id"].as_u64(), Some(DRIVE_FAULT), "{st}");
+    assert_eq!(st["drive_fault"], true, "{st}");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-relative",
+        json!({"position": 5.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+
+    let r = post(&s, fault, json!({"kind": "clear"})).await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let r = post(&s, "/api/v1/axes/x/reset?wait=true", json!({})).await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let st = until_status(&s, "x", 5, |st| st["state"] == "standstill").await;
+    assert_eq!(st["error_id"], 0, "{st}");
+    assert_eq!(st["drive_fault"], false, "{st}");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-relative?wait=true",
+        json!({"position": 5.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_eq!(
+        r.json["state"], "done",
+        "the axis does not move again: {}",
+        r.text
+    );
+
+    // A load force gives a following error of force / load_stiffness (1000 by default).
+    let r = post(
+        &s,
+        "/api/v1/axes/y/simulation/fault",
+        json!({"kind": "load", "force": 5.0}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    until_status(&s, "y", 5, |st| {
+        (st["following_error"].as_f64().unwrap() - 0.005).abs() < 1e-5
+    })
+    .await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/simulation/fault",
+        json!({"kind": "clear"}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    until_status(&s, "y", 5, |st| {
+        st["following_error"].as_f64().unwrap().abs() < 1e-5
+    })
+    .await;
+
+    // Every injection is audited with its client.
+    let entries = until_audit(&s, "", |e| {
+        e.iter()
+            .filter(|e| e["action"] == "simulation.fault")
+            .count()
+            >= 4
+    })
+    .await;
+    let injected = entries
+        .iter()
+        .find(|e| e["action"] == "simulation.fault" && e["detail"]["kind"] == "drive_fault")
+        .expect("drive fault audited");
+    assert_eq!(injected["target"], "x", "{injected}");
+    assert_eq!(injected["detail"]["code"], 0x2310, "{injected}");
+    assert_eq!(injected["client_id"], "integration-test", "{injected}");
+    assert_eq!(injected["outcome"], "applied", "{injected}");
+}
+
+/// Polls `GET /audit?limit=1000{query}` until `f` holds for the entries.
+async fn until_audit(s: &Server, query: &str, f: impl Fn(&[Value]) -> bool) -> Vec<Value> {
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    loop {
+        let r = get(s, &format!("/api/v1/audit?limit=1000{query}")).await;
+        assert_eq!(r.status, 200, "{}", r.text);
+        let entries = r.json.as_array().unwrap().clone();
+        if f(&entries) {
+            return entries;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "audit log incomplete: {}",
+            r.text
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_audit_log_shows_changes_and_motion_commands_with_their_client() {
+    let s = Server::start();
+    let r = get(&s, "/api/v1/audit").await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let demo: Vec<&Value> = r
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["action"] == "axis.create")
+        .collect();
+    assert_eq!(demo.len(), 3, "{}", r.text);
+    assert!(demo.iter().all(|e| e["client_id"] == "demo"), "{}", r.text);
+    let since = r.json[0]["id"].as_i64().unwrap();
+
+    let p = put(
+        &s,
+        "/api/v1/axes/y/parameters/AxisAcc",
+        json!({"value": 3000.0}),
+    )
+    .await;
+    assert_eq!(p.status, 200, "{}", p.text);
+    let power = power_on(&s, "y").await;
+    let mv = post(
+        &s,
+        "/api/v1/axes/y/move-relative?wait=true",
+        json!({"position": 2.0, "velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(mv.json["state"], "done", "{}", mv.text);
+    let query = format!("&since_id={since}");
+    let entries = until_audit(&s, &query, |e| {
+        e.iter()
+            .any(|e| e["action"] == "command.final" && e["command_id"] == mv.json["id"])
+    })
+    .await;
+    let ids: Vec<i64> = entries.iter().map(|e| e["id"].as_i64().unwrap()).collect();
+    assert!(ids.iter().all(|id| *id > since), "{ids:?}");
+    assert!(
+        ids.windows(2).all(|w| w[0] > w[1]),
+        "not newest first: {ids:?}"
+    );
+    let find = |action: &str| {
+        entries
+            .iter()
+            .find(|e| e["action"] == action)
+            .unwrap_or_else(|| panic!("no {action}: {entries:?}"))
+    };
+    for e in &entries {
+        assert_eq!(e["client_id"], "integration-test", "{e}");
+        assert!(
+            e["client_addr"].as_str().unwrap().starts_with("127.0.0.1:"),
+            "{e}"
+        );
+    }
+    let w = find("parameter.write");
+    assert_eq!(w["target"], "y", "{w}");
+    assert_eq!(w["detail"]["parameter"], 1004, "{w}");
+    assert_eq!(w["detail"]["value"], 3000.0, "{w}");
+    assert_eq!(w["outcome"], "committed", "{w}");
+    let c = find("command.power");
+    assert_eq!(c["command_id"], power["id"], "{c}");
+    assert_eq!(c["target"], "y", "{c}");
+    assert_eq!(c["outcome"], "accepted", "{c}");
+    let m = find("command.move-relative");
+    assert_eq!(m["detail"]["position"], 2.0, "{m}");
+    // Its end comes after its submission.
+    let fin = entries
+        .iter()
+        .find(|e| e["action"] == "command.final" && e["command_id"] == mv.json["id"])
+        .unwrap();
+    assert_eq!(fin["outcome"], "done", "{fin}");
+    assert!(fin["id"].as_i64() > m["id"].as_i64(), "{fin} {m}");
+
+    let one = get(&s, "/api/v1/audit?limit=1").await;
+    assert_eq!(one.json.as_array().unwrap().len(), 1, "{}", one.text);
+    assert!(
+        one.json[0]["id"].as_i64().unwrap() >= ids[0],
+        "{}",
+        one.text
+    );
+    for q in ["limit=0", "limit=1001", "since=3", "limit=many"] {
+        assert_problem(
+            &get(&s, &format!("/api/v1/audit?{q}")).await,
+            422,
+            "validation_failed",
+        );
+    }
 }

@@ -80,6 +80,8 @@ pub struct CommandRecord {
     pub last_cycle: u64,
     pub finished_at: Option<String>,
     pub events: VecDeque<CommandEventDto>,
+    /// The audit entry of its end, when it ended before its acceptance was recorded.
+    pub final_audit: Option<AuditEntry>,
 }
 
 impl CommandRecord {
@@ -246,41 +248,45 @@ impl AppState {
 
     /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
     pub fn drain(&self) {
+        // Replies are taken first but completed only after the events: the cycle thread pushes
+        // a submit's events before its reply, so a handler woken by its reply sees them.
+        let mut replies = Vec::new();
         while let Some(r) = self.shared.replies.pop() {
-            if let Some(tx) = self.pending.lock().unwrap().remove(&r.ticket) {
-                let _ = tx.send(r);
-            }
+            replies.push(r);
         }
         let mut notices = Vec::new();
+        let mut audits = Vec::new();
         {
             let mut store = self.commands.lock().unwrap();
             while let Some(ev) = self.shared.events.pop() {
-                if let Some(n) = apply_event(&mut store, &ev) {
-                    notices.push(n);
+                let Some(n) = apply_event(&mut store, &ev) else {
+                    continue;
+                };
+                if n.is_final {
+                    if let Some(r) = store.map.get_mut(&n.command) {
+                        let entry = final_audit(&n, &r.client);
+                        if r.accepted {
+                            audits.push(entry);
+                        } else {
+                            // Ended before its verdict was handled: `submit` writes this entry
+                            // after the one of the submission.
+                            r.final_audit = Some(entry);
+                        }
+                    }
                 }
+                notices.push(n);
             }
         }
+        for e in audits {
+            self.audit(e);
+        }
         for n in notices {
-            if n.is_final {
-                self.audit(AuditEntry {
-                    at: store::now_rfc3339(),
-                    action: "command.final".into(),
-                    target: Some(n.axis.clone()),
-                    command_id: Some(n.command),
-                    detail: serde_json::to_string(&n).unwrap_or_default(),
-                    outcome: Some(match n.state {
-                        CommandState::Error => {
-                            format!("error:{}", ErrorId(n.outputs.error_id).code())
-                        }
-                        s => serde_json::to_value(s)
-                            .ok()
-                            .and_then(|v| v.as_str().map(String::from))
-                            .unwrap_or_default(),
-                    }),
-                    ..Default::default()
-                });
-            }
             let _ = self.notices.send(Arc::new(n));
+        }
+        for r in replies {
+            if let Some(tx) = self.pending.lock().unwrap().remove(&r.ticket) {
+                let _ = tx.send(r);
+            }
         }
         while let Some(g) = self.shared.garbage.pop() {
             drop(g);
@@ -380,6 +386,52 @@ impl AppState {
         Ok(r.result)
     }
 
+    /// Releases a command (the falling edge of Execute/Enable) and audits it.
+    pub async fn release(
+        &self,
+        slot: AxisSlot,
+        id: CommandId,
+        client: &ClientInfo,
+    ) -> ApiResult<Result<u64, ErrorId>> {
+        let result = self
+            .kernel_command(slot, CommandKind::Release { target: id })
+            .await?;
+        self.audit(AuditEntry {
+            at: store::now_rfc3339(),
+            client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
+            client_id: client.id.clone(),
+            action: "command.release".into(),
+            target: Some(id.to_string()),
+            command_id: Some(id),
+            detail: serde_json::json!({"via": client.via}).to_string(),
+            outcome: Some(match result {
+                Ok(_) => "accepted".into(),
+                Err(e) => format!("rejected:{}", e.code()),
+            }),
+        });
+        Ok(result)
+    }
+
+    /// Hands a fault or disturbance to the simulated drive of a slot.
+    pub async fn inject_fault(
+        &self,
+        slot: AxisSlot,
+        fault: crate::sim::SimFault,
+    ) -> ApiResult<Result<u64, ErrorId>> {
+        let ticket = self.next_id();
+        let r = self
+            .request(
+                ticket,
+                Request::InjectFault {
+                    ticket,
+                    slot,
+                    fault,
+                },
+            )
+            .await?;
+        Ok(r.result.map(|_| r.cycle))
+    }
+
     /// Builds the kernel's axis and drive for a configuration plus its persistent overlay.
     pub fn build_axis(
         &self,
@@ -452,6 +504,7 @@ impl AppState {
             last_cycle: 0,
             finished_at: None,
             events: VecDeque::new(),
+            final_audit: None,
         });
         let reply = match self
             .request(
@@ -472,17 +525,27 @@ impl AppState {
         };
         match reply.result {
             Ok(()) => {
-                if let Some(r) = self.commands.lock().unwrap().map.get_mut(&id) {
-                    r.accepted = true;
-                    r.accepted_cycle = reply.cycle;
-                    if r.finished_at.is_none() && r.is_final() {
-                        r.finished_at = Some(store::now_rfc3339());
-                    }
-                }
+                let final_audit = self
+                    .commands
+                    .lock()
+                    .unwrap()
+                    .map
+                    .get_mut(&id)
+                    .and_then(|r| {
+                        r.accepted = true;
+                        r.accepted_cycle = reply.cycle;
+                        if r.finished_at.is_none() && r.is_final() {
+                            r.finished_at = Some(store::now_rfc3339());
+                        }
+                        r.final_audit.take()
+                    });
                 self.audit(AuditEntry {
                     outcome: Some("accepted".into()),
                     ..audit
                 });
+                if let Some(e) = final_audit {
+                    self.audit(e);
+                }
                 Ok(id)
             }
             Err(e) => {
@@ -521,6 +584,26 @@ impl AppState {
                 Ok(_) => {}
             }
         }
+    }
+}
+
+/// The audit entry of a command that has ended, naming the client as its submission does.
+fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry {
+    AuditEntry {
+        at: store::now_rfc3339(),
+        client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
+        client_id: client.id.clone(),
+        action: "command.final".into(),
+        target: Some(n.axis.clone()),
+        command_id: Some(n.command),
+        detail: serde_json::to_string(n).unwrap_or_default(),
+        outcome: Some(match n.state {
+            CommandState::Error => format!("error:{}", ErrorId(n.outputs.error_id).code()),
+            s => serde_json::to_value(s)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
+        }),
     }
 }
 

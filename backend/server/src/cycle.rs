@@ -14,7 +14,7 @@ use motion::{
     EventSink, Kernel, Verdict,
 };
 
-use crate::sim::SimDrive;
+use crate::sim::{SimDrive, SimFault};
 use crate::stats::CycleStats;
 
 /// Number of axis slots (fixed so that the cycle never allocates).
@@ -41,6 +41,13 @@ pub enum Request {
         ticket: u64,
         slot: AxisSlot,
         require_disabled: bool,
+    },
+    /// Inject a fault or disturbance into the simulated drive of a slot. It acts on the
+    /// drive's step in this cycle; the kernel reads it in the next cycle's feedback.
+    InjectFault {
+        ticket: u64,
+        slot: AxisSlot,
+        fault: SimFault,
     },
 }
 
@@ -367,6 +374,28 @@ impl CycleThread {
                             cycle,
                             result: Ok(()),
                         }
+                    }
+                }
+                Request::InjectFault {
+                    ticket,
+                    slot,
+                    fault,
+                } => {
+                    let drive = self
+                        .drives
+                        .get_mut(slot as usize)
+                        .and_then(|d| d.as_deref_mut());
+                    let result = match drive {
+                        Some(d) => {
+                            d.inject(fault);
+                            Ok(())
+                        }
+                        None => Err(ErrorId::AXIS_UNKNOWN),
+                    };
+                    Reply {
+                        ticket,
+                        cycle,
+                        result,
                     }
                 }
             };

@@ -155,6 +155,44 @@ pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
         .map(|_| ())
 }
 
+/// One audit log row as stored.
+pub struct AuditRow {
+    pub id: i64,
+    pub entry: AuditEntry,
+}
+
+/// The newest rows with an id above `since_id`, newest first.
+pub async fn read_audit(
+    pool: &SqlitePool,
+    limit: u32,
+    since_id: i64,
+) -> Result<Vec<AuditRow>, sqlx::Error> {
+    let rows = sqlx::query(
+        "SELECT id, at, client_addr, client_id, action, target, command_id, detail, outcome \
+         FROM audit_log WHERE id > ? ORDER BY id DESC LIMIT ?",
+    )
+    .bind(since_id)
+    .bind(limit as i64)
+    .fetch_all(pool)
+    .await?;
+    Ok(rows
+        .into_iter()
+        .map(|r| AuditRow {
+            id: r.get(0),
+            entry: AuditEntry {
+                at: r.get(1),
+                client_addr: r.get(2),
+                client_id: r.get(3),
+                action: r.get(4),
+                target: r.get(5),
+                command_id: r.get::<Option<i64>, _>(6).map(|c| c as u64),
+                detail: r.get(7),
+                outcome: r.get(8),
+            },
+        })
+        .collect())
+}
+
 pub fn now_rfc3339() -> String {
     humantime::format_rfc3339_millis(std::time::SystemTime::now()).to_string()
 }

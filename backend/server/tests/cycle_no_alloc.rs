@@ -10,7 +10,7 @@ use motion::{
     Positioning,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
-use server::sim::{SimDrive, SimDriveConfig};
+use server::sim::{SimDrive, SimDriveConfig, SimFault};
 
 struct Counting;
 
@@ -143,18 +143,40 @@ fn a_cycle_allocates_nothing() {
                         .is_ok()
                 );
             }
+            2000 | 2100 | 2200 => {
+                let fault = match i {
+                    2000 => SimFault::Load { force: 1.0 },
+                    2100 => SimFault::DriveFault { code: 0 },
+                    _ => SimFault::Clear,
+                };
+                assert!(
+                    shared
+                        .requests
+                        .push(Request::InjectFault {
+                            ticket: i,
+                            slot: 1,
+                            fault
+                        })
+                        .is_ok()
+                );
+            }
             _ => {}
         }
         let ((), n) = counted(|| cycle.one_cycle(&mut fb, &mut sp));
         total += n;
         // The async side drains (and frees) outside the counted region.
-        while shared.replies.pop().is_some() {}
+        while let Some(r) = shared.replies.pop() {
+            assert!(r.result.is_ok(), "request {} refused: {r:?}", r.ticket);
+        }
         while shared.events.pop().is_some() {}
         while shared.garbage.pop().is_some() {}
     }
     assert_eq!(total, 0, "the cycle allocated or freed {total} times");
     let snap = output.read();
     assert_eq!(snap.cycle, 3000);
+    // The injected drive fault reached axis 1 (and stays, no reset was sent).
+    let a1 = snap.axes[1].unwrap();
+    assert_eq!(a1.error_id, motion::ErrorId::DRIVE_FAULT.0, "{a1:?}");
     assert!(
         snap.axes[0].unwrap().set_position != 0.0,
         "axis 0 never moved: {:?}",

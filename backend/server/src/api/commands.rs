@@ -643,27 +643,11 @@ pub async fn release_command(
 ) -> ApiResult<Json<CommandResource>> {
     let id = parse_id(&id)?;
     let slot = slot_of(&s, id)?;
-    let result = s
-        .kernel_command(slot, motion::CommandKind::Release { target: id })
-        .await?;
-    s.audit(crate::store::AuditEntry {
-        at: crate::store::now_rfc3339(),
-        client_addr: Some(client.0.addr.clone()),
-        client_id: client.0.id.clone(),
-        action: "command.release".into(),
-        target: Some(id.to_string()),
-        command_id: Some(id),
-        detail: "{}".into(),
-        outcome: Some(match result {
-            Ok(_) => "accepted".into(),
-            Err(e) => format!("rejected:{}", e.code()),
-        }),
-    });
-    if let Err(e) = result {
+    if let Err(e) = s.release(slot, id, &client.0).await? {
         return Err(ApiError::rejected(e));
     }
-    // Let the release's effect (if any) reach the command's outputs before showing it.
-    tokio::time::sleep(Duration::from_millis(2)).await;
+    // The release's immediate effects (a jog dropping in_velocity, a gear-in-dyn ending) are
+    // events of its submit: the pump applies them before it answers, so they show here.
     s.command(id)
         .map(Json)
         .ok_or_else(|| ApiError::not_found("command", &id.to_string()))

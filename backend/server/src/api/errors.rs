@@ -75,3 +75,26 @@ pub enum ReadErrors {
                          "detail": "no axis 'z'", "code": "axis_not_found"}))]
     NotFound(Problem),
 }
+
+#[allow(dead_code)]
+#[derive(IntoResponses)]
+pub enum FaultErrors {
+    /// The body is not JSON.
+    #[response(status = 400, content_type = "application/problem+json")]
+    BadJson(Problem),
+    /// No such axis.
+    #[response(status = 404, content_type = "application/problem+json",
+        example = json!({"type": "urn:motiond:problem:axis_not_found", "title": "Not found", "status": 404,
+                         "detail": "no axis 'z'", "code": "axis_not_found"}))]
+    NotFound(Problem),
+    /// Not a fault: unknown `kind`, missing or wrong fields.
+    #[response(status = 422, content_type = "application/problem+json",
+        example = json!({"type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
+                         "detail": "body: unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`",
+                         "code": "validation_failed",
+                         "errors": [{"field": "body", "message": "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"}]}))]
+    Invalid(Problem),
+    /// The cycle thread is not available.
+    #[response(status = 503, content_type = "application/problem+json")]
+    Unavailable(Problem),
+}

@@ -1,8 +1,10 @@
 //! HTTP API (DESIGN §4): router, extractors, OpenAPI document.
 
+pub mod audit;
 pub mod axes;
 pub mod commands;
 pub mod errors;
+pub mod simulation;
 pub mod system;
 pub mod ws;
 
@@ -145,6 +147,10 @@ pub fn router(state: Arc<AppState>) -> Router {
             "/axes/{axis}/abort-superposition",
             post(commands::abort_superposition),
         )
+        .route(
+            "/axes/{axis}/simulation/fault",
+            post(simulation::inject_fault),
+        )
         .route("/commands", get(commands::list_commands))
         .route(
             "/commands/{id}",
@@ -152,6 +158,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         )
         .route("/commands/{id}/keepalive", post(commands::keepalive))
         .route("/system", get(system::system))
+        .route("/audit", get(audit::audit_log))
         .route("/config", get(axes::export_config).put(axes::import_config))
         .route("/ws", get(ws::upgrade))
         .fallback(not_found);
@@ -193,13 +200,15 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         commands::halt, commands::stop, commands::jog, commands::home, commands::gear_in, commands::gear_in_dyn, commands::gear_out,
         commands::move_superimposed, commands::abort_superposition,
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
-        axes::export_config, axes::import_config, system::system, system::metrics, ws::upgrade,
+        simulation::inject_fault,
+        axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
         (name = "commands", description = "One endpoint per function block; command resources"),
-        (name = "system", description = "Version, cycle timing, metrics, configuration export/import"),
+        (name = "simulation", description = "Fault injection into the simulated drives"),
+        (name = "system", description = "Version, cycle timing, metrics, configuration export/import, audit log"),
     )
 )]
 pub struct ApiDoc;

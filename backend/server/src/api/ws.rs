@@ -138,9 +138,7 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
     let held: Vec<(u16, u64)> = std::mem::take(&mut *jogs.lock().unwrap());
     for (slot, id) in held {
         if s.command(id).is_some_and(|c| !c.is_final) {
-            let _ = s
-                .kernel_command(slot, motion::CommandKind::Release { target: id })
-                .await;
+            let _ = s.release(slot, id, &client).await;
         }
     }
 }
@@ -320,17 +318,19 @@ fn handle(
             };
             let s = s.clone();
             let out = out_tx.clone();
+            let client = client.clone();
             tokio::spawn(async move {
                 let slot = s.commands.lock().unwrap().map.get(&cmd).map(|r| r.slot);
                 let msg = match slot {
                     None => api_error(&id, ApiError::not_found("command", &cmd.to_string())),
                     Some(slot) => {
-                        let kind = if method == "keepalive" {
-                            motion::CommandKind::Keepalive { target: cmd }
+                        let r = if method == "keepalive" {
+                            let kind = motion::CommandKind::Keepalive { target: cmd };
+                            s.kernel_command(slot, kind).await
                         } else {
-                            motion::CommandKind::Release { target: cmd }
+                            s.release(slot, cmd, &client).await
                         };
-                        match s.kernel_command(slot, kind).await {
+                        match r {
                             Ok(Ok(cycle)) => {
                                 rpc_result(&id, json!({"command": cmd, "cycle": cycle}))
                             }
