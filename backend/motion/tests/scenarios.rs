@@ -1715,3 +1715,96 @@ fn hardware_limit_switch_stops_fast_and_blocks_that_direction_only() {
     let back = r.ok(0, CommandKind::MoveRelative(mv(-5.0, 10.0)));
     r.until(2.0, |r| r.out(back).done);
 }
+
+#[test]
+fn homing_reference_modes_plc_cam_and_drive_latch_on_the_cam_edge() {
+    // PLC cam (#1076 = 1): the reference is the falling edge of the cam seen by the kernel.
+    let mut p = params();
+    p.axis_encoder_reference_mode = 1;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.plants[0].cam = Some((50.0, 55.0));
+    r.power_on(0);
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(0.0),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(20.0, |r| !r.out(h).busy);
+    assert!(r.out(h).done);
+    r.run(0.01);
+    // Leaving the cam backwards, its falling edge is at 50 (within one cycle of travel at the
+    // sync velocity 5 mm/s, the resolution of a PLC cam).
+    let zero_at_drive = r.plants[0].pos - r.st(0).actual_position;
+    assert!(
+        (zero_at_drive - 50.0).abs() <= 5.0 * DT + 1e-9,
+        "{zero_at_drive}"
+    );
+
+    // Hardware latch on the rising cam edge (#1076 = 3), found while searching: exact.
+    let mut p = params();
+    p.axis_encoder_reference_mode = 3;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.plants[0].cam = Some((50.0, 55.0));
+    r.power_on(0);
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(7.0),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(20.0, |r| !r.out(h).busy);
+    assert!(r.out(h).done);
+    r.run(0.01);
+    let at = r.plants[0].pos - (r.st(0).actual_position - 7.0);
+    assert!((at - 50.0).abs() < 1e-9, "{at}");
+}
+
+#[test]
+fn gear_coupling_to_the_masters_actual_values_with_parameter_1064() {
+    let mut ps = params();
+    ps.axis_couple_slave_to_actual_values = true;
+    let mut pm = params();
+    pm.axis_max_pos_lag_value = 10.0;
+    let mut r = Rig::with(vec![(false, pm), (false, ps)]);
+    r.plants[0].tau = 0.02; // the master lags behind its setpoint (2 mm at 100 mm/s)
+    r.power_on(0);
+    r.power_on(1);
+    r.ok(
+        1,
+        CommandKind::GearIn {
+            master: 0,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        },
+    );
+    r.bounds[1].jerk = 1e12; // an actual value is not jerk-limited
+    r.bounds[1].acceleration = 1e12;
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(0.3);
+    let (m, s) = (r.st(0), r.st(1));
+    // The slave follows the master's actual position (one cycle late), not its setpoint.
+    assert!(
+        (s.set_position - m.actual_position).abs() < 0.2,
+        "{} vs {}",
+        s.set_position,
+        m.actual_position
+    );
+    assert!(
+        (s.set_position - m.set_position).abs() > 1.0,
+        "follows the set value"
+    );
+}
