@@ -1,0 +1,83 @@
+// REST client: JSON in and out, problem+json errors as ApiError with field errors by path.
+import type { Problem } from './types';
+
+export class ApiError extends Error {
+  readonly status: number;
+  readonly problem: Problem | null;
+  /** Field path (`dynamics.jerk`, `value`, `velocity`) → message. */
+  readonly fields: Record<string, string>;
+
+  constructor(status: number, problem: Problem | null, message?: string) {
+    super(message ?? problem?.detail ?? `HTTP ${status}`);
+    this.status = status;
+    this.problem = problem;
+    this.fields = fieldErrors(problem);
+  }
+
+  get code(): string {
+    return this.problem?.code ?? (this.status === 0 ? 'network_error' : `http_${this.status}`);
+  }
+}
+
+/**
+ * Field errors of a problem, by field path. Type errors of the JSON body come as field
+ * `body` (or `params` over the websocket) with serde's message; `missing field `x`` and
+ * `unknown field `x`` are mapped to the field they name.
+ */
+export function fieldErrors(p: Problem | null | undefined): Record<string, string> {
+  const out: Record<string, string> = {};
+  for (const e of p?.errors ?? []) {
+    let field = e.field;
+    if (field === 'body' || field === 'params') {
+      const m = /(?:missing|unknown) field `([^`]+)`/.exec(e.message);
+      if (m) field = m[1];
+    }
+    out[field] = out[field] ? `${out[field]}; ${e.message}` : e.message;
+  }
+  return out;
+}
+
+export function isProblem(x: unknown): x is Problem {
+  return !!x && typeof x === 'object' && typeof (x as Problem).status === 'number' &&
+    typeof (x as Problem).code === 'string';
+}
+
+export const BASE = '/api/v1';
+
+/** `/axes` → `/api/v1/axes`; absolute server paths (`/api/…`, `/openapi.json`) stay. */
+export function url(path: string): string {
+  return path.startsWith('/api/') || path.startsWith('/openapi') ? path : BASE + path;
+}
+
+export async function api<T>(method: string, path: string, body?: unknown): Promise<T> {
+  let res: Response;
+  try {
+    res = await fetch(url(path), {
+      method,
+      headers: body === undefined ? { 'X-Client-Id': 'motiond-ui' } : { 'Content-Type': 'application/json', 'X-Client-Id': 'motiond-ui' },
+      body: body === undefined ? undefined : JSON.stringify(body),
+    });
+  } catch (e) {
+    throw new ApiError(0, null, `server not reachable (${(e as Error).message})`);
+  }
+  const text = await res.text();
+  let json: unknown = null;
+  if (text) {
+    try {
+      json = JSON.parse(text);
+    } catch {
+      json = null;
+    }
+  }
+  if (!res.ok) {
+    throw new ApiError(res.status, isProblem(json) ? json : null, isProblem(json) ? undefined : `HTTP ${res.status} ${text.slice(0, 200)}`);
+  }
+  return json as T;
+}
+
+export const get = <T>(path: string) => api<T>('GET', path);
+export const post = <T>(path: string, body: unknown = {}) => api<T>('POST', path, body);
+export const put = <T>(path: string, body: unknown) => api<T>('PUT', path, body);
+export const del = <T>(path: string) => api<T>('DELETE', path);
+
+export const enc = encodeURIComponent;

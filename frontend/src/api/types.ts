@@ -1,0 +1,38 @@
+// Names for the generated OpenAPI types (schema.d.ts is generated: npm run gen:api).
+import type { components } from './schema';
+
+type S = components['schemas'];
+export type AxisResource = S['AxisResource'];
+export type AxisConfig = S['AxisConfigDto'];
+export type AxisStatus = S['AxisStatus'];
+export type AxisState = S['AxisState'];
+export type CommandResource = S['CommandResource'];
+export type CommandState = S['CommandState'];
+export type FbOutputs = S['FbOutputs'];
+export type ParameterResource = S['ParameterResource'];
+export type ParamGroup = S['ParamGroup'];
+export type ParamValue = S['ParamValue'];
+export type SystemResource = S['SystemResource'];
+export type Problem = S['Problem'];
+export type FieldError = S['FieldError'];
+export type HomingMode = S['HomingMode'];
+export type JogMode = S['JogMode'];
+export type JogDirection = S['JogDirection'];
+export type PowerBody = S['PowerBody'];
+export type MoveBody = S['MoveBody'];
+export type MoveVelocityBody = S['MoveVelocityBody'];
+export type HomeBody = S['HomeBody'];
+export type Direction = S['Direction'];
+export type SimDriveConfig = S['SimDriveConfig'];
+export type PlantModel = S['PlantModel'];
+
+/** A `command_event` notification of the `commands` websocket topic. */
+export interface CommandEvent {
+  cycle: number;
+  command: number;
+  axis: string;
+  name: string;
+  state: CommandState;
+  final: boolean;
+  outputs: FbOutputs;
+}

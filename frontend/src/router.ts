@@ -1,0 +1,50 @@
+import { useEffect, useState } from 'preact/hooks';
+
+export type Route =
+  | { page: 'overview' }
+  | { page: 'axis'; axis: string; tab: 'online' | 'parameters' | 'config' }
+  | { page: 'new-axis' }
+  | { page: 'scope' }
+  | { page: 'not-found'; path: string };
+
+export function parseRoute(hash: string): Route {
+  const path = hash.replace(/^#/, '') || '/';
+  const parts = path.split('/').filter(Boolean).map(decodeURIComponent);
+  if (parts.length === 0) return { page: 'overview' };
+  if (parts[0] === 'scope' && parts.length === 1) return { page: 'scope' };
+  if (parts[0] === 'new-axis' && parts.length === 1) return { page: 'new-axis' };
+  if (parts[0] === 'axes' && parts.length >= 2 && parts.length <= 3) {
+    const tab = parts[2] ?? 'online';
+    if (tab === 'online' || tab === 'parameters' || tab === 'config') return { page: 'axis', axis: parts[1], tab };
+  }
+  return { page: 'not-found', path };
+}
+
+export function href(r: Route): string {
+  switch (r.page) {
+    case 'overview':
+      return '#/';
+    case 'scope':
+      return '#/scope';
+    case 'new-axis':
+      return '#/new-axis';
+    case 'axis':
+      return `#/axes/${encodeURIComponent(r.axis)}${r.tab === 'online' ? '' : '/' + r.tab}`;
+    default:
+      return '#/';
+  }
+}
+
+export function navigate(r: Route): void {
+  location.hash = href(r);
+}
+
+export function useRoute(): Route {
+  const [route, setRoute] = useState(() => parseRoute(location.hash));
+  useEffect(() => {
+    const on = () => setRoute(parseRoute(location.hash));
+    window.addEventListener('hashchange', on);
+    return () => window.removeEventListener('hashchange', on);
+  }, []);
+  return route;
+}

@@ -1,0 +1,35 @@
+// The scope recording endpoints (POST/GET/DELETE /api/v1/scope/recordings).
+import { del, get, post, enc } from '../api/rest';
+import type { Recording, RecordingRequest } from './data';
+
+export const RECORDINGS = '/scope/recordings';
+
+/** Whether the server has the recording endpoints (looked up in its OpenAPI document). */
+export async function scopeAvailable(): Promise<boolean> {
+  try {
+    const doc = await get<{ paths?: Record<string, unknown> }>('/openapi.json');
+    return !!doc.paths && Object.keys(doc.paths).some((p) => p.startsWith('/api/v1/scope/recordings'));
+  } catch {
+    return false;
+  }
+}
+
+export const createRecording = (r: RecordingRequest) => post<Recording>(RECORDINGS, r);
+export const getRecording = (id: Recording['id']) => get<Recording>(`${RECORDINGS}/${enc(String(id))}`);
+export const cancelRecording = (id: Recording['id']) => del<unknown>(`${RECORDINGS}/${enc(String(id))}`);
+export const csvUrl = (id: Recording['id']) => `/api/v1${RECORDINGS}/${enc(String(id))}?format=csv`;
+
+/** Polls until the recording is done or cancelled (or `abort` says stop). */
+export async function waitForRecording(
+  id: Recording['id'],
+  onProgress: (r: Recording) => void,
+  abort: { aborted: boolean },
+  intervalMs = 200,
+): Promise<Recording> {
+  for (;;) {
+    const r = await getRecording(id);
+    onProgress(r);
+    if (r.state === 'done' || r.state === 'cancelled' || abort.aborted) return r;
+    await new Promise((res) => setTimeout(res, intervalMs));
+  }
+}

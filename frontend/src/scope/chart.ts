@@ -1,0 +1,210 @@
+// uPlot wrapper for scope recordings: one y scale per unit, drag-select zoom, wheel zoom,
+// pan (shift-drag or middle-drag), two cursors placed by clicking (alternating C1/C2).
+import uPlot from 'uplot';
+import { panRange, zoomRange } from './data';
+
+export const COLORS = ['#1363c6', '#d9480f', '#2b8a3e', '#ae3ec9', '#e67700', '#0b7285', '#c92a2a', '#5c5f66'];
+
+export interface ChartSeries {
+  label: string;
+  unit: string;
+  scale: string;
+  values: ArrayLike<number>;
+}
+
+export interface ChartCallbacks {
+  onCursors: (c1: number | null, c2: number | null) => void;
+  onRange: (min: number, max: number) => void;
+}
+
+export class ScopeChart {
+  private u: uPlot;
+  private c1: number | null = null;
+  private c2: number | null = null;
+  private next: 1 | 2 = 1;
+  private limits: { min: number; max: number };
+  private ro: ResizeObserver | null = null;
+  private onMove: (e: MouseEvent) => void = () => {};
+  private onUp: (e: MouseEvent) => void = () => {};
+
+  constructor(
+    private readonly el: HTMLElement,
+    t: ArrayLike<number>,
+    series: ChartSeries[],
+    private readonly cb: ChartCallbacks,
+  ) {
+    const n = t.length;
+    this.limits = { min: n ? t[0] : 0, max: n ? t[n - 1] : 1 };
+    if (this.limits.max <= this.limits.min) this.limits.max = this.limits.min + 1e-3;
+    const scales: uPlot.Scales = { x: { time: false, min: this.limits.min, max: this.limits.max } };
+    const axes: uPlot.Axis[] = [{ label: 't (s)', stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }];
+    const seen: string[] = [];
+    series.forEach((s) => {
+      if (seen.includes(s.scale)) return;
+      seen.push(s.scale);
+      scales[s.scale] = { auto: true };
+      axes.push({
+        scale: s.scale,
+        label: s.unit,
+        side: seen.length % 2 === 1 ? 3 : 1,
+        stroke: '#4a5563',
+        grid: { show: seen.length === 1, stroke: '#eef0f3' },
+        ticks: { stroke: '#c9cfd6' },
+        size: 64,
+      });
+    });
+    const opts: uPlot.Options = {
+      width: Math.max(300, el.clientWidth),
+      height: Math.max(220, el.clientHeight || 420),
+      scales,
+      axes,
+      legend: { show: true, live: true },
+      cursor: { drag: { x: true, y: false, setScale: true }, points: { show: false } },
+      series: [
+        { label: 't (s)', value: (_u, v) => (v === null || v === undefined ? '—' : v.toFixed(4)) },
+        ...series.map((s, i) => ({
+          label: `${s.label} (${s.unit})`,
+          scale: s.scale,
+          stroke: COLORS[i % COLORS.length],
+          width: 1.5,
+          value: (_u: uPlot, v: number | null) => (v === null || v === undefined ? '—' : String(Number(v.toPrecision(6)))),
+        })),
+      ],
+      hooks: {
+        draw: [(u) => this.drawCursors(u)],
+        setScale: [
+          (u, key) => {
+            if (key === 'x') this.cb.onRange(u.scales.x.min ?? 0, u.scales.x.max ?? 0);
+          },
+        ],
+      },
+    };
+    const data = [Array.from(t), ...series.map((s) => Array.from(s.values))] as uPlot.AlignedData;
+    this.u = new uPlot(opts, data, el);
+    this.installInteractions();
+    if (typeof ResizeObserver !== 'undefined') {
+      this.ro = new ResizeObserver(() => this.resize());
+      this.ro.observe(el);
+    }
+  }
+
+  private resize(): void {
+    const w = Math.max(300, this.el.clientWidth);
+    if (Math.abs(w - this.u.width) > 2) this.u.setSize({ width: w, height: this.u.height });
+  }
+
+  private range(): { min: number; max: number } {
+    return { min: this.u.scales.x.min ?? this.limits.min, max: this.u.scales.x.max ?? this.limits.max };
+  }
+
+  private setRange(r: { min: number; max: number }): void {
+    this.u.setScale('x', r);
+  }
+
+  zoom(factor: number, at?: number): void {
+    const r = this.range();
+    this.setRange(zoomRange(r, at ?? (r.min + r.max) / 2, factor, this.limits));
+  }
+
+  pan(fraction: number): void {
+    const r = this.range();
+    this.setRange(panRange(r, (r.max - r.min) * fraction, this.limits));
+  }
+
+  reset(): void {
+    this.setRange({ ...this.limits });
+  }
+
+  setCursor(which: 1 | 2, x: number | null): void {
+    if (which === 1) this.c1 = x;
+    else this.c2 = x;
+    this.u.redraw(false, false);
+    this.cb.onCursors(this.c1, this.c2);
+  }
+
+  clearCursors(): void {
+    this.c1 = this.c2 = null;
+    this.next = 1;
+    this.u.redraw(false, false);
+    this.cb.onCursors(null, null);
+  }
+
+  private installInteractions(): void {
+    const over = this.u.over;
+    over.addEventListener(
+      'wheel',
+      (e) => {
+        e.preventDefault();
+        const x = this.u.posToVal(e.offsetX, 'x');
+        this.zoom(e.deltaY < 0 ? 0.8 : 1.25, x);
+      },
+      { passive: false },
+    );
+    let down: { x: number; y: number; pan: boolean; min: number; max: number } | null = null;
+    over.addEventListener(
+      'mousedown',
+      (e) => {
+        const pan = e.shiftKey || e.button === 1;
+        const r = this.range();
+        down = { x: e.clientX, y: e.clientY, pan, ...r };
+        if (pan) {
+          e.preventDefault();
+          e.stopPropagation(); // no drag-select while panning
+        }
+      },
+      true,
+    );
+    this.onMove = (e: MouseEvent) => {
+      if (!down || !down.pan) return;
+      const pxPerS = this.u.bbox.width / devicePixelRatio / (down.max - down.min);
+      const dx = -(e.clientX - down.x) / pxPerS;
+      this.setRange(panRange({ min: down.min, max: down.max }, dx, this.limits));
+    };
+    this.onUp = (e: MouseEvent) => {
+      const d = down;
+      down = null;
+      if (!d || d.pan) return;
+      if (Math.abs(e.clientX - d.x) < 4 && Math.abs(e.clientY - d.y) < 4) {
+        const rect = over.getBoundingClientRect();
+        const x = this.u.posToVal(e.clientX - rect.left, 'x');
+        this.setCursor(this.next, x);
+        this.next = this.next === 1 ? 2 : 1;
+      }
+    };
+    window.addEventListener('mousemove', this.onMove);
+    window.addEventListener('mouseup', this.onUp);
+    over.addEventListener('dblclick', () => this.reset());
+  }
+
+  private drawCursors(u: uPlot): void {
+    const ctx = u.ctx;
+    const { top, height } = u.bbox;
+    const draw = (x: number | null, label: string, color: string) => {
+      if (x === null) return;
+      const px = u.valToPos(x, 'x', true);
+      if (px < u.bbox.left || px > u.bbox.left + u.bbox.width) return;
+      ctx.save();
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 1.5 * devicePixelRatio;
+      ctx.setLineDash([6 * devicePixelRatio, 4 * devicePixelRatio]);
+      ctx.beginPath();
+      ctx.moveTo(px, top);
+      ctx.lineTo(px, top + height);
+      ctx.stroke();
+      ctx.setLineDash([]);
+      ctx.fillStyle = color;
+      ctx.font = `${11 * devicePixelRatio}px system-ui, sans-serif`;
+      ctx.fillText(label, px + 4 * devicePixelRatio, top + 12 * devicePixelRatio);
+      ctx.restore();
+    };
+    draw(this.c1, 'C1', '#111827');
+    draw(this.c2, 'C2', '#b91c1c');
+  }
+
+  destroy(): void {
+    this.ro?.disconnect();
+    window.removeEventListener('mousemove', this.onMove);
+    window.removeEventListener('mouseup', this.onUp);
+    this.u.destroy();
+  }
+}

@@ -1,0 +1,163 @@
+import { useEffect, useState } from 'preact/hooks';
+import { href, useRoute, type Route } from '../router';
+import { useStore } from '../store';
+import { axes, axesLoaded, live, setFocus, statuses, system } from '../services';
+import { Lamp } from './common';
+import { pos } from '../format';
+import { Overview } from './overview';
+import { AxisPage } from './axis-page';
+import { AxisConfigPage } from './axis-config';
+import { ScopePage } from './scope';
+import type { ConnState } from '../live/client';
+
+function Connection() {
+  const c = useStore(live.state);
+  const sys = useStore(system);
+  const [, tick] = useState(0);
+  useEffect(() => {
+    if (c.kind !== 'closed') return;
+    const t = setInterval(() => tick((n) => n + 1), 250);
+    return () => clearInterval(t);
+  }, [c.kind]);
+  if (c.kind === 'open') {
+    return (
+      <div class="conn conn-open" data-conn="open" title="websocket connected">
+        <span class="conn-dot" />
+        <span>online</span>
+        {sys && (
+          <span class="conn-info">
+            cycle {(sys.cycle_time * 1000).toFixed(sys.cycle_time < 0.001 ? 3 : 1)} ms · #{sys.cycle}
+          </span>
+        )}
+      </div>
+    );
+  }
+  if (c.kind === 'connecting') {
+    return (
+      <div class="conn conn-connecting" data-conn="connecting">
+        <span class="conn-dot" />
+        connecting…
+      </div>
+    );
+  }
+  return (
+    <div class="conn conn-closed" data-conn="closed">
+      <span class="conn-dot" />
+      server gone · retry in {Math.max(0, Math.ceil((c.retryAt - Date.now()) / 1000))} s
+      <button type="button" class="btn btn-small" onClick={() => live.retryNow()}>
+        retry now
+      </button>
+    </div>
+  );
+}
+
+/** Full-width notice while the server cannot be reached: live values are stale. */
+function ConnectionNotice({ c }: { c: ConnState }) {
+  if (c.kind === 'open') return null;
+  if (c.kind === 'connecting' && c.attempt === 0) {
+    return <div class="notice notice-info" data-notice="connecting">Connecting to motiond…</div>;
+  }
+  return (
+    <div class="notice notice-error" data-notice="server-gone" role="alert">
+      <b>Server gone.</b> motiond does not answer ({c.kind === 'closed' ? c.reason : 'reconnecting'}). Values shown are the last
+      received and are <b>not live</b>; commands are disabled. Reconnecting automatically.
+    </div>
+  );
+}
+
+function Sidebar({ route }: { route: Route }) {
+  const list = useStore(axes);
+  const st = useStore(statuses);
+  const current = route.page === 'axis' ? route.axis : null;
+  return (
+    <nav class="sidebar">
+      <div class="sidebar-head">Axes</div>
+      <ul class="axis-list">
+        {list.map((a) => {
+          const s = st.get(a.config.name);
+          const status = s?.status;
+          return (
+            <li key={a.id}>
+              <a
+                href={href({ page: 'axis', axis: a.config.name, tab: route.page === 'axis' ? route.tab : 'online' })}
+                class={`axis-item ${current === a.config.name ? 'active' : ''} ${s?.stale ? 'stale' : ''}`}
+                data-axis={a.config.name}
+              >
+                <Lamp state={status?.state ?? a.state} errorId={status?.error_id ?? 0} />
+                <span class="axis-item-name">{a.config.name}</span>
+                <span class="axis-item-pos">
+                  {pos(status?.actual_position)} <small>{a.config.unit}</small>
+                </span>
+              </a>
+            </li>
+          );
+        })}
+      </ul>
+      <a class="btn btn-plain sidebar-new" href="#/new-axis">
+        + New axis
+      </a>
+    </nav>
+  );
+}
+
+export function App() {
+  const route = useRoute();
+  const conn = useStore(live.state);
+  const loaded = useStore(axesLoaded);
+  useEffect(() => {
+    setFocus(route.page === 'axis' && route.tab === 'online' ? route.axis : null);
+  }, [route]);
+  let page;
+  switch (route.page) {
+    case 'overview':
+      page = <Overview />;
+      break;
+    case 'axis':
+      page = <AxisPage key={route.axis} axis={route.axis} tab={route.tab} />;
+      break;
+    case 'new-axis':
+      page = <AxisConfigPage axis={null} />;
+      break;
+    case 'scope':
+      page = <ScopePage />;
+      break;
+    default:
+      page = (
+        <div class="page">
+          <p>
+            No page here. <a href="#/">Overview</a>
+          </p>
+        </div>
+      );
+  }
+  const nav = (r: Route, label: string, active: boolean) => (
+    <a href={href(r)} class={`nav-link ${active ? 'active' : ''}`}>
+      {label}
+    </a>
+  );
+  return (
+    <div class={`app conn-${conn.kind}`}>
+      <header class="topbar">
+        <a class="brand" href="#/">
+          motiond
+        </a>
+        <nav class="nav">
+          {nav({ page: 'overview' }, 'Overview', route.page === 'overview')}
+          {nav({ page: 'scope' }, 'Scope', route.page === 'scope')}
+          {nav({ page: 'new-axis' }, 'New axis', route.page === 'new-axis')}
+        </nav>
+        <div class="topbar-right">
+          <a class="nav-link small" href="/docs" target="_blank" rel="noreferrer">
+            API
+          </a>
+          <Connection />
+        </div>
+      </header>
+      <ConnectionNotice c={conn} />
+      <div class="body">
+        <Sidebar route={route} />
+        <main class="main">{loaded || conn.kind === 'open' ? page : <div class="page muted">Waiting for motiond…</div>}</main>
+      </div>
+    </div>
+  );
+}

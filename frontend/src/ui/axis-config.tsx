@@ -1,0 +1,453 @@
+// Create / edit / delete an axis. The form mirrors AxisConfigDto; the server's 422 field
+// errors (JSON paths such as `dynamics.jerk`, `drive.plant.damping`, `parameters.X`) are shown
+// at the field they name, anything else in the banner.
+import { useEffect, useState } from 'preact/hooks';
+import type { AxisConfig, AxisResource, ParamValue } from '../api/types';
+import { ApiError, del, enc, post, put } from '../api/rest';
+import { command, refreshAxes, statuses } from '../services';
+import { navigate } from '../router';
+import { useStore } from '../store';
+import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf } from './common';
+import { inputNum } from '../format';
+
+export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
+
+type PlantKind = 'ideal' | 'pt1' | 'pt2';
+
+export interface ConfigForm {
+  name: string;
+  unit: string;
+  modulo: boolean;
+  period: string;
+  softLimits: boolean;
+  min: string;
+  max: string;
+  dyn: Record<'max_velocity' | 'acceleration' | 'deceleration' | 'jerk' | 'jog_velocity_slow' | 'jog_velocity_fast', string>;
+  plant: PlantKind;
+  time_constant: string;
+  natural_frequency_hz: string;
+  damping: string;
+  drive: Record<'dead_time' | 'velocity_feed_forward' | 'acceleration_feed_forward' | 'enable_delay' | 'coast_deceleration' | 'load_stiffness', string>;
+  dead_time_compensation: boolean;
+  refCam: boolean;
+  camStart: string;
+  camEnd: string;
+  index: boolean;
+  indexPeriod: string;
+  indexOffset: string;
+  limitNeg: string;
+  limitPos: string;
+  faultOnHit: boolean;
+  parameters: { key: string; value: string }[];
+}
+
+export const DEFAULT_FORM: ConfigForm = {
+  name: '',
+  unit: 'mm',
+  modulo: false,
+  period: '360',
+  softLimits: false,
+  min: '0',
+  max: '1000',
+  dyn: { max_velocity: '500', acceleration: '2500', deceleration: '2500', jerk: '25000', jog_velocity_slow: '10', jog_velocity_fast: '100' },
+  plant: 'pt2',
+  time_constant: '0.005',
+  natural_frequency_hz: '50',
+  damping: '0.8',
+  drive: { dead_time: '0.001', velocity_feed_forward: '1', acceleration_feed_forward: '0', enable_delay: '0.005', coast_deceleration: '10000', load_stiffness: '1000' },
+  dead_time_compensation: true,
+  refCam: true,
+  camStart: '20',
+  camEnd: '25',
+  index: true,
+  indexPeriod: '10',
+  indexOffset: '0',
+  limitNeg: '',
+  limitPos: '',
+  faultOnHit: false,
+  parameters: [],
+};
+
+export function formOf(c: AxisConfig): ConfigForm {
+  const d = (c.drive ?? {}) as NonNullable<AxisConfig['drive']>;
+  const plant = (d.plant ?? { kind: 'pt2', natural_frequency_hz: 50, damping: 0.8 }) as { kind: PlantKind; time_constant?: number; natural_frequency_hz?: number; damping?: number };
+  const n = (v: number | null | undefined, dflt = '') => (v === null || v === undefined ? dflt : inputNum(v));
+  return {
+    name: c.name,
+    unit: c.unit,
+    modulo: !!c.modulo,
+    period: n(c.modulo?.period, '360'),
+    softLimits: !!c.soft_limits,
+    min: n(c.soft_limits?.min, '0'),
+    max: n(c.soft_limits?.max, '1000'),
+    dyn: {
+      max_velocity: n(c.dynamics.max_velocity),
+      acceleration: n(c.dynamics.acceleration),
+      deceleration: n(c.dynamics.deceleration),
+      jerk: n(c.dynamics.jerk),
+      jog_velocity_slow: n(c.dynamics.jog_velocity_slow),
+      jog_velocity_fast: n(c.dynamics.jog_velocity_fast),
+    },
+    plant: plant.kind,
+    time_constant: n(plant.time_constant, '0.005'),
+    natural_frequency_hz: n(plant.natural_frequency_hz, '50'),
+    damping: n(plant.damping, '0.8'),
+    drive: {
+      dead_time: n(d.dead_time, '0.001'),
+      velocity_feed_forward: n(d.velocity_feed_forward, '1'),
+      acceleration_feed_forward: n(d.acceleration_feed_forward, '0'),
+      enable_delay: n(d.enable_delay, '0.005'),
+      coast_deceleration: n(d.coast_deceleration, '10000'),
+      load_stiffness: n(d.load_stiffness, '1000'),
+    },
+    dead_time_compensation: d.dead_time_compensation ?? true,
+    refCam: !!d.reference_cam,
+    camStart: n(d.reference_cam?.start, '20'),
+    camEnd: n(d.reference_cam?.end, '25'),
+    index: !!d.index_pulse,
+    indexPeriod: n(d.index_pulse?.period, '10'),
+    indexOffset: n(d.index_pulse?.offset, '0'),
+    limitNeg: n(d.limit_switches?.negative),
+    limitPos: n(d.limit_switches?.positive),
+    faultOnHit: d.limit_switches?.fault_on_hit ?? false,
+    parameters: Object.entries(c.parameters ?? {}).map(([key, value]) => ({ key, value: String(value) })),
+  };
+}
+
+/** The request body, or the fields whose text is not a number (checked here: the server only sees JSON). */
+export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Record<string, string> } {
+  const errors: Record<string, string> = {};
+  const num = (path: string, s: string): number => {
+    const t = s.trim().replace(',', '.');
+    const v = t === '' ? NaN : Number(t);
+    if (!Number.isFinite(v)) errors[path] = t === '' ? 'required' : 'not a number';
+    return v;
+  };
+  const opt = (path: string, s: string): number | null => (s.trim() === '' ? null : num(path, s));
+  const plant =
+    f.plant === 'ideal'
+      ? { kind: 'ideal' as const }
+      : f.plant === 'pt1'
+        ? { kind: 'pt1' as const, time_constant: num('drive.plant.time_constant', f.time_constant) }
+        : { kind: 'pt2' as const, natural_frequency_hz: num('drive.plant.natural_frequency_hz', f.natural_frequency_hz), damping: num('drive.plant.damping', f.damping) };
+  const parameters: Record<string, ParamValue> = {};
+  for (const p of f.parameters) {
+    if (!p.key.trim()) continue;
+    const t = p.value.trim();
+    parameters[p.key.trim()] = t === 'true' ? true : t === 'false' ? false : num(`parameters.${p.key.trim()}`, t);
+  }
+  const config: AxisConfig = {
+    name: f.name.trim(),
+    unit: f.unit,
+    ...(f.modulo ? { modulo: { period: num('modulo.period', f.period) } } : {}),
+    ...(f.softLimits ? { soft_limits: { min: num('soft_limits.min', f.min), max: num('soft_limits.max', f.max) } } : {}),
+    dynamics: {
+      max_velocity: num('dynamics.max_velocity', f.dyn.max_velocity),
+      acceleration: num('dynamics.acceleration', f.dyn.acceleration),
+      deceleration: num('dynamics.deceleration', f.dyn.deceleration),
+      jerk: num('dynamics.jerk', f.dyn.jerk),
+      jog_velocity_slow: num('dynamics.jog_velocity_slow', f.dyn.jog_velocity_slow),
+      jog_velocity_fast: num('dynamics.jog_velocity_fast', f.dyn.jog_velocity_fast),
+    },
+    // The schema says `object` without value types (utoipa value_type = Object).
+    parameters: parameters as unknown as AxisConfig['parameters'],
+    drive: {
+      plant,
+      dead_time: num('drive.dead_time', f.drive.dead_time),
+      dead_time_compensation: f.dead_time_compensation,
+      velocity_feed_forward: num('drive.velocity_feed_forward', f.drive.velocity_feed_forward),
+      acceleration_feed_forward: num('drive.acceleration_feed_forward', f.drive.acceleration_feed_forward),
+      enable_delay: num('drive.enable_delay', f.drive.enable_delay),
+      coast_deceleration: num('drive.coast_deceleration', f.drive.coast_deceleration),
+      load_stiffness: num('drive.load_stiffness', f.drive.load_stiffness),
+      reference_cam: f.refCam ? { start: num('drive.reference_cam.start', f.camStart), end: num('drive.reference_cam.end', f.camEnd) } : null,
+      index_pulse: f.index ? { period: num('drive.index_pulse.period', f.indexPeriod), offset: num('drive.index_pulse.offset', f.indexOffset) } : null,
+      limit_switches: { negative: opt('drive.limit_switches.negative', f.limitNeg), positive: opt('drive.limit_switches.positive', f.limitPos), fault_on_hit: f.faultOnHit },
+    } as AxisConfig['drive'],
+  };
+  return { config: Object.keys(errors).length ? null : config, errors };
+}
+
+/** Every field path the form shows (errors for other paths go to the banner). */
+function shownFields(f: ConfigForm): Set<string> {
+  const s = new Set([
+    'name',
+    'unit',
+    'modulo',
+    'modulo.period',
+    'soft_limits',
+    'soft_limits.min',
+    'soft_limits.max',
+    ...Object.keys(f.dyn).map((k) => `dynamics.${k}`),
+    'drive.plant.time_constant',
+    'drive.plant.natural_frequency_hz',
+    'drive.plant.damping',
+    ...Object.keys(f.drive).map((k) => `drive.${k}`),
+    'drive.reference_cam.start',
+    'drive.reference_cam.end',
+    'drive.index_pulse.period',
+    'drive.index_pulse.offset',
+    'drive.limit_switches.negative',
+    'drive.limit_switches.positive',
+  ]);
+  for (const p of f.parameters) s.add(`parameters.${p.key.trim()}`);
+  return s;
+}
+
+const DYN_LABELS: [keyof ConfigForm['dyn'], string, string, string][] = [
+  ['max_velocity', 'Max velocity', '/s', '#1003 AxisVeloMax'],
+  ['acceleration', 'Acceleration', '/s²', '#1004 AxisAcc'],
+  ['deceleration', 'Deceleration', '/s²', '#1005 AxisDec'],
+  ['jerk', 'Jerk', '/s³', '#1006 AxisJerk'],
+  ['jog_velocity_slow', 'Jog velocity slow', '/s', '#1001 AxisVeloManSlow (− / +)'],
+  ['jog_velocity_fast', 'Jog velocity fast', '/s', '#1002 AxisVeloManFast (−− / ++)'],
+];
+
+const DRIVE_LABELS: [keyof ConfigForm['drive'], string, string][] = [
+  ['dead_time', 'Dead time (s)', '0 … 0.1'],
+  ['enable_delay', 'Enable delay (s)', '0 … 10'],
+  ['velocity_feed_forward', 'Velocity feed-forward', '0 … 2 (1 = full)'],
+  ['acceleration_feed_forward', 'Acceleration feed-forward', '0 … 2 (PT2 only)'],
+  ['coast_deceleration', 'Coast deceleration (u/s²)', 'power stage off'],
+  ['load_stiffness', 'Load stiffness', '> 0'],
+];
+
+export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
+  const creating = axis === null;
+  const [form, setForm] = useState<ConfigForm>(() => (axis ? formOf(axis.config) : DEFAULT_FORM));
+  const [fields, setFields] = useState<Record<string, string>>({});
+  const [error, setError] = useState<string | null>(null);
+  const [notDisabled, setNotDisabled] = useState(false);
+  const [message, setMessage] = useState<string | null>(null);
+  const [confirmDelete, setConfirmDelete] = useState(false);
+  const st = useStore(statuses);
+  useEffect(() => {
+    setForm(axis ? formOf(axis.config) : DEFAULT_FORM);
+    setFields({});
+    setError(null);
+  }, [axis?.id]);
+  const enabled = axis ? (st.get(axis.config.name)?.status?.power_status ?? false) : false;
+
+  const set = <K extends keyof ConfigForm>(k: K, v: ConfigForm[K]) => setForm({ ...form, [k]: v });
+  const err = (path: string) => fields[path];
+
+  const fail = (e: unknown) => {
+    const f = { ...fieldsOf(e) };
+    if (e instanceof ApiError && e.problem?.code === 'axis_name_taken') f.name = e.problem.detail;
+    setFields(f);
+    setNotDisabled(e instanceof ApiError && e.problem?.code === 'axis_not_disabled');
+    const shown = shownFields(form);
+    const other = Object.entries(f).filter(([k]) => !shown.has(k));
+    if (Object.keys(f).length && other.length === 0) setError('The server refused the configuration: see the fields marked red.');
+    else if (other.length) setError(`${errorText(e)}`);
+    else setError(errorText(e));
+  };
+
+  const save = async () => {
+    setMessage(null);
+    setError(null);
+    setNotDisabled(false);
+    const { config, errors } = configOf(form);
+    setFields(errors);
+    if (!config) {
+      setError('Some fields are not numbers: see the fields marked red.');
+      return;
+    }
+    try {
+      if (creating) {
+        const r = await post<AxisResource>('/axes', config);
+        await refreshAxes();
+        navigate({ page: 'axis', axis: r.config.name, tab: 'online' });
+      } else {
+        const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}`, config);
+        await refreshAxes();
+        setFields({});
+        setMessage('Saved. The axis runs with the new configuration (its persistent parameters were dropped).');
+        if (r.config.name !== axis.config.name) navigate({ page: 'axis', axis: r.config.name, tab: 'config' });
+      }
+    } catch (e) {
+      fail(e);
+    }
+  };
+
+  const remove = async () => {
+    if (!axis) return;
+    setError(null);
+    try {
+      await del(`/axes/${enc(axis.config.name)}`);
+      await refreshAxes();
+      navigate({ page: 'overview' });
+    } catch (e) {
+      setConfirmDelete(false);
+      fail(e);
+    }
+  };
+
+  const num = (path: string, value: string, on: (v: string) => void, label: string, hint?: string) => (
+    <Field label={label} error={err(path)} hint={hint} name={path}>
+      <NumberInput name={path} value={value} onValue={on} />
+    </Field>
+  );
+
+  return (
+    <div class={creating ? 'page page-config' : 'config'}>
+      {creating && (
+        <div class="page-head">
+          <h2>New axis</h2>
+          <span class="muted">a simulated axis; every field can be changed later (while the axis is disabled)</span>
+        </div>
+      )}
+      <ErrorBanner error={error} onClose={() => setError(null)} />
+      {notDisabled && axis && (
+        <div class="banner banner-warn">
+          The axis must be disabled first.
+          <ActionButton kind="warn" name="disable-axis" onClick={() => command(axis.config.name, 'power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 }).then(() => setNotDisabled(false), (e) => setError(errorText(e)))}>
+            Disable {axis.config.name} now
+          </ActionButton>
+        </div>
+      )}
+      {!creating && enabled && <div class="banner banner-info">The axis is enabled: saving or deleting needs it disabled.</div>}
+      {message && <div class="banner banner-ok">{message}</div>}
+      <form
+        class="config-form"
+        onSubmit={(e) => {
+          e.preventDefault();
+          void save();
+        }}
+      >
+        <div class="config-grid">
+          <Panel title="Axis">
+            <div class="form-grid">
+              <Field label="Name" error={err('name')} name="name" hint="letter or _, then letters, digits, _ or -">
+                <input type="text" name="name" value={form.name} autocomplete="off" onInput={(e) => set('name', (e.target as HTMLInputElement).value)} />
+              </Field>
+              <Field label="Unit" error={err('unit')} name="unit">
+                <select name="unit" value={form.unit} onChange={(e) => set('unit', (e.target as HTMLSelectElement).value)}>
+                  {UNITS.map((u) => (
+                    <option value={u}>{u}</option>
+                  ))}
+                </select>
+              </Field>
+              <Field label="Modulo (rotary)" error={err('modulo')} name="modulo">
+                <span class="inline">
+                  <input type="checkbox" name="modulo-on" checked={form.modulo} onChange={(e) => set('modulo', (e.target as HTMLInputElement).checked)} />
+                  <NumberInput name="modulo.period" value={form.period} onValue={(v) => set('period', v)} disabled={!form.modulo} placeholder="period" />
+                </span>
+              </Field>
+              {err('modulo.period') && <div class="field-error">{err('modulo.period')}</div>}
+              <Field label="Software limits" error={err('soft_limits')} name="soft_limits">
+                <span class="inline">
+                  <input type="checkbox" name="soft-limits-on" checked={form.softLimits} onChange={(e) => set('softLimits', (e.target as HTMLInputElement).checked)} />
+                  <NumberInput name="soft_limits.min" value={form.min} onValue={(v) => set('min', v)} disabled={!form.softLimits} placeholder="min" />
+                  <NumberInput name="soft_limits.max" value={form.max} onValue={(v) => set('max', v)} disabled={!form.softLimits} placeholder="max" />
+                </span>
+              </Field>
+              {(err('soft_limits.min') || err('soft_limits.max')) && <div class="field-error">{err('soft_limits.min') ?? err('soft_limits.max')}</div>}
+            </div>
+          </Panel>
+          <Panel title="Dynamics (defaults when a command passes 0)">
+            <div class="form-grid">
+              {DYN_LABELS.map(([k, label, per, hint]) =>
+                num(`dynamics.${k}`, form.dyn[k], (v) => set('dyn', { ...form.dyn, [k]: v }), `${label} (${form.unit}${per})`, hint),
+              )}
+            </div>
+          </Panel>
+          <Panel title="Simulated drive">
+            <div class="form-grid">
+              <Field label="Plant" name="drive.plant">
+                <select name="drive.plant.kind" value={form.plant} onChange={(e) => set('plant', (e.target as HTMLSelectElement).value as PlantKind)}>
+                  <option value="ideal">ideal (load = reference)</option>
+                  <option value="pt1">PT1 (first-order lag)</option>
+                  <option value="pt2">PT2 (tuned position loop)</option>
+                </select>
+              </Field>
+              {form.plant === 'pt1' && num('drive.plant.time_constant', form.time_constant, (v) => set('time_constant', v), 'Time constant (s)', '> 0 and ≤ 10')}
+              {form.plant === 'pt2' && num('drive.plant.natural_frequency_hz', form.natural_frequency_hz, (v) => set('natural_frequency_hz', v), 'Natural frequency (Hz)', '> 0 and ≤ 1000')}
+              {form.plant === 'pt2' && num('drive.plant.damping', form.damping, (v) => set('damping', v), 'Damping', '1 = critically damped')}
+              {DRIVE_LABELS.map(([k, label, hint]) => num(`drive.${k}`, form.drive[k], (v) => set('drive', { ...form.drive, [k]: v }), label, hint))}
+              <label class="check">
+                <input type="checkbox" name="drive.dead_time_compensation" checked={form.dead_time_compensation} onChange={(e) => set('dead_time_compensation', (e.target as HTMLInputElement).checked)} /> dead-time
+                compensation
+              </label>
+            </div>
+          </Panel>
+          <Panel title="Homing and switches (simulated)">
+            <div class="form-grid">
+              <Field label={`Reference cam (${form.unit})`} name="drive.reference_cam" error={err('drive.reference_cam.start') ?? err('drive.reference_cam.end')}>
+                <span class="inline">
+                  <input type="checkbox" name="ref-cam-on" checked={form.refCam} onChange={(e) => set('refCam', (e.target as HTMLInputElement).checked)} />
+                  <NumberInput name="drive.reference_cam.start" value={form.camStart} onValue={(v) => set('camStart', v)} disabled={!form.refCam} placeholder="start" />
+                  <NumberInput name="drive.reference_cam.end" value={form.camEnd} onValue={(v) => set('camEnd', v)} disabled={!form.refCam} placeholder="end" />
+                </span>
+              </Field>
+              <Field label={`Index pulse (${form.unit})`} name="drive.index_pulse" error={err('drive.index_pulse.period') ?? err('drive.index_pulse.offset')}>
+                <span class="inline">
+                  <input type="checkbox" name="index-on" checked={form.index} onChange={(e) => set('index', (e.target as HTMLInputElement).checked)} />
+                  <NumberInput name="drive.index_pulse.period" value={form.indexPeriod} onValue={(v) => set('indexPeriod', v)} disabled={!form.index} placeholder="period" />
+                  <NumberInput name="drive.index_pulse.offset" value={form.indexOffset} onValue={(v) => set('indexOffset', v)} disabled={!form.index} placeholder="offset" />
+                </span>
+              </Field>
+              {num('drive.limit_switches.negative', form.limitNeg, (v) => set('limitNeg', v), `Limit switch − (${form.unit})`, 'blank = none')}
+              {num('drive.limit_switches.positive', form.limitPos, (v) => set('limitPos', v), `Limit switch + (${form.unit})`, 'blank = none')}
+              <label class="check">
+                <input type="checkbox" name="drive.limit_switches.fault_on_hit" checked={form.faultOnHit} onChange={(e) => set('faultOnHit', (e.target as HTMLInputElement).checked)} /> a switch
+                faults the drive
+              </label>
+            </div>
+          </Panel>
+          <Panel title="Further base parameters (MC_AxisParameter by name)" class="wide">
+            <table class="grid kv">
+              <tbody>
+                {form.parameters.map((p, i) => (
+                  <tr key={i}>
+                    <td>
+                      <input type="text" value={p.key} placeholder="AxisTargetPositionWindow" onInput={(e) => set('parameters', form.parameters.map((q, j) => (j === i ? { ...q, key: (e.target as HTMLInputElement).value } : q)))} />
+                    </td>
+                    <td>
+                      <input type="text" class="num" value={p.value} onInput={(e) => set('parameters', form.parameters.map((q, j) => (j === i ? { ...q, value: (e.target as HTMLInputElement).value } : q)))} />
+                      {err(`parameters.${p.key.trim()}`) && <div class="field-error">{err(`parameters.${p.key.trim()}`)}</div>}
+                    </td>
+                    <td>
+                      <button type="button" class="btn btn-small" onClick={() => set('parameters', form.parameters.filter((_, j) => j !== i))}>
+                        remove
+                      </button>
+                    </td>
+                  </tr>
+                ))}
+              </tbody>
+            </table>
+            <button type="button" class="btn btn-small" onClick={() => set('parameters', [...form.parameters, { key: '', value: '' }])}>
+              + parameter
+            </button>
+          </Panel>
+        </div>
+        <div class="form-actions sticky-actions">
+          <button type="submit" class="btn btn-primary" name="save">
+            {creating ? 'Create axis' : 'Save configuration'}
+          </button>
+          {!creating && (
+            <button type="button" class="btn" name="revert" onClick={() => { setForm(formOf(axis.config)); setFields({}); setError(null); }}>
+              Revert
+            </button>
+          )}
+          {!creating &&
+            (confirmDelete ? (
+              <span class="confirm">
+                Delete axis <b>{axis.config.name}</b> and its persistent parameters?
+                <ActionButton kind="danger" name="delete-confirm" onClick={remove}>
+                  Delete
+                </ActionButton>
+                <button type="button" class="btn" onClick={() => setConfirmDelete(false)}>
+                  Cancel
+                </button>
+              </span>
+            ) : (
+              <button type="button" class="btn btn-danger-outline" name="delete" onClick={() => setConfirmDelete(true)}>
+                Delete axis…
+              </button>
+            ))}
+        </div>
+      </form>
+    </div>
+  );
+}

@@ -1,0 +1,89 @@
+import { useEffect, useState } from 'preact/hooks';
+import { useStore } from '../store';
+import { axes, axesLoaded, command, statuses } from '../services';
+import { href } from '../router';
+import { ActionButton, Lamp } from './common';
+import { STATE_LABEL } from '../format';
+import { errorInfo } from '../api/errors';
+import { OnlineTab } from './online';
+import { ParametersTab } from './parameters';
+import { AxisConfigPage } from './axis-config';
+
+export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'parameters' | 'config' }) {
+  const list = useStore(axes);
+  const loaded = useStore(axesLoaded);
+  const st = useStore(statuses);
+  const a = list.find((x) => x.config.name === axis);
+  const [resetError, setResetError] = useState<string | null>(null);
+  useEffect(() => setResetError(null), [axis]);
+  if (!a) {
+    return (
+      <div class="page">
+        {loaded ? (
+          <p>
+            There is no axis <b>{axis}</b>. <a href="#/">Overview</a>
+          </p>
+        ) : (
+          <p class="muted">Loading…</p>
+        )}
+      </div>
+    );
+  }
+  const live = st.get(axis);
+  const s = live?.status;
+  const err = s && (s.error_id || s.state === 'error_stop') ? errorInfo(s.error_id) : null;
+  const tabLink = (t: typeof tab, label: string) => (
+    <a href={href({ page: 'axis', axis, tab: t })} class={`tab ${tab === t ? 'active' : ''}`} data-tab={t}>
+      {label}
+    </a>
+  );
+  return (
+    <div class="page page-axis">
+      <div class="axis-head">
+        <h2>
+          <Lamp state={s?.state ?? a.state} errorId={s?.error_id ?? 0} />
+          {a.config.name}
+        </h2>
+        <span class="axis-state" data-testid="axis-state">
+          {STATE_LABEL[s?.state ?? a.state]}
+        </span>
+        <span class="muted small">
+          id {a.id} · {a.config.unit}
+          {a.config.modulo ? ` · modulo ${a.config.modulo.period}` : ''}
+          {a.config.soft_limits ? ` · soft limits ${a.config.soft_limits.min} … ${a.config.soft_limits.max}` : ''}
+        </span>
+        <nav class="tabs">
+          {tabLink('online', 'Online')}
+          {tabLink('parameters', 'Parameters')}
+          {tabLink('config', 'Configuration')}
+        </nav>
+      </div>
+      {err && (
+        <div class="banner banner-error axis-error" role="alert" data-testid="axis-error">
+          <span>
+            <b>Axis in error</b> · <b>{err.hex}</b> <code>{err.code}</code> — {err.text}
+            {s?.drive_fault ? ' · drive fault' : ''}
+          </span>
+          <ActionButton
+            kind="danger"
+            name="reset-error"
+            onClick={async () => {
+              try {
+                setResetError(null);
+                await command(axis, 'reset');
+              } catch (e) {
+                setResetError((e as Error).message);
+              }
+            }}
+          >
+            Reset
+          </ActionButton>
+          {resetError && <span class="small">{resetError}</span>}
+        </div>
+      )}
+      {tab === 'online' && <OnlineTab axis={a} />}
+      {tab === 'parameters' && <ParametersTab axis={a} />}
+      {tab === 'config' && <AxisConfigPage axis={a} />}
+    </div>
+  );
+}

@@ -1,0 +1,151 @@
+import type { ComponentChildren } from 'preact';
+import { useState } from 'preact/hooks';
+import { stateLamp, STATE_LABEL } from '../format';
+import type { AxisState } from '../api/types';
+import { ApiError } from '../api/rest';
+import { RpcError } from '../live/client';
+import { errorInfo } from '../api/errors';
+
+export function Lamp({ state, errorId = 0, label = false, title }: { state?: AxisState; errorId?: number; label?: boolean; title?: string }) {
+  const text = state ? STATE_LABEL[state] : 'unknown';
+  return (
+    <span class="lamp-wrap" title={title ?? text} data-state={state ?? 'unknown'}>
+      <span class={`lamp ${stateLamp(state, errorId)}`} />
+      {label && <span class="lamp-label">{text}</span>}
+    </span>
+  );
+}
+
+/** A status LED with its name (TwinCAT online tab style). */
+export function Led({ on, label, tone = 'green', title }: { on: boolean | undefined; label: string; tone?: 'green' | 'red' | 'amber' | 'blue'; title?: string }) {
+  return (
+    <span class={`led ${on ? `led-on led-${tone}` : ''}`} title={title ?? label} data-on={on ? '1' : '0'}>
+      <span class="led-dot" />
+      {label}
+    </span>
+  );
+}
+
+export function Panel({ title, children, class: cls, actions, id }: { title: ComponentChildren; children: ComponentChildren; class?: string; actions?: ComponentChildren; id?: string }) {
+  return (
+    <section class={`panel ${cls ?? ''}`} id={id}>
+      <header class="panel-head">
+        <h3>{title}</h3>
+        {actions && <div class="panel-actions">{actions}</div>}
+      </header>
+      <div class="panel-body">{children}</div>
+    </section>
+  );
+}
+
+/** A label + input + the server's message for that field. */
+export function Field({ label, error, hint, children, class: cls, name }: { label: ComponentChildren; error?: string; hint?: ComponentChildren; children: ComponentChildren; class?: string; name?: string }) {
+  return (
+    <label class={`field ${error ? 'has-error' : ''} ${cls ?? ''}`} data-field={name}>
+      <span class="field-label">{label}</span>
+      {children}
+      {error ? <span class="field-error" role="alert">{error}</span> : hint ? <span class="field-hint">{hint}</span> : null}
+    </label>
+  );
+}
+
+/** A number input that keeps the text as typed (so "1." or "-" can be entered). */
+export function NumberInput({ value, onValue, name, placeholder, step = 'any', disabled, class: cls, title }: {
+  value: string;
+  onValue: (v: string) => void;
+  name?: string;
+  placeholder?: string;
+  step?: string;
+  disabled?: boolean;
+  class?: string;
+  title?: string;
+}) {
+  return (
+    <input
+      class={`num ${cls ?? ''}`}
+      type="text"
+      inputMode="decimal"
+      name={name}
+      value={value}
+      placeholder={placeholder}
+      disabled={disabled}
+      step={step}
+      title={title}
+      autocomplete="off"
+      spellcheck={false}
+      onInput={(e) => onValue((e.target as HTMLInputElement).value)}
+    />
+  );
+}
+
+/**
+ * Parses an input: '' → the fallback (or NaN), otherwise the number. A text that is not a
+ * number is sent as NaN→null so that the server's validation answers for it.
+ */
+export function parseNum(s: string, fallback?: number): number {
+  const t = s.trim().replace(',', '.');
+  if (t === '') return fallback ?? NaN;
+  const v = Number(t);
+  return v;
+}
+
+/** The text of an error for a banner: problem title/detail with the error number. */
+export function errorText(e: unknown): string {
+  if (e instanceof ApiError || e instanceof RpcError) {
+    const p = e.problem;
+    if (p) {
+      const id = p.error_id ? ` (${errorInfo(p.error_id).hex})` : '';
+      return `${p.title}: ${p.detail}${id}`;
+    }
+    return e.message;
+  }
+  return e instanceof Error ? e.message : String(e);
+}
+
+export function fieldsOf(e: unknown): Record<string, string> {
+  return e instanceof ApiError || e instanceof RpcError ? e.fields : {};
+}
+
+/** A button that shows it is busy while its async action runs. */
+export function ActionButton({ onClick, children, class: cls, disabled, title, name, kind }: {
+  onClick: () => Promise<unknown> | void;
+  children: ComponentChildren;
+  class?: string;
+  disabled?: boolean;
+  title?: string;
+  name?: string;
+  kind?: 'primary' | 'danger' | 'warn' | 'plain';
+}) {
+  const [busy, setBusy] = useState(false);
+  const click = async (ev: MouseEvent) => {
+    ev.preventDefault();
+    if (busy) return;
+    setBusy(true);
+    try {
+      await onClick();
+    } catch {
+      /* shown by the caller */
+    } finally {
+      setBusy(false);
+    }
+  };
+  return (
+    <button type="button" class={`btn btn-${kind ?? 'plain'} ${busy ? 'busy' : ''} ${cls ?? ''}`} disabled={disabled} title={title} name={name} onClick={click}>
+      {children}
+    </button>
+  );
+}
+
+export function ErrorBanner({ error, onClose }: { error: string | null; onClose?: () => void }) {
+  if (!error) return null;
+  return (
+    <div class="banner banner-error" role="alert">
+      <span>{error}</span>
+      {onClose && (
+        <button type="button" class="banner-close" onClick={onClose} aria-label="dismiss">
+          ×
+        </button>
+      )}
+    </div>
+  );
+}

@@ -1,0 +1,291 @@
+// MC_AxisParameter pages: grouped, with units, ranges and help; edits are shown as a diff
+// (old → new) and applied one PUT at a time; the server's validation errors appear at the row.
+import { useEffect, useMemo, useState } from 'preact/hooks';
+import { get, put, enc } from '../api/rest';
+import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
+import { ErrorBanner, errorText, fieldsOf } from './common';
+import { inputNum } from '../format';
+import { ApiError } from '../api/rest';
+import { errorInfo } from '../api/errors';
+import { refreshAxes } from '../services';
+
+export const GROUPS: { key: ParamGroup; label: string }[] = [
+  { key: 'dynamics', label: 'Dynamics' },
+  { key: 'manual', label: 'Manual (jog)' },
+  { key: 'limits', label: 'Limits' },
+  { key: 'monitoring', label: 'Monitoring' },
+  { key: 'homing', label: 'Homing' },
+  { key: 'encoder', label: 'Encoder' },
+  { key: 'drive', label: 'Drive' },
+  { key: 'controller', label: 'Controller' },
+  { key: 'coupling', label: 'Coupling' },
+  { key: 'system', label: 'System' },
+  { key: 'status', label: 'Status (read-only)' },
+];
+
+/** Range text of a descriptor: "> 0", "0 … 1", "≥ 0", "any". min/max are null when unbounded. */
+export function rangeText(p: Pick<ParameterResource, 'min' | 'max' | 'min_exclusive' | 'type'>): string {
+  const min = p.min as number | null;
+  const max = p.max as number | null;
+  if (p.type === 'bool') return 'true / false';
+  const lo = min === null || min === undefined ? null : min;
+  const hi = max === null || max === undefined ? null : max;
+  if (lo === null && hi === null) return 'any';
+  if (hi === null) return `${p.min_exclusive ? '>' : '≥'} ${lo}`;
+  if (lo === null) return `≤ ${hi}`;
+  return `${p.min_exclusive ? '>' : ''}${lo} … ${hi}`;
+}
+
+export function valueText(v: ParamValue | undefined | null): string {
+  if (v === undefined || v === null) return '';
+  if (typeof v === 'boolean') return v ? 'true' : 'false';
+  return inputNum(v);
+}
+
+/** The edited text as the value to send: booleans for BOOL, numbers otherwise. */
+export function parseValue(p: ParameterResource, text: string): ParamValue | null {
+  if (p.type === 'bool') return text === 'true' ? true : text === 'false' ? false : null;
+  const t = text.trim().replace(',', '.');
+  if (t === '') return null;
+  const v = Number(t);
+  return Number.isNaN(v) ? null : v;
+}
+
+export interface Change {
+  param: ParameterResource;
+  old: ParamValue;
+  next: ParamValue;
+}
+
+export function diff(list: ParameterResource[], edits: Record<number, string>): { changes: Change[]; invalid: Record<number, string> } {
+  const changes: Change[] = [];
+  const invalid: Record<number, string> = {};
+  for (const p of list) {
+    const text = edits[p.number];
+    if (text === undefined) continue;
+    const next = parseValue(p, text);
+    if (next === null) {
+      invalid[p.number] = p.type === 'bool' ? 'true or false' : 'not a number';
+      continue;
+    }
+    if (next !== p.value) changes.push({ param: p, old: p.value, next });
+  }
+  return { changes, invalid };
+}
+
+export function ParametersTab({ axis: a }: { axis: AxisResource }) {
+  const axis = a.config.name;
+  const [list, setList] = useState<ParameterResource[] | null>(null);
+  const [edits, setEdits] = useState<Record<number, string>>({});
+  const [rowErrors, setRowErrors] = useState<Record<number, string>>({});
+  const [filter, setFilter] = useState('');
+  const [group, setGroup] = useState<ParamGroup | 'all'>('all');
+  const [persistent, setPersistent] = useState(false);
+  const [review, setReview] = useState(false);
+  const [applying, setApplying] = useState(false);
+  const [error, setError] = useState<string | null>(null);
+  const [message, setMessage] = useState<string | null>(null);
+  const [openHelp, setOpenHelp] = useState<number | null>(null);
+
+  const load = () =>
+    get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(setList, (e) => setError(errorText(e)));
+  useEffect(() => {
+    void load();
+  }, [axis]);
+
+  const { changes, invalid } = useMemo(() => diff(list ?? [], edits), [list, edits]);
+  const f = filter.trim().toLowerCase();
+  const shown = (list ?? []).filter(
+    (p) =>
+      (group === 'all' || p.group === group) &&
+      (!f || p.name.toLowerCase().includes(f) || String(p.number).includes(f) || p.help.toLowerCase().includes(f)),
+  );
+
+  const apply = async () => {
+    setApplying(true);
+    setError(null);
+    setMessage(null);
+    const errs: Record<number, string> = {};
+    let ok = 0;
+    const remaining: Record<number, string> = { ...edits };
+    for (const c of changes) {
+      try {
+        const r = await put<ParameterResource>(`/axes/${enc(axis)}/parameters/${c.param.number}`, { value: c.next, persistent });
+        ok++;
+        delete remaining[c.param.number];
+        setList((l) => l && l.map((p) => (p.number === r.number ? r : p)));
+      } catch (e) {
+        const fields = fieldsOf(e);
+        const id = e instanceof ApiError ? e.problem?.error_id : undefined;
+        errs[c.param.number] = (fields.value ?? errorText(e)) + (id ? ` (${errorInfo(id).hex} ${errorInfo(id).code})` : '');
+      }
+    }
+    setEdits(remaining);
+    setRowErrors(errs);
+    setApplying(false);
+    setReview(false);
+    const failed = Object.keys(errs).length;
+    setMessage(`${ok} parameter${ok === 1 ? '' : 's'} written${persistent ? ' persistently' : ''}${failed ? `, ${failed} refused (see the rows marked red)` : ''}.`);
+    // Aliases and dependent entries may have changed too.
+    void load();
+    void refreshAxes();
+  };
+
+  if (!list) return <div class="muted">{error ?? 'Loading parameters…'}</div>;
+
+  return (
+    <div class="params">
+      <ErrorBanner error={error} onClose={() => setError(null)} />
+      <div class="toolbar">
+        <input class="filter" type="search" placeholder="filter: name, number, text" value={filter} onInput={(e) => setFilter((e.target as HTMLInputElement).value)} />
+        <div class="seg">
+          <button type="button" class={`seg-btn ${group === 'all' ? 'active' : ''}`} onClick={() => setGroup('all')}>
+            All
+          </button>
+          {GROUPS.filter((g) => list.some((p) => p.group === g.key)).map((g) => (
+            <button type="button" class={`seg-btn ${group === g.key ? 'active' : ''}`} data-group={g.key} onClick={() => setGroup(g.key)}>
+              {g.label.replace(' (read-only)', '')}
+            </button>
+          ))}
+        </div>
+      </div>
+      <div class="toolbar apply-bar">
+        <label class="check" title="MC_WriteParameterPersistent: kept across restarts until the axis configuration is replaced">
+          <input type="checkbox" name="persistent" checked={persistent} onChange={(e) => setPersistent((e.target as HTMLInputElement).checked)} /> persistent
+        </label>
+        <span class="muted" data-testid="change-count">
+          {changes.length} change{changes.length === 1 ? '' : 's'}
+          {Object.keys(invalid).length ? ` · ${Object.keys(invalid).length} invalid` : ''}
+        </span>
+        <button type="button" class="btn btn-primary" name="review" disabled={changes.length === 0 || applying} onClick={() => setReview(true)}>
+          Review & apply…
+        </button>
+        <button
+          type="button"
+          class="btn"
+          name="discard"
+          disabled={Object.keys(edits).length === 0}
+          onClick={() => {
+            setEdits({});
+            setRowErrors({});
+          }}
+        >
+          Discard
+        </button>
+        {message && <span class="msg" data-testid="apply-message">{message}</span>}
+      </div>
+
+      {review && (
+        <div class="diff" data-testid="param-diff">
+          <h4>
+            Apply {changes.length} change{changes.length === 1 ? '' : 's'} to axis {axis}
+            {persistent ? ' (persistent)' : ' (until restart)'}?
+          </h4>
+          <table class="grid">
+            <thead>
+              <tr>
+                <th class="r">No.</th>
+                <th>Name</th>
+                <th class="r">Old</th>
+                <th></th>
+                <th class="r">New</th>
+                <th>Unit</th>
+              </tr>
+            </thead>
+            <tbody>
+              {changes.map((c) => (
+                <tr key={c.param.number} data-param={c.param.name}>
+                  <td class="r mono">{c.param.number}</td>
+                  <td>{c.param.name}</td>
+                  <td class="r mono old">{valueText(c.old)}</td>
+                  <td>→</td>
+                  <td class="r mono new">{valueText(c.next)}</td>
+                  <td>{c.param.unit_text}</td>
+                </tr>
+              ))}
+            </tbody>
+          </table>
+          <div class="form-actions">
+            <button type="button" class="btn btn-primary" name="apply" disabled={applying} onClick={() => void apply()}>
+              {applying ? 'Applying…' : 'Apply'}
+            </button>
+            <button type="button" class="btn" name="cancel" onClick={() => setReview(false)}>
+              Cancel
+            </button>
+          </div>
+        </div>
+      )}
+
+      <table class="grid param-table">
+        <thead>
+          <tr>
+            <th class="r">No.</th>
+            <th>Name</th>
+            <th class="r">Value</th>
+            <th>Unit</th>
+            <th>Range</th>
+            <th class="r">Persistent</th>
+            <th>Description</th>
+          </tr>
+        </thead>
+        {GROUPS.filter((g) => shown.some((p) => p.group === g.key)).map((g) => (
+          <tbody key={g.key}>
+            <tr class="group-row">
+              <th colSpan={7}>{g.label}</th>
+            </tr>
+            {shown
+              .filter((p) => p.group === g.key)
+              .map((p) => {
+                const edited = edits[p.number] !== undefined && edits[p.number] !== valueText(p.value);
+                const err = rowErrors[p.number] ?? invalid[p.number];
+                const ro = p.read_only || p.group === 'status';
+                return (
+                    <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
+                      <td class="r mono">{p.number}</td>
+                      <td class="pname" title={p.storage && p.storage !== p.number ? `alias of #${p.storage}` : undefined}>
+                        {p.name}
+                        {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
+                      </td>
+                      <td class="r value-cell">
+                        {ro ? (
+                          <span class="mono">{valueText(p.value)}</span>
+                        ) : p.type === 'bool' ? (
+                          <select
+                            name={`param-${p.number}`}
+                            value={edits[p.number] ?? valueText(p.value)}
+                            onChange={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLSelectElement).value })}
+                          >
+                            <option value="true">true</option>
+                            <option value="false">false</option>
+                          </select>
+                        ) : (
+                          <input
+                            class="num"
+                            type="text"
+                            inputMode="decimal"
+                            name={`param-${p.number}`}
+                            value={edits[p.number] ?? valueText(p.value)}
+                            onInput={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLInputElement).value })}
+                          />
+                        )}
+                        {err && (
+                          <div class="field-error" role="alert">
+                            {err}
+                          </div>
+                        )}
+                      </td>
+                      <td>{p.unit_text}</td>
+                      <td class="mono small">{rangeText(p)}</td>
+                      <td class="r mono small">{p.persistent_value !== undefined && p.persistent_value !== null ? valueText(p.persistent_value) : ''}</td>
+                      <td class="help" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
+                        <span class={openHelp === p.number ? 'help-open' : 'help-short'}>{p.help}</span>
+                      </td>
+                    </tr>
+                );
+              })}
+          </tbody>
+        ))}
+      </table>
+    </div>
+  );
+}
