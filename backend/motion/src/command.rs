@@ -410,7 +410,8 @@ pub struct FbOutputs {
     pub status: bool,
     /// MoveSuperImposed: not completed as asked (executed as far as possible).
     pub warning: bool,
-    /// 0x4243 with `warning`.
+    /// With `warning`: 0x4243 (MoveSuperImposed done only in part) or 0x7061 (a jog's
+    /// dead-man fired; the jog then ends with that error at rest).
     pub warning_id: u32,
 }
 

@@ -665,8 +665,14 @@ impl Axis {
                         (c.target_ratio - c.ratio).clamp(-c.ratio_rate * dt, c.ratio_rate * dt);
                     c.slave_start += c.ratio * (mp - c.master_start);
                     c.master_start = mp;
-                    c.ratio += step;
-                    dratio = step / dt;
+                    let before = c.ratio;
+                    // The last step lands exactly on the target (no float residue).
+                    c.ratio = if (c.target_ratio - c.ratio).abs() <= c.ratio_rate * dt {
+                        c.target_ratio
+                    } else {
+                        c.ratio + step
+                    };
+                    dratio = (c.ratio - before) / dt;
                     if c.ratio == c.target_ratio && job.id != 0 && !job.out.in_gear {
                         let out = FbOutputs {
                             in_gear: true,
