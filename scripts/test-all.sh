@@ -15,3 +15,17 @@ if ! command -v cc >/dev/null 2>&1; then
 fi
 
 cargo test --workspace --all-targets 2>&1
+
+# --- Frontend (frontend/, tests/e2e/) ------------------------------------------------------
+# The UI's API types must match openapi/openapi.json, the UI must build, its logic tests
+# (Vitest) must pass, and the browser tests drive the real motiond binary with headless
+# Debian Chromium (playwright-core; never a downloaded browser).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+    echo "test-all: node/npm not found; install Node.js 20.19 or newer" >&2
+    exit 1
+fi
+command -v chromium >/dev/null 2>&1 || (apt-get update && apt-get install -y chromium)
+(cd frontend && npm ci --no-audit --no-fund && npm run check:api && npm run build && npm test)
+# The browser tests start target/debug/motiond (the workspace target/, whatever the caller's CARGO_TARGET_DIR).
+env -u CARGO_TARGET_DIR cargo build -p motiond 2>&1
+(cd tests/e2e && npm ci --no-audit --no-fund && env -u CARGO_TARGET_DIR npm test)

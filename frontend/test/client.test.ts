@@ -85,7 +85,7 @@ describe('LiveClient', () => {
         data: { type: 'urn:motiond:problem:validation_failed', title: 'Invalid request', status: 422, detail: 'velocity: must be > 0', code: 'validation_failed', errors: [{ field: 'velocity', message: 'must be > 0' }] },
       },
     });
-    const e = await bad.catch((x) => x);
+    const e = (await bad.catch((x: unknown) => x)) as RpcError;
     expect(e).toBeInstanceOf(RpcError);
     expect(e.fields).toEqual({ velocity: 'must be > 0' });
   });

@@ -59,8 +59,8 @@ function ConnectionNotice({ c }: { c: ConnState }) {
   }
   return (
     <div class="notice notice-error" data-notice="server-gone" role="alert">
-      <b>Server gone.</b> motiond does not answer ({c.kind === 'closed' ? c.reason : 'reconnecting'}). Values shown are the last
-      received and are <b>not live</b>; commands are disabled. Reconnecting automatically.
+      <b>Server gone.</b> motiond does not answer. The values shown are the last received and are <b>not live</b>; commands are
+      disabled. Reconnecting automatically{c.attempt > 1 ? ` (attempt ${c.attempt})` : ''}…
     </div>
   );
 }
@@ -136,7 +136,7 @@ export function App() {
     </a>
   );
   return (
-    <div class={`app conn-${conn.kind}`}>
+    <div class={`app app-${conn.kind === 'open' ? 'online' : 'offline'}`}>
       <header class="topbar">
         <a class="brand" href="#/">
           motiond

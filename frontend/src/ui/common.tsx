@@ -19,7 +19,7 @@ export function Lamp({ state, errorId = 0, label = false, title }: { state?: Axi
 /** A status LED with its name (TwinCAT online tab style). */
 export function Led({ on, label, tone = 'green', title }: { on: boolean | undefined; label: string; tone?: 'green' | 'red' | 'amber' | 'blue'; title?: string }) {
   return (
-    <span class={`led ${on ? `led-on led-${tone}` : ''}`} title={title ?? label} data-on={on ? '1' : '0'}>
+    <span class={`led ${on ? `led-on led-${tone}` : ''}`} title={title ?? label} data-led={label} data-on={on ? '1' : '0'}>
       <span class="led-dot" />
       {label}
     </span>

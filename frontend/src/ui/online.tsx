@@ -190,7 +190,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="online-grid">
         <div class="online-col">
-          <Panel title="Live" class="dro" actions={<span class="muted small">{s ? `cycle ${liveStatus?.cycle}` : ''}</span>}>
+          <Panel title="Live" class="dro" actions={<span class="muted small">{stale ? 'not live' : s ? `cycle ${liveStatus?.cycle}` : ''}</span>}>
             <Readout name="set_position" label="Set position" value={pos(s?.set_position)} unit={u} />
             <Readout name="actual_position" label="Actual position" value={pos(s?.actual_position)} unit={u} />
             <Readout name="set_velocity" label="Set velocity" value={vel(s?.set_velocity)} unit={`${u}/s`} />
@@ -198,7 +198,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
             <Readout name="set_acceleration" label="Set acceleration" value={acc(s?.set_acceleration)} unit={`${u}/s²`} />
             <Readout name="following_error" label="Following error" value={pos(s?.following_error)} unit={lagUnit} />
             <div class="dro-row dro-peak" data-readout="lag_peak">
-              <span class="dro-label">Lag peak min / max</span>
+              <span class="dro-label" title="lowest and highest following error seen since the last reset">Lag peak − / +</span>
               <span class="dro-value mono small">
                 {pos(liveStatus?.lagMin)} / {pos(liveStatus?.lagMax)}
               </span>
@@ -404,60 +404,56 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
             </form>
           </Panel>
 
-          <div class="split">
-            <Panel title="Set position" class="setpos">
-              <form
-                class="row"
-                onSubmit={async (e) => {
-                  e.preventDefault();
-                  setSetPosErrors({});
-                  try {
-                    await run('set-position', { position: parseNum(setPos) });
-                  } catch (err) {
-                    setSetPosErrors(fieldsOf(err));
-                  }
-                }}
-              >
-                <Field label={`Position (${u})`} error={setPosErrors.position} name="set-position">
-                  <NumberInput name="set-position" value={setPos} onValue={setSetPos} />
-                </Field>
-                <button type="submit" class="btn" name="set-position-btn" disabled={offline}>
-                  Set
-                </button>
-              </form>
-            </Panel>
-            <Panel title="Home" class="home">
-              <form
-                class="row"
-                onSubmit={async (e) => {
-                  e.preventDefault();
-                  setHomeErrors({});
-                  const body: Record<string, unknown> = { mode: homeMode };
-                  if (homePos.trim() !== '') body.position = parseNum(homePos);
-                  try {
-                    await run('home', body);
-                  } catch (err) {
-                    setHomeErrors(fieldsOf(err));
-                  }
-                }}
-              >
-                <Field label="Mode" name="home-mode" error={homeErrors.mode}>
-                  <select name="home-mode" value={homeMode} onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}>
-                    <option value="default">default (referencing sequence)</option>
-                    <option value="direct">direct (set here)</option>
-                    <option value="force_calibration">force calibration</option>
-                    <option value="reset_calibration">reset calibration</option>
-                  </select>
-                </Field>
-                <Field label={`Position (${u})`} name="home-position" error={homeErrors.position} hint="blank = calibration value #1075">
-                  <NumberInput name="home-position" value={homePos} onValue={setHomePos} />
-                </Field>
-                <button type="submit" class="btn" name="home-btn" disabled={offline}>
-                  Home
-                </button>
-              </form>
-            </Panel>
-          </div>
+          <Panel title="Position and homing" class="poshome">
+            <form
+              class="row"
+              onSubmit={async (e) => {
+                e.preventDefault();
+                setSetPosErrors({});
+                try {
+                  await run('set-position', { position: parseNum(setPos) });
+                } catch (err) {
+                  setSetPosErrors(fieldsOf(err));
+                }
+              }}
+            >
+              <Field label={`Set actual position to (${u})`} error={setPosErrors.position} name="set-position" class="wide">
+                <NumberInput name="set-position" value={setPos} onValue={setSetPos} />
+              </Field>
+              <button type="submit" class="btn" name="set-position-btn" disabled={offline} title="MC_SetPosition">
+                Set position
+              </button>
+            </form>
+            <form
+              class="row"
+              onSubmit={async (e) => {
+                e.preventDefault();
+                setHomeErrors({});
+                const body: Record<string, unknown> = { mode: homeMode };
+                if (homePos.trim() !== '') body.position = parseNum(homePos);
+                try {
+                  await run('home', body);
+                } catch (err) {
+                  setHomeErrors(fieldsOf(err));
+                }
+              }}
+            >
+              <Field label="Homing mode" name="home-mode" error={homeErrors.mode} class="wide">
+                <select name="home-mode" value={homeMode} onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}>
+                  <option value="default">default: referencing sequence (#1076)</option>
+                  <option value="direct">direct: set the position here</option>
+                  <option value="force_calibration">force calibration: mark as homed</option>
+                  <option value="reset_calibration">reset calibration: mark as not homed</option>
+                </select>
+              </Field>
+              <Field label={`Home position (${u})`} name="home-position" error={homeErrors.position}>
+                <NumberInput name="home-position" value={homePos} onValue={setHomePos} placeholder="#1075" title="blank = the calibration value (#1075)" />
+              </Field>
+              <button type="submit" class="btn" name="home-btn" disabled={offline} title="MC_Home">
+                Home
+              </button>
+            </form>
+          </Panel>
         </div>
       </div>
       <Panel title="Commands" class="log-panel">

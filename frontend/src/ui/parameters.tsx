@@ -86,6 +86,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
   const [error, setError] = useState<string | null>(null);
   const [message, setMessage] = useState<string | null>(null);
   const [openHelp, setOpenHelp] = useState<number | null>(null);
+  const [aliases, setAliases] = useState(false);
 
   const load = () =>
     get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(setList, (e) => setError(errorText(e)));
@@ -95,9 +96,12 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
 
   const { changes, invalid } = useMemo(() => diff(list ?? [], edits), [list, edits]);
   const f = filter.trim().toLowerCase();
+  // Aliases (PLCopen names sharing a TwinCAT entry's storage) only when asked for or searched.
+  const isAlias = (p: ParameterResource) => p.storage !== 0 && p.storage !== p.number;
   const shown = (list ?? []).filter(
     (p) =>
       (group === 'all' || p.group === group) &&
+      (aliases || !!f || !isAlias(p) || edits[p.number] !== undefined) &&
       (!f || p.name.toLowerCase().includes(f) || String(p.number).includes(f) || p.help.toLowerCase().includes(f)),
   );
 
@@ -137,7 +141,11 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
     <div class="params">
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="toolbar">
-        <input class="filter" type="search" placeholder="filter: name, number, text" value={filter} onInput={(e) => setFilter((e.target as HTMLInputElement).value)} />
+        <input class="filter" type="search" name="filter" placeholder="filter: name, number, text" value={filter} onInput={(e) => setFilter((e.target as HTMLInputElement).value)} />
+        <label class="check" title="PLCopen names that share the storage of a TwinCAT entry (e.g. MaxVelocityAppl → #1003)">
+          <input type="checkbox" name="aliases" checked={aliases} onChange={(e) => setAliases((e.target as HTMLInputElement).checked)} /> aliases
+        </label>
+        <span class="muted small">{shown.length} of {list.length}</span>
         <div class="seg">
           <button type="button" class={`seg-btn ${group === 'all' ? 'active' : ''}`} onClick={() => setGroup('all')}>
             All
@@ -217,6 +225,14 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
       )}
 
       <table class="grid param-table">
+        <colgroup>
+          <col class="c-no" />
+          <col class="c-name" />
+          <col class="c-value" />
+          <col class="c-unit" />
+          <col class="c-range" />
+          <col class="c-pers" />
+        </colgroup>
         <thead>
           <tr>
             <th class="r">No.</th>
@@ -224,14 +240,13 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
             <th class="r">Value</th>
             <th>Unit</th>
             <th>Range</th>
-            <th class="r">Persistent</th>
-            <th>Description</th>
+            <th class="r" title="value of the persistent overlay (MC_WriteParameterPersistent)">Persistent</th>
           </tr>
         </thead>
         {GROUPS.filter((g) => shown.some((p) => p.group === g.key)).map((g) => (
           <tbody key={g.key}>
             <tr class="group-row">
-              <th colSpan={7}>{g.label}</th>
+              <th colSpan={6}>{g.label}</th>
             </tr>
             {shown
               .filter((p) => p.group === g.key)
@@ -242,9 +257,10 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                 return (
                     <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
                       <td class="r mono">{p.number}</td>
-                      <td class="pname" title={p.storage && p.storage !== p.number ? `alias of #${p.storage}` : undefined}>
+                      <td class="pname" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
                         {p.name}
                         {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
+                        <div class={`help ${openHelp === p.number ? 'help-open' : 'help-short'}`}>{p.help}</div>
                       </td>
                       <td class="r value-cell">
                         {ro ? (
@@ -277,9 +293,6 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                       <td>{p.unit_text}</td>
                       <td class="mono small">{rangeText(p)}</td>
                       <td class="r mono small">{p.persistent_value !== undefined && p.persistent_value !== null ? valueText(p.persistent_value) : ''}</td>
-                      <td class="help" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
-                        <span class={openHelp === p.number ? 'help-open' : 'help-short'}>{p.help}</span>
-                      </td>
                     </tr>
                 );
               })}

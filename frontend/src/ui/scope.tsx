@@ -174,46 +174,30 @@ export function ScopePage() {
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="scope-grid">
         <Panel title="Recording" class="scope-setup">
-          <table class="grid channels">
-            <thead>
-              <tr>
-                <th>#</th>
-                <th>Axis</th>
-                <th>Signal</th>
-                <th></th>
-              </tr>
-            </thead>
-            <tbody>
-              {form.channels.map((c, i) => (
-                <tr key={i} data-channel={i}>
-                  <td>
-                    <span class="swatch" style={{ background: COLORS[i % COLORS.length] }} />
-                    {i}
-                  </td>
-                  <td>
-                    <select name={`channel-${i}-axis`} value={c.axis} onChange={(e) => setChannel(i, { axis: (e.target as HTMLSelectElement).value })}>
-                      {list.map((a) => (
-                        <option value={a.config.name}>{a.config.name}</option>
-                      ))}
-                    </select>
-                  </td>
-                  <td>
-                    <select name={`channel-${i}-signal`} value={c.signal} onChange={(e) => setChannel(i, { signal: (e.target as HTMLSelectElement).value as Signal })}>
-                      {SIGNALS.map((s) => (
-                        <option value={s}>{SIGNAL_LABEL[s]}</option>
-                      ))}
-                    </select>
-                    {errors[`channels[${i}].signal`] && <div class="field-error">{errors[`channels[${i}].signal`]}</div>}
-                  </td>
-                  <td>
-                    <button type="button" class="btn btn-small" title="remove" onClick={() => setForm({ ...form, channels: form.channels.filter((_, j) => j !== i) })}>
-                      ×
-                    </button>
-                  </td>
-                </tr>
-              ))}
-            </tbody>
-          </table>
+          <div class="channels">
+            {form.channels.map((c, i) => (
+              <div class="channel" key={i} data-channel={i}>
+                <span class="channel-no">
+                  <span class="swatch" style={{ background: COLORS[i % COLORS.length] }} />
+                  {i}
+                </span>
+                <select name={`channel-${i}-axis`} value={c.axis} title="axis" onChange={(e) => setChannel(i, { axis: (e.target as HTMLSelectElement).value })}>
+                  {list.map((a) => (
+                    <option value={a.config.name}>{a.config.name}</option>
+                  ))}
+                </select>
+                <select name={`channel-${i}-signal`} value={c.signal} title="signal" onChange={(e) => setChannel(i, { signal: (e.target as HTMLSelectElement).value as Signal })}>
+                  {SIGNALS.map((s) => (
+                    <option value={s}>{SIGNAL_LABEL[s]}</option>
+                  ))}
+                </select>
+                <button type="button" class="btn btn-small" title="remove this channel" onClick={() => setForm({ ...form, channels: form.channels.filter((_, j) => j !== i) })}>
+                  ×
+                </button>
+                {errors[`channels[${i}].signal`] && <div class="field-error channel-error">{errors[`channels[${i}].signal`]}</div>}
+              </div>
+            ))}
+          </div>
           {errors.channels && <div class="field-error">{errors.channels}</div>}
           <button
             type="button"

@@ -1,0 +1,186 @@
+// Harness of the browser tests: the real motiond binary on a free port with a temporary
+// database, the built UI (served by motiond when it has --ui-dir, else by `vite preview`
+// with a proxy to motiond), and Debian's Chromium driven by playwright-core.
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdtempSync, mkdirSync, rmSync, existsSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
+export const FRONTEND = join(ROOT, 'frontend');
+export const DIST = join(FRONTEND, 'dist');
+export const SHOTS = join(ROOT, 'target', 'ui-screenshots');
+const CARGO_TARGET = process.env.CARGO_TARGET_DIR ? resolve(process.env.CARGO_TARGET_DIR) : join(ROOT, 'target');
+export const MOTIOND = process.env.MOTIOND_BIN ?? join(CARGO_TARGET, 'debug', 'motiond');
+export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
+
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+export function freePort() {
+  return new Promise((res, rej) => {
+    const s = createServer();
+    s.unref();
+    s.on('error', rej);
+    s.listen(0, '127.0.0.1', () => {
+      const { port } = s.address();
+      s.close(() => res(port));
+    });
+  });
+}
+
+/** Polls `f` until it returns a truthy value (no timing assertions: a generous deadline). */
+export async function until(f, { timeout = 20000, interval = 50, what = 'condition' } = {}) {
+  const end = Date.now() + timeout;
+  let last;
+  for (;;) {
+    try {
+      last = await f();
+      if (last) return last;
+    } catch (e) {
+      last = e;
+    }
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what} (last: ${last instanceof Error ? last.message : JSON.stringify(last)})`);
+    await sleep(interval);
+  }
+}
+
+export function motiondHelp() {
+  try {
+    return execFileSync(MOTIOND, ['serve', '--help'], { encoding: 'utf8' }) + execFileSync(MOTIOND, ['--help'], { encoding: 'utf8' });
+  } catch (e) {
+    return String(e.stdout ?? '');
+  }
+}
+
+/** Whether this motiond serves the UI itself (`--ui-dir`). */
+export const servesUi = () => /--ui-dir/.test(motiondHelp());
+
+function spawnLogged(cmd, args, opts, name) {
+  const p = spawn(cmd, args, { ...opts, stdio: ['ignore', 'pipe', 'pipe'] });
+  const log = [];
+  const keep = (d) => {
+    log.push(String(d));
+    if (log.length > 400) log.splice(0, 100);
+  };
+  p.stdout.on('data', keep);
+  p.stderr.on('data', keep);
+  p.log = () => `--- ${name} output ---\n${log.join('')}`;
+  return p;
+}
+
+async function stopProcess(p) {
+  if (!p || p.exitCode !== null || p.signalCode !== null) return;
+  const gone = new Promise((r) => p.once('exit', r));
+  p.kill('SIGTERM');
+  const t = setTimeout(() => p.kill('SIGKILL'), 5000);
+  await gone;
+  clearTimeout(t);
+}
+
+/**
+ * Starts motiond (fresh database, demo machine unless noDemo) and whatever serves the UI.
+ * Returns { url (the UI), api (motiond), stop() }.
+ */
+export async function startStack({ noDemo = true } = {}) {
+  if (!existsSync(MOTIOND)) throw new Error(`${MOTIOND} missing: cargo build -p motiond`);
+  if (!existsSync(join(DIST, 'index.html'))) throw new Error(`${DIST} missing: cd frontend && npm run build`);
+  const dir = mkdtempSync(join(tmpdir(), 'motiond-e2e-'));
+  const port = await freePort();
+  const api = `http://127.0.0.1:${port}`;
+  const ownUi = servesUi();
+  const args = ['serve', '--listen', `127.0.0.1:${port}`, '--db', join(dir, 'm.db')];
+  if (noDemo) args.push('--no-demo');
+  if (ownUi) args.push('--ui-dir', DIST);
+  const procs = [];
+  const startMotiond = async () => {
+    const p = spawnLogged(MOTIOND, args, { cwd: dir, env: { ...process.env, RUST_LOG: process.env.RUST_LOG ?? 'warn' } }, 'motiond');
+    procs.push(p);
+    await until(async () => (await fetch(`${api}/api/v1/system`)).ok, { what: 'motiond to answer', timeout: 30000 });
+    return p;
+  };
+  let motiond = null;
+  const stop = async () => {
+    for (const p of procs.reverse()) await stopProcess(p);
+    rmSync(dir, { recursive: true, force: true });
+  };
+  try {
+    motiond = await startMotiond();
+    let url = api;
+    if (!ownUi) {
+      const uiPort = await freePort();
+      const vite = spawnLogged(
+        process.execPath,
+        [join(FRONTEND, 'node_modules', 'vite', 'bin', 'vite.js'), 'preview', '--host', '127.0.0.1', '--port', String(uiPort), '--strictPort'],
+        { cwd: FRONTEND, env: { ...process.env, MOTIOND_URL: api } },
+        'vite preview',
+      );
+      procs.push(vite);
+      url = `http://127.0.0.1:${uiPort}`;
+      await until(async () => (await fetch(`${url}/`)).ok, { what: 'vite preview to answer', timeout: 30000 });
+    }
+    /** Stops motiond (the UI server stays when it is vite preview). */
+    const killMotiond = async () => {
+      await stopProcess(motiond);
+    };
+    /** Starts motiond again on the same port and database. */
+    const restartMotiond = async () => {
+      motiond = await startMotiond();
+    };
+    return { url, api, ownUi, stop, killMotiond, restartMotiond, logs: () => procs.map((p) => p.log()).join('\n') };
+  } catch (e) {
+    const logs = procs.map((p) => p.log()).join('\n');
+    await stop();
+    throw new Error(`${e.message}\n${logs}`);
+  }
+}
+
+/** Headless Debian Chromium with a fresh user-data-dir (never a downloaded browser). */
+export async function launch({ width = 1280, height = 800 } = {}) {
+  const profile = mkdtempSync(join(tmpdir(), 'motiond-e2e-chromium-'));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: CHROMIUM,
+    headless: true,
+    viewport: { width, height },
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+  const close = async () => {
+    await context.close().catch(() => {});
+    rmSync(profile, { recursive: true, force: true });
+  };
+  return { context, close };
+}
+
+export async function shot(page, name) {
+  mkdirSync(SHOTS, { recursive: true });
+  const path = join(SHOTS, `${name}.png`);
+  await page.screenshot({ path, fullPage: false });
+  return path;
+}
+
+/** REST helper against motiond. */
+export async function rest(api, method, path, body) {
+  const r = await fetch(`${api}/api/v1${path}`, {
+    method,
+    headers: body === undefined ? {} : { 'content-type': 'application/json' },
+    body: body === undefined ? undefined : JSON.stringify(body),
+  });
+  const text = await r.text();
+  let json = null;
+  try {
+    json = text ? JSON.parse(text) : null;
+  } catch {
+    json = text;
+  }
+  return { status: r.status, body: json };
+}
+
+export const status = async (api, axis) => (await rest(api, 'GET', `/axes/${axis}/status`)).body.status;
+
+/** A readout of the online tab as a number. */
+export async function readout(page, name) {
+  const t = await page.locator(`[data-readout="${name}"] .dro-value`).first().textContent();
+  return Number(t);
+}
