@@ -103,6 +103,13 @@ describe('samples and the time axis', () => {
     expect(t[9]).toBeCloseTo(0.006, 12);
   });
 
+  it("takes the server's pre_trigger_samples when t is missing", () => {
+    const r = recording(6, 0.002);
+    delete r.t;
+    r.pre_trigger_samples = 2;
+    expect(timeAxis(r)).toEqual([-0.004, -0.002, 0, 0.002, 0.004, 0.006]);
+  });
+
   it("uses the server's t when present", () => {
     const r = recording(4);
     r.t = [10, 11, 12, 13];
@@ -160,6 +167,11 @@ describe('cursors', () => {
     expect(o.rows[1].dv).toBe(0);
   });
 
+  it('a missing value (null) reads as no value', () => {
+    const o = cursorReadout([0, 1, 2], [[5, null, 7]], ['a'], 0, 1);
+    expect(o.rows[0]).toEqual({ label: 'a', v1: 5, v2: null, dv: null });
+  });
+
   it('one cursor alone has no differences', () => {
     const r = recording(10);
     const o = cursorReadout(r.t!, r.data!, ['a', 'b'], 0.004, null);
@@ -174,6 +186,11 @@ describe('CSV', () => {
     const r = recording(3);
     const csv = toCsv(r.t!, r.channels, r.data!);
     expect(csv).toBe('t,x.set_position,x.set_velocity\n0,0,100\n0.001,0.1,100\n0.002,0.2,100\n');
+  });
+
+  it('leaves a value empty where the axis was missing (null)', () => {
+    const csv = toCsv([0, 0.001], [{ axis: 'x', signal: 'set_position' }], [[1, null]]);
+    expect(csv).toBe('t,x.set_position\n0,1\n0.001,\n');
   });
 
   it('writes only the visible range when asked', () => {

@@ -227,6 +227,47 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
+  test('stop locks the axis until released; override; home with a chosen mode', async () => {
+    await enabled();
+    const page = await open(`/axes/${AXIS}`);
+    // override slider → set-override
+    await page.click('.override button:has-text("50")');
+    await until(async () => (await status(stack.api, AXIS)).override_percent === 50, { what: 'override 50 %' });
+    await page.click('.override button:has-text("100")');
+    await until(async () => (await status(stack.api, AXIS)).override_percent === 100, { what: 'override 100 %' });
+    // MC_Stop and its release
+    await page.click('[data-move="move-velocity"]');
+    await page.fill('input[name="velocity"]', '50');
+    await page.click('button[name="start"]');
+    await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'moving' });
+    await page.click('button[name="stop"]');
+    await page.waitForSelector('[data-led="Stop lock"][data-on="1"]', { timeout: 10000 });
+    // PLCopen: the axis stays in Stopping while the stop is held
+    await until(async () => {
+      const s = await status(stack.api, AXIS);
+      return s.set_velocity === 0 && s.state === 'stopping';
+    }, { what: 'stopped and locked' });
+    assert.equal(await page.locator('[data-testid="axis-state"]').textContent(), 'Stopping');
+    await page.click('[data-move="move-relative"]');
+    await page.fill('input[name="position"]', '10');
+    await page.click('button[name="start"]');
+    await page.waitForSelector('[data-testid="command-log"] tr[data-state="rejected"][data-command="move-relative"]');
+    await page.click('button[name="release-stop"]');
+    await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
+    assert.equal((await status(stack.api, AXIS)).motion_commands_locked, false);
+    await atRest();
+    // MC_Home, mode direct at 12.5
+    await page.selectOption('select[name="home-mode"]', 'direct');
+    await page.fill('input[name="home-position"]', '12.5');
+    await page.click('button[name="home-btn"]');
+    await page.waitForSelector('[data-led="Homed"][data-on="1"]', { timeout: 10000 });
+    const s = await status(stack.api, AXIS);
+    assert.ok(s.homed);
+    assert.ok(Math.abs(s.set_position - 12.5) < 1e-9, `homed at ${s.set_position}`);
+    await shot(page, 'online-homed');
+    await page.close();
+  });
+
   test('an axis in error is shown with its error text; reset clears it', async () => {
     await enabled();
     const f = await rest(stack.api, 'POST', `/axes/${AXIS}/simulation/fault`, { kind: 'drive_fault', code: 8976 });

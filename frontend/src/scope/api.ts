@@ -29,7 +29,7 @@ export async function waitForRecording(
   for (;;) {
     const r = await getRecording(id);
     onProgress(r);
-    if (r.state === 'done' || r.state === 'cancelled' || abort.aborted) return r;
+    if (r.state === 'done' || r.state === 'cancelled' || r.state === 'failed' || abort.aborted) return r;
     await new Promise((res) => setTimeout(res, intervalMs));
   }
 }

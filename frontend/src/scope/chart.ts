@@ -9,7 +9,7 @@ export interface ChartSeries {
   label: string;
   unit: string;
   scale: string;
-  values: ArrayLike<number>;
+  values: ArrayLike<number | null>;
 }
 
 export interface ChartCallbacks {

@@ -43,7 +43,7 @@ export interface RecordingRequest {
   trigger: TriggerSpec | null;
 }
 
-export type RecordingState = 'armed' | 'recording' | 'done' | 'cancelled';
+export type RecordingState = 'armed' | 'recording' | 'done' | 'cancelled' | 'failed';
 
 export interface Recording {
   id: number | string;
@@ -53,8 +53,15 @@ export interface Recording {
   samples: number;
   duration_s?: number;
   trigger?: TriggerSpec | null;
+  /** Samples before the trigger sample (t = 0). */
+  pre_trigger_samples?: number;
+  /** Samples per channel recorded so far (progress). */
+  samples_recorded?: number;
+  /** Why it failed or was cancelled. */
+  reason?: string;
   t?: number[];
-  data?: number[][];
+  /** Per channel, `samples` values; null where the axis was missing. */
+  data?: (number | null)[][];
   [k: string]: unknown;
 }
 
@@ -136,7 +143,7 @@ export function scaleKey(signal: Signal, unit: string): string {
 export function timeAxis(rec: Recording): number[] {
   if (rec.t && rec.t.length) return rec.t;
   const n = rec.data?.[0]?.length ?? rec.samples;
-  const pre = preTriggerSamples(rec.trigger, rec.cycle_time_s);
+  const pre = rec.pre_trigger_samples ?? preTriggerSamples(rec.trigger, rec.cycle_time_s);
   const t = new Array<number>(n);
   for (let i = 0; i < n; i++) t[i] = (i - pre) * rec.cycle_time_s;
   return t;
@@ -194,7 +201,7 @@ export interface CursorReadout {
 /** Readouts of two cursors (each snapped to the nearest sample): t, values, Δt, Δvalue. */
 export function cursorReadout(
   t: ArrayLike<number>,
-  data: ArrayLike<number>[],
+  data: ArrayLike<number | null>[],
   labels: string[],
   x1: number | null,
   x2: number | null,
@@ -211,8 +218,8 @@ export function cursorReadout(
     t2,
     dt: t1 !== null && t2 !== null ? t2 - t1 : null,
     rows: data.map((d, k) => {
-      const v1 = i1 === null || i1 < 0 ? null : d[i1];
-      const v2 = i2 === null || i2 < 0 ? null : d[i2];
+      const v1 = i1 === null || i1 < 0 ? null : (d[i1] ?? null);
+      const v2 = i2 === null || i2 < 0 ? null : (d[i2] ?? null);
       return { label: labels[k], v1, v2, dv: v1 !== null && v2 !== null ? v2 - v1 : null };
     }),
   };
@@ -222,7 +229,7 @@ export function cursorReadout(
 export function toCsv(
   t: ArrayLike<number>,
   channels: ChannelSpec[],
-  data: ArrayLike<number>[],
+  data: ArrayLike<number | null>[],
   range?: { from: number; to: number },
 ): string {
   const lo = range ? Math.max(0, indexAt(t, range.from)) : 0;
@@ -230,7 +237,7 @@ export function toCsv(
   const lines = [['t', ...channels.map(channelLabel)].join(',')];
   for (let i = lo; i <= hi; i++) {
     const row = [String(t[i])];
-    for (const d of data) row.push(String(d[i]));
+    for (const d of data) row.push(d[i] === null || d[i] === undefined ? '' : String(d[i]));
     lines.push(row.join(','));
   }
   return lines.join('\n') + '\n';

@@ -351,10 +351,10 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Field label={`Velocity (${u}/s)`} error={moveErrors.velocity} name="velocity">
                 <NumberInput name="velocity" value={velocity} onValue={setVelocity} />
               </Field>
-              <Field label={`Acceleration (${u}/s²)`} error={moveErrors.acceleration} hint="0 = axis default" name="acceleration">
+              <Field label={`Acc (${u}/s²)`} error={moveErrors.acceleration} hint="0 = axis default" name="acceleration">
                 <NumberInput name="acceleration" value={accel} onValue={setAccel} />
               </Field>
-              <Field label={`Deceleration (${u}/s²)`} error={moveErrors.deceleration} hint="0 = axis default" name="deceleration">
+              <Field label={`Dec (${u}/s²)`} error={moveErrors.deceleration} hint="0 = axis default" name="deceleration">
                 <NumberInput name="deceleration" value={decel} onValue={setDecel} />
               </Field>
               <Field label={`Jerk (${u}/s³)`} error={moveErrors.jerk} hint="0 = axis default" name="jerk">

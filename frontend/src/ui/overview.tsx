@@ -4,6 +4,8 @@ import { Lamp } from './common';
 import { pos, vel, STATE_LABEL } from '../format';
 import { errorInfo } from '../api/errors';
 import { href, navigate } from '../router';
+import { CommandLog } from './command-log';
+import { Panel } from './common';
 
 export function Overview() {
   const list = useStore(axes);
@@ -85,6 +87,9 @@ export function Overview() {
           )}
         </tbody>
       </table>
+      <Panel title="Recent commands (all axes)" class="overview-log">
+        <CommandLog limit={15} />
+      </Panel>
     </div>
   );
 }

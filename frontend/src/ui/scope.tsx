@@ -135,7 +135,7 @@ export function ScopePage() {
       if (done.state === 'done') {
         savedRecording = done;
         setRec(done);
-      } else if (!abort.current.aborted) setError(`recording ${done.state}`);
+      } else if (!abort.current.aborted) setError(`recording ${done.state}${done.reason ? `: ${done.reason}` : ''}`);
     } catch (e) {
       setRunning(null);
       setErrors(fieldsOf(e));
@@ -194,7 +194,9 @@ export function ScopePage() {
                 <button type="button" class="btn btn-small" title="remove this channel" onClick={() => setForm({ ...form, channels: form.channels.filter((_, j) => j !== i) })}>
                   ×
                 </button>
-                {errors[`channels[${i}].signal`] && <div class="field-error channel-error">{errors[`channels[${i}].signal`]}</div>}
+                {(errors[`channels[${i}].axis`] || errors[`channels[${i}].signal`]) && (
+                  <div class="field-error channel-error">{errors[`channels[${i}].axis`] ?? errors[`channels[${i}].signal`]}</div>
+                )}
               </div>
             ))}
           </div>
@@ -264,7 +266,9 @@ export function ScopePage() {
           </div>
           {running && (
             <div class="muted small" data-testid="recording-state">
-              {running.state === 'armed' ? 'armed: waiting for the trigger…' : `${running.state}…`}
+              {running.state === 'armed'
+                ? 'armed: waiting for the trigger…'
+                : `${running.state}… ${running.samples_recorded ?? 0} / ${running.samples} samples`}
             </div>
           )}
         </Panel>
