@@ -682,10 +682,12 @@ async fn openapi_json_is_current() {
         "/api/v1/config",
         "/metrics",
         "/api/v1/ws",
+        "/api/v1/scope/recordings",
+        "/api/v1/scope/recordings/{id}",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 34, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 36, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -18,6 +18,7 @@ use crate::cycle::{MAX_AXES, RealtimeGrant, Reply, Request, Shared, Snapshot};
 use crate::error::{ApiError, ApiResult};
 use crate::model::{AxisConfigDto, ClientInfo, CommandEventDto, CommandResource, CommandState};
 use crate::params::{self, ParamValue};
+use crate::scope::{NewRecording, Recordings, ScopeBusy, ScopeRecording};
 use crate::sim::{FieldError, SimDrive};
 use crate::store::{self, AuditEntry};
 
@@ -161,6 +162,8 @@ pub struct SystemInfo {
     pub db: String,
     pub realtime: RealtimeGrant,
     pub started: Instant,
+    /// Where the commissioning UI's built files are (`--ui-dir`).
+    pub ui_dir: std::path::PathBuf,
 }
 
 /// A status as a JSON object, shared by every websocket subscriber of that cycle.
@@ -182,6 +185,8 @@ pub struct AppState {
     audit_tx: mpsc::Sender<AuditEntry>,
     pub audit_dropped: AtomicU64,
     pub info: SystemInfo,
+    /// Scope recordings and the channel layout the cycle thread samples.
+    pub scope: Mutex<Recordings>,
 }
 
 impl AppState {
@@ -193,7 +198,9 @@ impl AppState {
         info: SystemInfo,
     ) -> (Arc<AppState>, mpsc::Receiver<AuditEntry>) {
         let (audit_tx, audit_rx) = mpsc::channel(8192);
+        let scope = Mutex::new(Recordings::new(info.cycle_time_s, shared.period_ns));
         let state = AppState {
+            scope,
             shared,
             snapshot: Mutex::new(snapshot),
             status_json: Mutex::new(vec![None; MAX_AXES]),
@@ -280,6 +287,17 @@ impl AppState {
         for e in audits {
             self.audit(e);
         }
+        {
+            let mut scope = self.scope.lock().unwrap();
+            scope.feed(std::iter::from_fn(|| self.shared.scope_frames.pop()));
+            if let Some(config) = scope.take_dirty() {
+                // Nobody waits for this reply (ticket 0); a full queue is retried next time.
+                let req = Request::ScopeConfig { ticket: 0, config };
+                if self.shared.requests.push(req).is_err() {
+                    scope.handover_failed();
+                }
+            }
+        }
         for n in notices {
             let _ = self.notices.send(Arc::new(n));
         }
@@ -315,6 +333,70 @@ impl AppState {
             Ok(Ok(r)) => Ok(r),
             _ => {
                 self.pending.lock().unwrap().remove(&ticket);
+                Err(ApiError::unavailable(
+                    "cycle_unavailable",
+                    "the cycle thread did not answer",
+                ))
+            }
+        }
+    }
+
+    /// Creates a scope recording: allocates its channels, hands the new sampling configuration
+    /// to the cycle thread and waits until it is in effect (the recording's first cycle).
+    pub async fn create_recording(&self, r: NewRecording) -> ApiResult<ScopeRecording> {
+        let ticket = self.next_id();
+        let (tx, rx) = oneshot::channel();
+        let id = {
+            let mut scope = self.scope.lock().unwrap();
+            let (id, config) = scope.create(r).map_err(|e| match e {
+                ScopeBusy::Channels { in_use, needed } => ApiError::conflict(
+                    "scope_channels_busy",
+                    format!(
+                        "the scope samples at most {} signals at once: {in_use} are in use by \
+                         active recordings and this one needs {needed} more; cancel one or \
+                         wait until it is done",
+                        crate::scope::SCOPE_CHANNELS
+                    ),
+                ),
+                ScopeBusy::Recordings => ApiError::conflict(
+                    "scope_busy",
+                    format!(
+                        "too many active recordings (at most {} recordings and {} values are \
+                         kept); cancel one or wait until it is done",
+                        crate::scope::MAX_RECORDINGS,
+                        crate::scope::MAX_VALUES
+                    ),
+                ),
+            })?;
+            // Pushed under the scope lock so that configurations reach the cycle thread in the
+            // order of their generations.
+            self.pending.lock().unwrap().insert(ticket, tx);
+            if self
+                .shared
+                .requests
+                .push(Request::ScopeConfig { ticket, config })
+                .is_err()
+            {
+                self.pending.lock().unwrap().remove(&ticket);
+                scope.abandon(id);
+                return Err(ApiError::unavailable(
+                    "command_queue_full",
+                    "the command queue to the cycle thread is full; try again",
+                ));
+            }
+            id
+        };
+        match tokio::time::timeout(VERDICT_TIMEOUT, rx).await {
+            Ok(Ok(reply)) => {
+                let mut scope = self.scope.lock().unwrap();
+                scope.started(id, reply.cycle);
+                scope.get(id, false).ok_or_else(|| {
+                    ApiError::unavailable("scope_unavailable", "the recording was evicted")
+                })
+            }
+            _ => {
+                self.pending.lock().unwrap().remove(&ticket);
+                self.scope.lock().unwrap().abandon(id);
                 Err(ApiError::unavailable(
                     "cycle_unavailable",
                     "the cycle thread did not answer",

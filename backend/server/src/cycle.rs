@@ -14,6 +14,7 @@ use motion::{
     EventSink, Kernel, Verdict,
 };
 
+use crate::scope::{SCOPE_RING, ScopeConfig, ScopeFrame};
 use crate::sim::{SimDrive, SimFault};
 use crate::stats::CycleStats;
 
@@ -48,6 +49,11 @@ pub enum Request {
         ticket: u64,
         slot: AxisSlot,
         fault: SimFault,
+    },
+    /// What the scope samples from the cycle this is drained in (see `scope.rs`).
+    ScopeConfig {
+        ticket: u64,
+        config: ScopeConfig,
     },
 }
 
@@ -89,6 +95,9 @@ pub struct Shared {
     pub replies: ArrayQueue<Reply>,
     pub events: ArrayQueue<CommandEvent>,
     pub garbage: ArrayQueue<Garbage>,
+    /// One frame per cycle while the scope samples something; a full ring drops the frame
+    /// (counted in `stats.scope_frames_dropped`).
+    pub scope_frames: ArrayQueue<ScopeFrame>,
     pub stats: CycleStats,
     pub cycle: AtomicU64,
     pub shutdown: AtomicBool,
@@ -102,6 +111,7 @@ impl Shared {
             replies: ArrayQueue::new(REPLY_QUEUE),
             events: ArrayQueue::new(EVENT_RING),
             garbage: ArrayQueue::new(4 * MAX_AXES + COMMAND_QUEUE),
+            scope_frames: ArrayQueue::new(SCOPE_RING),
             stats: CycleStats::default(),
             cycle: AtomicU64::new(0),
             shutdown: AtomicBool::new(false),
@@ -227,6 +237,8 @@ pub struct CycleThread {
     pub drives: Vec<Option<Box<SimDrive>>>,
     pub shared: Arc<Shared>,
     pub snapshot: triple_buffer::Input<Snapshot>,
+    /// What the scope samples (nothing by default: no frames are pushed then).
+    pub scope: ScopeConfig,
 }
 
 impl CycleThread {
@@ -240,6 +252,7 @@ impl CycleThread {
             drives: (0..MAX_AXES).map(|_| None).collect(),
             shared,
             snapshot,
+            scope: ScopeConfig::default(),
         }
     }
 
@@ -398,6 +411,14 @@ impl CycleThread {
                         result,
                     }
                 }
+                Request::ScopeConfig { ticket, config } => {
+                    self.scope = config;
+                    Reply {
+                        ticket,
+                        cycle,
+                        result: Ok(()),
+                    }
+                }
             };
             // The async side waits on every ticket; the reply queue is larger than the request
             // queue, so this only fails if the async side has stopped draining.
@@ -423,6 +444,12 @@ impl CycleThread {
         snap.cycle = cycle;
         for (i, s) in snap.axes.iter_mut().enumerate() {
             *s = self.kernel.status(i as AxisSlot);
+        }
+        if self.scope.is_active() {
+            let frame = ScopeFrame::sample(cycle, &self.scope, &snap.axes);
+            if shared.scope_frames.push(frame).is_err() {
+                shared.stats.scope_frames_dropped.fetch_add(1, Relaxed);
+            }
         }
         self.snapshot.publish();
         shared.cycle.store(cycle, Relaxed);

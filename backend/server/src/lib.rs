@@ -10,9 +10,11 @@ pub mod cycle;
 pub mod error;
 pub mod model;
 pub mod params;
+pub mod scope;
 pub mod sim;
 pub mod stats;
 pub mod store;
+pub mod ui;
 
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
@@ -61,6 +63,10 @@ pub struct ServeArgs {
     /// Do not create the demo axes on a new database.
     #[arg(long)]
     pub no_demo: bool,
+    /// The built commissioning UI, served at `/` [default: `frontend/dist` in the current
+    /// directory, else the one of the source tree motiond was built from].
+    #[arg(long, value_name = "PATH")]
+    pub ui_dir: Option<std::path::PathBuf>,
 }
 
 /// Entry point of the `motiond` binary.
@@ -208,7 +214,18 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         db: args.db.clone(),
         realtime,
         started: Instant::now(),
+        ui_dir: ui::resolve_dir(args.ui_dir.as_deref()),
     };
+    if ui::is_built(&info.ui_dir) {
+        tracing::info!("commissioning UI: {}", info.ui_dir.display());
+    } else {
+        tracing::warn!(
+            "commissioning UI not built (no index.html in {}): / shows how to build it \
+             (`{}`, or start motiond with ./scripts/run.sh)",
+            info.ui_dir.display(),
+            ui::BUILD_COMMAND
+        );
+    }
     let (state, audit_rx) = AppState::new(shared.clone(), output, db.clone(), first_id, info);
     tokio::spawn(app::pump(state.clone()));
     let audit_task = tokio::spawn(app::audit_writer(db.clone(), audit_rx));
@@ -219,7 +236,7 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", args.listen))?;
     let local = listener.local_addr().map_err(|e| e.to_string())?;
-    tracing::info!("listening on http://{local} (API /api/v1, docs /docs)");
+    tracing::info!("listening on http://{local} (UI /, API /api/v1, docs /docs)");
     let app = api::router(state.clone()).into_make_service_with_connect_info::<SocketAddr>();
     let (stopping_tx, mut stopping) = tokio::sync::watch::channel(false);
     let server = axum::serve(listener, app).with_graceful_shutdown(async move {

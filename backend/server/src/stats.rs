@@ -147,6 +147,8 @@ pub struct CycleStats {
     pub overruns: AtomicU64,
     pub events_dropped: AtomicU64,
     pub commands_drained: AtomicU64,
+    /// Scope frames lost because the scope ring was full (each fails the recordings running).
+    pub scope_frames_dropped: AtomicU64,
 }
 
 #[cfg(test)]

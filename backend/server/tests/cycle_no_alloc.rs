@@ -1,5 +1,5 @@
-//! The cycle thread's work (drain requests, step, publish) allocates nothing and frees nothing,
-//! including while commands and axis hand-overs arrive.
+//! The cycle thread's work (drain requests, step, publish, scope samples) allocates nothing and
+//! frees nothing, including while commands, axis hand-overs and scope configurations arrive.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -10,6 +10,7 @@ use motion::{
     Positioning,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
+use server::scope::{ScopeConfig, ScopeSignal};
 use server::sim::{SimDrive, SimDriveConfig, SimFault};
 
 struct Counting;
@@ -85,6 +86,20 @@ fn a_cycle_allocates_nothing() {
     }
     let mut total = 0;
     let mut id = 100;
+    let mut frames = Vec::with_capacity(4096);
+    let scope = |generation: u64, signals: &[(u16, ScopeSignal)]| {
+        let mut config = ScopeConfig {
+            generation,
+            ..Default::default()
+        };
+        for (c, s) in config.channels.iter_mut().zip(signals) {
+            *c = Some(*s);
+        }
+        Request::ScopeConfig {
+            ticket: 1000 + generation,
+            config,
+        }
+    };
     for i in 0..3000u64 {
         // Commands arrive now and then: power, moves back and forth, a replacement axis.
         match i {
@@ -160,9 +175,40 @@ fn a_cycle_allocates_nothing() {
                         .is_ok()
                 );
             }
+            // The scope samples from cycle 300 on, changes its channels at 1200, stops at 2600.
+            300 => assert!(
+                shared
+                    .requests
+                    .push(scope(
+                        1,
+                        &[(0, ScopeSignal::SetPosition), (0, ScopeSignal::SetVelocity)]
+                    ))
+                    .is_ok()
+            ),
+            1200 => assert!(
+                shared
+                    .requests
+                    .push(scope(
+                        2,
+                        &[
+                            (0, ScopeSignal::SetPosition),
+                            (1, ScopeSignal::FollowingError),
+                            (7, ScopeSignal::ActualPosition)
+                        ]
+                    ))
+                    .is_ok()
+            ),
+            2600 => assert!(shared.requests.push(scope(3, &[])).is_ok()),
             _ => {}
         }
         let ((), n) = counted(|| cycle.one_cycle(&mut fb, &mut sp));
+        while let Some(f) = shared.scope_frames.pop() {
+            // The frame is the status the snapshot of that cycle publishes.
+            let snap = output.read();
+            assert_eq!(f.cycle, snap.cycle);
+            assert_eq!(f.values[0], snap.axes[0].unwrap().set_position);
+            frames.push(f);
+        }
         total += n;
         // The async side drains (and frees) outside the counted region.
         while let Some(r) = shared.replies.pop() {
@@ -172,6 +218,27 @@ fn a_cycle_allocates_nothing() {
         while shared.garbage.pop().is_some() {}
     }
     assert_eq!(total, 0, "the cycle allocated or freed {total} times");
+    // One frame per cycle while the scope sampled (cycles 301 … 2600), none after.
+    assert_eq!(frames.len(), 2300);
+    assert!(frames.windows(2).all(|w| w[1].cycle == w[0].cycle + 1));
+    assert_eq!((frames[0].cycle, frames[0].generation), (301, 1));
+    let switch = frames.iter().position(|f| f.generation == 2).unwrap();
+    assert_eq!(frames[switch].cycle, 1201);
+    let f = frames[switch];
+    assert!(f.values[1].is_finite() && f.values[2].is_nan() && f.values[3].is_nan());
+    assert!(
+        frames[..switch]
+            .iter()
+            .all(|f| f.values[1].is_finite() && f.values[2].is_nan())
+    );
+    assert!(frames.iter().any(|f| f.values[0] != 0.0));
+    assert_eq!(
+        shared
+            .stats
+            .scope_frames_dropped
+            .load(std::sync::atomic::Ordering::Relaxed),
+        0
+    );
     let snap = output.read();
     assert_eq!(snap.cycle, 3000);
     // The injected drive fault reached axis 1 (and stays, no reset was sent).

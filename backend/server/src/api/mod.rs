@@ -4,6 +4,7 @@ pub mod audit;
 pub mod axes;
 pub mod commands;
 pub mod errors;
+pub mod scope;
 pub mod simulation;
 pub mod system;
 pub mod ws;
@@ -157,6 +158,14 @@ pub fn router(state: Arc<AppState>) -> Router {
             get(commands::get_command).delete(commands::release_command),
         )
         .route("/commands/{id}/keepalive", post(commands::keepalive))
+        .route(
+            "/scope/recordings",
+            get(scope::list_recordings).post(scope::create_recording),
+        )
+        .route(
+            "/scope/recordings/{id}",
+            get(scope::get_recording).delete(scope::delete_recording),
+        )
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
         .route("/config", get(axes::export_config).put(axes::import_config))
@@ -165,13 +174,13 @@ pub fn router(state: Arc<AppState>) -> Router {
     Router::new()
         .nest("/api/v1", api)
         .route("/metrics", get(system::metrics))
-        .route("/", get(system::index))
         .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::openapi()))
-        .fallback(not_found)
+        // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
+        .fallback(crate::ui::serve)
         .with_state(state)
 }
 
-async fn not_found(uri: axum::http::Uri) -> Response {
+pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
     ApiError::new(
         StatusCode::NOT_FOUND,
         "route_not_found",
@@ -201,6 +210,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         commands::move_superimposed, commands::abort_superposition,
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
         simulation::inject_fault,
+        scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     tags(
@@ -208,6 +218,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
         (name = "commands", description = "One endpoint per function block; command resources"),
         (name = "simulation", description = "Fault injection into the simulated drives"),
+        (name = "scope", description = "Recordings of axis signals at the cycle rate, optionally triggered"),
         (name = "system", description = "Version, cycle timing, metrics, configuration export/import, audit log"),
     )
 )]

@@ -1,4 +1,4 @@
-//! `GET /system`, `/metrics`, `/`.
+//! `GET /system`, `/metrics`.
 
 use std::fmt::Write;
 use std::sync::Arc;
@@ -7,7 +7,7 @@ use std::sync::atomic::Ordering::Relaxed;
 use axum::Json;
 use axum::extract::State;
 use axum::http::header;
-use axum::response::{Html, IntoResponse};
+use axum::response::IntoResponse;
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -31,6 +31,8 @@ pub struct Timing {
     pub events_dropped: u64,
     /// Audit entries lost because the audit queue was full.
     pub audit_dropped: u64,
+    /// Scope frames lost because the scope ring was full (the recordings running then failed).
+    pub scope_frames_dropped: u64,
 }
 
 #[derive(Clone, Debug, Serialize, ToSchema)]
@@ -72,6 +74,7 @@ pub fn system_resource(s: &AppState) -> SystemResource {
             overruns: st.overruns.load(Relaxed),
             events_dropped: st.events_dropped.load(Relaxed),
             audit_dropped: s.audit_dropped.load(Relaxed),
+            scope_frames_dropped: st.scope_frames_dropped.load(Relaxed),
         },
     }
 }
@@ -121,6 +124,11 @@ pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
             st.commands_drained.load(Relaxed),
         ),
         (
+            "motiond_scope_frames_dropped_total",
+            "Scope frames lost (scope ring full).",
+            st.scope_frames_dropped.load(Relaxed),
+        ),
+        (
             "motiond_audit_dropped_total",
             "Audit entries lost (queue full).",
             s.audit_dropped.load(Relaxed),
@@ -148,13 +156,4 @@ pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
         s.info.realtime.sched_fifo as u8
     );
     ([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], out)
-}
-
-pub async fn index() -> Html<&'static str> {
-    Html(concat!(
-        "<!doctype html><meta charset=utf-8><title>motiond</title>",
-        "<h1>motiond</h1><p>The commissioning UI is not built yet. ",
-        "API: <a href=/docs>Swagger UI</a>, <a href=/openapi.json>openapi.json</a>, ",
-        "<a href=/api/v1/axes>/api/v1/axes</a>, <a href=/api/v1/system>/api/v1/system</a>, <a href=/metrics>/metrics</a>.</p>"
-    ))
 }
