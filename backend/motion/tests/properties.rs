@@ -156,7 +156,12 @@ proptest! {
                 }
             }
         }
-        // Every command that is still busy belongs to something that can be running.
+        // Switching both axes off ends every command: nothing stays busy for ever.
+        for axis in 0..2u16 {
+            r.cmd(axis, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+        }
         r.run(0.5);
+        let busy = r.busy_commands();
+        prop_assert!(busy.is_empty(), "still busy after power off: {:?}", busy);
     }
 }

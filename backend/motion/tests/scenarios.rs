@@ -1016,8 +1016,10 @@ fn s11a_28_gear_out_in_motion_keeps_constant_velocity() {
     );
     r.run(1.0);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
+    // MC_GearIn ended with InGear once coupled; GearOut has nothing to abort.
+    assert!(r.out(g).in_gear && r.out(g).done && !r.out(g).busy);
     r.ok(1, CommandKind::GearOut);
-    assert!(r.out(g).command_aborted);
+    assert!(!r.out(g).command_aborted);
     assert_eq!(r.st(1).state, AxisState::ContinuousMotion);
     r.ok(
         0,
@@ -1807,4 +1809,397 @@ fn gear_coupling_to_the_masters_actual_values_with_parameter_1064() {
         (s.set_position - m.set_position).abs() > 1.0,
         "follows the set value"
     );
+}
+
+// ---------------------------------------------------------------- review regressions
+
+#[test]
+fn a_second_homing_run_never_uses_a_latch_left_from_an_aborted_one() {
+    let mut r = Rig::new(1);
+    r.plants[0].cam = Some((50.0, 55.0));
+    r.plants[0].index_period = Some(8.0);
+    r.power_on(0);
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(100.0),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(20.0, |r| r.st(0).homing_phase == HomingPhase::WaitLatch);
+    r.run(0.1); // latch armed; the next pulse (48) is not reached yet
+    let s = r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    );
+    assert!(r.out(h).command_aborted);
+    r.until(2.0, |r| r.out(s).done);
+    r.ok(0, CommandKind::Release { target: s });
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(200.0, 300.0)));
+    r.until(5.0, |r| r.out(m).done);
+    r.plants[0].cam = Some((250.0, 255.0));
+    let h2 = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(100.0),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(30.0, |r| !r.out(h2).busy);
+    assert!(r.out(h2).done);
+    r.run(0.01);
+    // Referenced to the pulse at 248 (below the new cam), not the stale one at 48.
+    let zero = r.plants[0].pos - (r.st(0).actual_position - 100.0);
+    assert!((zero - 248.0).abs() < 1e-9, "{zero}");
+}
+
+#[test]
+fn a_stop_whose_position_window_times_out_ends_with_the_error_and_unlocks() {
+    let mut p = params();
+    p.axis_in_target_timeout = 0.2;
+    p.axis_en_position_lag_monitoring = false;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.power_on(0);
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(0.3);
+    r.plants[0].load_lag = 0.5;
+    let s = r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions {
+                enable_stop_position_monitoring: true,
+                ..MoveOptions::default()
+            },
+        },
+    );
+    r.until(3.0, |r| !r.out(s).busy);
+    assert_eq!(r.out(s).error_id, ErrorId::IN_TARGET_TIMEOUT.0);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
+    assert!(!r.st(0).motion_commands_locked);
+}
+
+#[test]
+fn s11a_15_a_valid_blending_position_is_where_the_successor_takes_over() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    let mut m = mvb(200.0, 100.0, BufferMode::BlendingNext);
+    m.options.blending_position = Some(50.0);
+    let b = r.ok(0, CommandKind::MoveAbsolute(m));
+    assert!(!r.out(b).active);
+    r.until(3.0, |r| r.out(b).active);
+    let p = r.st(0).set_position;
+    assert!((50.0..51.0).contains(&p), "took over at {p}");
+    assert!(r.out(a).command_aborted);
+    // Behind an endless motion a blending position buffers too.
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    let here = r.st(0).set_position;
+    let mut m = mvb(here + 100.0, 50.0, BufferMode::BlendingLow);
+    m.options.blending_position = Some(here + 20.0);
+    let c = r.ok(0, CommandKind::MoveAbsolute(m));
+    assert!(r.out(v).busy && !r.out(c).active);
+    r.until(3.0, |r| r.out(c).active);
+    assert!(r.st(0).set_position >= here + 20.0);
+    r.until(5.0, |r| r.out(c).done);
+}
+
+#[test]
+fn halt_buffered_with_blending_previous_starts_its_ramp_at_the_original_target() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    let h = r.ok(
+        0,
+        CommandKind::Halt {
+            deceleration: 0.0,
+            jerk: 0.0,
+            buffer_mode: BufferMode::BlendingPrevious,
+            options: MoveOptions::default(),
+        },
+    );
+    r.until(5.0, |r| r.out(h).done);
+    let h_ = &r.history[0];
+    let at_target = h_.iter().find(|s| s.set_position >= 100.0).unwrap();
+    assert!(
+        at_target.set_velocity > 90.0,
+        "passed the target at {}",
+        at_target.set_velocity
+    );
+    assert!(
+        r.st(0).set_position > 100.0 + 1.0,
+        "stopped at {}",
+        r.st(0).set_position
+    );
+}
+
+#[test]
+fn override_applies_to_a_move_with_a_pending_blend() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
+    r.ok(
+        0,
+        CommandKind::MoveAbsolute(mvb(400.0, 200.0, BufferMode::BlendingPrevious)),
+    );
+    r.run(0.5);
+    r.ok(
+        0,
+        CommandKind::SetOverride {
+            velocity_factor: 0.1,
+        },
+    );
+    r.run(1.0);
+    assert!(
+        r.st(0).set_velocity <= 20.0 + 1e-9,
+        "{}",
+        r.st(0).set_velocity
+    );
+}
+
+#[test]
+fn s11a_17_move_additive_after_an_endless_motion_starts_from_the_set_position() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 300.0)));
+    r.until(3.0, |r| r.out(a).done);
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(1.0);
+    let h = r.ok(
+        0,
+        CommandKind::Halt {
+            deceleration: 0.0,
+            jerk: 0.0,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.until(3.0, |r| r.out(h).done);
+    let s = r.st(0).set_position;
+    r.ok(0, CommandKind::MoveAdditive(mv(50.0, 100.0)));
+    assert!((r.st(0).target_position - (s + 50.0)).abs() < 1e-9);
+}
+
+#[test]
+fn move_modulo_shortest_way_while_the_last_move_settles_is_a_start_from_standstill() {
+    let mut p = params();
+    p.axis_target_position_monitoring_time = 0.5; // a long settling phase
+    let mut r = Rig::with(vec![(true, p)]);
+    r.power_on(0);
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
+    r.until(3.0, |r| !r.st(0).moving && r.st(0).set_position == 10.0);
+    assert!(r.out(a).busy, "still settling");
+    r.ok(
+        0,
+        CommandKind::MoveModulo {
+            move_: mv(350.0, 100.0),
+            direction: Direction::ShortestWay,
+        },
+    );
+    assert!(
+        (r.st(0).target_position + 10.0).abs() < 1e-9,
+        "{}",
+        r.st(0).target_position
+    );
+}
+
+#[test]
+fn move_modulo_from_motion_refuses_reversal_and_respects_soft_limits() {
+    let mut p = params();
+    p.axis_en_max_soft_pos_limit = true;
+    p.axis_max_soft_pos_limit = 400.0;
+    let mut r = Rig::with(vec![(true, p)]);
+    r.power_on(0);
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 200.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.until(3.0, |r| r.st(0).set_position > 300.0);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::MoveModulo {
+                move_: mv(350.0, 200.0),
+                direction: Direction::Negative
+            }
+        ),
+        ErrorId::INVALID_MODE
+    );
+    // 350 lies within the braking distance: the next 350 is 710, beyond the limit 400.
+    let m = r.ok(
+        0,
+        CommandKind::MoveModulo {
+            move_: mv(310.0, 200.0),
+            direction: Direction::Positive,
+        },
+    );
+    r.until(3.0, |r| !r.out(m).busy);
+    assert_eq!(r.out(m).error_id, ErrorId::TARGET_ABOVE_SOFT_LIMIT.0);
+    r.until(3.0, |r| r.st(0).state == AxisState::Standstill);
+    assert!(r.st(0).set_position <= 400.0);
+}
+
+#[test]
+fn set_position_with_clear_lag_during_motion_clears_it_for_good() {
+    let mut p = params();
+    p.axis_en_position_lag_monitoring = false;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.power_on(0);
+    r.plants[0].tau = 0.05; // a drive that lags (2.5 mm at 50 mm/s)
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 50.0)));
+    r.run(0.5);
+    let before = r.st(0);
+    assert!(before.following_error > 1.0);
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 0.0,
+            relative: true,
+            clear_position_lag: true,
+        },
+    );
+    let after = r.st(0);
+    assert_eq!(after.set_position, after.actual_position);
+    r.step();
+    // The motion continues from the actual position (the next sample does not bring the old
+    // set position back).
+    let s = r.st(0);
+    assert!(
+        (s.set_position - after.actual_position).abs() < 0.2,
+        "{} vs {}",
+        s.set_position,
+        after.actual_position
+    );
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(m).done);
+}
+
+#[test]
+fn homing_stops_at_a_limit_switch_in_any_phase() {
+    let mut r = Rig::new(1);
+    r.plants[0].cam = Some((10.0, 15.0)); // a cam, but no index pulse ever comes
+    r.power_on(0);
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: None,
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(20.0, |r| r.st(0).homing_phase == HomingPhase::WaitLatch);
+    r.run(0.5);
+    r.plants[0].limit_negative = true;
+    r.until(3.0, |r| !r.out(h).busy);
+    assert_eq!(r.out(h).error_id, ErrorId::HOMING_FAILED.0);
+}
+
+#[test]
+fn reset_during_the_error_stop_ramp_waits_for_standstill() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 400.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(1.0);
+    r.plants[0].load_lag = 5.0;
+    r.until(1.0, |r| r.st(0).state == AxisState::ErrorStop);
+    r.plants[0].load_lag = 0.0;
+    assert!(r.st(0).moving);
+    let reset = r.ok(0, CommandKind::Reset);
+    assert!(r.out(reset).busy);
+    // The rig checks every cycle that the velocity does not jump.
+    r.until(2.0, |r| !r.out(reset).busy);
+    assert!(r.out(reset).done);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
+}
+
+#[test]
+fn repeated_fault_and_reset_rounds_can_always_be_re_enabled() {
+    let mut r = Rig::new(1);
+    r.plants[0].enable_delay_cycles = 300; // a slow drive (0.3 s)
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+        },
+    );
+    for _ in 0..5 {
+        r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+        r.plants[0].fault = true;
+        r.until(0.1, |r| r.st(0).state == AxisState::ErrorStop);
+        r.plants[0].fault = false;
+        r.ok(0, CommandKind::Reset);
+    }
+}
+
+#[test]
+fn move_continuous_with_end_velocity_zero_stays_busy_at_the_target() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    let c = r.ok(
+        0,
+        CommandKind::MoveContinuousAbsolute {
+            move_: mv(50.0, 100.0),
+            end_velocity: 0.0,
+        },
+    );
+    r.until(3.0, |r| r.out(c).in_end_velocity);
+    r.run(0.5);
+    let o = r.out(c);
+    assert!(o.busy && o.in_end_velocity && !o.done);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 100.0)));
+    let o = r.out(c);
+    assert!(o.command_aborted && !o.in_end_velocity, "{o:?}");
+    r.until(3.0, |r| r.out(m).done);
 }

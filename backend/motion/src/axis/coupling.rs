@@ -188,6 +188,7 @@ impl Axis {
     ) {
         let slot = self.slot;
         let use_actual = self.p().axis_couple_slave_to_actual_values;
+        self.abort_superposition(cycle, events);
         self.abort_all(cycle, events);
         self.coupling = Some(Coupling {
             master: master_slot,
@@ -209,6 +210,18 @@ impl Axis {
             ..j.out
         };
         j.emit(out, slot, cycle, events);
+        if dyn_command == 0 {
+            // MC_GearIn ends once coupled (Busy falls with InGear, manual §6.5.1); the
+            // coupling goes on without an owning command until GearOut or a new motion.
+            let out = FbOutputs {
+                busy: false,
+                active: false,
+                done: true,
+                ..j.out
+            };
+            j.emit(out, slot, cycle, events);
+            j.id = 0;
+        }
         self.job = Some(j);
     }
 }

@@ -23,7 +23,8 @@ impl Axis {
         }
         match mode {
             HomingMode::Direct => {
-                let shift = reference - self.set.position;
+                // Like MC_SetPosition absolute: the actual position becomes `reference`.
+                let shift = reference - self.act_pos;
                 self.shift_coordinates(shift);
                 if options.clear_position_lag {
                     self.set.position = self.act_pos;
@@ -132,8 +133,9 @@ impl Axis {
             self.set_has_superposition = false;
         }
         let stopped = self.planner.finished() && self.set.velocity.abs() <= EPS_V;
-        let limit_hit =
-            (h.search_dir > 0.0 && fb.limit_positive) || (h.search_dir < 0.0 && fb.limit_negative);
+        // A limit switch ahead ends the sequence in every phase (no reference without it).
+        let v = self.set.velocity;
+        let limit_hit = (v > EPS_V && fb.limit_positive) || (v < -EPS_V && fb.limit_negative);
         if let Some(e) = h.failed {
             if stopped {
                 job.home = HomeSeq {
@@ -151,19 +153,16 @@ impl Axis {
         match h.phase {
             HomingPhase::SearchCam => {
                 if drive_latch {
-                    self.latch = Some(
-                        if matches!(
-                            h.mode,
-                            ReferenceMode::HardwareLatchPos | ReferenceMode::SoftDriveLatchPos
-                        ) {
-                            LatchSource::CamRising
-                        } else {
-                            LatchSource::CamFalling
-                        },
-                    );
-                    if fb.latch_valid {
-                        h.latched = Some(fb.latch_position + self.offset);
-                        self.latch = None;
+                    let source = if matches!(
+                        h.mode,
+                        ReferenceMode::HardwareLatchPos | ReferenceMode::SoftDriveLatchPos
+                    ) {
+                        LatchSource::CamRising
+                    } else {
+                        LatchSource::CamFalling
+                    };
+                    if let Some(p) = self.poll_latch(source, fb) {
+                        h.latched = Some(p);
                         h.phase = HomingPhase::SetPosition;
                         replan = true;
                     }
@@ -176,9 +175,6 @@ impl Axis {
                         HomingPhase::StopOnCam
                     };
                     replan = true;
-                }
-                if limit_hit && h.phase == HomingPhase::SearchCam {
-                    fail = Some(ErrorId::HOMING_FAILED);
                 }
             }
             HomingPhase::StopOnCam => {
@@ -203,16 +199,15 @@ impl Axis {
                             replan = true;
                         }
                         _ => {
-                            self.latch = Some(LatchSource::IndexPulse);
+                            self.poll_latch(LatchSource::IndexPulse, fb);
                             h.phase = HomingPhase::WaitLatch;
                         }
                     }
                 }
             }
             HomingPhase::WaitLatch => {
-                if fb.latch_valid {
-                    h.latched = Some(fb.latch_position + self.offset);
-                    self.latch = None;
+                if let Some(p) = self.poll_latch(LatchSource::IndexPulse, fb) {
+                    h.latched = Some(p);
                     h.phase = HomingPhase::SetPosition;
                     replan = true;
                 }
@@ -237,6 +232,9 @@ impl Axis {
             }
             HomingPhase::Idle => {}
         }
+        if limit_hit && h.phase != HomingPhase::SetPosition {
+            fail = Some(ErrorId::HOMING_FAILED);
+        }
         if let Some(e) = fail {
             self.latch = None;
             h.failed = Some(e);
@@ -251,5 +249,21 @@ impl Axis {
         if replan {
             self.plan_job_now();
         }
+    }
+
+    /// Arms the drive's latch for `source` and returns the latched axis position once it
+    /// fired. Arms only in a cycle in which the drive shows no latch, so a latch left valid
+    /// from an earlier (aborted) run is never taken for this one: the drive drops it when it
+    /// sees `latch_enable` false for a cycle.
+    fn poll_latch(&mut self, source: LatchSource, fb: &DriveFeedback) -> Option<f64> {
+        if self.latch != Some(source) {
+            self.latch = if fb.latch_valid { None } else { Some(source) };
+            return None;
+        }
+        if fb.latch_valid {
+            self.latch = None;
+            return Some(fb.latch_position + self.offset);
+        }
+        None
     }
 }

@@ -152,6 +152,8 @@ struct Job {
     home: HomeSeq,
     /// Error to report when this (internal stop of a) job ends: dead-man, planning failure.
     pending_error: Option<ErrorId>,
+    /// Buffered with its own blending position: (position, direction of travel).
+    blend_at: Option<(f64, f64)>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -195,6 +197,7 @@ impl Job {
             modulo: None,
             home: HomeSeq::default(),
             pending_error: None,
+            blend_at: None,
         }
     }
 
@@ -310,8 +313,8 @@ fn ended(out: FbOutputs, end: End) -> FbOutputs {
         error: error != 0,
         error_id: error,
         in_velocity: out.in_velocity && ok,
-        in_gear: out.in_gear && error == 0,
-        in_end_velocity: out.in_end_velocity && error == 0,
+        in_gear: out.in_gear && ok,
+        in_end_velocity: out.in_end_velocity && ok,
         status: false,
         warning: out.warning && error == 0,
         warning_id: if error == 0 { out.warning_id } else { 0 },
@@ -399,6 +402,8 @@ pub struct Axis {
     next: Option<Job>,
     power: Option<Held>,
     stop: Option<Held>,
+    /// MC_Reset waiting for the error-stop ramp to end.
+    pending_reset: Option<Held>,
     enable: bool,
     enable_positive: bool,
     enable_negative: bool,
@@ -461,6 +466,7 @@ impl Axis {
             next: None,
             power: None,
             stop: None,
+            pending_reset: None,
             enable: false,
             enable_positive: false,
             enable_negative: false,
@@ -620,6 +626,29 @@ impl Axis {
                 Ok(())
             }
             CommandKind::Reset => {
+                if self.mode == Mode::ErrorStop && self.job.is_some() {
+                    // The axis is still on its error-stop ramp: the reset waits for standstill
+                    // (no velocity step with the drive enabled); a newer reset replaces it.
+                    if let Some(mut old) = self.pending_reset.take() {
+                        old.end(End::Aborted, slot, cycle, events);
+                    }
+                    let mut held = Held {
+                        id: cmd.id,
+                        out: FbOutputs::default(),
+                        released: false,
+                    };
+                    held.emit(
+                        FbOutputs {
+                            busy: true,
+                            ..FbOutputs::default()
+                        },
+                        slot,
+                        cycle,
+                        events,
+                    );
+                    self.pending_reset = Some(held);
+                    return Ok(());
+                }
                 self.reset(cycle, events);
                 emit_once(cmd.id, DONE, slot, cycle, events);
                 Ok(())
@@ -653,7 +682,16 @@ impl Axis {
                 self.shift_coordinates(shift);
                 self.set_position_offset += shift;
                 if clear_position_lag {
+                    // set = actual; a running motion continues from there (re-planned, or
+                    // the coupling re-based) so the next sample does not bring the lag back.
+                    let d = self.act_pos - self.set.position;
                     self.set.position = self.act_pos;
+                    self.sent_position = self.act_pos;
+                    if let Some(c) = self.coupling.as_mut() {
+                        c.slave_start += d;
+                    } else if self.job.is_some() {
+                        self.plan_job_now();
+                    }
                 }
                 emit_once(cmd.id, DONE, slot, cycle, events);
                 Ok(())
@@ -902,9 +940,23 @@ impl Axis {
         events: &mut impl EventSink,
     ) -> DriveSetpoint {
         let slot = self.slot;
+        if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
+            // A drive that reports no number is a faulty drive; keep the last good values.
+            let fb = DriveFeedback {
+                fault: true,
+                actual_position: self.act_pos - self.offset,
+                actual_velocity: 0.0,
+                ..*fb
+            };
+            return self.step(dt, &fb, master, cycle, events);
+        }
         self.act_pos = fb.actual_position + self.offset;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
+        if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {
+            // Whatever ended a homing run (stop, power off, error, reset) disarms its latch.
+            self.latch = None;
+        }
         self.act_vel = fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
@@ -939,7 +991,20 @@ impl Axis {
             self.step_soft_limits(dt, cycle, events);
             self.step_following_error(dt, cycle, events);
         }
+        if self.mode == Mode::ErrorStop && self.job.is_none() {
+            if let Some(mut r) = self.pending_reset.take() {
+                self.reset(cycle, events);
+                r.end(End::Done, self.slot, cycle, events);
+            }
+        }
         self.try_unlock(cycle, events);
+        // InTargetPosition's dwell counts cycles (not status updates: submits update too).
+        let lag = (self.act_pos - self.set.position).abs();
+        if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {
+            self.in_window_timer += dt;
+        } else {
+            self.in_window_timer = 0.0;
+        }
         self.update_status();
         self.sent_position = self.set.position;
         self.prev_cam = fb.reference_cam;
@@ -1007,12 +1072,6 @@ impl Axis {
         s.accelerating = s.moving && set.acceleration * set.velocity > 0.0;
         s.decelerating = s.moving && set.acceleration * set.velocity < 0.0;
         s.constant_velocity = s.moving && set.acceleration == 0.0;
-        let lag = (self.act_pos - set.position).abs();
-        if !s.moving && lag <= p.axis_target_position_window {
-            self.in_window_timer += self.cycle_time;
-        } else {
-            self.in_window_timer = 0.0;
-        }
         s.in_target_position = !s.moving
             && self.in_window_timer + 1e-12 >= p.axis_target_position_monitoring_time
             && state != AxisState::Disabled;

@@ -8,6 +8,7 @@ impl Axis {
     pub(super) fn disable(&mut self, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
         self.enable = false;
+        self.last_target = None;
         self.abort_superposition(cycle, events);
         self.abort_all(cycle, events);
         if let Some(mut s) = self.stop.take() {
@@ -38,6 +39,8 @@ impl Axis {
             // Otherwise the ramp ends in Standstill without the lock (see step_job).
         }
         if self.mode == Mode::ErrorStop {
+            self.last_target = None;
+            self.power_on_timer = 0.0;
             self.fault_reset = true;
             self.reset_grace = 3;
             self.error = ErrorId(0);
@@ -127,6 +130,8 @@ impl Axis {
             };
             self.mode = Mode::Enabled;
             self.lag_timer = 0.0;
+            self.power_on_timer = 0.0;
+            self.last_target = None;
         }
         if self.enable
             && !fb.enabled

@@ -135,8 +135,13 @@ impl Axis {
                     CommandKind::MoveModulo { direction, .. } => {
                         let period = self.period();
                         let tf = self.p().axis_modulo_tolerance_window;
-                        let from_standstill = self.state() == AxisState::Standstill
-                            || m.buffer_mode == BufferMode::Buffered;
+                        // At rest (also while a finished move still settles) it is a start
+                        // from standstill; behind a Buffered predecessor too.
+                        let at_rest = self.set.velocity.abs() <= EPS_V
+                            && self.set.acceleration.abs() <= EPS_V;
+                        let from_standstill = (at_rest && m.buffer_mode == BufferMode::Aborting)
+                            || m.buffer_mode == BufferMode::Buffered
+                            || self.state() == AxisState::Standstill;
                         // Validate now (errors are the command's verdict); moves from motion
                         // are resolved against the state at their start.
                         let end = modulo_end_position(
@@ -148,10 +153,16 @@ impl Axis {
                             from_standstill,
                         )?;
                         if !from_standstill {
-                            if direction == Direction::ShortestWay
-                                || direction == Direction::CurrentDirection
-                            {
-                                // Must not reverse: keep the direction of travel.
+                            // From motion the direction must not be reversed (spec §5.1.4);
+                            // shortest way keeps the direction of travel.
+                            let travel = sign(self.set.velocity);
+                            let reversed = match direction {
+                                Direction::Positive => travel < 0.0,
+                                Direction::Negative => travel > 0.0,
+                                _ => false,
+                            };
+                            if reversed {
+                                return Err(ErrorId::INVALID_MODE);
                             }
                             modulo = Some((m.position, direction));
                         }
@@ -309,44 +320,59 @@ impl Axis {
             _ => return Err(ErrorId::COMMAND_NOT_PERMITTED),
         }
 
-        // Blending position (optional): must lie before the previous target; already passed
-        // → the command acts at once (Aborting).
+        // Blending position (optional, §3.8): the successor takes over where the axis passes
+        // it, instead of at the previous target. It must lie before that target (0x4296);
+        // already passed → the command acts at once (Aborting). With an endless predecessor
+        // it is the only way to buffer behind it.
         let mut mode = job.buffer_mode;
+        let mut blend_at = None;
         if let Some(bp) = job.options.blending_position {
             if mode != BufferMode::Aborting {
                 if !bp.is_finite() {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
-                if let Some(prev) = self
-                    .predecessor()
-                    .filter(|p| p.is_positioning() && !p.is_endless())
-                {
-                    let dir = sign(prev.target - self.set.position);
-                    if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
-                        return Err(ErrorId::BLENDING_POSITION_INVALID);
-                    }
+                if let Some(prev) = self.predecessor() {
+                    let dir = if prev.is_positioning() && !prev.is_endless() {
+                        let dir = sign(prev.target - self.set.position);
+                        if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
+                            return Err(ErrorId::BLENDING_POSITION_INVALID);
+                        }
+                        dir
+                    } else if self.set.velocity.abs() > EPS_V {
+                        sign(self.set.velocity)
+                    } else {
+                        prev.direction
+                    };
                     if (self.set.position - bp) * dir >= 0.0 {
                         mode = BufferMode::Aborting;
+                    } else {
+                        blend_at = Some((bp, dir));
                     }
                 }
             }
         }
+        job.blend_at = blend_at;
 
-        // Buffer modes (§3.8): an endless job takes no successor; the queue holds one.
+        // Buffer modes (§3.8): an endless job takes no successor (unless it is to take over
+        // at a blending position); the queue holds one.
         let running_endless = self.job.as_ref().is_some_and(|j| j.is_endless())
             || self
                 .job
                 .as_ref()
                 .is_some_and(|j| j.kind == JobKind::Halt && j.id == 0);
-        if mode != BufferMode::Aborting && (self.job.is_none() || running_endless) {
+        if mode != BufferMode::Aborting
+            && (self.job.is_none() || (running_endless && blend_at.is_none()))
+        {
             mode = BufferMode::Aborting;
         }
         if mode != BufferMode::Aborting && self.next.is_some() {
             return Err(ErrorId::BUFFER_FULL);
         }
 
-        // Accepted from here on.
+        // Accepted from here on. A motion command decouples a slave (and with it ends a
+        // superposition on it, abort table row 6).
         if self.coupling.is_some() {
+            self.abort_superposition(cycle, events);
             self.coupling = None;
         }
         if job.is_positioning() {
@@ -407,9 +433,23 @@ impl Axis {
         let slot = self.slot;
         job.activate(slot, cycle, events);
         job.since_keepalive = 0;
-        self.in_window_timer = 0.0;
+        if job.kind != (JobKind::Positioning { continuous: false }) {
+            // MoveAdditive after an endless motion, a halt or a stop starts from the set
+            // position (spec §5.1.3).
+            self.last_target = None;
+        }
         self.job = Some(job);
-        self.resolve_modulo_from_motion();
+        if job.modulo.is_some() {
+            self.resolve_modulo_from_motion();
+            let target = self.job.map(|j| j.target).unwrap_or(self.set.position);
+            if let Err(e) = self.check_soft_limits(target) {
+                // The oriented stop would cross a software limit: stop safely, with the
+                // error, not at the position (spec §5.1.4).
+                self.stop_internally(e, false, cycle, events);
+                return;
+            }
+            self.last_target = Some(target);
+        }
         self.plan_job_now();
         self.prepare_blend(cycle, events);
     }
@@ -480,16 +520,11 @@ impl Axis {
                 if ovr <= 0.0 {
                     self.planner.plan_velocity(from, 0.0, &j.limits(1.0))
                 } else {
+                    // End velocity (continuous moves, blending) is kept before override.
+                    let end = j.end_velocity * ovr;
                     let mut lim = j.limits(ovr);
-                    if j.end_velocity.abs() > lim.velocity {
-                        lim.velocity = j.end_velocity.abs();
-                    }
-                    self.planner.plan_position(
-                        from,
-                        j.target,
-                        j.end_velocity * if j.is_endless() { ovr } else { 1.0 },
-                        &lim,
-                    )
+                    lim.velocity = lim.velocity.max(end.abs());
+                    self.planner.plan_position(from, j.target, end, &lim)
                 }
             }
             JobKind::Velocity | JobKind::JogHeld { released: false } => {
@@ -547,60 +582,82 @@ impl Axis {
         if !a.is_positioning() || a.is_endless() || a.phase != Phase::Moving {
             return;
         }
-        if b.kind == JobKind::Halt {
-            // Halt buffered with BlendingNext/Low may only strengthen the final ramp.
-            if matches!(
-                b.buffer_mode,
-                BufferMode::BlendingNext | BufferMode::BlendingLow
-            ) && b.dec > a.dec
-            {
-                let dec = b.dec;
-                if let Some(a) = self.job.as_mut() {
-                    a.dec = dec;
-                }
-                self.plan_job_now();
-            }
-            return;
+        if b.blend_at.is_some() {
+            return; // takes over at its own blending position (see step_job)
         }
-        if !b.buffer_mode.is_blending() {
-            return;
-        }
-        // Direction of the successor's travel from A's target.
-        let b_dir = match b.kind {
-            JobKind::Positioning { .. } => sign(b.target - a.target),
-            JobKind::Velocity | JobKind::JogHeld { .. } => b.direction,
-            _ => 0.0,
-        };
         let a_dir = sign(a.target - self.set.position);
-        if b_dir == 0.0 || a_dir == 0.0 || b_dir != a_dir {
-            return; // a reversal blends at rest, as Buffered
-        }
         let (v1, v2) = (a.velocity, b.velocity);
-        let vb = match b.buffer_mode {
-            BufferMode::BlendingLow => v1.min(v2),
-            BufferMode::BlendingPrevious => v1,
-            BufferMode::BlendingNext => v2,
-            BufferMode::BlendingHigh => v1.max(v2),
-            _ => 0.0,
-        } * ovr;
-        let from = self.set;
+        // Blending velocity at A's target, before override (A keeps it unscaled so that an
+        // override change re-plans it too).
+        let vb = if b.kind == JobKind::Halt {
+            match b.buffer_mode {
+                // Halt: travel on to the original target and start the stop ramp only there.
+                BufferMode::BlendingPrevious | BufferMode::BlendingHigh => v1,
+                // Halt: the target stays, only the stop ramp may get stronger.
+                BufferMode::BlendingNext | BufferMode::BlendingLow => {
+                    if b.dec > a.dec {
+                        let dec = b.dec;
+                        if let Some(a) = self.job.as_mut() {
+                            a.dec = dec;
+                        }
+                        self.plan_job_now();
+                    }
+                    return;
+                }
+                _ => return,
+            }
+        } else {
+            if !b.buffer_mode.is_blending() {
+                return;
+            }
+            // Direction of the successor's travel from A's target.
+            let b_dir = match b.kind {
+                JobKind::Positioning { .. } => sign(b.target - a.target),
+                JobKind::Velocity | JobKind::JogHeld { .. } => b.direction,
+                _ => 0.0,
+            };
+            if b_dir == 0.0 || a_dir == 0.0 || b_dir != a_dir {
+                return; // a reversal blends at rest, as Buffered
+            }
+            match b.buffer_mode {
+                BufferMode::BlendingLow => v1.min(v2),
+                BufferMode::BlendingPrevious => v1,
+                BufferMode::BlendingNext => v2,
+                BufferMode::BlendingHigh => v1.max(v2),
+                _ => 0.0,
+            }
+        };
+        if a_dir == 0.0 {
+            return;
+        }
+        let from = self.plan_origin();
         let target = a.target;
         let mut lim = a.limits(ovr);
-        lim.velocity = lim.velocity.max(vb);
+        lim.velocity = lim.velocity.max(vb * ovr);
         // Try the blending velocity; if it cannot be reached without overshooting the
         // target, pass the target as fast as we can brake to, else stop there.
-        for cand in [vb, from.velocity.abs().min(vb), 0.0] {
-            let ok = self
-                .planner
-                .plan_position(from, target, a_dir * cand, &lim)
-                .is_ok()
+        let now = if ovr > 0.0 {
+            from.velocity.abs() / ovr
+        } else {
+            0.0
+        };
+        for cand in [vb, now.min(vb), 0.0] {
+            let ok = ovr > 0.0
+                && self
+                    .planner
+                    .plan_position(from, target, a_dir * cand * ovr, &lim)
+                    .is_ok()
                 && !self.planner.overshoots(target, a_dir);
             if ok {
                 if let Some(a) = self.job.as_mut() {
                     a.end_velocity = a_dir * cand;
+                    a.planned_override = ovr;
                 }
                 return;
             }
+        }
+        if let Some(a) = self.job.as_mut() {
+            a.end_velocity = 0.0;
         }
         self.plan_job_now();
     }
@@ -748,6 +805,17 @@ impl Axis {
             self.set = k;
             self.set_has_superposition = false;
         }
+        // A successor with its own blending position takes over where the axis passes it.
+        if let Some((bp, dir)) = self.next.as_ref().and_then(|n| n.blend_at) {
+            if (self.set.position - bp) * dir >= 0.0 {
+                job.finish_aborted(slot, cycle, events);
+                self.job = None;
+                if let Some(n) = self.next.take() {
+                    self.start_job(n, cycle, events);
+                }
+                return;
+            }
+        }
         let finished = self.planner.finished();
 
         match job.kind {
@@ -775,14 +843,6 @@ impl Axis {
                         ..job.out
                     };
                     job.emit(out, slot, cycle, events);
-                    if job.end_velocity == 0.0 {
-                        // End velocity 0: the target is an end; done at rest.
-                        job.finish_done(slot, cycle, events);
-                        self.job = None;
-                        self.planner.clear();
-                        self.start_next(cycle, events);
-                        return;
-                    }
                 }
                 self.job = Some(job);
             }
@@ -856,6 +916,14 @@ impl Axis {
                         self.planner.clear();
                         if let Some(mut n) = self.next.take() {
                             n.finish_aborted(slot, cycle, events);
+                        }
+                        if self.mode == Mode::Stopping {
+                            // MC_Stop's own ramp missed its position window: the stop ends
+                            // with the error, and with it the lock.
+                            if let Some(mut s) = self.stop.take() {
+                                s.end(End::Error(e), slot, cycle, events);
+                            }
+                            self.mode = Mode::Enabled;
                         }
                     }
                 }

@@ -275,6 +275,15 @@ impl Rig {
         self.outputs.get(&id).copied().unwrap_or_default()
     }
 
+    /// Commands whose last outputs are still busy.
+    pub fn busy_commands(&self) -> Vec<(CommandId, FbOutputs)> {
+        self.outputs
+            .iter()
+            .filter(|(_, o)| o.busy)
+            .map(|(i, o)| (*i, *o))
+            .collect()
+    }
+
     pub fn st(&self, axis: u16) -> AxisStatus {
         self.k.status(axis).unwrap()
     }
@@ -354,6 +363,10 @@ impl Rig {
             assert!(
                 !(o.error && (o.in_velocity || o.in_gear || o.in_end_velocity)),
                 "success flag with error: {e:?}"
+            );
+            assert!(
+                !(o.command_aborted && (o.in_velocity || o.in_gear || o.in_end_velocity)),
+                "success flag with command_aborted: {e:?}"
             );
             assert_eq!(
                 o.error,
