@@ -368,6 +368,8 @@ describe('commissioning UI', () => {
     await atRest();
     const page = await open('/scope');
     // channels: e2e.set_position, e2e.set_velocity
+    await page.waitForSelector('[data-channel="0"]');
+    while ((await page.locator('[data-channel]').count()) < 2) await page.click('button[name="add-channel"]');
     await page.selectOption('select[name="channel-0-axis"]', AXIS);
     await page.selectOption('select[name="channel-0-signal"]', 'set_position');
     await page.selectOption('select[name="channel-1-axis"]', AXIS);
@@ -381,8 +383,21 @@ describe('commissioning UI', () => {
     await page.fill('input[name="trigger.pre_trigger_s"]', '0.1');
     await page.click('button[name="record"]');
     await page.waitForSelector('[data-testid="recording-state"]');
+    // the trigger looks only once the pre-trigger history is full
+    const armed = (await rest(stack.api, 'GET', '/scope/recordings')).body[0];
+    assert.equal(armed.state, 'armed');
+    await until(async () => (await rest(stack.api, 'GET', '/system')).body.cycle > armed.start_cycle + armed.pre_trigger_samples + 10, {
+      what: 'the pre-trigger history',
+    });
     await rest(stack.api, 'POST', `/axes/${AXIS}/move-absolute`, { position: 100, velocity: 400 });
-    const info = await page.locator('[data-testid="recording-info"]').textContent({ timeout: 30000 });
+    const info = await page
+      .locator('[data-testid="recording-info"]')
+      .textContent({ timeout: 30000 })
+      .catch(async (e) => {
+        await shot(page, 'scope-recording-failed');
+        const list = await rest(stack.api, 'GET', '/scope/recordings');
+        throw new Error(`${e.message}\nrecordings: ${JSON.stringify(list.body)}`);
+      });
     const cycle = (await rest(stack.api, 'GET', '/system')).body.cycle_time;
     const id = /recording (\S+)/.exec(info)[1];
     const rec = (await rest(stack.api, 'GET', `/scope/recordings/${id}`)).body;

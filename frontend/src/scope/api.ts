@@ -14,6 +14,16 @@ export async function scopeAvailable(): Promise<boolean> {
   }
 }
 
+/** The recordings the server keeps (newest first, without data); [] when it has no list. */
+export async function listRecordings(): Promise<Recording[]> {
+  try {
+    const l = await get<Recording[]>(RECORDINGS);
+    return Array.isArray(l) ? l : [];
+  } catch {
+    return [];
+  }
+}
+
 export const createRecording = (r: RecordingRequest) => post<Recording>(RECORDINGS, r);
 export const getRecording = (id: Recording['id']) => get<Recording>(`${RECORDINGS}/${enc(String(id))}`);
 export const cancelRecording = (id: Recording['id']) => del<unknown>(`${RECORDINGS}/${enc(String(id))}`);

@@ -32,6 +32,8 @@ export class ScopeChart {
     t: ArrayLike<number>,
     series: ChartSeries[],
     private readonly cb: ChartCallbacks,
+    /** Draw the trigger: a line at t = 0 and the level on the trigger channel's scale. */
+    private readonly trigger: { scale: string; level: number } | null = null,
   ) {
     const n = t.length;
     this.limits = { min: n ? t[0] : 0, max: n ? t[n - 1] : 1 };
@@ -197,6 +199,30 @@ export class ScopeChart {
       ctx.fillText(label, px + 4 * devicePixelRatio, top + 12 * devicePixelRatio);
       ctx.restore();
     };
+    if (this.trigger) {
+      const px = u.valToPos(0, 'x', true);
+      const py = u.valToPos(this.trigger.level, this.trigger.scale, true);
+      ctx.save();
+      ctx.strokeStyle = '#2b8a3e';
+      ctx.fillStyle = '#2b8a3e';
+      ctx.lineWidth = 1 * devicePixelRatio;
+      ctx.setLineDash([2 * devicePixelRatio, 3 * devicePixelRatio]);
+      if (px >= u.bbox.left && px <= u.bbox.left + u.bbox.width) {
+        ctx.beginPath();
+        ctx.moveTo(px, top);
+        ctx.lineTo(px, top + height);
+        ctx.stroke();
+        ctx.font = `${11 * devicePixelRatio}px system-ui, sans-serif`;
+        ctx.fillText('T', px + 3 * devicePixelRatio, top + height - 4 * devicePixelRatio);
+      }
+      if (Number.isFinite(py) && py >= top && py <= top + height) {
+        ctx.beginPath();
+        ctx.moveTo(u.bbox.left, py);
+        ctx.lineTo(u.bbox.left + u.bbox.width, py);
+        ctx.stroke();
+      }
+      ctx.restore();
+    }
     draw(this.c1, 'C1', '#111827');
     draw(this.c2, 'C2', '#b91c1c');
   }

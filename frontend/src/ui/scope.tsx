@@ -21,7 +21,7 @@ import {
   type ScopeForm,
   type Signal,
 } from '../scope/data';
-import { cancelRecording, createRecording, csvUrl, scopeAvailable, waitForRecording } from '../scope/api';
+import { cancelRecording, createRecording, csvUrl, getRecording, listRecordings, scopeAvailable, waitForRecording } from '../scope/api';
 import { COLORS, ScopeChart } from '../scope/chart';
 import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum } from './common';
 import { sig } from '../format';
@@ -44,16 +44,18 @@ export function ScopePage() {
   const sys = useStore(system);
   const unitOf = (axis: string) => list.find((a) => a.config.name === axis)?.config.unit ?? '';
   const [available, setAvailable] = useState<boolean | null>(null);
+  const defaultChannels = (): ScopeForm['channels'] =>
+    list.length
+      ? [
+          { axis: list[0].config.name, signal: 'set_position' },
+          { axis: list[0].config.name, signal: 'actual_position' },
+          { axis: list[0].config.name, signal: 'set_velocity' },
+        ]
+      : [];
   const [form, setForm] = useState<ScopeForm>(
     () =>
       savedForm ?? {
-        channels: list.length
-          ? [
-              { axis: list[0].config.name, signal: 'set_position' },
-              { axis: list[0].config.name, signal: 'actual_position' },
-              { axis: list[0].config.name, signal: 'set_velocity' },
-            ]
-          : [],
+        channels: defaultChannels(),
         duration_s: 2,
         trigger: { enabled: false, channel: 0, level: 0, edge: 'rising', pre_trigger_s: 0.2 },
       },
@@ -71,8 +73,13 @@ export function ScopePage() {
   const chartEl = useRef<HTMLDivElement>(null);
   const chart = useRef<ScopeChart | null>(null);
 
+  const [kept, setKept] = useState<Recording[]>([]);
+  const refreshKept = () => listRecordings().then(setKept);
   useEffect(() => {
-    scopeAvailable().then(setAvailable);
+    scopeAvailable().then((a) => {
+      setAvailable(a);
+      if (a) void refreshKept();
+    });
     return () => {
       abort.current.aborted = true;
     };
@@ -81,8 +88,9 @@ export function ScopePage() {
     savedForm = form;
   }, [form]);
   useEffect(() => {
-    if (form.channels.length === 0 && list.length) {
-      setForm({ ...form, channels: [{ axis: list[0].config.name, signal: 'set_position' }] });
+    // The axes arrive after the page: start with the first axis's positions and velocity.
+    if (form.channels.length === 0 && list.length && !savedForm?.channels.length) {
+      setForm({ ...form, channels: defaultChannels() });
     }
   }, [list]);
 
@@ -103,6 +111,9 @@ export function ScopePage() {
         return { label: channelLabel(c), unit, scale: scaleKey(c.signal as Signal, unitOf(c.axis)), values: rec.data![i] };
       }),
       { onCursors: (a, b) => setCursors([a, b]), onRange: (min, max) => setView({ min, max }) },
+      rec.trigger && rec.channels[rec.trigger.channel]
+        ? { scale: scaleKey(rec.channels[rec.trigger.channel].signal as Signal, unitOf(rec.channels[rec.trigger.channel].axis)), level: rec.trigger.level }
+        : null,
     );
     return () => {
       chart.current?.destroy();
@@ -132,6 +143,7 @@ export function ScopePage() {
       setRunning(created);
       const done = await waitForRecording(created.id, setRunning, abort.current);
       setRunning(null);
+      void refreshKept();
       if (done.state === 'done') {
         savedRecording = done;
         setRec(done);
@@ -293,6 +305,33 @@ export function ScopePage() {
               clear cursors
             </button>
             <span class="spacer" />
+            {kept.filter((r) => r.state === 'done').length > 0 && (
+              <select
+                name="recordings"
+                title="recordings kept by the server"
+                value={rec ? String(rec.id) : ''}
+                onChange={async (e) => {
+                  const id = (e.target as HTMLSelectElement).value;
+                  if (!id) return;
+                  try {
+                    const r = await getRecording(id);
+                    savedRecording = r;
+                    setRec(r);
+                  } catch (err) {
+                    setError(errorText(err));
+                  }
+                }}
+              >
+                <option value="">recordings…</option>
+                {kept
+                  .filter((r) => r.state === 'done')
+                  .map((r) => (
+                    <option value={String(r.id)}>
+                      #{String(r.id)} · {r.channels.map(channelLabel).join(', ')} · {r.duration_s ?? ''} s
+                    </option>
+                  ))}
+              </select>
+            )}
             {rec && (
               <>
                 <a class="btn btn-small" href={csvUrl(rec.id)} download={`scope-${rec.id}.csv`} data-testid="csv">
