@@ -422,4 +422,23 @@ describe('commissioning UI', () => {
     assert.match(csv.split('\n')[0], new RegExp(`^t,${AXIS}\\.set_position,${AXIS}\\.set_velocity`));
     await page.close();
   });
+  test('edit and delete the axis (it must be disabled first: the UI offers to do it)', async () => {
+    await enabled();
+    const page = await open(`/axes/${AXIS}/config`);
+    await page.fill('input[name="dynamics.jog_velocity_fast"]', '150');
+    await page.click('button[name="save"]');
+    await page.waitForSelector('button[name="disable-axis"]', { timeout: 10000 });
+    await page.click('button[name="disable-axis"]');
+    await until(async () => !(await status(stack.api, AXIS)).power_status, { what: 'axis disabled' });
+    await page.click('button[name="save"]');
+    await page.waitForSelector('.banner-ok', { timeout: 10000 });
+    assert.equal((await rest(stack.api, 'GET', `/axes/${AXIS}`)).body.config.dynamics.jog_velocity_fast, 150);
+    await shot(page, 'configuration-saved');
+    await page.click('button[name="delete"]');
+    await page.click('button[name="delete-confirm"]');
+    await page.waitForURL(/#\/$/, { timeout: 10000 });
+    assert.equal((await rest(stack.api, 'GET', `/axes/${AXIS}`)).status, 404);
+    await page.waitForSelector('text=No axes yet');
+    await page.close();
+  });
 });

@@ -85,6 +85,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
   const [applying, setApplying] = useState(false);
   const [error, setError] = useState<string | null>(null);
   const [message, setMessage] = useState<string | null>(null);
+  const [messageError, setMessageError] = useState(false);
   const [openHelp, setOpenHelp] = useState<number | null>(null);
   const [aliases, setAliases] = useState(false);
 
@@ -129,7 +130,12 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
     setApplying(false);
     setReview(false);
     const failed = Object.keys(errs).length;
-    setMessage(`${ok} parameter${ok === 1 ? '' : 's'} written${persistent ? ' persistently' : ''}${failed ? `, ${failed} refused (see the rows marked red)` : ''}.`);
+    const refused = changes
+      .filter((c) => errs[c.param.number])
+      .map((c) => `${c.param.name} (${errs[c.param.number]})`)
+      .join('; ');
+    setMessage(`${ok} parameter${ok === 1 ? '' : 's'} written${persistent ? ' persistently' : ''}.${failed ? ` Refused: ${refused}.` : ''}`);
+    setMessageError(failed > 0);
     // Aliases and dependent entries may have changed too.
     void load();
     void refreshAxes();
@@ -180,7 +186,11 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
         >
           Discard
         </button>
-        {message && <span class="msg" data-testid="apply-message">{message}</span>}
+        {message && (
+          <span class={`msg ${messageError ? 'text-error' : ''}`} data-testid="apply-message">
+            {message}
+          </span>
+        )}
       </div>
 
       {review && (
