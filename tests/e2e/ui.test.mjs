@@ -265,6 +265,23 @@ describe('commissioning UI', () => {
     assert.ok(s.homed);
     assert.ok(Math.abs(s.set_position - 12.5) < 1e-9, `homed at ${s.set_position}`);
     await shot(page, 'online-homed');
+    // inching: one step of the chosen increment per click
+    await page.fill('input[name="inch-step"]', '2.5');
+    await page.click('button[name="inch-forward"]');
+    await until(async () => {
+      const s = await status(stack.api, AXIS);
+      return s.in_target_position && Math.abs(s.set_position - 15) < 1e-9;
+    }, { what: 'one inching step forward' });
+    await page.click('button[name="inch-backward"]');
+    await until(async () => {
+      const s = await status(stack.api, AXIS);
+      return s.in_target_position && Math.abs(s.set_position - 12.5) < 1e-9;
+    }, { what: 'one inching step backward' });
+    // the following-error peak hold resets to the present value
+    await page.click('button[name="reset-peak"]');
+    await until(async () => /^-?0\.0000 \/ -?0\.0000$/.test((await page.locator('[data-readout="lag_peak"] .dro-value').textContent()).trim()), {
+      what: 'peak reset',
+    });
     await page.close();
   });
 
