@@ -465,6 +465,10 @@ impl AppState {
                 },
             )
             .await?;
+        if r.result.is_ok() {
+            // The pump hands the smaller sampling configuration over.
+            self.scope.lock().unwrap().axis_removed(slot);
+        }
         Ok(r.result)
     }
 

@@ -26,7 +26,7 @@ use clap::{Parser, Subcommand};
 use crate::app::{AppState, AxisEntry, SystemInfo};
 use crate::model::{AxisConfigDto, AxisDynamics, ModuloConfig, SoftLimits};
 use crate::params::ParamValue;
-use crate::sim::SimDriveConfig;
+use crate::sim::{LimitSwitches, SimDriveConfig};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -92,8 +92,11 @@ pub fn run() {
     }
 }
 
+/// The demo machine: two linear axes with limit switches just outside their travel (so that a
+/// homing search that misses the cam ends with homing_failed at a switch instead of running
+/// forever; the switches only report, they do not fault the drive) and a rotary spindle.
 pub fn demo_axes() -> Vec<AxisConfigDto> {
-    let linear = |name: &str, limits: Option<SoftLimits>| AxisConfigDto {
+    let linear = |name: &str, limits: Option<SoftLimits>, switches: (f64, f64)| AxisConfigDto {
         name: name.into(),
         unit: "mm".into(),
         modulo: None,
@@ -110,17 +113,27 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             "AxisTargetPositionWindow".to_string(),
             ParamValue::Number(0.01),
         )]),
-        drive: SimDriveConfig::default(),
+        drive: SimDriveConfig {
+            limit_switches: LimitSwitches {
+                negative: Some(switches.0),
+                positive: Some(switches.1),
+                fault_on_hit: false,
+            },
+            ..SimDriveConfig::default()
+        },
     };
     vec![
+        // Travel 0–1000 mm (software limits), switches 5 mm beyond.
         linear(
             "x",
             Some(SoftLimits {
                 min: 0.0,
                 max: 1000.0,
             }),
+            (-5.0, 1005.0),
         ),
-        linear("y", None),
+        // No software limits; travel ±1000 mm between the switches.
+        linear("y", None, (-1005.0, 1005.0)),
         AxisConfigDto {
             name: "spindle".into(),
             unit: "deg".into(),
@@ -217,7 +230,11 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         ui_dir: ui::resolve_dir(args.ui_dir.as_deref()),
     };
     if ui::is_built(&info.ui_dir) {
-        tracing::info!("commissioning UI: {}", info.ui_dir.display());
+        let dir = info.ui_dir.canonicalize();
+        tracing::info!(
+            "commissioning UI: {}",
+            dir.as_deref().unwrap_or(&info.ui_dir).display()
+        );
     } else {
         tracing::warn!(
             "commissioning UI not built (no index.html in {}): / shows how to build it \

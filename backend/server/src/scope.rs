@@ -642,6 +642,33 @@ impl Recordings {
         changed
     }
 
+    /// An axis left its slot: the active recordings of it fail (the slot may get another
+    /// axis). Returns true when the layout changed.
+    pub fn axis_removed(&mut self, slot: AxisSlot) -> bool {
+        let layout = self.layout;
+        let mut ended = Vec::new();
+        for r in self.recordings.values_mut() {
+            if !r.state.is_active() {
+                continue;
+            }
+            let hit = r
+                .index
+                .iter()
+                .zip(&r.channels)
+                .find(|(i, _)| layout[**i].is_some_and(|(s, _, _)| s == slot));
+            if let Some((_, c)) = hit {
+                let reason = format!("axis '{}' was removed during the recording", c.axis);
+                r.fail(reason);
+                ended.push(r.id);
+            }
+        }
+        let changed = !ended.is_empty();
+        for id in ended {
+            self.release(id);
+        }
+        changed
+    }
+
     /// Removes a recording that failed to start (its configuration never reached the cycle).
     pub fn abandon(&mut self, id: u64) {
         if self
@@ -864,6 +891,22 @@ mod tests {
         assert!(matches!(rs.delete(a), Some(None)));
         assert!(rs.get(a, false).is_none());
         assert!(rs.get(third, false).is_some());
+    }
+
+    #[test]
+    fn removing_an_axis_fails_its_active_recordings() {
+        let mut rs = Recordings::new(1e-3, DT_NS);
+        let (id, config) = rs.create(new(100, None, 0)).unwrap();
+        rs.feed((10..20).map(|c| frame(c, &config)));
+        assert!(!rs.axis_removed(3));
+        assert!(rs.axis_removed(0));
+        let r = rs.get(id, false).unwrap();
+        assert_eq!(r.state, RecordingState::Failed);
+        assert_eq!(
+            r.reason.as_deref(),
+            Some("axis 'x' was removed during the recording")
+        );
+        assert_eq!(rs.channels_in_use(), 0);
     }
 
     #[test]
