@@ -668,6 +668,30 @@ async fn openapi_json_is_current() {
         "openapi/openapi.json is stale: regenerate with `cargo run -- openapi > openapi/openapi.json` (or UPDATE_OPENAPI=1 cargo test --test api openapi)"
     );
     let doc: Value = serde_json::from_str(&generated).unwrap();
+    // Every $ref resolves (the frontend generates its API types from this document).
+    fn refs<'a>(v: &'a Value, out: &mut Vec<&'a str>) {
+        match v {
+            Value::Object(m) => {
+                if let Some(Value::String(r)) = m.get("$ref") {
+                    out.push(r);
+                }
+                m.values().for_each(|v| refs(v, out));
+            }
+            Value::Array(a) => a.iter().for_each(|v| refs(v, out)),
+            _ => {}
+        }
+    }
+    let mut all = Vec::new();
+    refs(&doc, &mut all);
+    for r in all {
+        let name = r
+            .strip_prefix("#/components/schemas/")
+            .unwrap_or_else(|| panic!("unexpected $ref {r}"));
+        assert!(
+            doc["components"]["schemas"].get(name).is_some(),
+            "$ref {r} does not resolve"
+        );
+    }
     let paths = doc["paths"].as_object().unwrap();
     for p in [
         "/api/v1/axes",

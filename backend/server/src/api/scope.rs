@@ -300,6 +300,7 @@ pub enum RecordingFormat {
 #[serde(deny_unknown_fields)]
 pub struct RecordingQuery {
     /// `json` (default) or `csv` (also chosen by `Accept: text/csv`).
+    #[param(inline)]
     pub format: Option<RecordingFormat>,
 }
 
