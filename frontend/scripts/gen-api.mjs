@@ -9,7 +9,7 @@ import openapiTS, { astToString } from 'openapi-typescript';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const root = resolve(here, '..');
-const openapiPath = resolve(root, '../openapi/openapi.json');
+const openapiPath = process.env.OPENAPI_JSON ? resolve(process.env.OPENAPI_JSON) : resolve(root, '../openapi/openapi.json');
 const errorsPath = resolve(root, '../docs/errors.md');
 const schemaOut = resolve(root, 'src/api/schema.d.ts');
 const errorsOut = resolve(root, 'src/api/errors.gen.ts');
@@ -64,7 +64,14 @@ function errorsText() {
     `export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text: string]> = [\n${body}\n];\n`;
 }
 
-const outputs = [[schemaOut, await schemaText()], [errorsOut, errorsText()]];
+let outputs;
+try {
+  outputs = [[schemaOut, await schemaText()], [errorsOut, errorsText()]];
+} catch (e) {
+  console.error(`gen-api: cannot generate the UI's API types from ${openapiPath}:\n  ${e.message}\n` +
+    'This is a defect of the OpenAPI document (e.g. a $ref to a schema that is not in components.schemas).');
+  process.exit(1);
+}
 let stale = 0;
 for (const [path, text] of outputs) {
   if (check) {

@@ -74,7 +74,8 @@ describe('recording request', () => {
     const trig = (t: Partial<ScopeForm['trigger']>) => buildRequest(form({ trigger: { enabled: true, channel: 0, level: 1, edge: 'rising', pre_trigger_s: 0.1, ...t } })).errors;
     expect(trig({ channel: 2 })['trigger.channel']).toBeTruthy();
     expect(trig({ pre_trigger_s: -1 })['trigger.pre_trigger_s']).toBeTruthy();
-    expect(trig({ pre_trigger_s: 3 })['trigger.pre_trigger_s']).toMatch(/shorter/);
+    expect(trig({ pre_trigger_s: 3 })['trigger.pre_trigger_s']).toMatch(/exceed/);
+    expect(trig({ pre_trigger_s: 2 })['trigger.pre_trigger_s']).toBeUndefined();
     expect(trig({ level: NaN })['trigger.level']).toBeTruthy();
   });
 });

@@ -539,6 +539,51 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/scope/recordings": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The recordings kept (newest first, without data) */
+        get: operations["list_recordings"];
+        put?: never;
+        /**
+         * Record signals at the cycle rate, now or on a trigger
+         * @description Samples up to 8 signals (set/actual position and velocity, set acceleration, following error) of one or more axes in every cycle for `duration_s`: `samples` = round(duration_s / cycle time), at most 600 000. Without a trigger the recording starts in the cycle the request takes effect in (`start_cycle`, state `recording`). With a trigger it is `armed`: it keeps `pre_trigger_s` of history and starts when `channels[trigger.channel]` crosses `level` (rising: previous < level ≤ sample; falling: previous > level ≥ sample). The trigger is only looked at once the full pre-trigger history is there. An unknown axis is a 422 naming `channels[i].axis`. Poll `GET /scope/recordings/{id}` until `state` is `done` (or `failed`: samples were lost, a recording never has gaps). All active recordings together sample at most 8 distinct signals; at most 8 recordings are kept (the oldest finished ones are dropped first) and at most 9 600 000 values.
+         */
+        post: operations["create_recording"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/scope/recordings/{id}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * A recording; with `t` and `data` once done, or as CSV
+         * @description JSON: the recording; when `done` also `t` (s, one per sample: relative to the trigger sample, negative before it, or to the first sample without a trigger) and `data` (per channel, exactly `samples` values, one per cycle). CSV (`?format=csv` or `Accept: text/csv`, only when done): header `t,<axis>.<signal>,…`, one row per sample.
+         */
+        get: operations["get_recording"];
+        put?: never;
+        post?: never;
+        /**
+         * Cancel an active recording, or delete a finished one
+         * @description An `armed` or `recording` recording is cancelled (200 with the recording, state `cancelled`; it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, `failed`) is deleted (204).
+         */
+        delete: operations["delete_recording"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/system": {
         parameters: {
             query?: never;
@@ -841,6 +886,15 @@ export interface components {
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
+        /** @description One signal of one axis. */
+        ChannelRequest: {
+            /**
+             * @description Axis id or name.
+             * @example x
+             */
+            axis: string;
+            signal: components["schemas"]["ScopeSignal"];
+        };
         /** @description Where a command came from. */
         ClientInfo: {
             /** @description Remote address. */
@@ -995,7 +1049,8 @@ export interface components {
             warning: boolean;
             /**
              * Format: int32
-             * @description 0x4243 with `warning`.
+             * @description With `warning`: 0x4243 (MoveSuperImposed done only in part) or 0x7061 (a jog's
+             *     dead-man fired; the jog then ends with that error at rest).
              */
             warning_id: number;
         };
@@ -1521,6 +1576,40 @@ export interface components {
             /** @description Why something was refused (empty when all was granted). */
             notes: string[];
         };
+        /**
+         * @description `POST /scope/recordings`.
+         * @example {
+         *       "channels": [
+         *         {
+         *           "axis": "x",
+         *           "signal": "set_position"
+         *         },
+         *         {
+         *           "axis": "x",
+         *           "signal": "set_velocity"
+         *         }
+         *       ],
+         *       "duration_s": 2,
+         *       "trigger": {
+         *         "channel": 0,
+         *         "edge": "rising",
+         *         "level": 100,
+         *         "pre_trigger_s": 0.2
+         *       }
+         *     }
+         */
+        RecordingRequest: {
+            /** @description 1 to 8 signals. */
+            channels: components["schemas"]["ChannelRequest"][];
+            /**
+             * Format: double
+             * @description Length of the recording (s): round(duration_s / cycle time) samples, at most 600 000.
+             */
+            duration_s: number;
+            trigger?: null | components["schemas"]["TriggerRequest"];
+        };
+        /** @enum {string} */
+        RecordingState: "armed" | "recording" | "done" | "cancelled" | "failed";
         /** @description Reference cam: active while `start ≤ actual position ≤ end`. */
         ReferenceCam: {
             /** Format: double */
@@ -1533,6 +1622,96 @@ export interface components {
          * @enum {string}
          */
         ReferenceMode: "default" | "plc_cam" | "hardware_sync" | "hardware_latch_pos" | "hardware_latch_neg" | "software_sync" | "soft_drive_latch_pos" | "soft_drive_latch_neg";
+        /** @description One channel of a recording, as resolved by the server. */
+        ScopeChannel: {
+            /**
+             * @description The axis's name (also when it was given by id).
+             * @example x
+             */
+            axis: string;
+            /** Format: int64 */
+            axis_id: number;
+            signal: components["schemas"]["ScopeSignal"];
+            /**
+             * @description Unit of the values (axis unit, unit/s, unit/s²).
+             * @example mm
+             */
+            unit: string;
+        };
+        /**
+         * @description A scope recording. `t` and `data` are only present in `GET /scope/recordings/{id}` of a
+         *     recording that is `done`.
+         */
+        ScopeRecording: {
+            /** Format: int64 */
+            id: number;
+            state: components["schemas"]["RecordingState"];
+            /** @description Why it failed or was cancelled. */
+            reason?: string | null;
+            /**
+             * Format: double
+             * @description One sample per cycle of this length (s).
+             * @example 0.001
+             */
+            cycle_time_s: number;
+            channels: components["schemas"]["ScopeChannel"][];
+            /**
+             * Format: double
+             * @description As requested.
+             */
+            duration_s: number;
+            trigger?: null | components["schemas"]["ScopeTrigger"];
+            /** @description Samples per channel when done: round(duration_s / cycle_time_s). */
+            samples: number;
+            /**
+             * @description Samples before the trigger sample: min(round(pre_trigger_s / cycle_time_s), samples − 1);
+             *     0 without a trigger.
+             */
+            pre_trigger_samples: number;
+            /** @description Samples per channel recorded so far (the pre-trigger history counts once triggered). */
+            samples_recorded: number;
+            /**
+             * Format: int64
+             * @description Cycle of the first sample. While armed: the cycle the pre-trigger history began in.
+             */
+            start_cycle: number;
+            /**
+             * Format: int64
+             * @description Cycle of the trigger sample (`t` = 0).
+             */
+            trigger_cycle?: number | null;
+            created_at: string;
+            finished_at?: string | null;
+            /**
+             * @description Seconds, one per sample: relative to the trigger sample (negative before it), or to the
+             *     first sample without a trigger.
+             */
+            t?: number[] | null;
+            /** @description Per channel, exactly `samples` values (null where the axis was missing from its slot). */
+            data?: number[][] | null;
+        };
+        /**
+         * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step).
+         * @enum {string}
+         */
+        ScopeSignal: "set_position" | "actual_position" | "set_velocity" | "actual_velocity" | "set_acceleration" | "following_error";
+        /** @description A trigger on one of the recording's channels. */
+        ScopeTrigger: {
+            /** @description Index into `channels`. */
+            channel: number;
+            /**
+             * Format: double
+             * @description Threshold in the channel's unit.
+             */
+            level: number;
+            /** @description Default `rising`. */
+            edge?: components["schemas"]["TriggerEdge"];
+            /**
+             * Format: double
+             * @description History kept before the trigger sample (s, 0 … duration_s; default 0).
+             */
+            pre_trigger_s?: number;
+        };
         /**
          * @description MC_SetOverride.
          * @example {
@@ -1777,6 +1956,33 @@ export interface components {
              * @description Audit entries lost because the audit queue was full.
              */
             audit_dropped: number;
+            /**
+             * Format: int64
+             * @description Scope frames lost because the scope ring was full (the recordings running then failed).
+             */
+            scope_frames_dropped: number;
+        };
+        /**
+         * @description Direction of a trigger crossing.
+         * @enum {string}
+         */
+        TriggerEdge: "rising" | "falling" | "either";
+        /** @description Start the recording when `channels[channel]` crosses `level` in the direction of `edge`. */
+        TriggerRequest: {
+            /** @description Index into `channels`. */
+            channel: number;
+            /** Format: double */
+            level: number;
+            /**
+             * @description `rising` (previous < level ≤ sample, the default), `falling` (previous > level ≥
+             *     sample) or `either`.
+             */
+            edge?: components["schemas"]["TriggerEdge"];
+            /**
+             * Format: double
+             * @description History before the trigger sample (s, 0 … duration_s, default 0).
+             */
+            pre_trigger_s?: number;
         };
         /**
          * @description Physical unit of a parameter, relative to the axis unit `u` (mm, °, …).
@@ -5859,6 +6065,270 @@ export interface operations {
                      *       "type": "urn:motiond:problem:storage_unavailable"
                      *     }
                      */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+        };
+    };
+    list_recordings: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Recordings */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeRecording"][];
+                };
+            };
+        };
+    };
+    create_recording: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["RecordingRequest"];
+            };
+        };
+        responses: {
+            /** @description Recording or armed */
+            201: {
+                headers: {
+                    /** @description /api/v1/scope/recordings/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeRecording"];
+                };
+            };
+            /** @description The body is not JSON. */
+            400: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /**
+             * @description The active recordings already use the scope's 8 signals (`scope_channels_busy`), or
+             *     8 recordings are active or their memory is used up (`scope_busy`).
+             */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "scope_channels_busy",
+                     *       "detail": "the scope samples at most 8 signals at once: 7 are in use by active recordings and this one needs 2 more; cancel one or wait until it is done",
+                     *       "status": 409,
+                     *       "title": "Conflict",
+                     *       "type": "urn:motiond:problem:scope_channels_busy"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /**
+             * @description Invalid request; `errors` names every invalid field (`channels[1].axis` for an
+             *     unknown axis, `trigger.pre_trigger_s` …).
+             */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "validation_failed",
+                     *       "detail": "channels[0].axis: no axis 'z'",
+                     *       "errors": [
+                     *         {
+                     *           "field": "channels[0].axis",
+                     *           "message": "no axis 'z'"
+                     *         }
+                     *       ],
+                     *       "status": 422,
+                     *       "title": "Invalid request",
+                     *       "type": "urn:motiond:problem:validation_failed"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /** @description The cycle thread is not available. */
+            503: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+        };
+    };
+    get_recording: {
+        parameters: {
+            query?: {
+                /** @description `json` (default) or `csv` (also chosen by `Accept: text/csv`). */
+                format?: "json" | "csv";
+            };
+            header?: never;
+            path: {
+                /** @description recording id */
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The recording */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeRecording"];
+                    /**
+                     * @example t,x.set_position,x.set_velocity
+                     *     0,0,0
+                     *     0.001,0.0000125,0.0375
+                     */
+                    "text/csv": string;
+                };
+            };
+            /** @description No such recording (never made, deleted, or evicted). */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "recording_not_found",
+                     *       "detail": "no recording '7'",
+                     *       "status": 404,
+                     *       "title": "Not found",
+                     *       "type": "urn:motiond:problem:recording_not_found"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /** @description CSV of a recording that is not done. */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "recording_not_done",
+                     *       "detail": "recording 7 is armed; CSV is available when it is done",
+                     *       "status": 409,
+                     *       "title": "Conflict",
+                     *       "type": "urn:motiond:problem:recording_not_done"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /** @description Unknown `format`. */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+        };
+    };
+    delete_recording: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description recording id */
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Cancelled */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeRecording"];
+                };
+            };
+            /** @description Deleted */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            /** @description No such recording (never made, deleted, or evicted). */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "recording_not_found",
+                     *       "detail": "no recording '7'",
+                     *       "status": 404,
+                     *       "title": "Not found",
+                     *       "type": "urn:motiond:problem:recording_not_found"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /** @description CSV of a recording that is not done. */
+            409: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "recording_not_done",
+                     *       "detail": "recording 7 is armed; CSV is available when it is done",
+                     *       "status": 409,
+                     *       "title": "Conflict",
+                     *       "type": "urn:motiond:problem:recording_not_done"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+            /** @description Unknown `format`. */
+            422: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
                     "application/problem+json": components["schemas"]["Problem"];
                 };
             };

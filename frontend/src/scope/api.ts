@@ -1,6 +1,9 @@
 // The scope recording endpoints (POST/GET/DELETE /api/v1/scope/recordings).
 import { del, get, post, enc } from '../api/rest';
-import type { Recording, RecordingRequest } from './data';
+import type { components } from '../api/schema';
+import type { RecordingRequest } from './data';
+
+type Recording = components['schemas']['ScopeRecording'];
 
 export const RECORDINGS = '/scope/recordings';
 

@@ -2,15 +2,12 @@
 // The server records every cycle into a ring (POST /api/v1/scope/recordings) and returns
 // `t` (seconds relative to the trigger, or to the start without one) and `data` per channel.
 
-export const SIGNALS = [
-  'set_position',
-  'actual_position',
-  'set_velocity',
-  'actual_velocity',
-  'set_acceleration',
-  'following_error',
-] as const;
-export type Signal = (typeof SIGNALS)[number];
+import type { components } from '../api/schema';
+
+type S = components['schemas'];
+
+/** The signals the server can record (generated from the OpenAPI document). */
+export type Signal = S['ScopeSignal'];
 
 export const SIGNAL_LABEL: Record<Signal, string> = {
   set_position: 'set position',
@@ -21,49 +18,35 @@ export const SIGNAL_LABEL: Record<Signal, string> = {
   following_error: 'following error',
 };
 
+export const SIGNALS = Object.keys(SIGNAL_LABEL) as Signal[];
+
 export const MAX_CHANNELS = 8;
 
-export type Edge = 'rising' | 'falling' | 'either';
+export type Edge = S['TriggerEdge'];
+export type RecordingRequest = S['RecordingRequest'];
+export type TriggerSpec = S['TriggerRequest'];
+export type RecordingState = S['RecordingState'];
 
 export interface ChannelSpec {
   axis: string;
   signal: Signal;
+  /** The signal's unit (the server names it in a recording). */
+  unit?: string;
 }
 
-export interface TriggerSpec {
-  channel: number;
-  level: number;
-  edge: Edge;
-  pre_trigger_s: number;
-}
+type Rec = S['ScopeRecording'];
 
-export interface RecordingRequest {
-  channels: ChannelSpec[];
-  duration_s: number;
-  trigger: TriggerSpec | null;
-}
-
-export type RecordingState = 'armed' | 'recording' | 'done' | 'cancelled' | 'failed';
-
-export interface Recording {
-  id: number | string;
-  state: RecordingState;
-  cycle_time_s: number;
-  channels: ChannelSpec[];
-  samples: number;
-  duration_s?: number;
-  trigger?: TriggerSpec | null;
-  /** Samples before the trigger sample (t = 0). */
-  pre_trigger_samples?: number;
-  /** Samples per channel recorded so far (progress). */
-  samples_recorded?: number;
-  /** Why it failed or was cancelled. */
-  reason?: string;
-  t?: number[];
-  /** Per channel, `samples` values; null where the axis was missing. */
-  data?: (number | null)[][];
-  [k: string]: unknown;
-}
+/**
+ * What this module needs of a recording: the server's `ScopeRecording` (fixtures in tests
+ * may leave out the bookkeeping fields). `data` holds null where an axis was missing.
+ */
+export type Recording = Pick<Rec, 'id' | 'state' | 'cycle_time_s' | 'samples'> &
+  Partial<Pick<Rec, 'duration_s' | 'pre_trigger_samples' | 'samples_recorded' | 'reason' | 'start_cycle' | 'trigger_cycle'>> & {
+    channels: ChannelSpec[];
+    trigger?: TriggerSpec | null;
+    t?: number[] | null;
+    data?: (number | null)[][] | null;
+  };
 
 /** Number of samples of a recording: one per cycle, duration / cycle time exactly. */
 export function expectedSamples(duration_s: number, cycle_time_s: number): number {
@@ -72,7 +55,7 @@ export function expectedSamples(duration_s: number, cycle_time_s: number): numbe
 
 /** Samples before the trigger. */
 export function preTriggerSamples(trigger: TriggerSpec | null | undefined, cycle_time_s: number): number {
-  return trigger ? Math.round(trigger.pre_trigger_s / cycle_time_s) : 0;
+  return trigger ? Math.round((trigger.pre_trigger_s ?? 0) / cycle_time_s) : 0;
 }
 
 export interface FormChannel {
@@ -104,7 +87,7 @@ export function buildRequest(f: ScopeForm): { request: RecordingRequest | null; 
     }
     if (!Number.isFinite(t.level)) errors['trigger.level'] = 'must be a number';
     if (!(Number.isFinite(t.pre_trigger_s) && t.pre_trigger_s >= 0)) errors['trigger.pre_trigger_s'] = 'must be ≥ 0';
-    else if (t.pre_trigger_s >= f.duration_s) errors['trigger.pre_trigger_s'] = 'must be shorter than the duration';
+    else if (t.pre_trigger_s > f.duration_s) errors['trigger.pre_trigger_s'] = 'must not exceed the duration';
     trigger = { channel: t.channel, level: t.level, edge: t.edge, pre_trigger_s: t.pre_trigger_s };
   }
   if (Object.keys(errors).length) return { request: null, errors };

@@ -107,7 +107,7 @@ export function ScopePage() {
       chartEl.current,
       t,
       rec.channels.map((c, i) => {
-        const unit = signalUnit(c.signal as Signal, unitOf(c.axis));
+        const unit = c.unit ?? signalUnit(c.signal as Signal, unitOf(c.axis));
         return { label: channelLabel(c), unit, scale: scaleKey(c.signal as Signal, unitOf(c.axis)), values: rec.data![i] };
       }),
       { onCursors: (a, b) => setCursors([a, b]), onRange: (min, max) => setView({ min, max }) },
@@ -314,7 +314,7 @@ export function ScopePage() {
                   const id = (e.target as HTMLSelectElement).value;
                   if (!id) return;
                   try {
-                    const r = await getRecording(id);
+                    const r = await getRecording(Number(id));
                     savedRecording = r;
                     setRec(r);
                   } catch (err) {
