@@ -25,7 +25,7 @@ if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
     exit 1
 fi
 command -v chromium >/dev/null 2>&1 || (apt-get update && apt-get install -y chromium)
-(cd frontend && npm ci --no-audit --no-fund && npm run check:api && npm run build && npm test)
+(cd frontend && npm ci --no-audit --no-fund && npm run check:api && npm run build && NO_COLOR=1 npm test)
 # The browser tests start target/debug/motiond (the workspace target/, whatever the caller's CARGO_TARGET_DIR).
 env -u CARGO_TARGET_DIR cargo build -p motiond 2>&1
 (cd tests/e2e && npm ci --no-audit --no-fund && env -u CARGO_TARGET_DIR npm test)

@@ -40,7 +40,10 @@ function wsUrl(): string {
 }
 
 export const live = new LiveClient({ url: wsUrl() });
-export const jog = new JogController(live);
+export const jog = new JogController(live, {
+  started: (r) => logCommand(r),
+  rejected: (axis, params, e) => logRejected(axis, 'jog', params, e),
+});
 export const axes = new Store<AxisResource[]>([]);
 export const axesLoaded = new Store<boolean>(false);
 export const statuses = new Store<Map<string, LiveStatus>>(new Map(), true);

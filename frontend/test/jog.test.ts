@@ -140,6 +140,24 @@ describe('JogController', () => {
     expect(t.of('keepalive').length).toBe(0);
   });
 
+  it('reports started and refused jogs for the command log, with the error number', async () => {
+    const t = new FakeTransport();
+    const started: unknown[] = [];
+    const rejected: unknown[][] = [];
+    const j = new JogController(t, { started: (r) => started.push(r), rejected: (...a) => rejected.push(a) });
+    j.press('x', 'forward', 'standard_slow');
+    t.of('jog')[0].resolve({ id: 5, final: false });
+    await flush();
+    expect(started).toEqual([{ id: 5, final: false }]);
+    j.release('button released');
+    j.press('x', 'forward', 'standard_fast');
+    const e = Object.assign(new Error('feed enable for this direction missing'), { problem: { error_id: 0x7020 } });
+    t.of('jog')[1].reject(e);
+    await flush();
+    expect(rejected).toEqual([['x', { direction: 'forward', mode: 'standard_fast', deadman_timeout: DEADMAN_S }, e]]);
+    expect(j.snapshot().error).toBe('feed enable for this direction missing (0x7020)');
+  });
+
   it('pressing another button releases the first jog', async () => {
     const t = new FakeTransport();
     const j = new JogController(t);

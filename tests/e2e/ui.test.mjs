@@ -227,9 +227,21 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
-  test('stop locks the axis until released; override; home with a chosen mode', async () => {
+  test('stop locks the axis until released; feed enables; override; home with a chosen mode', async () => {
     await enabled();
     const page = await open(`/axes/${AXIS}`);
+    // without the positive feed enable a forward jog is refused, with its error text
+    await page.uncheck('input[name="feed-positive"]');
+    await page.click('button[name="power-set"]');
+    await page.waitForSelector('[data-led="Feed +"][data-on="0"]', { timeout: 10000 });
+    await holdJog(page, 'slow-forward');
+    const refused = await page.locator('[data-jog-phase="idle"] .text-error').textContent({ timeout: 10000 });
+    await page.mouse.up();
+    assert.match(refused, /0x7020/);
+    await page.waitForSelector('[data-testid="command-log"] tr[data-state="rejected"][data-command="jog"]');
+    await page.check('input[name="feed-positive"]');
+    await page.click('button[name="power-set"]');
+    await page.waitForSelector('[data-led="Feed +"][data-on="1"]', { timeout: 10000 });
     // override slider → set-override
     await page.click('.override button:has-text("50")');
     await until(async () => (await status(stack.api, AXIS)).override_percent === 50, { what: 'override 50 %' });

@@ -2,13 +2,27 @@
 // jog's dead-man (keepalive every KEEPALIVE_MS); every way of letting go ends in release().
 // Should the browser die instead, the server stops the axis: it releases a socket's jogs
 // when the socket closes, and the dead-man (DEADMAN_S) fires when keepalives stop.
-import type { JogDirection, JogMode, CommandResource } from '../api/types';
+import type { JogDirection, JogMode, CommandResource, Problem } from '../api/types';
+import { hexId } from '../api/errors';
 
 export const KEEPALIVE_MS = 150;
 export const DEADMAN_S = 0.5;
 
 export interface JogTransport {
   call<R = unknown>(method: string, params: Record<string, unknown>): Promise<R>;
+}
+
+/** Where the controller reports jogs for the command log. */
+export interface JogLog {
+  started?(r: CommandResource): void;
+  rejected?(axis: string, params: Record<string, unknown>, e: unknown): void;
+}
+
+/** An error's text with the PLCopen error number when the server gave one. */
+function describe(e: unknown): string {
+  const p = (e as { problem?: Problem | null }).problem;
+  const msg = e instanceof Error ? e.message : String(e);
+  return p?.error_id ? `${msg} (${hexId(p.error_id)})` : msg;
 }
 
 export type JogPhase = 'idle' | 'starting' | 'held';
@@ -41,7 +55,10 @@ export class JogController {
   private lastEnd: string | null = null;
   private error: string | null = null;
 
-  constructor(private readonly t: JogTransport) {}
+  constructor(
+    private readonly t: JogTransport,
+    private readonly log: JogLog = {},
+  ) {}
 
   snapshot(): JogSnapshot {
     const h = this.hold;
@@ -83,9 +100,11 @@ export class JogController {
     this.error = null;
     this.lastEnd = null;
     this.changed();
+    const params = { direction, mode, deadman_timeout: DEADMAN_S, ...extra };
     this.t
-      .call<CommandResource>('jog', { axis, direction, mode, deadman_timeout: DEADMAN_S, ...extra })
+      .call<CommandResource>('jog', { axis, ...params })
       .then((r) => {
+        this.log.started?.(r);
         if (h.released) {
           // Let go before the server answered: release at once.
           this.t.call('release', { command: r.id }).catch(() => {});
@@ -98,9 +117,10 @@ export class JogController {
       })
       .catch((e: Error) => {
         clearInterval(h.timer);
+        this.log.rejected?.(axis, params, e);
         if (this.hold === h) {
           this.hold = null;
-          this.error = e.message;
+          this.error = describe(e);
           this.lastEnd = 'rejected';
           this.changed();
         }

@@ -71,8 +71,17 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const [feedPos, setFeedPos] = useState(true);
   const [feedNeg, setFeedNeg] = useState(true);
   const [override, setOverride] = useState<number | null>(null);
+  const seeded = useRef(false);
   useEffect(() => {
     if (override === null && s) setOverride(Math.round(s.override_percent));
+    // The enable checkboxes start as the axis is (all on for a disabled axis).
+    if (!seeded.current && s) {
+      seeded.current = true;
+      if (s.power_status) {
+        setFeedPos(s.enable_positive);
+        setFeedNeg(s.enable_negative);
+      }
+    }
   }, [s, override]);
   const overrideTimer = useRef<ReturnType<typeof setTimeout> | null>(null);
   const overrideSent = useRef<number | null>(null);
