@@ -54,6 +54,11 @@ pub struct AxisStatus {
     pub actual_velocity: f64,
     /// set − actual.
     pub following_error: f64,
+    /// Lowest and highest following error of any cycle since the peak was last reset
+    /// (TwinCAT's online "lag distance min/max"): tracked by the kernel every cycle, so a
+    /// peak between two status reads is never missed.
+    pub following_error_min: f64,
+    pub following_error_max: f64,
     /// Modulo set position in [0, period) (equal to set_position on linear axes).
     pub modulo_set_position: f64,
     pub modulo_actual_position: f64,

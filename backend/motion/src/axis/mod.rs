@@ -1006,6 +1006,11 @@ impl Axis {
             self.in_window_timer = 0.0;
         }
         self.update_status();
+        // The peak hold counts cycles only: a submit's status update sees the setpoint the
+        // drive has not answered yet. NaN feedback cannot stick (f64::min/max skip NaN).
+        let s = &mut self.status;
+        s.following_error_min = s.following_error_min.min(s.following_error);
+        s.following_error_max = s.following_error_max.max(s.following_error);
         self.sent_position = self.set.position;
         self.prev_cam = fb.reference_cam;
         let _ = slot;
@@ -1019,6 +1024,13 @@ impl Axis {
             latch_enable: self.latch.is_some(),
             latch_source: self.latch.unwrap_or_default(),
         }
+    }
+
+    /// Starts a new following-error peak hold from the present following error.
+    pub fn reset_following_error_peak(&mut self) {
+        let s = &mut self.status;
+        s.following_error_min = s.following_error;
+        s.following_error_max = s.following_error;
     }
 
     fn update_status(&mut self) {

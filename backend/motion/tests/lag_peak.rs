@@ -1,0 +1,40 @@
+//! The following-error peak hold (TwinCAT online "lag distance min/max"): kept by the kernel
+//! every cycle, so it equals the extremes of the per-cycle following error, and a reset starts
+//! it again from the present value without touching the motion.
+
+mod rig;
+
+use motion::*;
+use rig::*;
+
+#[test]
+fn the_peak_hold_is_the_extreme_of_every_cycle_and_restarts_on_reset() {
+    let mut r = Rig::new(1);
+    r.plants[0].tau = 0.004; // a lagging drive: following error while accelerating
+    r.power_on(0);
+    r.run(0.05);
+    r.k.reset_following_error_peak(0);
+    let from = r.history[0].len();
+    r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 200.0)));
+    r.run(0.4);
+    r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
+    r.run(1.5);
+    let lags: Vec<f64> = r.history[0][from..].iter().map(|s| s.following_error).collect();
+    let max = lags.iter().cloned().fold(f64::MIN, f64::max);
+    let min = lags.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(max > 0.1 && min < -0.1, "the move made no lag both ways: {min} {max}");
+    let st = r.st(0);
+    assert_eq!(st.following_error_max, max);
+    assert_eq!(st.following_error_min, min);
+    // the peaks are not where the move ended
+    assert!(st.following_error.abs() < 0.1 * max);
+
+    let before = r.st(0);
+    assert!(r.k.reset_following_error_peak(0));
+    let after = r.st(0);
+    assert_eq!(after.following_error_min, after.following_error);
+    assert_eq!(after.following_error_max, after.following_error);
+    assert_eq!(after.set_position, before.set_position);
+    assert_eq!(after.state, before.state);
+    assert!(!r.k.reset_following_error_peak(5), "no axis in slot 5");
+}
