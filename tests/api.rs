@@ -708,10 +708,11 @@ async fn openapi_json_is_current() {
         "/api/v1/ws",
         "/api/v1/scope/recordings",
         "/api/v1/scope/recordings/{id}",
+        "/api/v1/axes/{axis}/status/following-error-peak/reset",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 36, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 37, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -934,10 +935,10 @@ async fn gear_in_dyn_couples_y_to_x_and_a_second_call_changes_the_ratio() {
     assert_eq!(g1.status, 202, "{}", g1.text);
     assert_eq!(g1.json["outputs"]["in_gear"], true, "{}", g1.text);
     assert_eq!(g1.json["final"], false, "an enabled gear-in-dyn stays busy");
-    let x_slot = get(&s, "/api/v1/axes/x").await.json["slot"].clone();
     let st = status(&s, "y").await["status"].clone();
     assert_eq!(st["state"], "synchronized_motion", "{st}");
-    assert_eq!(st["master"], x_slot, "{st}");
+    // The master by its name (a kernel slot means nothing to a client).
+    assert_eq!(st["master"], "x", "{st}");
 
     let mv = post(
         &s,
@@ -1196,4 +1197,67 @@ async fn the_audit_log_shows_changes_and_motion_commands_with_their_client() {
             "validation_failed",
         );
     }
+}
+
+/// The following-error peak hold is kept by the kernel every cycle: after a move the held
+/// peaks are larger than the following error at rest, and a reset restarts them from there.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_following_error_peak_hold_is_kept_every_cycle_and_resets() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let st = status(&s, "x").await["status"].clone();
+    assert_eq!(st["master"], Value::Null, "{st}");
+    let mv = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 300.0, "velocity": 500.0}),
+    )
+    .await;
+    assert_eq!(mv.json["state"], "done", "{}", mv.text);
+    let st = status(&s, "x").await["status"].clone();
+    let f = |k: &str| st[k].as_f64().unwrap_or_else(|| panic!("{k}: {st}"));
+    let (min, max, now) = (
+        f("following_error_min"),
+        f("following_error_max"),
+        f("following_error"),
+    );
+    assert!(max > 1e-3 && min < -1e-3, "the move lagged both ways: {st}");
+    assert!(min <= now && now <= max, "{st}");
+    assert!(
+        now.abs() < 0.5 * max,
+        "at rest the lag is below its peak: {st}"
+    );
+
+    let r = post(
+        &s,
+        "/api/v1/axes/x/status/following-error-peak/reset",
+        json!({}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let from = r.json["cycle"].as_u64().unwrap();
+    let after = loop {
+        let v = status(&s, "x").await;
+        if v["cycle"].as_u64().unwrap() >= from {
+            break v["status"].clone();
+        }
+    };
+    let g = |k: &str| after[k].as_f64().unwrap();
+    assert!(
+        g("following_error_max") - g("following_error_min") < 1e-3,
+        "{after}"
+    );
+    assert!(g("following_error_max") < max, "{after}");
+    assert_eq!(
+        after["set_position"], 300.0,
+        "the reset moves nothing: {after}"
+    );
+    assert_eq!(after["state"], "standstill", "{after}");
+    let r = post(
+        &s,
+        "/api/v1/axes/nobody/status/following-error-peak/reset",
+        json!({}),
+    )
+    .await;
+    assert_problem(&r, 404, "axis_not_found");
 }

@@ -215,28 +215,58 @@ async fn rpc_errors_and_unsubscribe() {
     assert!(next(&mut ws, Duration::from_millis(300)).await.is_none());
 }
 
+async fn socket_jog(ws: &mut Ws, rpc: u64) -> u64 {
+    let params = json!({"axis": "y", "direction": "forward", "deadman_timeout": 0.3});
+    send(ws, rpc, "jog", params).await;
+    let (r, _) = response(ws, rpc).await;
+    assert!(r["error"].is_null(), "{r}");
+    r["result"]["id"].as_u64().unwrap()
+}
+
+/// A socket jog runs while the client renews it (keepalives on the socket), stops by its
+/// dead-man when the client falls silent with the socket still open (a frozen page), and is
+/// released at once when the socket closes.
 #[tokio::test(flavor = "multi_thread")]
-async fn a_jog_sent_over_the_socket_is_held_while_open_and_released_when_it_closes() {
+async fn a_socket_jog_runs_while_renewed_stops_when_its_client_falls_silent_and_is_released_on_close()
+ {
+    const DEADMAN_TIMEOUT: u64 = 0x7061;
     let s = Server::start();
     power_on(&s, "y").await;
+    // Renewed every 100 ms for 1.2 s (four dead-man times): still running.
     let mut ws = connect(&s).await;
-    send(
-        &mut ws,
-        1,
-        "jog",
-        json!({"axis": "y", "direction": "forward", "deadman_timeout": 0.3}),
-    )
-    .await;
-    let (r, _) = response(&mut ws, 1).await;
-    assert!(r["error"].is_null(), "{r}");
-    let id = r["result"]["id"].as_u64().unwrap();
-    tokio::time::sleep(Duration::from_millis(1200)).await;
+    let id = socket_jog(&mut ws, 1).await;
+    for k in 0..12u64 {
+        send(&mut ws, 10 + k, "keepalive", json!({"command": id})).await;
+        let (r, _) = response(&mut ws, 10 + k).await;
+        assert!(r["error"].is_null(), "{r}");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
     let c = get(&s, &format!("/api/v1/commands/{id}")).await;
     assert_eq!(
         c.json["final"], false,
-        "jog on an open socket stopped: {}",
+        "renewed socket jog stopped: {}",
         c.text
     );
+    assert_eq!(c.json["outputs"]["warning_id"], 0, "{}", c.text);
+
+    // Silent with the socket open: the dead-man stops it, the socket does not renew it.
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "error", "{fin}");
+    assert_eq!(
+        fin["outputs"]["error_id"].as_u64(),
+        Some(DEADMAN_TIMEOUT),
+        "{fin}"
+    );
+    let t0 = std::time::Instant::now();
+    while status(&s, "y").await["status"]["moving"] != false {
+        assert!(t0.elapsed() < Duration::from_secs(10), "y still moving");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+
+    // A renewed jog whose socket closes is released: done, not a dead-man error.
+    let id = socket_jog(&mut ws, 2).await;
+    send(&mut ws, 30, "keepalive", json!({"command": id})).await;
+    response(&mut ws, 30).await;
     drop(ws);
     let fin = until_final(&s, id, 10).await;
     assert_eq!(fin["state"], "done", "{fin}");
@@ -255,7 +285,7 @@ async fn a_jog_whose_keepalives_stop_halts_within_deadman_plus_one_cycle() {
     response(&mut ws, 1).await;
     let deadman: f64 = 0.3;
     let deadman_cycles = (deadman / 0.001).round() as u64;
-    // A REST jog: the socket does not renew it by itself, only the keepalives below do.
+    // A REST jog renewed over the socket: only the keepalives below renew it.
     let jog = post(
         &s,
         "/api/v1/axes/y/jog",

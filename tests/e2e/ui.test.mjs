@@ -165,7 +165,6 @@ describe('commissioning UI', () => {
 
   test(
     'a frozen page (script hung, socket still open): the dead-man stops the jog',
-    { todo: 'motiond renews a socket’s jogs itself every 100 ms while the socket is open (backend/server/src/api/ws.rs renew_jogs), so a hung page keeps the axis moving; needs renewal driven by the client’s keepalives' },
     async () => {
       await enabled();
       const page = await open(`/axes/${AXIS}`);

@@ -92,7 +92,9 @@ pub struct AxisStatus {
     pub soft_limit_min_exceeded: bool,
     pub soft_limit_max_exceeded: bool,
     pub coupled: bool,
-    /// Slot of the master while coupled.
+    /// Slot of the master while coupled. A kernel slot means nothing to API clients: the
+    /// server names the master axis instead, so the slot is not serialised.
+    #[serde(skip)]
     pub master: Option<u16>,
     pub gear_ratio: f64,
     /// A superposition (MC_MoveSuperImposed) is running (StateDWord bit 13 Compensating).

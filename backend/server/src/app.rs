@@ -229,6 +229,15 @@ impl AppState {
         (s.cycle, s.axes.get(slot as usize).copied().flatten())
     }
 
+    /// A kernel status as the API shows it: the master named by its axis, not its slot.
+    pub fn status_view(&self, status: AxisStatus) -> crate::model::LiveStatus {
+        let master = status.master.and_then(|slot| {
+            let reg = self.registry.read().unwrap();
+            reg.by_slot(slot).map(|e| e.name.clone())
+        });
+        crate::model::LiveStatus { status, master }
+    }
+
     /// The latest status of a slot as JSON, serialised once per cycle whoever asks.
     pub fn status_json(&self, slot: AxisSlot) -> Option<(u64, StatusJson)> {
         let (cycle, status) = self.status(slot);
@@ -240,7 +249,8 @@ impl AppState {
                 return Some((cycle, j.clone()));
             }
         }
-        let serde_json::Value::Object(map) = serde_json::to_value(status).ok()? else {
+        let view = self.status_view(status);
+        let serde_json::Value::Object(map) = serde_json::to_value(view).ok()? else {
             return None;
         };
         let j = Arc::new(map);
@@ -504,17 +514,27 @@ impl AppState {
         slot: AxisSlot,
         fault: crate::sim::SimFault,
     ) -> ApiResult<Result<u64, ErrorId>> {
+        self.ticketed(|ticket| Request::InjectFault {
+            ticket,
+            slot,
+            fault,
+        })
+        .await
+    }
+
+    /// Restarts the following-error peak hold of a slot; the cycle it counts from.
+    pub async fn reset_following_error_peak(
+        &self,
+        slot: AxisSlot,
+    ) -> ApiResult<Result<u64, ErrorId>> {
+        self.ticketed(|ticket| Request::ResetFollowingErrorPeak { ticket, slot })
+            .await
+    }
+
+    /// A request that only needs its verdict and the cycle it takes effect in.
+    async fn ticketed(&self, make: impl FnOnce(u64) -> Request) -> ApiResult<Result<u64, ErrorId>> {
         let ticket = self.next_id();
-        let r = self
-            .request(
-                ticket,
-                Request::InjectFault {
-                    ticket,
-                    slot,
-                    fault,
-                },
-            )
-            .await?;
+        let r = self.request(ticket, make(ticket)).await?;
         Ok(r.result.map(|_| r.cycle))
     }
 

@@ -50,6 +50,11 @@ pub enum Request {
         slot: AxisSlot,
         fault: SimFault,
     },
+    /// Restart the following-error peak hold of a slot (the online tab's reset).
+    ResetFollowingErrorPeak {
+        ticket: u64,
+        slot: AxisSlot,
+    },
     /// What the scope samples from the cycle this is drained in (see `scope.rs`).
     ScopeConfig {
         ticket: u64,
@@ -411,6 +416,14 @@ impl CycleThread {
                         result,
                     }
                 }
+                Request::ResetFollowingErrorPeak { ticket, slot } => Reply {
+                    ticket,
+                    cycle,
+                    result: match self.kernel.reset_following_error_peak(slot) {
+                        true => Ok(()),
+                        false => Err(ErrorId::AXIS_UNKNOWN),
+                    },
+                },
                 Request::ScopeConfig { ticket, config } => {
                     self.scope = config;
                     Reply {

@@ -621,3 +621,13 @@ pub fn dynamics(acceleration: f64, deceleration: f64, jerk: f64) -> Dynamics {
         jerk,
     }
 }
+
+/// The live status of an axis: the kernel's status plus what only the server can name.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+pub struct LiveStatus {
+    #[serde(flatten)]
+    pub status: motion::AxisStatus,
+    /// The master axis (name) while the axis is coupled as a gear slave.
+    #[schema(example = "x")]
+    pub master: Option<String>,
+}

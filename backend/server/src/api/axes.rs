@@ -16,7 +16,8 @@ use super::{Client, JsonBody};
 use crate::app::{AppState, AxisEntry};
 use crate::error::{ApiError, ApiResult};
 use crate::model::{
-    AxisConfigDto, AxisResource, ConfigAxis, ConfigDocument, ParameterResource, ParameterWrite,
+    AxisConfigDto, AxisResource, ConfigAxis, ConfigDocument, LiveStatus, ParameterResource,
+    ParameterWrite,
 };
 use crate::params::{self, ParamValue};
 use crate::sim::FieldError;
@@ -299,7 +300,7 @@ pub struct StatusResource {
     /// The cycle the snapshot was taken in.
     pub cycle: u64,
     pub unit: String,
-    pub status: AxisStatus,
+    pub status: LiveStatus,
 }
 
 #[utoipa::path(get, path = "/api/v1/axes/{axis}/status", tag = "axes", summary = "Live status (PLCopen state, positions, flags)",
@@ -322,8 +323,61 @@ pub async fn axis_status(
         axis_id: id,
         cycle,
         unit,
-        status: status.unwrap_or_default(),
+        status: s.status_view(status.unwrap_or_default()),
     }))
+}
+
+/// When the following-error peak hold counts from.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"axis": "x", "cycle": 120345}))]
+pub struct PeakResetResource {
+    pub axis: String,
+    /// The first cycle of the new peak hold.
+    pub cycle: u64,
+}
+
+#[utoipa::path(post, path = "/api/v1/axes/{axis}/status/following-error-peak/reset", tag = "axes",
+    summary = "Restart the following-error peak hold",
+    description = "`following_error_min` / `following_error_max` of the status hold the lowest and highest \
+following error of every cycle since the last reset (TwinCAT's online \"lag distance min/max\"). This restarts \
+them from the present following error; it changes no motion and creates no command.",
+    params(("axis" = String, Path, description = "axis id or name", example = "x")),
+    responses((status = 200, description = "Reset; the peak hold counts from `cycle`", body = PeakResetResource), ReadErrors))]
+pub async fn reset_following_error_peak(
+    State(s): State<Arc<AppState>>,
+    Path(axis): Path<String>,
+    client: Client,
+) -> ApiResult<Json<PeakResetResource>> {
+    let (slot, name) = {
+        let reg = s.registry.read().unwrap();
+        let e = reg
+            .find(&axis)
+            .ok_or_else(|| ApiError::not_found("axis", &axis))?;
+        (e.slot, e.name.clone())
+    };
+    let result = s.reset_following_error_peak(slot).await?;
+    s.audit(AuditEntry {
+        at: store::now_rfc3339(),
+        client_addr: Some(client.0.addr.clone()),
+        client_id: client.0.id.clone(),
+        action: "axis.following_error_peak.reset".into(),
+        target: Some(name.clone()),
+        command_id: None,
+        detail: String::new(),
+        outcome: Some(
+            if result.is_ok() {
+                "applied"
+            } else {
+                "rejected:axis_unknown"
+            }
+            .into(),
+        ),
+    });
+    match result {
+        Ok(cycle) => Ok(Json(PeakResetResource { axis: name, cycle })),
+        // The axis was removed between the look-up and the cycle thread.
+        Err(_) => Err(ApiError::not_found("axis", &axis)),
+    }
 }
 
 fn parameter_resource(
@@ -668,12 +722,30 @@ pub async fn import_config(
         restore(removed).await;
         return Err(not_disabled(&name));
     }
+    // Install the new axes, then commit; if anything fails on the way (the cycle thread
+    // unavailable, a slot refused, the commit) the kernel goes back to the old axes and the
+    // transaction rolls back, so registry, kernel and database always agree.
     let mut entries = Vec::new();
+    let mut failed: Option<ApiError> = None;
     for (slot, (a, persistent)) in doc.axes.iter().zip(built).enumerate() {
-        let (p, axis, drive) = s
-            .build_axis(a.id, &a.config, &persistent)
-            .map_err(ApiError::invalid)?;
-        let _ = s.install_axis(slot as u16, axis, drive, false).await?;
+        let (p, axis, drive) = match s.build_axis(a.id, &a.config, &persistent) {
+            Ok(x) => x,
+            Err(fe) => {
+                failed = Some(ApiError::invalid(fe));
+                break;
+            }
+        };
+        match s.install_axis(slot as u16, axis, drive, false).await {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => {
+                failed = Some(ApiError::rejected(e));
+                break;
+            }
+            Err(e) => {
+                failed = Some(e);
+                break;
+            }
+        }
         entries.push(AxisEntry {
             id: a.id,
             name: a.config.name.clone(),
@@ -683,12 +755,18 @@ pub async fn import_config(
             persistent,
         });
     }
-    if let Err(e) = tx.commit().await {
-        for slot in 0..entries.len() {
+    if failed.is_none() {
+        if let Err(e) = tx.commit().await {
+            failed = Some(e.into());
+        }
+    }
+    if let Some(e) = failed {
+        // A slot whose insert failed may hold nothing: removing it is harmless.
+        for slot in 0..=entries.len().min(doc.axes.len().saturating_sub(1)) {
             let _ = s.uninstall_axis(slot as u16, false).await;
         }
         restore(removed).await;
-        return Err(e.into());
+        return Err(e);
     }
     {
         let mut reg = s.registry.write().unwrap();

@@ -111,6 +111,10 @@ pub fn router(state: Arc<AppState>) -> Router {
                 .delete(axes::delete_axis),
         )
         .route("/axes/{axis}/status", get(axes::axis_status))
+        .route(
+            "/axes/{axis}/status/following-error-peak/reset",
+            post(axes::reset_following_error_peak),
+        )
         .route("/axes/{axis}/parameters", get(axes::list_parameters))
         .route(
             "/axes/{axis}/parameters/{parameter}",
@@ -202,7 +206,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
     ),
     paths(
         axes::list_axes, axes::create_axis, axes::get_axis, axes::replace_axis, axes::delete_axis,
-        axes::axis_status, axes::list_parameters, axes::get_parameter, axes::write_parameter,
+        axes::axis_status, axes::reset_following_error_peak, axes::list_parameters, axes::get_parameter, axes::write_parameter,
         commands::power, commands::reset, commands::set_position, commands::set_override,
         commands::move_absolute, commands::move_relative, commands::move_additive, commands::move_modulo,
         commands::move_velocity, commands::move_continuous_absolute, commands::move_continuous_relative,

@@ -26,15 +26,16 @@ use crate::model::*;
 /// Highest subscription rate.
 pub const MAX_RATE_HZ: f64 = 100.0;
 const TICK: Duration = Duration::from_millis(5);
-const KEEPALIVE_EVERY: Duration = Duration::from_millis(100);
 
 #[utoipa::path(get, path = "/api/v1/ws", tag = "system", summary = "Websocket: JSON-RPC 2.0 subscriptions and commands",
     description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
 (rate capped at 100 Hz; default 10); `unsubscribe` {topic}; every command endpoint by its name (`power`, \
 `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); \
 `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, \
-then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog sent over the \
-socket is kept alive while the socket is open and released when it closes.",
+then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is \
+the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
+not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
+closes.",
     responses((status = 101, description = "Switching protocols")))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
@@ -104,7 +105,6 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
     let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
     let mut tick = tokio::time::interval(TICK);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
-    let mut next_keepalive = Instant::now() + KEEPALIVE_EVERY;
     loop {
         let outgoing: Vec<String> = tokio::select! {
             msg = socket.recv() => match msg {
@@ -120,12 +120,9 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
                 Err(broadcast::error::RecvError::Closed) => vec![],
             },
             _ = tick.tick() => {
-                let now = Instant::now();
-                if now >= next_keepalive {
-                    next_keepalive = now + KEEPALIVE_EVERY;
-                    renew_jogs(&s, &jogs);
-                }
-                updates(&s, &mut subs, now)
+                // Socket jogs are not renewed here: only the client's keepalives renew them,
+                // so a client whose script hangs with the socket open still stops the axis.
+                updates(&s, &mut subs, Instant::now())
             }
         };
         for m in outgoing {
@@ -140,19 +137,6 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
         if s.command(id).is_some_and(|c| !c.is_final) {
             let _ = s.release(slot, id, &client).await;
         }
-    }
-}
-
-fn renew_jogs(s: &Arc<AppState>, jogs: &Arc<Mutex<Vec<(u16, u64)>>>) {
-    let mut held = jogs.lock().unwrap();
-    held.retain(|(_, id)| s.command(*id).is_some_and(|c| !c.is_final));
-    for &(slot, id) in held.iter() {
-        let s = s.clone();
-        tokio::spawn(async move {
-            let _ = s
-                .kernel_command(slot, motion::CommandKind::Keepalive { target: id })
-                .await;
-        });
     }
 }
 
@@ -375,7 +359,9 @@ fn handle(
                         if name == "jog" {
                             let slot = s.registry.read().unwrap().find(&axis).map(|e| e.slot);
                             if let Some(slot) = slot {
-                                jogs.lock().unwrap().push((slot, v.id));
+                                let mut held = jogs.lock().unwrap();
+                                held.retain(|(_, id)| s.command(*id).is_some_and(|c| !c.is_final));
+                                held.push((slot, v.id));
                             }
                         }
                         rpc_result(&id, serde_json::to_value(v).unwrap_or_default())
