@@ -135,10 +135,7 @@ fn move_is_done_only_when_the_lagging_drive_is_in_the_target_window() {
     // … and Done waited for the window dwell (10 ms; the cycle the setpoint arrives in counts
     // as its first) after the setpoint had arrived.
     let dwell = m.k.cycle() - ended_at.get().unwrap();
-    assert!(
-        dwell >= 9,
-        "done {dwell} cycles after the setpoint stopped"
-    );
+    assert!(dwell >= 9, "done {dwell} cycles after the setpoint stopped");
 }
 
 #[test]

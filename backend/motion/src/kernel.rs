@@ -76,7 +76,11 @@ impl Kernel {
     /// Restarts the following-error peak hold of an axis (not a PLCopen command: like the
     /// online tab's reset, it creates no command and changes no motion). False: no axis.
     pub fn reset_following_error_peak(&mut self, slot: AxisSlot) -> bool {
-        match self.axes.get_mut(slot as usize).and_then(|a| a.as_deref_mut()) {
+        match self
+            .axes
+            .get_mut(slot as usize)
+            .and_then(|a| a.as_deref_mut())
+        {
             Some(a) => {
                 a.reset_following_error_peak();
                 true

@@ -19,10 +19,16 @@ fn the_peak_hold_is_the_extreme_of_every_cycle_and_restarts_on_reset() {
     r.run(0.4);
     r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
     r.run(1.5);
-    let lags: Vec<f64> = r.history[0][from..].iter().map(|s| s.following_error).collect();
+    let lags: Vec<f64> = r.history[0][from..]
+        .iter()
+        .map(|s| s.following_error)
+        .collect();
     let max = lags.iter().cloned().fold(f64::MIN, f64::max);
     let min = lags.iter().cloned().fold(f64::MAX, f64::min);
-    assert!(max > 0.1 && min < -0.1, "the move made no lag both ways: {min} {max}");
+    assert!(
+        max > 0.1 && min < -0.1,
+        "the move made no lag both ways: {min} {max}"
+    );
     let st = r.st(0);
     assert_eq!(st.following_error_max, max);
     assert_eq!(st.following_error_min, min);
