@@ -643,6 +643,110 @@ fn move_modulo_from_motion_keeps_direction_and_ignores_extra_turns() {
     );
 }
 
+/// Behind endless motion a Buffered MoveModulo acts at once on the moving axis (§3.8): it must
+/// run exactly as an Aborting one issued in the same cycle — from-motion rules, extra turns
+/// ignored, no reversal, the target past the braking distance.
+#[test]
+fn buffered_move_modulo_behind_endless_motion_resolves_from_motion_like_aborting() {
+    let endless: [(&str, CommandKind); 4] = [
+        (
+            "move velocity",
+            CommandKind::MoveVelocity {
+                velocity: 300.0,
+                dynamics: Dynamics::default(),
+                direction: Direction::Positive,
+                buffer_mode: BufferMode::Aborting,
+                options: MoveOptions::default(),
+            },
+        ),
+        (
+            "move velocity negative",
+            CommandKind::MoveVelocity {
+                velocity: 300.0,
+                dynamics: Dynamics::default(),
+                direction: Direction::Negative,
+                buffer_mode: BufferMode::Aborting,
+                options: MoveOptions::default(),
+            },
+        ),
+        (
+            "continuous jog",
+            CommandKind::Jog {
+                mode: JogMode::Continuous,
+                forward: true,
+                position: 0.0,
+                velocity: 300.0,
+                dynamics: Dynamics::default(),
+                deadman: 0.0,
+            },
+        ),
+        (
+            "move continuous at its end velocity",
+            CommandKind::MoveContinuousRelative {
+                move_: mv(100.0, 300.0),
+                end_velocity: 250.0,
+            },
+        ),
+    ];
+    for (name, start) in endless {
+        let run = |buffer_mode: BufferMode| {
+            let mut r = Rig::with(vec![(true, params())]);
+            r.power_on(0);
+            r.ok(0, start);
+            r.run(0.8);
+            let v0 = r.st(0).set_velocity;
+            let (p0, a0) = (r.st(0).set_position, r.st(0).set_acceleration);
+            assert!(v0.abs() > 200.0, "{name}: moving");
+            let direction = if v0 > 0.0 {
+                Direction::Positive
+            } else {
+                Direction::Negative
+            };
+            // Two extra turns asked: ignored from motion.
+            let m = r.ok(
+                0,
+                CommandKind::MoveModulo {
+                    move_: mvb(720.0 + 100.0, 200.0, buffer_mode),
+                    direction,
+                },
+            );
+            assert!(r.out(m).active, "{name}: acts at once");
+            let target = r.st(0).target_position;
+            r.until(5.0, |r| !r.out(m).busy);
+            assert!(r.out(m).done, "{name} {buffer_mode:?}: {:?}", r.out(m));
+            (r, m, v0, p0, a0, target)
+        };
+        let (a, _, v0, p0, a0, target) = run(BufferMode::Aborting);
+        let (b, _, _, _, _, target_b) = run(BufferMode::Buffered);
+        assert_eq!(target, target_b, "{name}: same target");
+        assert_eq!(
+            a.history[0], b.history[0],
+            "{name}: Buffered and Aborting move alike in every cycle"
+        );
+        // From-motion rules: never reversed, no extra turns, not before the brake point.
+        let dir = v0.signum();
+        assert!(
+            b.history[0]
+                .iter()
+                .rev()
+                .take(4000)
+                .all(|h| h.set_velocity * dir >= -1e-9),
+            "{name}: reversed"
+        );
+        let brake = params().axis_dec;
+        let min_travel = v0 * v0 / (2.0 * brake) * 0.9 * dir.abs();
+        let travel = (target - p0) * dir;
+        assert!(
+            travel >= min_travel && travel < min_travel / 0.9 + 360.0 + 1e-9,
+            "{name}: travel {travel} from {p0} (v {v0}, a {a0})"
+        );
+        assert!(
+            (target.rem_euclid(360.0) - 100.0).abs() < 1e-9,
+            "{name}: modulo target {target}"
+        );
+    }
+}
+
 #[test]
 fn s11a_23_halt_has_no_lock_and_never_weaker_dynamics() {
     let mut r = Rig::new(1);

@@ -97,6 +97,58 @@ impl Axis {
         self.set.position
     }
 
+    /// How a command with `buffer_mode` and `options` runs (§3.8): the buffer mode in effect
+    /// and, when it is to take over at its own blending position, that position with the
+    /// direction of travel there.
+    ///
+    /// The blending position must lie before the previous target (0x4296); already passed,
+    /// the command acts at once (Aborting). An endless job takes no successor except at a
+    /// blending position, so behind one (and behind no job) every buffer mode acts at once.
+    pub(super) fn buffering(
+        &self,
+        buffer_mode: BufferMode,
+        options: &MoveOptions,
+    ) -> Result<(BufferMode, Option<(f64, f64)>), ErrorId> {
+        let mut mode = buffer_mode;
+        let mut blend_at = None;
+        if let Some(bp) = options.blending_position {
+            if mode != BufferMode::Aborting {
+                if !bp.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                if let Some(prev) = self.predecessor() {
+                    let dir = if prev.is_positioning() && !prev.is_endless() {
+                        let dir = sign(prev.target - self.set.position);
+                        if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
+                            return Err(ErrorId::BLENDING_POSITION_INVALID);
+                        }
+                        dir
+                    } else if self.set.velocity.abs() > EPS_V {
+                        sign(self.set.velocity)
+                    } else {
+                        prev.direction
+                    };
+                    if (self.set.position - bp) * dir >= 0.0 {
+                        mode = BufferMode::Aborting;
+                    } else {
+                        blend_at = Some((bp, dir));
+                    }
+                }
+            }
+        }
+        let running_endless = self.job.as_ref().is_some_and(|j| j.is_endless())
+            || self
+                .job
+                .as_ref()
+                .is_some_and(|j| j.kind == JobKind::Halt && j.id == 0);
+        if mode != BufferMode::Aborting
+            && (self.job.is_none() || (running_endless && blend_at.is_none()))
+        {
+            mode = BufferMode::Aborting;
+        }
+        Ok((mode, blend_at))
+    }
+
     pub(super) fn submit_motion(
         &mut self,
         cmd: Command,
@@ -135,13 +187,27 @@ impl Axis {
                     CommandKind::MoveModulo { direction, .. } => {
                         let period = self.period();
                         let tf = self.p().axis_modulo_tolerance_window;
-                        // At rest (also while a finished move still settles) it is a start
-                        // from standstill; behind a Buffered predecessor too.
+                        // The rules follow from where the move will start, not from the
+                        // buffer mode asked for: acting at once (Aborting, or Buffered/
+                        // blending behind endless motion, §3.8) it starts from the present
+                        // state — at rest (also while a finished move still settles) from
+                        // standstill, else from motion; queued Buffered behind a discrete
+                        // move from that move's standstill; blending, or taking over at a
+                        // blending position, from motion. An invalid blending position is
+                        // rejected below; until then take the mode as asked.
+                        let (mode, blend_at) = self
+                            .buffering(m.buffer_mode, &m.options)
+                            .unwrap_or((m.buffer_mode, None));
                         let at_rest = self.set.velocity.abs() <= EPS_V
                             && self.set.acceleration.abs() <= EPS_V;
-                        let from_standstill = (at_rest && m.buffer_mode == BufferMode::Aborting)
-                            || m.buffer_mode == BufferMode::Buffered
-                            || self.state() == AxisState::Standstill;
+                        let from_standstill = blend_at.is_none()
+                            && match mode {
+                                BufferMode::Aborting => {
+                                    at_rest || self.state() == AxisState::Standstill
+                                }
+                                BufferMode::Buffered => true,
+                                _ => false,
+                            };
                         // Validate now (errors are the command's verdict); moves from motion
                         // are resolved against the state at their start.
                         let end = modulo_end_position(
@@ -320,51 +386,8 @@ impl Axis {
             _ => return Err(ErrorId::COMMAND_NOT_PERMITTED),
         }
 
-        // Blending position (optional, §3.8): the successor takes over where the axis passes
-        // it, instead of at the previous target. It must lie before that target (0x4296);
-        // already passed → the command acts at once (Aborting). With an endless predecessor
-        // it is the only way to buffer behind it.
-        let mut mode = job.buffer_mode;
-        let mut blend_at = None;
-        if let Some(bp) = job.options.blending_position {
-            if mode != BufferMode::Aborting {
-                if !bp.is_finite() {
-                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
-                }
-                if let Some(prev) = self.predecessor() {
-                    let dir = if prev.is_positioning() && !prev.is_endless() {
-                        let dir = sign(prev.target - self.set.position);
-                        if (bp - prev.target) * dir > 0.0 || (dir == 0.0 && bp != prev.target) {
-                            return Err(ErrorId::BLENDING_POSITION_INVALID);
-                        }
-                        dir
-                    } else if self.set.velocity.abs() > EPS_V {
-                        sign(self.set.velocity)
-                    } else {
-                        prev.direction
-                    };
-                    if (self.set.position - bp) * dir >= 0.0 {
-                        mode = BufferMode::Aborting;
-                    } else {
-                        blend_at = Some((bp, dir));
-                    }
-                }
-            }
-        }
+        let (mode, blend_at) = self.buffering(job.buffer_mode, &job.options)?;
         job.blend_at = blend_at;
-
-        // Buffer modes (§3.8): an endless job takes no successor (unless it is to take over
-        // at a blending position); the queue holds one.
-        let running_endless = self.job.as_ref().is_some_and(|j| j.is_endless())
-            || self
-                .job
-                .as_ref()
-                .is_some_and(|j| j.kind == JobKind::Halt && j.id == 0);
-        if mode != BufferMode::Aborting
-            && (self.job.is_none() || (running_endless && blend_at.is_none()))
-        {
-            mode = BufferMode::Aborting;
-        }
         if mode != BufferMode::Aborting && self.next.is_some() {
             return Err(ErrorId::BUFFER_FULL);
         }
