@@ -64,7 +64,8 @@ async fn subscriber_sees_deltas_during_a_move_with_increasing_cycle_stamps() {
     let (r, _) = response(&mut ws, 2).await;
     assert_eq!(r["result"]["rate_hz"], 50.0, "{r}");
     send(&mut ws, 3, "subscribe", json!({"topic": "commands"})).await;
-    response(&mut ws, 3).await;
+    // The first (full) update may come before this reply: keep it.
+    let (_, early) = response(&mut ws, 3).await;
     send(
         &mut ws,
         4,
@@ -73,7 +74,11 @@ async fn subscriber_sees_deltas_during_a_move_with_increasing_cycle_stamps() {
     )
     .await;
 
-    let mut updates = Vec::new();
+    let mut updates: Vec<Value> = early
+        .into_iter()
+        .filter(|m| m["method"] == "update")
+        .map(|m| m["params"].clone())
+        .collect();
     let mut events = Vec::new();
     let mut move_id = None;
     let deadline = tokio::time::Instant::now() + Duration::from_secs(20);
@@ -206,6 +211,18 @@ async fn rpc_errors_and_unsubscribe() {
     .await;
     let (r, _) = response(&mut ws, 5).await;
     assert_eq!(r["result"]["rate_hz"], 100.0, "rate not capped: {r}");
+    // A rate too small to schedule is refused; the session goes on.
+    for (k, rate) in [(50u64, json!(1e-300)), (51, json!(0)), (52, json!("fast"))] {
+        send(
+            &mut ws,
+            k,
+            "subscribe",
+            json!({"topic": "commands", "rate_hz": rate}),
+        )
+        .await;
+        let (r, _) = response(&mut ws, k).await;
+        assert_eq!(r["error"]["code"], -32602, "{r}");
+    }
     let first = next(&mut ws, Duration::from_secs(5)).await.unwrap();
     assert_eq!(first["params"]["topic"], "system");
     assert_eq!(first["params"]["full"], true);
@@ -360,4 +377,37 @@ async fn a_jog_whose_keepalives_stop_halts_within_deadman_plus_one_cycle() {
     );
     assert!(fin["cycle"].as_u64().unwrap() > fired_cycle, "{fin}");
     assert_eq!(status(&s, "y").await["status"]["moving"], false);
+}
+
+/// An axis subscription follows its axis; when the axis is deleted the subscription ends with
+/// a notification instead of going silent (or streaming whatever takes the slot next).
+#[tokio::test(flavor = "multi_thread")]
+async fn an_axis_subscription_ends_when_its_axis_is_deleted() {
+    let s = Server::start();
+    let mut ws = connect(&s).await;
+    send(
+        &mut ws,
+        1,
+        "subscribe",
+        json!({"topic": "axes/y/status", "rate_hz": 50}),
+    )
+    .await;
+    response(&mut ws, 1).await;
+    let first = next(&mut ws, Duration::from_secs(5)).await.unwrap();
+    assert_eq!(first["params"]["full"], true, "{first}");
+    let r = delete(&s, "/api/v1/axes/y").await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let ended = loop {
+        let m = next(&mut ws, Duration::from_secs(5))
+            .await
+            .expect("subscription_ended");
+        if m["method"] == "subscription_ended" {
+            break m;
+        }
+        assert_eq!(m["params"]["topic"], "axes/y/status", "{m}");
+    };
+    assert_eq!(ended["params"]["topic"], "axes/y/status", "{ended}");
+    assert_eq!(ended["params"]["reason"], "axis_removed", "{ended}");
+    // nothing more for it
+    assert!(next(&mut ws, Duration::from_millis(300)).await.is_none());
 }

@@ -25,17 +25,23 @@ use crate::model::*;
 
 /// Highest subscription rate.
 pub const MAX_RATE_HZ: f64 = 100.0;
+/// Lowest subscription rate (one update every 10 s).
+pub const MIN_RATE_HZ: f64 = 0.1;
+/// Commands, keepalives and releases of one socket whose responses are still outstanding: a
+/// client that sends faster than it reads is refused instead of queued without bound.
+const MAX_IN_FLIGHT: usize = 32;
 const TICK: Duration = Duration::from_millis(5);
 
 #[utoipa::path(get, path = "/api/v1/ws", tag = "system", summary = "Websocket: JSON-RPC 2.0 subscriptions and commands",
     description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
-(rate capped at 100 Hz; default 10); `unsubscribe` {topic}; every command endpoint by its name (`power`, \
+(0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and \
+ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, \
 `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); \
 `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, \
 then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is \
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
-closes.",
+closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`).",
     responses((status = 101, description = "Switching protocols")))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
@@ -56,7 +62,12 @@ pub async fn upgrade(
 }
 
 enum Topic {
-    Axis { slot: u16, name: String },
+    /// Followed by the axis id: an import or a re-created axis may move it to another slot.
+    Axis {
+        id: i64,
+        slot: u16,
+        name: String,
+    },
     Commands,
     System,
 }
@@ -103,12 +114,13 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
     let mut notices: Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>> = None;
     let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
     let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
+    let in_flight = Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT));
     let mut tick = tokio::time::interval(TICK);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     loop {
         let outgoing: Vec<String> = tokio::select! {
             msg = socket.recv() => match msg {
-                Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, t.as_str()).into_iter().collect(),
+                Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
                 Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
                 Some(Ok(_)) => vec![],
                 _ => break,
@@ -140,8 +152,41 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
     }
 }
 
-fn updates(s: &AppState, subs: &mut [Sub], now: Instant) -> Vec<String> {
+/// Follows axis subscriptions to the slot their axis is in now; ends those whose axis is gone.
+fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
+    let reg = s.registry.read().unwrap();
+    subs.retain_mut(|sub| {
+        let Topic::Axis { id, slot, name } = &mut sub.topic else {
+            return true;
+        };
+        match reg.axes.get(id) {
+            None => {
+                out.push(notify(
+                    "subscription_ended",
+                    json!({"topic": sub.key, "reason": "axis_removed"}),
+                ));
+                false
+            }
+            Some(e) => {
+                if e.slot != *slot || e.name != *name {
+                    // Another axis object now: start again with a full object.
+                    (*slot, *name) = (e.slot, e.name.clone());
+                    sub.last = None;
+                }
+                true
+            }
+        }
+    });
+}
+
+fn updates(s: &AppState, subs: &mut Vec<Sub>, now: Instant) -> Vec<String> {
     let mut out = Vec::new();
+    if subs
+        .iter()
+        .any(|x| now >= x.due && matches!(x.topic, Topic::Axis { .. }))
+    {
+        follow_axes(s, subs, &mut out);
+    }
     for sub in subs.iter_mut().filter(|x| now >= x.due) {
         // Keep the rate's grid; a client that fell behind skips what it missed.
         sub.due += sub.every;
@@ -191,6 +236,7 @@ fn handle(
     client: &ClientInfo,
     out_tx: &mpsc::Sender<String>,
     jogs: &Arc<Mutex<Vec<(u16, u64)>>>,
+    in_flight: &Arc<tokio::sync::Semaphore>,
     text: &str,
 ) -> Option<String> {
     let req: Value = match serde_json::from_str(text) {
@@ -235,8 +281,13 @@ fn handle(
             let rate = match params.get("rate_hz") {
                 None => 10.0,
                 Some(v) => match v.as_f64() {
-                    Some(r) if r > 0.0 && r.is_finite() => r.min(MAX_RATE_HZ),
-                    _ => return Some(rpc_error(&id, -32602, "rate_hz must be a number > 0", None)),
+                    Some(r) if r >= MIN_RATE_HZ && r.is_finite() => r.min(MAX_RATE_HZ),
+                    _ => {
+                        let msg = format!(
+                            "rate_hz must be a number ≥ {MIN_RATE_HZ} (more than {MAX_RATE_HZ} is capped)"
+                        );
+                        return Some(rpc_error(&id, -32602, &msg, None));
+                    }
                 },
             };
             let topic = if key == "commands" {
@@ -251,6 +302,7 @@ fn handle(
                 let reg = s.registry.read().unwrap();
                 match reg.find(axis) {
                     Some(e) => Topic::Axis {
+                        id: e.id,
                         slot: e.slot,
                         name: e.name.clone(),
                     },
@@ -300,6 +352,10 @@ fn handle(
             let Some(cmd) = params.get("command").and_then(|c| c.as_u64()) else {
                 return Some(rpc_error(&id, -32602, "command (id) is required", None));
             };
+            let permit = match in_flight.clone().try_acquire_owned() {
+                Ok(p) => p,
+                Err(_) => return Some(too_many_in_flight(&id)),
+            };
             let s = s.clone();
             let out = out_tx.clone();
             let client = client.clone();
@@ -324,6 +380,7 @@ fn handle(
                     }
                 };
                 let _ = out.send(msg).await;
+                drop(permit);
             });
             None
         }
@@ -347,6 +404,10 @@ fn handle(
                 )),
                 _ => None,
             };
+            let permit = match in_flight.clone().try_acquire_owned() {
+                Ok(p) => p,
+                Err(_) => return Some(too_many_in_flight(&id)),
+            };
             let s = s.clone();
             let out = out_tx.clone();
             let client = client.clone();
@@ -369,10 +430,20 @@ fn handle(
                     Err(e) => api_error(&id, e),
                 };
                 let _ = out.send(msg).await;
+                drop(permit);
             });
             None
         }
     }
+}
+
+fn too_many_in_flight(id: &Value) -> String {
+    rpc_error(
+        id,
+        -32000,
+        &format!("too many requests in flight ({MAX_IN_FLIGHT}): read their responses first"),
+        Some(json!({"code": "too_many_in_flight"})),
+    )
 }
 
 pub const COMMANDS: &[&str] = &[
