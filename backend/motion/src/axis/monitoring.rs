@@ -219,13 +219,31 @@ impl Axis {
         self.start_job(h, cycle, events);
     }
 
-    /// Endless motion stops at an enabled software limit with its deceleration.
+    /// Endless motion stops at an enabled software limit with its deceleration; a coupled
+    /// slave that crosses one is an axis error.
     pub(super) fn step_soft_limits(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
         let p = self.p();
         let Some(job) = self.job else { return };
-        let endless = job.is_endless() && job.kind != JobKind::Gear;
         let v = self.set.velocity;
+        if job.kind == JobKind::Gear {
+            // A slave follows its master and cannot brake for a limit of its own while
+            // coupled. Crossing one (moving outwards beyond it) decouples it and stops it on
+            // the fast-stop ramp in ErrorStop (TwinCAT raises an axis error for a slave
+            // outside its software limits); a GearInDyn still enabled and a superposition
+            // end with the error.
+            let out_max = p.axis_en_max_soft_pos_limit
+                && self.set.position > p.axis_max_soft_pos_limit
+                && v > EPS_V;
+            let out_min = p.axis_en_min_soft_pos_limit
+                && self.set.position < p.axis_min_soft_pos_limit
+                && v < -EPS_V;
+            if out_max || out_min {
+                self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
+            }
+            return;
+        }
+        let endless = job.is_endless();
         if !endless && !(job.id == 0 && job.kind == JobKind::Velocity) || v.abs() <= EPS_V {
             return;
         }

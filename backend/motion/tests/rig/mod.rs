@@ -500,3 +500,14 @@ pub fn mvb(position: f64, velocity: f64, buffer_mode: BufferMode) -> Positioning
         ..mv(position, velocity)
     }
 }
+
+/// MC_MoveVelocity, Aborting, axis dynamics.
+pub fn velocity(velocity: f64, direction: Direction) -> CommandKind {
+    CommandKind::MoveVelocity {
+        velocity,
+        dynamics: Dynamics::default(),
+        direction,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
+}
