@@ -43,29 +43,31 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Cmd {
-    /// Run the appliance (the default).
-    Serve(ServeArgs),
+    /// Run the appliance (the default). Its options may stand before or after `serve`.
+    Serve,
     /// Print the OpenAPI document (what `openapi/openapi.json` must contain).
     Openapi,
 }
 
+/// The options of `serve`. Global, so that `motiond --db m.db serve` and
+/// `motiond serve --db m.db` mean the same (a systemd unit may write either).
 #[derive(clap::Args, Debug, Clone)]
 pub struct ServeArgs {
     /// Address to listen on. Only loopback addresses are allowed until authentication exists.
-    #[arg(long, default_value = "127.0.0.1:8080")]
+    #[arg(long, global = true, default_value = "127.0.0.1:8080")]
     pub listen: SocketAddr,
     /// SQLite database file (`:memory:` for a throw-away one).
-    #[arg(long, default_value = "./motiond.db")]
+    #[arg(long, global = true, default_value = "./motiond.db")]
     pub db: String,
     /// Cycle time in microseconds.
-    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(250..=10_000))]
+    #[arg(long, global = true, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(250..=10_000))]
     pub cycle_us: u32,
     /// Do not create the demo axes on a new database.
-    #[arg(long)]
+    #[arg(long, global = true)]
     pub no_demo: bool,
     /// The built commissioning UI, served at `/` [default: `frontend/dist` in the current
     /// directory, else the one of the source tree motiond was built from].
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, global = true, value_name = "PATH")]
     pub ui_dir: Option<std::path::PathBuf>,
 }
 
@@ -77,8 +79,7 @@ pub fn run() {
             print!("{}", api::openapi_json());
             return;
         }
-        Some(Cmd::Serve(a)) => a,
-        None => cli.serve,
+        Some(Cmd::Serve) | None => cli.serve,
     };
     tracing_subscriber::fmt()
         .with_target(false)
@@ -177,7 +178,11 @@ fn serve(args: ServeArgs) -> Result<(), String> {
 
 async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let db = store::open(&args.db).await?;
-    tracing::info!("database {} (WAL, synchronous=FULL)", args.db);
+    if args.db == ":memory:" {
+        tracing::info!("database :memory: (in memory: nothing is kept after exit)");
+    } else {
+        tracing::info!("database {} (WAL, synchronous=FULL)", args.db);
+    }
 
     let cycle_time = args.cycle_us as f64 * 1e-6;
     let shared = Arc::new(cycle::Shared::new(args.cycle_us as u64 * 1000));
