@@ -27,6 +27,10 @@ pub const HISTORY: usize = 2000;
 const EVENTS_PER_COMMAND: usize = 64;
 /// How long the async side waits for the cycle thread's verdict.
 const VERDICT_TIMEOUT: Duration = Duration::from_secs(2);
+/// How long a request may wait in the queue before the cycle thread drops it undone: shorter
+/// than `VERDICT_TIMEOUT` by far more than the pump's period, so that a verdict the cycle thread
+/// gives always reaches its waiting requester.
+const REQUEST_TTL: Duration = Duration::from_millis(1500);
 
 pub struct AxisEntry {
     pub id: i64,
@@ -183,7 +187,8 @@ pub struct AppState {
     next_id: AtomicU64,
     pub db: SqlitePool,
     audit_tx: mpsc::Sender<AuditEntry>,
-    pub audit_dropped: AtomicU64,
+    /// Audit rows lost (queue full, or not written after retries); shared with the writer.
+    pub audit_dropped: Arc<AtomicU64>,
     pub info: SystemInfo,
     /// Scope recordings and the channel layout the cycle thread samples.
     pub scope: Mutex<Recordings>,
@@ -212,7 +217,7 @@ impl AppState {
             next_id: AtomicU64::new(first_command_id.max(1)),
             db,
             audit_tx,
-            audit_dropped: AtomicU64::new(0),
+            audit_dropped: Arc::new(AtomicU64::new(0)),
             info,
         };
         (Arc::new(state), audit_rx)
@@ -303,7 +308,7 @@ impl AppState {
             if let Some(config) = scope.take_dirty() {
                 // Nobody waits for this reply (ticket 0); a full queue is retried next time.
                 let req = Request::ScopeConfig { ticket: 0, config };
-                if self.shared.requests.push(req).is_err() {
+                if self.shared.push(req).is_err() {
                     scope.handover_failed();
                 }
             }
@@ -332,7 +337,8 @@ impl AppState {
     async fn request(&self, ticket: u64, req: Request) -> ApiResult<Reply> {
         let (tx, rx) = oneshot::channel();
         self.pending.lock().unwrap().insert(ticket, tx);
-        if self.shared.requests.push(req).is_err() {
+        // Expires well before we stop waiting: a request we answer 503 for never acts later.
+        if self.shared.push_expiring(req, REQUEST_TTL).is_err() {
             self.pending.lock().unwrap().remove(&ticket);
             return Err(ApiError::unavailable(
                 "command_queue_full",
@@ -383,7 +389,6 @@ impl AppState {
             self.pending.lock().unwrap().insert(ticket, tx);
             if self
                 .shared
-                .requests
                 .push(Request::ScopeConfig { ticket, config })
                 .is_err()
             {
@@ -760,20 +765,34 @@ pub async fn pump(state: Arc<AppState>) {
     }
 }
 
-/// Writes queued audit entries in batches, one transaction per batch.
-pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditEntry>) {
+/// Writes queued audit entries in batches, one transaction per batch. A batch that cannot be
+/// written (database locked past its busy timeout, disk full) is tried again a few times; what
+/// is still not written is logged and counted in `lost` (`audit_dropped` in /system, /metrics).
+pub async fn audit_writer(
+    db: SqlitePool,
+    mut rx: mpsc::Receiver<AuditEntry>,
+    lost: Arc<AtomicU64>,
+) {
+    const TRIES: u32 = 3;
     let mut batch = Vec::with_capacity(256);
     while rx.recv_many(&mut batch, 256).await > 0 {
-        let result = async {
-            let mut tx = db.begin().await?;
-            for e in &batch {
-                store::audit(&mut *tx, e).await?;
+        for attempt in 1..=TRIES {
+            let result = async {
+                let mut tx = db.begin().await?;
+                for e in &batch {
+                    store::audit(&mut *tx, e).await?;
+                }
+                tx.commit().await
             }
-            tx.commit().await
-        }
-        .await;
-        if let Err(e) = result {
-            tracing::error!("audit log: {} entries not written: {e}", batch.len());
+            .await;
+            match result {
+                Ok(()) => break,
+                Err(e) if attempt == TRIES => {
+                    tracing::error!("audit log: {} entries not written: {e}", batch.len());
+                    lost.fetch_add(batch.len() as u64, Relaxed);
+                }
+                Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
+            }
         }
         batch.clear();
     }

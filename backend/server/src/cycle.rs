@@ -94,9 +94,17 @@ impl Default for Snapshot {
     }
 }
 
+/// A request in the queue to the cycle thread, with the moment its requester stops waiting.
+pub struct Queued {
+    pub request: Request,
+    /// `CLOCK_MONOTONIC` nanoseconds after which the request is dropped undone (its requester
+    /// has answered 503 by then, so it must not act later); 0 = never.
+    pub expires_ns: u64,
+}
+
 /// The queues and counters shared by both sides.
 pub struct Shared {
-    pub requests: ArrayQueue<Request>,
+    requests: ArrayQueue<Queued>,
     pub replies: ArrayQueue<Reply>,
     pub events: ArrayQueue<CommandEvent>,
     pub garbage: ArrayQueue<Garbage>,
@@ -122,6 +130,27 @@ impl Shared {
             shutdown: AtomicBool::new(false),
             period_ns,
         }
+    }
+
+    /// Queues a request that never expires (nobody waits for it, or a test steps the cycle).
+    pub fn push(&self, request: Request) -> Result<(), Request> {
+        self.requests
+            .push(Queued {
+                request,
+                expires_ns: 0,
+            })
+            .map_err(|q| q.request)
+    }
+
+    /// Queues a request that is dropped undone unless the cycle thread takes it within `ttl`.
+    pub fn push_expiring(&self, request: Request, ttl: std::time::Duration) -> Result<(), Request> {
+        let expires_ns = now_ns() + ttl.as_nanos() as u64;
+        self.requests
+            .push(Queued {
+                request,
+                expires_ns,
+            })
+            .map_err(|q| q.request)
     }
 }
 
@@ -151,7 +180,7 @@ impl EventSink for RingSink<'_> {
     }
 }
 
-fn now_ns() -> u64 {
+pub fn now_ns() -> u64 {
     let mut ts = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,
@@ -308,11 +337,32 @@ impl CycleThread {
             dropped: 0,
         };
         let mut drained = 0;
+        // Read once per cycle, and only when something waits (a vDSO call, no syscall).
+        let mut now = 0;
         while drained < DRAIN_PER_CYCLE {
-            let Some(req) = shared.requests.pop() else {
+            let Some(Queued {
+                request: req,
+                expires_ns,
+            }) = shared.requests.pop()
+            else {
                 break;
             };
             drained += 1;
+            if expires_ns != 0 {
+                if now == 0 {
+                    now = now_ns();
+                }
+                if now > expires_ns {
+                    // Its requester has given up (503): acting now would be a command nobody
+                    // tracks. Boxes go back to be freed off the thread; no reply is awaited.
+                    shared.stats.requests_expired.fetch_add(1, Relaxed);
+                    if let Request::InsertAxis { axis, drive, .. } = req {
+                        let _ = shared.garbage.push(Garbage::Axis(axis));
+                        let _ = shared.garbage.push(Garbage::Drive(drive));
+                    }
+                    continue;
+                }
+            }
             let cycle = self.kernel.cycle() + 1;
             let reply = match req {
                 Request::Command(cmd) => {

@@ -250,7 +250,11 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     }
     let (state, audit_rx) = AppState::new(shared.clone(), output, db.clone(), first_id, info);
     tokio::spawn(app::pump(state.clone()));
-    let audit_task = tokio::spawn(app::audit_writer(db.clone(), audit_rx));
+    let audit_task = tokio::spawn(app::audit_writer(
+        db.clone(),
+        audit_rx,
+        state.audit_dropped.clone(),
+    ));
 
     load_axes(&state, args.no_demo).await?;
 

@@ -149,6 +149,8 @@ pub struct CycleStats {
     pub commands_drained: AtomicU64,
     /// Scope frames lost because the scope ring was full (each fails the recordings running).
     pub scope_frames_dropped: AtomicU64,
+    /// Requests dropped undone because their requester had stopped waiting (it answered 503).
+    pub requests_expired: AtomicU64,
 }
 
 #[cfg(test)]

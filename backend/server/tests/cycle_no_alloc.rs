@@ -73,7 +73,6 @@ fn a_cycle_allocates_nothing() {
     for slot in 0..3u16 {
         assert!(
             shared
-                .requests
                 .push(Request::InsertAxis {
                     ticket: slot as u64,
                     slot,
@@ -114,7 +113,6 @@ fn a_cycle_allocates_nothing() {
                     };
                     assert!(
                         shared
-                            .requests
                             .push(Request::Command(Command {
                                 id,
                                 axis: slot,
@@ -135,19 +133,21 @@ fn a_cycle_allocates_nothing() {
                 };
                 assert!(
                     shared
-                        .requests
-                        .push(Request::Command(Command {
-                            id,
-                            axis: 0,
-                            kind: CommandKind::MoveAbsolute(p)
-                        }))
+                        // (expiring, as the server sends them: the expiry check is in the cycle too)
+                        .push_expiring(
+                            Request::Command(Command {
+                                id,
+                                axis: 0,
+                                kind: CommandKind::MoveAbsolute(p)
+                            }),
+                            std::time::Duration::from_secs(60)
+                        )
                         .is_ok()
                 );
             }
             1500 => {
                 assert!(
                     shared
-                        .requests
                         .push(Request::InsertAxis {
                             ticket: 9,
                             slot: 2,
@@ -166,7 +166,6 @@ fn a_cycle_allocates_nothing() {
                 };
                 assert!(
                     shared
-                        .requests
                         .push(Request::InjectFault {
                             ticket: i,
                             slot: 1,
@@ -178,7 +177,6 @@ fn a_cycle_allocates_nothing() {
             // The scope samples from cycle 300 on, changes its channels at 1200, stops at 2600.
             300 => assert!(
                 shared
-                    .requests
                     .push(scope(
                         1,
                         &[(0, ScopeSignal::SetPosition), (0, ScopeSignal::SetVelocity)]
@@ -187,7 +185,6 @@ fn a_cycle_allocates_nothing() {
             ),
             1200 => assert!(
                 shared
-                    .requests
                     .push(scope(
                         2,
                         &[
@@ -198,7 +195,7 @@ fn a_cycle_allocates_nothing() {
                     ))
                     .is_ok()
             ),
-            2600 => assert!(shared.requests.push(scope(3, &[])).is_ok()),
+            2600 => assert!(shared.push(scope(3, &[])).is_ok()),
             _ => {}
         }
         let ((), n) = counted(|| cycle.one_cycle(&mut fb, &mut sp));

@@ -29,8 +29,12 @@ pub struct Timing {
     pub overruns: u64,
     /// Command events lost because the event ring was full.
     pub events_dropped: u64,
-    /// Audit entries lost because the audit queue was full.
+    /// Audit entries lost: the audit queue was full or writing them failed (disk full,
+    /// database locked); each one is also logged.
     pub audit_dropped: u64,
+    /// Requests the cycle thread dropped undone because their requester had already answered
+    /// 503 (the cycle thread took longer than that to drain them).
+    pub requests_expired: u64,
     /// Scope frames lost because the scope ring was full (the recordings running then failed).
     pub scope_frames_dropped: u64,
 }
@@ -74,6 +78,7 @@ pub fn system_resource(s: &AppState) -> SystemResource {
             overruns: st.overruns.load(Relaxed),
             events_dropped: st.events_dropped.load(Relaxed),
             audit_dropped: s.audit_dropped.load(Relaxed),
+            requests_expired: st.requests_expired.load(Relaxed),
             scope_frames_dropped: st.scope_frames_dropped.load(Relaxed),
         },
     }
@@ -130,8 +135,13 @@ pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
         ),
         (
             "motiond_audit_dropped_total",
-            "Audit entries lost (queue full).",
+            "Audit entries lost (queue full or write failed).",
             s.audit_dropped.load(Relaxed),
+        ),
+        (
+            "motiond_requests_expired_total",
+            "Requests dropped undone after their requester had answered 503.",
+            st.requests_expired.load(Relaxed),
         ),
     ];
     for (name, help, v) in counters {
