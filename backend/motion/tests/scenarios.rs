@@ -1810,6 +1810,61 @@ fn s11a_31_superposition_abort_options() {
     );
 }
 
+/// The largest velocity change of a cycle that its accelerations do not explain (a velocity
+/// step; the superposition profile is C² but not jerk-limited, so the rig's jerk bound is
+/// lifted in these tests and cannot see one).
+fn max_velocity_step(history: &[AxisStatus]) -> f64 {
+    history
+        .windows(2)
+        .map(|w| {
+            let dv = w[1].set_velocity - w[0].set_velocity;
+            (dv - (w[0].set_acceleration + w[1].set_acceleration) / 2.0 * DT).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// An aborted superposition hands the velocity it was adding to the main motion, which is
+/// re-planned from there: no velocity step (it was a step of what the superposition added).
+#[test]
+fn an_aborted_superposition_leaves_no_velocity_step() {
+    use SuperpositionAbortOption::*;
+    let halt = CommandKind::Halt {
+        deceleration: 0.0,
+        jerk: 0.0,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    };
+    for (option, then) in [
+        (AbortAtStandstill, halt),
+        (ResumeAfterStandstill, halt),
+        (AbortAtStandstill, velocity(200.0, Direction::Negative)),
+        (AbortAtStandstill, CommandKind::AbortSuperposition),
+    ] {
+        let mut r = conveyor(200.0);
+        let s = r.ok(
+            0,
+            CommandKind::MoveSuperImposed(Superposition {
+                mode: SuperpositionMode::VeloReductionAdditiveMotion,
+                distance: 50.0,
+                velocity_diff: 200.0,
+                acceleration: 0.0,
+                deceleration: 0.0,
+                velocity_process: 200.0,
+                length: 400.0,
+                abort_option: option,
+            }),
+        );
+        r.run(0.2);
+        assert!(r.st(0).set_velocity > 201.0, "adding velocity");
+        r.ok(0, then);
+        r.until(1.0, |r| !r.out(s).busy);
+        assert!(r.out(s).command_aborted, "{option:?} {then:?}");
+        r.run(0.5);
+        let step = max_velocity_step(&r.history[0]);
+        assert!(step < 0.1, "{option:?} {then:?}: velocity step {step}");
+    }
+}
+
 #[test]
 fn superposition_shifts_the_target_of_the_running_move() {
     let mut r = Rig::new(1);

@@ -204,17 +204,20 @@ impl Axis {
         };
         if abort {
             // This cycle's sample is the bare main motion: keep last cycle's contribution in
-            // it so that the planner takes over from a continuous state.
+            // it so that the planner takes over from a continuous state (the abort re-plans
+            // the main motion from there; without it the velocity would step back by what
+            // the superposition added).
             self.set.position += sp.added.0 * dt;
             self.set.velocity += sp.added.0;
             self.set.acceleration += sp.added.1;
             if self.planner.is_planned() {
                 self.planner.shift(sp.added.0 * dt);
             }
-            self.superimposed = Some(Superimposed {
-                added: (0.0, 0.0),
-                ..sp
-            });
+            if let Some(c) = self.coupling.as_mut() {
+                c.slave_start += sp.added.0 * dt;
+            }
+            self.set_has_superposition = false;
+            self.superimposed = Some(sp);
             self.abort_superposition(cycle, events);
             return;
         }
