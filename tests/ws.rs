@@ -226,6 +226,33 @@ async fn rpc_errors_and_unsubscribe() {
     let first = next(&mut ws, Duration::from_secs(5)).await.unwrap();
     assert_eq!(first["params"]["topic"], "system");
     assert_eq!(first["params"]["full"], true);
+    // wait must be a boolean, and timeout_ms comes only with wait: true.
+    for (k, extra) in [
+        (40u64, json!({"wait": "yes"})),
+        (41, json!({"timeout_ms": 100})),
+        (42, json!({"wait": true, "timeout_ms": -5})),
+    ] {
+        let mut p = json!({"axis": "x", "position": 1.0, "velocity": 1.0});
+        p.as_object_mut()
+            .unwrap()
+            .extend(extra.as_object().unwrap().clone());
+        send(&mut ws, k, "move-absolute", p).await;
+        let (r, _) = response(&mut ws, k).await;
+        assert_eq!(r["error"]["code"], -32602, "{r}");
+    }
+    // A notification (no id) is carried out but not answered: the next answer is id 43's.
+    let m = json!({"jsonrpc": "2.0", "method": "unsubscribe", "params": {"topic": "commands"}});
+    ws.send(Message::Text(m.to_string().into())).await.unwrap();
+    let m = json!({"jsonrpc": "2.0", "method": "move-absolute", "params": {"axis": "x"}});
+    ws.send(Message::Text(m.to_string().into())).await.unwrap();
+    send(&mut ws, 43, "unsubscribe", json!({"topic": "nothing"})).await;
+    let m = loop {
+        let m = next(&mut ws, Duration::from_secs(5)).await.unwrap();
+        if m.get("id").is_some() {
+            break m;
+        }
+    };
+    assert_eq!(m["id"], 43, "a notification was answered: {m}");
     send(&mut ws, 6, "unsubscribe", json!({"topic": "system"})).await;
     response(&mut ws, 6).await;
     // after the unsubscribe reply no system update arrives any more

@@ -41,7 +41,8 @@ ends with a `subscription_ended` {topic, reason} notification when the axis is r
 then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is \
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
-closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`).",
+closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). \
+A request without an id is a notification: carried out, never answered.",
     responses((status = 101, description = "Switching protocols")))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
@@ -269,7 +270,11 @@ fn handle(
         Some(_) => return Some(rpc_error(&id, -32602, "params must be an object", None)),
     };
     let method = method.to_string();
-    match method.as_str() {
+    // A JSON-RPC notification (no id) is carried out but never answered.
+    let notification = req.get("id").is_none();
+    // (a closure, so that its early error returns are silenced for notifications too)
+    #[allow(clippy::redundant_closure_call)]
+    let reply = (|| match method.as_str() {
         "subscribe" => {
             let Some(key) = params
                 .get("topic")
@@ -379,7 +384,9 @@ fn handle(
                         }
                     }
                 };
-                let _ = out.send(msg).await;
+                if !notification {
+                    let _ = out.send(msg).await;
+                }
                 drop(permit);
             });
             None
@@ -399,10 +406,26 @@ fn handle(
                 _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
             };
             let wait = match (params.remove("wait"), params.remove("timeout_ms")) {
-                (Some(Value::Bool(true)), t) => Some(Duration::from_millis(
-                    t.and_then(|t| t.as_u64()).unwrap_or(10_000).min(600_000),
-                )),
-                _ => None,
+                (Some(Value::Bool(true)), t @ (None | Some(Value::Number(_)))) => {
+                    match t.map(|t| t.as_u64()) {
+                        Some(None) => {
+                            let msg = "timeout_ms must be a whole number of milliseconds";
+                            return Some(rpc_error(&id, -32602, msg, None));
+                        }
+                        t => Some(Duration::from_millis(
+                            t.flatten().unwrap_or(10_000).min(600_000),
+                        )),
+                    }
+                }
+                (None | Some(Value::Bool(false)), None) => None,
+                (None | Some(Value::Bool(false)), Some(_)) => {
+                    let msg = "timeout_ms needs wait: true";
+                    return Some(rpc_error(&id, -32602, msg, None));
+                }
+                _ => {
+                    let msg = "wait must be true or false, timeout_ms a number";
+                    return Some(rpc_error(&id, -32602, msg, None));
+                }
             };
             let permit = match in_flight.clone().try_acquire_owned() {
                 Ok(p) => p,
@@ -429,12 +452,15 @@ fn handle(
                     }
                     Err(e) => api_error(&id, e),
                 };
-                let _ = out.send(msg).await;
+                if !notification {
+                    let _ = out.send(msg).await;
+                }
                 drop(permit);
             });
             None
         }
-    }
+    })();
+    reply.filter(|_| !notification)
 }
 
 fn too_many_in_flight(id: &Value) -> String {
