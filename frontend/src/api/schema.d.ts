@@ -452,6 +452,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/status/following-error-peak/reset": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Restart the following-error peak hold
+         * @description `following_error_min` / `following_error_max` of the status hold the lowest and highest following error of every cycle since the last reset (TwinCAT's online "lag distance min/max"). This restarts them from the present following error; it changes no motion and creates no command.
+         */
+        post: operations["reset_following_error_peak"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/stop": {
         parameters: {
             query?: never;
@@ -610,7 +630,7 @@ export interface paths {
         };
         /**
          * Websocket: JSON-RPC 2.0 subscriptions and commands
-         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (rate capped at 100 Hz; default 10); `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog sent over the socket is kept alive while the socket is open and released when it closes.
+         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). A request without an id is a notification: carried out, never answered.
          */
         get: operations["upgrade"];
         put?: never;
@@ -807,6 +827,15 @@ export interface components {
             following_error: number;
             /**
              * Format: double
+             * @description Lowest and highest following error of any cycle since the peak was last reset
+             *     (TwinCAT's online "lag distance min/max"): tracked by the kernel every cycle, so a
+             *     peak between two status reads is never missed.
+             */
+            following_error_min: number;
+            /** Format: double */
+            following_error_max: number;
+            /**
+             * Format: double
              * @description Modulo set position in [0, period) (equal to set_position on linear axes).
              */
             modulo_set_position: number;
@@ -853,11 +882,6 @@ export interface components {
             soft_limit_min_exceeded: boolean;
             soft_limit_max_exceeded: boolean;
             coupled: boolean;
-            /**
-             * Format: int32
-             * @description Slot of the master while coupled.
-             */
-            master?: number | null;
             /** Format: double */
             gear_ratio: number;
             /** @description A superposition (MC_MoveSuperImposed) is running (StateDWord bit 13 Compensating). */
@@ -1271,6 +1295,14 @@ export interface components {
              */
             fault_on_hit: boolean;
         };
+        /** @description The live status of an axis: the kernel's status plus what only the server can name. */
+        LiveStatus: components["schemas"]["AxisStatus"] & {
+            /**
+             * @description The master axis (name) while the axis is coupled as a gear slave.
+             * @example x
+             */
+            master?: string | null;
+        };
         /** @description Modulo (rotary) axis: positions wrap at `period`. */
         ModuloConfig: {
             /**
@@ -1491,6 +1523,21 @@ export interface components {
             value: components["schemas"]["ParamValue"];
             /** @description MC_WriteParameterPersistent: kept across restarts until the axis is replaced. */
             persistent?: boolean;
+        };
+        /**
+         * @description When the following-error peak hold counts from.
+         * @example {
+         *       "axis": "x",
+         *       "cycle": 120345
+         *     }
+         */
+        PeakResetResource: {
+            axis: string;
+            /**
+             * Format: int64
+             * @description The first cycle of the new peak hold.
+             */
+            cycle: number;
         };
         /** @description Closed-loop response of the load to the position reference. */
         PlantModel: {
@@ -1857,7 +1904,7 @@ export interface components {
              */
             cycle: number;
             unit: string;
-            status: components["schemas"]["AxisStatus"];
+            status: components["schemas"]["LiveStatus"];
         };
         /** @description MC_Stop. */
         StopBody: {
@@ -1953,9 +2000,16 @@ export interface components {
             events_dropped: number;
             /**
              * Format: int64
-             * @description Audit entries lost because the audit queue was full.
+             * @description Audit entries lost: the audit queue was full or writing them failed (disk full,
+             *     database locked); each one is also logged.
              */
             audit_dropped: number;
+            /**
+             * Format: int64
+             * @description Requests the cycle thread dropped undone because their requester had already answered
+             *     503 (the cycle thread took longer than that to drain them).
+             */
+            requests_expired: number;
             /**
              * Format: int64
              * @description Scope frames lost because the scope ring was full (the recordings running then failed).
@@ -5377,6 +5431,50 @@ export interface operations {
                 };
                 content: {
                     "application/json": components["schemas"]["StatusResource"];
+                };
+            };
+            /** @description No such resource. */
+            404: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    /**
+                     * @example {
+                     *       "code": "axis_not_found",
+                     *       "detail": "no axis 'z'",
+                     *       "status": 404,
+                     *       "title": "Not found",
+                     *       "type": "urn:motiond:problem:axis_not_found"
+                     *     }
+                     */
+                    "application/problem+json": components["schemas"]["Problem"];
+                };
+            };
+        };
+    };
+    reset_following_error_peak: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Reset; the peak hold counts from `cycle` */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["PeakResetResource"];
                 };
             };
             /** @description No such resource. */
