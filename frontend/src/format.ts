@@ -1,4 +1,5 @@
 import type { AxisState } from './api/types';
+import { errorInfo } from './api/errors';
 
 export const STATE_LABEL: Record<AxisState, string> = {
   disabled: 'Disabled',
@@ -59,4 +60,20 @@ export function time(iso: string | undefined | null): string {
   const d = new Date(iso);
   if (Number.isNaN(d.getTime())) return iso;
   return d.toLocaleTimeString(undefined, { hour12: false }) + '.' + String(d.getMilliseconds()).padStart(3, '0');
+}
+
+/** What the axis-error banner says: the error number's entry, or (error_id 0) why it stopped. */
+export interface AxisErrorText {
+  hex: string | null;
+  code: string | null;
+  text: string;
+}
+
+export function axisError(s: { state: AxisState; error_id: number; drive_fault: boolean } | null | undefined): AxisErrorText | null {
+  if (!s || (!s.error_id && s.state !== 'error_stop')) return null;
+  if (s.error_id) {
+    const e = errorInfo(s.error_id);
+    return { hex: e.hex, code: e.code, text: e.text + (s.drive_fault && e.code !== 'drive_fault' ? ' · drive fault' : '') };
+  }
+  return { hex: null, code: null, text: s.drive_fault ? 'drive fault (no error number)' : 'error stop (no error number)' };
 }

@@ -347,15 +347,44 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
-  test('server gone: the UI says so, then reconnects by itself', async () => {
-    const page = await open(`/axes/${AXIS}`);
+  test('server gone: the UI says so, every command button is disabled, then it reconnects by itself', async () => {
+    await enabled();
+    // an axis in error (the banner's Reset) with an edited parameter (Review & apply)
+    assert.ok((await rest(stack.api, 'POST', `/axes/${AXIS}/simulation/fault`, { kind: 'drive_fault', code: 8976 })).status < 300);
+    const page = await open(`/axes/${AXIS}/parameters`);
+    await page.locator('[data-testid="axis-error"]').waitFor({ timeout: 10000 });
+    await page.locator('tr[data-param="AxisVeloManFast"] input').fill('150');
+    assert.equal(await page.locator('button[name="review"]').isDisabled(), false);
     await stack.killMotiond();
     await page.waitForSelector('[data-notice="server-gone"]', { timeout: 15000 });
-    assert.equal(await page.locator('[data-jog="slow-forward"]').isDisabled(), true, 'no jogging while offline');
+    const disabled = async (where, names) => {
+      for (const n of names) assert.equal(await page.locator(n).first().isDisabled(), true, `${n} disabled while offline (${where})`);
+    };
+    await disabled('parameters', ['button[name="review"]', 'button[name="reset-error"]']);
+    await page.click('[data-tab="config"]');
+    await disabled('configuration', ['button[name="save"]', 'button[name="delete"]']);
+    await page.click('[data-tab="online"]');
+    await disabled('online', [
+      '[data-jog="slow-forward"]',
+      'button[name="inch-forward"]',
+      'button[name="power-set"]',
+      'button[name="reset"]',
+      'button[name="start"]',
+      'button[name="halt"]',
+      'button[name="stop"]',
+      'button[name="set-position-btn"]',
+      'button[name="home-btn"]',
+      'input[name="override"]',
+      'button[name="reset-error"]',
+    ]);
     await shot(page, 'online-server-gone');
+    await page.click('.nav a:has-text("Scope")');
+    await disabled('scope', ['button[name="record"]']);
     await stack.restartMotiond();
     await page.waitForSelector('[data-conn="open"]', { timeout: 30000 });
     await page.waitForSelector('[data-notice="server-gone"]', { state: 'detached' });
+    await page.waitForSelector('button[name="record"]:not([disabled])', { timeout: 10000 });
+    await page.click(`.axis-item[data-axis="${AXIS}"]`);
     await until(async () => Number.isFinite(await readout(page, 'actual_position')), { what: 'live values again' });
     await page.close();
   });

@@ -7,7 +7,7 @@ import { ApiError, del, enc, post, put } from '../api/rest';
 import { command, refreshAxes, statuses } from '../services';
 import { navigate } from '../router';
 import { useStore } from '../store';
-import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf } from './common';
+import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
 import { inputNum } from '../format';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
@@ -221,6 +221,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
   const [message, setMessage] = useState<string | null>(null);
   const [confirmDelete, setConfirmDelete] = useState(false);
   const st = useStore(statuses);
+  const online = useOnline();
   useEffect(() => {
     setForm(axis ? formOf(axis.config) : DEFAULT_FORM);
     setFields({});
@@ -301,7 +302,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
       {notDisabled && axis && (
         <div class="banner banner-warn">
           The axis must be disabled first.
-          <ActionButton kind="warn" name="disable-axis" onClick={() => command(axis.config.name, 'power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 }).then(() => setNotDisabled(false), (e) => setError(errorText(e)))}>
+          <ActionButton kind="warn" name="disable-axis" disabled={!online} onClick={() => command(axis.config.name, 'power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 }).then(() => setNotDisabled(false), (e) => setError(errorText(e)))}>
             Disable {axis.config.name} now
           </ActionButton>
         </div>
@@ -312,7 +313,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
         class="config-form"
         onSubmit={(e) => {
           e.preventDefault();
-          void save();
+          if (online) void save();
         }}
       >
         <div class="config-grid">
@@ -422,7 +423,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
           </Panel>
         </div>
         <div class="form-actions sticky-actions">
-          <button type="submit" class="btn btn-primary" name="save">
+          <button type="submit" class="btn btn-primary" name="save" disabled={!online}>
             {creating ? 'Create axis' : 'Save configuration'}
           </button>
           {!creating && (
@@ -434,7 +435,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
             (confirmDelete ? (
               <span class="confirm">
                 Delete axis <b>{axis.config.name}</b> and its persistent parameters?
-                <ActionButton kind="danger" name="delete-confirm" onClick={remove}>
+                <ActionButton kind="danger" name="delete-confirm" disabled={!online} onClick={remove}>
                   Delete
                 </ActionButton>
                 <button type="button" class="btn" onClick={() => setConfirmDelete(false)}>
@@ -442,7 +443,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
                 </button>
               </span>
             ) : (
-              <button type="button" class="btn btn-danger-outline" name="delete" onClick={() => setConfirmDelete(true)}>
+              <button type="button" class="btn btn-danger-outline" name="delete" disabled={!online} onClick={() => setConfirmDelete(true)}>
                 Delete axis…
               </button>
             ))}

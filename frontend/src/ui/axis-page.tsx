@@ -2,9 +2,8 @@ import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { axes, axesLoaded, command, statuses } from '../services';
 import { href } from '../router';
-import { ActionButton, Lamp } from './common';
-import { STATE_LABEL } from '../format';
-import { errorInfo } from '../api/errors';
+import { ActionButton, Lamp, useOnline } from './common';
+import { STATE_LABEL, axisError } from '../format';
 import { OnlineTab } from './online';
 import { ParametersTab } from './parameters';
 import { AxisConfigPage } from './axis-config';
@@ -13,6 +12,7 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
   const list = useStore(axes);
   const loaded = useStore(axesLoaded);
   const st = useStore(statuses);
+  const online = useOnline();
   const a = list.find((x) => x.config.name === axis);
   const [resetError, setResetError] = useState<string | null>(null);
   useEffect(() => setResetError(null), [axis]);
@@ -31,7 +31,7 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
   }
   const live = st.get(axis);
   const s = live?.status;
-  const err = s && (s.error_id || s.state === 'error_stop') ? errorInfo(s.error_id) : null;
+  const err = axisError(s);
   const tabLink = (t: typeof tab, label: string) => (
     <a href={href({ page: 'axis', axis, tab: t })} class={`tab ${tab === t ? 'active' : ''}`} data-tab={t}>
       {label}
@@ -61,12 +61,19 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
       {err && (
         <div class="banner banner-error axis-error" role="alert" data-testid="axis-error">
           <span>
-            <b>Axis in error</b> · <b>{err.hex}</b> <code>{err.code}</code> — {err.text}
-            {s?.drive_fault ? ' · drive fault' : ''}
+            <b>Axis in error</b> ·{' '}
+            {err.hex && (
+              <>
+                <b>{err.hex}</b> <code>{err.code}</code> —{' '}
+              </>
+            )}
+            <span data-testid="axis-error-text">{err.text}</span>
           </span>
           <ActionButton
             kind="danger"
             name="reset-error"
+            title="MC_Reset (F8 on the Online tab)"
+            disabled={!online}
             onClick={async () => {
               try {
                 setResetError(null);

@@ -5,6 +5,13 @@ import type { AxisState } from '../api/types';
 import { ApiError } from '../api/rest';
 import { RpcError } from '../live/client';
 import { errorInfo } from '../api/errors';
+import { useStore } from '../store';
+import { live } from '../services';
+
+/** Whether the socket to motiond is open: every command button is disabled while it is not. */
+export function useOnline(): boolean {
+  return useStore(live.state).kind === 'open';
+}
 
 export function Lamp({ state, errorId = 0, label = false, title }: { state?: AxisState; errorId?: number; label?: boolean; title?: string }) {
   const text = state ? STATE_LABEL[state] : 'unknown';

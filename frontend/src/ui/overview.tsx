@@ -1,8 +1,7 @@
 import { useStore } from '../store';
 import { axes, statuses } from '../services';
 import { Lamp } from './common';
-import { pos, vel, STATE_LABEL } from '../format';
-import { errorInfo } from '../api/errors';
+import { pos, vel, STATE_LABEL, axisError } from '../format';
 import { href, navigate } from '../router';
 import { CommandLog } from './command-log';
 import { Panel } from './common';
@@ -39,7 +38,7 @@ export function Overview() {
             const live = st.get(a.config.name);
             const s = live?.status;
             const u = a.config.unit;
-            const err = s?.error_id ? errorInfo(s.error_id) : null;
+            const err = axisError(s);
             return (
               <tr
                 key={a.id}
@@ -66,8 +65,8 @@ export function Overview() {
                 <td>{s?.homed ? <span class="tag tag-green">homed</span> : <span class="tag">no</span>}</td>
                 <td class="err-cell" data-col="error">
                   {err ? (
-                    <span class="err-text" title={err.code}>
-                      <b>{err.hex}</b> {err.text}
+                    <span class="err-text" title={err.code ?? undefined}>
+                      {err.hex && <b>{err.hex}</b>} {err.text}
                     </span>
                   ) : s?.drive_fault ? (
                     <span class="err-text">drive fault</span>

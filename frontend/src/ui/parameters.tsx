@@ -3,7 +3,7 @@
 import { useEffect, useMemo, useState } from 'preact/hooks';
 import { get, put, enc } from '../api/rest';
 import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
-import { ErrorBanner, errorText, fieldsOf } from './common';
+import { ErrorBanner, errorText, fieldsOf, useOnline } from './common';
 import { inputNum } from '../format';
 import { ApiError } from '../api/rest';
 import { errorInfo } from '../api/errors';
@@ -88,6 +88,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
   const [messageError, setMessageError] = useState(false);
   const [openHelp, setOpenHelp] = useState<number | null>(null);
   const [aliases, setAliases] = useState(false);
+  const online = useOnline();
 
   const load = () =>
     get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(setList, (e) => setError(errorText(e)));
@@ -171,7 +172,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
           {changes.length} change{changes.length === 1 ? '' : 's'}
           {Object.keys(invalid).length ? ` · ${Object.keys(invalid).length} invalid` : ''}
         </span>
-        <button type="button" class="btn btn-primary" name="review" disabled={changes.length === 0 || applying} onClick={() => setReview(true)}>
+        <button type="button" class="btn btn-primary" name="review" disabled={changes.length === 0 || applying || !online} onClick={() => setReview(true)}>
           Review & apply…
         </button>
         <button
@@ -224,7 +225,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
             </tbody>
           </table>
           <div class="form-actions">
-            <button type="button" class="btn btn-primary" name="apply" disabled={applying} onClick={() => void apply()}>
+            <button type="button" class="btn btn-primary" name="apply" disabled={applying || !online} onClick={() => void apply()}>
               {applying ? 'Applying…' : 'Apply'}
             </button>
             <button type="button" class="btn" name="cancel" onClick={() => setReview(false)}>
