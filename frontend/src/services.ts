@@ -6,6 +6,8 @@ import { ApiError, del, enc, get, post } from './api/rest';
 import { errorInfo } from './api/errors';
 import type { AxisResource, AxisStatus, CommandEvent, CommandResource, SystemResource } from './api/types';
 import { RpcError } from './live/client';
+import { ScopeSession } from './scope/session';
+import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
 
 export interface LiveStatus {
   status: AxisStatus | null;
@@ -49,6 +51,8 @@ export const axesLoaded = new Store<boolean>(false);
 export const statuses = new Store<Map<string, LiveStatus>>(new Map(), true);
 export const system = new Store<SystemResource | null>(null, true);
 export const commandLog = new Store<LogEntry[]>([], true);
+/** Scope recordings followed across page changes. */
+export const scope = new ScopeSession({ list: listRecordings, get: getRecording, create: createRecording, cancel: cancelRecording });
 
 let focus: string | null = null;
 const subscribed = new Map<string, { rate: number; off: () => void }>();

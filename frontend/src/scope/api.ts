@@ -31,18 +31,3 @@ export const createRecording = (r: RecordingRequest) => post<Recording>(RECORDIN
 export const getRecording = (id: Recording['id']) => get<Recording>(`${RECORDINGS}/${enc(String(id))}`);
 export const cancelRecording = (id: Recording['id']) => del<unknown>(`${RECORDINGS}/${enc(String(id))}`);
 export const csvUrl = (id: Recording['id']) => `/api/v1${RECORDINGS}/${enc(String(id))}?format=csv`;
-
-/** Polls until the recording is done or cancelled (or `abort` says stop). */
-export async function waitForRecording(
-  id: Recording['id'],
-  onProgress: (r: Recording) => void,
-  abort: { aborted: boolean },
-  intervalMs = 200,
-): Promise<Recording> {
-  for (;;) {
-    const r = await getRecording(id);
-    onProgress(r);
-    if (r.state === 'done' || r.state === 'cancelled' || r.state === 'failed' || abort.aborted) return r;
-    await new Promise((res) => setTimeout(res, intervalMs));
-  }
-}

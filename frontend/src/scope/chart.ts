@@ -1,5 +1,7 @@
 // uPlot wrapper for scope recordings: one y scale per unit, drag-select zoom, wheel zoom,
-// pan (shift-drag or middle-drag), two cursors placed by clicking (alternating C1/C2).
+// pan (shift-drag or middle-drag, or a sideways swipe on a touch screen), two cursors placed
+// by clicking or tapping (alternating C1/C2). The element carries what is drawn as data
+// attributes (`data-samples`, `data-series`, `data-view` = "min,max" of t) for the tests.
 import uPlot from 'uplot';
 import { panRange, zoomRange } from './data';
 
@@ -76,13 +78,19 @@ export class ScopeChart {
         draw: [(u) => this.drawCursors(u)],
         setScale: [
           (u, key) => {
-            if (key === 'x') this.cb.onRange(u.scales.x.min ?? 0, u.scales.x.max ?? 0);
+            if (key !== 'x') return;
+            const min = u.scales.x.min ?? 0;
+            const max = u.scales.x.max ?? 0;
+            this.el.dataset.view = `${min},${max}`;
+            this.cb.onRange(min, max);
           },
         ],
       },
     };
     const data = [Array.from(t), ...series.map((s) => Array.from(s.values))] as uPlot.AlignedData;
     this.u = new uPlot(opts, data, el);
+    el.dataset.samples = String(n);
+    el.dataset.series = String(series.length);
     this.installInteractions();
     if (typeof ResizeObserver !== 'undefined') {
       this.ro = new ResizeObserver(() => this.resize());
@@ -176,6 +184,22 @@ export class ScopeChart {
     window.addEventListener('mousemove', this.onMove);
     window.addEventListener('mouseup', this.onUp);
     over.addEventListener('dblclick', () => this.reset());
+    // Touch: a sideways swipe pans (vertical ones still scroll the page: touch-action pan-y);
+    // a tap arrives as a click and places a cursor; zoom with the toolbar's buttons.
+    let swipe: { id: number; x: number; min: number; max: number } | null = null;
+    over.addEventListener('pointerdown', (e) => {
+      if (e.pointerType === 'touch') swipe = { id: e.pointerId, x: e.clientX, ...this.range() };
+    });
+    over.addEventListener('pointermove', (e) => {
+      if (!swipe || e.pointerId !== swipe.id) return;
+      const pxPerS = this.u.bbox.width / devicePixelRatio / (swipe.max - swipe.min);
+      this.setRange(panRange({ min: swipe.min, max: swipe.max }, -(e.clientX - swipe.x) / pxPerS, this.limits));
+    });
+    const endSwipe = () => {
+      swipe = null;
+    };
+    over.addEventListener('pointerup', endSwipe);
+    over.addEventListener('pointercancel', endSwipe);
   }
 
   private drawCursors(u: uPlot): void {
@@ -229,6 +253,9 @@ export class ScopeChart {
 
   destroy(): void {
     this.ro?.disconnect();
+    delete this.el.dataset.samples;
+    delete this.el.dataset.series;
+    delete this.el.dataset.view;
     window.removeEventListener('mousemove', this.onMove);
     window.removeEventListener('mouseup', this.onUp);
     this.u.destroy();

@@ -1,8 +1,10 @@
 // Scope: pick signals of one or more axes, record N seconds at the cycle rate on the server
 // (optionally from a trigger with pre-trigger), then zoom, pan, place two cursors, export CSV.
+// The recordings are followed by services' `scope` (ScopeSession), not by this page: leaving
+// the page to move the axis does not lose an armed or running recording.
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { axes, system } from '../services';
+import { axes, scope, system } from '../services';
 import {
   MAX_CHANNELS,
   SIGNALS,
@@ -17,13 +19,12 @@ import {
   timeAxis,
   toCsv,
   type Edge,
-  type Recording,
   type ScopeForm,
   type Signal,
 } from '../scope/data';
-import { cancelRecording, createRecording, csvUrl, getRecording, listRecordings, scopeAvailable, waitForRecording } from '../scope/api';
+import { csvUrl, scopeAvailable } from '../scope/api';
 import { COLORS, ScopeChart } from '../scope/chart';
-import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum } from './common';
+import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { sig } from '../format';
 
 function download(name: string, text: string): void {
@@ -37,11 +38,12 @@ function download(name: string, text: string): void {
 
 /** Form state survives leaving the page. */
 let savedForm: ScopeForm | null = null;
-let savedRecording: Recording | null = null;
 
 export function ScopePage() {
   const list = useStore(axes);
   const sys = useStore(system);
+  const session = useStore(scope.state);
+  const online = useOnline();
   const unitOf = (axis: string) => list.find((a) => a.config.name === axis)?.config.unit ?? '';
   const [available, setAvailable] = useState<boolean | null>(null);
   const defaultChannels = (): ScopeForm['channels'] =>
@@ -65,25 +67,19 @@ export function ScopePage() {
   const [preText, setPreText] = useState(String(form.trigger.pre_trigger_s));
   const [errors, setErrors] = useState<Record<string, string>>({});
   const [error, setError] = useState<string | null>(null);
-  const [running, setRunning] = useState<Recording | null>(null);
-  const [rec, setRec] = useState<Recording | null>(savedRecording);
+  const running = session.running;
+  const rec = session.shown;
   const [cursors, setCursors] = useState<[number | null, number | null]>([null, null]);
   const [view, setView] = useState<{ min: number; max: number } | null>(null);
-  const abort = useRef({ aborted: false });
   const chartEl = useRef<HTMLDivElement>(null);
   const chart = useRef<ScopeChart | null>(null);
 
-  const [kept, setKept] = useState<Recording[]>([]);
-  const refreshKept = () => listRecordings().then(setKept);
+  const kept = session.kept;
+  // The server's recordings now and every few seconds; an armed or running one is followed.
+  useEffect(() => scope.attach(), []);
   useEffect(() => {
-    scopeAvailable().then((a) => {
-      setAvailable(a);
-      if (a) void refreshKept();
-    });
-    return () => {
-      abort.current.aborted = true;
-    };
-  }, []);
+    if (online) void scopeAvailable().then(setAvailable);
+  }, [online]);
   useEffect(() => {
     savedForm = form;
   }, [form]);
@@ -137,34 +133,14 @@ export function ScopePage() {
     const { request, errors: errs } = buildRequest(f);
     setErrors(errs);
     if (!request) return;
-    abort.current = { aborted: false };
     try {
-      const created = await createRecording(request);
-      setRunning(created);
-      const done = await waitForRecording(created.id, setRunning, abort.current);
-      setRunning(null);
-      void refreshKept();
-      if (done.state === 'done') {
-        savedRecording = done;
-        setRec(done);
-      } else if (!abort.current.aborted) setError(`recording ${done.state}${done.reason ? `: ${done.reason}` : ''}`);
+      await scope.record(request);
     } catch (e) {
-      setRunning(null);
       setErrors(fieldsOf(e));
       setError(errorText(e));
     }
   };
 
-  const cancel = async () => {
-    if (!running) return;
-    abort.current.aborted = true;
-    try {
-      await cancelRecording(running.id);
-    } catch (e) {
-      setError(errorText(e));
-    }
-    setRunning(null);
-  };
 
   const cycle = rec?.cycle_time_s ?? sys?.cycle_time ?? null;
   const duration = parseNum(durationText);
@@ -177,13 +153,19 @@ export function ScopePage() {
           {cycle && Number.isFinite(duration) && duration > 0 ? ` · ${expectedSamples(duration, cycle)} samples` : ''}
         </span>
       </div>
-      {available === false && (
+      {available === false && online && (
         <div class="banner banner-warn" data-testid="scope-unavailable">
           This motiond has no scope recording endpoints yet (<code>POST /api/v1/scope/recordings</code>). Recording is disabled until the
           server provides them.
         </div>
       )}
-      <ErrorBanner error={error} onClose={() => setError(null)} />
+      <ErrorBanner
+        error={error ?? session.error}
+        onClose={() => {
+          setError(null);
+          scope.clearError();
+        }}
+      />
       <div class="scope-grid">
         <Panel title="Recording" class="scope-setup">
           <div class="channels">
@@ -267,17 +249,18 @@ export function ScopePage() {
             )}
           </div>
           <div class="form-actions">
-            <button type="button" class="btn btn-primary" name="record" disabled={!available || !!running} onClick={() => void record()}>
+            <button type="button" class="btn btn-primary" name="record" disabled={!available || !!running || !online} onClick={() => void record()}>
               {running ? 'Recording…' : 'Record'}
             </button>
             {running && (
-              <button type="button" class="btn" name="cancel-recording" onClick={() => void cancel()}>
+              <button type="button" class="btn" name="cancel-recording" disabled={!online} onClick={() => void scope.cancel()}>
                 Cancel
               </button>
             )}
           </div>
           {running && (
-            <div class="muted small" data-testid="recording-state">
+            <div class="muted small" data-testid="recording-state" data-state={running.state} data-recording={String(running.id)}>
+              #{String(running.id)}{' '}
               {running.state === 'armed'
                 ? 'armed: waiting for the trigger…'
                 : `${running.state}… ${running.samples_recorded ?? 0} / ${running.samples} samples`}
@@ -286,22 +269,22 @@ export function ScopePage() {
         </Panel>
         <div class="scope-main">
           <div class="toolbar scope-toolbar">
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.zoom(0.5)} title="zoom in">
+            <button type="button" class="btn btn-small" name="zoom-in" disabled={!rec} onClick={() => chart.current?.zoom(0.5)} title="zoom in (half the time range)">
               zoom +
             </button>
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.zoom(2)} title="zoom out">
+            <button type="button" class="btn btn-small" name="zoom-out" disabled={!rec} onClick={() => chart.current?.zoom(2)} title="zoom out (twice the time range)">
               zoom −
             </button>
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.pan(-0.25)} title="pan left">
+            <button type="button" class="btn btn-small" name="pan-left" disabled={!rec} onClick={() => chart.current?.pan(-0.25)} title="pan left (a quarter of the view)">
               ◀
             </button>
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.pan(0.25)} title="pan right">
+            <button type="button" class="btn btn-small" name="pan-right" disabled={!rec} onClick={() => chart.current?.pan(0.25)} title="pan right (a quarter of the view)">
               ▶
             </button>
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.reset()}>
+            <button type="button" class="btn btn-small" name="full-view" disabled={!rec} onClick={() => chart.current?.reset()}>
               full view
             </button>
-            <button type="button" class="btn btn-small" disabled={!rec} onClick={() => chart.current?.clearCursors()}>
+            <button type="button" class="btn btn-small" name="clear-cursors" disabled={!rec} onClick={() => chart.current?.clearCursors()}>
               clear cursors
             </button>
             <span class="spacer" />
@@ -310,16 +293,9 @@ export function ScopePage() {
                 name="recordings"
                 title="recordings kept by the server"
                 value={rec ? String(rec.id) : ''}
-                onChange={async (e) => {
+                onChange={(e) => {
                   const id = (e.target as HTMLSelectElement).value;
-                  if (!id) return;
-                  try {
-                    const r = await getRecording(Number(id));
-                    savedRecording = r;
-                    setRec(r);
-                  } catch (err) {
-                    setError(errorText(err));
-                  }
+                  if (id) void scope.show(Number(id));
                 }}
               >
                 <option value="">recordings…</option>
@@ -352,7 +328,10 @@ export function ScopePage() {
             <div ref={chartEl} class="chart" data-testid="scope-chart" />
             {!rec && <div class="chart-empty muted">No recording yet. Pick signals, set a duration and press Record; then move the axis.</div>}
           </div>
-          <div class="muted small hint">drag: zoom to a range · wheel: zoom · shift-drag: pan · click: place cursor C1, then C2 · double-click: full view</div>
+          <div class="muted small hint">
+            drag: zoom to a range · wheel: zoom · shift-drag: pan · click: place cursor C1, then C2 · double-click: full view · touch: tap for a cursor,
+            swipe sideways to pan, the buttons above to zoom
+          </div>
           {rec && (
             <div class="muted small" data-testid="recording-info">
               recording {String(rec.id)} · {rec.samples} samples × {rec.channels.length} channels · cycle {(rec.cycle_time_s * 1000).toPrecision(3)} ms
@@ -371,7 +350,7 @@ export function ScopePage() {
                 </tr>
               </thead>
               <tbody>
-                <tr>
+                <tr data-row="t">
                   <th>t (s)</th>
                   <td class="r mono">{sig(readout.t1)}</td>
                   <td class="r mono">{sig(readout.t2)}</td>
@@ -381,7 +360,7 @@ export function ScopePage() {
                   </td>
                 </tr>
                 {readout.rows.map((r, i) => (
-                  <tr key={r.label}>
+                  <tr key={r.label} data-row={r.label}>
                     <th>
                       <span class="swatch" style={{ background: COLORS[i % COLORS.length] }} />
                       {r.label}

@@ -392,7 +392,9 @@ pub fn wait_duration(q: &WaitQuery) -> ApiResult<Option<Duration>> {
     match (q.wait, q.timeout_ms) {
         (_, Some(t)) if t > 600_000 => Err(ApiError::field("timeout_ms", "at most 600000")),
         (true, t) => Ok(Some(Duration::from_millis(t.unwrap_or(10_000)))),
-        (false, _) => Ok(None),
+        // A timeout without a wait is a client that meant to wait: say so instead of not waiting.
+        (false, Some(_)) => Err(ApiError::field("timeout_ms", "only with wait=true")),
+        (false, None) => Ok(None),
     }
 }
 

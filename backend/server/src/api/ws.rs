@@ -405,27 +405,24 @@ fn handle(
                 Some(Value::Number(n)) => n.to_string(),
                 _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
             };
-            let wait = match (params.remove("wait"), params.remove("timeout_ms")) {
-                (Some(Value::Bool(true)), t @ (None | Some(Value::Number(_)))) => {
-                    match t.map(|t| t.as_u64()) {
-                        Some(None) => {
-                            let msg = "timeout_ms must be a whole number of milliseconds";
-                            return Some(rpc_error(&id, -32602, msg, None));
-                        }
-                        t => Some(Duration::from_millis(
-                            t.flatten().unwrap_or(10_000).min(600_000),
-                        )),
+            // The REST query's rules (`?wait=true&timeout_ms=N`), from the params.
+            let query = match (params.remove("wait"), params.remove("timeout_ms")) {
+                (w @ (None | Some(Value::Bool(_))), t @ (None | Some(Value::Number(_))))
+                    if t.as_ref().is_none_or(|t| t.as_u64().is_some()) =>
+                {
+                    super::WaitQuery {
+                        wait: w.and_then(|w| w.as_bool()).unwrap_or(false),
+                        timeout_ms: t.and_then(|t| t.as_u64()),
                     }
                 }
-                (None | Some(Value::Bool(false)), None) => None,
-                (None | Some(Value::Bool(false)), Some(_)) => {
-                    let msg = "timeout_ms needs wait: true";
-                    return Some(rpc_error(&id, -32602, msg, None));
-                }
                 _ => {
-                    let msg = "wait must be true or false, timeout_ms a number";
+                    let msg = "wait must be true or false, timeout_ms a whole number of ms";
                     return Some(rpc_error(&id, -32602, msg, None));
                 }
+            };
+            let wait = match super::commands::wait_duration(&query) {
+                Ok(w) => w,
+                Err(e) => return Some(api_error(&id, e)),
             };
             let permit = match in_flight.clone().try_acquire_owned() {
                 Ok(p) => p,
