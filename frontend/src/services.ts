@@ -156,6 +156,7 @@ function upsert(e: LogEntry): void {
 }
 
 export function logCommand(r: CommandResource): void {
+  if (r.command === 'power') notePower(r.axis, r.id, r.parameters);
   upsert(entryOf(r));
 }
 
@@ -196,6 +197,7 @@ function onCommandEvent(ev: CommandEvent): void {
     at: known?.at ?? new Date().toISOString(),
     cycle: ev.cycle,
   });
+  if (ev.name === 'power') notePower(ev.axis, ev.command, known?.parameters ?? null);
   if (!known && !fetchedDetails.has(ev.command)) {
     fetchedDetails.add(ev.command);
     get<CommandResource>(`/commands/${ev.command}`).then(logCommand, () => {});
@@ -206,7 +208,7 @@ function onCommandEvent(ev: CommandEvent): void {
 export async function refreshCommands(): Promise<void> {
   try {
     const list = await get<CommandResource[]>('/commands?limit=100');
-    for (const r of list.reverse()) upsert(entryOf(r));
+    for (const r of list.reverse()) logCommand(r);
   } catch {
     /* shown by the connection state */
   }
@@ -235,6 +237,56 @@ export async function releaseCommand(id: number, axis: string): Promise<void> {
   }
 }
 
+/**
+ * The MC_Stop of this axis that still holds its lock (not final), asked of the server at
+ * the moment it is needed: a stop may come from another client or an earlier page. While
+ * ramping it is `active`, at standstill `done` but not final until released.
+ */
+export async function findHeldStop(axis: string): Promise<number | null> {
+  for (const state of ['active', 'done'] as const) {
+    const list = await get<CommandResource[]>(`/commands?axis=${enc(axis)}&state=${state}&limit=500`);
+    const stop = list.find((c) => c.command === 'stop' && !c.final);
+    if (stop) return stop.id;
+  }
+  return null;
+}
+
+/**
+ * The MC_Power override (percent) in force per axis: that of the axis's newest accepted power
+ * command (`percent` null while its parameters are not known yet). The effective override
+ * (`status.override_percent`) is this × the MC_SetOverride factor.
+ */
+export const powerOverrides = new Store<Map<string, { id: number; percent: number | null }>>(new Map());
+
+function notePower(axis: string, id: number, parameters: unknown): void {
+  const m = powerOverrides.get();
+  const old = m.get(axis);
+  if (old && old.id > id) return;
+  const v = parameters && typeof parameters === 'object' ? (parameters as { override_percent?: unknown }).override_percent : undefined;
+  // The server's default is 100 when the body leaves it out.
+  const percent = parameters && typeof parameters === 'object' ? (typeof v === 'number' ? v : 100) : null;
+  if (old && old.id === id && (percent === null || old.percent === percent)) return;
+  m.set(axis, { id, percent });
+  powerOverrides.emit();
+}
+
+/** The power override of an axis: 100 (the server's default) when no power command is known. */
+export function powerOverride(axis: string): number | null {
+  const p = powerOverrides.get().get(axis);
+  return p ? p.percent : 100;
+}
+
+/** Learns the axis's newest power command (it may be older than the command log's window). */
+export async function loadPowerCommand(axis: string): Promise<void> {
+  try {
+    const list = await get<CommandResource[]>(`/commands?axis=${enc(axis)}&limit=500`);
+    const p = list.find((c) => c.command === 'power');
+    if (p) notePower(p.axis, p.id, p.parameters);
+  } catch {
+    /* shown by the connection state */
+  }
+}
+
 // ---- wiring -----------------------------------------------------------------------------
 
 let started = false;
@@ -251,6 +303,8 @@ export function start(): void {
   });
   live.subscribe('commands', 1, () => {});
   live.onOpen(() => {
+    // Command ids start again after a server restart: forget what was learnt before.
+    powerOverrides.set(new Map());
     void refreshAxes();
     void refreshCommands();
   });

@@ -248,6 +248,19 @@ describe('commissioning UI', () => {
     await until(async () => (await status(stack.api, AXIS)).override_percent === 50, { what: 'override 50 %' });
     await page.click('.override button:has-text("100")');
     await until(async () => (await status(stack.api, AXIS)).override_percent === 100, { what: 'override 100 %' });
+    // changed by another client: the slider follows; under a power override of 50 % it still
+    // shows the MC_SetOverride factor (effective = 50 % × 30 % = 15 %)
+    await rest(stack.api, 'POST', `/axes/${AXIS}/set-override`, { velocity_factor: 0.3 });
+    await until(async () => (await page.inputValue('input[name="override"]')) === '30', { what: 'the slider to follow set-override' });
+    await rest(stack.api, 'POST', `/axes/${AXIS}/power`, { override_percent: 50 });
+    await until(async () => (await status(stack.api, AXIS)).override_percent === 15, { what: 'effective override 15 %' });
+    await page.waitForSelector('[data-testid="override-power"]:has-text("50 %")', { timeout: 10000 });
+    await sleep(300);
+    assert.equal(await page.inputValue('input[name="override"]'), '30');
+    await page.click('button[name="power-set"]'); // the UI's power sends override 100
+    await page.click('.override button:has-text("100")');
+    await until(async () => (await status(stack.api, AXIS)).override_percent === 100, { what: 'override 100 % again' });
+    await page.waitForSelector('[data-testid="override-power"]', { state: 'detached', timeout: 10000 });
     // MC_Stop and its release
     await page.click('[data-move="move-velocity"]');
     await page.fill('input[name="velocity"]', '50');
@@ -269,6 +282,13 @@ describe('commissioning UI', () => {
     await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
     assert.equal((await status(stack.api, AXIS)).motion_commands_locked, false);
     await atRest();
+    // a stop from another client (with its own deceleration), released from this page
+    const other = await rest(stack.api, 'POST', `/axes/${AXIS}/stop`, { deceleration: 1000 });
+    assert.equal(other.status, 202, JSON.stringify(other.body));
+    await page.waitForSelector('button[name="release-stop"]', { timeout: 10000 });
+    await page.click('button[name="release-stop"]');
+    await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
+    assert.ok((await rest(stack.api, 'GET', `/commands/${other.body.id}`)).body.final, 'the other client’s stop was released');
     // MC_Home, mode direct at 12.5
     await page.selectOption('select[name="home-mode"]', 'direct');
     await page.fill('input[name="home-position"]', '12.5');
@@ -278,8 +298,11 @@ describe('commissioning UI', () => {
     assert.ok(s.homed);
     assert.ok(Math.abs(s.set_position - 12.5) < 1e-9, `homed at ${s.set_position}`);
     await shot(page, 'online-homed');
-    // inching: one step of the chosen increment per click
-    await page.fill('input[name="inch-step"]', '2.5');
+    // inching: one step of the chosen increment per click; the steps start as #1015 / #1014
+    assert.equal(await page.inputValue('input[name="inch-step-backward"]'), String((await rest(stack.api, 'GET', `/axes/${AXIS}/parameters/1015`)).body.value));
+    assert.equal(await page.inputValue('input[name="inch-step-forward"]'), String((await rest(stack.api, 'GET', `/axes/${AXIS}/parameters/1014`)).body.value));
+    await page.fill('input[name="inch-step-forward"]', '2.5');
+    await page.fill('input[name="inch-step-backward"]', '2.5');
     await page.click('button[name="inch-forward"]');
     await until(async () => {
       const s = await status(stack.api, AXIS);
@@ -296,6 +319,135 @@ describe('commissioning UI', () => {
       what: 'peak reset',
     });
     await page.close();
+  });
+
+  test('TwinCAT function keys on the Online tab: F3/F2 held jog, F5 starts the move, F6 stops, F8 resets, F9 homes', async () => {
+    await enabled();
+    await atRest();
+    const page = await open(`/axes/${AXIS}`);
+    await page.waitForSelector('[data-led="Enabled"][data-on="1"]', { timeout: 10000 });
+    assert.match(await page.getAttribute('[data-jog="slow-forward"]', 'title'), /F3/);
+    assert.match(await page.getAttribute('button[name="stop"]', 'title'), /\(F6\)/);
+    assert.match(await page.getAttribute('button[name="start"]', 'title'), /\(F5\)/);
+    assert.match(await page.getAttribute('button[name="reset"]', 'title'), /\(F8\)/);
+    assert.match(await page.getAttribute('button[name="home-btn"]', 'title'), /\(F9\)/);
+    // F5 must not reload the page: a mark on the window survives
+    await page.evaluate(() => (window.__mark = 1));
+    // with the focus in a text field too: the F-keys type nothing
+    await page.click('input[name="velocity"]');
+    const start = (await status(stack.api, AXIS)).set_position;
+    await page.keyboard.down('F3');
+    await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'F3 jogs forward' });
+    await page.waitForSelector('[data-jog="slow-forward"].held');
+    await sleep(700); // beyond the dead-man: the key keeps it going like the button
+    assert.ok((await status(stack.api, AXIS)).set_velocity > 0, 'still jogging while F3 is held');
+    await page.keyboard.up('F3');
+    const s1 = await atRest();
+    assert.ok(s1.set_position > start + 5, `moved forward (${start} → ${s1.set_position})`);
+    await page.keyboard.down('F2');
+    await until(async () => (await status(stack.api, AXIS)).set_velocity < 0, { what: 'F2 jogs backward' });
+    await page.keyboard.up('F2');
+    await atRest();
+    // F5: the selected move (absolute to 40)
+    await page.click('[data-move="move-absolute"]');
+    await page.fill('input[name="position"]', '40');
+    await page.fill('input[name="velocity"]', '200');
+    await page.keyboard.press('F5');
+    await until(async () => {
+      const s = await status(stack.api, AXIS);
+      return s.in_target_position && Math.abs(s.set_position - 40) < 1e-9;
+    }, { what: 'F5 moved to 40' });
+    assert.equal(await page.evaluate(() => window.__mark), 1, 'F5 did not reload the page');
+    // F6 during a velocity move: MC_Stop, with the stop deceleration of the form
+    await page.click('[data-move="move-velocity"]');
+    await page.fill('input[name="velocity"]', '50');
+    await page.fill('input[name="stop-deceleration"]', '800');
+    await page.keyboard.press('F5');
+    await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'F5 started the velocity move' });
+    await page.keyboard.press('F6');
+    await page.waitForSelector('[data-led="Stop lock"][data-on="1"]', { timeout: 10000 });
+    const stop = (await rest(stack.api, 'GET', `/commands?axis=${AXIS}&limit=5`)).body.find((c) => c.command === 'stop');
+    assert.equal(stop.parameters.deceleration, 800);
+    await page.click('button[name="release-stop"]');
+    await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
+    await page.fill('input[name="stop-deceleration"]', '');
+    // F8: MC_Reset
+    await page.keyboard.press('F8');
+    await page.waitForSelector('[data-testid="command-log"] tr[data-command="reset"]', { timeout: 10000 });
+    // F9: MC_Home with the chosen mode
+    await atRest();
+    await page.selectOption('select[name="home-mode"]', 'direct');
+    await page.fill('input[name="home-position"]', '7');
+    await page.keyboard.press('F9');
+    await until(async () => Math.abs((await status(stack.api, AXIS)).set_position - 7) < 1e-9, { what: 'F9 homed at 7' });
+    await shot(page, 'online-function-keys');
+    await page.close();
+  });
+
+  test('halt with its own deceleration (a bad one at its field), set position relative', async () => {
+    await enabled();
+    await atRest();
+    const page = await open(`/axes/${AXIS}`);
+    await page.click('[data-move="move-velocity"]');
+    await page.fill('input[name="velocity"]', '50');
+    await page.click('button[name="start"]');
+    await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'moving' });
+    await page.fill('input[name="stop-deceleration"]', '-1');
+    await page.click('button[name="halt"]');
+    const msg = await page.locator('[data-field="stop-deceleration"] .field-error').textContent({ timeout: 10000 });
+    const server = await rest(stack.api, 'POST', `/axes/${AXIS}/halt`, { deceleration: -1 });
+    assert.equal(server.status, 422);
+    assert.equal(msg, server.body.errors.find((e) => e.field === 'deceleration').message);
+    await page.fill('input[name="stop-deceleration"]', '600');
+    await page.fill('input[name="stop-jerk"]', '60000');
+    await page.click('button[name="halt"]');
+    await atRest();
+    const halt = (await rest(stack.api, 'GET', `/commands?axis=${AXIS}&limit=5`)).body.find((c) => c.command === 'halt');
+    assert.deepEqual([halt.parameters.deceleration, halt.parameters.jerk], [600, 60000]);
+    // MC_SetPosition relative: shifted by 10
+    const before = (await status(stack.api, AXIS)).set_position;
+    await page.fill('input[name="set-position"]', '10');
+    await page.check('input[name="set-position-relative"]');
+    await page.click('button[name="set-position-btn"]');
+    await until(async () => Math.abs((await status(stack.api, AXIS)).set_position - (before + 10)) < 1e-9, { what: 'position shifted by 10' });
+    await page.close();
+  });
+
+  test('a modulo axis offers MC_MoveModulo with a direction', async () => {
+    const created = await rest(stack.api, 'POST', '/axes', {
+      name: 'rot',
+      unit: 'deg',
+      modulo: { period: 360 },
+      dynamics: { max_velocity: 720, acceleration: 3600, deceleration: 3600, jerk: 36000, jog_velocity_slow: 10, jog_velocity_fast: 90 },
+    });
+    assert.equal(created.status, 201, JSON.stringify(created.body));
+    try {
+      await rest(stack.api, 'POST', '/axes/rot/power', {});
+      await until(async () => (await status(stack.api, 'rot')).power_status, { what: 'rot enabled' });
+      const page = await open('/axes/rot');
+      await page.click('[data-move="move-modulo"]');
+      await page.fill('input[name="position"]', '270');
+      await page.selectOption('select[name="direction"]', 'negative');
+      await page.fill('input[name="velocity"]', '360');
+      await page.click('button[name="start"]');
+      // from 0 the negative way to 270 is −90°
+      await until(async () => {
+        const s = await status(stack.api, 'rot');
+        return s.in_target_position && Math.abs(s.modulo_set_position - 270) < 1e-6 ? s : null;
+      }, { what: 'rot at 270° modulo' });
+      assert.ok(Math.abs((await status(stack.api, 'rot')).set_position + 90) < 1e-6, 'went the negative way');
+      const cmd = (await rest(stack.api, 'GET', '/commands?axis=rot&limit=5')).body.find((c) => c.command === 'move-modulo');
+      assert.equal(cmd.parameters.direction, 'negative');
+      await page.close();
+      // the linear axis has no modulo move
+      const lin = await open(`/axes/${AXIS}`);
+      assert.equal(await lin.locator('[data-move="move-modulo"]').count(), 0);
+      await lin.close();
+    } finally {
+      await rest(stack.api, 'POST', '/axes/rot/power', { enable: false });
+      await until(async () => !(await status(stack.api, 'rot')).power_status, { what: 'rot disabled' });
+      assert.equal((await rest(stack.api, 'DELETE', '/axes/rot')).status, 204);
+    }
   });
 
   test('an axis in error is shown with its error text; reset clears it', async () => {

@@ -13,6 +13,8 @@ export interface JogButtonDef {
   mode: JogMode;
   velocity: number | null;
   key: string;
+  /** The function key that holds it too (F1 … F4), shown in the title. */
+  fkey?: string;
 }
 
 let globalHooksInstalled = false;
@@ -51,6 +53,7 @@ export function JogButtons({ axis, unit, buttons, disabled }: { axis: string; un
             name={`jog-${b.key}`}
             data-jog={b.key}
             class={`btn jog-btn ${held(b) ? 'held' : ''}`}
+            title={`jog ${b.direction} ${b.mode === 'standard_fast' ? 'fast (#1002)' : 'slow (#1001)'}: hold${b.fkey ? ` (or hold ${b.fkey})` : ''}`}
             disabled={disabled || conn.kind !== 'open'}
             onPointerDown={(e) => {
               if (e.button !== 0) return;
@@ -72,6 +75,7 @@ export function JogButtons({ axis, unit, buttons, disabled }: { axis: string; un
             }}
             onBlur={() => jog.release('button lost focus')}
           >
+            {b.fkey && <kbd class="jog-key">{b.fkey}</kbd>}
             <span class="jog-label">{b.label}</span>
             <span class="jog-velo">{b.velocity === null ? '…' : `${b.velocity} ${unit}/s`}</span>
           </button>

@@ -1,46 +1,17 @@
-// The axis "Online" tab: live readouts, status LEDs, enable/override/reset, jog, moves,
-// halt/stop, set position, home, and the axis's command log.
+// The axis "Online" tab: live readouts, status LEDs, enable/override/reset, jog and inching,
+// moves, halt/stop, set position, home, TwinCAT's function keys, and the axis's command log.
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { command, live, releaseCommand, resetLagPeak, statuses } from '../services';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum } from './common';
+import { command, findHeldStop, jog, releaseCommand, resetLagPeak, statuses } from '../services';
+import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { acc, pos, vel, num, inputNum } from '../format';
-import { get, enc } from '../api/rest';
-import type { AxisResource, CommandResource, HomingMode, ParameterResource } from '../api/types';
+import type { AxisResource, Direction, HomingMode } from '../api/types';
 import { JogButtons, type JogButtonDef } from './jog-buttons';
 import { CommandLog } from './command-log';
-
-/** The axis's parameters by number (for jog velocities, increments). */
-export function useParameters(axis: string, version = 0): Map<number, ParameterResource> {
-  const [map, setMap] = useState(new Map<number, ParameterResource>());
-  useEffect(() => {
-    let gone = false;
-    get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(
-      (list) => !gone && setMap(new Map(list.map((p) => [p.number, p]))),
-      () => {},
-    );
-    return () => {
-      gone = true;
-    };
-  }, [axis, version]);
-  return map;
-}
-
-const numParam = (m: Map<number, ParameterResource>, n: number): number | null => {
-  const v = m.get(n)?.value;
-  return typeof v === 'number' ? v : null;
-};
-
-/** Stop commands issued from this page, by axis (to release the MC_Stop lock). */
-const stopIds = new Map<string, number>();
-
-async function findStopCommand(axis: string): Promise<number | null> {
-  const known = stopIds.get(axis);
-  if (known) return known;
-  const list = await get<CommandResource[]>(`/commands?axis=${enc(axis)}&limit=200`);
-  const stop = list.find((c) => c.command === 'stop');
-  return stop ? stop.id : null;
-}
+import { OverrideControl } from './override';
+import { Inching } from './inching';
+import { P_JOG_FAST, P_JOG_SLOW, numParam, useParameters } from './axis-params';
+import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
 
 function Readout({ label, value, unit, name, extra }: { label: string; value: string; unit: string; name: string; extra?: preact.ComponentChildren }) {
   return (
@@ -53,16 +24,33 @@ function Readout({ label, value, unit, name, extra }: { label: string; value: st
   );
 }
 
-type MoveKind = 'move-absolute' | 'move-relative' | 'move-velocity';
+type MoveKind = 'move-absolute' | 'move-relative' | 'move-velocity' | 'move-modulo';
+
+const MOVE_LABEL: Record<MoveKind, string> = {
+  'move-absolute': 'Absolute',
+  'move-relative': 'Relative',
+  'move-velocity': 'Velocity',
+  'move-modulo': 'Modulo',
+};
+
+const MODULO_DIRECTIONS: [Direction, string][] = [
+  ['positive', 'positive'],
+  ['negative', 'negative'],
+  ['shortest_way', 'shortest way'],
+  ['current_direction', 'current direction'],
+];
+
+/** " (F6)" for titles. */
+const fk = (a: FunctionAction) => ` (${keyOf(a)})`;
 
 export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const axis = a.config.name;
   const u = a.config.unit;
   const st = useStore(statuses);
-  const conn = useStore(live.state);
+  const online = useOnline();
   const liveStatus = st.get(axis);
   const s = liveStatus?.status ?? null;
-  const offline = conn.kind !== 'open';
+  const offline = !online;
   const params = useParameters(axis);
   const [error, setError] = useState<string | null>(null);
 
@@ -70,10 +58,8 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const [ctrl, setCtrl] = useState(true);
   const [feedPos, setFeedPos] = useState(true);
   const [feedNeg, setFeedNeg] = useState(true);
-  const [override, setOverride] = useState<number | null>(null);
   const seeded = useRef(false);
   useEffect(() => {
-    if (override === null && s) setOverride(Math.round(s.override_percent));
     // The enable checkboxes start as the axis is (all on for a disabled axis).
     if (!seeded.current && s) {
       seeded.current = true;
@@ -82,24 +68,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
         setFeedNeg(s.enable_negative);
       }
     }
-  }, [s, override]);
-  const overrideTimer = useRef<ReturnType<typeof setTimeout> | null>(null);
-  const overrideSent = useRef<number | null>(null);
-  const sendOverride = (v: number) => {
-    setOverride(v);
-    overrideSent.current = v;
-    // Throttled while dragging: one command every 100 ms, the last value always.
-    if (overrideTimer.current) return;
-    overrideTimer.current = setTimeout(async function flush() {
-      const value = overrideSent.current!;
-      try {
-        await command(axis, 'set-override', { velocity_factor: value / 100 });
-      } catch (e) {
-        setError(errorText(e));
-      }
-      overrideTimer.current = overrideSent.current !== value ? setTimeout(flush, 100) : null;
-    }, 100);
-  };
+  }, [s]);
 
   const run = async (name: string, body: Record<string, unknown> = {}) => {
     setError(null);
@@ -112,17 +81,23 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   };
 
   // --- move -----------------------------------------------------------------------------
+  const moveKinds: MoveKind[] = a.config.modulo
+    ? ['move-absolute', 'move-relative', 'move-modulo', 'move-velocity']
+    : ['move-absolute', 'move-relative', 'move-velocity'];
   const [moveKind, setMoveKind] = useState<MoveKind>('move-absolute');
   const [target, setTarget] = useState('');
   const [distance, setDistance] = useState('');
+  const [moduloTarget, setModuloTarget] = useState('');
   const [velocity, setVelocity] = useState('');
   const [direction, setDirection] = useState<'positive' | 'negative'>('positive');
+  const [moduloDir, setModuloDir] = useState<Direction>('positive');
   const [accel, setAccel] = useState('0');
   const [decel, setDecel] = useState('0');
   const [jerk, setJerk] = useState('0');
   const [moveErrors, setMoveErrors] = useState<Record<string, string>>({});
+  const moveFormId = `move-form-${a.id}`;
   useEffect(() => {
-    const fast = numParam(params, 1002);
+    const fast = numParam(params, P_JOG_FAST);
     if (velocity === '' && fast !== null) setVelocity(inputNum(fast));
   }, [params]);
   const startMove = async () => {
@@ -133,15 +108,13 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       deceleration: parseNum(decel, 0),
       jerk: parseNum(jerk, 0),
     };
-    if (moveKind === 'move-absolute') {
-      if (target.trim() === '') errs.position = 'enter a target position';
-      body.position = parseNum(target);
-    } else if (moveKind === 'move-relative') {
-      if (distance.trim() === '') errs.position = 'enter a distance';
-      body.position = parseNum(distance);
-    } else {
-      body.direction = direction;
+    const position = { 'move-absolute': target, 'move-relative': distance, 'move-modulo': moduloTarget, 'move-velocity': null }[moveKind];
+    if (position !== null) {
+      if (position.trim() === '') errs.position = moveKind === 'move-relative' ? 'enter a distance' : 'enter a target position';
+      body.position = parseNum(position);
     }
+    if (moveKind === 'move-velocity') body.direction = direction;
+    if (moveKind === 'move-modulo') body.direction = moduloDir;
     if (velocity.trim() === '') errs.velocity = 'enter a velocity';
     setMoveErrors(errs);
     if (Object.keys(errs).length) return;
@@ -152,45 +125,84 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
     }
   };
 
-  // --- set position / home --------------------------------------------------------------
-  const [setPos, setSetPos] = useState('0');
-  const [setPosErrors, setSetPosErrors] = useState<Record<string, string>>({});
-  const [homeMode, setHomeMode] = useState<HomingMode>('default');
-  const [homePos, setHomePos] = useState('');
-  const [homeErrors, setHomeErrors] = useState<Record<string, string>>({});
-
-  // --- inching --------------------------------------------------------------------------
-  const [inc, setInc] = useState('');
-  const [incErrors, setIncErrors] = useState<Record<string, string>>({});
-  useEffect(() => {
-    const i = numParam(params, 1014);
-    if (inc === '' && i !== null) setInc(inputNum(i));
-  }, [params]);
-  const inch = async (forward: boolean) => {
-    setIncErrors({});
-    const slow = numParam(params, 1001) ?? 0;
+  // --- halt / stop ----------------------------------------------------------------------
+  const [stopDec, setStopDec] = useState('');
+  const [stopJerk, setStopJerk] = useState('');
+  const [stopErrors, setStopErrors] = useState<Record<string, string>>({});
+  const haltOrStop = async (name: 'halt' | 'stop') => {
+    setStopErrors({});
     try {
-      // One step per click; not held (a positioning job of `position` distance).
-      await command(axis, 'jog', {
-        direction: forward ? 'forward' : 'backward',
-        mode: 'inching',
-        position: parseNum(inc),
-        velocity: slow,
-      });
+      await run(name, { deceleration: parseNum(stopDec, 0), jerk: parseNum(stopJerk, 0) });
     } catch (e) {
-      setIncErrors(fieldsOf(e));
+      setStopErrors(fieldsOf(e));
+    }
+  };
+  const releaseStop = async () => {
+    setError(null);
+    try {
+      // Asked of the server now: the stop may be another client's or an earlier page's.
+      const id = await findHeldStop(axis);
+      if (id === null) throw new Error('the server knows no MC_Stop of this axis that holds the lock');
+      await releaseCommand(id, axis);
+    } catch (e) {
       setError(errorText(e));
     }
   };
 
-  const slow = numParam(params, 1001);
-  const fast = numParam(params, 1002);
+  // --- set position / home --------------------------------------------------------------
+  const [setPos, setSetPos] = useState('0');
+  const [setPosRelative, setSetPosRelative] = useState(false);
+  const [setPosClearLag, setSetPosClearLag] = useState(false);
+  const [setPosErrors, setSetPosErrors] = useState<Record<string, string>>({});
+  const [homeMode, setHomeMode] = useState<HomingMode>('default');
+  const [homePos, setHomePos] = useState('');
+  const [homeErrors, setHomeErrors] = useState<Record<string, string>>({});
+  const setPosition = async () => {
+    setSetPosErrors({});
+    try {
+      await run('set-position', { position: parseNum(setPos), relative: setPosRelative, clear_position_lag: setPosClearLag });
+    } catch (err) {
+      setSetPosErrors(fieldsOf(err));
+    }
+  };
+  const home = async () => {
+    setHomeErrors({});
+    const body: Record<string, unknown> = { mode: homeMode };
+    if (homePos.trim() !== '') body.position = parseNum(homePos);
+    try {
+      await run('home', body);
+    } catch (err) {
+      setHomeErrors(fieldsOf(err));
+    }
+  };
+  const reset = () => run('reset').catch(() => {});
+
+  // --- jog and function keys ------------------------------------------------------------
+  const slow = numParam(params, P_JOG_SLOW);
+  const fast = numParam(params, P_JOG_FAST);
   const jogButtons: JogButtonDef[] = [
-    { key: 'fast-backward', label: '−−', direction: 'backward', mode: 'standard_fast', velocity: fast },
-    { key: 'slow-backward', label: '−', direction: 'backward', mode: 'standard_slow', velocity: slow },
-    { key: 'slow-forward', label: '+', direction: 'forward', mode: 'standard_slow', velocity: slow },
-    { key: 'fast-forward', label: '++', direction: 'forward', mode: 'standard_fast', velocity: fast },
+    { key: 'fast-backward', label: '−−', direction: 'backward', mode: 'standard_fast', velocity: fast, fkey: keyOf('fast-backward') },
+    { key: 'slow-backward', label: '−', direction: 'backward', mode: 'standard_slow', velocity: slow, fkey: keyOf('slow-backward') },
+    { key: 'slow-forward', label: '+', direction: 'forward', mode: 'standard_slow', velocity: slow, fkey: keyOf('slow-forward') },
+    { key: 'fast-forward', label: '++', direction: 'forward', mode: 'standard_fast', velocity: fast, fkey: keyOf('fast-forward') },
   ];
+  const keys: FunctionKeyHandlers = {
+    enabled: () => online,
+    jog: (k) => {
+      const b = jogButtons.find((x) => x.key === k)!;
+      jog.press(axis, b.direction, b.mode);
+    },
+    release: (why) => jog.release(why),
+    action: (what) => {
+      if (what === 'start') void startMove();
+      else if (what === 'stop') void haltOrStop('stop');
+      else if (what === 'reset') void reset();
+      else void home();
+    },
+  };
+  const keysRef = useRef(keys);
+  keysRef.current = keys;
+  useEffect(() => installFunctionKeys(window, () => keysRef.current), []);
 
   const stale = liveStatus?.stale || offline;
   const lagUnit = u;
@@ -273,44 +285,16 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               >
                 Disable
               </ActionButton>
-              <ActionButton name="reset" kind="warn" disabled={offline} title="MC_Reset" onClick={() => run('reset')}>
+              <ActionButton name="reset" kind="warn" disabled={offline} title={`MC_Reset${fk('reset')}`} onClick={reset}>
                 Reset
               </ActionButton>
             </div>
-            <div class="row override">
-              <span class="field-label">Override</span>
-              <input
-                type="range"
-                name="override"
-                min={0}
-                max={100}
-                step={1}
-                value={override ?? 100}
-                disabled={offline}
-                onInput={(e) => sendOverride(Number((e.target as HTMLInputElement).value))}
-              />
-              <span class="mono override-value">{override ?? '—'} %</span>
-              {[0, 25, 50, 100].map((v) => (
-                <button type="button" class="btn btn-small" disabled={offline} onClick={() => sendOverride(v)}>
-                  {v}
-                </button>
-              ))}
-            </div>
+            <OverrideControl axis={axis} effective={s?.override_percent} online={online} onError={setError} />
           </Panel>
 
           <Panel title="Jog" class="jog-panel">
             <JogButtons axis={axis} unit={u} buttons={jogButtons} disabled={offline} />
-            <div class="row inching">
-              <Field label={`Inching step (${u})`} error={incErrors.position} name="inch-step">
-                <NumberInput name="inch-step" value={inc} onValue={setInc} />
-              </Field>
-              <ActionButton name="inch-backward" disabled={offline} onClick={() => inch(false)} title="one step backward">
-                ◀ step
-              </ActionButton>
-              <ActionButton name="inch-forward" disabled={offline} onClick={() => inch(true)} title="one step forward">
-                step ▶
-              </ActionButton>
-            </div>
+            <Inching axis={axis} unit={u} params={params} online={online} onError={setError} />
           </Panel>
 
           <Panel
@@ -318,25 +302,20 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
             class="move"
             actions={
               <div class="seg" role="tablist">
-                {(
-                  [
-                    ['move-absolute', 'Absolute'],
-                    ['move-relative', 'Relative'],
-                    ['move-velocity', 'Velocity'],
-                  ] as const
-                ).map(([k, label]) => (
+                {moveKinds.map((k) => (
                   <button type="button" class={`seg-btn ${moveKind === k ? 'active' : ''}`} data-move={k} onClick={() => { setMoveKind(k); setMoveErrors({}); }}>
-                    {label}
+                    {MOVE_LABEL[k]}
                   </button>
                 ))}
               </div>
             }
           >
             <form
+              id={moveFormId}
               class="form-grid move-form"
               onSubmit={(e) => {
                 e.preventDefault();
-                void startMove();
+                if (online) void startMove();
               }}
             >
               {moveKind === 'move-absolute' && (
@@ -347,6 +326,20 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               {moveKind === 'move-relative' && (
                 <Field label={`Distance (${u})`} error={moveErrors.position} name="position">
                   <NumberInput name="position" value={distance} onValue={setDistance} />
+                </Field>
+              )}
+              {moveKind === 'move-modulo' && (
+                <Field label={`Modulo target (${u})`} error={moveErrors.position} name="position" hint={`0 … ${a.config.modulo?.period ?? ''}`}>
+                  <NumberInput name="position" value={moduloTarget} onValue={setModuloTarget} />
+                </Field>
+              )}
+              {moveKind === 'move-modulo' && (
+                <Field label="Direction" error={moveErrors.direction} name="direction">
+                  <select name="direction" value={moduloDir} onChange={(e) => setModuloDir((e.target as HTMLSelectElement).value as Direction)}>
+                    {MODULO_DIRECTIONS.map(([v, label]) => (
+                      <option value={v}>{label}</option>
+                    ))}
+                  </select>
                 </Field>
               )}
               {moveKind === 'move-velocity' && (
@@ -369,82 +362,57 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Field label={`Jerk (${u}/s³)`} error={moveErrors.jerk} hint="0 = axis default" name="jerk">
                 <NumberInput name="jerk" value={jerk} onValue={setJerk} />
               </Field>
-              <div class="form-actions">
-                <button type="submit" class="btn btn-primary" name="start" disabled={offline}>
-                  Start
-                </button>
-                <ActionButton name="halt" disabled={offline} title="MC_Halt: decelerate to standstill" onClick={() => run('halt')}>
-                  Halt
-                </ActionButton>
-                <ActionButton
-                  name="stop"
-                  kind="danger"
-                  disabled={offline}
-                  title="MC_Stop: stop and lock motion until released"
-                  onClick={async () => {
-                    const r = await run('stop');
-                    stopIds.set(axis, r.id);
-                  }}
-                >
-                  Stop
-                </ActionButton>
-                {s?.motion_commands_locked && (
-                  <ActionButton
-                    name="release-stop"
-                    kind="warn"
-                    disabled={offline}
-                    title="Release the MC_Stop (falling edge of Execute)"
-                    onClick={async () => {
-                      setError(null);
-                      try {
-                        const id = await findStopCommand(axis);
-                        if (id === null) throw new Error('no stop command of this axis is known to the server');
-                        await releaseCommand(id, axis);
-                        stopIds.delete(axis);
-                      } catch (e) {
-                        setError(errorText(e));
-                      }
-                    }}
-                  >
-                    Release stop
-                  </ActionButton>
-                )}
-              </div>
             </form>
+            <div class="row stop-row">
+              <button type="submit" form={moveFormId} class="btn btn-primary" name="start" disabled={offline} title={`start the ${MOVE_LABEL[moveKind].toLowerCase()} move${fk('start')}`}>
+                Start
+              </button>
+              <Field label={`Stop dec (${u}/s²)`} error={stopErrors.deceleration} name="stop-deceleration">
+                <NumberInput name="stop-deceleration" value={stopDec} onValue={setStopDec} placeholder="default" title="MC_Halt / MC_Stop deceleration; blank or 0 = default" />
+              </Field>
+              <Field label={`Stop jerk (${u}/s³)`} error={stopErrors.jerk} name="stop-jerk">
+                <NumberInput name="stop-jerk" value={stopJerk} onValue={setStopJerk} placeholder="default" title="MC_Halt / MC_Stop jerk; blank or 0 = default" />
+              </Field>
+              <ActionButton name="halt" disabled={offline} title="MC_Halt: decelerate to standstill" onClick={() => haltOrStop('halt')}>
+                Halt
+              </ActionButton>
+              <ActionButton name="stop" kind="danger" disabled={offline} title={`MC_Stop: stop and lock motion until released${fk('stop')}`} onClick={() => haltOrStop('stop')}>
+                Stop
+              </ActionButton>
+              {s?.motion_commands_locked && (
+                <ActionButton name="release-stop" kind="warn" disabled={offline} title="Release the MC_Stop (falling edge of Execute)" onClick={releaseStop}>
+                  Release stop
+                </ActionButton>
+              )}
+            </div>
           </Panel>
 
           <Panel title="Position and homing" class="poshome">
             <form
               class="row"
-              onSubmit={async (e) => {
+              onSubmit={(e) => {
                 e.preventDefault();
-                setSetPosErrors({});
-                try {
-                  await run('set-position', { position: parseNum(setPos) });
-                } catch (err) {
-                  setSetPosErrors(fieldsOf(err));
-                }
+                if (online) void setPosition();
               }}
             >
-              <Field label={`Set actual position to (${u})`} error={setPosErrors.position} name="set-position" class="wide">
+              <Field label={`Set actual position ${setPosRelative ? 'by' : 'to'} (${u})`} error={setPosErrors.position} name="set-position" class="wide">
                 <NumberInput name="set-position" value={setPos} onValue={setSetPos} />
               </Field>
+              <label class="check" title="shift the position by this amount (also while moving)">
+                <input type="checkbox" name="set-position-relative" checked={setPosRelative} onChange={(e) => setSetPosRelative((e.target as HTMLInputElement).checked)} /> relative
+              </label>
+              <label class="check" title="set position = actual position: the following error becomes 0">
+                <input type="checkbox" name="set-position-clear-lag" checked={setPosClearLag} onChange={(e) => setSetPosClearLag((e.target as HTMLInputElement).checked)} /> clear lag
+              </label>
               <button type="submit" class="btn" name="set-position-btn" disabled={offline} title="MC_SetPosition">
                 Set position
               </button>
             </form>
             <form
               class="row"
-              onSubmit={async (e) => {
+              onSubmit={(e) => {
                 e.preventDefault();
-                setHomeErrors({});
-                const body: Record<string, unknown> = { mode: homeMode };
-                if (homePos.trim() !== '') body.position = parseNum(homePos);
-                try {
-                  await run('home', body);
-                } catch (err) {
-                  setHomeErrors(fieldsOf(err));
-                }
+                if (online) void home();
               }}
             >
               <Field label="Homing mode" name="home-mode" error={homeErrors.mode} class="wide">
@@ -458,7 +426,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Field label={`Home position (${u})`} name="home-position" error={homeErrors.position}>
                 <NumberInput name="home-position" value={homePos} onValue={setHomePos} placeholder="#1075" title="blank = the calibration value (#1075)" />
               </Field>
-              <button type="submit" class="btn" name="home-btn" disabled={offline} title="MC_Home">
+              <button type="submit" class="btn" name="home-btn" disabled={offline} title={`MC_Home${fk('home')}`}>
                 Home
               </button>
             </form>
