@@ -234,6 +234,15 @@ impl AppState {
         (s.cycle, s.axes.get(slot as usize).copied().flatten())
     }
 
+    /// The slot and name of an axis given by id or name (404 when there is none).
+    pub fn axis_slot(&self, key: &str) -> ApiResult<(AxisSlot, String)> {
+        let reg = self.registry.read().unwrap();
+        let e = reg
+            .find(key)
+            .ok_or_else(|| ApiError::not_found("axis", key))?;
+        Ok((e.slot, e.name.clone()))
+    }
+
     /// A kernel status as the API shows it: the master named by its axis, not its slot.
     pub fn status_view(&self, status: AxisStatus) -> crate::model::LiveStatus {
         let master = status.master.and_then(|slot| {

@@ -348,13 +348,7 @@ pub async fn reset_following_error_peak(
     Path(axis): Path<String>,
     client: Client,
 ) -> ApiResult<Json<PeakResetResource>> {
-    let (slot, name) = {
-        let reg = s.registry.read().unwrap();
-        let e = reg
-            .find(&axis)
-            .ok_or_else(|| ApiError::not_found("axis", &axis))?;
-        (e.slot, e.name.clone())
-    };
+    let (slot, name) = s.axis_slot(&axis)?;
     let result = s.reset_following_error_peak(slot).await?;
     s.audit(AuditEntry {
         at: store::now_rfc3339(),

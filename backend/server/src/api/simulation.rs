@@ -45,13 +45,7 @@ pub async fn inject_fault(
             return Err(ApiError::field("force", "must be a finite number"));
         }
     }
-    let (slot, name) = {
-        let reg = s.registry.read().unwrap();
-        let e = reg
-            .find(&axis)
-            .ok_or_else(|| ApiError::not_found("axis", &axis))?;
-        (e.slot, e.name.clone())
-    };
+    let (slot, name) = s.axis_slot(&axis)?;
     let result = s.inject_fault(slot, fault).await?;
     s.audit(AuditEntry {
         at: store::now_rfc3339(),
