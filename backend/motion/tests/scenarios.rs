@@ -1253,11 +1253,7 @@ fn soft_limits_reject_targets_and_stop_endless_motion_at_the_limit() {
 #[test]
 fn a_gear_slave_crossing_a_soft_limit_decouples_and_stops_fast_in_error_stop() {
     for (dyn_coupling, dir) in [(true, Direction::Positive), (false, Direction::Negative)] {
-        let mut p = params();
-        p.axis_en_max_soft_pos_limit = true;
-        p.axis_max_soft_pos_limit = 100.0;
-        p.axis_en_min_soft_pos_limit = true;
-        p.axis_min_soft_pos_limit = -100.0;
+        let p = params_with_soft_limits(-100.0, 100.0);
         let mut r = Rig::with(vec![(false, params()), (false, p.clone())]);
         r.power_on(0);
         r.power_on(1);
@@ -1810,15 +1806,16 @@ fn s11a_31_superposition_abort_options() {
     );
 }
 
-/// The largest velocity change of a cycle that its accelerations do not explain (a velocity
-/// step; the superposition profile is C² but not jerk-limited, so the rig's jerk bound is
+/// The largest velocity change of a cycle beyond what its accelerations allow (a velocity
+/// step; the superposition is acceleration- but not jerk-limited, so the rig's jerk bound is
 /// lifted in these tests and cannot see one).
 fn max_velocity_step(history: &[AxisStatus]) -> f64 {
     history
         .windows(2)
         .map(|w| {
-            let dv = w[1].set_velocity - w[0].set_velocity;
-            (dv - (w[0].set_acceleration + w[1].set_acceleration) / 2.0 * DT).abs()
+            let dv = (w[1].set_velocity - w[0].set_velocity).abs();
+            let a = w[0].set_acceleration.abs().max(w[1].set_acceleration.abs());
+            (dv - a * DT).max(0.0)
         })
         .fold(0.0, f64::max)
 }
@@ -1847,11 +1844,10 @@ fn an_aborted_superposition_leaves_no_velocity_step() {
                 mode: SuperpositionMode::VeloReductionAdditiveMotion,
                 distance: 50.0,
                 velocity_diff: 200.0,
-                acceleration: 0.0,
-                deceleration: 0.0,
                 velocity_process: 200.0,
                 length: 400.0,
                 abort_option: option,
+                ..Default::default()
             }),
         );
         r.run(0.2);
@@ -1893,6 +1889,158 @@ fn superposition_shifts_the_target_of_the_running_move() {
         "{}",
         r.st(0).set_position
     );
+}
+
+/// Decision: a superposition never moves the target of the running move beyond an enabled
+/// soft limit. It is limited (done as far as the limit allows, Warning 0x4243), not refused.
+#[test]
+fn superposition_is_limited_to_keep_the_target_within_the_soft_limits() {
+    // A positive distance gets ahead in the direction of travel, towards the limit there.
+    for target in [400.0f64, -400.0] {
+        let distance = 20.0;
+        let mut r = Rig::with(vec![(false, params_with_soft_limits(-410.0, 410.0))]);
+        r.bounds[0].jerk = 1e9; // the superposition profile is C² but not jerk-limited
+        r.power_on(0);
+        let m = r.ok(0, CommandKind::MoveAbsolute(mv(target, 200.0)));
+        r.run(0.5);
+        let sp = Superposition {
+            mode: SuperpositionMode::LengthReductionAdditiveMotion,
+            distance,
+            velocity_diff: 100.0,
+            velocity_process: 200.0,
+            length: 200.0,
+            abort_option: SuperpositionAbortOption::AbortAtStandstill,
+            ..Default::default()
+        };
+        let s = r.ok(0, CommandKind::MoveSuperImposed(sp));
+        let o = r.out(s);
+        assert!(o.busy && o.warning, "{o:?}");
+        assert_eq!(o.warning_id, ErrorId::SUPERPOSITION_INCOMPLETE.0);
+        let limit = 410.0 * target.signum();
+        assert_eq!(r.st(0).target_position, target, "shifts as it goes");
+        r.until(5.0, |r| !r.out(m).busy);
+        assert!(r.out(m).done);
+        let o = r.out(s);
+        assert!(o.done && o.warning, "done as far as possible: {o:?}");
+        assert!((r.st(0).set_position - limit).abs() < 1e-9, "{:?}", r.st(0));
+        assert!(r.history[0].iter().all(
+            |h| h.set_position.abs() <= 410.0 + 1e-9 && h.target_position.abs() <= 410.0 + 1e-9
+        ));
+        // Away from the limit, or within it, the distance is done in full.
+        let m = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
+        r.run(0.5);
+        let s = r.ok(
+            0,
+            CommandKind::MoveSuperImposed(Superposition {
+                distance: -distance,
+                ..sp
+            }),
+        );
+        assert!(!r.out(s).warning);
+        r.until(5.0, |r| !r.out(m).busy);
+        assert!(r.out(s).done && !r.out(s).warning, "{:?}", r.out(s));
+        // Falling back on the way to 0: the target moves back, away from 0.
+        assert!((r.st(0).set_position - distance * target.signum()).abs() < 1e-9);
+    }
+}
+
+/// Endless motion under a superposition stops for the soft limit: the superposition ends
+/// (abort table row 4: the main motion is stopped) and hands its velocity to the stop; one
+/// that resumes after a motion stop is held at the limit. Either way the limit holds.
+#[test]
+fn superposition_on_endless_motion_never_carries_it_past_a_soft_limit() {
+    use SuperpositionAbortOption::*;
+    for option in [
+        AbortAtStandstill,
+        ResumeAfterStandstill,
+        ResumeAfterMotionStop,
+    ] {
+        let mut p = params();
+        p.axis_en_max_soft_pos_limit = true;
+        p.axis_max_soft_pos_limit = 300.0;
+        let mut r = Rig::with(vec![(false, p)]);
+        r.bounds[0].jerk = 1e9;
+        r.power_on(0);
+        let v = r.ok(0, velocity(200.0, Direction::Positive));
+        r.until(3.0, |r| r.st(0).set_position > 200.0);
+        let s = r.ok(
+            0,
+            CommandKind::MoveSuperImposed(Superposition {
+                mode: SuperpositionMode::VeloReductionAdditiveMotion,
+                distance: 100.0,
+                velocity_diff: 100.0,
+                velocity_process: 200.0,
+                length: 300.0,
+                abort_option: option,
+                ..Default::default()
+            }),
+        );
+        r.until(3.0, |r| !r.out(v).busy);
+        assert_eq!(r.out(v).error_id, ErrorId::SOFT_LIMIT_REACHED.0);
+        r.until(3.0, |r| r.st(0).state == AxisState::Standstill);
+        let o = r.out(s);
+        if option == ResumeAfterMotionStop {
+            // It would resume, but what it still has to do lies beyond the limit.
+            assert!(o.done && o.warning, "{option:?}: {o:?}");
+            assert_eq!(o.warning_id, ErrorId::SUPERPOSITION_INCOMPLETE.0);
+        } else {
+            assert!(o.command_aborted, "{option:?}: {o:?}");
+        }
+        assert!(
+            r.history[0].iter().all(|h| h.set_position <= 300.0 + 1e-9),
+            "{option:?}: past the limit"
+        );
+        assert!(r.st(0).set_position > 290.0, "{option:?}: {:?}", r.st(0));
+        let step = max_velocity_step(&r.history[0]);
+        assert!(step < 0.1, "{option:?}: velocity step {step}");
+    }
+}
+
+/// A superposition that resumes with the next motion is held within the soft limits by that
+/// motion's target too: it does what still fits, with the warning.
+#[test]
+fn a_resumed_superposition_is_limited_by_the_next_moves_target() {
+    let mut p = params();
+    p.axis_en_max_soft_pos_limit = true;
+    p.axis_max_soft_pos_limit = 410.0;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.bounds[0].jerk = 1e9;
+    r.power_on(0);
+    r.ok(0, velocity(200.0, Direction::Positive));
+    r.run(0.5);
+    let s = r.ok(
+        0,
+        CommandKind::MoveSuperImposed(Superposition {
+            mode: SuperpositionMode::VeloReductionAdditiveMotion,
+            distance: 40.0,
+            velocity_diff: 100.0,
+            velocity_process: 200.0,
+            length: 400.0,
+            abort_option: SuperpositionAbortOption::ResumeAfterMotionStop,
+            ..Default::default()
+        }),
+    );
+    r.run(0.3);
+    let applied = r.st(0).superimposed_distance;
+    assert!(applied > 0.0 && applied < 20.0, "{applied}");
+    // A move to 400 leaves room for 10 more: less than the superposition still has to do.
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(400.0, 200.0)));
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(m).done);
+    let o = r.out(s);
+    assert!(
+        o.busy && o.warning,
+        "resumes after the motion stop, reduced: {o:?}"
+    );
+    assert!(r.st(0).set_position <= 410.0 + 1e-9, "{:?}", r.st(0));
+    // It completes (what is left of it) with the next motion.
+    r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
+    r.until(5.0, |r| !r.out(s).busy);
+    let o = r.out(s);
+    assert!(o.done && o.warning, "{o:?}");
+    assert!(r.history[0].iter().all(|h| h.set_position <= 410.0 + 1e-9));
+    let step = max_velocity_step(&r.history[0]);
+    assert!(step < 0.1, "velocity step {step}");
 }
 
 #[test]

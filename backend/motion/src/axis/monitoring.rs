@@ -274,6 +274,17 @@ impl Axis {
         h.options.ignore_position_monitoring = true;
         self.job = None;
         self.start_job(h, cycle, events);
+        // The main motion is being stopped (superposition abort table row 4): a superposition
+        // ends unless it is to resume after a motion stop, and then too if what it still has
+        // to do would carry the stop past the limit; its velocity goes into the stop.
+        if let Some(sp) = self.superimposed {
+            let to_come = sp.distance - sp.applied;
+            if sp.option != SuperpositionAbortOption::ResumeAfterMotionStop {
+                self.abort_superposition(cycle, events);
+            } else if self.superposition_room(to_come) != to_come {
+                self.end_superposition_incomplete(cycle, events);
+            }
+        }
         // If the limit cannot be reached without overshoot, stop as hard as allowed.
         if self.planner.overshoots(limit, v.signum()) {
             if let Some(h) = self.job.as_mut() {

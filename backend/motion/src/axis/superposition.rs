@@ -111,8 +111,12 @@ impl Axis {
         };
         let (nv, na) = need(length);
         let scale = (vdiff / nv.max(EPS_V)).min(a_lim / na.max(EPS_V)).min(1.0);
-        let distance = dir * sp.distance.signum() * d * if d > 0.0 { scale } else { 1.0 };
-        let warning = d > 0.0 && scale < 1.0 - 1e-12;
+        let wanted = dir * sp.distance.signum() * d * if d > 0.0 { scale } else { 1.0 };
+        // Never beyond an enabled soft limit: the target of the running move moves with the
+        // superposition, so only what keeps it within the limits is done (as far as possible,
+        // with the warning, like any superposition the parameters do not allow in full).
+        let distance = self.superposition_room(wanted);
+        let warning = d > 0.0 && (scale < 1.0 - 1e-12 || distance != wanted);
         // A new superposition replaces the running one (what it applied so far stays).
         self.abort_superposition(cycle, events);
         let out = FbOutputs {
@@ -148,19 +152,57 @@ impl Axis {
         Ok(())
     }
 
-    /// Ends a superposition with CommandAborted; what it applied stays. The velocity it was
-    /// adding is handed to the main motion's planner, which takes it away smoothly.
+    /// The part of a superimposed `distance` still to come that keeps the target of the
+    /// running positioning (which moves with it) within the enabled soft limits. Endless
+    /// motion has no target: it brakes for the limit itself (and a coupled slave crossing
+    /// one is an axis error), so there the distance is not limited.
+    pub(super) fn superposition_room(&self, distance: f64) -> f64 {
+        let p = self.p();
+        let Some(target) = self.job.filter(|j| j.is_positioning()).map(|j| j.target) else {
+            return distance;
+        };
+        if distance > 0.0 && p.axis_en_max_soft_pos_limit {
+            distance.min((p.axis_max_soft_pos_limit - target).max(0.0))
+        } else if distance < 0.0 && p.axis_en_min_soft_pos_limit {
+            distance.max((p.axis_min_soft_pos_limit - target).min(0.0))
+        } else {
+            distance
+        }
+    }
+
+    /// Ends a superposition with CommandAborted; what it applied stays.
     pub(super) fn abort_superposition(&mut self, cycle: u64, events: &mut impl EventSink) {
+        self.end_superposition(End::Aborted, cycle, events);
+    }
+
+    /// Ends a superposition that cannot go on within the soft limits: Done as far as it got,
+    /// with Warning 0x4243 (as a superposition the parameters do not allow in full).
+    pub(super) fn end_superposition_incomplete(&mut self, cycle: u64, events: &mut impl EventSink) {
+        let slot = self.slot;
+        if let Some(sp) = self.superimposed.as_mut() {
+            let out = FbOutputs {
+                warning: true,
+                warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
+                ..sp.cmd.out
+            };
+            sp.cmd.emit(out, slot, cycle, events);
+        }
+        self.end_superposition(End::Done, cycle, events);
+    }
+
+    /// Ends a superposition; what it applied stays. The velocity it was adding is handed to
+    /// the main motion's planner, which takes it away smoothly.
+    fn end_superposition(&mut self, end: End, cycle: u64, events: &mut impl EventSink) {
         if let Some(mut sp) = self.superimposed.take() {
-            sp.cmd.end(End::Aborted, self.slot, cycle, events);
-            if sp.added != (0.0, 0.0) && self.mode != Mode::Disabled {
-                if self
+            sp.cmd.end(end, self.slot, cycle, events);
+            if sp.added != (0.0, 0.0)
+                && self.mode != Mode::Disabled
+                && self
                     .job
                     .as_ref()
                     .is_some_and(|j| j.kind != JobKind::Gear && j.kind != JobKind::Home)
-                {
-                    self.plan_job_now();
-                }
+            {
+                self.plan_job_now();
             }
         }
     }
@@ -202,11 +244,20 @@ impl Axis {
             SuperpositionAbortOption::ResumeAfterStandstill => !travelling,
             SuperpositionAbortOption::ResumeAfterMotionStop => false,
         };
-        if abort {
+        // The main motion may have changed since the start (a new move under
+        // ResumeAfterMotionStop, a stop at the soft limit): what is still to come must keep
+        // its target within the soft limits too. Less is done, with the warning: by braking
+        // within the room left where the superposition can, else it ends here.
+        let to_come = sp.distance - sp.applied;
+        let room = self.superposition_room(to_come);
+        let prev = sp.added.0.abs();
+        let cut_short =
+            room != to_come && (room == 0.0 || prev * prev > 2.0 * sp.acc_limit * room.abs());
+        if abort || cut_short {
             // This cycle's sample is the bare main motion: keep last cycle's contribution in
-            // it so that the planner takes over from a continuous state (the abort re-plans
-            // the main motion from there; without it the velocity would step back by what
-            // the superposition added).
+            // it so that the planner takes over from a continuous state (ending re-plans the
+            // main motion from there; without it the velocity would step back by what the
+            // superposition added).
             self.set.position += sp.added.0 * dt;
             self.set.velocity += sp.added.0;
             self.set.acceleration += sp.added.1;
@@ -218,8 +269,21 @@ impl Axis {
             }
             self.set_has_superposition = false;
             self.superimposed = Some(sp);
-            self.abort_superposition(cycle, events);
+            if abort {
+                self.abort_superposition(cycle, events);
+            } else {
+                self.end_superposition_incomplete(cycle, events);
+            }
             return;
+        }
+        if room != to_come {
+            sp.distance = sp.applied + room;
+            let out = FbOutputs {
+                warning: true,
+                warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
+                ..sp.cmd.out
+            };
+            sp.cmd.emit(out, self.slot, cycle, events);
         }
         if moved != 0.0 {
             sp.last_direction = moved.signum();

@@ -511,3 +511,13 @@ pub fn velocity(velocity: f64, direction: Direction) -> CommandKind {
         options: MoveOptions::default(),
     }
 }
+
+/// The rig's parameters with both software limits enabled at `min` and `max`.
+pub fn params_with_soft_limits(min: f64, max: f64) -> AxisParameters {
+    let mut p = params();
+    p.axis_en_min_soft_pos_limit = true;
+    p.axis_min_soft_pos_limit = min;
+    p.axis_en_max_soft_pos_limit = true;
+    p.axis_max_soft_pos_limit = max;
+    p
+}
