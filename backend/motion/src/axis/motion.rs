@@ -353,14 +353,7 @@ impl Axis {
                         let target = if mode == JogMode::Inching {
                             s + dir * position
                         } else {
-                            // Snap to the next multiple of the step in the direction of travel.
-                            let n = s / position;
-                            let k = if forward {
-                                (n + 1e-9).floor() + 1.0
-                            } else {
-                                (n - 1e-9).ceil() - 1.0
-                            };
-                            k * position
+                            self.inching_modulo_target(s, position, forward)
                         };
                         self.check_soft_limits(target)?;
                         job = Job::new(cmd.id, JobKind::Positioning { continuous: false });
@@ -435,6 +428,41 @@ impl Axis {
             self.prepare_blend(cycle, events);
         }
         Ok(())
+    }
+
+    /// MC_Jog INCHING_MODULO: the next multiple of `step` after `s` in the direction of
+    /// travel. On a modulo axis the multiples count from 0 of each turn (modulo coordinates),
+    /// so the stops repeat every turn even when the period is no multiple of the step: the
+    /// last stop of a turn is followed by 0 of the next one.
+    pub(super) fn inching_modulo_target(&self, s: f64, step: f64, forward: bool) -> f64 {
+        let period = self.period();
+        let (base, m) = if self.config.modulo && period > 0.0 {
+            let base = (s / period).floor() * period;
+            let m = (s - base).clamp(0.0, period);
+            // Standing on the end of a turn (within float noise) is standing on 0 of the next.
+            if period - m <= 1e-9 * step {
+                (base + period, 0.0)
+            } else {
+                (base, m)
+            }
+        } else {
+            (0.0, s)
+        };
+        let n = m / step;
+        let mut t = if forward {
+            ((n + 1e-9).floor() + 1.0) * step
+        } else {
+            ((n - 1e-9).ceil() - 1.0) * step
+        };
+        if self.config.modulo && period > 0.0 {
+            if t >= period * (1.0 - 1e-12) {
+                t = period;
+            } else if t < 0.0 {
+                // The last stop of the turn before: the highest multiple below the period.
+                t = ((period / step - 1e-9).ceil() - 1.0) * step - period;
+            }
+        }
+        base + t
     }
 
     /// MC_Halt/MC_Stop dynamics: ≤ 0 means the last move's; never weaker than the running job.
