@@ -70,6 +70,10 @@ pub struct AxisStatus {
     pub remaining_time: f64,
     /// Effective override in percent (MC_Power override × MC_SetOverride factor).
     pub override_percent: f64,
+    /// Its two parts: MC_Power's Override (percent) and MC_SetOverride's VelFactor (0…1), so
+    /// that a client can show and change one without guessing the other.
+    pub power_override_percent: f64,
+    pub set_override_factor: f64,
     pub power_status: bool,
     pub enable_positive: bool,
     pub enable_negative: bool,

@@ -1068,6 +1068,8 @@ impl Axis {
             0.0
         };
         s.override_percent = self.power_override * self.override_factor;
+        s.power_override_percent = self.power_override;
+        s.set_override_factor = self.override_factor;
         s.enable_positive = self.enable_positive;
         s.enable_negative = self.enable_negative;
         s.homed = self.homed;

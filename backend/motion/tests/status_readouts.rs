@@ -1,6 +1,7 @@
-//! The following-error peak hold (TwinCAT online "lag distance min/max"): kept by the kernel
-//! every cycle, so it equals the extremes of the per-cycle following error, and a reset starts
-//! it again from the present value without touching the motion.
+//! Status readouts beyond the state: the following-error peak hold (TwinCAT online "lag
+//! distance min/max") is kept by the kernel every cycle, so it equals the extremes of the
+//! per-cycle following error, and a reset starts it again without touching the motion; the
+//! override is shown as its two parts as well as their product.
 
 mod rig;
 
@@ -43,4 +44,33 @@ fn the_peak_hold_is_the_extreme_of_every_cycle_and_restarts_on_reset() {
     assert_eq!(after.set_position, before.set_position);
     assert_eq!(after.state, before.state);
     assert!(!r.k.reset_following_error_peak(5), "no axis in slot 5");
+}
+
+#[test]
+fn the_status_shows_the_power_override_and_the_set_override_factor() {
+    let mut r = Rig::new(1);
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+        },
+    );
+    r.ok(
+        0,
+        CommandKind::SetOverride {
+            velocity_factor: 0.4,
+        },
+    );
+    r.step();
+    let st = r.st(0);
+    assert_eq!(st.power_override_percent, 50.0);
+    assert_eq!(st.set_override_factor, 0.4);
+    assert!(
+        (st.override_percent - 20.0).abs() < 1e-12,
+        "{}",
+        st.override_percent
+    );
 }
