@@ -2228,6 +2228,71 @@ fn homing_reference_modes_plc_cam_and_drive_latch_on_the_cam_edge() {
     assert!((at - 50.0).abs() < 1e-9, "{at}");
 }
 
+/// Spec §5.3.1: with the cam already active at the start, homing begins at phase 3 (leave
+/// the cam) — also in the drive-latch modes (#1076 = 3, 4, 6, 7), which leave the cam against
+/// the search direction and search it again: they latch the same cam edge as a search from
+/// outside (rising: the cam's start 50, falling: its end 55, searching positive).
+#[test]
+fn homing_with_the_cam_active_at_the_start_begins_by_leaving_the_cam_in_every_mode() {
+    use ReferenceMode::*;
+    for (mode, edge) in [
+        (HardwareLatchPos, Some(50.0)),
+        (HardwareLatchNeg, Some(55.0)),
+        (SoftDriveLatchPos, Some(50.0)),
+        (SoftDriveLatchNeg, Some(55.0)),
+        (PlcCam, None),
+        (HardwareSync, None),
+    ] {
+        let mut references = vec![];
+        for start in [0.0, 52.0] {
+            let mut r = Rig::new(1);
+            r.plants[0].cam = Some((50.0, 55.0));
+            r.plants[0].index_period = Some(8.0);
+            r.plants[0].pos = start;
+            r.power_on(0);
+            let h = r.ok(
+                0,
+                CommandKind::Home {
+                    position: Some(7.0),
+                    mode: HomingMode::Default,
+                    options: HomingOptions {
+                        reference_mode: Some(mode),
+                        ..HomingOptions::default()
+                    },
+                },
+            );
+            let mut phases = vec![r.st(0).homing_phase];
+            r.until(20.0, |r| {
+                let p = r.st(0).homing_phase;
+                if phases.last() != Some(&p) {
+                    phases.push(p);
+                }
+                !r.out(h).busy
+            });
+            assert!(r.out(h).done, "{mode:?} from {start}: {:?}", r.out(h));
+            if start == 52.0 {
+                assert_eq!(phases[0], HomingPhase::LeaveCam, "{mode:?}: {phases:?}");
+            } else {
+                assert_eq!(phases[0], HomingPhase::SearchCam, "{mode:?}: {phases:?}");
+            }
+            r.run(0.01);
+            // Where the drive position that became 7 lies.
+            references.push(r.plants[0].pos - (r.st(0).actual_position - 7.0));
+        }
+        if let Some(edge) = edge {
+            for at in &references {
+                assert!((at - edge).abs() < 1e-9, "{mode:?}: {references:?}");
+            }
+        } else {
+            // The same reference (cam left backwards; PLC cam to within one cycle of travel).
+            assert!(
+                (references[0] - references[1]).abs() <= 5.0 * DT + 1e-9,
+                "{mode:?}: {references:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn gear_coupling_to_the_masters_actual_values_with_parameter_1064() {
     let mut ps = params();

@@ -80,14 +80,30 @@ impl Axis {
                     None => ReferenceMode::from_number(p.axis_encoder_reference_mode)
                         .ok_or(ErrorId::INVALID_MODE)?,
                 };
+                // The drive-latch modes take their reference from the cam edge met while
+                // searching; they have no sync phase. Starting on the cam they leave it
+                // against the search direction and search it again, so the latched edge is
+                // the one a search from outside meets.
+                let sync_dir = if is_drive_latch(rm) {
+                    -search_dir
+                } else {
+                    sync_dir
+                };
                 self.check_feed_enable(search_dir)?;
                 self.check_feed_enable(sync_dir)?;
+                // Spec §5.3.1: with the cam already active at the start, homing begins
+                // directly at phase 3 (leave the cam). The cam as the drive reported it last.
+                let phase = if self.prev_cam {
+                    HomingPhase::LeaveCam
+                } else {
+                    HomingPhase::SearchCam
+                };
                 let mut j = Job::new(id, JobKind::Home);
                 j.acc = p.axis_acc;
                 j.dec = p.axis_dec;
                 j.jerk = p.axis_jerk;
                 j.home = HomeSeq {
-                    phase: HomingPhase::SearchCam,
+                    phase,
                     reference,
                     mode: rm,
                     search_dir,
@@ -95,7 +111,7 @@ impl Axis {
                     sync_dir,
                     sync_velocity,
                     latched: None,
-                    cam_seen: false,
+                    cam_seen: self.prev_cam,
                     failed: None,
                 };
                 self.homed = false;
@@ -119,13 +135,7 @@ impl Axis {
         let cam = fb.reference_cam;
         let cam_rise = cam && !self.prev_cam;
         let cam_fall = !cam && self.prev_cam;
-        let drive_latch = matches!(
-            h.mode,
-            ReferenceMode::HardwareLatchPos
-                | ReferenceMode::HardwareLatchNeg
-                | ReferenceMode::SoftDriveLatchPos
-                | ReferenceMode::SoftDriveLatchNeg
-        );
+        let drive_latch = is_drive_latch(h.mode);
         let mut replan = false;
         let mut fail = None;
         if let Some(k) = self.planner.step(dt) {
@@ -193,6 +203,11 @@ impl Axis {
             HomingPhase::WaitCamFallingEdge => {
                 if cam_fall || !cam {
                     match h.mode {
+                        _ if drive_latch => {
+                            // Off the cam it started on: search it again, latch armed.
+                            h.phase = HomingPhase::SearchCam;
+                            replan = true;
+                        }
                         ReferenceMode::PlcCam => {
                             h.latched = Some(self.act_pos);
                             h.phase = HomingPhase::SetPosition;
@@ -266,4 +281,15 @@ impl Axis {
         }
         None
     }
+}
+
+/// The reference modes whose reference is a cam edge latched by the drive (#1076 = 3, 4, 6, 7).
+fn is_drive_latch(mode: ReferenceMode) -> bool {
+    matches!(
+        mode,
+        ReferenceMode::HardwareLatchPos
+            | ReferenceMode::HardwareLatchNeg
+            | ReferenceMode::SoftDriveLatchPos
+            | ReferenceMode::SoftDriveLatchNeg
+    )
 }
