@@ -325,7 +325,8 @@ pub enum CommandKind {
     MoveSuperImposed(Superposition),
     /// MC_AbortSuperposition.
     AbortSuperposition,
-    /// MC_WriteParameter / MC_WriteBoolParameter at runtime (value already validated).
+    /// MC_WriteParameter / MC_WriteBoolParameter at runtime; a BOOL as 0 or 1. The kernel
+    /// checks it against the parameter table itself ([`crate::AxisParameters::write`]).
     WriteParameter {
         number: u16,
         value: f64,

@@ -1209,38 +1209,55 @@ impl AxisParameters {
     ///
     /// Returns the first problem found (all are `PARAMETER_OUT_OF_RANGE`).
     pub fn validate(&self) -> Result<(), ParamIssue> {
+        match self.problem() {
+            None => Ok(()),
+            Some(Problem::Range(info, value)) => Err(issue(
+                info.number,
+                format!(
+                    "{} = {} is outside its range {}",
+                    info.name,
+                    value,
+                    range_text(info)
+                ),
+            )),
+            Some(Problem::AboveVeloMax(number)) => {
+                let name = self.info_of(number).name;
+                Err(issue(number, format!("{name} must not exceed AxisVeloMax")))
+            }
+            Some(Problem::Relation(number, message)) => Err(issue(number, message.into())),
+        }
+    }
+
+    /// The first problem [`AxisParameters::validate`] reports, found without allocating (the
+    /// kernel checks writes in the cycle thread).
+    fn problem(&self) -> Option<Problem> {
         for info in PARAMETERS.iter().filter(|p| p.storage == p.number) {
             let Some(value) = self.slot(info.number) else {
                 continue;
             };
             if info.check(value).is_err() {
-                return Err(issue(
-                    info.number,
-                    format!(
-                        "{} = {} is outside its range {}",
-                        info.name,
-                        value,
-                        range_text(info)
-                    ),
-                ));
+                return Some(Problem::Range(info, value));
             }
         }
         if self.axis_en_min_soft_pos_limit
             && self.axis_en_max_soft_pos_limit
             && self.axis_min_soft_pos_limit >= self.axis_max_soft_pos_limit
         {
-            return Err(issue(1017, "AxisMinSoftPosLimit must be below AxisMaxSoftPosLimit while both limits are enabled".into()));
+            return Some(Problem::Relation(
+                1017,
+                "AxisMinSoftPosLimit must be below AxisMaxSoftPosLimit while both limits are enabled",
+            ));
         }
         if self.axis_acc > self.axis_maximum_acceleration {
-            return Err(issue(
+            return Some(Problem::Relation(
                 1004,
-                "AxisAcc must not exceed AxisMaximumAcceleration".into(),
+                "AxisAcc must not exceed AxisMaximumAcceleration",
             ));
         }
         if self.axis_dec > self.axis_maximum_deceleration {
-            return Err(issue(
+            return Some(Problem::Relation(
                 1005,
-                "AxisDec must not exceed AxisMaximumDeceleration".into(),
+                "AxisDec must not exceed AxisMaximumDeceleration",
             ));
         }
         for (number, v) in [
@@ -1251,27 +1268,57 @@ impl AxisParameters {
             (1013, self.axis_calibration_velocity_backward),
         ] {
             if v > self.axis_velo_max {
-                let name = self.info_of(number).name;
-                return Err(issue(number, format!("{name} must not exceed AxisVeloMax")));
+                return Some(Problem::AboveVeloMax(number));
             }
         }
         if self.axis_modulo_tolerance_window >= self.axis_encoder_modulo_value / 2.0 {
-            return Err(issue(
+            return Some(Problem::Relation(
                 1045,
-                "AxisModuloToleranceWindow must be below half of AxisEncoderModuloValue".into(),
+                "AxisModuloToleranceWindow must be below half of AxisEncoderModuloValue",
             ));
         }
         if self.axis_drive_min_output_limitation >= self.axis_drive_max_output_limitation {
-            return Err(issue(
+            return Some(Problem::Relation(
                 1081,
-                "AxisDriveMinOutputLimitation must be below AxisDriveMaxOutputLimitation".into(),
+                "AxisDriveMinOutputLimitation must be below AxisDriveMaxOutputLimitation",
             ));
         }
         if self.axis_encoder_scaling_factor
             != self.axis_encoder_scaling_numerator / self.axis_encoder_scaling_denominator
         {
-            return Err(issue(1040, "AxisEncoderScalingFactor must equal AxisEncoderScalingNumerator / AxisEncoderScalingDenominator".into()));
+            return Some(Problem::Relation(
+                1040,
+                "AxisEncoderScalingFactor must equal AxisEncoderScalingNumerator / AxisEncoderScalingDenominator",
+            ));
         }
+        None
+    }
+
+    /// MC_WriteParameter / MC_WriteBoolParameter as the kernel receives them: the value as a
+    /// number, a BOOL as 0 or 1. The kernel checks every write itself (whoever submits it)
+    /// with the same table as [`AxisParameters::set`]: unknown number → `PARAMETER_UNKNOWN`;
+    /// read-only entry (status entries, 1000, 1050, 3000, 4000, 4001) → `PARAMETER_READ_ONLY`;
+    /// a BOOL other than 0/1, NaN, ±∞ or a value outside the range → `PARAMETER_OUT_OF_RANGE`;
+    /// a fractional DWORD → `COMMAND_NOT_PERMITTED`. A set that was consistent must stay so
+    /// ([`AxisParameters::validate`]; else `PARAMETER_OUT_OF_RANGE`). A refused write changes
+    /// nothing. Allocates nothing.
+    pub fn write(&mut self, number: u16, value: f64) -> Result<(), ErrorId> {
+        let info = by_number(number).ok_or(ErrorId::PARAMETER_UNKNOWN)?;
+        if info.read_only {
+            return Err(ErrorId::PARAMETER_READ_ONLY);
+        }
+        let value = match info.ty {
+            ParamType::Bool if value == 0.0 => ParamValue::Bool(false),
+            ParamType::Bool if value == 1.0 => ParamValue::Bool(true),
+            ParamType::Bool => return Err(ErrorId::PARAMETER_OUT_OF_RANGE),
+            _ => ParamValue::Number(value),
+        };
+        let mut next = self.clone();
+        next.set(number, value)?;
+        if next.problem().is_some() && self.problem().is_none() {
+            return Err(ErrorId::PARAMETER_OUT_OF_RANGE);
+        }
+        *self = next;
         Ok(())
     }
 
@@ -1316,6 +1363,17 @@ impl AxisParameters {
             _ => self.put_slot(storage, x),
         }
     }
+}
+
+/// What [`AxisParameters::validate`] found wrong first.
+#[derive(Clone, Copy, Debug)]
+enum Problem {
+    /// A stored value outside its entry's range.
+    Range(&'static ParameterInfo, ParamValue),
+    /// A velocity (its number) above AxisVeloMax.
+    AboveVeloMax(u16),
+    /// Another relation between entries: the entry to correct and why.
+    Relation(u16, &'static str),
 }
 
 fn issue(number: u16, message: String) -> ParamIssue {

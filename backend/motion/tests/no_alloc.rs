@@ -152,6 +152,26 @@ fn step_and_replanning_allocate_nothing() {
             deadman: 0.5,
         },
     );
+    // Parameter writes are checked in the cycle thread as well: accepted or refused (here a
+    // relation broken), nothing allocates.
+    submit(
+        &mut k,
+        &mut events,
+        6,
+        CommandKind::WriteParameter {
+            number: 1026,
+            value: 0.05,
+        },
+    );
+    for (number, value) in [(1003, 1.0), (1003, f64::NAN), (9999, 1.0), (1050, 0.002)] {
+        let kind = CommandKind::WriteParameter { number, value };
+        let cmd = Command {
+            id: 100_000,
+            axis: 6,
+            kind,
+        };
+        assert_ne!(k.submit(cmd, &mut events), Verdict::Accepted, "{kind:?}");
+    }
     for c in 0..2000 {
         // Re-planning every cycle on axis 5 (override changes), keepalives on the jog.
         let o = 50.0 + 50.0 * ((c as f64) * 0.01).sin().abs();

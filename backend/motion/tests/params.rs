@@ -861,3 +861,52 @@ proptest! {
         let _ = p.entries().count();
     }
 }
+
+/// The kernel's checked write (`AxisParameters::write`, a BOOL as 0/1) agrees with the
+/// server's `set` for every entry of the table, and a refused write changes nothing.
+#[test]
+fn the_kernels_write_checks_like_set_for_every_entry() {
+    for info in PARAMETERS {
+        for x in [
+            0.0,
+            1.0,
+            -1.0,
+            0.5,
+            2.0,
+            1e12,
+            -1e12,
+            f64::NAN,
+            f64::INFINITY,
+        ] {
+            let value = match info.ty {
+                ParamType::Bool if x == 0.0 || x == 1.0 => ParamValue::Bool(x == 1.0),
+                ParamType::Bool => continue,
+                _ => ParamValue::Number(x),
+            };
+            let mut by_set = AxisParameters::default();
+            let expected = by_set
+                .set(info.number, value)
+                .and_then(|()| by_set.validate().map_err(|i| i.error));
+            let mut by_write = AxisParameters::default();
+            let got = by_write.write(info.number, x);
+            assert_eq!(got, expected, "#{} {} = {x}", info.number, info.name);
+            if got.is_ok() {
+                assert_eq!(by_write, by_set, "#{} = {x}", info.number);
+            } else {
+                assert_eq!(
+                    by_write,
+                    AxisParameters::default(),
+                    "#{} = {x}",
+                    info.number
+                );
+            }
+        }
+    }
+    // A BOOL other than 0/1 is out of range.
+    let mut p = AxisParameters::default();
+    assert_eq!(p.write(1018, 0.5), Err(ErrorId::PARAMETER_OUT_OF_RANGE));
+    assert_eq!(
+        p.write(1018, f64::NAN),
+        Err(ErrorId::PARAMETER_OUT_OF_RANGE)
+    );
+}

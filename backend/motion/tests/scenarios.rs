@@ -186,6 +186,79 @@ fn s11a_06_parameter_writes_do_not_change_the_state() {
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
 }
 
+/// MC_WriteParameter is checked by the kernel with the parameter table (params.rs), whoever
+/// submits it: unknown and read-only numbers, NaN, ±∞, values out of range, a BOOL other than
+/// 0/1, a fractional DWORD, and a write that breaks the relations of a consistent set are
+/// refused with their error numbers and change nothing (the rig checks that a rejected
+/// command changes nothing and emits nothing).
+#[test]
+fn write_parameter_is_validated_by_the_kernel() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let before = r.k.parameters(0).unwrap().clone();
+    let write = |number: u16, value: f64| CommandKind::WriteParameter { number, value };
+    for (number, value, error) in [
+        (999, 1.0, ErrorId::PARAMETER_UNKNOWN),
+        (5000, 1.0, ErrorId::PARAMETER_UNKNOWN),
+        (1, 5.0, ErrorId::PARAMETER_READ_ONLY),
+        (2000, 5.0, ErrorId::PARAMETER_READ_ONLY),
+        (1000, 7.0, ErrorId::PARAMETER_READ_ONLY),
+        (1050, 0.002, ErrorId::PARAMETER_READ_ONLY),
+        (4000, 0.002, ErrorId::PARAMETER_READ_ONLY),
+        (1003, f64::NAN, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, f64::INFINITY, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, 0.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, -500.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1026, -0.1, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1018, 0.5, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1018, f64::NAN, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1062, 2.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1062, 0.5, ErrorId::COMMAND_NOT_PERMITTED),
+        // Relations: AxisAcc above AxisMaximumAcceleration (5000), a jog velocity above
+        // AxisVeloMax (500), the soft limits crossed while both are enabled.
+        (1004, 6000.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1001, 600.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, 1.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+    ] {
+        assert_eq!(
+            r.rejected(0, write(number, value)),
+            error,
+            "#{number} = {value}"
+        );
+        assert_eq!(r.k.parameters(0).unwrap(), &before, "#{number} = {value}");
+    }
+    // 3000 (AxisGearRatio) may be written only on a coupled slave.
+    assert_eq!(
+        r.rejected(0, write(3000, 2.0)),
+        ErrorId::COMMAND_NOT_PERMITTED
+    );
+    // Valid writes, BOOL as 0/1, aliases (#2 = #1019) share their storage.
+    // AxisVeloMax below the rapid traverse velocity (500) breaks a relation: lower that first.
+    assert_eq!(
+        r.rejected(0, write(1003, 400.0)),
+        ErrorId::PARAMETER_OUT_OF_RANGE
+    );
+    r.ok(0, write(1009, 300.0));
+    r.ok(0, write(1003, 400.0));
+    r.ok(0, write(1018, 1.0));
+    r.ok(0, write(2, 50.0));
+    let p = r.k.parameters(0).unwrap();
+    assert_eq!(p.axis_velo_max, 400.0);
+    assert!(p.axis_en_max_soft_pos_limit);
+    assert_eq!(p.axis_max_soft_pos_limit, 50.0);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(60.0, 100.0))),
+        ErrorId::TARGET_ABOVE_SOFT_LIMIT
+    );
+    r.ok(0, write(1016, 1.0));
+    r.ok(0, write(1017, -50.0));
+    assert_eq!(
+        r.rejected(0, write(1017, 50.0)),
+        ErrorId::PARAMETER_OUT_OF_RANGE,
+        "min limit not below max"
+    );
+}
+
 // ---------------------------------------------------------------- FB protocol
 
 #[test]
