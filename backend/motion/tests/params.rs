@@ -163,7 +163,7 @@ fn other_valid(p: &AxisParameters, info: &ParameterInfo) -> ParamValue {
 }
 
 #[test]
-fn item_32_every_spec_entry_is_present_once_in_order() {
+fn s11a_32_every_spec_entry_is_present_once_in_order() {
     let ours: Vec<(u16, &str)> = PARAMETERS.iter().map(|p| (p.number, p.name)).collect();
     let spec: Vec<(u16, &str)> = SPEC.iter().map(|&(n, name, _)| (n, name)).collect();
     assert_eq!(ours, spec);
@@ -252,7 +252,7 @@ const ALIAS_GROUPS: &[&[u16]] = &[
 ];
 
 #[test]
-fn item_32_alias_groups_are_exactly_the_spec_ones() {
+fn s11a_32_alias_groups_are_exactly_the_spec_ones() {
     let mut grouped: Vec<u16> = ALIAS_GROUPS
         .iter()
         .flat_map(|g| g.iter().copied())
@@ -280,7 +280,7 @@ fn item_32_alias_groups_are_exactly_the_spec_ones() {
 }
 
 #[test]
-fn item_32_aliases_share_storage_both_ways() {
+fn s11a_32_aliases_share_storage_both_ways() {
     for group in ALIAS_GROUPS {
         for &writer in *group {
             let mut p = AxisParameters::default();
@@ -308,7 +308,7 @@ fn item_32_aliases_share_storage_both_ways() {
 }
 
 #[test]
-fn item_32_write_then_read_every_writable_entry() {
+fn s11a_32_write_then_read_every_writable_entry() {
     let mut count = 0;
     for info in writable() {
         let mut p = AxisParameters::default();

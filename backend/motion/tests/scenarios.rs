@@ -1,5 +1,7 @@
 //! Scenario tests in virtual time. Test names carry the spec §11a item they cover
-//! (`s11a_NN_…`); every cycle of every test also runs the rig's invariant checks.
+//! (`s11a_NN_…`); every cycle of every test also runs the rig's invariant checks. Item 32
+//! (parameters by number, aliases) is in `tests/params.rs`; item 33 (persistent writes survive
+//! a restart) has no kernel meaning — persistence is the server's.
 
 mod rig;
 
@@ -617,6 +619,39 @@ fn s11a_20_move_velocity_in_velocity_and_stays_busy() {
     assert!((r.st(0).set_velocity + 60.0).abs() < 1e-9);
 }
 
+/// §11a #20: a superposition on a MoveVelocity keeps InVelocity TRUE in every cycle (the
+/// commanded velocity of the main motion is unchanged; the setpoint carries the extra).
+#[test]
+fn s11a_20_superposition_keeps_in_velocity_of_a_move_velocity() {
+    let mut r = Rig::new(1);
+    r.bounds[0].jerk = 1e9; // the superposition profile is C² but not jerk-limited
+    power(&mut r);
+    let v = r.ok(0, velocity(120.0, Direction::Positive));
+    r.until(1.0, |r| r.out(v).in_velocity);
+    let s = r.ok(
+        0,
+        CommandKind::MoveSuperImposed(Superposition {
+            mode: SuperpositionMode::VeloReductionAdditiveMotion,
+            distance: 30.0,
+            velocity_diff: 100.0,
+            velocity_process: 120.0,
+            length: 200.0,
+            ..Default::default()
+        }),
+    );
+    let mut faster = false;
+    while r.out(s).busy {
+        r.step();
+        let o = r.out(v);
+        assert!(o.busy && o.active && o.in_velocity, "{o:?}");
+        faster |= r.st(0).set_velocity > 120.0 + 1.0;
+    }
+    assert!(r.out(s).done && faster, "the superposition ran");
+    r.run(0.1);
+    assert!(r.out(v).in_velocity);
+    assert!((r.st(0).set_velocity - 120.0).abs() < 1e-9);
+}
+
 #[test]
 fn s11a_21_move_continuous_reaches_target_then_keeps_end_velocity() {
     let mut r = Rig::new(1);
@@ -914,10 +949,8 @@ fn s11a_24_stop_locks_until_released_done_while_busy() {
 
 // ---------------------------------------------------------------- homing, jog, gearing
 
-#[test]
-fn s11a_25_home_direct_force_reset_calibration() {
-    let mut r = Rig::new(1);
-    power(&mut r);
+/// MC_SetPosition relative +5: the MC_SetPosition offset (#2003) is 5.
+fn set_position_offset_5(r: &mut Rig) {
     r.ok(
         0,
         CommandKind::SetPosition {
@@ -927,6 +960,13 @@ fn s11a_25_home_direct_force_reset_calibration() {
         },
     );
     assert_eq!(r.st(0).set_position_offset, 5.0);
+}
+
+#[test]
+fn s11a_25_home_direct_force_reset_calibration() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    set_position_offset_5(&mut r);
     r.ok(
         0,
         CommandKind::Home {
@@ -959,6 +999,34 @@ fn s11a_25_home_direct_force_reset_calibration() {
     );
     assert!(r.st(0).homed);
     assert!((r.st(0).set_position - 42.0).abs() < 1e-9);
+}
+
+/// MC_Home with the referencing sequence (#1076) to `position`; returns when it has ended.
+fn home_by_sequence(r: &mut Rig, position: f64) -> CommandId {
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(position),
+            mode: HomingMode::Default,
+            options: HomingOptions::default(),
+        },
+    );
+    r.until(20.0, |r| !r.out(h).busy);
+    h
+}
+
+/// §11a #25 for the referencing sequence (not only MC_Direct): homing clears the
+/// MC_SetPosition offset.
+#[test]
+fn s11a_25_a_homing_sequence_clears_the_set_position_offset() {
+    let mut r = Rig::new(1);
+    r.plants[0].cam = Some((50.0, 55.0));
+    r.plants[0].index_period = Some(8.0);
+    power(&mut r);
+    set_position_offset_5(&mut r);
+    let h = home_by_sequence(&mut r, 100.0);
+    assert!(r.out(h).done && r.st(0).homed);
+    assert_eq!(r.st(0).set_position_offset, 0.0);
 }
 
 #[test]
@@ -1817,6 +1885,157 @@ fn s11a_30_superposition_conveyor_example_and_infeasible_warning() {
     assert!(ahead < 300.0 - 1.0 && ahead > 0.0, "{ahead}");
 }
 
+/// MC_MoveSuperImposed: 50 more over 400 of main travel at 200 (velocity reduction, additive).
+fn superimpose_50_over_400(abort_option: SuperpositionAbortOption) -> CommandKind {
+    CommandKind::MoveSuperImposed(Superposition {
+        mode: SuperpositionMode::VeloReductionAdditiveMotion,
+        distance: 50.0,
+        velocity_diff: 200.0,
+        velocity_process: 200.0,
+        length: 400.0,
+        abort_option,
+        ..Default::default()
+    })
+}
+
+/// What happens to the main motion in one row of the superposition abort table (spec §6.13).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum MainMotion {
+    /// Row 1: override 0 %.
+    OverrideZero,
+    /// Row 2: a temporary standstill (a gear slave whose master halts and starts again).
+    TemporaryStandstill,
+    /// Row 3: the main motion reverses.
+    Reversal,
+    /// Row 4: the axis reaches its target.
+    ReachedTarget,
+    /// Row 4: the axis is stopped (MC_Halt).
+    Stopped,
+    /// Row 5: MC_Reset.
+    Reset,
+    /// Row 5: MC_Power Enable FALSE.
+    PowerOff,
+    /// Row 6: a slave is decoupled (MC_GearOut).
+    Decoupled,
+}
+
+/// §11a #31: every row × column of the superposition abort table (spec §6.13): whether the
+/// superposition is aborted, and when it continues, that it completes once the main motion
+/// goes on.
+#[test]
+fn s11a_31_superposition_abort_table_every_row_and_column() {
+    use MainMotion::*;
+    use SuperpositionAbortOption::*;
+    // (row event, aborted with AbortAtStandstill, ResumeAfterStandstill, ResumeAfterMotionStop)
+    let table = [
+        (OverrideZero, [false, false, false]),
+        (TemporaryStandstill, [true, false, false]),
+        (Reversal, [true, false, false]),
+        (ReachedTarget, [true, true, false]),
+        (Stopped, [true, true, false]),
+        (Reset, [true, true, true]),
+        (PowerOff, [true, true, true]),
+        (Decoupled, [true, true, true]),
+    ];
+    for (event, aborted) in table {
+        for (option, aborted) in [
+            AbortAtStandstill,
+            ResumeAfterStandstill,
+            ResumeAfterMotionStop,
+        ]
+        .into_iter()
+        .zip(aborted)
+        {
+            let what = format!("{event:?} / {option:?}");
+            // The superposed axis (a slave of axis 0 for the coupling rows) runs at 200.
+            let slave = matches!(event, TemporaryStandstill | Decoupled);
+            let mut p = params();
+            p.axis_velo_max = 1500.0;
+            let mut r = Rig::with(vec![(false, p.clone()), (false, p)]);
+            r.bounds[1].jerk = 1e9; // the superposition profile is C² but not jerk-limited
+            r.power_on(0);
+            r.power_on(1);
+            if slave {
+                r.ok(
+                    1,
+                    CommandKind::GearIn {
+                        master: 0,
+                        ratio_numerator: 1.0,
+                        ratio_denominator: 1,
+                    },
+                );
+                r.ok(0, velocity(200.0, Direction::Positive));
+            } else if event == ReachedTarget {
+                r.ok(1, CommandKind::MoveAbsolute(mv(200.0, 200.0)));
+            } else {
+                r.ok(1, velocity(200.0, Direction::Positive));
+            }
+            r.run(0.5);
+            let s = r.ok(1, superimpose_50_over_400(option));
+            r.run(0.2);
+            assert!(r.out(s).busy, "{what}: running before the event");
+            match event {
+                OverrideZero => {
+                    r.ok(
+                        1,
+                        CommandKind::SetOverride {
+                            velocity_factor: 0.0,
+                        },
+                    );
+                }
+                TemporaryStandstill => {
+                    r.ok(0, halt());
+                }
+                Reversal => {
+                    r.ok(1, velocity(200.0, Direction::Negative));
+                }
+                ReachedTarget => {}
+                Stopped => {
+                    r.ok(1, halt());
+                }
+                Reset => {
+                    r.ok(1, CommandKind::Reset);
+                }
+                PowerOff => {
+                    r.ok(1, power_off());
+                }
+                Decoupled => {
+                    r.ok(1, CommandKind::GearOut);
+                }
+            }
+            // Long enough for the main motion to stand still, reverse or reach its target.
+            r.run(1.0);
+            let o = r.out(s);
+            if aborted {
+                assert!(o.command_aborted && !o.busy, "{what}: {o:?}");
+                continue;
+            }
+            assert!(o.busy && !o.command_aborted, "{what}: {o:?}");
+            // The main motion goes on: the superposition completes.
+            match event {
+                OverrideZero => {
+                    r.ok(
+                        1,
+                        CommandKind::SetOverride {
+                            velocity_factor: 1.0,
+                        },
+                    );
+                }
+                TemporaryStandstill => {
+                    r.ok(0, velocity(200.0, Direction::Positive));
+                }
+                ReachedTarget | Stopped => {
+                    r.ok(1, velocity(200.0, Direction::Positive));
+                }
+                _ => {}
+            }
+            r.until(10.0, |r| !r.out(s).busy);
+            let o = r.out(s);
+            assert!(o.done && !o.warning, "{what}: {o:?}");
+        }
+    }
+}
+
 #[test]
 fn s11a_31_superposition_abort_options() {
     let sp = |abort_option| Superposition {
@@ -1953,12 +2172,7 @@ fn max_velocity_step(history: &[AxisStatus]) -> f64 {
 #[test]
 fn an_aborted_superposition_leaves_no_velocity_step() {
     use SuperpositionAbortOption::*;
-    let halt = CommandKind::Halt {
-        deceleration: 0.0,
-        jerk: 0.0,
-        buffer_mode: BufferMode::Aborting,
-        options: MoveOptions::default(),
-    };
+    let halt = halt();
     for (option, then) in [
         (AbortAtStandstill, halt),
         (ResumeAfterStandstill, halt),
@@ -1966,18 +2180,7 @@ fn an_aborted_superposition_leaves_no_velocity_step() {
         (AbortAtStandstill, CommandKind::AbortSuperposition),
     ] {
         let mut r = conveyor(200.0);
-        let s = r.ok(
-            0,
-            CommandKind::MoveSuperImposed(Superposition {
-                mode: SuperpositionMode::VeloReductionAdditiveMotion,
-                distance: 50.0,
-                velocity_diff: 200.0,
-                velocity_process: 200.0,
-                length: 400.0,
-                abort_option: option,
-                ..Default::default()
-            }),
-        );
+        let s = r.ok(0, superimpose_50_over_400(option));
         r.run(0.2);
         assert!(r.st(0).set_velocity > 201.0, "adding velocity");
         r.ok(0, then);
@@ -2261,15 +2464,7 @@ fn homing_reference_modes_plc_cam_and_drive_latch_on_the_cam_edge() {
     let mut r = Rig::with(vec![(false, p)]);
     r.plants[0].cam = Some((50.0, 55.0));
     r.power_on(0);
-    let h = r.ok(
-        0,
-        CommandKind::Home {
-            position: Some(0.0),
-            mode: HomingMode::Default,
-            options: HomingOptions::default(),
-        },
-    );
-    r.until(20.0, |r| !r.out(h).busy);
+    let h = home_by_sequence(&mut r, 0.0);
     assert!(r.out(h).done);
     r.run(0.01);
     // Leaving the cam backwards, its falling edge is at 50 (within one cycle of travel at the
@@ -2286,15 +2481,7 @@ fn homing_reference_modes_plc_cam_and_drive_latch_on_the_cam_edge() {
     let mut r = Rig::with(vec![(false, p)]);
     r.plants[0].cam = Some((50.0, 55.0));
     r.power_on(0);
-    let h = r.ok(
-        0,
-        CommandKind::Home {
-            position: Some(7.0),
-            mode: HomingMode::Default,
-            options: HomingOptions::default(),
-        },
-    );
-    r.until(20.0, |r| !r.out(h).busy);
+    let h = home_by_sequence(&mut r, 7.0);
     assert!(r.out(h).done);
     r.run(0.01);
     let at = r.plants[0].pos - (r.st(0).actual_position - 7.0);

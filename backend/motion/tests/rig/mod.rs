@@ -521,3 +521,23 @@ pub fn params_with_soft_limits(min: f64, max: f64) -> AxisParameters {
     p.axis_max_soft_pos_limit = max;
     p
 }
+
+/// MC_Power Enable FALSE.
+pub fn power_off() -> CommandKind {
+    CommandKind::Power {
+        enable: false,
+        enable_positive: false,
+        enable_negative: false,
+        override_percent: 100.0,
+    }
+}
+
+/// MC_Halt, Aborting, with the last move's dynamics.
+pub fn halt() -> CommandKind {
+    CommandKind::Halt {
+        deceleration: 0.0,
+        jerk: 0.0,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
+}
