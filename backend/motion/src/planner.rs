@@ -213,10 +213,37 @@ impl Planner {
         };
         self.input.target_position[0] = target_position;
         self.input.target_velocity[0] = target_velocity;
-        self.solve(from, &limits, max_acc, min_acc)
+        self.solve_signed(from, &limits, max_acc, min_acc)
     }
 
     fn solve(
+        &mut self,
+        from: Kinematics,
+        limits: &Limits,
+        max_acc: f64,
+        min_acc: f64,
+    ) -> Result<f64, PlanError> {
+        let duration = self.solve_signed(from, limits, max_acc, min_acc)?;
+        // The signed limits map PLCopen acceleration/deceleration onto one direction of
+        // travel. A profile that turns round on the way (e.g. it must back up to pass its
+        // target at the end velocity) also speeds up in the other direction, where they would
+        // be swapped: plan it with the lower of both throughout.
+        if max_acc != -min_acc && !self.is_monotonic(from.position) {
+            let a = max_acc.min(-min_acc);
+            return self.solve_signed(from, limits, a, -a);
+        }
+        Ok(duration)
+    }
+
+    /// The planned position never turns round (no extremum inside the profile).
+    fn is_monotonic(&mut self, start: f64) -> bool {
+        let end = self.end.position;
+        let ext = &self.traj.get_position_extrema()[0];
+        let tol = 1e-9 * (1.0 + start.abs().max(end.abs()));
+        ext.min >= start.min(end) - tol && ext.max <= start.max(end) + tol
+    }
+
+    fn solve_signed(
         &mut self,
         from: Kinematics,
         limits: &Limits,
@@ -602,6 +629,36 @@ mod tests {
         let amax = ks.iter().map(|k| k.acceleration).fold(f64::MIN, f64::max);
         assert!(amin >= -1000.0 - 1e-6 && amin < -900.0);
         assert!(amax <= 500.0 + 1e-6 && amax > 450.0);
+    }
+
+    /// Whenever |v| rises the acceleration is within `acceleration`, whenever it falls within
+    /// `deceleration` — also in a profile that turns round on the way.
+    fn assert_plcopen_dynamics(ks: &[Kinematics], lim: &Limits) {
+        for k in ks {
+            let a_max = if k.acceleration * k.velocity >= 0.0 {
+                lim.acceleration
+            } else {
+                lim.deceleration
+            };
+            assert!(k.acceleration.abs() <= a_max + 1e-6, "{k:?} above {a_max}");
+        }
+    }
+
+    #[test]
+    fn a_profile_that_turns_round_keeps_acceleration_and_deceleration_apart() {
+        let lim = Limits {
+            velocity: 500.0,
+            acceleration: 100.0,
+            deceleration: 1000.0,
+            jerk: 20000.0,
+        };
+        let mut p = Planner::new(0.001);
+        // Through the start position at 40 u/s: it has to back up first.
+        p.plan_position(Kinematics::default(), 0.0, 40.0, &lim)
+            .unwrap();
+        let ks = run(&mut p, 0.001);
+        assert!(ks.iter().any(|k| k.velocity < -1.0), "backs up");
+        assert_plcopen_dynamics(&ks, &lim);
     }
 
     #[test]
