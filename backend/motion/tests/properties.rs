@@ -165,3 +165,63 @@ proptest! {
         prop_assert!(busy.is_empty(), "still busy after power off: {:?}", busy);
     }
 }
+
+/// An Aborting positioning with random target or distance, velocity and dynamics.
+fn single() -> impl Strategy<Value = Positioning> {
+    (-800.0..800.0f64, 1.0..500.0f64, dynamics()).prop_map(|(position, velocity, dynamics)| {
+        Positioning {
+            position,
+            velocity,
+            dynamics,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        }
+    })
+}
+
+/// A motion command from rest, started alone.
+fn move_from_rest() -> impl Strategy<Value = CommandKind> {
+    prop_oneof![
+        3 => single().prop_map(CommandKind::MoveAbsolute),
+        2 => single().prop_map(CommandKind::MoveRelative),
+        1 => single().prop_map(CommandKind::MoveAdditive),
+        2 => (single(), 0usize..3).prop_map(|(mut m, d)| { m.position = m.position.abs(); CommandKind::MoveModulo { move_: m, direction: [Direction::Positive, Direction::Negative, Direction::ShortestWay][d] } }),
+        3 => (1.0..500.0f64, dynamics(), any::<bool>()).prop_map(|(velocity, dynamics, fwd)| CommandKind::MoveVelocity { velocity, dynamics, direction: if fwd { Direction::Positive } else { Direction::Negative }, buffer_mode: BufferMode::Aborting, options: MoveOptions::default() }),
+        2 => (single(), 0.0..500.0f64).prop_map(|(move_, end_velocity)| CommandKind::MoveContinuousAbsolute { move_, end_velocity }),
+        1 => (single(), 0.0..500.0f64).prop_map(|(move_, end_velocity)| CommandKind::MoveContinuousRelative { move_, end_velocity }),
+        2 => (0usize..5, any::<bool>(), 0.1..50.0f64, 1.0..500.0f64, dynamics()).prop_map(|(mode, forward, position, velocity, dynamics)| CommandKind::Jog { mode: [JogMode::StandardSlow, JogMode::StandardFast, JogMode::Continuous, JogMode::Inching, JogMode::InchingModulo][mode], forward, position, velocity, dynamics, deadman: 0.0 }),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: std::env::var("MOTION_PROP_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(300), ..ProptestConfig::default() })]
+
+    /// A move started from rest and left alone keeps, in every cycle, its own velocity ×
+    /// override, acceleration (speeding up), deceleration (slowing down) and jerk: the rig
+    /// checks it (`Rig::from_rest`); this drives it through many random moves.
+    #[test]
+    fn undisturbed_moves_from_rest_keep_their_own_dynamics(
+        kind in move_from_rest(),
+        override_percent in prop_oneof![Just(100.0), 1.0..100.0f64],
+        modulo in any::<bool>(),
+        start in -200.0..200.0f64,
+    ) {
+        let mut p = params();
+        p.axis_velo_man_slow = 20.0;
+        p.axis_velo_man_fast = 100.0;
+        let mut r = Rig::with(vec![(modulo, p)]);
+        r.plants[0].pos = start;
+        r.power_on_with_override(0, override_percent);
+        let (id, verdict) = r.cmd(0, kind);
+        prop_assume!(verdict == Verdict::Accepted);
+        prop_assert!(r.from_rest[0].is_some_and(|t| t.command == id), "not checked: {:?}", kind);
+        for _ in 0..20_000 {
+            if !r.out(id).busy || r.out(id).in_velocity || r.out(id).in_end_velocity {
+                break;
+            }
+            r.step();
+        }
+        r.run(0.05);
+        prop_assert!(r.from_rest_cycles > 0);
+    }
+}

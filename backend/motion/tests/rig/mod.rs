@@ -1,6 +1,7 @@
 //! Virtual-time test rig: a kernel, an ideal/PT1 plant per axis with cam, index pulse and
 //! latch, and invariant checks that run in EVERY cycle (FB protocol, state diagram,
-//! continuity, velocity/acceleration/jerk bounds).
+//! continuity, velocity/acceleration/jerk bounds of the axis, and of a motion command started
+//! from rest and left undisturbed its own dynamics: see [`FromRest`]).
 #![allow(dead_code)]
 
 use std::collections::{HashMap, HashSet};
@@ -144,6 +145,20 @@ pub struct Bounds {
     pub jerk: f64,
 }
 
+/// A positioning or velocity command that started from rest (v = 0, a = 0) and has run
+/// undisturbed since: no other command on its axis was accepted (nothing aborted, blended,
+/// buffered, overrode, stopped or superimposed it). Every cycle its own dynamics bound the
+/// setpoint: |v| ≤ velocity × override, |a| ≤ acceleration while |v| rises and ≤ deceleration
+/// while it falls, |j| ≤ jerk (axis defaults for 0).
+#[derive(Clone, Copy, Debug)]
+pub struct FromRest {
+    pub command: CommandId,
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
+}
+
 pub struct Rig {
     pub k: Kernel,
     pub plants: Vec<Plant>,
@@ -158,6 +173,10 @@ pub struct Rig {
     shifted: Vec<bool>,
     pub history: Vec<Vec<AxisStatus>>,
     pub checked_cycles: u64,
+    /// Per axis: the command started from rest whose own bounds are checked (see [`FromRest`]).
+    pub from_rest: Vec<Option<FromRest>>,
+    /// Cycles checked against a [`FromRest`] command's own bounds (all axes).
+    pub from_rest_cycles: u64,
 }
 
 pub fn params() -> AxisParameters {
@@ -221,6 +240,8 @@ impl Rig {
             shifted: vec![true; n],
             history: vec![Vec::new(); n],
             checked_cycles: 0,
+            from_rest: vec![None; n],
+            from_rest_cycles: 0,
         }
     }
 
@@ -246,6 +267,18 @@ impl Rig {
         }
         // Events of a submit are stamped with the cycle the command takes effect in.
         self.check_events_at(n, self.k.cycle() + 1);
+        if v == Verdict::Accepted {
+            // Any accepted command disturbs the one started from rest; a motion command that
+            // starts at once from rest is the next one checked against its own bounds.
+            let before = before.unwrap();
+            self.from_rest[axis as usize] = None;
+            let at_rest = before.set_velocity == 0.0
+                && before.set_acceleration == 0.0
+                && !before.compensating;
+            if at_rest && self.out(id).active {
+                self.from_rest[axis as usize] = self.own_bounds(axis, id, &kind, &before);
+            }
+        }
         // The state changes in the cycle the command is accepted: check that transition too.
         let now = self.k.status(axis).unwrap().state;
         let prev = self.prev[axis as usize].state;
@@ -320,17 +353,116 @@ impl Rig {
     }
 
     pub fn power_on(&mut self, axis: u16) -> CommandId {
+        self.power_on_with_override(axis, 100.0)
+    }
+
+    /// MC_Power with both feed enables and the given override; waits for Standstill.
+    pub fn power_on_with_override(&mut self, axis: u16, override_percent: f64) -> CommandId {
         let id = self.ok(
             axis,
             CommandKind::Power {
                 enable: true,
                 enable_positive: true,
                 enable_negative: true,
-                override_percent: 100.0,
+                override_percent,
             },
         );
         self.until(0.1, |r| r.st(axis).state == AxisState::Standstill);
         id
+    }
+
+    /// The bounds a motion command sets itself (`None` for other commands).
+    fn own_bounds(
+        &self,
+        axis: u16,
+        id: CommandId,
+        kind: &CommandKind,
+        before: &AxisStatus,
+    ) -> Option<FromRest> {
+        let p = self.k.parameters(axis).unwrap();
+        let axis_dynamics = Dynamics::default();
+        let (velocity, dynamics) = match *kind {
+            CommandKind::MoveAbsolute(m)
+            | CommandKind::MoveRelative(m)
+            | CommandKind::MoveAdditive(m)
+            | CommandKind::MoveModulo { move_: m, .. } => (m.velocity, m.dynamics),
+            CommandKind::MoveContinuousAbsolute {
+                move_: m,
+                end_velocity,
+            }
+            | CommandKind::MoveContinuousRelative {
+                move_: m,
+                end_velocity,
+            } => (m.velocity.max(end_velocity), m.dynamics),
+            CommandKind::MoveVelocity {
+                velocity, dynamics, ..
+            } => (velocity, dynamics),
+            CommandKind::Jog {
+                mode,
+                velocity,
+                dynamics,
+                ..
+            } => match mode {
+                JogMode::StandardSlow => (p.axis_velo_man_slow, axis_dynamics),
+                JogMode::StandardFast => (p.axis_velo_man_fast, axis_dynamics),
+                _ => (velocity, dynamics),
+            },
+            _ => return None,
+        };
+        let or = |x: f64, default: f64| if x == 0.0 { default } else { x };
+        let ovr = (before.override_percent / 100.0).clamp(0.0, 1.0);
+        Some(FromRest {
+            command: id,
+            velocity: velocity * ovr,
+            acceleration: or(dynamics.acceleration, p.axis_acc),
+            deceleration: or(dynamics.deceleration, p.axis_dec),
+            jerk: or(dynamics.jerk, p.axis_jerk),
+        })
+    }
+
+    /// Checks a cycle of axis `i` against the bounds of its command started from rest.
+    fn check_from_rest(&mut self, i: usize, p: &AxisStatus, s: &AxisStatus) {
+        let Some(t) = self.from_rest[i] else { return };
+        if self.finals.contains(&t.command) {
+            // It ended in this cycle (at its target, or with an error whose stop now runs).
+            self.from_rest[i] = None;
+            return;
+        }
+        self.from_rest_cycles += 1;
+        let tol = 1e-9;
+        assert!(
+            s.set_velocity.abs() <= t.velocity * (1.0 + tol),
+            "axis {i}: |v| {} above the command's velocity × override {} ({t:?})",
+            s.set_velocity,
+            t.velocity
+        );
+        let speeding_up = s.set_acceleration * s.set_velocity >= 0.0;
+        let a_max = if speeding_up {
+            t.acceleration
+        } else {
+            t.deceleration
+        };
+        assert!(
+            s.set_acceleration.abs() <= a_max * (1.0 + tol) + tol,
+            "axis {i}: |a| {} above the command's {} {a_max} (v {}, {t:?})",
+            s.set_acceleration,
+            if speeding_up {
+                "acceleration"
+            } else {
+                "deceleration"
+            },
+            s.set_velocity
+        );
+        assert!(
+            s.set_jerk.abs() <= t.jerk * (1.0 + tol)
+                && (s.set_acceleration - p.set_acceleration).abs()
+                    <= t.jerk * DT * (1.0 + 1e-6) + 1e-6,
+            "axis {i}: jerk {} (a {} -> {}) above the command's {} ({t:?})",
+            s.set_jerk,
+            p.set_acceleration,
+            s.set_acceleration,
+            t.jerk
+        );
     }
 
     fn check_events(&mut self, from: usize) {
@@ -451,6 +583,7 @@ impl Rig {
                     s.set_velocity
                 );
             }
+            self.check_from_rest(i, &p, &s);
             self.shifted[i] = false;
             self.prev[i] = s;
             self.history[i].push(s);
