@@ -2,20 +2,18 @@
 import { LiveClient } from './live/client';
 import { JogController } from './live/jog';
 import { Store } from './store';
-import { ApiError, del, enc, get, post } from './api/rest';
+import { ApiError, api, del, enc, get, post } from './api/rest';
 import { errorInfo } from './api/errors';
-import type { AxisResource, AxisStatus, CommandEvent, CommandResource, SystemResource } from './api/types';
+import type { AxisLiveStatus, AxisResource, CommandEvent, CommandResource, PeakResetResource, SystemResource } from './api/types';
 import { RpcError } from './live/client';
 import { ScopeSession } from './scope/session';
 import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
+import { TrendBuffer } from './live/trend';
 
 export interface LiveStatus {
-  status: AxisStatus | null;
+  status: AxisLiveStatus | null;
   cycle: number;
   stale: boolean;
-  /** Peak hold of the following error (of the values received), reset by the user. */
-  lagMax: number;
-  lagMin: number;
 }
 
 export interface LogEntry {
@@ -57,27 +55,35 @@ export const scope = new ScopeSession({ list: listRecordings, get: getRecording,
 let focus: string | null = null;
 const subscribed = new Map<string, { rate: number; off: () => void }>();
 
-function onStatus(name: string, value: AxisStatus | null, stale: boolean, cycle: number): void {
+/**
+ * The live trend of each axis (set and actual velocity, following error): a fixed-size ring
+ * buffer fed by its status subscription, 50 Hz while the axis is on screen.
+ */
+const trends = new Map<string, TrendBuffer>();
+
+export function trendOf(name: string): TrendBuffer {
+  let t = trends.get(name);
+  if (!t) trends.set(name, (t = new TrendBuffer()));
+  return t;
+}
+
+const clock = () => (typeof performance !== 'undefined' ? performance.now() : Date.now());
+
+function onStatus(name: string, value: AxisLiveStatus | null, stale: boolean, cycle: number): void {
   const m = statuses.get();
-  const prev = m.get(name);
-  const lag = value?.following_error ?? 0;
-  m.set(name, {
-    status: value,
-    cycle,
-    stale,
-    lagMax: prev ? Math.max(prev.lagMax, lag) : lag,
-    lagMin: prev ? Math.min(prev.lagMin, lag) : lag,
-  });
+  m.set(name, { status: value, cycle, stale });
+  const trend = trendOf(name);
+  if (stale || !value) trend.gap();
+  else trend.push(cycle, value.set_velocity, value.actual_velocity, value.following_error, clock());
   statuses.emit();
 }
 
-export function resetLagPeak(name: string): void {
-  const s = statuses.get().get(name);
-  if (!s) return;
-  const lag = s.status?.following_error ?? 0;
-  s.lagMax = lag;
-  s.lagMin = lag;
-  statuses.emit();
+/**
+ * Restarts the server's following-error peak hold of an axis (`following_error_min/max` of
+ * its status, kept over every cycle). Not a command: it changes no motion.
+ */
+export function resetFollowingErrorPeak(axis: string): Promise<PeakResetResource> {
+  return api<PeakResetResource>('POST', `/axes/${enc(axis)}/status/following-error-peak/reset`);
 }
 
 /** Keeps one status subscription per axis; the focused axis (online tab) at a higher rate. */
@@ -91,11 +97,12 @@ function syncSubscriptions(): void {
       statuses.emit();
     }
   }
+  for (const name of trends.keys()) if (!names.has(name)) trends.delete(name);
   for (const name of names) {
     const rate = name === focus ? FOCUS_RATE_HZ : STATUS_RATE_HZ;
     const sub = subscribed.get(name);
     if (sub && sub.rate === rate) continue;
-    const off = live.subscribe<AxisStatus>(`axes/${name}/status`, rate, (v, stale, cycle) => onStatus(name, v, stale, cycle));
+    const off = live.subscribe<AxisLiveStatus>(`axes/${name}/status`, rate, (v, stale, cycle) => onStatus(name, v, stale, cycle));
     subscribed.set(name, { rate, off });
   }
 }
@@ -156,7 +163,6 @@ function upsert(e: LogEntry): void {
 }
 
 export function logCommand(r: CommandResource): void {
-  if (r.command === 'power') notePower(r.axis, r.id, r.parameters);
   upsert(entryOf(r));
 }
 
@@ -197,7 +203,6 @@ function onCommandEvent(ev: CommandEvent): void {
     at: known?.at ?? new Date().toISOString(),
     cycle: ev.cycle,
   });
-  if (ev.name === 'power') notePower(ev.axis, ev.command, known?.parameters ?? null);
   if (!known && !fetchedDetails.has(ev.command)) {
     fetchedDetails.add(ev.command);
     get<CommandResource>(`/commands/${ev.command}`).then(logCommand, () => {});
@@ -251,42 +256,6 @@ export async function findHeldStop(axis: string): Promise<number | null> {
   return null;
 }
 
-/**
- * The MC_Power override (percent) in force per axis: that of the axis's newest accepted power
- * command (`percent` null while its parameters are not known yet). The effective override
- * (`status.override_percent`) is this × the MC_SetOverride factor.
- */
-export const powerOverrides = new Store<Map<string, { id: number; percent: number | null }>>(new Map());
-
-function notePower(axis: string, id: number, parameters: unknown): void {
-  const m = powerOverrides.get();
-  const old = m.get(axis);
-  if (old && old.id > id) return;
-  const v = parameters && typeof parameters === 'object' ? (parameters as { override_percent?: unknown }).override_percent : undefined;
-  // The server's default is 100 when the body leaves it out.
-  const percent = parameters && typeof parameters === 'object' ? (typeof v === 'number' ? v : 100) : null;
-  if (old && old.id === id && (percent === null || old.percent === percent)) return;
-  m.set(axis, { id, percent });
-  powerOverrides.emit();
-}
-
-/** The power override of an axis: 100 (the server's default) when no power command is known. */
-export function powerOverride(axis: string): number | null {
-  const p = powerOverrides.get().get(axis);
-  return p ? p.percent : 100;
-}
-
-/** Learns the axis's newest power command (it may be older than the command log's window). */
-export async function loadPowerCommand(axis: string): Promise<void> {
-  try {
-    const list = await get<CommandResource[]>(`/commands?axis=${enc(axis)}&limit=500`);
-    const p = list.find((c) => c.command === 'power');
-    if (p) notePower(p.axis, p.id, p.parameters);
-  } catch {
-    /* shown by the connection state */
-  }
-}
-
 // ---- wiring -----------------------------------------------------------------------------
 
 let started = false;
@@ -303,8 +272,6 @@ export function start(): void {
   });
   live.subscribe('commands', 1, () => {});
   live.onOpen(() => {
-    // Command ids start again after a server restart: forget what was learnt before.
-    powerOverrides.set(new Map());
     void refreshAxes();
     void refreshCommands();
   });

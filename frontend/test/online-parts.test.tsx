@@ -1,30 +1,29 @@
 // Parts of the Online tab at the DOM level (services mocked): the override slider follows the
-// axis, inching waits for the parameters and takes each direction's step.
+// axis's MC_SetOverride factor, inching waits for the parameters and takes each direction's step.
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
 
-const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), loadPowerCommand: vi.fn(async () => {}) }));
+const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), fetch: vi.fn() }));
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
   return {
     command: h.command,
-    loadPowerCommand: h.loadPowerCommand,
-    powerOverrides: new Store(new Map()),
     live: { state: new Store({ kind: 'open', since: 0 }) },
   };
 });
 
-import { OverrideControl, overrideFactorPercent, HOLD_MS } from '../src/ui/override';
+import { OverrideControl, factorPercent, HOLD_MS, type OverrideStatus } from '../src/ui/override';
 import { Inching } from '../src/ui/inching';
-import { powerOverrides } from '../src/services';
 import type { ParameterResource } from '../src/api/types';
 
 let root: HTMLElement;
 beforeEach(() => {
   h.command.mockClear();
-  powerOverrides.set(new Map());
+  h.fetch.mockClear();
+  // Nothing is asked of the server to show the override (no command history search).
+  vi.stubGlobal('fetch', h.fetch);
   root = document.createElement('div');
   document.body.appendChild(root);
 });
@@ -32,40 +31,52 @@ afterEach(() => {
   act(() => render(null, root));
   root.remove();
   vi.useRealTimers();
+  expect(h.fetch).not.toHaveBeenCalled();
+  vi.unstubAllGlobals();
 });
 
 describe('override', () => {
-  it('the slider is the MC_SetOverride factor: effective ÷ power override', () => {
-    expect(overrideFactorPercent(50, 100)).toBe(50);
-    expect(overrideFactorPercent(25, 50)).toBe(50);
-    expect(overrideFactorPercent(40, 40)).toBe(100);
-    expect(overrideFactorPercent(0, 0)).toBeNull(); // factor unknowable
-    expect(overrideFactorPercent(30, null)).toBeNull(); // power override not known yet
-    expect(overrideFactorPercent(undefined, 100)).toBeNull();
+  it('the slider is the MC_SetOverride factor in percent', () => {
+    expect(factorPercent(0.5)).toBe(50);
+    expect(factorPercent(0.333)).toBe(33);
+    expect(factorPercent(1)).toBe(100);
+    expect(factorPercent(0)).toBe(0);
+    expect(factorPercent(1.2)).toBe(100);
+    expect(factorPercent(undefined)).toBeNull();
+    expect(factorPercent(NaN)).toBeNull();
   });
 
   const slider = () => root.querySelector('input[name="override"]') as HTMLInputElement;
-  const show = (effective: number | undefined) =>
-    act(() => render(<OverrideControl axis="x" effective={effective} online={true} onError={() => {}} />, root));
+  const powerNote = () => root.querySelector('[data-testid="override-power"]');
+  /** The status as the server reports it: effective = power override × factor. */
+  const st = (factor: number, power = 100): OverrideStatus => ({ set_override_factor: factor, power_override_percent: power, override_percent: factor * power });
+  const show = (status: OverrideStatus | null) => act(() => render(<OverrideControl axis="x" status={status} online={true} onError={() => {}} />, root));
 
   it('follows the axis when the override is changed elsewhere', () => {
-    show(100);
+    show(null);
+    expect(root.querySelector('[data-testid="override-value"]')!.textContent).toBe('— %');
+    show(st(1));
     expect(slider().value).toBe('100');
-    show(30);
+    show(st(0.3));
     expect(slider().value).toBe('30');
     expect(h.command).not.toHaveBeenCalled();
   });
 
   it('with a power override of 50 % the slider shows the factor, not the effective value', () => {
-    act(() => powerOverrides.set(new Map([['x', { id: 3, percent: 50 }]])));
-    show(25);
+    show(st(0.5, 50));
     expect(slider().value).toBe('50');
-    expect(root.querySelector('[data-testid="override-power"]')!.textContent).toMatch(/50 % = 25\.0 % effective/);
+    expect(powerNote()!.textContent).toBe('× MC_Power override 50 % = 25.0 % effective');
+    // another client's power command changes only the power part: the slider stays
+    show(st(0.5, 80));
+    expect(slider().value).toBe('50');
+    expect(powerNote()!.textContent).toMatch(/80 % = 40\.0 % effective/);
+    show(st(0.5, 100));
+    expect(powerNote()).toBeNull();
   });
 
   it('is not moved under the user’s finger; sends the factor; follows again after letting go', async () => {
     vi.useFakeTimers();
-    show(100);
+    show(st(1));
     act(() => {
       slider().dispatchEvent(new PointerEvent('pointerdown', { bubbles: true }));
       slider().value = '40';
@@ -75,7 +86,7 @@ describe('override', () => {
       await vi.advanceTimersByTimeAsync(150);
     });
     expect(h.command).toHaveBeenCalledWith('x', 'set-override', { velocity_factor: 0.4 });
-    show(70); // someone else's value arrives while dragging
+    show(st(0.7)); // someone else's value arrives while dragging
     expect(slider().value).toBe('40');
     act(() => {
       window.dispatchEvent(new PointerEvent('pointerup'));

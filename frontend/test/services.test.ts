@@ -1,31 +1,31 @@
 // services.ts against a fetch double: the held MC_Stop is asked of the server at click time;
-// the MC_Power override is learnt from the axis's power commands.
-import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
-import { findHeldStop, loadPowerCommand, logCommand, powerOverride, powerOverrides } from '../src/services';
+// the following-error peak hold is the server's (reset by its endpoint); the status stream
+// feeds each axis's trend buffer.
+import { afterEach, describe, expect, it, vi } from 'vitest';
+import { findHeldStop, live, refreshAxes, resetFollowingErrorPeak, statuses, trendOf } from '../src/services';
 import type { CommandResource } from '../src/api/types';
 
 const cmd = (id: number, command: string, state: CommandResource['state'], final: boolean, parameters: object = {}, axis = 'x') =>
   ({ id, axis, command, state, final, parameters, outputs: { error_id: 0 }, last_cycle: id, submitted_at: '' }) as unknown as CommandResource;
 
 let asked: string[];
-function serve(byQuery: (url: string) => CommandResource[]) {
+function serve(byQuery: (url: string) => unknown) {
   asked = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string) => {
-      asked.push(url);
+    vi.fn(async (url: string, init?: RequestInit) => {
+      asked.push(`${init?.method ?? 'GET'} ${url}`);
       return new Response(JSON.stringify(byQuery(url)), { status: 200 });
     }),
   );
 }
-beforeEach(() => powerOverrides.set(new Map()));
 afterEach(() => vi.unstubAllGlobals());
 
 describe('release of a stop', () => {
   it('asks the server for the axis’s stop that still holds the lock (ramping: active)', async () => {
     serve((u) => (u.includes('state=active') ? [cmd(9, 'move-velocity', 'active', false), cmd(8, 'stop', 'active', false)] : []));
     expect(await findHeldStop('x')).toBe(8);
-    expect(asked[0]).toBe('/api/v1/commands?axis=x&state=active&limit=500');
+    expect(asked[0]).toBe('GET /api/v1/commands?axis=x&state=active&limit=500');
   });
 
   it('at standstill the held stop is done but not final; a released (final) one is not taken', async () => {
@@ -39,25 +39,40 @@ describe('release of a stop', () => {
   });
 });
 
-describe('power override', () => {
-  it('100 (the server’s default) until a power command is known', () => {
-    expect(powerOverride('x')).toBe(100);
+describe('following-error peak hold', () => {
+  it('is reset on the server (no command, no body)', async () => {
+    serve(() => ({ axis: 'x', cycle: 1234 }));
+    expect(await resetFollowingErrorPeak('x y')).toEqual({ axis: 'x', cycle: 1234 });
+    expect(asked).toEqual(['POST /api/v1/axes/x%20y/status/following-error-peak/reset']);
   });
+});
 
-  it('that of the newest power command of the axis', () => {
-    logCommand(cmd(5, 'power', 'active', false, { enable: true, override_percent: 40 }));
-    logCommand(cmd(4, 'power', 'done', true, { enable: true, override_percent: 70 })); // older
-    logCommand(cmd(6, 'power', 'active', false, { enable: true, override_percent: 20 }, 'y'));
-    expect(powerOverride('x')).toBe(40);
-    expect(powerOverride('y')).toBe(20);
-    logCommand(cmd(7, 'power', 'active', false, { enable: true }));
-    expect(powerOverride('x')).toBe(100);
+describe('status stream', () => {
+  const status = (v: number, lag: number) => ({
+    set_velocity: v,
+    actual_velocity: v - 1,
+    following_error: lag,
+    following_error_min: -0.5,
+    following_error_max: 0.75,
   });
+  // What the socket delivers, without a socket: the client's message handler.
+  const deliver = (msg: object) => (live as unknown as { onMessage(t: string): void }).onMessage(JSON.stringify({ jsonrpc: '2.0', method: 'update', params: msg }));
 
-  it('is looked up on the server when the log does not have it', async () => {
-    serve(() => [cmd(30, 'move-absolute', 'done', true), cmd(2, 'power', 'active', false, { override_percent: 60 })]);
-    await loadPowerCommand('x');
-    expect(asked[0]).toBe('/api/v1/commands?axis=x&limit=500');
-    expect(powerOverride('x')).toBe(60);
+  it('feeds the axis’s trend; min/max of the following error are the server’s fields', async () => {
+    serve((u) => (u.endsWith('/axes') ? [{ id: 1, state: 'standstill', config: { name: 'tx', unit: 'mm' } }] : []));
+    await refreshAxes();
+    const topic = 'axes/tx/status';
+    deliver({ topic, cycle: 100, full: true, data: status(10, 0.25) });
+    deliver({ topic, cycle: 120, full: false, data: { set_velocity: 20, following_error: 0.5 } });
+    const t = trendOf('tx');
+    expect(t.length).toBe(2);
+    expect(t.at(1)).toMatchObject({ cycle: 120, setVelocity: 20, actualVelocity: 9, followingError: 0.5 });
+    const s = statuses.get().get('tx')!.status!;
+    // not a peak hold of the streamed values (0.25, 0.5): what the server kept
+    expect([s.following_error_min, s.following_error_max]).toEqual([-0.5, 0.75]);
+    // the socket lost: a gap, not a hold
+    (live as unknown as { lost(r: string): void }).lost('test');
+    expect(t.broken).toBe(true);
+    expect(statuses.get().get('tx')!.stale).toBe(true);
   });
 });

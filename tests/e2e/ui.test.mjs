@@ -120,6 +120,13 @@ describe('commissioning UI', () => {
     await until(async () => (await readout(page, 'actual_position')) > start + 8, { what: 'the UI position to grow' });
     const moving = await status(stack.api, AXIS);
     assert.ok(moving.set_velocity > 0 && moving.state === 'continuous_motion', JSON.stringify(moving));
+    // the live trend draws the jog: samples in its 10 s window, the jog velocity among them
+    const trend = page.locator('[data-testid="trend"]');
+    const drawn = () => trend.evaluate((e) => ({ points: Number(e.dataset.points), vmax: Number(e.dataset.vmax) }));
+    await until(async () => {
+      const d = await drawn();
+      return d.points >= 25 && Math.abs(d.vmax - 10) < 1e-3 ? d : null;
+    }, { what: 'the trend to draw the jog' });
     await shot(page, 'online-jogging');
     await page.mouse.up();
     const rest1 = await atRest();
@@ -129,6 +136,19 @@ describe('commissioning UI', () => {
     await until(async () => Math.abs((await readout(page, 'set_position')) - rest2.set_position) < 1e-3, { what: 'the UI to show the stop' });
     // the log shows the jog, released
     await page.waitForSelector('[data-testid="command-log"] tr[data-command="jog"]');
+    // the trend paused stands still (recording goes on); clear empties it; resumed it draws
+    await page.click('button[name="trend-pause"]');
+    await page.waitForSelector('[data-testid="trend"][data-paused="1"]');
+    const frozen = await drawn();
+    await sleep(300);
+    assert.deepEqual(await drawn(), frozen, 'a paused trend is not redrawn');
+    await page.click('button[name="trend-clear"]');
+    assert.equal((await drawn()).points, 0);
+    await page.click('button[name="trend-pause"]');
+    await page.waitForSelector('[data-testid="trend"][data-paused="0"]');
+    assert.equal((await rest(stack.api, 'POST', `/axes/${AXIS}/move-relative`, { position: 2, velocity: 10 })).status, 202);
+    await until(async () => (await drawn()).points >= 5, { what: 'the trend to draw again after resume' });
+    await atRest();
     await page.close();
   });
 
@@ -313,10 +333,26 @@ describe('commissioning UI', () => {
       const s = await status(stack.api, AXIS);
       return s.in_target_position && Math.abs(s.set_position - 12.5) < 1e-9;
     }, { what: 'one inching step backward' });
-    // the following-error peak hold resets to the present value
+    // the following-error peak hold is the server's (every cycle): the readout shows its
+    // min / max, and reset restarts it on the server, not only on this page
+    const lagText = (v) => (v.toFixed(4) === '-0.0000' ? '0.0000' : v.toFixed(4));
+    const peakShown = async () => (await page.locator('[data-readout="lag_peak"] .dro-value').textContent()).trim();
+    const before = await status(stack.api, AXIS);
+    assert.ok(before.following_error_max - before.following_error_min > 1e-4, `a peak to reset: ${JSON.stringify(before)}`);
+    await until(async () => (await peakShown()) === `${lagText(before.following_error_min)} / ${lagText(before.following_error_max)}`, {
+      what: 'the readout to show the server’s peak hold',
+    });
     await page.click('button[name="reset-peak"]');
-    await until(async () => /^-?0\.0000 \/ -?0\.0000$/.test((await page.locator('[data-readout="lag_peak"] .dro-value').textContent()).trim()), {
-      what: 'peak reset',
+    const after = await until(
+      async () => {
+        const s = await status(stack.api, AXIS);
+        return s.following_error_max - s.following_error_min < 1e-6 ? s : null;
+      },
+      { what: 'the server’s peak hold restarted' },
+    );
+    assert.ok(Math.abs(after.following_error_max - after.following_error) < 1e-6, JSON.stringify(after));
+    await until(async () => (await peakShown()) === `${lagText(after.following_error_min)} / ${lagText(after.following_error_max)}`, {
+      what: 'the readout to agree with GET status after the reset',
     });
     await page.close();
   });
@@ -438,6 +474,14 @@ describe('commissioning UI', () => {
       assert.ok(Math.abs((await status(stack.api, 'rot')).set_position + 90) < 1e-6, 'went the negative way');
       const cmd = (await rest(stack.api, 'GET', '/commands?axis=rot&limit=5')).body.find((c) => c.command === 'move-modulo');
       assert.equal(cmd.parameters.direction, 'negative');
+      // coupled as a gear slave: the Online tab names its master
+      await enabled();
+      const gear = await rest(stack.api, 'POST', '/axes/rot/gear-in', { master: AXIS, ratio_numerator: 1, ratio_denominator: 1 });
+      assert.equal(gear.status, 202, JSON.stringify(gear.body));
+      await until(async () => (await status(stack.api, 'rot')).master === AXIS, { what: 'rot coupled to e2e' });
+      assert.equal((await page.locator('[data-testid="master"]').textContent({ timeout: 10000 })).trim(), `coupled to master ${AXIS}`);
+      assert.equal((await rest(stack.api, 'POST', '/axes/rot/gear-out', {})).status, 202);
+      await page.waitForSelector('[data-testid="master"]', { state: 'detached', timeout: 10000 });
       await page.close();
       // the linear axis has no modulo move
       const lin = await open(`/axes/${AXIS}`);
@@ -530,7 +574,10 @@ describe('commissioning UI', () => {
       'button[name="home-btn"]',
       'input[name="override"]',
       'button[name="reset-error"]',
+      'button[name="reset-peak"]',
     ]);
+    assert.equal(await page.locator('[data-testid="trend-state"]').textContent(), 'not live');
+    assert.match(await page.getAttribute('.trend', 'class'), /trend-off/);
     await shot(page, 'online-server-gone');
     await page.click('.nav a:has-text("Scope")');
     await disabled('scope', ['button[name="record"]']);

@@ -860,6 +860,14 @@ export interface components {
              * @description Effective override in percent (MC_Power override × MC_SetOverride factor).
              */
             override_percent: number;
+            /**
+             * Format: double
+             * @description Its two parts: MC_Power's Override (percent) and MC_SetOverride's VelFactor (0…1), so
+             *     that a client can show and change one without guessing the other.
+             */
+            power_override_percent: number;
+            /** Format: double */
+            set_override_factor: number;
             power_status: boolean;
             enable_positive: boolean;
             enable_negative: boolean;
@@ -2511,7 +2519,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -2648,7 +2659,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -2785,7 +2799,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -2922,7 +2939,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3059,7 +3079,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3196,7 +3219,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3333,7 +3359,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3470,7 +3499,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3607,7 +3639,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3744,7 +3779,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -3881,7 +3919,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4018,7 +4059,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4155,7 +4199,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4292,7 +4339,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4429,7 +4479,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4781,7 +4834,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -4918,7 +4974,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -5055,7 +5114,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -5192,7 +5254,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;
@@ -5505,7 +5570,10 @@ export interface operations {
                  *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
                  */
                 wait?: boolean;
-                /** @description Longest wait (default 10000, at most 600000); then the command is returned as it stands. */
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
                 timeout_ms?: number;
             };
             header?: never;

@@ -5,6 +5,9 @@ type S = components['schemas'];
 export type AxisResource = S['AxisResource'];
 export type AxisConfig = S['AxisConfigDto'];
 export type AxisStatus = S['AxisStatus'];
+/** The status as the server sends it (REST and websocket): the kernel's plus the master's name. */
+export type AxisLiveStatus = S['LiveStatus'];
+export type PeakResetResource = S['PeakResetResource'];
 export type AxisState = S['AxisState'];
 export type CommandResource = S['CommandResource'];
 export type CommandState = S['CommandState'];

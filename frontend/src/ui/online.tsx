@@ -2,7 +2,7 @@
 // moves, halt/stop, set position, home, TwinCAT's function keys, and the axis's command log.
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { command, findHeldStop, jog, releaseCommand, resetLagPeak, statuses } from '../services';
+import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses } from '../services';
 import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { acc, pos, vel, num, inputNum } from '../format';
 import type { AxisResource, Direction, HomingMode } from '../api/types';
@@ -10,6 +10,8 @@ import { JogButtons, type JogButtonDef } from './jog-buttons';
 import { CommandLog } from './command-log';
 import { OverrideControl } from './override';
 import { Inching } from './inching';
+import { Trend } from './trend';
+import { href } from '../router';
 import { P_JOG_FAST, P_JOG_SLOW, numParam, useParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
 
@@ -176,6 +178,14 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
     }
   };
   const reset = () => run('reset').catch(() => {});
+  const resetPeak = async () => {
+    setError(null);
+    try {
+      await resetFollowingErrorPeak(axis);
+    } catch (e) {
+      setError(errorText(e));
+    }
+  };
 
   // --- jog and function keys ------------------------------------------------------------
   const slow = numParam(params, P_JOG_SLOW);
@@ -219,12 +229,14 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
             <Readout name="set_acceleration" label="Set acceleration" value={acc(s?.set_acceleration)} unit={`${u}/s²`} />
             <Readout name="following_error" label="Following error" value={pos(s?.following_error)} unit={lagUnit} />
             <div class="dro-row dro-peak" data-readout="lag_peak">
-              <span class="dro-label" title="lowest and highest following error seen since the last reset">Lag peak − / +</span>
+              <span class="dro-label" title="lowest and highest following error of every cycle since the last reset (TwinCAT: lag distance min/max), kept by the server">
+                Lag min / max
+              </span>
               <span class="dro-value mono small">
-                {pos(liveStatus?.lagMin)} / {pos(liveStatus?.lagMax)}
+                {pos(s?.following_error_min)} / {pos(s?.following_error_max)}
               </span>
               <span class="dro-unit">
-                <button type="button" class="btn btn-small" name="reset-peak" onClick={() => resetLagPeak(axis)} title="Reset the peak hold">
+                <button type="button" class="btn btn-small" name="reset-peak" disabled={offline} onClick={resetPeak} title="Restart the peak hold from the present following error">
                   reset
                 </button>
               </span>
@@ -253,8 +265,14 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Led on={s?.coupled} label="Coupled" tone="blue" />
               <Led on={s?.drive_fault} label="Drive fault" tone="red" />
             </div>
+            {s?.master && (
+              <div class="small muted" data-testid="master">
+                coupled to master <a href={href({ page: 'axis', axis: s.master, tab: 'online' })}>{s.master}</a>
+              </div>
+            )}
             {s && s.homing_phase !== 'idle' && <div class="small muted">homing phase: {s.homing_phase}</div>}
           </Panel>
+          <Trend axis={axis} unit={u} online={online} />
         </div>
 
         <div class="online-col">
@@ -289,7 +307,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
                 Reset
               </ActionButton>
             </div>
-            <OverrideControl axis={axis} effective={s?.override_percent} online={online} onError={setError} />
+            <OverrideControl axis={axis} status={s} online={online} onError={setError} />
           </Panel>
 
           <Panel title="Jog" class="jog-panel">

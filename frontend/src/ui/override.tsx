@@ -1,37 +1,36 @@
 // The override slider of the Online tab. It sets the MC_SetOverride factor (0–100 %); the
-// axis's effective override (`status.override_percent`) is the MC_Power override × that
-// factor, so the slider shows effective ÷ power override. It follows changes made elsewhere
-// (another client, a power command) unless the user is moving it.
+// axis's effective override (`status.override_percent`) is the MC_Power override
+// (`status.power_override_percent`) × that factor (`status.set_override_factor`), all three
+// reported by the server. It follows changes made elsewhere (another client, a power command)
+// unless the user is moving it.
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { command, loadPowerCommand, powerOverrides } from '../services';
+import { command } from '../services';
 import { errorText } from './common';
 import { num } from '../format';
+import type { AxisStatus } from '../api/types';
 
 /** After the user's last input the slider waits this long for the axis to follow. */
 export const HOLD_MS = 600;
 const THROTTLE_MS = 100;
 
-/** The MC_SetOverride factor in percent behind an effective override, or null if unknown. */
-export function overrideFactorPercent(effective: number | null | undefined, power: number | null): number | null {
-  if (effective === null || effective === undefined || !Number.isFinite(effective)) return null;
-  if (power === null || !(power > 0)) return null;
-  return Math.min(100, Math.max(0, Math.round((effective / power) * 100)));
+/** The parts of the axis status the control shows. */
+export type OverrideStatus = Pick<AxisStatus, 'override_percent' | 'power_override_percent' | 'set_override_factor'>;
+
+/** The MC_SetOverride factor (0…1) as the slider's percent, or null if unknown. */
+export function factorPercent(factor: number | null | undefined): number | null {
+  if (factor === null || factor === undefined || !Number.isFinite(factor)) return null;
+  return Math.min(100, Math.max(0, Math.round(factor * 100)));
 }
 
-export function OverrideControl({ axis, effective, online, onError }: {
+export function OverrideControl({ axis, status, online, onError }: {
   axis: string;
-  /** status.override_percent (undefined before the first status). */
-  effective: number | undefined;
+  /** The axis status (null before the first one). */
+  status: OverrideStatus | null;
   online: boolean;
   onError: (text: string) => void;
 }) {
-  const powers = useStore(powerOverrides);
-  const known = powers.get(axis);
-  const power = known ? known.percent : 100;
-  useEffect(() => {
-    if (online) void loadPowerCommand(axis);
-  }, [axis, online]);
+  const power = status ? status.power_override_percent : null;
+  const effective = status?.override_percent;
 
   const [value, setValue] = useState<number | null>(null);
   const dragging = useRef(false);
@@ -39,7 +38,7 @@ export function OverrideControl({ axis, effective, online, onError }: {
   const timer = useRef<ReturnType<typeof setTimeout> | null>(null);
   const wanted = useRef<number | null>(null);
   const later = useRef<ReturnType<typeof setTimeout> | null>(null);
-  const tracked = overrideFactorPercent(effective, power);
+  const tracked = factorPercent(status?.set_override_factor);
   const trackedRef = useRef(tracked);
   trackedRef.current = tracked;
 
@@ -119,9 +118,9 @@ export function OverrideControl({ axis, effective, online, onError }: {
           {v}
         </button>
       ))}
-      {power !== 100 && (
+      {power !== null && power !== 100 && (
         <div class="small muted override-power" data-testid="override-power">
-          × MC_Power override {power === null ? '…' : `${num(power, 0)} %`} = {num(effective, 1)} % effective
+          × MC_Power override {Number(power.toFixed(1))} % = {num(effective, 1)} % effective
         </div>
       )}
     </div>
