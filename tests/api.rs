@@ -1270,3 +1270,122 @@ async fn the_following_error_peak_hold_is_kept_every_cycle_and_resets() {
     .await;
     assert_problem(&r, 404, "axis_not_found");
 }
+
+/// What axum answers by itself is problem+json too: a method the route does not take is a 405
+/// `method_not_allowed` that keeps its `Allow` header, a path that is not UTF-8 a 400.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_method_a_route_does_not_take_is_a_405_problem_with_allow() {
+    let s = Server::start();
+    let client = reqwest::Client::new();
+    for (method, path, allow) in [
+        (reqwest::Method::GET, "/api/v1/axes/x/power", "POST"),
+        (
+            reqwest::Method::PATCH,
+            "/api/v1/axes/x",
+            "GET,HEAD,PUT,DELETE",
+        ),
+        (reqwest::Method::DELETE, "/api/v1/commands", "GET,HEAD"),
+        (reqwest::Method::POST, "/metrics", "GET,HEAD"),
+    ] {
+        let resp = client
+            .request(method.clone(), s.url(path))
+            .send()
+            .await
+            .unwrap();
+        let allow_header = resp.headers()["allow"].to_str().unwrap().to_owned();
+        let r = problem_of(resp).await;
+        assert_problem(&r, 405, "method_not_allowed");
+        assert_eq!(allow_header, allow, "{method} {path}");
+        assert!(
+            r.json["detail"].as_str().unwrap().contains(method.as_str()),
+            "{}",
+            r.json
+        );
+    }
+    assert_problem(&get(&s, "/api/v1/axes/%FF").await, 400, "bad_request");
+    // The server is still fine and nothing was done.
+    assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
+}
+
+/// A body over the 2 MiB limit is a 413 problem (not a 400 malformed_json) and leaves no
+/// command; one just under the limit is read.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_body_over_the_limit_is_a_413_problem() {
+    let s = Server::start();
+    let client = reqwest::Client::new();
+    let padded = |len: usize| {
+        let body = r#"{"position": 10.0, "velocity": 5.0}"#;
+        format!("{body}{}", " ".repeat(len - body.len()))
+    };
+    let send = |path: &'static str, method: reqwest::Method, body: String| {
+        let request = client
+            .request(method, s.url(path))
+            .header("content-type", "application/json")
+            .body(body);
+        async move { problem_of(request.send().await.unwrap()).await }
+    };
+    let over = 2 * 1024 * 1024 + 1;
+    let r = send(
+        "/api/v1/axes/x/move-absolute",
+        reqwest::Method::POST,
+        padded(over),
+    )
+    .await;
+    assert_problem(&r, 413, "payload_too_large");
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("2097152"),
+        "{}",
+        r.json
+    );
+    let r = send("/api/v1/config", reqwest::Method::PUT, padded(3 * over)).await;
+    assert_problem(&r, 413, "payload_too_large");
+    assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
+    // Just under the limit the body is read: the move is refused by the disabled axis.
+    let r = send(
+        "/api/v1/axes/x/move-absolute",
+        reqwest::Method::POST,
+        padded(over - 1),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+}
+
+/// `/api/v1/ws` without a websocket handshake: 426 `websocket_upgrade_required` with the
+/// `Upgrade` header for a plain GET, 400 for a malformed handshake; a real one still connects.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_plain_get_on_the_websocket_is_a_426_problem() {
+    let s = Server::start();
+    let resp = reqwest::get(s.url("/api/v1/ws")).await.unwrap();
+    assert_eq!(resp.headers()["upgrade"], "websocket");
+    assert_eq!(resp.headers()["sec-websocket-version"], "13");
+    assert_problem(&problem_of(resp).await, 426, "websocket_upgrade_required");
+    let resp = reqwest::Client::new()
+        .get(s.url("/api/v1/ws"))
+        .header("connection", "upgrade")
+        .header("upgrade", "websocket")
+        .header("sec-websocket-version", "13")
+        .send()
+        .await
+        .unwrap();
+    assert_problem(&problem_of(resp).await, 400, "websocket_handshake_invalid");
+    let (mut socket, response) =
+        tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
+            .await
+            .expect("a websocket handshake still connects");
+    assert_eq!(response.status().as_u16(), 101);
+    socket.close(None).await.unwrap();
+}
+
+/// A response sent with reqwest directly (for its headers or method), for `assert_problem`.
+async fn problem_of(resp: reqwest::Response) -> Resp {
+    let status = resp.status().as_u16();
+    let content_type = resp.headers()["content-type"].to_str().unwrap().to_owned();
+    let text = resp.text().await.unwrap();
+    Resp {
+        status,
+        content_type,
+        location: None,
+        json: serde_json::from_str(&text).unwrap_or(Value::Null),
+        text,
+    }
+}

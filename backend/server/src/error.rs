@@ -62,6 +62,24 @@ impl ApiError {
             detail,
         )
     }
+    /// A body over the limit (axum's rejection would be plain text).
+    pub fn too_large(limit: usize) -> Self {
+        Self::new(
+            StatusCode::PAYLOAD_TOO_LARGE,
+            "payload_too_large",
+            "Payload too large",
+            format!("the body is larger than {limit} bytes"),
+        )
+    }
+    /// A method the route does not have; the response's `Allow` header lists those it has.
+    pub fn method_not_allowed(method: &str, path: &str) -> Self {
+        Self::new(
+            StatusCode::METHOD_NOT_ALLOWED,
+            "method_not_allowed",
+            "Method not allowed",
+            format!("{path} does not take {method}; the Allow header lists the methods it takes"),
+        )
+    }
     pub fn invalid(errors: Vec<FieldError>) -> Self {
         let detail = errors
             .iter()

@@ -14,9 +14,13 @@ use std::sync::Arc;
 
 use axum::Router;
 use axum::extract::rejection::QueryRejection;
-use axum::extract::{ConnectInfo, FromRequest, FromRequestParts, Query, Request};
-use axum::http::StatusCode;
+use axum::extract::ws::{WebSocketUpgrade, rejection::WebSocketUpgradeRejection};
+use axum::extract::{
+    ConnectInfo, DefaultBodyLimit, FromRequest, FromRequestParts, Query, Request, State,
+};
 use axum::http::request::Parts;
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
+use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use serde::Deserialize;
@@ -27,8 +31,11 @@ use crate::app::AppState;
 use crate::error::ApiError;
 use crate::model::ClientInfo;
 
-/// A JSON body whose errors are problem+json: 400 for malformed JSON, 422 for wrong types,
-/// missing or unknown fields. An empty body is read as `{}`.
+/// The largest request body (axum's default, set explicitly so that the 413 can name it).
+pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
+
+/// A JSON body whose errors are problem+json: 400 for malformed JSON, 413 for a body over
+/// [`BODY_LIMIT`], 422 for wrong types, missing or unknown fields. An empty body is read as `{}`.
 pub struct JsonBody<T>(pub T, pub serde_json::Value);
 
 impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
@@ -37,7 +44,13 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
     async fn from_request(req: Request, state: &S) -> Result<Self, ApiError> {
         let bytes = axum::body::Bytes::from_request(req, state)
             .await
-            .map_err(|e| ApiError::bad_json(format!("cannot read the body: {e}")))?;
+            .map_err(|e| {
+                if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                    ApiError::too_large(BODY_LIMIT)
+                } else {
+                    ApiError::bad_json(format!("cannot read the body: {e}"))
+                }
+            })?;
         let bytes: &[u8] = if bytes.iter().all(|b| b.is_ascii_whitespace()) {
             b"{}"
         } else {
@@ -97,7 +110,8 @@ pub struct WaitQuery {
     /// (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
     #[serde(default)]
     pub wait: bool,
-    /// Longest wait (default 10000, at most 600000); then the command is returned as it stands.
+    /// Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+    /// is returned as it stands.
     pub timeout_ms: Option<u64>,
 }
 
@@ -173,7 +187,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
         .route("/config", get(axes::export_config).put(axes::import_config))
-        .route("/ws", get(ws::upgrade))
+        .route("/ws", get(websocket))
         .fallback(not_found);
     Router::new()
         .nest("/api/v1", api)
@@ -181,7 +195,104 @@ pub fn router(state: Arc<AppState>) -> Router {
         .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::openapi()))
         // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
         .fallback(crate::ui::serve)
+        .layer(axum::middleware::from_fn(problem_errors))
+        .layer(DefaultBodyLimit::max(BODY_LIMIT))
         .with_state(state)
+}
+/// Every error is problem+json, also those axum answers by itself: a method the route does not
+/// have (405 `method_not_allowed`; axum adds the `Allow` header), a path that is not UTF-8
+/// (400 `bad_request`) … The server's own problems pass unchanged.
+async fn problem_errors(req: Request, next: Next) -> Response {
+    let (method, path) = (req.method().clone(), req.uri().path().to_owned());
+    let resp = next.run(req).await;
+    let status = resp.status();
+    let is_problem = resp
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .is_some_and(|v| v.as_bytes().starts_with(b"application/problem+json"));
+    if is_problem || !(status.is_client_error() || status.is_server_error()) {
+        return resp;
+    }
+    let (parts, body) = resp.into_parts();
+    let error = match status {
+        StatusCode::METHOD_NOT_ALLOWED => ApiError::method_not_allowed(method.as_str(), &path),
+        StatusCode::PAYLOAD_TOO_LARGE => ApiError::too_large(BODY_LIMIT),
+        _ => {
+            let text = axum::body::to_bytes(body, 4096).await.unwrap_or_default();
+            let text = String::from_utf8_lossy(&text).trim().to_owned();
+            let reason = status.canonical_reason().unwrap_or("Error");
+            let title = reason[..1].to_owned() + &reason[1..].to_lowercase();
+            let code = reason.to_lowercase().replace([' ', '-'], "_");
+            ApiError::new(
+                status,
+                &code,
+                &title,
+                if text.is_empty() {
+                    reason.to_owned()
+                } else {
+                    text
+                },
+            )
+        }
+    };
+    let mut r = error.into_response();
+    for (k, v) in &parts.headers {
+        if k != header::CONTENT_TYPE && k != header::CONTENT_LENGTH {
+            r.headers_mut().append(k, v.clone());
+        }
+    }
+    r
+}
+
+/// 426 for a request to `/ws` that is not a websocket upgrade at all.
+pub(crate) fn upgrade_required(detail: &str) -> ApiError {
+    ApiError::new(
+        StatusCode::UPGRADE_REQUIRED,
+        "websocket_upgrade_required",
+        "Upgrade required",
+        format!("{detail}: /api/v1/ws only speaks websocket (JSON-RPC 2.0)"),
+    )
+}
+
+/// 400 for a websocket upgrade request that is malformed (no `Sec-WebSocket-Key` …).
+pub(crate) fn handshake_invalid(detail: &str) -> ApiError {
+    ApiError::new(
+        StatusCode::BAD_REQUEST,
+        "websocket_handshake_invalid",
+        "Invalid websocket handshake",
+        detail,
+    )
+}
+
+/// `GET /ws`: the websocket, or problem+json for a request that is not a websocket handshake.
+async fn websocket(
+    ws: Result<WebSocketUpgrade, WebSocketUpgradeRejection>,
+    state: State<Arc<AppState>>,
+    addr: ConnectInfo<SocketAddr>,
+    headers: HeaderMap,
+) -> Response {
+    use WebSocketUpgradeRejection as R;
+    let e = match ws {
+        Ok(ws) => return ws::upgrade(ws, state, addr, headers).await,
+        Err(e) => e,
+    };
+    match e {
+        R::InvalidConnectionHeader(_)
+        | R::InvalidUpgradeHeader(_)
+        | R::InvalidWebSocketVersionHeader(_)
+        | R::ConnectionNotUpgradable(_) => {
+            let mut r = upgrade_required(&e.body_text()).into_response();
+            let h = r.headers_mut();
+            h.insert(header::UPGRADE, HeaderValue::from_static("websocket"));
+            h.insert(header::CONNECTION, HeaderValue::from_static("Upgrade"));
+            h.insert(
+                header::SEC_WEBSOCKET_VERSION,
+                HeaderValue::from_static("13"),
+            );
+            r
+        }
+        _ => handshake_invalid(&e.body_text()).into_response(),
+    }
 }
 
 pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
