@@ -693,14 +693,17 @@ async fn openapi_json_is_current() {
     let mut all = Vec::new();
     refs(&doc, &mut all);
     for r in all {
-        let name = r
-            .strip_prefix("#/components/schemas/")
+        let (kind, name) = r
+            .strip_prefix("#/components/")
+            .and_then(|r| r.split_once('/'))
+            .filter(|(kind, _)| ["schemas", "responses"].contains(kind))
             .unwrap_or_else(|| panic!("unexpected $ref {r}"));
         assert!(
-            doc["components"]["schemas"].get(name).is_some(),
+            doc["components"][kind].get(name).is_some(),
             "$ref {r} does not resolve"
         );
     }
+    check_examples(&doc);
     let paths = doc["paths"].as_object().unwrap();
     for p in [
         "/api/v1/axes",
@@ -1269,6 +1272,240 @@ async fn the_following_error_peak_hold_is_kept_every_cycle_and_resets() {
     )
     .await;
     assert_problem(&r, 404, "axis_not_found");
+}
+
+/// The examples of the OpenAPI document (called by `openapi_json_is_current`). The rules:
+///
+/// - Every request body and every response with content has an example: on the media type
+///   (`example` or `examples`), or on its schema (through `$ref`, or on the items of an array).
+/// - A problem+json response has its own example(s) (the generic `Problem` example does not
+///   say which error it is), each with the response's `status` and a `code` the server emits:
+///   a string literal in backend/server/src (outside api/errors.rs, which builds the examples),
+///   `<what>_not_found` of an `ApiError::not_found("<what>", …)`, or a kernel code listed in
+///   docs/errors.md.
+/// - Every component schema has an example, except plain string enums: their `enum` already
+///   lists every value an example could show.
+/// - Every example conforms to its schema (types, enum values, required properties, no
+///   properties the schema does not have), so that examples cannot drift from the types.
+fn check_examples(doc: &Value) {
+    let schemas = doc["components"]["schemas"].as_object().unwrap();
+    let mut missing = Vec::new();
+    let mut wrong = Vec::new();
+    for (name, schema) in schemas {
+        let plain_enum = schema["type"] == "string" && schema.get("enum").is_some();
+        match schema.get("example") {
+            Some(example) => {
+                if let Err(e) = conforms(doc, schema, example, name, true) {
+                    wrong.push(format!("schema {name}: {e}"));
+                }
+            }
+            None if plain_enum => {}
+            None => missing.push(format!("schema {name}")),
+        }
+    }
+    let emitted = emitted_codes();
+    for (path, ops) in doc["paths"].as_object().unwrap() {
+        for (method, op) in ops.as_object().unwrap() {
+            let op_name = format!("{} {path}", method.to_uppercase());
+            let mut bodies: Vec<(String, Option<u64>, &Value)> = Vec::new();
+            for (ct, media) in op["requestBody"]["content"]
+                .as_object()
+                .into_iter()
+                .flatten()
+            {
+                bodies.push((format!("{op_name} request {ct}"), None, media));
+            }
+            for (status, r) in op["responses"].as_object().unwrap() {
+                let r = match r["$ref"].as_str() {
+                    Some(name) => {
+                        &doc["components"]["responses"]
+                            [name.trim_start_matches("#/components/responses/")]
+                    }
+                    None => r,
+                };
+                for (ct, media) in r["content"].as_object().into_iter().flatten() {
+                    let status = status.parse::<u64>().ok();
+                    bodies.push((
+                        format!("{op_name} {} {ct}", status.unwrap_or(0)),
+                        status,
+                        media,
+                    ));
+                }
+            }
+            for (what, status, media) in bodies {
+                let own: Vec<&Value> = media
+                    .get("example")
+                    .into_iter()
+                    .chain(
+                        media["examples"]
+                            .as_object()
+                            .into_iter()
+                            .flat_map(|m| m.values().map(|e| &e["value"])),
+                    )
+                    .collect();
+                let schema = &media["schema"];
+                for example in &own {
+                    if let Err(e) = conforms(doc, schema, example, &what, true) {
+                        wrong.push(format!("{what}: {e}"));
+                    }
+                }
+                if what.ends_with("application/problem+json") {
+                    if own.is_empty() {
+                        missing.push(what.clone());
+                    }
+                    for example in own {
+                        if example["status"].as_u64() != status {
+                            wrong.push(format!("{what}: example has status {}", example["status"]));
+                        }
+                        let code = example["code"].as_str().unwrap_or_default();
+                        if !emitted(code) {
+                            wrong.push(format!("{what}: the server never emits code '{code}'"));
+                        }
+                    }
+                } else if own.is_empty() && !schema_has_example(doc, schema) {
+                    missing.push(what);
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty() && wrong.is_empty(),
+        "OpenAPI examples (see check_examples for the rules)\nmissing:\n{}\nwrong:\n{}",
+        missing.join("\n"),
+        wrong.join("\n")
+    );
+}
+
+fn resolve<'a>(doc: &'a Value, schema: &'a Value) -> &'a Value {
+    match schema["$ref"].as_str() {
+        Some(r) => {
+            let name = r.trim_start_matches("#/components/schemas/");
+            resolve(doc, &doc["components"]["schemas"][name])
+        }
+        None => schema,
+    }
+}
+
+fn schema_has_example(doc: &Value, schema: &Value) -> bool {
+    let s = resolve(doc, schema);
+    s.get("example").is_some()
+        || (s["type"] == "array" && s.get("items").is_some_and(|i| schema_has_example(doc, i)))
+}
+
+/// The property names an object of `schema` may have; `None` when it may have any.
+fn property_names(doc: &Value, schema: &Value) -> Option<Vec<String>> {
+    let s = resolve(doc, schema);
+    if s.get("additionalProperties").is_some_and(|a| a != false) {
+        return None;
+    }
+    let mut names: Vec<String> = s["properties"]
+        .as_object()
+        .map(|m| m.keys().cloned().collect())
+        .unwrap_or_default();
+    let parts = s["allOf"].as_array();
+    for part in parts.into_iter().flatten() {
+        names.extend(property_names(doc, part)?);
+    }
+    if names.is_empty() && parts.is_none() {
+        return None;
+    }
+    Some(names)
+}
+
+/// Checks `v` against `schema` as far as the document uses JSON Schema: `$ref`, `allOf`,
+/// `oneOf`, `type` (also lists with "null"), `enum`, `required`, `properties`, `items`.
+/// `closed`: properties the schema does not name are an error (off for the parts of an
+/// `allOf`, which is checked as a whole).
+fn conforms(doc: &Value, schema: &Value, v: &Value, at: &str, closed: bool) -> Result<(), String> {
+    let s = resolve(doc, schema);
+    for part in s["allOf"].as_array().into_iter().flatten() {
+        conforms(doc, part, v, at, false)?;
+    }
+    if let Some(variants) = s["oneOf"].as_array() {
+        let errors: Vec<String> = variants
+            .iter()
+            .filter_map(|variant| conforms(doc, variant, v, at, true).err())
+            .collect();
+        if errors.len() == variants.len() {
+            return Err(format!(
+                "{at}: {v} is none of oneOf ({})",
+                errors.join("; ")
+            ));
+        }
+    }
+    let types: Vec<&str> = match &s["type"] {
+        Value::String(t) => vec![t.as_str()],
+        Value::Array(ts) => ts.iter().filter_map(Value::as_str).collect(),
+        _ => Vec::new(),
+    };
+    let type_ok = |t: &str| match t {
+        "null" => v.is_null(),
+        "boolean" => v.is_boolean(),
+        "string" => v.is_string(),
+        "integer" => v.is_i64() || v.is_u64(),
+        "number" => v.is_number(),
+        "array" => v.is_array(),
+        "object" => v.is_object(),
+        _ => true,
+    };
+    if !types.is_empty() && !types.iter().any(|t| type_ok(t)) {
+        return Err(format!("{at}: {v} is not of type {}", s["type"]));
+    }
+    if let Some(values) = s["enum"].as_array() {
+        if !values.contains(v) {
+            return Err(format!("{at}: {v} is not one of {}", s["enum"]));
+        }
+    }
+    if let Some(object) = v.as_object() {
+        for required in s["required"].as_array().into_iter().flatten() {
+            let required = required.as_str().unwrap();
+            if !object.contains_key(required) {
+                return Err(format!("{at}: `{required}` is missing"));
+            }
+        }
+        let names = if closed { property_names(doc, s) } else { None };
+        for (key, value) in object {
+            if let Some(p) = s["properties"].get(key) {
+                conforms(doc, p, value, &format!("{at}.{key}"), true)?;
+            } else if names.as_ref().is_some_and(|n| !n.contains(key)) {
+                return Err(format!("{at}: the schema has no property `{key}`"));
+            }
+        }
+    }
+    if let (Some(items), Some(array)) = (s.get("items"), v.as_array()) {
+        for (i, item) in array.iter().enumerate() {
+            conforms(doc, items, item, &format!("{at}[{i}]"), true)?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether the server can send a problem with this `code` (see `check_examples`).
+fn emitted_codes() -> impl Fn(&str) -> bool {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut source = String::new();
+    let mut dirs = vec![root.join("backend/server/src")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs")
+                && !path.ends_with("api/errors.rs")
+            {
+                source += &std::fs::read_to_string(&path).unwrap();
+            }
+        }
+    }
+    let kernel = std::fs::read_to_string(root.join("docs/errors.md")).unwrap();
+    move |code: &str| {
+        !code.is_empty()
+            && (source.contains(&format!("\"{code}\""))
+                || code
+                    .strip_suffix("_not_found")
+                    .is_some_and(|what| source.contains(&format!("not_found(\"{what}\"")))
+                || kernel.contains(&format!("`{code}`")))
+    }
 }
 
 /// What axum answers by itself is problem+json too: a method the route does not take is a 405

@@ -42,6 +42,32 @@ pub enum HomingPhase {
 
 /// Copyable status of one axis, published every cycle.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!(AxisStatus {
+    state: AxisState::DiscreteMotion,
+    set_position: 64.111,
+    set_velocity: 200.0,
+    actual_position: 64.109,
+    actual_velocity: 199.98,
+    following_error: 0.002,
+    following_error_min: -0.0001,
+    following_error_max: 0.0219,
+    modulo_set_position: 64.111,
+    modulo_actual_position: 64.109,
+    target_position: 250.0,
+    remaining_distance: 185.889,
+    remaining_time: 1.019,
+    override_percent: 100.0,
+    power_status: true,
+    enable_positive: true,
+    enable_negative: true,
+    homed: true,
+    has_job: true,
+    moving: true,
+    moving_forward: true,
+    constant_velocity: true,
+    active_command: 42,
+    ..AxisStatus::default()
+})))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct AxisStatus {
     pub state: AxisState,

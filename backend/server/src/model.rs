@@ -19,6 +19,7 @@ fn is_false(b: &bool) -> bool {
 /// Modulo (rotary) axis: positions wrap at `period`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"period": 360.0}))]
 pub struct ModuloConfig {
     /// Modulo period in axis units (#1044), e.g. 360.
     #[schema(example = 360.0)]
@@ -28,6 +29,7 @@ pub struct ModuloConfig {
 /// Software end positions (#1016–#1019); both are enabled when present.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"min": 0.0, "max": 1000.0}))]
 pub struct SoftLimits {
     #[schema(example = 0.0)]
     pub min: f64,
@@ -38,6 +40,8 @@ pub struct SoftLimits {
 /// Default dynamics of the axis (used when a command passes 0).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"max_velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0, "jerk": 25000.0,
+                          "jog_velocity_slow": 10.0, "jog_velocity_fast": 100.0}))]
 pub struct AxisDynamics {
     /// #1003 AxisVeloMax, units/s.
     #[schema(example = 500.0)]
@@ -227,6 +231,7 @@ impl AxisConfigDto {
 
 /// An axis as the API shows it.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = examples::axis_resource)]
 pub struct AxisResource {
     #[schema(example = 1)]
     pub id: i64,
@@ -239,6 +244,7 @@ pub struct AxisResource {
 /// The whole configuration (`GET/PUT /config`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = examples::config_document)]
 pub struct ConfigDocument {
     /// Format version (1).
     #[schema(example = 1)]
@@ -246,8 +252,10 @@ pub struct ConfigDocument {
     pub axes: Vec<ConfigAxis>,
 }
 
+/// One axis of the configuration document.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = examples::config_axis)]
 pub struct ConfigAxis {
     pub id: i64,
     pub config: AxisConfigDto,
@@ -259,6 +267,12 @@ pub struct ConfigAxis {
 
 /// One MC_AxisParameter entry with its value on an axis.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "number": 1096, "name": "AxisCtrlVelocityPreCtrlWeight", "type": "lreal", "unit": "percent",
+    "group": "controller", "read_only": false, "storage": 1096, "min": 0.0, "max": 100.0, "min_exclusive": false,
+    "ads_index_offset": "0x0002000B", "help": "Weight of the velocity feed-forward in percent (100 = full feed-forward).",
+    "unit_text": "%", "value": 90.0, "persistent_value": 90.0
+}))]
 pub struct ParameterResource {
     #[serde(flatten)]
     pub info: params::ParameterInfo,
@@ -311,6 +325,9 @@ impl CommandState {
 
 /// A change of a command's outputs.
 #[derive(Clone, Copy, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
+    "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+    "warning": false, "warning_id": 0}}))]
 pub struct CommandEventDto {
     /// The kernel cycle it happened in.
     pub cycle: u64,
@@ -319,6 +336,7 @@ pub struct CommandEventDto {
 
 /// Where a command came from.
 #[derive(Clone, Debug, Default, Serialize, ToSchema)]
+#[schema(example = json!({"addr": "127.0.0.1:50312", "id": "line-3-mes", "via": "rest"}))]
 pub struct ClientInfo {
     /// Remote address.
     pub addr: String,
@@ -397,9 +415,10 @@ impl Default for PowerBody {
     }
 }
 
-/// MC_Reset (no inputs).
+/// MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({}))]
 pub struct EmptyBody {}
 
 /// MC_SetPosition.
@@ -491,6 +510,7 @@ pub struct MoveVelocityBody {
 /// MC_Halt.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
 #[serde(default, deny_unknown_fields)]
+#[schema(example = json!({"deceleration": 1000.0}))]
 pub struct HaltBody {
     /// 0 = that of the running job.
     pub deceleration: f64,
@@ -502,6 +522,7 @@ pub struct HaltBody {
 /// MC_Stop.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
 #[serde(default, deny_unknown_fields)]
+#[schema(example = json!({"deceleration": 5000.0, "jerk": 50000.0}))]
 pub struct StopBody {
     pub deceleration: f64,
     pub jerk: f64,
@@ -624,10 +645,59 @@ pub fn dynamics(acceleration: f64, deceleration: f64, jerk: f64) -> Dynamics {
 
 /// The live status of an axis: the kernel's status plus what only the server can name.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = examples::live_status)]
 pub struct LiveStatus {
     #[serde(flatten)]
     pub status: motion::AxisStatus,
     /// The master axis (name) while the axis is coupled as a gear slave.
     #[schema(example = "x")]
     pub master: Option<String>,
+}
+
+/// Examples of the OpenAPI document that are built rather than written out: the demo machine's
+/// axes as `crate::demo_axes` makes them (what a new motiond answers), and the status example
+/// of `motion::AxisStatus`, which `LiveStatus` extends.
+pub(crate) mod examples {
+    use serde_json::{Value, json};
+    use utoipa::PartialSchema;
+    use utoipa::openapi::RefOr;
+    use utoipa::openapi::schema::Schema;
+
+    /// The example of a schema (null when it has none).
+    fn example_of<T: PartialSchema>() -> Value {
+        match T::schema() {
+            RefOr::T(Schema::Object(o)) => o.example.unwrap_or_default(),
+            _ => Value::Null,
+        }
+    }
+
+    /// The axis `x` of the demo machine, enabled.
+    pub fn axis_resource() -> Value {
+        json!({"id": 1, "slot": 0, "state": "standstill", "config": crate::demo_axes()[0]})
+    }
+
+    /// `x` with a persistent AxisVeloMax.
+    pub fn config_axis() -> Value {
+        json!({"id": 1, "config": crate::demo_axes()[0], "persistent_parameters": {"AxisVeloMax": 400.0}})
+    }
+
+    /// The demo machine (x with a persistent AxisVeloMax).
+    pub fn config_document() -> Value {
+        let axes: Vec<Value> = crate::demo_axes()
+            .into_iter()
+            .enumerate()
+            .map(|(i, config)| match i {
+                0 => config_axis(),
+                _ => json!({"id": i + 1, "config": config, "persistent_parameters": {}}),
+            })
+            .collect();
+        json!({"version": 1, "axes": axes})
+    }
+
+    /// `x` moving (the kernel's status example), not coupled.
+    pub fn live_status() -> Value {
+        let mut v = example_of::<motion::AxisStatus>();
+        v["master"] = Value::Null;
+        v
+    }
 }

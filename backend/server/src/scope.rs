@@ -159,6 +159,7 @@ impl TriggerEdge {
 /// A trigger on one of the recording's channels.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002}))]
 pub struct ScopeTrigger {
     /// Index into `channels`.
     pub channel: usize,
@@ -195,6 +196,7 @@ impl RecordingState {
 
 /// One channel of a recording, as resolved by the server.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[schema(example = json!({"axis": "x", "axis_id": 1, "signal": "set_velocity", "unit": "mm/s"}))]
 pub struct ScopeChannel {
     /// The axis's name (also when it was given by id).
     #[schema(example = "x")]
@@ -209,6 +211,16 @@ pub struct ScopeChannel {
 /// A scope recording. `t` and `data` are only present in `GET /scope/recordings/{id}` of a
 /// recording that is `done`.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "id": 3, "state": "done", "cycle_time_s": 0.001,
+    "channels": [{"axis": "x", "axis_id": 1, "signal": "set_position", "unit": "mm"},
+                 {"axis": "x", "axis_id": 1, "signal": "set_velocity", "unit": "mm/s"}],
+    "duration_s": 0.005, "trigger": {"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002},
+    "samples": 5, "pre_trigger_samples": 2, "samples_recorded": 5, "start_cycle": 120343, "trigger_cycle": 120345,
+    "created_at": "2025-01-01T12:00:00.000Z", "finished_at": "2025-01-01T12:00:01.204Z",
+    "t": [-0.002, -0.001, 0.0, 0.001, 0.002],
+    "data": [[99.6, 99.8, 100.0, 100.2, 100.4], [200.0, 200.0, 200.0, 200.0, 200.0]]
+}))]
 pub struct ScopeRecording {
     pub id: u64,
     pub state: RecordingState,

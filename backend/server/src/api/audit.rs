@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::{IntoParams, ToSchema};
 
 use super::Q;
+use super::errors::AuditErrors;
 use crate::app::AppState;
 use crate::error::{ApiError, ApiResult};
 use crate::store;
@@ -63,9 +64,7 @@ command (when it was submitted and when it ended), with the client's address and
 written in the same transaction as the change itself; motion commands are written in batches a few \
 milliseconds later, so that a slow disk never delays a command.",
     params(AuditQuery),
-    responses((status = 200, description = "Entries, newest first", body = Vec<AuditRecord>),
-        (status = 422, description = "limit out of range or an unknown query parameter", body = crate::error::Problem, content_type = "application/problem+json"),
-        (status = 503, description = "The database could not be read", body = crate::error::Problem, content_type = "application/problem+json")))]
+    responses((status = 200, description = "Entries, newest first", body = Vec<AuditRecord>), AuditErrors))]
 pub async fn audit_log(
     State(s): State<Arc<AppState>>,
     Q(q): Q<AuditQuery>,

@@ -155,7 +155,7 @@ pub async fn create(
 #[utoipa::path(post, path = "/api/v1/axes", tag = "axes", summary = "Create an axis",
     request_body = AxisConfigDto,
     responses((status = 201, description = "Created", body = AxisResource,
-        headers(("Location" = String, description = "/api/v1/axes/{id}"))), ConfigErrors))]
+        headers(("Location" = String, description = "/api/v1/axes/{id}"))), super::errors::AxisCreateErrors))]
 pub async fn create_axis(
     State(s): State<Arc<AppState>>,
     client: Client,
@@ -249,7 +249,7 @@ pub async fn replace_axis(
 
 #[utoipa::path(delete, path = "/api/v1/axes/{axis}", tag = "axes", summary = "Delete an axis (it must be disabled)",
     params(("axis" = String, Path, description = "axis id or name", example = "x")),
-    responses((status = 204, description = "Deleted"), ConfigErrors))]
+    responses((status = 204, description = "Deleted"), super::errors::AxisDeleteErrors))]
 pub async fn delete_axis(
     State(s): State<Arc<AppState>>,
     Path(axis): Path<String>,
@@ -294,6 +294,8 @@ pub async fn delete_axis(
 
 /// Live status of an axis.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"axis": "x", "axis_id": 1, "cycle": 2009, "unit": "mm",
+                          "status": crate::model::examples::live_status()}))]
 pub struct StatusResource {
     pub axis: String,
     pub axis_id: i64,
@@ -342,7 +344,7 @@ pub struct PeakResetResource {
 following error of every cycle since the last reset (TwinCAT's online \"lag distance min/max\"). This restarts \
 them from the present following error; it changes no motion and creates no command.",
     params(("axis" = String, Path, description = "axis id or name", example = "x")),
-    responses((status = 200, description = "Reset; the peak hold counts from `cycle`", body = PeakResetResource), ReadErrors))]
+    responses((status = 200, description = "Reset; the peak hold counts from `cycle`", body = PeakResetResource), super::errors::PeakResetErrors))]
 pub async fn reset_following_error_peak(
     State(s): State<Arc<AppState>>,
     Path(axis): Path<String>,
@@ -410,7 +412,7 @@ pub async fn list_parameters(
 #[utoipa::path(get, path = "/api/v1/axes/{axis}/parameters/{parameter}", tag = "parameters", summary = "One parameter (MC_ReadParameter)",
     params(("axis" = String, Path, description = "axis id or name", example = "x"),
            ("parameter" = String, Path, description = "number or name", example = "AxisVeloMax")),
-    responses((status = 200, description = "Descriptor and value", body = ParameterResource), ReadErrors))]
+    responses((status = 200, description = "Descriptor and value", body = ParameterResource), super::errors::ParameterReadErrors))]
 pub async fn get_parameter(
     State(s): State<Arc<AppState>>,
     Path((axis, parameter)): Path<(String, String)>,
@@ -430,7 +432,7 @@ pub async fn get_parameter(
     params(("axis" = String, Path, description = "axis id or name", example = "x"),
            ("parameter" = String, Path, description = "number or name", example = "AxisVeloMax")),
     request_body = ParameterWrite,
-    responses((status = 200, description = "Written (and committed when persistent)", body = ParameterResource), ConfigErrors))]
+    responses((status = 200, description = "Written (and committed when persistent)", body = ParameterResource), super::errors::ParameterWriteErrors))]
 pub async fn write_parameter(
     State(s): State<Arc<AppState>>,
     Path((axis, parameter)): Path<(String, String)>,
@@ -555,7 +557,7 @@ type InstalledAxis = (i64, u16, String, AxisConfigDto, BTreeMap<u16, ParamValue>
 #[utoipa::path(put, path = "/api/v1/config", tag = "system",
     summary = "Import a whole configuration (replaces every axis; all axes must be disabled)",
     request_body = ConfigDocument,
-    responses((status = 200, description = "Imported; the configuration as now active", body = ConfigDocument), ConfigErrors))]
+    responses((status = 200, description = "Imported; the configuration as now active", body = ConfigDocument), super::errors::ImportErrors))]
 pub async fn import_config(
     State(s): State<Arc<AppState>>,
     client: Client,

@@ -11,7 +11,7 @@ use motion::{AxisSlot, CommandKind, Direction, JogMode, Positioning, Superpositi
 use serde::Deserialize;
 use utoipa::IntoParams;
 
-use super::errors::{CommandErrors, ReadErrors};
+use super::errors::{CommandControlErrors, CommandErrors, CommandListErrors, CommandReadErrors};
 use super::{Client, JsonBody, Q, WaitQuery};
 use crate::app::{AppState, AxisEntry, Registry};
 use crate::error::{ApiError, ApiResult};
@@ -567,7 +567,7 @@ fn parse_id(id: &str) -> ApiResult<u64> {
 
 #[utoipa::path(get, path = "/api/v1/commands/{id}", tag = "commands", summary = "A command's life",
     params(("id" = u64, Path, description = "command id")),
-    responses((status = 200, description = "The command", body = CommandResource), ReadErrors))]
+    responses((status = 200, description = "The command", body = CommandResource), CommandReadErrors))]
 pub async fn get_command(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
@@ -592,7 +592,7 @@ pub struct ListQuery {
 
 #[utoipa::path(get, path = "/api/v1/commands", tag = "commands", summary = "Recent commands, newest first",
     params(ListQuery),
-    responses((status = 200, description = "Commands", body = Vec<CommandResource>), CommandErrors))]
+    responses((status = 200, description = "Commands", body = Vec<CommandResource>), CommandListErrors))]
 pub async fn list_commands(
     State(s): State<Arc<AppState>>,
     Q(q): Q<ListQuery>,
@@ -637,7 +637,7 @@ fn slot_of(s: &AppState, id: u64) -> ApiResult<u16> {
 #[utoipa::path(delete, path = "/api/v1/commands/{id}", tag = "commands",
     summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog, a power or a gear-in-dyn",
     params(("id" = u64, Path, description = "command id")),
-    responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandErrors))]
+    responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandControlErrors))]
 pub async fn release_command(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
@@ -657,7 +657,7 @@ pub async fn release_command(
 
 #[utoipa::path(post, path = "/api/v1/commands/{id}/keepalive", tag = "commands", summary = "Renew a jog's dead-man",
     params(("id" = u64, Path, description = "command id")),
-    responses((status = 204, description = "Renewed"), CommandErrors))]
+    responses((status = 204, description = "Renewed"), CommandControlErrors))]
 pub async fn keepalive(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,

@@ -1,100 +1,341 @@
-//! Error responses for the OpenAPI document.
+//! Error responses for the OpenAPI document. Every problem response is defined once, as a
+//! component (`#/components/responses/…`) with its description and examples; each kind of
+//! endpoint has a set that names, per status, the response it can answer (and only those).
+//!
+//! The examples are built by the constructors the handlers use (`ApiError::not_found`,
+//! `ApiError::rejected` …), so their `type`, `title` and `code` are exactly what the server sends;
+//! only the details name example values. `tests/api.rs` checks that every code in the document
+//! is one the server emits.
 
-use utoipa::IntoResponses;
+use motion::ErrorId;
+use utoipa::{IntoResponses, ToResponse};
 
-use crate::error::Problem;
+use super::BODY_LIMIT;
+use crate::error::{ApiError, Problem};
 
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum CommandErrors {
-    /// The body is not JSON.
-    #[response(status = 400, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:malformed_json", "title": "Malformed JSON", "status": 400,
-                         "detail": "expected value at line 1 column 2", "code": "malformed_json"}))]
-    BadJson(Problem),
-    /// No such axis.
-    #[response(status = 404, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_not_found", "title": "Not found", "status": 404,
-                         "detail": "no axis 'z'", "code": "axis_not_found"}))]
-    NotFound(Problem),
-    /// Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID.
-    #[response(status = 409, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_cannot_be_started", "title": "Command rejected by the axis",
-                         "status": 409, "detail": "axis cannot be started in its current state",
-                         "code": "axis_cannot_be_started", "error_id": 19201}))]
-    Rejected(Problem),
-    /// Invalid parameters (wrong type, unknown field, out of range); no command is kept.
-    #[response(status = 422, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
-                         "detail": "velocity: must be > 0", "code": "validation_failed",
-                         "errors": [{"field": "velocity", "message": "must be > 0"}]}))]
-    Invalid(Problem),
-    /// The cycle thread or the database is not available.
-    #[response(status = 503, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:command_queue_full", "title": "Service unavailable", "status": 503,
-                         "detail": "the command queue to the cycle thread is full; try again", "code": "command_queue_full"}))]
-    Unavailable(Problem),
+/// The body the server sends for `e`.
+fn p(e: ApiError) -> Problem {
+    *e.0
 }
 
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum ConfigErrors {
+// Examples used by several responses.
+
+fn malformed_json() -> Problem {
+    p(ApiError::bad_json(
+        "EOF while parsing a value at line 1 column 15",
+    ))
+}
+fn axis_not_found() -> Problem {
+    p(ApiError::not_found("axis", "z"))
+}
+fn axis_not_disabled() -> Problem {
+    p(ApiError::conflict(
+        "axis_not_disabled",
+        "axis 'x' is not disabled: switch it off (DELETE its power command) first",
+    ))
+}
+fn axis_name_taken() -> Problem {
+    p(ApiError::conflict(
+        "axis_name_taken",
+        "an axis named 'y' exists",
+    ))
+}
+fn queue_full() -> Problem {
+    p(ApiError::unavailable(
+        "command_queue_full",
+        "the command queue to the cycle thread is full; try again",
+    ))
+}
+fn cycle_unavailable() -> Problem {
+    p(ApiError::unavailable(
+        "cycle_unavailable",
+        "the cycle thread did not answer",
+    ))
+}
+fn storage_unavailable() -> Problem {
+    p(ApiError::unavailable(
+        "storage_unavailable",
+        "the database did not accept the write: database is locked",
+    ))
+}
+
+/// Defines problem+json response components (each a `ToResponse` struct: doc comment =
+/// description, then the response attributes) and `ErrorResponses`, which adds them all to the
+/// document's components.
+macro_rules! problem_responses {
+    ($($(#[doc = $doc:tt])* $name:ident($($attr:tt)*);)*) => {
+        $(
+            $(#[doc = $doc])*
+            #[allow(dead_code)]
+            #[derive(ToResponse)]
+            #[response(content_type = "application/problem+json", $($attr)*)]
+            pub struct $name(Problem);
+        )*
+
+        /// Adds every problem response to the components of the document.
+        pub struct ErrorResponses;
+
+        impl utoipa::Modify for ErrorResponses {
+            fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+                let components = doc.components.get_or_insert_with(Default::default);
+                $(
+                    let (name, response) = <$name as ToResponse>::response();
+                    components.responses.insert(name.to_owned(), response);
+                )*
+            }
+        }
+    };
+}
+
+/// Defines `IntoResponses` sets: per status, the response component the endpoint answers.
+macro_rules! error_sets {
+    ($($(#[doc = $doc:tt])* $set:ident { $($status:tt: $response:ident),+ $(,)? })*) => {
+        $(
+            $(#[doc = $doc])*
+            #[allow(dead_code)]
+            #[derive(IntoResponses)]
+            pub enum $set {
+                $(#[response(status = $status)] $response(#[ref_response] $response),)+
+            }
+        )*
+    };
+}
+
+problem_responses! {
+    // 400
+
     /// The body is not JSON.
-    #[response(status = 400, content_type = "application/problem+json")]
-    BadJson(Problem),
+    MalformedJson(example = json!(malformed_json()));
+
+    /// An upgrade request to the websocket without a `Sec-WebSocket-Key`.
+    WebsocketHandshakeInvalid(example = json!(p(super::handshake_invalid("`Sec-WebSocket-Key` header missing"))));
+
+    // 404
+
+    /// No such axis.
+    AxisNotFound(example = json!(axis_not_found()));
+
     /// No such axis or parameter.
-    #[response(status = 404, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_not_found", "title": "Not found", "status": 404,
-                         "detail": "no axis 'z'", "code": "axis_not_found"}))]
-    NotFound(Problem),
-    /// The axis is not disabled, or the name is taken.
-    #[response(status = 409, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_not_disabled", "title": "Conflict", "status": 409,
-                         "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                         "code": "axis_not_disabled"}))]
-    Conflict(Problem),
-    /// The configuration is invalid; `errors` lists every invalid field.
-    #[response(status = 422, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
-                         "detail": "dynamics.jerk: must be a finite number > 0", "code": "validation_failed",
-                         "errors": [{"field": "dynamics.jerk", "message": "must be a finite number > 0"}]}))]
-    Invalid(Problem),
-    /// The database did not accept the write (locked, full, I/O error); nothing was changed.
-    #[response(status = 503, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:storage_unavailable", "title": "Service unavailable", "status": 503,
-                         "detail": "the database did not accept the write: database is locked", "code": "storage_unavailable"}))]
-    Unavailable(Problem),
-}
+    AxisOrParameterNotFound(examples(
+        ("axis_not_found" = (value = json!(axis_not_found()))),
+        ("parameter_not_found" = (value = json!(p(ApiError::not_found("parameter", "AxisVeloMaximum")))))));
 
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum ReadErrors {
-    /// No such resource.
-    #[response(status = 404, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_not_found", "title": "Not found", "status": 404,
-                         "detail": "no axis 'z'", "code": "axis_not_found"}))]
-    NotFound(Problem),
-}
+    /// No such command (never accepted, or no longer among the last 2000).
+    CommandNotFound(example = json!(p(ApiError::not_found("command", "12345"))));
 
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum FaultErrors {
-    /// The body is not JSON.
-    #[response(status = 400, content_type = "application/problem+json")]
-    BadJson(Problem),
-    /// No such axis.
-    #[response(status = 404, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:axis_not_found", "title": "Not found", "status": 404,
-                         "detail": "no axis 'z'", "code": "axis_not_found"}))]
-    NotFound(Problem),
+    /// No such recording (never made, deleted, or evicted).
+    RecordingNotFound(example = json!(p(ApiError::not_found("recording", "7"))));
+
+    // 409
+
+    /// Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID and
+    /// `code` its name (docs/errors.md). No command is kept.
+    CommandRejected(examples(
+        ("axis_cannot_be_started" = (summary = "A move on a disabled axis",
+            value = json!(p(ApiError::rejected(ErrorId::AXIS_CANNOT_BE_STARTED))))),
+        ("feed_enable_missing" = (summary = "A jog without its direction's feed enable",
+            value = json!(p(ApiError::rejected(ErrorId::FEED_ENABLE_MISSING)))))));
+
+    /// The axis no longer runs the command (it has ended or was replaced): `command_unknown`.
+    CommandUnknown(example = json!(p(ApiError::rejected(ErrorId::COMMAND_UNKNOWN))));
+
+    /// The name is taken, or all 64 axis slots are used.
+    AxisCreateConflict(examples(
+        ("axis_name_taken" = (value = json!(axis_name_taken()))),
+        ("no_free_slot" = (value = json!(p(ApiError::conflict("no_free_slot", "all axis slots are used")))))));
+
+    /// The axis is not disabled, or another axis has the name.
+    AxisReplaceConflict(examples(
+        ("axis_not_disabled" = (value = json!(axis_not_disabled()))),
+        ("axis_name_taken" = (value = json!(axis_name_taken())))));
+
+    /// An axis is not disabled.
+    AxisNotDisabled(example = json!(axis_not_disabled()));
+
+    /// The active recordings already use the scope's 8 signals (`scope_channels_busy`), or 8
+    /// recordings are active or their memory is used up (`scope_busy`).
+    ScopeBusy(examples(
+        ("scope_channels_busy" = (value = json!(p(ApiError::conflict("scope_channels_busy",
+            "the scope samples at most 8 signals at once: 7 are in use by active recordings and this one \
+             needs 2 more; cancel one or wait until it is done"))))),
+        ("scope_busy" = (value = json!(p(ApiError::conflict("scope_busy",
+            "too many active recordings (at most 8 recordings and 9600000 values are kept); cancel one or \
+             wait until it is done")))))));
+
+    /// CSV of a recording that is not done.
+    RecordingNotDone(example = json!(p(ApiError::conflict(
+        "recording_not_done", "recording 7 is armed; CSV is available when it is done"))));
+
+    // 413
+
+    /// The body is larger than 2 MiB.
+    PayloadTooLarge(example = json!(p(ApiError::too_large(BODY_LIMIT))));
+
+    // 422
+
+    /// Invalid parameters (wrong type, unknown or missing field, out of range) or query;
+    /// `errors` lists every invalid field. No command is kept.
+    CommandInvalid(examples(
+        ("body" = (summary = "An invalid field", value = json!(p(ApiError::field("velocity", "must be > 0"))))),
+        ("query" = (summary = "An invalid query", value = json!(p(ApiError::field("timeout_ms", "at most 600000")))))));
+
+    /// An invalid or unknown query parameter.
+    QueryInvalid(example = json!(p(ApiError::field("query",
+        "Failed to deserialize query string: state: unknown variant `running`, expected one of \
+         `busy`, `active`, `done`, `aborted`, `error`"))));
+
+    /// The value is refused: `error_id` says why (read-only, out of range, not consistent with
+    /// the other parameters); `errors` names the field. Nothing was written.
+    ParameterInvalid(examples(
+        ("parameter_read_only" = (summary = "A read-only parameter (e.g. AxisId)",
+            value = json!(p(parameter_refused(ErrorId::PARAMETER_READ_ONLY))))),
+        ("parameter_out_of_range" = (summary = "A value out of range (e.g. AxisVeloMax -1)",
+            value = json!(p(parameter_refused(ErrorId::PARAMETER_OUT_OF_RANGE)))))));
+
+    /// The configuration is invalid; `errors` lists every invalid field. Nothing was changed.
+    ConfigInvalid(example = json!(p(ApiError::field("dynamics.jerk", "must be a finite number > 0"))));
+
+    /// The document is invalid; `errors` lists every invalid field (`axes[i].config.…`).
+    ImportInvalid(example = json!(p(ApiError::field("axes[1].config.name", "duplicate name"))));
+
     /// Not a fault: unknown `kind`, missing or wrong fields.
-    #[response(status = 422, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
-                         "detail": "body: unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`",
-                         "code": "validation_failed",
-                         "errors": [{"field": "body", "message": "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"}]}))]
-    Invalid(Problem),
-    /// The cycle thread is not available.
-    #[response(status = 503, content_type = "application/problem+json")]
-    Unavailable(Problem),
+    FaultInvalid(example = json!(p(ApiError::field("body",
+        "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"))));
+
+    /// `limit` out of range, or an unknown query parameter.
+    AuditInvalid(example = json!(p(ApiError::field("limit", "must be between 1 and 1000"))));
+
+    /// Invalid request; `errors` names every invalid field (`channels[1].axis` for an unknown
+    /// axis, `trigger.pre_trigger_s` …).
+    ScopeInvalid(example = json!(p(ApiError::field("channels[0].axis", "no axis 'z'"))));
+
+    /// Unknown `format` or query parameter.
+    RecordingQueryInvalid(example = json!(p(ApiError::field("query",
+        "Failed to deserialize query string: format: unknown variant `xml`, expected `json` or `csv`"))));
+
+    // 426
+
+    /// Not a websocket upgrade request (a plain GET, a `Sec-WebSocket-Version` other than 13):
+    /// the response carries `Upgrade: websocket` and `Sec-WebSocket-Version: 13`.
+    WebsocketUpgradeRequired(
+        example = json!(p(super::upgrade_required("Connection header did not include 'upgrade'"))),
+        headers(("Upgrade" = String, description = "websocket"),
+                ("Sec-WebSocket-Version" = String, description = "13")));
+
+    // 503
+
+    /// The cycle thread did not take the request (`command_queue_full`: try again) or did not
+    /// answer (`cycle_unavailable`).
+    CycleUnavailable(examples(
+        ("command_queue_full" = (value = json!(queue_full()))),
+        ("cycle_unavailable" = (value = json!(cycle_unavailable())))));
+
+    /// The cycle thread did not take the command (`command_queue_full`: try again;
+    /// `cycle_unavailable`: it did not answer), or the command was accepted but left the
+    /// history of 2000 before it could be shown (`command_forgotten`).
+    CommandUnavailable(examples(
+        ("command_queue_full" = (value = json!(queue_full()))),
+        ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
+        ("command_forgotten" = (value = json!(p(ApiError::unavailable(
+            "command_forgotten", "the command left the history before it could be shown")))))));
+
+    /// The database did not accept the write (`storage_unavailable`: locked, full, I/O error),
+    /// or the cycle thread did not take the change or did not answer; nothing was changed.
+    WriteUnavailable(examples(
+        ("storage_unavailable" = (value = json!(storage_unavailable()))),
+        ("command_queue_full" = (value = json!(queue_full()))),
+        ("cycle_unavailable" = (value = json!(cycle_unavailable())))));
+
+    /// The cycle thread did not take the write, or the database did not accept a persistent
+    /// one: nothing was written, except when only the commit failed (the value is then active
+    /// but not persisted, as the detail says).
+    ParameterWriteUnavailable(examples(
+        ("command_queue_full" = (value = json!(queue_full()))),
+        ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
+        ("storage_unavailable" = (value = json!(p(ApiError::unavailable("storage_unavailable",
+            "the value is active but was NOT persisted: database is locked")))))));
+
+    /// The audit log could not be read.
+    AuditUnavailable(example = json!(p(ApiError::unavailable(
+        "storage_unavailable", "the audit log could not be read: database is locked"))));
+
+    /// The cycle thread did not take the new sampling configuration or did not answer, or the
+    /// recording was evicted at once (`scope_unavailable`).
+    ScopeUnavailable(examples(
+        ("command_queue_full" = (value = json!(queue_full()))),
+        ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
+        ("scope_unavailable" = (value = json!(p(ApiError::unavailable("scope_unavailable", "the recording was evicted")))))));
+
+    /// The recording could not be written out.
+    RecordingUnavailable(example = json!(p(ApiError::unavailable("internal", "the recording could not be written"))));
+}
+
+/// A parameter value refused with its kernel error number, as `write_parameter` answers.
+fn parameter_refused(id: ErrorId) -> ApiError {
+    let mut e = ApiError::field("value", id.text());
+    e.0.error_id = Some(id.0);
+    e
+}
+
+error_sets! {
+    /// `POST /axes/{axis}/<command>`.
+    CommandErrors {
+        400: MalformedJson, 404: AxisNotFound, 409: CommandRejected, 413: PayloadTooLarge,
+        422: CommandInvalid, 503: CommandUnavailable,
+    }
+    /// `GET /commands`.
+    CommandListErrors { 404: AxisNotFound, 422: QueryInvalid }
+    /// `GET /commands/{id}`.
+    CommandReadErrors { 404: CommandNotFound }
+    /// `DELETE /commands/{id}`, `POST /commands/{id}/keepalive`.
+    CommandControlErrors { 404: CommandNotFound, 409: CommandUnknown, 503: CycleUnavailable }
+    /// `GET /axes/{axis}`, its status and its parameter list.
+    ReadErrors { 404: AxisNotFound }
+    /// `POST /axes/{axis}/status/following-error-peak/reset`.
+    PeakResetErrors { 404: AxisNotFound, 503: CycleUnavailable }
+    /// `GET /axes/{axis}/parameters/{parameter}`.
+    ParameterReadErrors { 404: AxisOrParameterNotFound }
+    /// `PUT /axes/{axis}/parameters/{parameter}`.
+    ParameterWriteErrors {
+        400: MalformedJson, 404: AxisOrParameterNotFound, 413: PayloadTooLarge,
+        422: ParameterInvalid, 503: ParameterWriteUnavailable,
+    }
+    /// `POST /axes`.
+    AxisCreateErrors {
+        400: MalformedJson, 409: AxisCreateConflict, 413: PayloadTooLarge, 422: ConfigInvalid,
+        503: WriteUnavailable,
+    }
+    /// `PUT /axes/{axis}`.
+    ConfigErrors {
+        400: MalformedJson, 404: AxisNotFound, 409: AxisReplaceConflict, 413: PayloadTooLarge,
+        422: ConfigInvalid, 503: WriteUnavailable,
+    }
+    /// `DELETE /axes/{axis}`.
+    AxisDeleteErrors { 404: AxisNotFound, 409: AxisNotDisabled, 503: WriteUnavailable }
+    /// `PUT /config` (on 503 the old configuration is still active).
+    ImportErrors {
+        400: MalformedJson, 409: AxisNotDisabled, 413: PayloadTooLarge, 422: ImportInvalid,
+        503: WriteUnavailable,
+    }
+    /// `POST /axes/{axis}/simulation/fault`.
+    FaultErrors {
+        400: MalformedJson, 404: AxisNotFound, 413: PayloadTooLarge, 422: FaultInvalid,
+        503: CycleUnavailable,
+    }
+    /// `GET /audit`.
+    AuditErrors { 422: AuditInvalid, 503: AuditUnavailable }
+    /// `GET /ws` without a websocket handshake.
+    WebsocketErrors { 400: WebsocketHandshakeInvalid, 426: WebsocketUpgradeRequired }
+    /// `POST /scope/recordings`.
+    ScopeCreateErrors {
+        400: MalformedJson, 409: ScopeBusy, 413: PayloadTooLarge, 422: ScopeInvalid,
+        503: ScopeUnavailable,
+    }
+    /// `GET /scope/recordings/{id}`.
+    ScopeGetErrors {
+        404: RecordingNotFound, 409: RecordingNotDone, 422: RecordingQueryInvalid,
+        503: RecordingUnavailable,
+    }
+    /// `DELETE /scope/recordings/{id}`.
+    ScopeDeleteErrors { 404: RecordingNotFound }
 }

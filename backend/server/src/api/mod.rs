@@ -30,6 +30,7 @@ use utoipa::{IntoParams, OpenApi};
 use crate::app::AppState;
 use crate::error::ApiError;
 use crate::model::ClientInfo;
+use errors::ErrorResponses;
 
 /// The largest request body (axum's default, set explicitly so that the 413 can name it).
 pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
@@ -199,6 +200,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .layer(DefaultBodyLimit::max(BODY_LIMIT))
         .with_state(state)
 }
+
 /// Every error is problem+json, also those axum answers by itself: a method the route does not
 /// have (405 `method_not_allowed`; axum adds the `Allow` header), a path that is not UTF-8
 /// (400 `bad_request`) … The server's own problems pass unchanged.
@@ -311,7 +313,9 @@ pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
         title = "motiond",
         description = "Motion controller appliance: PLCopen (TwinCAT NC / Tc2_MC2) axes over REST and websocket.\n\n\
 Errors are `application/problem+json` (RFC 9457) with a stable `code` and, for errors of the motion kernel, \
-the PLCopen `error_id`. Commands are accepted with 202 and a command resource; `?wait=true` holds the response \
+the PLCopen `error_id`. Besides the errors listed for each operation, any route answers a method it does not take \
+with 405 `method_not_allowed` (the `Allow` header lists those it takes), a body over 2 MiB with 413 \
+`payload_too_large` and a path that is not UTF-8 with 400 `bad_request`. Commands are accepted with 202 and a command resource; `?wait=true` holds the response \
 until the command finishes. Authentication is not implemented yet: motiond only listens on loopback addresses.",
         license(name = "MIT OR Apache-2.0")
     ),
@@ -328,6 +332,8 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
+    components(schemas(crate::error::Problem)),
+    modifiers(&ForeignExamples, &ErrorResponses),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
@@ -338,6 +344,93 @@ until the command finishes. Authentication is not implemented yet: motiond only 
     )
 )]
 pub struct ApiDoc;
+
+/// Examples for the schemas of types defined outside the API (kernel, simulated drive, cycle
+/// statistics): real values of those types, serialised. A schema with its own example keeps it.
+struct ForeignExamples;
+
+impl utoipa::Modify for ForeignExamples {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use serde_json::{json, to_value};
+        use utoipa::openapi::{RefOr, schema::Schema};
+        let drive = crate::demo_axes().remove(0).drive;
+        let examples = [
+            (
+                "FbOutputs",
+                to_value(motion::FbOutputs {
+                    busy: true,
+                    active: true,
+                    ..Default::default()
+                }),
+            ),
+            ("MoveOptions", to_value(motion::MoveOptions::default())),
+            (
+                "HomingOptions",
+                to_value(motion::HomingOptions {
+                    search_velocity: Some(20.0),
+                    ..Default::default()
+                }),
+            ),
+            (
+                "ParameterInfo",
+                to_value(motion::params::lookup("AxisCtrlVelocityPreCtrlWeight")),
+            ),
+            ("ParamValue", Ok(json!(90.0))),
+            (
+                "FieldError",
+                to_value(crate::sim::FieldError {
+                    field: "dynamics.jerk".into(),
+                    message: "must be a finite number > 0".into(),
+                }),
+            ),
+            ("SimDriveConfig", to_value(&drive)),
+            ("PlantModel", to_value(drive.plant)),
+            ("ReferenceCam", to_value(drive.reference_cam)),
+            ("IndexPulse", to_value(drive.index_pulse)),
+            ("LimitSwitches", to_value(drive.limit_switches)),
+            (
+                "SimFault",
+                to_value(crate::sim::SimFault::Load { force: 50.0 }),
+            ),
+            (
+                "Summary",
+                to_value(crate::stats::Summary {
+                    count: 5750,
+                    mean_us: 9.1,
+                    p50_us: 6.4,
+                    p90_us: 14.3,
+                    p99_us: 32.8,
+                    p999_us: 51.2,
+                    max_us: 64.7,
+                }),
+            ),
+            (
+                "RealtimeGrant",
+                to_value(crate::cycle::RealtimeGrant {
+                    sched_fifo: true,
+                    mlockall: true,
+                    pinned_cpu: Some(1),
+                    cpu_dma_latency_zero: true,
+                    notes: Vec::new(),
+                }),
+            ),
+        ];
+        let Some(components) = doc.components.as_mut() else {
+            return;
+        };
+        for (name, example) in examples {
+            let example = example.expect("examples serialise");
+            let slot = match components.schemas.get_mut(name) {
+                Some(RefOr::T(Schema::Object(s))) => &mut s.example,
+                Some(RefOr::T(Schema::OneOf(s))) => &mut s.example,
+                Some(RefOr::T(Schema::AllOf(s))) => &mut s.example,
+                Some(RefOr::T(Schema::Array(s))) => &mut s.example,
+                _ => continue,
+            };
+            slot.get_or_insert(example);
+        }
+    }
+}
 
 /// The OpenAPI document as written to `openapi/openapi.json`.
 pub fn openapi_json() -> String {

@@ -8,11 +8,12 @@ use axum::extract::{Path, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::Deserialize;
-use utoipa::{IntoParams, IntoResponses, ToSchema};
+use utoipa::{IntoParams, ToSchema};
 
+use super::errors::{ScopeCreateErrors, ScopeDeleteErrors, ScopeGetErrors};
 use super::{JsonBody, Q};
 use crate::app::AppState;
-use crate::error::{ApiError, ApiResult, Problem};
+use crate::error::{ApiError, ApiResult};
 use crate::scope::{
     MAX_SAMPLES, NewRecording, RecordingState, SCOPE_CHANNELS, ScopeChannel, ScopeRecording,
     ScopeSignal, ScopeTrigger, TriggerEdge,
@@ -39,6 +40,7 @@ impl AxisKey {
 /// One signal of one axis.
 #[derive(Clone, Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"axis": "x", "signal": "set_position"}))]
 pub struct ChannelRequest {
     /// Axis id or name.
     #[schema(value_type = String, example = "x")]
@@ -50,6 +52,7 @@ pub struct ChannelRequest {
 /// Start the recording when `channels[channel]` crosses `level` in the direction of `edge`.
 #[derive(Clone, Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002}))]
 pub struct TriggerRequest {
     /// Index into `channels`.
     #[schema(value_type = usize)]
@@ -85,49 +88,6 @@ pub struct RecordingRequest {
     /// `null` (or absent): record from the next cycle on.
     #[serde(default)]
     pub trigger: Option<TriggerRequest>,
-}
-
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum CreateErrors {
-    /// The body is not JSON.
-    #[response(status = 400, content_type = "application/problem+json")]
-    BadJson(Problem),
-    /// The active recordings already use the scope's 8 signals (`scope_channels_busy`), or
-    /// 8 recordings are active or their memory is used up (`scope_busy`).
-    #[response(status = 409, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:scope_channels_busy", "title": "Conflict", "status": 409,
-                         "detail": "the scope samples at most 8 signals at once: 7 are in use by active recordings and this one needs 2 more; cancel one or wait until it is done",
-                         "code": "scope_channels_busy"}))]
-    Busy(Problem),
-    /// Invalid request; `errors` names every invalid field (`channels[1].axis` for an
-    /// unknown axis, `trigger.pre_trigger_s` …).
-    #[response(status = 422, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
-                         "detail": "channels[0].axis: no axis 'z'", "code": "validation_failed",
-                         "errors": [{"field": "channels[0].axis", "message": "no axis 'z'"}]}))]
-    Invalid(Problem),
-    /// The cycle thread is not available.
-    #[response(status = 503, content_type = "application/problem+json")]
-    Unavailable(Problem),
-}
-
-#[allow(dead_code)]
-#[derive(IntoResponses)]
-pub enum GetErrors {
-    /// No such recording (never made, deleted, or evicted).
-    #[response(status = 404, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:recording_not_found", "title": "Not found", "status": 404,
-                         "detail": "no recording '7'", "code": "recording_not_found"}))]
-    NotFound(Problem),
-    /// CSV of a recording that is not done.
-    #[response(status = 409, content_type = "application/problem+json",
-        example = json!({"type": "urn:motiond:problem:recording_not_done", "title": "Conflict", "status": 409,
-                         "detail": "recording 7 is armed; CSV is available when it is done", "code": "recording_not_done"}))]
-    NotDone(Problem),
-    /// Unknown `format`.
-    #[response(status = 422, content_type = "application/problem+json")]
-    Invalid(Problem),
 }
 
 fn validate(s: &AppState, body: RecordingRequest) -> ApiResult<NewRecording> {
@@ -264,7 +224,7 @@ All active recordings together sample at most 8 distinct signals; at most 8 reco
 finished ones are dropped first) and at most 9 600 000 values.",
     request_body = RecordingRequest,
     responses((status = 201, description = "Recording or armed", body = ScopeRecording,
-        headers(("Location" = String, description = "/api/v1/scope/recordings/{id}"))), CreateErrors))]
+        headers(("Location" = String, description = "/api/v1/scope/recordings/{id}"))), ScopeCreateErrors))]
 pub async fn create_recording(
     State(s): State<Arc<AppState>>,
     JsonBody(body, _): JsonBody<RecordingRequest>,
@@ -319,7 +279,7 @@ per sample.",
         (status = 200, description = "The recording", content(
             (ScopeRecording = "application/json"),
             (String = "text/csv", example = "t,x.set_position,x.set_velocity\n0,0,0\n0.001,0.0000125,0.0375\n"))),
-        GetErrors))]
+        ScopeGetErrors))]
 pub async fn get_recording(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
@@ -414,7 +374,7 @@ it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, 
     responses(
         (status = 200, description = "Cancelled", body = ScopeRecording),
         (status = 204, description = "Deleted"),
-        GetErrors))]
+        ScopeDeleteErrors))]
 pub async fn delete_recording(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,

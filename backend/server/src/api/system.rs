@@ -17,6 +17,7 @@ use crate::stats::Summary;
 
 /// Timing of the cycle thread, measured by itself.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!(timing_example()))]
 pub struct Timing {
     /// Wake-up time minus the deadline.
     pub wakeup_latency: Summary,
@@ -39,7 +40,14 @@ pub struct Timing {
     pub scope_frames_dropped: u64,
 }
 
+/// What `GET /system` reports.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "version": "0.1.0", "cycle_time": 0.001, "cycle": 5750, "uptime_s": 5.76, "listen": "127.0.0.1:8080",
+    "database": "motiond.db", "axes": 3, "drive_bus": "simulated",
+    "realtime": {"sched_fifo": true, "mlockall": true, "pinned_cpu": 1, "cpu_dma_latency_zero": true, "notes": []},
+    "timing": timing_example()
+}))]
 pub struct SystemResource {
     #[schema(example = "0.1.0")]
     pub version: &'static str,
@@ -56,6 +64,19 @@ pub struct SystemResource {
     pub drive_bus: &'static str,
     pub realtime: RealtimeGrant,
     pub timing: Timing,
+}
+
+fn timing_example() -> serde_json::Value {
+    serde_json::json!({
+        "wakeup_latency": {"count": 5750, "mean_us": 23.6, "p50_us": 16.4, "p90_us": 26.6, "p99_us": 94.2,
+                           "p999_us": 852.0, "max_us": 8172.8},
+        "compute": {"count": 5750, "mean_us": 9.1, "p50_us": 6.4, "p90_us": 14.3, "p99_us": 32.8,
+                    "p999_us": 51.2, "max_us": 64.7},
+        "period": {"count": 5749, "mean_us": 1002.4, "p50_us": 1015.8, "p90_us": 1015.8, "p99_us": 1114.1,
+                   "p999_us": 1769.5, "max_us": 9157.2},
+        "cycles": 5750, "overruns": 14, "events_dropped": 0, "audit_dropped": 0, "requests_expired": 0,
+        "scope_frames_dropped": 0
+    })
 }
 
 pub fn system_resource(s: &AppState) -> SystemResource {
@@ -91,7 +112,13 @@ pub async fn system(State(s): State<Arc<AppState>>) -> Json<SystemResource> {
 }
 
 #[utoipa::path(get, path = "/metrics", tag = "system", summary = "Prometheus metrics (text format 0.0.4)",
-    responses((status = 200, description = "Metrics", content_type = "text/plain", body = String)))]
+    responses((status = 200, description = "Metrics", content_type = "text/plain", body = String,
+        example = "# HELP motiond_cycle_compute_seconds Work per cycle.\n# TYPE motiond_cycle_compute_seconds histogram\n\
+motiond_cycle_compute_seconds_bucket{le=\"6.4e-6\"} 2871\n…\nmotiond_cycle_compute_seconds_bucket{le=\"+Inf\"} 5750\n\
+motiond_cycle_compute_seconds_sum 0.0522\nmotiond_cycle_compute_seconds_count 5750\n\
+# HELP motiond_cycles_total Cycles run.\n# TYPE motiond_cycles_total counter\nmotiond_cycles_total 5750\n\
+# HELP motiond_cycle_overruns_total Deadlines missed.\n# TYPE motiond_cycle_overruns_total counter\nmotiond_cycle_overruns_total 14\n\
+# HELP motiond_axes Configured axes.\n# TYPE motiond_axes gauge\nmotiond_axes 3\n")))]
 pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
     let st = &s.shared.stats;
     let mut out = String::with_capacity(16 * 1024);

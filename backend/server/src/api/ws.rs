@@ -43,7 +43,7 @@ the client's to renew whatever the transport (`keepalive` within its `deadman_ti
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
 closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). \
 A request without an id is a notification: carried out, never answered.",
-    responses((status = 101, description = "Switching protocols")))]
+    responses((status = 101, description = "Switching protocols"), super::errors::WebsocketErrors))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
     State(s): State<Arc<AppState>>,
