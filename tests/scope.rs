@@ -350,3 +350,47 @@ async fn at_most_eight_signals_are_sampled_at_once() {
     .await;
     assert_problem(&r, 409, "scope_channels_busy");
 }
+
+/// The actual acceleration is recorded too: the actual velocity differentiated per cycle.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_actual_acceleration_is_the_recorded_actual_velocity_differentiated() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let cycle = get(&s, "/api/v1/system").await.json["cycle_time"]
+        .as_f64()
+        .unwrap();
+    let r = post(
+        &s,
+        RECORDINGS,
+        json!({"channels": [{"axis": "x", "signal": "actual_velocity"},
+                            {"axis": "x", "signal": "actual_acceleration"}],
+               "duration_s": 0.4}),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.json["channels"][1]["unit"], "mm/s²", "{}", r.text);
+    let id = r.json["id"].as_u64().unwrap();
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-relative",
+        json!({"position": 40.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(m.status, 202, "{}", m.text);
+    let rec = until_final(&s, id).await;
+    assert_eq!(rec["state"], "done", "{rec}");
+    let v = floats(&rec["data"][0]);
+    let a = floats(&rec["data"][1]);
+    for k in 1..v.len() {
+        let expected = (v[k] - v[k - 1]) / cycle;
+        assert!(
+            (a[k] - expected).abs() < 1e-6,
+            "sample {k}: {} vs {expected}",
+            a[k]
+        );
+    }
+    assert!(
+        a.iter().any(|x| *x > 500.0),
+        "the move's acceleration was recorded"
+    );
+}

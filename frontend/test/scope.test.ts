@@ -134,6 +134,7 @@ describe('channel mapping', () => {
     expect(signalUnit('set_position', 'mm')).toBe('mm');
     expect(signalUnit('actual_velocity', 'deg')).toBe('deg/s');
     expect(signalUnit('set_acceleration', 'mm')).toBe('mm/s²');
+    expect(signalUnit('actual_acceleration', 'mm')).toBe('mm/s²');
     expect(signalUnit('following_error', 'mm')).toBe('mm');
   });
 

@@ -78,6 +78,8 @@ pub struct AxisStatus {
     pub set_jerk: f64,
     pub actual_position: f64,
     pub actual_velocity: f64,
+    /// The actual velocity differentiated over one cycle (unfiltered).
+    pub actual_acceleration: f64,
     /// set − actual.
     pub following_error: f64,
     /// Lowest and highest following error of any cycle since the peak was last reset

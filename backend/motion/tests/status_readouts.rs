@@ -74,3 +74,28 @@ fn the_status_shows_the_power_override_and_the_set_override_factor() {
         st.override_percent
     );
 }
+
+#[test]
+fn the_actual_acceleration_is_the_actual_velocity_differentiated_over_each_cycle() {
+    let mut r = Rig::new(1);
+    r.plants[0].tau = 0.004;
+    r.power_on(0);
+    let from = r.history[0].len();
+    r.ok(0, CommandKind::MoveAbsolute(mv(50.0, 200.0)));
+    r.run(0.6);
+    let h = &r.history[0][from..];
+    for w in h.windows(2) {
+        let expected = (w[1].actual_velocity - w[0].actual_velocity) / DT;
+        assert!(
+            (w[1].actual_acceleration - expected).abs() < 1e-6,
+            "{expected} {:?}",
+            w[1]
+        );
+    }
+    let peak = h
+        .iter()
+        .map(|s| s.actual_acceleration.abs())
+        .fold(0.0, f64::max);
+    assert!(peak > 100.0, "the move accelerated: {peak}");
+    assert_eq!(r.st(0).actual_acceleration, 0.0, "at rest");
+}

@@ -40,16 +40,18 @@ pub enum ScopeSignal {
     SetVelocity,
     ActualVelocity,
     SetAcceleration,
+    ActualAcceleration,
     FollowingError,
 }
 
 impl ScopeSignal {
-    pub const ALL: [ScopeSignal; 6] = [
+    pub const ALL: [ScopeSignal; 7] = [
         ScopeSignal::SetPosition,
         ScopeSignal::ActualPosition,
         ScopeSignal::SetVelocity,
         ScopeSignal::ActualVelocity,
         ScopeSignal::SetAcceleration,
+        ScopeSignal::ActualAcceleration,
         ScopeSignal::FollowingError,
     ];
 
@@ -60,6 +62,7 @@ impl ScopeSignal {
             ScopeSignal::SetVelocity => "set_velocity",
             ScopeSignal::ActualVelocity => "actual_velocity",
             ScopeSignal::SetAcceleration => "set_acceleration",
+            ScopeSignal::ActualAcceleration => "actual_acceleration",
             ScopeSignal::FollowingError => "following_error",
         }
     }
@@ -76,6 +79,7 @@ impl ScopeSignal {
             ScopeSignal::SetVelocity => s.set_velocity,
             ScopeSignal::ActualVelocity => s.actual_velocity,
             ScopeSignal::SetAcceleration => s.set_acceleration,
+            ScopeSignal::ActualAcceleration => s.actual_acceleration,
             ScopeSignal::FollowingError => s.following_error,
         }
     }
@@ -84,7 +88,7 @@ impl ScopeSignal {
     pub fn unit(self, unit: &str) -> String {
         match self {
             ScopeSignal::SetVelocity | ScopeSignal::ActualVelocity => format!("{unit}/s"),
-            ScopeSignal::SetAcceleration => format!("{unit}/s²"),
+            ScopeSignal::SetAcceleration | ScopeSignal::ActualAcceleration => format!("{unit}/s²"),
             _ => unit.to_string(),
         }
     }

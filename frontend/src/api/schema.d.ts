@@ -743,7 +743,17 @@ export interface components {
             /** @description Model of the simulated drive. */
             drive?: components["schemas"]["SimDriveConfig"];
         };
-        /** @description Default dynamics of the axis (used when a command passes 0). */
+        /**
+         * @description Default dynamics of the axis (used when a command passes 0).
+         * @example {
+         *       "acceleration": 2500,
+         *       "deceleration": 2500,
+         *       "jerk": 25000,
+         *       "jog_velocity_fast": 100,
+         *       "jog_velocity_slow": 10,
+         *       "max_velocity": 500
+         *     }
+         */
         AxisDynamics: {
             /**
              * Format: double
@@ -782,7 +792,60 @@ export interface components {
              */
             jog_velocity_fast: number;
         };
-        /** @description An axis as the API shows it. */
+        /**
+         * @description An axis as the API shows it.
+         * @example {
+         *       "config": {
+         *         "drive": {
+         *           "acceleration_feed_forward": 0,
+         *           "coast_deceleration": 10000,
+         *           "dead_time": 0.001,
+         *           "dead_time_compensation": true,
+         *           "enable_delay": 0.005,
+         *           "index_pulse": {
+         *             "offset": 0,
+         *             "period": 10
+         *           },
+         *           "limit_switches": {
+         *             "fault_on_hit": false,
+         *             "negative": -5,
+         *             "positive": 1005
+         *           },
+         *           "load_stiffness": 1000,
+         *           "plant": {
+         *             "damping": 0.8,
+         *             "kind": "pt2",
+         *             "natural_frequency_hz": 50
+         *           },
+         *           "reference_cam": {
+         *             "end": 25,
+         *             "start": 20
+         *           },
+         *           "velocity_feed_forward": 1
+         *         },
+         *         "dynamics": {
+         *           "acceleration": 2500,
+         *           "deceleration": 2500,
+         *           "jerk": 25000,
+         *           "jog_velocity_fast": 100,
+         *           "jog_velocity_slow": 10,
+         *           "max_velocity": 500
+         *         },
+         *         "name": "x",
+         *         "parameters": {
+         *           "AxisTargetPositionWindow": 0.01
+         *         },
+         *         "soft_limits": {
+         *           "max": 1000,
+         *           "min": 0
+         *         },
+         *         "unit": "mm"
+         *       },
+         *       "id": 1,
+         *       "slot": 0,
+         *       "state": "standstill"
+         *     }
+         */
         AxisResource: {
             /**
              * Format: int64
@@ -802,7 +865,57 @@ export interface components {
          * @enum {string}
          */
         AxisState: "disabled" | "standstill" | "homing" | "discrete_motion" | "continuous_motion" | "synchronized_motion" | "stopping" | "error_stop";
-        /** @description Copyable status of one axis, published every cycle. */
+        /**
+         * @description Copyable status of one axis, published every cycle.
+         * @example {
+         *       "accelerating": false,
+         *       "active_command": 42,
+         *       "actual_acceleration": 0,
+         *       "actual_position": 64.109,
+         *       "actual_velocity": 199.98,
+         *       "command_buffered": false,
+         *       "compensating": false,
+         *       "constant_velocity": true,
+         *       "coupled": false,
+         *       "decelerating": false,
+         *       "drive_fault": false,
+         *       "enable_negative": true,
+         *       "enable_positive": true,
+         *       "error_id": 0,
+         *       "following_error": 0.002,
+         *       "following_error_max": 0.0219,
+         *       "following_error_min": -0.0001,
+         *       "gear_ratio": 0,
+         *       "has_job": true,
+         *       "homed": true,
+         *       "homing_phase": "idle",
+         *       "in_position_area": false,
+         *       "in_target_position": false,
+         *       "modulo_actual_position": 64.109,
+         *       "modulo_set_position": 64.111,
+         *       "modulo_set_turns": 0,
+         *       "motion_commands_locked": false,
+         *       "moving": true,
+         *       "moving_backward": false,
+         *       "moving_forward": true,
+         *       "override_percent": 100,
+         *       "power_override_percent": 0,
+         *       "power_status": true,
+         *       "remaining_distance": 185.889,
+         *       "remaining_time": 1.019,
+         *       "set_acceleration": 0,
+         *       "set_jerk": 0,
+         *       "set_override_factor": 0,
+         *       "set_position": 64.111,
+         *       "set_position_offset": 0,
+         *       "set_velocity": 200,
+         *       "soft_limit_max_exceeded": false,
+         *       "soft_limit_min_exceeded": false,
+         *       "state": "discrete_motion",
+         *       "superimposed_distance": 0,
+         *       "target_position": 250
+         *     }
+         */
         AxisStatus: {
             state: components["schemas"]["AxisState"];
             /**
@@ -820,6 +933,11 @@ export interface components {
             actual_position: number;
             /** Format: double */
             actual_velocity: number;
+            /**
+             * Format: double
+             * @description The actual velocity differentiated over one cycle (unfiltered).
+             */
+            actual_acceleration: number;
             /**
              * Format: double
              * @description set − actual.
@@ -918,7 +1036,13 @@ export interface components {
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
-        /** @description One signal of one axis. */
+        /**
+         * @description One signal of one axis.
+         * @example {
+         *       "axis": "x",
+         *       "signal": "set_position"
+         *     }
+         */
         ChannelRequest: {
             /**
              * @description Axis id or name.
@@ -927,7 +1051,14 @@ export interface components {
             axis: string;
             signal: components["schemas"]["ScopeSignal"];
         };
-        /** @description Where a command came from. */
+        /**
+         * @description Where a command came from.
+         * @example {
+         *       "addr": "127.0.0.1:50312",
+         *       "id": "line-3-mes",
+         *       "via": "rest"
+         *     }
+         */
         ClientInfo: {
             /** @description Remote address. */
             addr: string;
@@ -936,7 +1067,26 @@ export interface components {
             /** @description `rest` or `websocket`. */
             via: string;
         };
-        /** @description A change of a command's outputs. */
+        /**
+         * @description A change of a command's outputs.
+         * @example {
+         *       "cycle": 1200,
+         *       "outputs": {
+         *         "active": true,
+         *         "busy": true,
+         *         "command_aborted": false,
+         *         "done": false,
+         *         "error": false,
+         *         "error_id": 0,
+         *         "in_end_velocity": false,
+         *         "in_gear": false,
+         *         "in_velocity": false,
+         *         "status": false,
+         *         "warning": false,
+         *         "warning_id": 0
+         *       }
+         *     }
+         */
         CommandEventDto: {
             /**
              * Format: int64
@@ -1036,6 +1186,61 @@ export interface components {
          * @enum {string}
          */
         CommandState: "busy" | "active" | "done" | "aborted" | "error";
+        /**
+         * @description One axis of the configuration document.
+         * @example {
+         *       "config": {
+         *         "drive": {
+         *           "acceleration_feed_forward": 0,
+         *           "coast_deceleration": 10000,
+         *           "dead_time": 0.001,
+         *           "dead_time_compensation": true,
+         *           "enable_delay": 0.005,
+         *           "index_pulse": {
+         *             "offset": 0,
+         *             "period": 10
+         *           },
+         *           "limit_switches": {
+         *             "fault_on_hit": false,
+         *             "negative": -5,
+         *             "positive": 1005
+         *           },
+         *           "load_stiffness": 1000,
+         *           "plant": {
+         *             "damping": 0.8,
+         *             "kind": "pt2",
+         *             "natural_frequency_hz": 50
+         *           },
+         *           "reference_cam": {
+         *             "end": 25,
+         *             "start": 20
+         *           },
+         *           "velocity_feed_forward": 1
+         *         },
+         *         "dynamics": {
+         *           "acceleration": 2500,
+         *           "deceleration": 2500,
+         *           "jerk": 25000,
+         *           "jog_velocity_fast": 100,
+         *           "jog_velocity_slow": 10,
+         *           "max_velocity": 500
+         *         },
+         *         "name": "x",
+         *         "parameters": {
+         *           "AxisTargetPositionWindow": 0.01
+         *         },
+         *         "soft_limits": {
+         *           "max": 1000,
+         *           "min": 0
+         *         },
+         *         "unit": "mm"
+         *       },
+         *       "id": 1,
+         *       "persistent_parameters": {
+         *         "AxisVeloMax": 400
+         *       }
+         *     }
+         */
         ConfigAxis: {
             /** Format: int64 */
             id: number;
@@ -1043,7 +1248,158 @@ export interface components {
             /** @description The persistent parameter overlay, by parameter name. */
             persistent_parameters?: Record<string, never>;
         };
-        /** @description The whole configuration (`GET/PUT /config`). */
+        /**
+         * @description The whole configuration (`GET/PUT /config`).
+         * @example {
+         *       "axes": [
+         *         {
+         *           "config": {
+         *             "drive": {
+         *               "acceleration_feed_forward": 0,
+         *               "coast_deceleration": 10000,
+         *               "dead_time": 0.001,
+         *               "dead_time_compensation": true,
+         *               "enable_delay": 0.005,
+         *               "index_pulse": {
+         *                 "offset": 0,
+         *                 "period": 10
+         *               },
+         *               "limit_switches": {
+         *                 "fault_on_hit": false,
+         *                 "negative": -5,
+         *                 "positive": 1005
+         *               },
+         *               "load_stiffness": 1000,
+         *               "plant": {
+         *                 "damping": 0.8,
+         *                 "kind": "pt2",
+         *                 "natural_frequency_hz": 50
+         *               },
+         *               "reference_cam": {
+         *                 "end": 25,
+         *                 "start": 20
+         *               },
+         *               "velocity_feed_forward": 1
+         *             },
+         *             "dynamics": {
+         *               "acceleration": 2500,
+         *               "deceleration": 2500,
+         *               "jerk": 25000,
+         *               "jog_velocity_fast": 100,
+         *               "jog_velocity_slow": 10,
+         *               "max_velocity": 500
+         *             },
+         *             "name": "x",
+         *             "parameters": {
+         *               "AxisTargetPositionWindow": 0.01
+         *             },
+         *             "soft_limits": {
+         *               "max": 1000,
+         *               "min": 0
+         *             },
+         *             "unit": "mm"
+         *           },
+         *           "id": 1,
+         *           "persistent_parameters": {
+         *             "AxisVeloMax": 400
+         *           }
+         *         },
+         *         {
+         *           "config": {
+         *             "drive": {
+         *               "acceleration_feed_forward": 0,
+         *               "coast_deceleration": 10000,
+         *               "dead_time": 0.001,
+         *               "dead_time_compensation": true,
+         *               "enable_delay": 0.005,
+         *               "index_pulse": {
+         *                 "offset": 0,
+         *                 "period": 10
+         *               },
+         *               "limit_switches": {
+         *                 "fault_on_hit": false,
+         *                 "negative": -1005,
+         *                 "positive": 1005
+         *               },
+         *               "load_stiffness": 1000,
+         *               "plant": {
+         *                 "damping": 0.8,
+         *                 "kind": "pt2",
+         *                 "natural_frequency_hz": 50
+         *               },
+         *               "reference_cam": {
+         *                 "end": 25,
+         *                 "start": 20
+         *               },
+         *               "velocity_feed_forward": 1
+         *             },
+         *             "dynamics": {
+         *               "acceleration": 2500,
+         *               "deceleration": 2500,
+         *               "jerk": 25000,
+         *               "jog_velocity_fast": 100,
+         *               "jog_velocity_slow": 10,
+         *               "max_velocity": 500
+         *             },
+         *             "name": "y",
+         *             "parameters": {
+         *               "AxisTargetPositionWindow": 0.01
+         *             },
+         *             "unit": "mm"
+         *           },
+         *           "id": 2,
+         *           "persistent_parameters": {}
+         *         },
+         *         {
+         *           "config": {
+         *             "drive": {
+         *               "acceleration_feed_forward": 0,
+         *               "coast_deceleration": 10000,
+         *               "dead_time": 0.001,
+         *               "dead_time_compensation": true,
+         *               "enable_delay": 0.005,
+         *               "index_pulse": {
+         *                 "offset": 0,
+         *                 "period": 10
+         *               },
+         *               "limit_switches": {
+         *                 "fault_on_hit": false,
+         *                 "negative": null,
+         *                 "positive": null
+         *               },
+         *               "load_stiffness": 1000,
+         *               "plant": {
+         *                 "damping": 0.8,
+         *                 "kind": "pt2",
+         *                 "natural_frequency_hz": 50
+         *               },
+         *               "reference_cam": {
+         *                 "end": 25,
+         *                 "start": 20
+         *               },
+         *               "velocity_feed_forward": 1
+         *             },
+         *             "dynamics": {
+         *               "acceleration": 18000,
+         *               "deceleration": 18000,
+         *               "jerk": 180000,
+         *               "jog_velocity_fast": 720,
+         *               "jog_velocity_slow": 90,
+         *               "max_velocity": 3600
+         *             },
+         *             "modulo": {
+         *               "period": 360
+         *             },
+         *             "name": "spindle",
+         *             "unit": "deg"
+         *           },
+         *           "id": 3,
+         *           "persistent_parameters": {}
+         *         }
+         *       ],
+         *       "version": 1
+         *     }
+         */
         ConfigDocument: {
             /**
              * Format: int32
@@ -1055,9 +1411,28 @@ export interface components {
         };
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
-        /** @description MC_Reset (no inputs). */
+        /**
+         * @description MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
+         * @example {}
+         */
         EmptyBody: Record<string, never>;
-        /** @description The outputs of a function block (`ST_McOutputs` plus the milestone flags). */
+        /**
+         * @description The outputs of a function block (`ST_McOutputs` plus the milestone flags).
+         * @example {
+         *       "active": true,
+         *       "busy": true,
+         *       "command_aborted": false,
+         *       "done": false,
+         *       "error": false,
+         *       "error_id": 0,
+         *       "in_end_velocity": false,
+         *       "in_gear": false,
+         *       "in_velocity": false,
+         *       "status": false,
+         *       "warning": false,
+         *       "warning_id": 0
+         *     }
+         */
         FbOutputs: {
             busy: boolean;
             active: boolean;
@@ -1086,7 +1461,13 @@ export interface components {
              */
             warning_id: number;
         };
-        /** @description One invalid field of a configuration. */
+        /**
+         * @description One invalid field of a configuration.
+         * @example {
+         *       "field": "dynamics.jerk",
+         *       "message": "must be a finite number > 0"
+         *     }
+         */
         FieldError: {
             /** @description JSON path of the field, e.g. `plant.time_constant`. */
             field: string;
@@ -1133,7 +1514,12 @@ export interface components {
              */
             acceleration?: number;
         };
-        /** @description MC_Halt. */
+        /**
+         * @description MC_Halt.
+         * @example {
+         *       "deceleration": 1000
+         *     }
+         */
         HaltBody: {
             /**
              * Format: double
@@ -1187,7 +1573,17 @@ export interface components {
         };
         /** @enum {string} */
         HomingMode: "default" | "direct" | "force_calibration" | "reset_calibration";
-        /** @description `ST_HomingOptions`. */
+        /**
+         * @description `ST_HomingOptions`.
+         * @example {
+         *       "clear_position_lag": false,
+         *       "reference_mode": null,
+         *       "search_direction": null,
+         *       "search_velocity": 20,
+         *       "sync_direction": null,
+         *       "sync_velocity": null
+         *     }
+         */
         HomingOptions: {
             /**
              * @description MC_Direct only: set = actual afterwards.
@@ -1218,7 +1614,13 @@ export interface components {
          * @enum {string}
          */
         HomingPhase: "idle" | "search_cam" | "stop_on_cam" | "leave_cam" | "wait_cam_falling_edge" | "wait_latch" | "set_position";
-        /** @description Encoder index pulse at `offset + n·period` (e.g. once per motor revolution). */
+        /**
+         * @description Encoder index pulse at `offset + n·period` (e.g. once per motor revolution).
+         * @example {
+         *       "offset": 0,
+         *       "period": 10
+         *     }
+         */
         IndexPulse: {
             /**
              * Format: double
@@ -1282,7 +1684,14 @@ export interface components {
         JogDirection: "forward" | "backward";
         /** @enum {string} */
         JogMode: "standard_slow" | "standard_fast" | "continuous" | "inching" | "inching_modulo";
-        /** @description Hardware limit switches (each optional). */
+        /**
+         * @description Hardware limit switches (each optional).
+         * @example {
+         *       "fault_on_hit": false,
+         *       "negative": -5,
+         *       "positive": 1005
+         *     }
+         */
         LimitSwitches: {
             /**
              * Format: double
@@ -1303,7 +1712,58 @@ export interface components {
              */
             fault_on_hit: boolean;
         };
-        /** @description The live status of an axis: the kernel's status plus what only the server can name. */
+        /**
+         * @description The live status of an axis: the kernel's status plus what only the server can name.
+         * @example {
+         *       "accelerating": false,
+         *       "active_command": 42,
+         *       "actual_acceleration": 0,
+         *       "actual_position": 64.109,
+         *       "actual_velocity": 199.98,
+         *       "command_buffered": false,
+         *       "compensating": false,
+         *       "constant_velocity": true,
+         *       "coupled": false,
+         *       "decelerating": false,
+         *       "drive_fault": false,
+         *       "enable_negative": true,
+         *       "enable_positive": true,
+         *       "error_id": 0,
+         *       "following_error": 0.002,
+         *       "following_error_max": 0.0219,
+         *       "following_error_min": -0.0001,
+         *       "gear_ratio": 0,
+         *       "has_job": true,
+         *       "homed": true,
+         *       "homing_phase": "idle",
+         *       "in_position_area": false,
+         *       "in_target_position": false,
+         *       "master": null,
+         *       "modulo_actual_position": 64.109,
+         *       "modulo_set_position": 64.111,
+         *       "modulo_set_turns": 0,
+         *       "motion_commands_locked": false,
+         *       "moving": true,
+         *       "moving_backward": false,
+         *       "moving_forward": true,
+         *       "override_percent": 100,
+         *       "power_override_percent": 0,
+         *       "power_status": true,
+         *       "remaining_distance": 185.889,
+         *       "remaining_time": 1.019,
+         *       "set_acceleration": 0,
+         *       "set_jerk": 0,
+         *       "set_override_factor": 0,
+         *       "set_position": 64.111,
+         *       "set_position_offset": 0,
+         *       "set_velocity": 200,
+         *       "soft_limit_max_exceeded": false,
+         *       "soft_limit_min_exceeded": false,
+         *       "state": "discrete_motion",
+         *       "superimposed_distance": 0,
+         *       "target_position": 250
+         *     }
+         */
         LiveStatus: components["schemas"]["AxisStatus"] & {
             /**
              * @description The master axis (name) while the axis is coupled as a gear slave.
@@ -1311,7 +1771,12 @@ export interface components {
              */
             master?: string | null;
         };
-        /** @description Modulo (rotary) axis: positions wrap at `period`. */
+        /**
+         * @description Modulo (rotary) axis: positions wrap at `period`.
+         * @example {
+         *       "period": 360
+         *     }
+         */
         ModuloConfig: {
             /**
              * Format: double
@@ -1375,7 +1840,14 @@ export interface components {
             buffer_mode?: components["schemas"]["BufferMode"];
             options?: components["schemas"]["MoveOptions"];
         };
-        /** @description `ST_MoveOptions`. */
+        /**
+         * @description `ST_MoveOptions`.
+         * @example {
+         *       "blending_position": null,
+         *       "enable_stop_position_monitoring": false,
+         *       "ignore_position_monitoring": false
+         *     }
+         */
         MoveOptions: {
             /**
              * Format: double
@@ -1468,9 +1940,28 @@ export interface components {
          * @enum {string}
          */
         ParamType: "bool" | "lreal" | "dword";
-        /** @description A parameter value: JSON `true`/`false` for BOOL entries, a number otherwise. */
+        /**
+         * @description A parameter value: JSON `true`/`false` for BOOL entries, a number otherwise.
+         * @example 90
+         */
         ParamValue: boolean | number;
-        /** @description Descriptor of one `MC_AxisParameter` entry. */
+        /**
+         * @description Descriptor of one `MC_AxisParameter` entry.
+         * @example {
+         *       "ads_index_offset": "0x0002000B",
+         *       "group": "controller",
+         *       "help": "Weight of the velocity feed-forward in percent (100 = full feed-forward).",
+         *       "max": 100,
+         *       "min": 0,
+         *       "min_exclusive": false,
+         *       "name": "AxisCtrlVelocityPreCtrlWeight",
+         *       "number": 1096,
+         *       "read_only": false,
+         *       "storage": 1096,
+         *       "type": "lreal",
+         *       "unit": "percent"
+         *     }
+         */
         ParameterInfo: {
             /**
              * Format: int32
@@ -1510,7 +2001,26 @@ export interface components {
             /** @description What the parameter does and when motiond uses it. */
             help: string;
         };
-        /** @description One MC_AxisParameter entry with its value on an axis. */
+        /**
+         * @description One MC_AxisParameter entry with its value on an axis.
+         * @example {
+         *       "ads_index_offset": "0x0002000B",
+         *       "group": "controller",
+         *       "help": "Weight of the velocity feed-forward in percent (100 = full feed-forward).",
+         *       "max": 100,
+         *       "min": 0,
+         *       "min_exclusive": false,
+         *       "name": "AxisCtrlVelocityPreCtrlWeight",
+         *       "number": 1096,
+         *       "persistent_value": 90,
+         *       "read_only": false,
+         *       "storage": 1096,
+         *       "type": "lreal",
+         *       "unit": "percent",
+         *       "unit_text": "%",
+         *       "value": 90
+         *     }
+         */
         ParameterResource: components["schemas"]["ParameterInfo"] & {
             /**
              * @description The unit for this axis (e.g. `mm/s²`).
@@ -1547,7 +2057,14 @@ export interface components {
              */
             cycle: number;
         };
-        /** @description Closed-loop response of the load to the position reference. */
+        /**
+         * @description Closed-loop response of the load to the position reference.
+         * @example {
+         *       "damping": 0.8,
+         *       "kind": "pt2",
+         *       "natural_frequency_hz": 50
+         *     }
+         */
         PlantModel: {
             /** @enum {string} */
             kind: "ideal";
@@ -1620,7 +2137,16 @@ export interface components {
             /** @description Invalid fields (422). */
             errors?: components["schemas"]["FieldError"][];
         };
-        /** @description What real-time facilities the OS granted. */
+        /**
+         * @description What real-time facilities the OS granted.
+         * @example {
+         *       "cpu_dma_latency_zero": true,
+         *       "mlockall": true,
+         *       "notes": [],
+         *       "pinned_cpu": 1,
+         *       "sched_fifo": true
+         *     }
+         */
         RealtimeGrant: {
             sched_fifo: boolean;
             mlockall: boolean;
@@ -1665,7 +2191,13 @@ export interface components {
         };
         /** @enum {string} */
         RecordingState: "armed" | "recording" | "done" | "cancelled" | "failed";
-        /** @description Reference cam: active while `start ≤ actual position ≤ end`. */
+        /**
+         * @description Reference cam: active while `start ≤ actual position ≤ end`.
+         * @example {
+         *       "end": 25,
+         *       "start": 20
+         *     }
+         */
         ReferenceCam: {
             /** Format: double */
             start: number;
@@ -1677,7 +2209,15 @@ export interface components {
          * @enum {string}
          */
         ReferenceMode: "default" | "plc_cam" | "hardware_sync" | "hardware_latch_pos" | "hardware_latch_neg" | "software_sync" | "soft_drive_latch_pos" | "soft_drive_latch_neg";
-        /** @description One channel of a recording, as resolved by the server. */
+        /**
+         * @description One channel of a recording, as resolved by the server.
+         * @example {
+         *       "axis": "x",
+         *       "axis_id": 1,
+         *       "signal": "set_velocity",
+         *       "unit": "mm/s"
+         *     }
+         */
         ScopeChannel: {
             /**
              * @description The axis's name (also when it was given by id).
@@ -1696,6 +2236,62 @@ export interface components {
         /**
          * @description A scope recording. `t` and `data` are only present in `GET /scope/recordings/{id}` of a
          *     recording that is `done`.
+         * @example {
+         *       "channels": [
+         *         {
+         *           "axis": "x",
+         *           "axis_id": 1,
+         *           "signal": "set_position",
+         *           "unit": "mm"
+         *         },
+         *         {
+         *           "axis": "x",
+         *           "axis_id": 1,
+         *           "signal": "set_velocity",
+         *           "unit": "mm/s"
+         *         }
+         *       ],
+         *       "created_at": "2025-01-01T12:00:00.000Z",
+         *       "cycle_time_s": 0.001,
+         *       "data": [
+         *         [
+         *           99.6,
+         *           99.8,
+         *           100,
+         *           100.2,
+         *           100.4
+         *         ],
+         *         [
+         *           200,
+         *           200,
+         *           200,
+         *           200,
+         *           200
+         *         ]
+         *       ],
+         *       "duration_s": 0.005,
+         *       "finished_at": "2025-01-01T12:00:01.204Z",
+         *       "id": 3,
+         *       "pre_trigger_samples": 2,
+         *       "samples": 5,
+         *       "samples_recorded": 5,
+         *       "start_cycle": 120343,
+         *       "state": "done",
+         *       "t": [
+         *         -0.002,
+         *         -0.001,
+         *         0,
+         *         0.001,
+         *         0.002
+         *       ],
+         *       "trigger": {
+         *         "channel": 0,
+         *         "edge": "rising",
+         *         "level": 100,
+         *         "pre_trigger_s": 0.002
+         *       },
+         *       "trigger_cycle": 120345
+         *     }
          */
         ScopeRecording: {
             /** Format: int64 */
@@ -1749,8 +2345,16 @@ export interface components {
          * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step).
          * @enum {string}
          */
-        ScopeSignal: "set_position" | "actual_position" | "set_velocity" | "actual_velocity" | "set_acceleration" | "following_error";
-        /** @description A trigger on one of the recording's channels. */
+        ScopeSignal: "set_position" | "actual_position" | "set_velocity" | "actual_velocity" | "set_acceleration" | "actual_acceleration" | "following_error";
+        /**
+         * @description A trigger on one of the recording's channels.
+         * @example {
+         *       "channel": 0,
+         *       "edge": "rising",
+         *       "level": 100,
+         *       "pre_trigger_s": 0.002
+         *     }
+         */
         ScopeTrigger: {
             /** @description Index into `channels`. */
             channel: number;
@@ -1792,7 +2396,36 @@ export interface components {
             relative?: boolean;
             clear_position_lag?: boolean;
         };
-        /** @description Model of the simulated servo drive. Times in seconds, positions in the axis's units. */
+        /**
+         * @description Model of the simulated servo drive. Times in seconds, positions in the axis's units.
+         * @example {
+         *       "acceleration_feed_forward": 0,
+         *       "coast_deceleration": 10000,
+         *       "dead_time": 0.001,
+         *       "dead_time_compensation": true,
+         *       "enable_delay": 0.005,
+         *       "index_pulse": {
+         *         "offset": 0,
+         *         "period": 10
+         *       },
+         *       "limit_switches": {
+         *         "fault_on_hit": false,
+         *         "negative": -5,
+         *         "positive": 1005
+         *       },
+         *       "load_stiffness": 1000,
+         *       "plant": {
+         *         "damping": 0.8,
+         *         "kind": "pt2",
+         *         "natural_frequency_hz": 50
+         *       },
+         *       "reference_cam": {
+         *         "end": 25,
+         *         "start": 20
+         *       },
+         *       "velocity_feed_forward": 1
+         *     }
+         */
         SimDriveConfig: {
             /**
              * @default {
@@ -1868,7 +2501,13 @@ export interface components {
              */
             limit_switches: components["schemas"]["LimitSwitches"];
         };
-        /** @description A fault or disturbance injected into the simulation (tests, demos, commissioning). */
+        /**
+         * @description A fault or disturbance injected into the simulation (tests, demos, commissioning).
+         * @example {
+         *       "force": 50,
+         *       "kind": "load"
+         *     }
+         */
         SimFault: {
             /** Format: int32 */
             code: number;
@@ -1888,7 +2527,13 @@ export interface components {
             /** @enum {string} */
             kind: "clear";
         };
-        /** @description Software end positions (#1016–#1019); both are enabled when present. */
+        /**
+         * @description Software end positions (#1016–#1019); both are enabled when present.
+         * @example {
+         *       "max": 1000,
+         *       "min": 0
+         *     }
+         */
         SoftLimits: {
             /**
              * Format: double
@@ -1901,7 +2546,64 @@ export interface components {
              */
             max: number;
         };
-        /** @description Live status of an axis. */
+        /**
+         * @description Live status of an axis.
+         * @example {
+         *       "axis": "x",
+         *       "axis_id": 1,
+         *       "cycle": 2009,
+         *       "status": {
+         *         "accelerating": false,
+         *         "active_command": 42,
+         *         "actual_acceleration": 0,
+         *         "actual_position": 64.109,
+         *         "actual_velocity": 199.98,
+         *         "command_buffered": false,
+         *         "compensating": false,
+         *         "constant_velocity": true,
+         *         "coupled": false,
+         *         "decelerating": false,
+         *         "drive_fault": false,
+         *         "enable_negative": true,
+         *         "enable_positive": true,
+         *         "error_id": 0,
+         *         "following_error": 0.002,
+         *         "following_error_max": 0.0219,
+         *         "following_error_min": -0.0001,
+         *         "gear_ratio": 0,
+         *         "has_job": true,
+         *         "homed": true,
+         *         "homing_phase": "idle",
+         *         "in_position_area": false,
+         *         "in_target_position": false,
+         *         "master": null,
+         *         "modulo_actual_position": 64.109,
+         *         "modulo_set_position": 64.111,
+         *         "modulo_set_turns": 0,
+         *         "motion_commands_locked": false,
+         *         "moving": true,
+         *         "moving_backward": false,
+         *         "moving_forward": true,
+         *         "override_percent": 100,
+         *         "power_override_percent": 0,
+         *         "power_status": true,
+         *         "remaining_distance": 185.889,
+         *         "remaining_time": 1.019,
+         *         "set_acceleration": 0,
+         *         "set_jerk": 0,
+         *         "set_override_factor": 0,
+         *         "set_position": 64.111,
+         *         "set_position_offset": 0,
+         *         "set_velocity": 200,
+         *         "soft_limit_max_exceeded": false,
+         *         "soft_limit_min_exceeded": false,
+         *         "state": "discrete_motion",
+         *         "superimposed_distance": 0,
+         *         "target_position": 250
+         *       },
+         *       "unit": "mm"
+         *     }
+         */
         StatusResource: {
             axis: string;
             /** Format: int64 */
@@ -1914,7 +2616,13 @@ export interface components {
             unit: string;
             status: components["schemas"]["LiveStatus"];
         };
-        /** @description MC_Stop. */
+        /**
+         * @description MC_Stop.
+         * @example {
+         *       "deceleration": 5000,
+         *       "jerk": 50000
+         *     }
+         */
         StopBody: {
             /**
              * Format: double
@@ -1935,7 +2643,18 @@ export interface components {
              */
             options: components["schemas"]["MoveOptions"];
         };
-        /** @description A reader's copy of a histogram's figures, in microseconds. */
+        /**
+         * @description A reader's copy of a histogram's figures, in microseconds.
+         * @example {
+         *       "count": 5750,
+         *       "max_us": 64.7,
+         *       "mean_us": 9.1,
+         *       "p50_us": 6.4,
+         *       "p90_us": 14.3,
+         *       "p999_us": 51.2,
+         *       "p99_us": 32.8
+         *     }
+         */
         Summary: {
             /** Format: int64 */
             count: number;
@@ -1962,6 +2681,61 @@ export interface components {
          * @enum {string}
          */
         SuperpositionMode: "velo_reduction_additive_motion" | "velo_reduction_limited_motion" | "length_reduction_additive_motion" | "length_reduction_limited_motion" | "acc_reduction_additive_motion" | "acc_reduction_limited_motion";
+        /**
+         * @description What `GET /system` reports.
+         * @example {
+         *       "axes": 3,
+         *       "cycle": 5750,
+         *       "cycle_time": 0.001,
+         *       "database": "motiond.db",
+         *       "drive_bus": "simulated",
+         *       "listen": "127.0.0.1:8080",
+         *       "realtime": {
+         *         "cpu_dma_latency_zero": true,
+         *         "mlockall": true,
+         *         "notes": [],
+         *         "pinned_cpu": 1,
+         *         "sched_fifo": true
+         *       },
+         *       "timing": {
+         *         "audit_dropped": 0,
+         *         "compute": {
+         *           "count": 5750,
+         *           "max_us": 64.7,
+         *           "mean_us": 9.1,
+         *           "p50_us": 6.4,
+         *           "p90_us": 14.3,
+         *           "p999_us": 51.2,
+         *           "p99_us": 32.8
+         *         },
+         *         "cycles": 5750,
+         *         "events_dropped": 0,
+         *         "overruns": 14,
+         *         "period": {
+         *           "count": 5749,
+         *           "max_us": 9157.2,
+         *           "mean_us": 1002.4,
+         *           "p50_us": 1015.8,
+         *           "p90_us": 1015.8,
+         *           "p999_us": 1769.5,
+         *           "p99_us": 1114.1
+         *         },
+         *         "requests_expired": 0,
+         *         "scope_frames_dropped": 0,
+         *         "wakeup_latency": {
+         *           "count": 5750,
+         *           "max_us": 8172.8,
+         *           "mean_us": 23.6,
+         *           "p50_us": 16.4,
+         *           "p90_us": 26.6,
+         *           "p999_us": 852,
+         *           "p99_us": 94.2
+         *         }
+         *       },
+         *       "uptime_s": 5.76,
+         *       "version": "0.1.0"
+         *     }
+         */
         SystemResource: {
             /** @example 0.1.0 */
             version: string;
@@ -1986,7 +2760,44 @@ export interface components {
             realtime: components["schemas"]["RealtimeGrant"];
             timing: components["schemas"]["Timing"];
         };
-        /** @description Timing of the cycle thread, measured by itself. */
+        /**
+         * @description Timing of the cycle thread, measured by itself.
+         * @example {
+         *       "audit_dropped": 0,
+         *       "compute": {
+         *         "count": 5750,
+         *         "max_us": 64.7,
+         *         "mean_us": 9.1,
+         *         "p50_us": 6.4,
+         *         "p90_us": 14.3,
+         *         "p999_us": 51.2,
+         *         "p99_us": 32.8
+         *       },
+         *       "cycles": 5750,
+         *       "events_dropped": 0,
+         *       "overruns": 14,
+         *       "period": {
+         *         "count": 5749,
+         *         "max_us": 9157.2,
+         *         "mean_us": 1002.4,
+         *         "p50_us": 1015.8,
+         *         "p90_us": 1015.8,
+         *         "p999_us": 1769.5,
+         *         "p99_us": 1114.1
+         *       },
+         *       "requests_expired": 0,
+         *       "scope_frames_dropped": 0,
+         *       "wakeup_latency": {
+         *         "count": 5750,
+         *         "max_us": 8172.8,
+         *         "mean_us": 23.6,
+         *         "p50_us": 16.4,
+         *         "p90_us": 26.6,
+         *         "p999_us": 852,
+         *         "p99_us": 94.2
+         *       }
+         *     }
+         */
         Timing: {
             /** @description Wake-up time minus the deadline. */
             wakeup_latency: components["schemas"]["Summary"];
@@ -2029,7 +2840,15 @@ export interface components {
          * @enum {string}
          */
         TriggerEdge: "rising" | "falling" | "either";
-        /** @description Start the recording when `channels[channel]` crosses `level` in the direction of `edge`. */
+        /**
+         * @description Start the recording when `channels[channel]` crosses `level` in the direction of `edge`.
+         * @example {
+         *       "channel": 0,
+         *       "edge": "rising",
+         *       "level": 100,
+         *       "pre_trigger_s": 0.002
+         *     }
+         */
         TriggerRequest: {
             /** @description Index into `channels`. */
             channel: number;
@@ -2052,7 +2871,540 @@ export interface components {
          */
         Unit: "none" | "position" | "velocity" | "acceleration" | "jerk" | "seconds" | "factor" | "percent" | "per_second" | "position_per_increment" | "increments" | "count" | "code";
     };
-    responses: never;
+    responses: {
+        /** @description `limit` out of range, or an unknown query parameter. */
+        AuditInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "limit: must be between 1 and 1000",
+                 *       "errors": [
+                 *         {
+                 *           "field": "limit",
+                 *           "message": "must be between 1 and 1000"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The audit log could not be read. */
+        AuditUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "storage_unavailable",
+                 *       "detail": "the audit log could not be read: database is locked",
+                 *       "status": 503,
+                 *       "title": "Service unavailable",
+                 *       "type": "urn:motiond:problem:storage_unavailable"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The name is taken, or all 64 axis slots are used. */
+        AxisCreateConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description An axis is not disabled. */
+        AxisNotDisabled: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "axis_not_disabled",
+                 *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
+                 *       "status": 409,
+                 *       "title": "Conflict",
+                 *       "type": "urn:motiond:problem:axis_not_disabled"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such axis. */
+        AxisNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "axis_not_found",
+                 *       "detail": "no axis 'z'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:axis_not_found"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such axis or parameter. */
+        AxisOrParameterNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The axis is not disabled, or another axis has the name. */
+        AxisReplaceConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Invalid parameters (wrong type, unknown or missing field, out of range) or query;
+         *     `errors` lists every invalid field. No command is kept.
+         */
+        CommandInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such command (never accepted, or no longer among the last 2000). */
+        CommandNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "command_not_found",
+                 *       "detail": "no command '12345'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:command_not_found"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID and
+         *     `code` its name (docs/errors.md). No command is kept.
+         */
+        CommandRejected: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The cycle thread did not take the command (`command_queue_full`: try again;
+         *     `cycle_unavailable`: it did not answer), or the command was accepted but left the
+         *     history of 2000 before it could be shown (`command_forgotten`).
+         */
+        CommandUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The axis no longer runs the command (it has ended or was replaced): `command_unknown`. */
+        CommandUnknown: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "command_unknown",
+                 *       "detail": "unknown or finished command",
+                 *       "error_id": 28768,
+                 *       "status": 409,
+                 *       "title": "Command rejected by the axis",
+                 *       "type": "urn:motiond:problem:command_unknown"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The configuration is invalid; `errors` lists every invalid field. Nothing was changed. */
+        ConfigInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "dynamics.jerk: must be a finite number > 0",
+                 *       "errors": [
+                 *         {
+                 *           "field": "dynamics.jerk",
+                 *           "message": "must be a finite number > 0"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The cycle thread did not take the request (`command_queue_full`: try again) or did not
+         *     answer (`cycle_unavailable`).
+         */
+        CycleUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Not a fault: unknown `kind`, missing or wrong fields. */
+        FaultInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "body: unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`",
+                 *       "errors": [
+                 *         {
+                 *           "field": "body",
+                 *           "message": "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The document is invalid; `errors` lists every invalid field (`axes[i].config.…`). */
+        ImportInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "axes[1].config.name: duplicate name",
+                 *       "errors": [
+                 *         {
+                 *           "field": "axes[1].config.name",
+                 *           "message": "duplicate name"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The body is not JSON. */
+        MalformedJson: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "malformed_json",
+                 *       "detail": "EOF while parsing a value at line 1 column 15",
+                 *       "status": 400,
+                 *       "title": "Malformed JSON",
+                 *       "type": "urn:motiond:problem:malformed_json"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The value is refused: `error_id` says why (read-only, out of range, not consistent with
+         *     the other parameters); `errors` names the field. Nothing was written.
+         */
+        ParameterInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The cycle thread did not take the write, or the database did not accept a persistent
+         *     one: nothing was written, except when only the commit failed (the value is then active
+         *     but not persisted, as the detail says).
+         */
+        ParameterWriteUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The body is larger than 2 MiB. */
+        PayloadTooLarge: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "payload_too_large",
+                 *       "detail": "the body is larger than 2097152 bytes",
+                 *       "status": 413,
+                 *       "title": "Payload too large",
+                 *       "type": "urn:motiond:problem:payload_too_large"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description An invalid or unknown query parameter. */
+        QueryInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "query: Failed to deserialize query string: state: unknown variant `running`, expected one of `busy`, `active`, `done`, `aborted`, `error`",
+                 *       "errors": [
+                 *         {
+                 *           "field": "query",
+                 *           "message": "Failed to deserialize query string: state: unknown variant `running`, expected one of `busy`, `active`, `done`, `aborted`, `error`"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description CSV of a recording that is not done. */
+        RecordingNotDone: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "recording_not_done",
+                 *       "detail": "recording 7 is armed; CSV is available when it is done",
+                 *       "status": 409,
+                 *       "title": "Conflict",
+                 *       "type": "urn:motiond:problem:recording_not_done"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such recording (never made, deleted, or evicted). */
+        RecordingNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "recording_not_found",
+                 *       "detail": "no recording '7'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:recording_not_found"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Unknown `format` or query parameter. */
+        RecordingQueryInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "query: Failed to deserialize query string: format: unknown variant `xml`, expected `json` or `csv`",
+                 *       "errors": [
+                 *         {
+                 *           "field": "query",
+                 *           "message": "Failed to deserialize query string: format: unknown variant `xml`, expected `json` or `csv`"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The recording could not be written out. */
+        RecordingUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "internal",
+                 *       "detail": "the recording could not be written",
+                 *       "status": 503,
+                 *       "title": "Service unavailable",
+                 *       "type": "urn:motiond:problem:internal"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The active recordings already use the scope's 8 signals (`scope_channels_busy`), or 8
+         *     recordings are active or their memory is used up (`scope_busy`).
+         */
+        ScopeBusy: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Invalid request; `errors` names every invalid field (`channels[1].axis` for an unknown
+         *     axis, `trigger.pre_trigger_s` …).
+         */
+        ScopeInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "channels[0].axis: no axis 'z'",
+                 *       "errors": [
+                 *         {
+                 *           "field": "channels[0].axis",
+                 *           "message": "no axis 'z'"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The cycle thread did not take the new sampling configuration or did not answer, or the
+         *     recording was evicted at once (`scope_unavailable`).
+         */
+        ScopeUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description An upgrade request to the websocket without a `Sec-WebSocket-Key`. */
+        WebsocketHandshakeInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "websocket_handshake_invalid",
+                 *       "detail": "`Sec-WebSocket-Key` header missing",
+                 *       "status": 400,
+                 *       "title": "Invalid websocket handshake",
+                 *       "type": "urn:motiond:problem:websocket_handshake_invalid"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Not a websocket upgrade request (a plain GET, a `Sec-WebSocket-Version` other than 13):
+         *     the response carries `Upgrade: websocket` and `Sec-WebSocket-Version: 13`.
+         */
+        WebsocketUpgradeRequired: {
+            headers: {
+                /** @description 13 */
+                "Sec-WebSocket-Version"?: string;
+                /** @description websocket */
+                Upgrade?: string;
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "websocket_upgrade_required",
+                 *       "detail": "Connection header did not include 'upgrade': /api/v1/ws only speaks websocket (JSON-RPC 2.0)",
+                 *       "status": 426,
+                 *       "title": "Upgrade required",
+                 *       "type": "urn:motiond:problem:websocket_upgrade_required"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The database did not accept the write (`storage_unavailable`: locked, full, I/O error),
+         *     or the cycle thread did not take the change or did not answer; nothing was changed.
+         */
+        WriteUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+    };
     parameters: never;
     requestBodies: never;
     headers: never;
@@ -2086,24 +3438,8 @@ export interface operations {
                     "application/json": components["schemas"]["AuditRecord"][];
                 };
             };
-            /** @description limit out of range or an unknown query parameter */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database could not be read */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            422: components["responses"]["AuditInvalid"];
+            503: components["responses"]["AuditUnavailable"];
         };
     };
     list_axes: {
@@ -2150,93 +3486,11 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis or parameter. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The axis is not disabled, or the name is taken. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_disabled",
-                     *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:axis_not_disabled"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The configuration is invalid; `errors` lists every invalid field. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "dynamics.jerk: must be a finite number > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "dynamics.jerk",
-                     *           "message": "must be a finite number > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database did not accept the write (locked, full, I/O error); nothing was changed. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "storage_unavailable",
-                     *       "detail": "the database did not accept the write: database is locked",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:storage_unavailable"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            409: components["responses"]["AxisCreateConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["ConfigInvalid"];
+            503: components["responses"]["WriteUnavailable"];
         };
     };
     get_axis: {
@@ -2263,24 +3517,7 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
         };
     };
     replace_axis: {
@@ -2311,93 +3548,12 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis or parameter. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The axis is not disabled, or the name is taken. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_disabled",
-                     *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:axis_not_disabled"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The configuration is invalid; `errors` lists every invalid field. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "dynamics.jerk: must be a finite number > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "dynamics.jerk",
-                     *           "message": "must be a finite number > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database did not accept the write (locked, full, I/O error); nothing was changed. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "storage_unavailable",
-                     *       "detail": "the database did not accept the write: database is locked",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:storage_unavailable"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["AxisReplaceConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["ConfigInvalid"];
+            503: components["responses"]["WriteUnavailable"];
         };
     };
     delete_axis: {
@@ -2422,93 +3578,9 @@ export interface operations {
                 };
                 content?: never;
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis or parameter. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The axis is not disabled, or the name is taken. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_disabled",
-                     *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:axis_not_disabled"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The configuration is invalid; `errors` lists every invalid field. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "dynamics.jerk: must be a finite number > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "dynamics.jerk",
-                     *           "message": "must be a finite number > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database did not accept the write (locked, full, I/O error); nothing was changed. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "storage_unavailable",
-                     *       "detail": "the database did not accept the write: database is locked",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:storage_unavailable"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["AxisNotDisabled"];
+            503: components["responses"]["WriteUnavailable"];
         };
     };
     abort_superposition: {
@@ -2552,103 +3624,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     gear_in: {
@@ -2692,103 +3673,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     gear_in_dyn: {
@@ -2832,103 +3722,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     gear_out: {
@@ -2972,103 +3771,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     halt: {
@@ -3112,103 +3820,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     home: {
@@ -3252,103 +3869,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     jog: {
@@ -3392,103 +3918,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_absolute: {
@@ -3532,103 +3967,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_additive: {
@@ -3672,103 +4016,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_continuous_absolute: {
@@ -3812,103 +4065,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_continuous_relative: {
@@ -3952,103 +4114,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_modulo: {
@@ -4092,103 +4163,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_relative: {
@@ -4232,103 +4212,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_superimposed: {
@@ -4372,103 +4261,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     move_velocity: {
@@ -4512,103 +4310,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     list_parameters: {
@@ -4635,24 +4342,7 @@ export interface operations {
                     "application/json": components["schemas"]["ParameterResource"][];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
         };
     };
     get_parameter: {
@@ -4684,24 +4374,7 @@ export interface operations {
                     "application/json": components["schemas"]["ParameterResource"];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisOrParameterNotFound"];
         };
     };
     write_parameter: {
@@ -4737,93 +4410,11 @@ export interface operations {
                     "application/json": components["schemas"]["ParameterResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis or parameter. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The axis is not disabled, or the name is taken. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_disabled",
-                     *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:axis_not_disabled"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The configuration is invalid; `errors` lists every invalid field. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "dynamics.jerk: must be a finite number > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "dynamics.jerk",
-                     *           "message": "must be a finite number > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database did not accept the write (locked, full, I/O error); nothing was changed. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "storage_unavailable",
-                     *       "detail": "the database did not accept the write: database is locked",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:storage_unavailable"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisOrParameterNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["ParameterInvalid"];
+            503: components["responses"]["ParameterWriteUnavailable"];
         };
     };
     power: {
@@ -4867,103 +4458,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     reset: {
@@ -5007,103 +4507,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     set_override: {
@@ -5147,103 +4556,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     set_position: {
@@ -5287,103 +4605,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     inject_fault: {
@@ -5412,66 +4639,11 @@ export interface operations {
                 };
                 content?: never;
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Not a fault: unknown `kind`, missing or wrong fields. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "body: unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`",
-                     *       "errors": [
-                     *         {
-                     *           "field": "body",
-                     *           "message": "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["FaultInvalid"];
+            503: components["responses"]["CycleUnavailable"];
         };
     };
     axis_status: {
@@ -5498,24 +4670,7 @@ export interface operations {
                     "application/json": components["schemas"]["StatusResource"];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
         };
     };
     reset_following_error_peak: {
@@ -5542,24 +4697,8 @@ export interface operations {
                     "application/json": components["schemas"]["PeakResetResource"];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
+            503: components["responses"]["CycleUnavailable"];
         };
     };
     stop: {
@@ -5603,103 +4742,12 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     list_commands: {
@@ -5727,103 +4775,8 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"][];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["AxisNotFound"];
+            422: components["responses"]["QueryInvalid"];
         };
     };
     get_command: {
@@ -5847,24 +4800,7 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description No such resource. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["CommandNotFound"];
         };
     };
     release_command: {
@@ -5888,103 +4824,9 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["CommandNotFound"];
+            409: components["responses"]["CommandUnknown"];
+            503: components["responses"]["CycleUnavailable"];
         };
     };
     keepalive: {
@@ -6006,103 +4848,9 @@ export interface operations {
                 };
                 content?: never;
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "malformed_json",
-                     *       "detail": "expected value at line 1 column 2",
-                     *       "status": 400,
-                     *       "title": "Malformed JSON",
-                     *       "type": "urn:motiond:problem:malformed_json"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Rejected by the axis (wrong state, buffer full …); `error_id` is the PLCopen ErrorID. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_cannot_be_started",
-                     *       "detail": "axis cannot be started in its current state",
-                     *       "error_id": 19201,
-                     *       "status": 409,
-                     *       "title": "Command rejected by the axis",
-                     *       "type": "urn:motiond:problem:axis_cannot_be_started"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Invalid parameters (wrong type, unknown field, out of range); no command is kept. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "velocity: must be > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "velocity",
-                     *           "message": "must be > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread or the database is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "command_queue_full",
-                     *       "detail": "the command queue to the cycle thread is full; try again",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:command_queue_full"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["CommandNotFound"];
+            409: components["responses"]["CommandUnknown"];
+            503: components["responses"]["CycleUnavailable"];
         };
     };
     export_config: {
@@ -6147,93 +4895,11 @@ export interface operations {
                     "application/json": components["schemas"]["ConfigDocument"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description No such axis or parameter. */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_found",
-                     *       "detail": "no axis 'z'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:axis_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The axis is not disabled, or the name is taken. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "axis_not_disabled",
-                     *       "detail": "axis 'x' is not disabled: switch it off (DELETE its power command) first",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:axis_not_disabled"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The configuration is invalid; `errors` lists every invalid field. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "dynamics.jerk: must be a finite number > 0",
-                     *       "errors": [
-                     *         {
-                     *           "field": "dynamics.jerk",
-                     *           "message": "must be a finite number > 0"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The database did not accept the write (locked, full, I/O error); nothing was changed. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "storage_unavailable",
-                     *       "detail": "the database did not accept the write: database is locked",
-                     *       "status": 503,
-                     *       "title": "Service unavailable",
-                     *       "type": "urn:motiond:problem:storage_unavailable"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            409: components["responses"]["AxisNotDisabled"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["ImportInvalid"];
+            503: components["responses"]["WriteUnavailable"];
         };
     };
     list_recordings: {
@@ -6280,72 +4946,11 @@ export interface operations {
                     "application/json": components["schemas"]["ScopeRecording"];
                 };
             };
-            /** @description The body is not JSON. */
-            400: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /**
-             * @description The active recordings already use the scope's 8 signals (`scope_channels_busy`), or
-             *     8 recordings are active or their memory is used up (`scope_busy`).
-             */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "scope_channels_busy",
-                     *       "detail": "the scope samples at most 8 signals at once: 7 are in use by active recordings and this one needs 2 more; cancel one or wait until it is done",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:scope_channels_busy"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /**
-             * @description Invalid request; `errors` names every invalid field (`channels[1].axis` for an
-             *     unknown axis, `trigger.pre_trigger_s` …).
-             */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "validation_failed",
-                     *       "detail": "channels[0].axis: no axis 'z'",
-                     *       "errors": [
-                     *         {
-                     *           "field": "channels[0].axis",
-                     *           "message": "no axis 'z'"
-                     *         }
-                     *       ],
-                     *       "status": 422,
-                     *       "title": "Invalid request",
-                     *       "type": "urn:motiond:problem:validation_failed"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description The cycle thread is not available. */
-            503: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            400: components["responses"]["MalformedJson"];
+            409: components["responses"]["ScopeBusy"];
+            413: components["responses"]["PayloadTooLarge"];
+            422: components["responses"]["ScopeInvalid"];
+            503: components["responses"]["ScopeUnavailable"];
         };
     };
     get_recording: {
@@ -6378,51 +4983,10 @@ export interface operations {
                     "text/csv": string;
                 };
             };
-            /** @description No such recording (never made, deleted, or evicted). */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "recording_not_found",
-                     *       "detail": "no recording '7'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:recording_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description CSV of a recording that is not done. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "recording_not_done",
-                     *       "detail": "recording 7 is armed; CSV is available when it is done",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:recording_not_done"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Unknown `format`. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["RecordingNotFound"];
+            409: components["responses"]["RecordingNotDone"];
+            422: components["responses"]["RecordingQueryInvalid"];
+            503: components["responses"]["RecordingUnavailable"];
         };
     };
     delete_recording: {
@@ -6453,51 +5017,7 @@ export interface operations {
                 };
                 content?: never;
             };
-            /** @description No such recording (never made, deleted, or evicted). */
-            404: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "recording_not_found",
-                     *       "detail": "no recording '7'",
-                     *       "status": 404,
-                     *       "title": "Not found",
-                     *       "type": "urn:motiond:problem:recording_not_found"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description CSV of a recording that is not done. */
-            409: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    /**
-                     * @example {
-                     *       "code": "recording_not_done",
-                     *       "detail": "recording 7 is armed; CSV is available when it is done",
-                     *       "status": 409,
-                     *       "title": "Conflict",
-                     *       "type": "urn:motiond:problem:recording_not_done"
-                     *     }
-                     */
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
-            /** @description Unknown `format`. */
-            422: {
-                headers: {
-                    [name: string]: unknown;
-                };
-                content: {
-                    "application/problem+json": components["schemas"]["Problem"];
-                };
-            };
+            404: components["responses"]["RecordingNotFound"];
         };
     };
     system: {
@@ -6536,6 +5056,8 @@ export interface operations {
                 };
                 content?: never;
             };
+            400: components["responses"]["WebsocketHandshakeInvalid"];
+            426: components["responses"]["WebsocketUpgradeRequired"];
         };
     };
     metrics: {
@@ -6553,6 +5075,24 @@ export interface operations {
                     [name: string]: unknown;
                 };
                 content: {
+                    /**
+                     * @example # HELP motiond_cycle_compute_seconds Work per cycle.
+                     *     # TYPE motiond_cycle_compute_seconds histogram
+                     *     motiond_cycle_compute_seconds_bucket{le="6.4e-6"} 2871
+                     *     …
+                     *     motiond_cycle_compute_seconds_bucket{le="+Inf"} 5750
+                     *     motiond_cycle_compute_seconds_sum 0.0522
+                     *     motiond_cycle_compute_seconds_count 5750
+                     *     # HELP motiond_cycles_total Cycles run.
+                     *     # TYPE motiond_cycles_total counter
+                     *     motiond_cycles_total 5750
+                     *     # HELP motiond_cycle_overruns_total Deadlines missed.
+                     *     # TYPE motiond_cycle_overruns_total counter
+                     *     motiond_cycle_overruns_total 14
+                     *     # HELP motiond_axes Configured axes.
+                     *     # TYPE motiond_axes gauge
+                     *     motiond_axes 3
+                     */
                     "text/plain": string;
                 };
             };

@@ -15,6 +15,7 @@ export const SIGNAL_LABEL: Record<Signal, string> = {
   set_velocity: 'set velocity',
   actual_velocity: 'actual velocity',
   set_acceleration: 'set acceleration',
+  actual_acceleration: 'actual acceleration',
   following_error: 'following error',
 };
 
@@ -108,6 +109,7 @@ export function signalUnit(signal: Signal, unit: string): string {
     case 'actual_velocity':
       return `${unit}/s`;
     case 'set_acceleration':
+    case 'actual_acceleration':
       return `${unit}/s²`;
     default:
       return unit;

@@ -419,6 +419,10 @@ pub struct Axis {
     sent_position: f64,
     act_pos: f64,
     act_vel: f64,
+    /// Actual acceleration: the actual velocity differentiated over the cycle.
+    act_acc: f64,
+    /// Feedback has been read once (the first cycle has no velocity to differentiate).
+    fed: bool,
     /// axis position = drive position + offset (MC_SetPosition, homing).
     offset: f64,
     error: ErrorId,
@@ -479,6 +483,8 @@ impl Axis {
             sent_position: 0.0,
             act_pos: 0.0,
             act_vel: 0.0,
+            act_acc: 0.0,
+            fed: false,
             offset: 0.0,
             error: ErrorId(0),
             fault_reset: false,
@@ -962,6 +968,12 @@ impl Axis {
             // Whatever ended a homing run (stop, power off, error, reset) disarms its latch.
             self.latch = None;
         }
+        self.act_acc = if self.fed {
+            (fb.actual_velocity - self.act_vel) / dt
+        } else {
+            0.0
+        };
+        self.fed = true;
         self.act_vel = fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
@@ -1050,6 +1062,7 @@ impl Axis {
         s.set_jerk = set.jerk;
         s.actual_position = self.act_pos;
         s.actual_velocity = self.act_vel;
+        s.actual_acceleration = self.act_acc;
         s.following_error = self.sent_position - self.act_pos;
         let period = p.axis_encoder_modulo_value;
         if self.config.modulo && period > 0.0 {
