@@ -224,8 +224,10 @@ pub struct ParameterInfo {
     /// canonical entry, another number for an alias, 0 for a status entry (no storage).
     pub storage: u16,
     /// Lowest valid value (−∞ when unbounded; serialized as `null` then). 0 for BOOL.
+    #[cfg_attr(feature = "schema", schema(value_type = Option<f64>))]
     pub min: f64,
     /// Highest valid value (+∞ when unbounded; serialized as `null` then). 1 for BOOL.
+    #[cfg_attr(feature = "schema", schema(value_type = Option<f64>))]
     pub max: f64,
     /// `min` itself is not valid: the value must be strictly greater (`> 0`).
     pub min_exclusive: bool,

@@ -1985,12 +1985,12 @@ export interface components {
              * Format: double
              * @description Lowest valid value (−∞ when unbounded; serialized as `null` then). 0 for BOOL.
              */
-            min: number;
+            min?: number | null;
             /**
              * Format: double
              * @description Highest valid value (+∞ when unbounded; serialized as `null` then). 1 for BOOL.
              */
-            max: number;
+            max?: number | null;
             /** @description `min` itself is not valid: the value must be strictly greater (`> 0`). */
             min_exclusive: boolean;
             /**
