@@ -3040,3 +3040,48 @@ fn move_continuous_with_end_velocity_zero_stays_busy_at_the_target() {
     assert!(o.command_aborted && !o.in_end_velocity, "{o:?}");
     r.until(3.0, |r| r.out(m).done);
 }
+
+/// A drive-latch homing run (#1076 = 3, 4, 6, 7) started off the cam never travels against
+/// the search direction, so a blocked direction there (negative limit switch) does not refuse
+/// it; a mode with a sync phase does travel it and is refused, and so is a drive-latch run that
+/// starts on the cam (it leaves the cam backwards first).
+#[test]
+fn homing_is_refused_only_for_a_direction_the_run_will_travel() {
+    use ReferenceMode::*;
+    let home = |r: &mut Rig, mode: ReferenceMode| {
+        r.cmd(
+            0,
+            CommandKind::Home {
+                position: Some(0.0),
+                mode: HomingMode::Default,
+                options: HomingOptions {
+                    reference_mode: Some(mode),
+                    ..HomingOptions::default()
+                },
+            },
+        )
+    };
+    for (mode, start, accepted) in [
+        (HardwareLatchPos, 0.0, true),
+        (SoftDriveLatchNeg, 0.0, true),
+        (HardwareLatchPos, 52.0, false),
+        (HardwareSync, 0.0, false),
+    ] {
+        let mut r = Rig::new(1);
+        r.plants[0].cam = Some((50.0, 55.0));
+        r.plants[0].pos = start;
+        r.power_on(0);
+        r.plants[0].limit_negative = true;
+        r.run(0.01);
+        let (id, verdict) = home(&mut r, mode);
+        assert_eq!(
+            verdict == Verdict::Accepted,
+            accepted,
+            "{mode:?} from {start}: {verdict:?}"
+        );
+        if accepted {
+            r.until(20.0, |r| !r.out(id).busy);
+            assert!(r.out(id).done, "{mode:?}: {:?}", r.out(id));
+        }
+    }
+}

@@ -90,7 +90,11 @@ impl Axis {
                     sync_dir
                 };
                 self.check_feed_enable(search_dir)?;
-                self.check_feed_enable(sync_dir)?;
+                // Only a direction the run will travel must be free: the drive-latch modes go
+                // against the search direction only when they start on the cam.
+                if !is_drive_latch(rm) || self.prev_cam {
+                    self.check_feed_enable(sync_dir)?;
+                }
                 // Spec §5.3.1: with the cam already active at the start, homing begins
                 // directly at phase 3 (leave the cam). The cam as the drive reported it last.
                 let phase = if self.prev_cam {
