@@ -229,10 +229,10 @@ fn write_parameter_is_validated_by_the_kernel() {
         );
         assert_eq!(r.k.parameters(0).unwrap(), &before, "#{number} = {value}");
     }
-    // 3000 (AxisGearRatio) may be written only on a coupled slave.
+    // 3000 (AxisGearRatio) is read-only (MC_GearInDyn changes a ratio, acceleration-limited).
     assert_eq!(
         r.rejected(0, write(3000, 2.0)),
-        ErrorId::COMMAND_NOT_PERMITTED
+        ErrorId::PARAMETER_READ_ONLY
     );
     // Valid writes, BOOL as 0/1, aliases (#2 = #1019) share their storage.
     // AxisVeloMax below the rapid traverse velocity (500) breaks a relation: lower that first.

@@ -703,26 +703,11 @@ impl Axis {
                 Ok(())
             }
             CommandKind::WriteParameter { number, value } => {
-                if number == 3000 {
-                    // AxisGearRatio: read-only in the table (the coupling sets it), but the
-                    // ratio of a coupled slave may be written (spec §5.5.1): only while
-                    // coupled; takes effect without a position jump.
-                    let Some(c) = self.coupling.as_mut() else {
-                        return Err(ErrorId::COMMAND_NOT_PERMITTED);
-                    };
-                    if !value.is_finite() {
-                        return Err(ErrorId::PARAMETER_OUT_OF_RANGE);
-                    }
-                    c.slave_start = self.set.position;
-                    c.master_start = f64::NAN; // re-based on the next step
-                    c.ratio = value;
-                    c.target_ratio = value;
-                    self.config.parameters.set_raw(number, value);
-                } else {
-                    // Checked here as well: a bad value must never reach an axis, whoever
-                    // submits it.
-                    self.config.parameters.write(number, value)?;
-                }
+                // Checked here as well: a bad value must never reach an axis, whoever submits
+                // it. #3000 AxisGearRatio is read-only like in the table: a ratio written
+                // directly would step the slave's velocity; MC_GearInDyn changes it with a
+                // limited acceleration.
+                self.config.parameters.write(number, value)?;
                 emit_once(cmd.id, DONE, slot, cycle, events);
                 Ok(())
             }

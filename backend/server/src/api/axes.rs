@@ -490,8 +490,10 @@ pub async fn write_parameter(
             .execute(&mut *tx)
             .await?;
         store::audit(&mut *tx, &audit).await?;
+        // The kernel checks the value with the same table (it should agree with the checks
+        // above): its refusal is the same 422 with the error number.
         if let Err(e) = s.kernel_command(slot, kind).await? {
-            return Err(ApiError::rejected(e));
+            return Err(invalid(e, e.text().into()));
         }
         tx.commit().await.map_err(|e| {
             tracing::error!(
@@ -504,8 +506,10 @@ pub async fn write_parameter(
             )
         })?;
     } else {
+        // The kernel checks the value with the same table (it should agree with the checks
+        // above): its refusal is the same 422 with the error number.
         if let Err(e) = s.kernel_command(slot, kind).await? {
-            return Err(ApiError::rejected(e));
+            return Err(invalid(e, e.text().into()));
         }
         s.audit(audit);
     }
