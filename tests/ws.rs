@@ -259,8 +259,8 @@ async fn rpc_errors_and_unsubscribe() {
     assert!(next(&mut ws, Duration::from_millis(300)).await.is_none());
 }
 
-async fn socket_jog(ws: &mut Ws, rpc: u64) -> u64 {
-    let params = json!({"axis": "y", "direction": "forward", "deadman_timeout": 0.3});
+async fn socket_jog(ws: &mut Ws, rpc: u64, deadman: f64) -> u64 {
+    let params = json!({"axis": "y", "direction": "forward", "deadman_timeout": deadman});
     send(ws, rpc, "jog", params).await;
     let (r, _) = response(ws, rpc).await;
     assert!(r["error"].is_null(), "{r}");
@@ -276,10 +276,11 @@ async fn a_socket_jog_runs_while_renewed_stops_when_its_client_falls_silent_and_
     const DEADMAN_TIMEOUT: u64 = 0x7061;
     let s = Server::start();
     power_on(&s, "y").await;
-    // Renewed every 100 ms for 1.2 s (four dead-man times): still running.
+    // Renewed every 100 ms for 3 s (three dead-man times of 1 s): still running. (A machine
+    // stalled for the whole second would stop it — as it should.)
     let mut ws = connect(&s).await;
-    let id = socket_jog(&mut ws, 1).await;
-    for k in 0..12u64 {
+    let id = socket_jog(&mut ws, 1, 1.0).await;
+    for k in 0..30u64 {
         send(&mut ws, 10 + k, "keepalive", json!({"command": id})).await;
         let (r, _) = response(&mut ws, 10 + k).await;
         assert!(r["error"].is_null(), "{r}");
@@ -307,10 +308,11 @@ async fn a_socket_jog_runs_while_renewed_stops_when_its_client_falls_silent_and_
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
 
-    // A renewed jog whose socket closes is released: done, not a dead-man error.
-    let id = socket_jog(&mut ws, 2).await;
-    send(&mut ws, 30, "keepalive", json!({"command": id})).await;
-    response(&mut ws, 30).await;
+    // A jog whose socket closes is released: done, not a dead-man error (a dead-man of 5 s
+    // leaves the server ample time to see the close on a busy machine).
+    let id = socket_jog(&mut ws, 2, 5.0).await;
+    send(&mut ws, 50, "keepalive", json!({"command": id})).await;
+    response(&mut ws, 50).await;
     drop(ws);
     let fin = until_final(&s, id, 10).await;
     assert_eq!(fin["state"], "done", "{fin}");
