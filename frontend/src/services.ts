@@ -93,18 +93,37 @@ function syncSubscriptions(): void {
     if (!names.has(name)) {
       sub.off();
       subscribed.delete(name);
-      statuses.get().delete(name);
-      statuses.emit();
     }
   }
+  // Also the values of subscriptions the server ended (axis deleted): no longer an axis.
+  let gone = false;
+  for (const name of statuses.get().keys()) if (!names.has(name)) gone = statuses.get().delete(name) || gone;
+  if (gone) statuses.emit();
   for (const name of trends.keys()) if (!names.has(name)) trends.delete(name);
   for (const name of names) {
     const rate = name === focus ? FOCUS_RATE_HZ : STATUS_RATE_HZ;
     const sub = subscribed.get(name);
     if (sub && sub.rate === rate) continue;
-    const off = live.subscribe<AxisLiveStatus>(`axes/${name}/status`, rate, (v, stale, cycle) => onStatus(name, v, stale, cycle));
-    subscribed.set(name, { rate, off });
+    const entry = { rate, off: () => {} };
+    entry.off = live.subscribe<AxisLiveStatus>(
+      `axes/${name}/status`,
+      rate,
+      (v, stale, cycle) => onStatus(name, v, stale, cycle),
+      () => subscriptionEnded(name, entry),
+    );
+    subscribed.set(name, entry);
   }
+}
+
+/**
+ * The server ended an axis's status subscription: the axis it followed (by id) was deleted or
+ * replaced by an import. Its values stay on screen marked stale (the client has said so);
+ * the axes are read again and the name subscribed anew if an axis has it now (possibly
+ * another axis: its first update is a full object).
+ */
+function subscriptionEnded(name: string, entry: { rate: number; off: () => void }): void {
+  if (subscribed.get(name) === entry) subscribed.delete(name);
+  void refreshAxes();
 }
 
 export function setFocus(name: string | null): void {
@@ -113,9 +132,16 @@ export function setFocus(name: string | null): void {
   syncSubscriptions();
 }
 
+let axesAsked = 0;
+let axesApplied = 0;
+
 export async function refreshAxes(): Promise<void> {
+  const n = ++axesAsked;
   try {
     const list = await get<AxisResource[]>('/axes');
+    // An answer older than one already applied (requests overlap) would bring back the past.
+    if (n < axesApplied) return;
+    axesApplied = n;
     list.sort((a, b) => a.id - b.id);
     const old = axes.get();
     if (JSON.stringify(old) !== JSON.stringify(list)) axes.set(list);

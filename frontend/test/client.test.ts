@@ -164,6 +164,62 @@ describe('LiveClient', () => {
     expect(FakeSocket.all.at(-1)!.methods()).toEqual([]);
   });
 
+  it('subscription_ended: the values turn stale, the topic is dropped (not re-sent) and onEnded is told', () => {
+    const c = client();
+    const seen: any[] = [];
+    const ended: string[] = [];
+    const others: any[] = [];
+    c.on('subscription_ended', (p) => others.push(p));
+    const offX = c.subscribe<any>('axes/x/status', 25, (v, stale, cycle) => seen.push({ v, stale, cycle }), (reason) => ended.push(reason));
+    c.subscribe<any>('axes/y/status', 25, () => {}, () => ended.push('y'));
+    c.start();
+    const ws = FakeSocket.all[0];
+    ws.open();
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'axes/x/status', cycle: 7, full: true, data: { p: 1 } } });
+    ws.push({ jsonrpc: '2.0', method: 'subscription_ended', params: { topic: 'axes/x/status', reason: 'axis_removed' } });
+    expect(seen.at(-1)).toEqual({ v: { p: 1 }, stale: true, cycle: 7 });
+    expect(ended).toEqual(['axis_removed']);
+    expect(others).toEqual([{ topic: 'axes/x/status', reason: 'axis_removed' }]);
+    // nothing of the ended subscription is applied any more, not even a full object
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'axes/x/status', cycle: 8, full: true, data: { p: 2 } } });
+    expect(seen.length).toBe(2);
+    // an unknown topic or a repeated notification changes nothing
+    ws.push({ jsonrpc: '2.0', method: 'subscription_ended', params: { topic: 'axes/x/status', reason: 'axis_removed' } });
+    ws.push({ jsonrpc: '2.0', method: 'subscription_ended', params: { topic: 'axes/z/status', reason: 'axis_removed' } });
+    expect(ended).toEqual(['axis_removed']);
+    // the old unsubscribe function is now a no-op (the server has forgotten the topic)
+    offX();
+    expect(ws.methods()).not.toContain('unsubscribe');
+    // on reconnection only the topics still subscribed are sent
+    ws.serverClose();
+    vi.advanceTimersByTime(10000);
+    const ws2 = FakeSocket.all.at(-1)!;
+    ws2.open();
+    expect(ws2.sent.filter((m) => m.method === 'subscribe').map((m) => m.params.topic)).toEqual(['axes/y/status']);
+  });
+
+  it('after subscription_ended the same name can be subscribed again; its first full object is taken', () => {
+    const c = client();
+    const seen: any[] = [];
+    const onChange = (v: any, stale: boolean, cycle: number) => seen.push({ v, stale, cycle });
+    let off = c.subscribe<any>('axes/x/status', 25, onChange, () => {
+      off = c.subscribe<any>('axes/x/status', 25, onChange);
+    });
+    c.start();
+    const ws = FakeSocket.all[0];
+    ws.open();
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'axes/x/status', cycle: 50, full: true, data: { p: 1, q: 1 } } });
+    ws.push({ jsonrpc: '2.0', method: 'subscription_ended', params: { topic: 'axes/x/status', reason: 'axis_removed' } });
+    expect(ws.sent.filter((m) => m.method === 'subscribe').length).toBe(2);
+    // a delta before the new full object has no base
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'axes/x/status', cycle: 51, full: false, data: { p: 9 } } });
+    expect(seen.at(-1)).toEqual({ v: { p: 1, q: 1 }, stale: true, cycle: 50 });
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'axes/x/status', cycle: 52, full: true, data: { p: 3, q: 4 } } });
+    expect(seen.at(-1)).toEqual({ v: { p: 3, q: 4 }, stale: false, cycle: 52 });
+    off();
+    expect(ws.methods().at(-1)).toBe('unsubscribe');
+  });
+
   it('passes notifications to handlers', () => {
     const c = client();
     const events: any[] = [];

@@ -1,8 +1,9 @@
 // services.ts against a fetch double: the held MC_Stop is asked of the server at click time;
 // the following-error peak hold is the server's (reset by its endpoint); the status stream
-// feeds each axis's trend buffer.
+// feeds each axis's trend buffer; a subscription the server ends (axis deleted or replaced by
+// an import) turns stale and is taken up again by name when an axis still has it.
 import { afterEach, describe, expect, it, vi } from 'vitest';
-import { findHeldStop, live, refreshAxes, resetFollowingErrorPeak, statuses, trendOf } from '../src/services';
+import { axes, findHeldStop, live, refreshAxes, resetFollowingErrorPeak, statuses, trendOf } from '../src/services';
 import type { CommandResource } from '../src/api/types';
 
 const cmd = (id: number, command: string, state: CommandResource['state'], final: boolean, parameters: object = {}, axis = 'x') =>
@@ -74,5 +75,47 @@ describe('status stream', () => {
     (live as unknown as { lost(r: string): void }).lost('test');
     expect(t.broken).toBe(true);
     expect(statuses.get().get('tx')!.stale).toBe(true);
+  });
+});
+
+describe('a subscription the server ends', () => {
+  const topic = 'axes/rx/status';
+  const notify = (method: string, params: object) => (live as unknown as { onMessage(t: string): void }).onMessage(JSON.stringify({ jsonrpc: '2.0', method, params }));
+  const subscribedTopics = () => [...(live as unknown as { subs: Map<string, unknown> }).subs.keys()].filter((t) => t.startsWith('axes/'));
+  const axis = (id: number, name = 'rx') => ({ id, state: 'standstill', config: { name, unit: 'mm' } });
+  const status = (v: number) => ({ set_velocity: v, actual_velocity: v, following_error: 0, set_position: v });
+
+  it('replaced by an import: stale at once, the axes read again, subscribed anew by name, live on the new full object', async () => {
+    serve((u) => (u.endsWith('/axes') ? [axis(1)] : []));
+    await refreshAxes();
+    expect(subscribedTopics()).toEqual([topic]);
+    notify('update', { topic, cycle: 100, full: true, data: status(5) });
+    expect(statuses.get().get('rx')).toMatchObject({ stale: false, status: { set_velocity: 5 } });
+
+    // PUT /config: the same name, a new id
+    serve((u) => (u.endsWith('/axes') ? [axis(9)] : []));
+    notify('subscription_ended', { topic, reason: 'axis_removed' });
+    // the frozen values are not shown as live
+    expect(statuses.get().get('rx')).toMatchObject({ stale: true, status: { set_velocity: 5 } });
+    await vi.waitFor(() => expect(asked).toEqual(['GET /api/v1/axes']));
+    await vi.waitFor(() => expect(axes.get().map((a) => a.id)).toEqual([9]));
+    expect(subscribedTopics()).toEqual([topic]);
+    // the new subscription's changes need its full object first
+    notify('update', { topic, cycle: 130, full: false, data: { set_velocity: 7 } });
+    expect(statuses.get().get('rx')).toMatchObject({ stale: true, status: { set_velocity: 5 } });
+    notify('update', { topic, cycle: 131, full: true, data: status(0) });
+    expect(statuses.get().get('rx')).toMatchObject({ stale: false, cycle: 131, status: { set_velocity: 0 } });
+  });
+
+  it('deleted: its values and subscription go once the axes say so', async () => {
+    serve((u) => (u.endsWith('/axes') ? [axis(9)] : []));
+    await refreshAxes();
+    notify('update', { topic, cycle: 200, full: true, data: status(1) });
+    serve((u) => (u.endsWith('/axes') ? [] : []));
+    notify('subscription_ended', { topic, reason: 'axis_removed' });
+    expect(statuses.get().get('rx')?.stale).toBe(true);
+    await vi.waitFor(() => expect(statuses.get().has('rx')).toBe(false));
+    expect(asked).toEqual(['GET /api/v1/axes']);
+    expect(subscribedTopics()).toEqual([]);
   });
 });

@@ -277,7 +277,21 @@ describe('commissioning UI', () => {
     await page.waitForSelector('[data-testid="override-power"]:has-text("50 %")', { timeout: 10000 });
     await sleep(300);
     assert.equal(await page.inputValue('input[name="override"]'), '30');
-    await page.click('button[name="power-set"]'); // the UI's power sends override 100
+    // the UI's power keeps that override: enabling never changes the speed
+    const powerSent = page.waitForRequest((r) => r.method() === 'POST' && r.url().endsWith(`/axes/${AXIS}/power`));
+    const powerDone = page.waitForResponse((r) => r.request().method() === 'POST' && r.url().endsWith(`/axes/${AXIS}/power`));
+    await page.click('button[name="power-set"]');
+    assert.equal((await powerSent).postDataJSON().override_percent, 50);
+    const done = await powerDone;
+    assert.equal(done.status(), 202);
+    const { id } = await done.json();
+    await until(async () => (await rest(stack.api, 'GET', `/commands/${id}`)).body?.outputs?.status === true, { what: 'the UI’s power to be on' });
+    const kept = await status(stack.api, AXIS);
+    assert.equal(kept.power_override_percent, 50);
+    assert.equal(kept.override_percent, 15);
+    await page.waitForSelector('[data-testid="override-power"]:has-text("50 %")', { timeout: 10000 });
+    // back to 100 % by the other client's power, and the slider
+    await rest(stack.api, 'POST', `/axes/${AXIS}/power`, { override_percent: 100 });
     await page.click('.override button:has-text("100")');
     await until(async () => (await status(stack.api, AXIS)).override_percent === 100, { what: 'override 100 % again' });
     await page.waitForSelector('[data-testid="override-power"]', { state: 'detached', timeout: 10000 });

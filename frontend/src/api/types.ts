@@ -39,3 +39,13 @@ export interface CommandEvent {
   final: boolean;
   outputs: FbOutputs;
 }
+
+/**
+ * A `subscription_ended` notification: the server ended an axis topic's subscription because
+ * the axis it followed (by id) is gone — deleted, or replaced by an import (`PUT /config`
+ * gives new ids). Nothing more comes for the topic until it is subscribed again.
+ */
+export interface SubscriptionEnded {
+  topic: string;
+  reason: 'axis_removed';
+}

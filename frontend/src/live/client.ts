@@ -1,7 +1,7 @@
 // The websocket client: JSON-RPC 2.0 over /api/v1/ws with reconnect and backoff,
 // subscriptions that are re-sent on every (re)connection, and merged topic values.
 import { Store } from '../store';
-import type { Problem } from '../api/types';
+import type { Problem, SubscriptionEnded } from '../api/types';
 import { fieldErrors } from '../api/rest';
 import { DeltaMerger, type Update } from './merge';
 
@@ -41,6 +41,8 @@ export interface Subscription<T extends object> {
   readonly merger: DeltaMerger<T>;
   rateHz: number;
   onChange: (value: T | null, stale: boolean, cycle: number) => void;
+  /** The server ended the subscription (`subscription_ended`); the client has dropped it. */
+  onEnded?: (reason: string) => void;
 }
 
 type WsLike = Pick<WebSocket, 'send' | 'close' | 'readyState'> & {
@@ -182,9 +184,25 @@ export class LiveClient {
         const u = msg.params as Update<object> & { topic: string };
         const s = this.subs.get(u.topic);
         if (s && s.merger.apply(u)) s.onChange(s.merger.value, false, s.merger.cycle);
+      } else if (msg.method === 'subscription_ended') {
+        this.ended(msg.params as SubscriptionEnded);
       }
       this.notificationHandlers.get(msg.method)?.forEach((h) => h(msg.params));
     }
+  }
+
+  /**
+   * The server ended a subscription (its axis was deleted or replaced): the last value stays,
+   * marked stale, and the topic is no longer re-sent on reconnection; `onEnded` decides
+   * whether to subscribe again.
+   */
+  private ended(p: SubscriptionEnded): void {
+    const s = p && typeof p.topic === 'string' ? this.subs.get(p.topic) : undefined;
+    if (!s) return;
+    this.subs.delete(p.topic);
+    s.merger.reset();
+    s.onChange(s.merger.value, true, s.merger.cycle);
+    s.onEnded?.(p.reason);
   }
 
   /** A JSON-RPC call; rejects with RpcError (the problem+json in `problem`). */
@@ -210,16 +228,20 @@ export class LiveClient {
     });
   }
 
-  /** Subscribes to a topic (kept across reconnections); returns the unsubscribe function. */
+  /**
+   * Subscribes to a topic (kept across reconnections until unsubscribed or ended by the
+   * server, then `onEnded` is called); returns the unsubscribe function.
+   */
   subscribe<T extends object>(
     topic: string,
     rateHz: number,
     onChange: (value: T | null, stale: boolean, cycle: number) => void,
+    onEnded?: (reason: string) => void,
   ): () => void {
     const existing = this.subs.get(topic);
     const s: Subscription<T> = existing
-      ? Object.assign(existing as unknown as Subscription<T>, { rateHz, onChange })
-      : { topic, rateHz, onChange, merger: new DeltaMerger<T>() };
+      ? Object.assign(existing as unknown as Subscription<T>, { rateHz, onChange, onEnded })
+      : { topic, rateHz, onChange, onEnded, merger: new DeltaMerger<T>() };
     this.subs.set(topic, s as unknown as Subscription<object>);
     if (this.connected) this.sendSubscribe(s as unknown as Subscription<object>, false);
     return () => {

@@ -88,9 +88,11 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
           {resetError && <span class="small">{resetError}</span>}
         </div>
       )}
-      {tab === 'online' && <OnlineTab axis={a} />}
-      {tab === 'parameters' && <ParametersTab axis={a} />}
-      {tab === 'config' && <AxisConfigPage axis={a} />}
+      {/* Keyed by the axis's id: another axis (or one replaced under the same name by an
+          import) starts with fresh state, never the previous axis's inputs or parameters. */}
+      {tab === 'online' && <OnlineTab key={a.id} axis={a} />}
+      {tab === 'parameters' && <ParametersTab key={a.id} axis={a} />}
+      {tab === 'config' && <AxisConfigPage key={a.id} axis={a} />}
     </div>
   );
 }

@@ -3,20 +3,24 @@ import { useEffect, useState } from 'preact/hooks';
 import { get, enc } from '../api/rest';
 import type { ParameterResource } from '../api/types';
 
-/** The axis's parameters by number; null until they have loaded. */
-export function useParameters(axis: string, version = 0): Map<number, ParameterResource> | null {
-  const [map, setMap] = useState<Map<number, ParameterResource> | null>(null);
+/**
+ * The axis's parameters by number; null until those of this axis (name and id: an import can
+ * put another axis under the same name) have loaded, never another axis's meanwhile.
+ */
+export function useParameters(axis: string, id: number, version = 0): Map<number, ParameterResource> | null {
+  const key = `${id}/${axis}`;
+  const [loaded, setLoaded] = useState<{ key: string; map: Map<number, ParameterResource> } | null>(null);
   useEffect(() => {
     let gone = false;
     get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(
-      (list) => !gone && setMap(new Map(list.map((p) => [p.number, p]))),
+      (list) => !gone && setLoaded({ key, map: new Map(list.map((p) => [p.number, p])) }),
       () => {},
     );
     return () => {
       gone = true;
     };
-  }, [axis, version]);
-  return map;
+  }, [key, version]);
+  return loaded?.key === key ? loaded.map : null;
 }
 
 /** A numeric parameter's value, null when unknown (not loaded, no such parameter). */

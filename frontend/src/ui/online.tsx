@@ -5,7 +5,7 @@ import { useStore } from '../store';
 import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses } from '../services';
 import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { acc, pos, vel, num, inputNum } from '../format';
-import type { AxisResource, Direction, HomingMode } from '../api/types';
+import type { AxisLiveStatus, AxisResource, Direction, HomingMode } from '../api/types';
 import { JogButtons, type JogButtonDef } from './jog-buttons';
 import { CommandLog } from './command-log';
 import { OverrideControl } from './override';
@@ -42,6 +42,13 @@ const MODULO_DIRECTIONS: [Direction, string][] = [
   ['current_direction', 'current direction'],
 ];
 
+/**
+ * The override to send with MC_Power: the one the axis has now (possibly another client's),
+ * so enabling never changes the speed; 100 % only while the status is unknown.
+ */
+export const powerOverride = (s: Pick<AxisLiveStatus, 'power_override_percent'> | null | undefined): number =>
+  typeof s?.power_override_percent === 'number' && Number.isFinite(s.power_override_percent) ? s.power_override_percent : 100;
+
 /** " (F6)" for titles. */
 const fk = (a: FunctionAction) => ` (${keyOf(a)})`;
 
@@ -53,7 +60,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const liveStatus = st.get(axis);
   const s = liveStatus?.status ?? null;
   const offline = !online;
-  const params = useParameters(axis);
+  const params = useParameters(axis, a.id);
   const [error, setError] = useState<string | null>(null);
 
   // --- enable -------------------------------------------------------------------------
@@ -291,15 +298,15 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
                 kind="primary"
                 name="power-set"
                 disabled={offline}
-                title="MC_Power with these enables"
-                onClick={() => run('power', { enable: ctrl, enable_positive: feedPos, enable_negative: feedNeg, override_percent: 100 })}
+                title="MC_Power with these enables (its override stays as the axis has it)"
+                onClick={() => run('power', { enable: ctrl, enable_positive: feedPos, enable_negative: feedNeg, override_percent: powerOverride(s) })}
               >
                 Set
               </ActionButton>
               <ActionButton
                 name="power-off"
                 disabled={offline}
-                onClick={() => run('power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 })}
+                onClick={() => run('power', { enable: false, enable_positive: false, enable_negative: false, override_percent: powerOverride(s) })}
               >
                 Disable
               </ActionButton>
