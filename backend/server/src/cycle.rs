@@ -134,17 +134,15 @@ impl Shared {
 
     /// Queues a request that never expires (nobody waits for it, or a test steps the cycle).
     pub fn push(&self, request: Request) -> Result<(), Request> {
-        self.requests
-            .push(Queued {
-                request,
-                expires_ns: 0,
-            })
-            .map_err(|q| q.request)
+        self.enqueue(request, 0)
     }
 
     /// Queues a request that is dropped undone unless the cycle thread takes it within `ttl`.
     pub fn push_expiring(&self, request: Request, ttl: std::time::Duration) -> Result<(), Request> {
-        let expires_ns = now_ns() + ttl.as_nanos() as u64;
+        self.enqueue(request, now_ns() + ttl.as_nanos() as u64)
+    }
+
+    fn enqueue(&self, request: Request, expires_ns: u64) -> Result<(), Request> {
         self.requests
             .push(Queued {
                 request,

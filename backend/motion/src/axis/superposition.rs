@@ -180,12 +180,7 @@ impl Axis {
     pub(super) fn end_superposition_incomplete(&mut self, cycle: u64, events: &mut impl EventSink) {
         let slot = self.slot;
         if let Some(sp) = self.superimposed.as_mut() {
-            let out = FbOutputs {
-                warning: true,
-                warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
-                ..sp.cmd.out
-            };
-            sp.cmd.emit(out, slot, cycle, events);
+            warn_incomplete(sp, slot, cycle, events);
         }
         self.end_superposition(End::Done, cycle, events);
     }
@@ -278,12 +273,7 @@ impl Axis {
         }
         if room != to_come {
             sp.distance = sp.applied + room;
-            let out = FbOutputs {
-                warning: true,
-                warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
-                ..sp.cmd.out
-            };
-            sp.cmd.emit(out, self.slot, cycle, events);
+            warn_incomplete(&mut sp, self.slot, cycle, events);
         }
         if moved != 0.0 {
             sp.last_direction = moved.signum();
@@ -352,4 +342,14 @@ impl Axis {
             self.superimposed = None;
         }
     }
+}
+
+/// Warning 0x4243 on a running superposition: it does less than asked.
+fn warn_incomplete(sp: &mut Superimposed, slot: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+    let out = FbOutputs {
+        warning: true,
+        warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
+        ..sp.cmd.out
+    };
+    sp.cmd.emit(out, slot, cycle, events);
 }

@@ -761,8 +761,9 @@ pub async fn import_config(
         }
     }
     if let Some(e) = failed {
-        // A slot whose insert failed may hold nothing: removing it is harmless.
-        for slot in 0..=entries.len().min(doc.axes.len().saturating_sub(1)) {
+        // The old axes are out; a slot whose insert failed or never came holds nothing, and
+        // removing nothing is harmless.
+        for slot in 0..doc.axes.len() {
             let _ = s.uninstall_axis(slot as u16, false).await;
         }
         restore(removed).await;

@@ -406,18 +406,19 @@ fn handle(
                 _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
             };
             // The REST query's rules (`?wait=true&timeout_ms=N`), from the params.
-            let query = match (params.remove("wait"), params.remove("timeout_ms")) {
-                (w @ (None | Some(Value::Bool(_))), t @ (None | Some(Value::Number(_))))
-                    if t.as_ref().is_none_or(|t| t.as_u64().is_some()) =>
-                {
-                    super::WaitQuery {
-                        wait: w.and_then(|w| w.as_bool()).unwrap_or(false),
-                        timeout_ms: t.and_then(|t| t.as_u64()),
-                    }
-                }
-                _ => {
-                    let msg = "wait must be true or false, timeout_ms a whole number of ms";
-                    return Some(rpc_error(&id, -32602, msg, None));
+            let query: Map<String, Value> = ["wait", "timeout_ms"]
+                .into_iter()
+                .filter_map(|k| params.remove(k).map(|v| (k.to_owned(), v)))
+                .collect();
+            let query: super::WaitQuery = match serde_json::from_value(Value::Object(query)) {
+                Ok(q) => q,
+                Err(e) => {
+                    return Some(rpc_error(
+                        &id,
+                        -32602,
+                        &format!("wait/timeout_ms: {e}"),
+                        None,
+                    ));
                 }
             };
             let wait = match super::commands::wait_duration(&query) {
