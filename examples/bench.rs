@@ -26,7 +26,13 @@ async fn rtt(base: &str, n: usize) {
         let body =
             json!({"position": if i % 2 == 0 { 50.0 } else { 0.0 }, "velocity": 100.0}).to_string();
         let t = Instant::now();
-        let r = client.post(&url).body(body).send().await.expect("POST");
+        let r = client
+            .post(&url)
+            .header("content-type", "application/json")
+            .body(body)
+            .send()
+            .await
+            .expect("POST");
         let status = r.status().as_u16();
         let _ = r.bytes().await;
         let us = t.elapsed().as_micros() as u64;

@@ -137,14 +137,17 @@ export async function startStack({ noDemo = true } = {}) {
   }
 }
 
-/** Headless Debian Chromium with a fresh user-data-dir (never a downloaded browser). */
-export async function launch({ width = 1280, height = 800 } = {}) {
+/**
+ * Headless Debian Chromium with a fresh user-data-dir (never a downloaded browser); `args` are
+ * added to the usual ones (e.g. `--host-resolver-rules=…`).
+ */
+export async function launch({ width = 1280, height = 800, args = [] } = {}) {
   const profile = mkdtempSync(join(tmpdir(), 'motiond-e2e-chromium-'));
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: CHROMIUM,
     headless: true,
     viewport: { width, height },
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync', ...args],
   });
   const close = async () => {
     await context.close().catch(() => {});
@@ -160,11 +163,11 @@ export async function shot(page, name) {
   return path;
 }
 
-/** REST helper against motiond. */
+/** REST helper against motiond (anything but a GET is declared JSON, as motiond requires). */
 export async function rest(api, method, path, body) {
   const r = await fetch(`${api}/api/v1${path}`, {
     method,
-    headers: body === undefined ? {} : { 'content-type': 'application/json' },
+    headers: method === 'GET' ? {} : { 'content-type': 'application/json' },
     body: body === undefined ? undefined : JSON.stringify(body),
   });
   const text = await r.text();

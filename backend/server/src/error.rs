@@ -80,6 +80,33 @@ impl ApiError {
             format!("{path} does not take {method}; the Allow header lists the methods it takes"),
         )
     }
+    /// A state-changing request from another web origin (`Origin`, `Sec-Fetch-Site`).
+    pub fn cross_origin(detail: impl Into<String>) -> Self {
+        Self::new(
+            StatusCode::FORBIDDEN,
+            "cross_origin_forbidden",
+            "Cross-origin request refused",
+            detail,
+        )
+    }
+    /// A state-changing request whose body is not declared `application/json`.
+    pub fn unsupported_media_type(detail: impl Into<String>) -> Self {
+        Self::new(
+            StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            "unsupported_media_type",
+            "Unsupported media type",
+            detail,
+        )
+    }
+    /// A request for a host name motiond does not serve (DNS rebinding).
+    pub fn misdirected(detail: impl Into<String>) -> Self {
+        Self::new(
+            StatusCode::MISDIRECTED_REQUEST,
+            "misdirected_request",
+            "Misdirected request",
+            detail,
+        )
+    }
     pub fn invalid(errors: Vec<FieldError>) -> Self {
         let detail = errors
             .iter()

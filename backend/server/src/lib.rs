@@ -53,9 +53,20 @@ pub enum Cmd {
 /// `motiond serve --db m.db` mean the same (a systemd unit may write either).
 #[derive(clap::Args, Debug, Clone)]
 pub struct ServeArgs {
-    /// Address to listen on. Only loopback addresses are allowed until authentication exists.
-    #[arg(long, global = true, default_value = "127.0.0.1:8080")]
+    /// Address to listen on: an IP address or `localhost` (bound to its loopback address), and a
+    /// port. Only loopback addresses are allowed until authentication exists.
+    #[arg(long, global = true, default_value = "127.0.0.1:8080", value_parser = parse_listen)]
     pub listen: SocketAddr,
+    /// A host name (or address) motiond answers to besides loopback names and addresses, e.g.
+    /// the name a reverse proxy forwards; any other `Host` is refused with 421 (DNS
+    /// rebinding). Repeatable.
+    #[arg(long = "public-name", global = true, value_name = "NAME", value_parser = api::guard::parse_public_name)]
+    pub public_names: Vec<String>,
+    /// A foreign web origin (`http://localhost:5173`) whose pages may change things here
+    /// (commands, parameters, configuration, the websocket); other origins are refused with
+    /// 403. Repeatable.
+    #[arg(long = "allow-origin", global = true, value_name = "ORIGIN", value_parser = api::guard::parse_allow_origin)]
+    pub allowed_origins: Vec<String>,
     /// SQLite database file (`:memory:` for a throw-away one).
     #[arg(long, global = true, default_value = "./motiond.db")]
     pub db: String,
@@ -69,6 +80,29 @@ pub struct ServeArgs {
     /// directory, else the one of the source tree motiond was built from].
     #[arg(long, global = true, value_name = "PATH")]
     pub ui_dir: Option<std::path::PathBuf>,
+}
+
+/// `--listen`: `IP:PORT`, `[IPv6]:PORT` or `localhost:PORT` (resolved, its loopback address
+/// taken, IPv4 first).
+fn parse_listen(s: &str) -> Result<SocketAddr, String> {
+    if let Ok(a) = s.parse() {
+        return Ok(a);
+    }
+    let bad = || format!("{s:?} is not IP:PORT or localhost:PORT");
+    let (host, port) = s.rsplit_once(':').ok_or_else(bad)?;
+    let port: u16 = port.parse().map_err(|_| bad())?;
+    if !host.eq_ignore_ascii_case("localhost") {
+        return Err(bad());
+    }
+    let mut addrs: Vec<SocketAddr> = std::net::ToSocketAddrs::to_socket_addrs(&(host, port))
+        .map_err(|e| format!("cannot resolve {host}: {e}"))?
+        .filter(|a| a.ip().is_loopback())
+        .collect();
+    addrs.sort_by_key(|a| !a.is_ipv4());
+    addrs
+        .first()
+        .copied()
+        .ok_or_else(|| format!("{host} does not resolve to a loopback address"))
 }
 
 /// Entry point of the `motiond` binary.
@@ -263,7 +297,21 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot listen on {}: {e}", args.listen))?;
     let local = listener.local_addr().map_err(|e| e.to_string())?;
     tracing::info!("listening on http://{local} (UI /, API /api/v1, docs /docs)");
-    let app = api::router(state.clone()).into_make_service_with_connect_info::<SocketAddr>();
+    let guard = api::guard::Guard {
+        public_names: args.public_names.clone(),
+        allowed_origins: args.allowed_origins.clone(),
+    };
+    if !guard.public_names.is_empty() {
+        tracing::info!("also serving the names {}", guard.public_names.join(", "));
+    }
+    if !guard.allowed_origins.is_empty() {
+        tracing::info!(
+            "pages of {} may change things here",
+            guard.allowed_origins.join(", ")
+        );
+    }
+    let app = api::router(state.clone(), Arc::new(guard))
+        .into_make_service_with_connect_info::<SocketAddr>();
     let (stopping_tx, mut stopping) = tokio::sync::watch::channel(false);
     let server = axum::serve(listener, app).with_graceful_shutdown(async move {
         shutdown_signal().await;

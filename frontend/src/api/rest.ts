@@ -49,12 +49,22 @@ export function url(path: string): string {
   return path.startsWith('/api/') || path.startsWith('/openapi') ? path : BASE + path;
 }
 
+/**
+ * Every request that changes something (POST, PUT, DELETE …) is declared JSON, also one without
+ * a body: motiond refuses anything else with 415, because a page of another site may send
+ * other types to it without asking the browser first (docs/security.md).
+ */
+export function headers(method: string): Record<string, string> {
+  const safe = ['GET', 'HEAD', 'OPTIONS'].includes(method.toUpperCase());
+  return safe ? { 'X-Client-Id': 'motiond-ui' } : { 'Content-Type': 'application/json', 'X-Client-Id': 'motiond-ui' };
+}
+
 export async function api<T>(method: string, path: string, body?: unknown): Promise<T> {
   let res: Response;
   try {
     res = await fetch(url(path), {
       method,
-      headers: body === undefined ? { 'X-Client-Id': 'motiond-ui' } : { 'Content-Type': 'application/json', 'X-Client-Id': 'motiond-ui' },
+      headers: headers(method),
       body: body === undefined ? undefined : JSON.stringify(body),
     });
   } catch (e) {

@@ -3076,6 +3076,20 @@ export interface components {
             };
         };
         /**
+         * @description A request that changes something (or a websocket upgrade) from another web origin:
+         *     `Origin` is neither this server's own (the request's `Host`) nor allowed with
+         *     `--allow-origin`, or `Sec-Fetch-Site` is neither `same-origin` nor `none`. Nothing was
+         *     done.
+         */
+        CrossOriginForbidden: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
          * @description The cycle thread did not take the request (`command_queue_full`: try again) or did not
          *     answer (`cycle_unavailable`).
          */
@@ -3148,6 +3162,27 @@ export interface components {
                  *       "status": 400,
                  *       "title": "Malformed JSON",
                  *       "type": "urn:motiond:problem:malformed_json"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description `Host` is not a name this server serves (loopback names and addresses, `--public-name`):
+         *     a page of another site whose name resolves to this machine (DNS rebinding). Any request.
+         */
+        MisdirectedRequest: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "misdirected_request",
+                 *       "detail": "this server does not serve the host \"attacker.example:8080\": it answers to loopback names and addresses (localhost, 127.0.0.1, [::1]) and to the names given with --public-name",
+                 *       "status": 421,
+                 *       "title": "Misdirected request",
+                 *       "type": "urn:motiond:problem:misdirected_request"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -3349,6 +3384,27 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
+        /**
+         * @description The request is not declared `Content-Type: application/json`, which every POST, PUT,
+         *     PATCH and DELETE must be, also one without a body. Nothing was done.
+         */
+        UnsupportedMediaType: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "unsupported_media_type",
+                 *       "detail": "Content-Type \"text/plain\" is not application/json: every POST, PUT, PATCH and DELETE must be sent as Content-Type: application/json, also without a body (curl: --json '{…}' or -H 'Content-Type: application/json')",
+                 *       "status": 415,
+                 *       "title": "Unsupported media type",
+                 *       "type": "urn:motiond:problem:unsupported_media_type"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
         /** @description An upgrade request to the websocket without a `Sec-WebSocket-Key`. */
         WebsocketHandshakeInvalid: {
             headers: {
@@ -3438,6 +3494,7 @@ export interface operations {
                     "application/json": components["schemas"]["AuditRecord"][];
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["AuditInvalid"];
             503: components["responses"]["AuditUnavailable"];
         };
@@ -3460,6 +3517,7 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"][];
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     create_axis: {
@@ -3487,8 +3545,11 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             409: components["responses"]["AxisCreateConflict"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ConfigInvalid"];
             503: components["responses"]["WriteUnavailable"];
         };
@@ -3518,6 +3579,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     replace_axis: {
@@ -3549,9 +3611,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["AxisReplaceConflict"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ConfigInvalid"];
             503: components["responses"]["WriteUnavailable"];
         };
@@ -3578,8 +3643,11 @@ export interface operations {
                 };
                 content?: never;
             };
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["AxisNotDisabled"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             503: components["responses"]["WriteUnavailable"];
         };
     };
@@ -3625,9 +3693,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3674,9 +3745,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3723,9 +3797,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3772,9 +3849,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3821,9 +3901,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3870,9 +3953,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3919,9 +4005,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -3968,9 +4057,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4017,9 +4109,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4066,9 +4161,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4115,9 +4213,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4164,9 +4265,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4213,9 +4317,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4262,9 +4369,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4311,9 +4421,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4343,6 +4456,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     get_parameter: {
@@ -4375,6 +4489,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["AxisOrParameterNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     write_parameter: {
@@ -4411,8 +4526,11 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisOrParameterNotFound"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ParameterInvalid"];
             503: components["responses"]["ParameterWriteUnavailable"];
         };
@@ -4459,9 +4577,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4508,9 +4629,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4557,9 +4681,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4606,9 +4733,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4640,8 +4770,11 @@ export interface operations {
                 content?: never;
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["FaultInvalid"];
             503: components["responses"]["CycleUnavailable"];
         };
@@ -4671,6 +4804,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     reset_following_error_peak: {
@@ -4697,7 +4831,10 @@ export interface operations {
                     "application/json": components["schemas"]["PeakResetResource"];
                 };
             };
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -4743,9 +4880,12 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
         };
@@ -4776,6 +4916,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["QueryInvalid"];
         };
     };
@@ -4801,6 +4942,7 @@ export interface operations {
                 };
             };
             404: components["responses"]["CommandNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     release_command: {
@@ -4824,8 +4966,11 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -4848,8 +4993,11 @@ export interface operations {
                 };
                 content?: never;
             };
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -4871,6 +5019,7 @@ export interface operations {
                     "application/json": components["schemas"]["ConfigDocument"];
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     import_config: {
@@ -4896,8 +5045,11 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             409: components["responses"]["AxisNotDisabled"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ImportInvalid"];
             503: components["responses"]["WriteUnavailable"];
         };
@@ -4920,6 +5072,7 @@ export interface operations {
                     "application/json": components["schemas"]["ScopeRecording"][];
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     create_recording: {
@@ -4947,8 +5100,11 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
             409: components["responses"]["ScopeBusy"];
             413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ScopeInvalid"];
             503: components["responses"]["ScopeUnavailable"];
         };
@@ -4985,6 +5141,7 @@ export interface operations {
             };
             404: components["responses"]["RecordingNotFound"];
             409: components["responses"]["RecordingNotDone"];
+            421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["RecordingQueryInvalid"];
             503: components["responses"]["RecordingUnavailable"];
         };
@@ -5017,7 +5174,10 @@ export interface operations {
                 };
                 content?: never;
             };
+            403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["RecordingNotFound"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     system: {
@@ -5038,6 +5198,7 @@ export interface operations {
                     "application/json": components["schemas"]["SystemResource"];
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     upgrade: {
@@ -5057,6 +5218,8 @@ export interface operations {
                 content?: never;
             };
             400: components["responses"]["WebsocketHandshakeInvalid"];
+            403: components["responses"]["CrossOriginForbidden"];
+            421: components["responses"]["MisdirectedRequest"];
             426: components["responses"]["WebsocketUpgradeRequired"];
         };
     };
@@ -5096,6 +5259,7 @@ export interface operations {
                     "text/plain": string;
                 };
             };
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
 }

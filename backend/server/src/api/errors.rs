@@ -10,7 +10,7 @@
 use motion::ErrorId;
 use utoipa::{IntoResponses, ToResponse};
 
-use super::BODY_LIMIT;
+use super::{BODY_LIMIT, guard};
 use crate::error::{ApiError, Problem};
 
 /// The body the server sends for `e`.
@@ -110,6 +110,18 @@ problem_responses! {
     /// An upgrade request to the websocket without a `Sec-WebSocket-Key`.
     WebsocketHandshakeInvalid(example = json!(p(super::handshake_invalid("`Sec-WebSocket-Key` header missing"))));
 
+    // 403
+
+    /// A request that changes something (or a websocket upgrade) from another web origin:
+    /// `Origin` is neither this server's own (the request's `Host`) nor allowed with
+    /// `--allow-origin`, or `Sec-Fetch-Site` is neither `same-origin` nor `none`. Nothing was
+    /// done.
+    CrossOriginForbidden(examples(
+        ("origin" = (summary = "A page of another origin",
+            value = json!(p(ApiError::cross_origin(guard::foreign_origin("http://evil.example", Some("127.0.0.1:8080"))))))),
+        ("sec_fetch_site" = (summary = "A request the browser marks as from another site",
+            value = json!(p(ApiError::cross_origin(guard::foreign_site("cross-site"))))))));
+
     // 404
 
     /// No such axis.
@@ -170,6 +182,19 @@ problem_responses! {
 
     /// The body is larger than 2 MiB.
     PayloadTooLarge(example = json!(p(ApiError::too_large(BODY_LIMIT))));
+
+    // 415
+
+    /// The request is not declared `Content-Type: application/json`, which every POST, PUT,
+    /// PATCH and DELETE must be, also one without a body. Nothing was done.
+    UnsupportedMediaType(example = json!(p(ApiError::unsupported_media_type(guard::not_json(
+        "Content-Type \"text/plain\" is not application/json")))));
+
+    // 421
+
+    /// `Host` is not a name this server serves (loopback names and addresses, `--public-name`):
+    /// a page of another site whose name resolves to this machine (DNS rebinding). Any request.
+    MisdirectedRequest(example = json!(p(ApiError::misdirected(guard::not_served("attacker.example:8080")))));
 
     // 422
 
@@ -324,8 +349,10 @@ error_sets! {
     }
     /// `GET /audit`.
     AuditErrors { 422: AuditInvalid, 503: AuditUnavailable }
-    /// `GET /ws` without a websocket handshake.
-    WebsocketErrors { 400: WebsocketHandshakeInvalid, 426: WebsocketUpgradeRequired }
+    /// `GET /ws`: not a websocket handshake, or one from another origin.
+    WebsocketErrors {
+        400: WebsocketHandshakeInvalid, 403: CrossOriginForbidden, 426: WebsocketUpgradeRequired,
+    }
     /// `POST /scope/recordings`.
     ScopeCreateErrors {
         400: MalformedJson, 409: ScopeBusy, 413: PayloadTooLarge, 422: ScopeInvalid,
@@ -338,4 +365,42 @@ error_sets! {
     }
     /// `DELETE /scope/recordings/{id}`.
     ScopeDeleteErrors { 404: RecordingNotFound }
+}
+
+/// The answers of the request checks (`guard.rs`), added to every operation by the rule the
+/// checks follow: 421 to all, 403 and 415 to those that change something.
+pub struct RequestChecks;
+
+impl utoipa::Modify for RequestChecks {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::{Ref, RefOr};
+        let response = |name: &str| RefOr::Ref(Ref::from_response_name(name));
+        for item in doc.paths.paths.values_mut() {
+            let safe = [
+                &mut item.get,
+                &mut item.head,
+                &mut item.options,
+                &mut item.trace,
+            ];
+            let changing = [
+                &mut item.post,
+                &mut item.put,
+                &mut item.patch,
+                &mut item.delete,
+            ];
+            for (op, changes) in safe
+                .into_iter()
+                .map(|o| (o, false))
+                .chain(changing.into_iter().map(|o| (o, true)))
+            {
+                let Some(op) = op.as_mut() else { continue };
+                let responses = &mut op.responses.responses;
+                responses.insert("421".into(), response("MisdirectedRequest"));
+                if changes {
+                    responses.insert("403".into(), response("CrossOriginForbidden"));
+                    responses.insert("415".into(), response("UnsupportedMediaType"));
+                }
+            }
+        }
+    }
 }

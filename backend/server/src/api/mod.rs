@@ -4,6 +4,7 @@ pub mod audit;
 pub mod axes;
 pub mod commands;
 pub mod errors;
+pub mod guard;
 pub mod scope;
 pub mod simulation;
 pub mod system;
@@ -30,13 +31,14 @@ use utoipa::{IntoParams, OpenApi};
 use crate::app::AppState;
 use crate::error::ApiError;
 use crate::model::ClientInfo;
-use errors::ErrorResponses;
+use errors::{ErrorResponses, RequestChecks};
 
 /// The largest request body (axum's default, set explicitly so that the 413 can name it).
 pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
 
 /// A JSON body whose errors are problem+json: 400 for malformed JSON, 413 for a body over
-/// [`BODY_LIMIT`], 422 for wrong types, missing or unknown fields. An empty body is read as `{}`.
+/// [`BODY_LIMIT`], 422 for a body that is not an object (serde would read an array field by
+/// field), wrong types, missing or unknown fields. An empty body is read as `{}`.
 pub struct JsonBody<T>(pub T, pub serde_json::Value);
 
 impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
@@ -59,9 +61,26 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
         };
         let value: serde_json::Value =
             serde_json::from_slice(bytes).map_err(|e| ApiError::bad_json(e.to_string()))?;
+        if !value.is_object() {
+            return Err(not_an_object(&value));
+        }
         let t = T::deserialize(&value).map_err(|e| ApiError::field("body", &e.to_string()))?;
         Ok(JsonBody(t, value))
     }
+}
+
+/// 422 for a body that is JSON but not an object.
+fn not_an_object(value: &serde_json::Value) -> ApiError {
+    use serde_json::Value;
+    let what = match value {
+        Value::Array(_) => "an array",
+        Value::String(_) => "a string",
+        Value::Number(_) => "a number",
+        Value::Bool(_) => "a boolean",
+        Value::Null => "null",
+        Value::Object(_) => "an object",
+    };
+    ApiError::field("body", &format!("must be a JSON object, not {what}"))
 }
 
 /// Who sent the request: remote address and the optional `X-Client-Id` header.
@@ -116,7 +135,8 @@ pub struct WaitQuery {
     pub timeout_ms: Option<u64>,
 }
 
-pub fn router(state: Arc<AppState>) -> Router {
+/// The API, the documentation and the UI behind the request checks of [`guard`].
+pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>) -> Router {
     let api = Router::new()
         .route("/axes", get(axes::list_axes).post(axes::create_axis))
         .route(
@@ -189,7 +209,13 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/audit", get(audit::audit_log))
         .route("/config", get(axes::export_config).put(axes::import_config))
         .route("/ws", get(websocket))
-        .fallback(not_found);
+        .fallback(not_found)
+        // Origin and Content-Type, before routing: a POST that is not JSON is a 415 whatever
+        // its path (404) or method (405) would have been.
+        .layer(axum::middleware::from_fn_with_state(
+            guard.clone(),
+            guard::check_request,
+        ));
     Router::new()
         .nest("/api/v1", api)
         .route("/metrics", get(system::metrics))
@@ -198,6 +224,11 @@ pub fn router(state: Arc<AppState>) -> Router {
         .fallback(crate::ui::serve)
         .layer(axum::middleware::from_fn(problem_errors))
         .layer(DefaultBodyLimit::max(BODY_LIMIT))
+        // Outermost: a Host this server does not serve gets nothing else (DNS rebinding).
+        .layer(axum::middleware::from_fn_with_state(
+            guard,
+            guard::check_host,
+        ))
         .with_state(state)
 }
 
@@ -315,7 +346,14 @@ pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
 Errors are `application/problem+json` (RFC 9457) with a stable `code` and, for errors of the motion kernel, \
 the PLCopen `error_id`. Besides the errors listed for each operation, any route answers a method it does not take \
 with 405 `method_not_allowed` (the `Allow` header lists those it takes), a body over 2 MiB with 413 \
-`payload_too_large` and a path that is not UTF-8 with 400 `bad_request`. Commands are accepted with 202 and a command resource; `?wait=true` holds the response \
+`payload_too_large` and a path that is not UTF-8 with 400 `bad_request`.\n\n\
+Requests from web pages of other sites are refused: a `Host` that is not a loopback name or address or a name \
+given with `--public-name` is a 421 `misdirected_request` (any request); a request that changes something \
+(POST, PUT, PATCH, DELETE) or opens the websocket with an `Origin` other than the server's own or one given \
+with `--allow-origin`, or with a `Sec-Fetch-Site` other than `same-origin` or `none`, is a 403 \
+`cross_origin_forbidden`; a POST, PUT, PATCH or DELETE must be sent as `Content-Type: application/json`, \
+also without a body, else 415 `unsupported_media_type`; a body must be a JSON object (422). Clients that send \
+no `Origin` (curl, an MES) only need the Content-Type.\n\nCommands are accepted with 202 and a command resource; `?wait=true` holds the response \
 until the command finishes. Authentication is not implemented yet: motiond only listens on loopback addresses.",
         license(name = "MIT OR Apache-2.0")
     ),
@@ -333,7 +371,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),
-    modifiers(&ForeignExamples, &ErrorResponses),
+    modifiers(&ForeignExamples, &ErrorResponses, &RequestChecks),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
