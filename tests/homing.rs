@@ -1,5 +1,6 @@
 //! The demo machine homes (cam 20–25 mm, index pulse every 10 mm), and a homing search that
-//! misses the cam ends at a hardware limit switch with homing_failed instead of running on.
+//! misses the cam ends on a hardware limit switch in ErrorStop with homing_failed instead of
+//! running on.
 
 mod common;
 
@@ -66,9 +67,14 @@ async fn a_homing_search_past_the_cam_fails_at_the_limit_switch_which_then_block
     assert_eq!(r.json["state"], "error", "{}", r.text);
     assert_eq!(r.json["error_code"], "homing_failed", "{}", r.text);
     assert_eq!(r.json["outputs"]["error_id"].as_u64(), Some(HOMING_FAILED));
-    let st = until_standstill(&s, "y").await;
+    // On the switch (an end of travel): ErrorStop with why homing failed, until a reset.
+    let st = until(&s, "y", "error_stop").await;
     assert_eq!(st["homed"], false, "{st}");
+    assert_eq!(st["error_id"].as_u64(), Some(HOMING_FAILED), "{st}");
     assert!(st["actual_position"].as_f64().unwrap() >= 1005.0, "{st}");
+    let r = post(&s, "/api/v1/axes/y/reset?wait=true", json!({})).await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    until(&s, "y", "standstill").await;
     // On the switch: no motion further into it, motion away from it is fine.
     let r = post(
         &s,
@@ -87,13 +93,14 @@ async fn a_homing_search_past_the_cam_fails_at_the_limit_switch_which_then_block
     assert_eq!(r.json["state"], "done", "{}", r.text);
 }
 
-async fn until_standstill(s: &Server, axis: &str) -> serde_json::Value {
+/// Polls the status until the axis is in `state` and at rest (at most 10 s).
+async fn until(s: &Server, axis: &str, state: &str) -> serde_json::Value {
     for _ in 0..500 {
         let st = status(s, axis).await["status"].clone();
-        if st["state"] == "standstill" && st["moving"] == false {
+        if st["state"] == state && st["moving"] == false {
             return st;
         }
         tokio::time::sleep(std::time::Duration::from_millis(20)).await;
     }
-    panic!("{axis} did not come to a standstill");
+    panic!("{axis} did not come to rest in {state}");
 }

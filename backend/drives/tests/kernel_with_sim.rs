@@ -141,8 +141,9 @@ fn move_is_done_only_when_the_lagging_drive_is_in_the_target_window() {
 #[test]
 fn referencing_sequence_latches_the_index_pulse_of_the_simulated_encoder() {
     // Default sim drive: cam 20–25, index pulse every 10. From 0 the search runs positive
-    // onto the cam, stops, leaves it negative; after the falling edge (at 20) the next index
-    // pulse is at 10: that drive position becomes the reference 100.
+    // onto the cam, stops, leaves it positive (an undefined SyncDirection is positive,
+    // ST_HomingOptions); after the falling edge (at 25) the next index pulse is at 30: that
+    // drive position becomes the reference 100.
     let mut m = Machine::new(SimDriveConfig::default());
     m.power();
     let h = m.ok(CommandKind::Home {
@@ -159,7 +160,7 @@ fn referencing_sequence_latches_the_index_pulse_of_the_simulated_encoder() {
     assert!(s.homed);
     let drive_pos = m.drive.feedback().actual_position;
     assert!(
-        (s.actual_position - (100.0 + (drive_pos - 10.0))).abs() < 1e-6,
+        (s.actual_position - (100.0 + (drive_pos - 30.0))).abs() < 1e-6,
         "axis {} drive {}",
         s.actual_position,
         drive_pos

@@ -71,8 +71,14 @@ error_table! {
     FEED_ENABLE_MISSING = 0x7020, "feed_enable_missing", "feed enable for this direction missing";
     /// The trajectory planner could not solve the problem (the axis was stopped on a closed-form ramp).
     PLANNING_FAILED = 0x7021, "planning_failed", "trajectory planning failed";
-    /// Homing could not find the reference cam or sync pulse.
-    HOMING_FAILED = 0x7030, "homing_failed", "homing sequence failed";
+    /// An end or blending velocity could not be reached moving only towards the target; the best reachable one was used (a warning).
+    END_VELOCITY_ADJUSTED = 0x7022, "end_velocity_adjusted", "end or blending velocity not reachable within the distance: the best reachable one is used";
+    /// Homing did not find the reference cam: a limit switch was reached while searching it (phase 1).
+    HOMING_FAILED = 0x7030, "homing_failed", "homing failed: reference cam not found before a limit switch";
+    /// Homing found the cam but not the sync pulse (or the cam's end): a limit switch was reached while leaving the cam or searching the pulse (phases 3–5).
+    HOMING_SYNC_NOT_FOUND = 0x7031, "homing_sync_not_found", "homing failed: sync pulse not found before a limit switch";
+    /// Homing could not stop on the reference cam: braking from the search velocity carried the axis past it (phase 2), or into a limit switch.
+    HOMING_CAM_OVERRUN = 0x7032, "homing_cam_overrun", "homing failed: could not stop on the reference cam (search velocity too high for the cam)";
     /// The master axis of a coupling does not exist or is this axis.
     MASTER_INVALID = 0x7040, "master_invalid", "invalid master axis";
     /// The axis is a coupled slave and motion commands to slaves are not allowed (#1065).

@@ -61,6 +61,17 @@ impl RuckigErrorHandler for RejectErrors {
     }
 }
 
+/// How a planned position profile runs relative to its target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Course {
+    /// Only towards the target (up to what cannot be avoided).
+    Towards,
+    /// Moves away behind its start first (to gain a run-up).
+    BacksUp,
+    /// Passes beyond the target and returns.
+    Overshoots,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Plan {
     None,
@@ -73,6 +84,11 @@ pub struct Planner {
     otg: Ruckig<1, RejectErrors>,
     input: InputParameter<1>,
     traj: Trajectory<1>,
+    /// A braking segment sampled before `traj` for `split` seconds (0 = none): a position
+    /// plan that starts above its velocity limit first brakes to it on the velocity
+    /// interface (see [`Planner::plan_position`]).
+    brake: Trajectory<1>,
+    split: f64,
     plan: Plan,
     time: f64,
     duration: f64,
@@ -98,6 +114,8 @@ impl Planner {
             otg: Ruckig::new(None, cycle_time),
             input: InputParameter::new(None),
             traj: Trajectory::new(None),
+            brake: Trajectory::new(None),
+            split: 0.0,
             plan: Plan::None,
             time: 0.0,
             duration: 0.0,
@@ -120,6 +138,107 @@ impl Planner {
         if !target.is_finite() || !target_velocity.is_finite() {
             return Err(PlanError::InvalidInput);
         }
+        // Above the velocity limit towards the target (an override, a slower successor):
+        // Ruckig's own brake hands over with the braking acceleration still applied, so the
+        // velocity undershoots by up to a²/2j — backwards when the limit is low. Brake to the
+        // limit on the velocity interface instead (it ends with a = 0) and position from
+        // there, unless that longer braking would carry the axis past the target.
+        let d = self.plan_position_direct(from, target, target_velocity, limits)?;
+        if self.straight(from, target, limits.jerk) {
+            return Ok(d);
+        }
+        // Above the velocity limit (an override, a slower successor, the run-up of a turn):
+        // Ruckig's own brake hands over with the braking acceleration still applied, so the
+        // velocity undershoots by up to a²/2j — backwards when the limit is low. Brake (or
+        // turn) to the limit on the velocity interface instead, which ends with a = 0, and
+        // position from there; when that is too long to stop at the target and the axis is
+        // braking for it already, brake on from the present velocity, which only falls.
+        if let Ok(d) = self.plan_braked(from, target, target_velocity, limits) {
+            if self.straight(from, target, limits.jerk) {
+                return Ok(d);
+            }
+        }
+        let toward = from.velocity * (target - from.position) > 0.0;
+        if toward && from.velocity.abs() > limits.velocity {
+            let braking = Limits {
+                velocity: from.velocity.abs(),
+                ..*limits
+            };
+            if let Ok(d) = self.plan_position_direct(from, target, target_velocity, &braking) {
+                if self.straight(from, target, limits.jerk) {
+                    return Ok(d);
+                }
+            }
+        }
+        self.plan_position_direct(from, target, target_velocity, limits)
+    }
+
+    /// The plan goes beyond `target` in direction `dir`.
+    fn passes(&self, target: f64, dir: f64) -> bool {
+        let (min, max) = self.extrema();
+        let tol = 1e-9 * (1.0 + target.abs());
+        if dir > 0.0 {
+            max > target + tol
+        } else {
+            min < target - tol
+        }
+    }
+
+    /// The plan runs to `target` without passing it and without turning back on the way.
+    fn straight(&self, from: Kinematics, target: f64, jerk: f64) -> bool {
+        let dir = sign(target - from.position);
+        !self.passes(target, dir) && !self.backs_up_on_the_way(from, target, jerk)
+    }
+
+    /// Whether the plan turns back on its way to `target` more than releasing the present
+    /// acceleration forces it to.
+    fn backs_up_on_the_way(&self, from: Kinematics, target: f64, jerk: f64) -> bool {
+        let dir = sign(target - from.position);
+        let a_away = (from.acceleration * dir).min(0.0).abs();
+        let dip = (a_away * a_away / (2.0 * jerk) - (from.velocity * dir).max(0.0)).max(0.0);
+        let floor = -dip - 1e-9 * (1.0 + from.velocity.abs());
+        dir != 0.0 && self.reverses_after_turning(dir, from.velocity * dir, floor)
+    }
+
+    /// The braking segment to the velocity limit, then the position profile from its end.
+    fn plan_braked(
+        &mut self,
+        from: Kinematics,
+        target: f64,
+        target_velocity: f64,
+        limits: &Limits,
+    ) -> Result<f64, PlanError> {
+        let dir = sign(target - from.position);
+        if dir == 0.0 {
+            return Err(PlanError::Infeasible);
+        }
+        self.plan_velocity(from, dir * limits.velocity, limits)?;
+        let mid = self.end;
+        let braking = self.duration;
+        if (target - mid.position) * dir <= 0.0 {
+            return Err(PlanError::Infeasible); // it cannot brake before the target
+        }
+        core::mem::swap(&mut self.traj, &mut self.brake);
+        match self.plan_position_direct(mid, target, target_velocity, limits) {
+            Ok(d) => {
+                self.split = braking;
+                self.duration = braking + d;
+                Ok(self.duration)
+            }
+            Err(e) => {
+                core::mem::swap(&mut self.traj, &mut self.brake);
+                Err(e)
+            }
+        }
+    }
+
+    fn plan_position_direct(
+        &mut self,
+        from: Kinematics,
+        target: f64,
+        target_velocity: f64,
+        limits: &Limits,
+    ) -> Result<f64, PlanError> {
         let dist = target - from.position;
         let dir = if dist != 0.0 {
             dist.signum()
@@ -144,7 +263,137 @@ impl Planner {
         self.input.control_interface = ControlInterface::Position;
         self.input.target_position[0] = target;
         self.input.target_velocity[0] = target_velocity;
+        if overshoot && !away {
+            // The closed-form braking distance is a hair above the distance left when the
+            // axis is braking exactly for the target (a re-plan on the way): braking with the
+            // deceleration then still stops there, the lower symmetric limit would not.
+            let (max_dir, min_dir) = direction_limits(dir, limits);
+            if let Ok(d) = self.solve(from, limits, max_dir, min_dir) {
+                if !self.passes(target, dir) {
+                    return Ok(d);
+                }
+            }
+        }
         self.solve(from, limits, max_acc, min_acc)
+    }
+
+    /// Plans from `from` to `target`, passing it with an end velocity as close to
+    /// `end_velocity` as the axis can reach while it only ever moves towards the target: it
+    /// never backs up to gain a run-up for an end velocity it cannot reach within the
+    /// distance (the velocity is lowered to the best reachable one), and never overshoots
+    /// and returns to pass at an end velocity it cannot brake down to in time (the velocity is
+    /// raised to the lowest it can brake to). Motion away from the target that no profile
+    /// can avoid (the axis was moving away when the plan began) stays. A stop at the target
+    /// (`end_velocity` 0) and an end velocity pointing away from the target are planned as
+    /// asked. Returns the planned end velocity (signed).
+    ///
+    /// Cost: one solve when `end_velocity` is reachable, else a bisection of about 24 solves
+    /// (≈ 20 µs), only when a blending or continuous move is (re)planned.
+    pub fn plan_position_towards(
+        &mut self,
+        from: Kinematics,
+        target: f64,
+        end_velocity: f64,
+        limits: &Limits,
+    ) -> Result<f64, PlanError> {
+        check(from, limits)?;
+        if !target.is_finite() || !end_velocity.is_finite() {
+            return Err(PlanError::InvalidInput);
+        }
+        let dir = sign(target - from.position);
+        if end_velocity == 0.0 || end_velocity * dir < 0.0 {
+            self.plan_position(from, target, end_velocity, limits)?;
+            return Ok(end_velocity);
+        }
+        if dir == 0.0 {
+            // At the target already: it can only be passed now, at the present velocity.
+            let now = if from.velocity * end_velocity > 0.0 && from.acceleration == 0.0 {
+                from.velocity
+            } else {
+                0.0
+            };
+            self.plan_position(from, target, now, limits)?;
+            return Ok(now);
+        }
+        // Where the axis may get to behind its start: it cannot avoid braking a motion away
+        // from the target, nor (within a jerk-limited release) an acceleration away from it.
+        let a_away = (from.acceleration * dir).min(0.0).abs();
+        let mut back = from.position;
+        if from.velocity * dir < 0.0 {
+            let a = limits.acceleration.min(limits.deceleration);
+            back -= dir * stop_distance(from.velocity, from.acceleration, a, limits.jerk);
+        }
+        let scale = 1.0 + from.position.abs().max(target.abs());
+        let tol_back = 1e-9 * scale + a_away * a_away * a_away / (limits.jerk * limits.jerk);
+        let tol = 1e-9 * scale;
+        // Releasing an acceleration away from the target costs a²/2j of velocity: the dip
+        // below zero that no profile avoids.
+        let dip = (a_away * a_away / (2.0 * limits.jerk) - (from.velocity * dir).max(0.0)).max(0.0);
+        let floor = -dip - 1e-9 * (1.0 + end_velocity.abs());
+        let want = end_velocity.abs();
+        let course = |me: &mut Self, u: f64| -> Result<Course, PlanError> {
+            // Passing faster than the velocity limit is allowed (blending velocities are).
+            let lim = Limits {
+                velocity: limits.velocity.max(u),
+                ..*limits
+            };
+            me.plan_position(from, target, dir * u, &lim)?;
+            let (lo, hi) = me.extrema();
+            let (behind, beyond) = if dir > 0.0 {
+                (lo < back - tol_back, hi > target + tol)
+            } else {
+                (hi > back + tol_back, lo < target - tol)
+            };
+            // A way back in the middle (braking below zero, then on again) is a back-up too;
+            // turning back after passing the target is the overshoot.
+            let r = if beyond {
+                // Passing the target and turning back (also to run at it again from behind).
+                Course::Overshoots
+            } else if behind {
+                Course::BacksUp
+            } else if me.reverses_after_turning(dir, from.velocity * dir, floor) {
+                Course::BacksUp
+            } else {
+                Course::Towards
+            };
+            Ok(r)
+        };
+        // The velocity the axis passes through anyway (releasing its acceleration) divides
+        // the end velocities it must speed up to (unreachable: too high) from those it must
+        // brake down to (unreachable: too low); the reachable ones lie around it.
+        let (vd, ad) = (from.velocity * dir, from.acceleration * dir);
+        let v_free = vd + ad * ad.abs() / (2.0 * limits.jerk);
+        if course(self, want)? == Course::Towards {
+            return Ok(end_velocity);
+        }
+        let towards = |me: &mut Self, u: f64| course(me, u).ok() == Some(Course::Towards);
+        // Below: the highest reachable in [0, want]; above: the lowest in [want, v_free].
+        // Ruckig's time-optimal profile decides what is "reachable" (a monotonic profile to
+        // a velocity may exist where the time-optimal one dips), so both sides are searched
+        // and the nearer one taken.
+        let below = towards(self, 0.0).then(|| edge(self, 0.0, want, &towards));
+        let above =
+            (want < v_free && towards(self, v_free)).then(|| edge(self, v_free, want, &towards));
+        let best = match (below, above) {
+            (Some(b), Some(a)) => {
+                if want - b <= a - want {
+                    b
+                } else {
+                    a
+                }
+            }
+            (Some(b), None) => b,
+            (None, Some(a)) => a,
+            // It cannot avoid passing the target: at the velocity it passes through anyway
+            // (the caller hands the target over to a successor, or a continuous move goes on).
+            (None, None) => v_free.max(0.0),
+        };
+        let lim = Limits {
+            velocity: limits.velocity.max(best),
+            ..*limits
+        };
+        self.plan_position(from, target, dir * best, &lim)?;
+        Ok(dir * best)
     }
 
     /// Plans a change to `target_velocity` (velocity interface): MoveVelocity, Halt, Stop,
@@ -238,9 +487,112 @@ impl Planner {
     /// The planned position never turns round (no extremum inside the profile).
     fn is_monotonic(&mut self, start: f64) -> bool {
         let end = self.end.position;
-        let ext = &self.traj.get_position_extrema()[0];
+        let (min, max) = self.extrema();
         let tol = 1e-9 * (1.0 + start.abs().max(end.abs()));
-        ext.min >= start.min(end) - tol && ext.max <= start.max(end) + tol
+        min >= start.min(end) - tol && max <= start.max(end) + tol
+    }
+
+    /// Whether the planned velocity, once it points in `dir` (or from the start when
+    /// `v0_dir` ≥ 0), falls below `floor` (in `dir`) again: the profile backs up on the way.
+    /// Exact: the velocity is piecewise quadratic in Ruckig's constant-jerk phases.
+    fn reverses_after_turning(&self, dir: f64, v0_dir: f64, floor: f64) -> bool {
+        let mut toward = v0_dir >= 0.0;
+        let mut reversed = false;
+        let mut point = |x: f64| {
+            if toward && x < floor {
+                reversed = true;
+            }
+            if x >= 0.0 {
+                toward = true;
+            }
+        };
+        let mut phase = |v: f64, a: f64, j: f64, t: f64| {
+            if !(t > 0.0) {
+                return;
+            }
+            let (v, a, j) = (v * dir, a * dir, j * dir);
+            point(v);
+            if j != 0.0 {
+                let ts = -a / j;
+                if ts > 0.0 && ts < t {
+                    point(v - a * a / (2.0 * j));
+                }
+            }
+            point(v + a * t + 0.5 * j * t * t);
+        };
+        self.phases(|_, v, a, j, t| phase(v, a, j, t));
+        reversed
+    }
+
+    /// Every constant-jerk phase of the plan in time order, both segments, Ruckig's brake
+    /// pre-phases included: (position, velocity, acceleration, jerk, duration) at its start.
+    fn phases(&self, mut f: impl FnMut(f64, f64, f64, f64, f64)) {
+        let segments: [Option<&Trajectory<1>>; 2] = [
+            if self.split > 0.0 {
+                Some(&self.brake)
+            } else {
+                None
+            },
+            Some(&self.traj),
+        ];
+        for traj in segments.into_iter().flatten() {
+            for prof in traj.get_profiles() {
+                let p = &prof[0];
+                for pre in [&p.brake, &p.accel] {
+                    if pre.duration > 0.0 {
+                        for k in 0..2 {
+                            if pre.t[k] > 0.0 {
+                                f(pre.p[k], pre.v[k], pre.a[k], pre.j[k], pre.t[k]);
+                            }
+                        }
+                    }
+                }
+                for k in 0..7 {
+                    if p.t[k] > 0.0 {
+                        f(p.p[k], p.v[k], p.a[k], p.j[k], p.t[k]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Lowest and highest planned position (before any coordinate shift), both segments.
+    /// Our own scan of the phases: rsruckig's `get_position_extrema` counts the profile's
+    /// final position `pf`, which its velocity interface leaves stale from an earlier plan.
+    fn extrema(&self) -> (f64, f64) {
+        let (mut min, mut max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut at = |x: f64| {
+            min = min.min(x);
+            max = max.max(x);
+        };
+        self.phases(|p, v, a, j, t| {
+            let pos = |s: f64| p + s * (v + s * (a / 2.0 + s * j / 6.0));
+            at(p);
+            at(pos(t));
+            // Turning points inside the phase: v + a s + j s²/2 = 0.
+            if j != 0.0 {
+                let disc = a * a - 2.0 * j * v;
+                if disc >= 0.0 {
+                    let r = disc.sqrt();
+                    for s in [(-a + r) / j, (-a - r) / j] {
+                        if s > 0.0 && s < t {
+                            at(pos(s));
+                        }
+                    }
+                }
+            } else if a != 0.0 {
+                let s = -v / a;
+                if s > 0.0 && s < t {
+                    at(pos(s));
+                }
+            }
+        });
+        if min > max {
+            // No phase at all (a zero-length plan): it stands at its end.
+            let e = self.end.position - self.shift;
+            return (e, e);
+        }
+        (min, max)
     }
 
     fn solve_signed(
@@ -285,6 +637,7 @@ impl Planner {
         match solved {
             true => {
                 self.plan = Plan::Ruckig;
+                self.split = 0.0;
                 self.shift = 0.0;
                 self.time = 0.0;
                 self.duration = self.traj.get_duration();
@@ -325,12 +678,12 @@ impl Planner {
         if self.plan != Plan::Ruckig {
             return false;
         }
-        let ext = &self.traj.get_position_extrema()[0];
+        let (min, max) = self.extrema();
         let tol = 1e-9 * (1.0 + target.abs());
         if dir > 0.0 {
-            ext.max + self.shift > target + tol
+            max + self.shift > target + tol
         } else {
-            ext.min + self.shift < target - tol
+            min + self.shift < target - tol
         }
     }
 
@@ -383,8 +736,13 @@ impl Planner {
         let mut a = rsruckig::daov_stack![0.0];
         let mut j = rsruckig::daov_stack![0.0];
         let mut section = None;
-        self.traj.at_time(
-            t.min(self.duration),
+        let (traj, t) = if self.split > 0.0 && t < self.split {
+            (&self.brake, t)
+        } else {
+            (&self.traj, t - self.split)
+        };
+        traj.at_time(
+            t.min(traj.get_duration()),
             &mut Some(&mut p),
             &mut Some(&mut v),
             &mut Some(&mut a),
@@ -423,6 +781,31 @@ impl Planner {
     /// The end state of the current profile.
     pub fn end_state(&self) -> Kinematics {
         self.end
+    }
+}
+
+/// The last point from `ok` (where `pred` holds) towards `other` (where it does not) at which
+/// `pred` still holds, by bisection (24 steps: 6e-8 of the interval).
+fn edge<P>(me: &mut P, mut ok: f64, mut other: f64, pred: &impl Fn(&mut P, f64) -> bool) -> f64 {
+    for _ in 0..24 {
+        let mid = 0.5 * (ok + other);
+        if pred(me, mid) {
+            ok = mid;
+        } else {
+            other = mid;
+        }
+    }
+    ok
+}
+
+/// -1, 0 or 1 (unlike `f64::signum`, which gives ±1 for ±0).
+pub fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
     }
 }
 

@@ -1067,17 +1067,21 @@ fn homing_sequence_cam_then_index_pulse_references_exactly() {
             Idle
         ]
     );
-    // Leaving the cam backwards (falling edge at 50), the first index pulse is at 48: the
-    // drive position 48 is now the reference 100.
+    // ST_HomingOptions: an undefined SyncDirection is positive, so the cam is left forwards
+    // (falling edge at 55) and the first index pulse is at 56: the drive position 56 is now
+    // the reference 100.
     let s = r.st(0);
     assert!(s.homed && s.state == AxisState::Standstill);
     assert!(
-        (s.actual_position - (100.0 + (r.plants[0].pos - 48.0))).abs() < 1e-9,
+        (s.actual_position - (100.0 + (r.plants[0].pos - 56.0))).abs() < 1e-9,
         "{s:?} plant {}",
         r.plants[0].pos
     );
 }
 
+/// A homing run that reaches a limit switch before the cam says so (0x7030, cam not found)
+/// and stops on the switch in ErrorStop: an axis on an end of travel is never a silent
+/// Standstill.
 #[test]
 fn homing_fails_cleanly_when_the_cam_is_never_found() {
     let mut r = Rig::new(1);
@@ -1094,8 +1098,13 @@ fn homing_fails_cleanly_when_the_cam_is_never_found() {
     r.plants[0].limit_positive = true;
     r.until(2.0, |r| !r.out(h).busy);
     assert_eq!(r.out(h).error_id, ErrorId::HOMING_FAILED.0);
-    assert_eq!(r.st(0).state, AxisState::Standstill);
+    assert_eq!(r.st(0).state, AxisState::ErrorStop);
+    assert_eq!(r.st(0).error_id, ErrorId::HOMING_FAILED.0);
     assert!(!r.st(0).homed);
+    r.until(1.0, |r| !r.st(0).moving);
+    r.plants[0].limit_positive = false;
+    r.ok(0, CommandKind::Reset);
+    r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
 }
 
 #[test]
@@ -2488,9 +2497,15 @@ fn hardware_limit_switch_stops_fast_and_blocks_that_direction_only() {
     r.plants[0].limit_positive = true;
     r.step();
     r.step();
+    // An end of travel is an axis error: ErrorStop with the switch's error, not a standstill
+    // that a client could mistake for a finished move.
     assert_eq!(r.out(v).error_id, ErrorId::LIMIT_SWITCH.0);
-    assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
-    r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+    assert_eq!(r.st(0).state, AxisState::ErrorStop);
+    assert_eq!(r.st(0).error_id, ErrorId::LIMIT_SWITCH.0);
+    r.until(1.0, |r| !r.st(0).moving);
+    let reset = r.ok(0, CommandKind::Reset);
+    assert!(r.out(reset).done);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
     // Braked with the fast-stop deceleration (5000), not the axis default (1000).
     let amin = r.history[0]
         .iter()
@@ -2517,11 +2532,11 @@ fn homing_reference_modes_plc_cam_and_drive_latch_on_the_cam_edge() {
     let h = home_by_sequence(&mut r, 0.0);
     assert!(r.out(h).done);
     r.run(0.01);
-    // Leaving the cam backwards, its falling edge is at 50 (within one cycle of travel at the
-    // sync velocity 5 mm/s, the resolution of a PLC cam).
+    // Leaving the cam forwards (the default sync direction), its falling edge is at 55
+    // (within one cycle of travel at the sync velocity 5 mm/s, the resolution of a PLC cam).
     let zero_at_drive = r.plants[0].pos - r.st(0).actual_position;
     assert!(
-        (zero_at_drive - 50.0).abs() <= 5.0 * DT + 1e-9,
+        (zero_at_drive - 55.0).abs() <= 5.0 * DT + 1e-9,
         "{zero_at_drive}"
     );
 
@@ -2665,7 +2680,7 @@ fn a_second_homing_run_never_uses_a_latch_left_from_an_aborted_one() {
         },
     );
     r.until(20.0, |r| r.st(0).homing_phase == HomingPhase::WaitLatch);
-    r.run(0.1); // latch armed; the next pulse (48) is not reached yet
+    r.run(0.1); // latch armed; the next pulse (56) is not reached yet
     let s = r.ok(
         0,
         CommandKind::Stop {
@@ -2691,9 +2706,9 @@ fn a_second_homing_run_never_uses_a_latch_left_from_an_aborted_one() {
     r.until(30.0, |r| !r.out(h2).busy);
     assert!(r.out(h2).done);
     r.run(0.01);
-    // Referenced to the pulse at 248 (below the new cam), not the stale one at 48.
+    // Referenced to the pulse at 256 (above the new cam), not the stale one at 56.
     let zero = r.plants[0].pos - (r.st(0).actual_position - 100.0);
-    assert!((zero - 248.0).abs() < 1e-9, "{zero}");
+    assert!((zero - 256.0).abs() < 1e-9, "{zero}");
 }
 
 #[test]
@@ -2966,9 +2981,11 @@ fn homing_stops_at_a_limit_switch_in_any_phase() {
     );
     r.until(20.0, |r| r.st(0).homing_phase == HomingPhase::WaitLatch);
     r.run(0.5);
-    r.plants[0].limit_negative = true;
+    r.plants[0].limit_positive = true;
     r.until(3.0, |r| !r.out(h).busy);
-    assert_eq!(r.out(h).error_id, ErrorId::HOMING_FAILED.0);
+    // The cam was found, the sync pulse was not: the error says which.
+    assert_eq!(r.out(h).error_id, ErrorId::HOMING_SYNC_NOT_FOUND.0);
+    assert_eq!(r.st(0).state, AxisState::ErrorStop);
 }
 
 #[test]
@@ -3048,7 +3065,7 @@ fn move_continuous_with_end_velocity_zero_stays_busy_at_the_target() {
 #[test]
 fn homing_is_refused_only_for_a_direction_the_run_will_travel() {
     use ReferenceMode::*;
-    let home = |r: &mut Rig, mode: ReferenceMode| {
+    let home = |r: &mut Rig, mode: ReferenceMode, sync_direction: Option<Direction>| {
         r.cmd(
             0,
             CommandKind::Home {
@@ -3056,24 +3073,29 @@ fn homing_is_refused_only_for_a_direction_the_run_will_travel() {
                 mode: HomingMode::Default,
                 options: HomingOptions {
                     reference_mode: Some(mode),
+                    sync_direction,
                     ..HomingOptions::default()
                 },
             },
         )
     };
-    for (mode, start, accepted) in [
-        (HardwareLatchPos, 0.0, true),
-        (SoftDriveLatchNeg, 0.0, true),
-        (HardwareLatchPos, 52.0, false),
-        (HardwareSync, 0.0, false),
+    let neg = Some(Direction::Negative);
+    for (mode, start, sync, accepted) in [
+        (HardwareLatchPos, 0.0, None, true),
+        (SoftDriveLatchNeg, 0.0, None, true),
+        (HardwareLatchPos, 52.0, None, false),
+        (HardwareSync, 0.0, neg, false),
+        // The default sync direction is positive (ST_HomingOptions): never travels negative.
+        (HardwareSync, 0.0, None, true),
     ] {
         let mut r = Rig::new(1);
         r.plants[0].cam = Some((50.0, 55.0));
+        r.plants[0].index_period = Some(8.0);
         r.plants[0].pos = start;
         r.power_on(0);
         r.plants[0].limit_negative = true;
         r.run(0.01);
-        let (id, verdict) = home(&mut r, mode);
+        let (id, verdict) = home(&mut r, mode, sync);
         assert_eq!(
             verdict == Verdict::Accepted,
             accepted,

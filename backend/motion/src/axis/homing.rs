@@ -60,10 +60,12 @@ impl Axis {
                     p.axis_encoder_homing_inv_dir_cam_search,
                     1.0,
                 )?;
+                // ST_HomingOptions: an undefined SyncDirection searches positive, like an
+                // undefined SearchDirection (#1074 inverts it).
                 let sync_dir = dir_of(
                     options.sync_direction,
                     p.axis_encoder_homing_inv_dir_sync_search,
-                    -1.0,
+                    1.0,
                 )?;
                 let search_velocity = self.check_velocity(
                     options
@@ -194,7 +196,7 @@ impl Axis {
             HomingPhase::StopOnCam => {
                 if stopped {
                     if !cam {
-                        fail = Some(ErrorId::HOMING_FAILED);
+                        fail = Some(ErrorId::HOMING_CAM_OVERRUN);
                     } else {
                         h.phase = HomingPhase::LeaveCam;
                         replan = true;
@@ -252,7 +254,21 @@ impl Axis {
             HomingPhase::Idle => {}
         }
         if limit_hit && h.phase != HomingPhase::SetPosition {
-            fail = Some(ErrorId::HOMING_FAILED);
+            // The switch is an end of travel: the axis stops on it in ErrorStop, with why
+            // the run failed.
+            let e = match h.phase {
+                HomingPhase::SearchCam => ErrorId::HOMING_FAILED,
+                HomingPhase::StopOnCam => ErrorId::HOMING_CAM_OVERRUN,
+                _ => ErrorId::HOMING_SYNC_NOT_FOUND,
+            };
+            self.latch = None;
+            job.home = HomeSeq {
+                phase: HomingPhase::Idle,
+                ..h
+            };
+            self.job = Some(job);
+            self.enter_error(e, cycle, events);
+            return;
         }
         if let Some(e) = fail {
             self.latch = None;

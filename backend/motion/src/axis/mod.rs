@@ -15,7 +15,7 @@ use crate::drive::{DriveFeedback, DriveSetpoint, LatchSource};
 use crate::error::ErrorId;
 use crate::modulo::modulo_end_position;
 use crate::params::AxisParameters;
-use crate::planner::{Kinematics, Limits, Planner, stop_distance};
+use crate::planner::{Kinematics, Limits, Planner, sign, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
 
 mod coupling;
@@ -60,17 +60,6 @@ impl MasterSample {
             error: s.state == AxisState::ErrorStop,
             max_velocity: axis.parameters().axis_velo_max,
         }
-    }
-}
-
-/// -1, 0 or 1 (unlike `f64::signum`, which gives ±1 for ±0).
-fn sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
     }
 }
 
@@ -154,6 +143,17 @@ struct Job {
     pending_error: Option<ErrorId>,
     /// Buffered with its own blending position: (position, direction of travel).
     blend_at: Option<(f64, f64)>,
+    /// Signed velocity (before override) the current plan passes the target with: the end
+    /// velocity, or the best reachable one when it cannot be reached moving only towards
+    /// the target.
+    planned_end: f64,
+    /// A continuous move has passed its target (it now runs up to its end velocity).
+    past_target: bool,
+    /// A warning to report in the next cycle (end velocity adjusted).
+    warn: Option<ErrorId>,
+    /// Takes over at `blend_at` as a blending successor: the predecessor ends Done there
+    /// (it could not pass its target at any end velocity without overshooting it).
+    blend_done: bool,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -198,6 +198,10 @@ impl Job {
             home: HomeSeq::default(),
             pending_error: None,
             blend_at: None,
+            planned_end: 0.0,
+            past_target: false,
+            warn: None,
+            blend_done: false,
         }
     }
 
@@ -211,6 +215,16 @@ impl Job {
 
     fn is_positioning(&self) -> bool {
         matches!(self.kind, JobKind::Positioning { .. })
+    }
+
+    /// The limits with a velocity limit that lets the profile pass at `velocity` (an end or
+    /// blending velocity above the commanded one).
+    fn limits_passing(&self, ovr: f64, velocity: f64) -> Limits {
+        let lim = self.limits(ovr);
+        Limits {
+            velocity: lim.velocity.max(velocity.abs()),
+            ..lim
+        }
     }
 
     fn limits(&self, ovr: f64) -> Limits {

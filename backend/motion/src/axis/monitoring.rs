@@ -174,9 +174,9 @@ impl Axis {
             return;
         }
         if (v > EPS_V && self.limit_positive) || (v < -EPS_V && self.limit_negative) {
-            // A hardware limit switch in the direction of travel: stop with the fast-stop
-            // dynamics (#1053/#1054).
-            self.stop_internally(ErrorId::LIMIT_SWITCH, true, cycle, events);
+            // A hardware limit switch in the direction of travel is an end of travel: an
+            // axis error, stopped with the fast-stop dynamics (#1053/#1054) in ErrorStop.
+            self.enter_error(ErrorId::LIMIT_SWITCH, cycle, events);
         } else if (v > EPS_V && !self.enable_positive) || (v < -EPS_V && !self.enable_negative) {
             self.stop_internally(ErrorId::FEED_ENABLE_MISSING, false, cycle, events);
         }
@@ -243,8 +243,10 @@ impl Axis {
             }
             return;
         }
-        let endless = job.is_endless();
-        if !endless && !(job.id == 0 && job.kind == JobKind::Velocity) || v.abs() <= EPS_V {
+        let endless = job.is_endless() || (job.id == 0 && job.kind == JobKind::Velocity);
+        if v.abs() <= EPS_V || job.kind == JobKind::Home {
+            // A homing run searches for the reference of the coordinates the limits are
+            // given in; the limit switches end it.
             return;
         }
         let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {
@@ -258,6 +260,17 @@ impl Axis {
         let sd = stop_distance(v, self.set.acceleration, dec, jerk);
         let margin = 2.0 * v.abs() * dt;
         if (limit - self.set.position) * v.signum() > sd + margin {
+            return;
+        }
+        // A planned profile (positioning, a halt) ends where it ends: it is stopped only if
+        // it would carry the set position beyond the limit (an overshoot, braking a motion
+        // that was heading outwards).
+        if !endless && !self.planner.overshoots(limit, v.signum()) {
+            return;
+        }
+        if !endless && !job.is_positioning() {
+            // A stop whose own ramp would cross the limit: stop harder, as an axis error.
+            self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
             return;
         }
         let mut j = job;
@@ -285,12 +298,10 @@ impl Axis {
                 self.end_superposition_incomplete(cycle, events);
             }
         }
-        // If the limit cannot be reached without overshoot, stop as hard as allowed.
+        // If the limit cannot be reached without overshoot, the axis would end beyond it:
+        // stop as hard as allowed, as an axis error (never a silent standstill outside).
         if self.planner.overshoots(limit, v.signum()) {
-            if let Some(h) = self.job.as_mut() {
-                h.kind = JobKind::Halt;
-            }
-            self.plan_job_now();
+            self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
         }
     }
 

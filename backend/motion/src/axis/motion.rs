@@ -484,6 +484,14 @@ impl Axis {
         let slot = self.slot;
         job.activate(slot, cycle, events);
         job.since_keepalive = 0;
+        if job.kind == (JobKind::Positioning { continuous: true }) && !job.past_target {
+            // The end velocity keeps the direction from where the move really starts (a
+            // queued move's start was only a guess when it was accepted).
+            let d = sign(job.target - self.set.position);
+            if d != 0.0 {
+                job.end_velocity = d * job.continuous_velocity;
+            }
+        }
         if job.kind != (JobKind::Positioning { continuous: false }) {
             // MoveAdditive after an endless motion, a halt or a stop starts from the set
             // position (spec §5.1.3).
@@ -567,15 +575,42 @@ impl Axis {
             }
         }
         let res = match j.kind {
-            JobKind::Positioning { .. } => {
+            JobKind::Positioning { continuous } => {
+                // End velocity (continuous moves, blending) is kept before override.
+                let end = j.end_velocity * ovr;
                 if ovr <= 0.0 {
                     self.planner.plan_velocity(from, 0.0, &j.limits(1.0))
+                } else if continuous && j.past_target {
+                    // Past the target (passed slower than the end velocity): run up to it.
+                    self.planner
+                        .plan_velocity(from, end, &j.limits_passing(1.0, end))
                 } else {
-                    // End velocity (continuous moves, blending) is kept before override.
-                    let end = j.end_velocity * ovr;
-                    let mut lim = j.limits(ovr);
-                    lim.velocity = lim.velocity.max(end.abs());
-                    self.planner.plan_position(from, j.target, end, &lim)
+                    let lim = j.limits_passing(ovr, end);
+                    // Never away from the target to reach an end velocity: the best
+                    // reachable one instead, with a warning.
+                    let planned = self
+                        .planner
+                        .plan_position_towards(from, j.target, end, &lim)
+                        .map(|reached| {
+                            j.planned_end = reached / ovr;
+                            if (reached - end).abs() > 1e-9 * (1.0 + end.abs()) {
+                                j.warn = Some(ErrorId::END_VELOCITY_ADJUSTED);
+                            }
+                            0.0
+                        });
+                    let toward = sign(j.target - from.position);
+                    if continuous && end != 0.0 && self.planner.overshoots(j.target, toward) {
+                        // Too fast to pass the target at any end velocity without running
+                        // past it and back: it passes the target in its motion and goes on
+                        // to the end velocity from there (never back to run at it again).
+                        j.past_target = true;
+                        j.planned_end = j.end_velocity;
+                        j.warn = Some(ErrorId::END_VELOCITY_ADJUSTED);
+                        self.planner
+                            .plan_velocity(from, end, &j.limits_passing(1.0, end))
+                    } else {
+                        planned
+                    }
                 }
             }
             JobKind::Velocity | JobKind::JogHeld { released: false } => {
@@ -608,7 +643,16 @@ impl Axis {
             JobKind::Gear => return true,
         };
         match res {
-            Ok(_) => true,
+            Ok(_) => {
+                let a = self.job.expect("planned above");
+                let dir = sign(a.target - from.position);
+                let blending =
+                    a.kind == (JobKind::Positioning { continuous: false }) && a.end_velocity != 0.0;
+                if blending && dir != 0.0 && self.planner.overshoots(a.target, dir) {
+                    self.pass_target_to_successor(a.target, dir);
+                }
+                true
+            }
             Err(_) => {
                 let (dec, jerk) = (
                     j.dec.max(self.config.parameters.axis_dec),
@@ -620,6 +664,22 @@ impl Axis {
                 j.pending_error = Some(ErrorId::PLANNING_FAILED);
                 false
             }
+        }
+    }
+
+    /// No end velocity lets the running positioning pass its target without overshooting it
+    /// (it is too fast to brake down to any in time): its blending successor takes over where
+    /// the axis passes the target, from the motion it has then, and the running job is done
+    /// there (with the warning that the blending velocity was not met).
+    fn pass_target_to_successor(&mut self, target: f64, dir: f64) {
+        let Some(b) = self.next.as_mut() else { return };
+        if !b.buffer_mode.is_blending() || (b.blend_at.is_some() && !b.blend_done) {
+            return;
+        }
+        b.blend_at = Some((target, dir));
+        b.blend_done = true;
+        if let Some(a) = self.job.as_mut() {
+            a.warn = Some(ErrorId::END_VELOCITY_ADJUSTED);
         }
     }
 
@@ -681,36 +741,63 @@ impl Axis {
         if a_dir == 0.0 {
             return;
         }
-        let from = self.plan_origin();
-        let target = a.target;
-        let mut lim = a.limits(ovr);
-        lim.velocity = lim.velocity.max(vb * ovr);
-        // Try the blending velocity; if it cannot be reached without overshooting the
-        // target, pass the target as fast as we can brake to, else stop there.
-        let now = if ovr > 0.0 {
-            from.velocity.abs() / ovr
-        } else {
-            0.0
-        };
-        for cand in [vb, now.min(vb), 0.0] {
-            let ok = ovr > 0.0
-                && self
-                    .planner
-                    .plan_position(from, target, a_dir * cand * ovr, &lim)
-                    .is_ok()
-                && !self.planner.overshoots(target, a_dir);
-            if ok {
-                if let Some(a) = self.job.as_mut() {
-                    a.end_velocity = a_dir * cand;
-                    a.planned_override = ovr;
+        // A successor that stops at its target must be able to stop there from the blending
+        // velocity: faster would overshoot its target and come back.
+        let (vb_asked, mut vb) = (vb, vb);
+        if b.kind == (JobKind::Positioning { continuous: false }) && ovr > 0.0 {
+            let room = (b.target - a.target).abs();
+            let (dec, jerk) = (b.dec.max(1e-9), b.jerk.max(1e-9));
+            // The successor takes over in the cycle after the target: up to a cycle later.
+            let dt = self.cycle_time;
+            let needs = |v: f64| stop_distance(v, 0.0, dec, jerk) + v * dt;
+            if needs(vb * ovr) > room {
+                let (mut lo, mut hi) = (0.0, vb * ovr);
+                for _ in 0..48 {
+                    let mid = 0.5 * (lo + hi);
+                    if needs(mid) > room {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
                 }
-                return;
+                vb = lo / ovr;
             }
         }
-        if let Some(a) = self.job.as_mut() {
-            a.end_velocity = 0.0;
+        let capped = vb < vb_asked;
+        let from = self.plan_origin();
+        let target = a.target;
+        let lim = a.limits_passing(ovr, vb * ovr);
+        // Pass the target at the blending velocity, or at the best one reachable moving only
+        // towards it (never backing up for a run-up, never overshooting and returning).
+        let planned = if ovr > 0.0 {
+            self.planner
+                .plan_position_towards(from, target, a_dir * vb * ovr, &lim)
+                .ok()
+        } else {
+            None
+        };
+        match planned {
+            Some(_) if self.planner.overshoots(target, a_dir) => {
+                self.pass_target_to_successor(target, a_dir);
+            }
+            Some(reached) => {
+                if let Some(a) = self.job.as_mut() {
+                    a.end_velocity = reached / ovr;
+                    a.planned_end = a.end_velocity;
+                    a.planned_override = ovr;
+                    let adjusted = (reached - a_dir * vb * ovr).abs() > 1e-9 * (1.0 + vb * ovr);
+                    if adjusted || capped {
+                        a.warn = Some(ErrorId::END_VELOCITY_ADJUSTED);
+                    }
+                }
+            }
+            None => {
+                if let Some(a) = self.job.as_mut() {
+                    a.end_velocity = 0.0;
+                }
+                self.plan_job_now();
+            }
         }
-        self.plan_job_now();
     }
 
     pub(super) fn step_job(
@@ -819,15 +906,9 @@ impl Axis {
                 let j = self.job.as_mut().expect("set");
                 j.planned_override = ovr;
                 let v = j.end_velocity * ovr;
-                let lim = j.limits(1.0);
-                let _ = self.planner.plan_velocity(
-                    self.set,
-                    v,
-                    &Limits {
-                        velocity: lim.velocity.max(v.abs()),
-                        ..lim
-                    },
-                );
+                let _ = self
+                    .planner
+                    .plan_velocity(self.set, v, &j.limits_passing(1.0, v));
             } else {
                 self.plan_job_now();
                 // Re-planning restarts the milestone.
@@ -856,10 +937,24 @@ impl Axis {
             self.set = k;
             self.set_has_superposition = false;
         }
+        // An end or blending velocity that could not be reached moving only towards the
+        // target was adjusted to the best reachable one: say so.
+        if let Some(w) = job.warn.take() {
+            let out = FbOutputs {
+                warning: true,
+                warning_id: w.0,
+                ..job.out
+            };
+            job.emit(out, slot, cycle, events);
+        }
         // A successor with its own blending position takes over where the axis passes it.
         if let Some((bp, dir)) = self.next.as_ref().and_then(|n| n.blend_at) {
             if (self.set.position - bp) * dir >= 0.0 {
-                job.finish_aborted(slot, cycle, events);
+                if self.next.as_ref().is_some_and(|n| n.blend_done) {
+                    job.finish_done(slot, cycle, events);
+                } else {
+                    job.finish_aborted(slot, cycle, events);
+                }
                 self.job = None;
                 if let Some(n) = self.next.take() {
                     self.start_job(n, cycle, events);
@@ -887,7 +982,22 @@ impl Axis {
                 self.job = Some(job);
             }
             JobKind::Positioning { continuous: true } => {
+                let short = (job.planned_end - job.end_velocity).abs()
+                    > 1e-9 * (1.0 + job.end_velocity.abs());
+                if finished
+                    && job.phase == Phase::Moving
+                    && job.planned_override > 0.0
+                    && !job.past_target
+                    && short
+                {
+                    // Passed the target slower than the end velocity: now run up to it.
+                    job.past_target = true;
+                    self.job = Some(job);
+                    self.plan_job_now();
+                    return;
+                }
                 if finished && job.phase == Phase::Moving && job.planned_override > 0.0 {
+                    job.past_target = true;
                     job.phase = Phase::Holding;
                     let out = FbOutputs {
                         in_end_velocity: true,

@@ -1,11 +1,14 @@
 //! Virtual-time test rig: a kernel, an ideal/PT1 plant per axis with cam, index pulse and
 //! latch, and invariant checks that run in EVERY cycle (FB protocol, state diagram,
 //! continuity, velocity/acceleration/jerk bounds of the axis, and of a motion command started
-//! from rest and left undisturbed its own dynamics: see [`FromRest`]).
+//! from rest and left undisturbed its own dynamics: see [`FromRest`]; a positioning job never
+//! moves away from its target: see [`Course`]; the set position never leaves an enabled
+//! software limit while the axis is commanded: see `check_soft_limits`).
 #![allow(dead_code)]
 
 use std::collections::{HashMap, HashSet};
 
+use motion::planner::sign;
 use motion::*;
 
 pub const DT: f64 = 0.001;
@@ -159,6 +162,26 @@ pub struct FromRest {
     pub jerk: f64,
 }
 
+/// A positioning job (MoveAbsolute/Relative/Additive/Continuous*, inching) as it runs: it
+/// may move away from its target only where no profile could avoid it — braking a motion
+/// that was heading away when it began, the release of an acceleration away from it, or an
+/// overshoot it could not brake for from its start — and after passing its target only when
+/// it goes on at an end velocity (MoveContinuous). MoveModulo's path and stops are not
+/// positioning towards a target and are not tracked.
+#[derive(Clone, Copy, Debug)]
+pub struct Course {
+    pub command: CommandId,
+    pub target: f64,
+    /// Direction from the start towards the target (±1).
+    dir: f64,
+    /// Still braking a motion away from the target that it began with.
+    braking_away: bool,
+    /// Backwards travel no profile avoids (release of an acceleration away from the target).
+    tolerance: f64,
+    /// It may pass its target: it goes on beyond it (continuous), or it could not stop in time.
+    may_pass: bool,
+}
+
 pub struct Rig {
     pub k: Kernel,
     pub plants: Vec<Plant>,
@@ -177,6 +200,14 @@ pub struct Rig {
     pub from_rest: Vec<Option<FromRest>>,
     /// Cycles checked against a [`FromRest`] command's own bounds (all axes).
     pub from_rest_cycles: u64,
+    /// Every accepted command's kind.
+    pub kinds: HashMap<CommandId, CommandKind>,
+    /// Per axis: the positioning job whose course is checked (see [`Course`]).
+    pub course: Vec<Option<Course>>,
+    /// Cycles checked against a positioning job's course (all axes).
+    pub course_cycles: u64,
+    /// Cycles checked against enabled software limits (all axes).
+    pub soft_limit_cycles: u64,
 }
 
 pub fn params() -> AxisParameters {
@@ -242,6 +273,10 @@ impl Rig {
             checked_cycles: 0,
             from_rest: vec![None; n],
             from_rest_cycles: 0,
+            kinds: HashMap::new(),
+            course: vec![None; n],
+            course_cycles: 0,
+            soft_limit_cycles: 0,
         }
     }
 
@@ -268,6 +303,7 @@ impl Rig {
         // Events of a submit are stamped with the cycle the command takes effect in.
         self.check_events_at(n, self.k.cycle() + 1);
         if v == Verdict::Accepted {
+            self.kinds.insert(id, kind);
             // Any accepted command disturbs the one started from rest; a motion command that
             // starts at once from rest is the next one checked against its own bounds.
             let before = before.unwrap();
@@ -465,6 +501,147 @@ impl Rig {
         );
     }
 
+    /// The dynamics (deceleration, jerk) a positioning command plans with, if it is one whose
+    /// course is checked, and whether it goes on beyond its target.
+    fn positioning(&self, axis: usize, id: CommandId) -> Option<(f64, f64, bool)> {
+        let p = self.k.parameters(axis as u16).unwrap();
+        let or = |x: f64, default: f64| if x == 0.0 { default } else { x };
+        let (d, continuous) = match *self.kinds.get(&id)? {
+            CommandKind::MoveAbsolute(m)
+            | CommandKind::MoveRelative(m)
+            | CommandKind::MoveAdditive(m) => (m.dynamics, false),
+            CommandKind::MoveContinuousAbsolute { move_: m, .. }
+            | CommandKind::MoveContinuousRelative { move_: m, .. } => (m.dynamics, true),
+            CommandKind::Jog {
+                mode: JogMode::Inching | JogMode::InchingModulo,
+                dynamics,
+                ..
+            } => (dynamics, false),
+            _ => return None,
+        };
+        Some((
+            or(d.deceleration, p.axis_dec),
+            or(d.jerk, p.axis_jerk),
+            continuous,
+        ))
+    }
+
+    /// Invariant (a): a positioning job never moves away from its target except where no
+    /// profile could avoid it (see [`Course`]). Checked in every cycle of every test.
+    fn check_course(&mut self, i: usize, p: &AxisStatus, s: &AxisStatus) {
+        let tracked = s.has_job
+            && matches!(
+                s.state,
+                AxisState::DiscreteMotion | AxisState::ContinuousMotion
+            )
+            && !s.compensating
+            && !p.compensating
+            && !self.shifted[i]
+            && !s.coupled;
+        let job = if tracked {
+            self.positioning(i, s.active_command)
+        } else {
+            None
+        };
+        let Some((dec, jerk, continuous)) = job else {
+            self.course[i] = None;
+            return;
+        };
+        let same = self.course[i]
+            .is_some_and(|c| c.command == s.active_command && c.target == s.target_position);
+        if !same {
+            // A new job (or one re-based): it begins from the previous cycle's setpoint.
+            let dir = sign(s.target_position - p.set_position);
+            if dir == 0.0 {
+                self.course[i] = None;
+                return;
+            }
+            let a_away = (p.set_acceleration * dir).min(0.0).abs();
+            let room = (s.target_position - p.set_position).abs();
+            let cannot_stop = p.set_velocity * dir > 0.0
+                && motion::planner::stop_distance(p.set_velocity, p.set_acceleration, dec, jerk)
+                    > room * (1.0 - 1e-9);
+            self.course[i] = Some(Course {
+                command: s.active_command,
+                target: s.target_position,
+                dir,
+                braking_away: p.set_velocity * dir < 0.0,
+                tolerance: a_away * a_away * a_away / (jerk * jerk),
+                may_pass: continuous || cannot_stop,
+            });
+        }
+        let c = self.course[i].unwrap();
+        self.course_cycles += 1;
+        if c.braking_away && s.set_velocity * c.dir >= 0.0 {
+            // Turned towards the target in this cycle: from the next one on, never back.
+            self.course[i].as_mut().unwrap().braking_away = false;
+        }
+        let tol = 1e-9 * (1.0 + s.set_position.abs()) + c.tolerance;
+        let step = (s.set_position - p.set_position) * c.dir;
+        let before_target = (c.target - p.set_position) * c.dir > 0.0;
+        if before_target {
+            assert!(
+                c.braking_away || step >= -tol,
+                "axis {i}: command {} moves away from its target {} before reaching it: \
+                 {} -> {} (v {}, {c:?})",
+                c.command,
+                c.target,
+                p.set_position,
+                s.set_position,
+                s.set_velocity
+            );
+        } else {
+            let beyond = (s.set_position - c.target) * c.dir;
+            assert!(
+                c.may_pass || beyond <= s.set_velocity.abs() * DT + tol,
+                "axis {i}: command {} passes its target {} by {beyond} although it could have \
+                 stopped there ({c:?})",
+                c.command,
+                c.target
+            );
+        }
+    }
+
+    /// Invariant (b): while the axis is commanded (not disabled, not in ErrorStop, not a
+    /// homing run, not a coupled slave, whose crossing is an axis error), the set position
+    /// never moves beyond an enabled software limit.
+    fn check_soft_limits(&mut self, i: usize, p: &AxisStatus, s: &AxisStatus) {
+        let par = self.k.parameters(i as u16).unwrap();
+        let commanded = !matches!(
+            s.state,
+            AxisState::Disabled | AxisState::ErrorStop | AxisState::Homing
+        ) && !matches!(p.state, AxisState::Disabled | AxisState::Homing)
+            && !s.coupled
+            && !p.coupled
+            && !self.shifted[i];
+        if !commanded || !(par.axis_en_max_soft_pos_limit || par.axis_en_min_soft_pos_limit) {
+            return;
+        }
+        self.soft_limit_cycles += 1;
+        let tol = 1e-9 * (1.0 + s.set_position.abs());
+        let outwards = s.set_position - p.set_position;
+        assert!(
+            !(par.axis_en_max_soft_pos_limit
+                && s.set_position > par.axis_max_soft_pos_limit + tol
+                && outwards > tol),
+            "axis {i}: set position {} -> {} beyond the positive software limit {} ({:?})",
+            p.set_position,
+            s.set_position,
+            par.axis_max_soft_pos_limit,
+            s.state
+        );
+        assert!(
+            !(par.axis_en_min_soft_pos_limit
+                && s.set_position < par.axis_min_soft_pos_limit - tol
+                && outwards < -tol),
+            "axis {i}: set position {} -> {} beyond the negative software limit {} ({:?})",
+            p.set_position,
+            s.set_position,
+            par.axis_min_soft_pos_limit,
+            s.state
+        );
+    }
+
     fn check_events(&mut self, from: usize) {
         self.check_events_at(from, self.k.cycle());
     }
@@ -584,6 +761,8 @@ impl Rig {
                 );
             }
             self.check_from_rest(i, &p, &s);
+            self.check_course(i, &p, &s);
+            self.check_soft_limits(i, &p, &s);
             self.shifted[i] = false;
             self.prev[i] = s;
             self.history[i].push(s);
