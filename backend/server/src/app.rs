@@ -19,8 +19,9 @@ use crate::error::{ApiError, ApiResult};
 use crate::model::{AxisConfigDto, ClientInfo, CommandEventDto, CommandResource, CommandState};
 use crate::params::{self, ParamValue};
 use crate::scope::{NewRecording, Recordings, ScopeBusy, ScopeRecording};
-use crate::sim::{FieldError, SimDrive};
+use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
+use drives::{Drive, DriveConfig};
 
 /// How many commands `GET /commands` remembers.
 pub const HISTORY: usize = 2000;
@@ -454,7 +455,7 @@ impl AppState {
         &self,
         slot: AxisSlot,
         axis: Box<Axis>,
-        drive: Box<SimDrive>,
+        drive: Drive,
         require_disabled: bool,
     ) -> ApiResult<Result<(), ErrorId>> {
         let ticket = self.next_id();
@@ -558,7 +559,7 @@ impl AppState {
         id: i64,
         config: &AxisConfigDto,
         persistent: &BTreeMap<u16, ParamValue>,
-    ) -> Result<(AxisParameters, Box<Axis>, Box<SimDrive>), Vec<FieldError>> {
+    ) -> Result<(AxisParameters, Box<Axis>, Drive), Vec<FieldError>> {
         let ct = self.info.cycle_time_s;
         let mut p = config.to_parameters(id, ct)?;
         for (n, v) in persistent {
@@ -577,7 +578,7 @@ impl AppState {
             },
             ct,
         );
-        let drive = Box::new(SimDrive::new(config.drive.clone(), ct));
+        let drive = DriveConfig::Simulated(config.drive.clone()).build(ct);
         Ok((p, axis, drive))
     }
 

@@ -1,5 +1,5 @@
-//! The cycle thread (DESIGN §2): owns the kernel and the drives; talks to the async side only
-//! through bounded lock-free queues and a triple buffer.
+//! The cycle thread (DESIGN §2): owns the kernel and the drive bus; talks to the async side
+//! only through bounded lock-free queues and a triple buffer.
 //!
 //! Inside the loop there is no allocation, no lock, no logging and no syscall except the
 //! timer (`clock_nanosleep` / `clock_gettime`). Axes are built off the thread and handed in as
@@ -14,8 +14,9 @@ use motion::{
     EventSink, Kernel, Verdict,
 };
 
+use drives::{BusError, Drive, DriveBus, SimFault};
+
 use crate::scope::{SCOPE_RING, ScopeConfig, ScopeFrame};
-use crate::sim::{SimDrive, SimFault};
 use crate::stats::CycleStats;
 
 /// Number of axis slots (fixed so that the cycle never allocates).
@@ -35,7 +36,7 @@ pub enum Request {
         ticket: u64,
         slot: AxisSlot,
         axis: Box<Axis>,
-        drive: Box<SimDrive>,
+        drive: Drive,
         require_disabled: bool,
     },
     RemoveAxis {
@@ -43,8 +44,9 @@ pub enum Request {
         slot: AxisSlot,
         require_disabled: bool,
     },
-    /// Inject a fault or disturbance into the simulated drive of a slot. It acts on the
-    /// drive's step in this cycle; the kernel reads it in the next cycle's feedback.
+    /// Inject a fault or disturbance into the simulated drive of a slot (the simulated bus
+    /// only). It acts on the drive's step in this cycle's exchange; the kernel reads it in
+    /// the next cycle.
     InjectFault {
         ticket: u64,
         slot: AxisSlot,
@@ -75,7 +77,7 @@ pub struct Reply {
 
 pub enum Garbage {
     Axis(#[allow(dead_code)] Box<Axis>),
-    Drive(#[allow(dead_code)] Box<SimDrive>),
+    Drive(#[allow(dead_code)] Drive),
 }
 
 /// Status of every slot at the end of one cycle.
@@ -266,7 +268,8 @@ pub fn request_realtime(priority: i32) -> RealtimeGrant {
 /// The state the cycle thread owns.
 pub struct CycleThread {
     pub kernel: Kernel,
-    pub drives: Vec<Option<Box<SimDrive>>>,
+    /// The process image exchange with every slot's drive (the simulated bus today).
+    pub bus: Box<dyn DriveBus>,
     pub shared: Arc<Shared>,
     pub snapshot: triple_buffer::Input<Snapshot>,
     /// What the scope samples (nothing by default: no frames are pushed then).
@@ -274,14 +277,17 @@ pub struct CycleThread {
 }
 
 impl CycleThread {
+    /// `bus` must have [`MAX_AXES`] slots.
     pub fn new(
         cycle_time_s: f64,
+        bus: Box<dyn DriveBus>,
         shared: Arc<Shared>,
         snapshot: triple_buffer::Input<Snapshot>,
     ) -> Self {
+        assert_eq!(bus.slots(), MAX_AXES, "one bus slot per axis slot");
         CycleThread {
             kernel: Kernel::new(cycle_time_s, MAX_AXES),
-            drives: (0..MAX_AXES).map(|_| None).collect(),
+            bus,
             shared,
             snapshot,
             scope: ScopeConfig::default(),
@@ -321,15 +327,10 @@ impl CycleThread {
         }
     }
 
-    /// One cycle without the timing: feedback, commands, kernel step, setpoints, publish.
+    /// One cycle without the timing: commands, kernel step on the feedback of the last
+    /// exchange, bus exchange (setpoints out, feedback in for the next cycle), publish.
     pub fn one_cycle(&mut self, feedback: &mut [DriveFeedback], setpoints: &mut [DriveSetpoint]) {
         let shared = &*self.shared;
-        for (fb, d) in feedback.iter_mut().zip(&self.drives) {
-            *fb = match d {
-                Some(d) => d.feedback(),
-                None => DriveFeedback::default(),
-            };
-        }
         let mut sink = RingSink {
             q: &shared.events,
             dropped: 0,
@@ -395,13 +396,22 @@ impl CycleThread {
                                 if let Some(old) = old {
                                     self.discard(Garbage::Axis(old));
                                 }
-                                if let Some(old) = self.drives[slot as usize].replace(drive) {
-                                    self.discard(Garbage::Drive(old));
-                                }
+                                let result = match self.bus.attach(slot as usize, drive) {
+                                    Ok(old) => {
+                                        if let Some(old) = old {
+                                            self.discard(Garbage::Drive(old));
+                                        }
+                                        Ok(())
+                                    }
+                                    Err(drive) => {
+                                        self.discard(Garbage::Drive(drive));
+                                        Err(ErrorId::AXIS_UNKNOWN)
+                                    }
+                                };
                                 Reply {
                                     ticket,
                                     cycle,
-                                    result: Ok(()),
+                                    result,
                                 }
                             }
                             Err(axis) => {
@@ -431,8 +441,7 @@ impl CycleThread {
                         if let Some(old) = self.kernel.remove_axis(slot) {
                             self.discard(Garbage::Axis(old));
                         }
-                        if let Some(old) = self.drives.get_mut(slot as usize).and_then(|d| d.take())
-                        {
+                        if let Some(old) = self.bus.detach(slot as usize) {
                             self.discard(Garbage::Drive(old));
                         }
                         Reply {
@@ -447,16 +456,10 @@ impl CycleThread {
                     slot,
                     fault,
                 } => {
-                    let drive = self
-                        .drives
-                        .get_mut(slot as usize)
-                        .and_then(|d| d.as_deref_mut());
-                    let result = match drive {
-                        Some(d) => {
-                            d.inject(fault);
-                            Ok(())
-                        }
-                        None => Err(ErrorId::AXIS_UNKNOWN),
+                    let result = match self.bus.inject(slot as usize, fault) {
+                        Ok(()) => Ok(()),
+                        Err(BusError::NoDrive) => Err(ErrorId::AXIS_UNKNOWN),
+                        Err(BusError::Unsupported) => Err(ErrorId::COMMAND_NOT_PERMITTED),
                     };
                     Reply {
                         ticket,
@@ -491,11 +494,8 @@ impl CycleThread {
             .fetch_add(drained as u64, Relaxed);
 
         self.kernel.step(feedback, setpoints, &mut sink);
-        for (d, sp) in self.drives.iter_mut().zip(setpoints.iter()) {
-            if let Some(d) = d {
-                d.apply(sp);
-            }
-        }
+        // Setpoints out, the drives' answers in: read by the next cycle's step.
+        self.bus.exchange(setpoints, feedback);
         if sink.dropped > 0 {
             shared.stats.events_dropped.fetch_add(sink.dropped, Relaxed);
         }

@@ -226,7 +226,8 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let cycle_thread = std::thread::Builder::new()
         .name("motiond-cycle".into())
         .spawn(move || {
-            let ct = cycle::CycleThread::new(cycle_time, thread_shared, input);
+            let bus = Box::new(drives::SimBus::new(cycle::MAX_AXES));
+            let ct = cycle::CycleThread::new(cycle_time, bus, thread_shared, input);
             let _ = grant_tx.send(cycle::request_realtime(80));
             ct.run();
         })

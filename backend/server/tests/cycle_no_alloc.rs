@@ -5,13 +5,13 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::Arc;
 
+use drives::{DriveConfig, SimBus, SimFault};
 use motion::{
     Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint,
     Positioning,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
 use server::scope::{ScopeConfig, ScopeSignal};
-use server::sim::{SimDrive, SimDriveConfig, SimFault};
 
 struct Counting;
 
@@ -57,7 +57,7 @@ fn a_cycle_allocates_nothing() {
     let ct = 0.001;
     let shared = Arc::new(Shared::new(1_000_000));
     let (input, mut output) = triple_buffer::triple_buffer(&Snapshot::default());
-    let mut cycle = CycleThread::new(ct, shared.clone(), input);
+    let mut cycle = CycleThread::new(ct, Box::new(SimBus::new(MAX_AXES)), shared.clone(), input);
     let mut fb = vec![DriveFeedback::default(); MAX_AXES];
     let mut sp = vec![DriveSetpoint::default(); MAX_AXES];
     let axis = || {
@@ -69,7 +69,7 @@ fn a_cycle_allocates_nothing() {
             ct,
         )
     };
-    let drive = || Box::new(SimDrive::new(SimDriveConfig::default(), ct));
+    let drive = || DriveConfig::default().build(ct);
     for slot in 0..3u16 {
         assert!(
             shared

@@ -5,18 +5,18 @@ use std::sync::Arc;
 use std::sync::atomic::Ordering::Relaxed;
 use std::time::Duration;
 
+use drives::{DriveConfig, SimBus};
 use motion::{
     Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
-use server::sim::{SimDrive, SimDriveConfig};
 
 #[test]
 fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
     let ct = 0.001;
     let shared = Arc::new(Shared::new(1_000_000));
     let (input, _output) = triple_buffer::triple_buffer(&Snapshot::default());
-    let mut cycle = CycleThread::new(ct, shared.clone(), input);
+    let mut cycle = CycleThread::new(ct, Box::new(SimBus::new(MAX_AXES)), shared.clone(), input);
     let mut fb = vec![DriveFeedback::default(); MAX_AXES];
     let mut sp = vec![DriveSetpoint::default(); MAX_AXES];
     let insert = |ticket: u64, slot: u16| Request::InsertAxis {
@@ -29,7 +29,7 @@ fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
             },
             ct,
         ),
-        drive: Box::new(SimDrive::new(SimDriveConfig::default(), ct)),
+        drive: DriveConfig::default().build(ct),
         require_disabled: false,
     };
     let power = |id: u64| {
