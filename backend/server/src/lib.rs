@@ -358,9 +358,7 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
         .map_err(|e| e.to_string())?
         .is_some();
     if !initialised {
-        sqlx::query("INSERT INTO meta (key, value) VALUES ('initialised', ?)")
-            .bind(store::now_rfc3339())
-            .execute(db)
+        store::mark_initialised(db)
             .await
             .map_err(|e| format!("cannot write the database: {e}"))?;
         if stored.is_empty() && !no_demo {

@@ -109,14 +109,7 @@ pub async fn create(
     let json = serde_json::to_string(&config).expect("config serialises");
     let mut tx = s.db.begin().await?;
     let now = store::now_rfc3339();
-    let id: i64 = sqlx::query_scalar("INSERT INTO axes (id, name, config, created_at, updated_at) VALUES (?, ?, ?, ?, ?) RETURNING id")
-        .bind(id)
-        .bind(&config.name)
-        .bind(&json)
-        .bind(&now)
-        .bind(&now)
-        .fetch_one(&mut *tx)
-        .await?;
+    let id = store::axes::insert_axis(&mut tx, id, &config.name, &json, &now).await?;
     store::audit(
         &mut *tx,
         &AuditEntry {
@@ -204,17 +197,8 @@ pub async fn replace_axis(
     check_name_free(&s, &config.name, Some(id))?;
     let json = serde_json::to_string(&config).expect("config serialises");
     let mut tx = s.db.begin().await?;
-    sqlx::query("UPDATE axes SET name = ?, config = ?, updated_at = ? WHERE id = ?")
-        .bind(&config.name)
-        .bind(&json)
-        .bind(store::now_rfc3339())
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
-    sqlx::query("DELETE FROM persistent_parameters WHERE axis_id = ?")
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
+    store::axes::update_axis(&mut tx, id, &config.name, &json, &store::now_rfc3339()).await?;
+    store::axes::clear_persistent(&mut tx, id).await?;
     store::audit(
         &mut *tx,
         &audit_entry(&client, "axis.replace", &old_name, json),
@@ -270,10 +254,7 @@ pub async fn delete_axis(
         )
     };
     let mut tx = s.db.begin().await?;
-    sqlx::query("DELETE FROM axes WHERE id = ?")
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
+    store::axes::delete_axis(&mut tx, id).await?;
     store::audit(
         &mut *tx,
         &audit_entry(&client, "axis.delete", &name, String::new()),
@@ -482,12 +463,8 @@ pub async fn write_parameter(
     };
     if w.persistent {
         let mut tx = s.db.begin().await?;
-        sqlx::query("INSERT INTO persistent_parameters (axis_id, number, value, updated_at) VALUES (?, ?, ?, ?) ON CONFLICT (axis_id, number) DO UPDATE SET value = excluded.value, updated_at = excluded.updated_at")
-            .bind(id)
-            .bind(info.storage as i64)
-            .bind(serde_json::to_string(&w.value).expect("value"))
-            .bind(store::now_rfc3339())
-            .execute(&mut *tx)
+        let value = serde_json::to_string(&w.value).expect("value");
+        store::axes::upsert_persistent(&mut tx, id, info.storage, &value, &store::now_rfc3339())
             .await?;
         store::audit(&mut *tx, &audit).await?;
         // The kernel checks the value with the same table (it should agree with the checks
@@ -665,27 +642,14 @@ pub async fn import_config(
         }
     }
     let mut tx = s.db.begin().await?;
-    sqlx::query("DELETE FROM axes").execute(&mut *tx).await?;
+    store::axes::delete_all_axes(&mut tx).await?;
     let now = store::now_rfc3339();
     for (a, persistent) in doc.axes.iter().zip(&built) {
-        sqlx::query(
-            "INSERT INTO axes (id, name, config, created_at, updated_at) VALUES (?, ?, ?, ?, ?)",
-        )
-        .bind(a.id)
-        .bind(&a.config.name)
-        .bind(serde_json::to_string(&a.config).expect("config"))
-        .bind(&now)
-        .bind(&now)
-        .execute(&mut *tx)
-        .await?;
+        let json = serde_json::to_string(&a.config).expect("config");
+        store::axes::insert_axis(&mut tx, Some(a.id), &a.config.name, &json, &now).await?;
         for (n, v) in persistent {
-            sqlx::query("INSERT INTO persistent_parameters (axis_id, number, value, updated_at) VALUES (?, ?, ?, ?)")
-                .bind(a.id)
-                .bind(*n as i64)
-                .bind(serde_json::to_string(v).expect("value"))
-                .bind(&now)
-                .execute(&mut *tx)
-                .await?;
+            let value = serde_json::to_string(v).expect("value");
+            store::axes::upsert_persistent(&mut tx, a.id, *n, &value, &now).await?;
         }
     }
     store::audit(

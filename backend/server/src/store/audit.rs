@@ -1,0 +1,73 @@
+//! The audit log: who did what, one row per change or command (written in the same
+//! transaction as a configuration change, or in batches for commands).
+
+use sqlx::{Row, SqlitePool};
+
+/// One audit log row.
+#[derive(Clone, Debug, Default)]
+pub struct AuditEntry {
+    pub at: String,
+    pub client_addr: Option<String>,
+    pub client_id: Option<String>,
+    pub action: String,
+    pub target: Option<String>,
+    pub command_id: Option<u64>,
+    pub detail: String,
+    pub outcome: Option<String>,
+}
+
+pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
+    e: E,
+    a: &AuditEntry,
+) -> Result<(), sqlx::Error> {
+    sqlx::query("INSERT INTO audit_log (at, client_addr, client_id, action, target, command_id, detail, outcome) VALUES (?, ?, ?, ?, ?, ?, ?, ?)")
+        .bind(&a.at)
+        .bind(&a.client_addr)
+        .bind(&a.client_id)
+        .bind(&a.action)
+        .bind(&a.target)
+        .bind(a.command_id.map(|c| c as i64))
+        .bind(&a.detail)
+        .bind(&a.outcome)
+        .execute(e)
+        .await
+        .map(|_| ())
+}
+
+/// One audit log row as stored.
+pub struct AuditRow {
+    pub id: i64,
+    pub entry: AuditEntry,
+}
+
+/// The newest rows with an id above `since_id`, newest first.
+pub async fn read_audit(
+    pool: &SqlitePool,
+    limit: u32,
+    since_id: i64,
+) -> Result<Vec<AuditRow>, sqlx::Error> {
+    let rows = sqlx::query(
+        "SELECT id, at, client_addr, client_id, action, target, command_id, detail, outcome \
+         FROM audit_log WHERE id > ? ORDER BY id DESC LIMIT ?",
+    )
+    .bind(since_id)
+    .bind(limit as i64)
+    .fetch_all(pool)
+    .await?;
+    Ok(rows
+        .into_iter()
+        .map(|r| AuditRow {
+            id: r.get(0),
+            entry: AuditEntry {
+                at: r.get(1),
+                client_addr: r.get(2),
+                client_id: r.get(3),
+                action: r.get(4),
+                target: r.get(5),
+                command_id: r.get::<Option<i64>, _>(6).map(|c| c as u64),
+                detail: r.get(7),
+                outcome: r.get(8),
+            },
+        })
+        .collect())
+}

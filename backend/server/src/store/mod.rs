@@ -1,0 +1,105 @@
+//! SQLite store (DESIGN §5): WAL, synchronous=FULL, one writer connection. All SQL lives in
+//! this module, one submodule per table group ([`axes`]: axes and their persistent
+//! parameters; [`audit`]: the audit log); the service decides what goes into a transaction.
+//!
+//! The database is opened with `locking_mode=EXCLUSIVE`, so a second motiond on the same
+//! file fails at start-up with "database is locked" instead of two processes writing.
+
+pub mod audit;
+pub mod axes;
+
+pub use audit::{AuditEntry, AuditRow, audit, read_audit};
+pub use axes::{StoredAxis, load_axes, load_persistent};
+
+use std::str::FromStr;
+use std::time::Duration;
+
+use sqlx::SqlitePool;
+use sqlx::migrate::Migrator;
+use sqlx::sqlite::{
+    SqliteConnectOptions, SqliteJournalMode, SqliteLockingMode, SqlitePoolOptions,
+    SqliteSynchronous,
+};
+
+/// The schema migrations of `migrations/`, embedded at build time.
+pub fn migrator() -> Migrator {
+    sqlx::migrate!("../../migrations")
+}
+
+/// Opens (creating if needed), checks and migrates the database.
+pub async fn open(path: &str) -> Result<SqlitePool, String> {
+    let memory = path == ":memory:";
+    let opts = if memory {
+        SqliteConnectOptions::from_str("sqlite::memory:").map_err(|e| e.to_string())?
+    } else {
+        SqliteConnectOptions::new()
+            .filename(path)
+            .create_if_missing(true)
+    };
+    let opts = opts
+        .journal_mode(if memory {
+            SqliteJournalMode::Memory
+        } else {
+            SqliteJournalMode::Wal
+        })
+        .synchronous(SqliteSynchronous::Full)
+        .locking_mode(SqliteLockingMode::Exclusive)
+        .busy_timeout(Duration::from_secs(2))
+        .foreign_keys(true);
+    // One connection: SQLite has one writer anyway, `:memory:` is per connection, and the
+    // exclusive lock is per connection.
+    let pool = SqlitePoolOptions::new()
+        .max_connections(1)
+        .min_connections(1)
+        .idle_timeout(None)
+        .max_lifetime(None)
+        .acquire_timeout(Duration::from_secs(10))
+        .connect_with(opts)
+        .await
+        .map_err(|e| format!("cannot open database {path}: {e}"))?;
+    let check: String = sqlx::query_scalar("PRAGMA quick_check")
+        .fetch_one(&pool)
+        .await
+        .map_err(|e| format!("database {path} is unreadable: {e}"))?;
+    if check != "ok" {
+        return Err(format!("database {path} is corrupt: {check}"));
+    }
+    migrator()
+        .run(&pool)
+        .await
+        .map_err(|e| format!("cannot migrate database {path}: {e}"))?;
+    // A write takes the exclusive lock and keeps it: a second motiond on this file fails.
+    sqlx::query("INSERT INTO meta (key, value) VALUES ('last_start', ?) ON CONFLICT (key) DO UPDATE SET value = excluded.value")
+        .bind(now_rfc3339())
+        .execute(&pool)
+        .await
+        .map_err(|e| format!("cannot write database {path} (is another motiond using it?): {e}"))?;
+    Ok(pool)
+}
+
+pub async fn meta(pool: &SqlitePool, key: &str) -> Result<Option<String>, sqlx::Error> {
+    sqlx::query_scalar("SELECT value FROM meta WHERE key = ?")
+        .bind(key)
+        .fetch_optional(pool)
+        .await
+}
+
+pub async fn max_command_id(pool: &SqlitePool) -> Result<u64, sqlx::Error> {
+    let v: Option<i64> = sqlx::query_scalar("SELECT max(command_id) FROM audit_log")
+        .fetch_one(pool)
+        .await?;
+    Ok(v.unwrap_or(0) as u64)
+}
+
+/// Records the first start of a database (the demo machine is created only then).
+pub async fn mark_initialised(pool: &SqlitePool) -> Result<(), sqlx::Error> {
+    sqlx::query("INSERT INTO meta (key, value) VALUES ('initialised', ?)")
+        .bind(now_rfc3339())
+        .execute(pool)
+        .await
+        .map(|_| ())
+}
+
+pub fn now_rfc3339() -> String {
+    humantime::format_rfc3339_millis(std::time::SystemTime::now()).to_string()
+}
