@@ -591,8 +591,16 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
 #[tokio::test(flavor = "multi_thread")]
 async fn system_and_metrics_report_cycle_timing() {
     let s = Server::start();
-    tokio::time::sleep(Duration::from_millis(300)).await;
-    let r = get(&s, "/api/v1/system").await;
+    // At least 100 cycles (counted, not waited for: a loaded machine stretches time).
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    let r = loop {
+        let r = get(&s, "/api/v1/system").await;
+        if r.json["timing"]["cycles"].as_u64().unwrap_or(0) > 100 {
+            break r;
+        }
+        assert!(std::time::Instant::now() < deadline, "{}", r.text);
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
     assert_eq!(r.status, 200);
     assert_eq!(r.json["cycle_time"], 0.001);
     assert!(

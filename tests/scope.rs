@@ -142,8 +142,15 @@ async fn a_triggered_recording_puts_the_crossing_at_t_zero_after_its_pre_trigger
     assert_eq!(r.json["state"], "armed");
     let pre = (0.1 / cycle).round() as usize;
     assert_eq!(r.json["pre_trigger_samples"].as_u64(), Some(pre as u64));
-    // The trigger looks for crossings once the pre-trigger history is full.
-    tokio::time::sleep(Duration::from_millis(250)).await;
+    // The trigger looks for crossings once the pre-trigger history is full: wait for the
+    // cycles (not for time, which a loaded machine stretches).
+    let armed_at = get(&s, "/api/v1/system").await.json["cycle"].as_u64().unwrap();
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    while get(&s, "/api/v1/system").await.json["cycle"].as_u64().unwrap() < armed_at + pre as u64 + 10
+    {
+        assert!(std::time::Instant::now() < deadline, "the cycle does not advance");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
     let armed = get(&s, &format!("{RECORDINGS}/{id}")).await;
     assert_eq!(armed.json["state"], "armed", "{}", armed.text);
     let m = post(
