@@ -713,6 +713,7 @@ async fn openapi_json_is_current() {
         );
     }
     check_examples(&doc);
+    check_generator_friendly(&doc, "#");
     let paths = doc["paths"].as_object().unwrap();
     for p in [
         "/api/v1/axes",
@@ -736,6 +737,41 @@ async fn openapi_json_is_current() {
     assert_eq!(paths.len(), 37, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
+}
+
+/// What client generators refuse (openapi-python-client drops every schema and operation that
+/// uses one): a one-element `oneOf` (utoipa's way of giving a `$ref` a default) and an object or
+/// array `default` beside a `$ref`. `tests/client/check.sh` runs the generators themselves.
+fn check_generator_friendly(v: &Value, at: &str) {
+    match v {
+        Value::Object(m) => {
+            if let Some(Value::Array(items)) = m.get("oneOf") {
+                assert!(items.len() > 1, "{at}: a oneOf of one schema");
+            }
+            let has_ref = m.contains_key("$ref")
+                || m.get("oneOf").and_then(Value::as_array).is_some_and(|items| {
+                    items.iter().any(|i| i.get("$ref").is_some())
+                });
+            if has_ref {
+                assert!(
+                    !m.get("default").is_some_and(|d| d.is_object() || d.is_array()),
+                    "{at}: an object default beside a $ref"
+                );
+            }
+            for (k, v) in m {
+                // Examples are values, not schemas.
+                if k != "example" && k != "examples" {
+                    check_generator_friendly(v, &format!("{at}/{k}"));
+                }
+            }
+        }
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                check_generator_friendly(v, &format!("{at}/{i}"));
+            }
+        }
+        _ => {}
+    }
 }
 
 /// A full disk at run time: the write that does not fit is a 503 and leaves nothing behind;

@@ -507,25 +507,44 @@ pub struct MoveVelocityBody {
     pub options: MoveOptions,
 }
 
+// Bodies whose every field may be left out name their defaults field by field (not with a
+// container `#[serde(default)]`): utoipa would write a nested struct's default as an object
+// `default` beside a one-element `oneOf`, which client generators refuse. Scalars keep a
+// documented `default`; enums and objects say theirs in the description.
+
 /// MC_Halt.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 #[schema(example = json!({"deceleration": 1000.0}))]
 pub struct HaltBody {
     /// 0 = that of the running job.
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub deceleration: f64,
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub jerk: f64,
+    /// Default `aborting`.
+    #[serde(default)]
     pub buffer_mode: BufferMode,
+    /// Default: none set.
+    #[serde(default)]
     pub options: MoveOptions,
 }
 
 /// MC_Stop.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 #[schema(example = json!({"deceleration": 5000.0, "jerk": 50000.0}))]
 pub struct StopBody {
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub deceleration: f64,
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub jerk: f64,
+    /// Default: none set.
+    #[serde(default)]
     pub options: MoveOptions,
 }
 
@@ -539,20 +558,39 @@ pub enum JogDirection {
 
 /// MC_Jog: a press of JogForward / JogBackwards; held by keepalives (dead-man).
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 #[schema(example = json!({"direction": "forward", "mode": "standard_slow", "deadman_timeout": 0.5}))]
 pub struct JogBody {
+    /// Default `forward`.
+    #[serde(default)]
     pub direction: JogDirection,
+    /// Default `standard_slow`.
+    #[serde(default)]
     pub mode: JogMode,
     /// Inching distance (inching modes).
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub position: f64,
     /// Continuous mode velocity.
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub velocity: f64,
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub acceleration: f64,
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub deceleration: f64,
+    #[serde(default)]
+    #[schema(default = 0.0)]
     pub jerk: f64,
     /// Seconds without keepalive after which the jog stops (0.05–10; default 0.5).
+    #[serde(default = "default_deadman_timeout")]
+    #[schema(default = 0.5)]
     pub deadman_timeout: f64,
+}
+fn default_deadman_timeout() -> f64 {
+    0.5
 }
 impl Default for JogBody {
     fn default() -> Self {
@@ -564,20 +602,24 @@ impl Default for JogBody {
             acceleration: 0.0,
             deceleration: 0.0,
             jerk: 0.0,
-            deadman_timeout: 0.5,
+            deadman_timeout: default_deadman_timeout(),
         }
     }
 }
 
 /// MC_Home.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 #[schema(example = json!({"mode": "direct", "position": 0.0}))]
 pub struct HomeBody {
     /// None = the calibration value (#1075).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position: Option<f64>,
+    /// Default `default` (the referencing sequence configured by #1076).
+    #[serde(default)]
     pub mode: HomingMode,
+    /// Default: none set.
+    #[serde(default)]
     pub options: HomingOptions,
 }
 

@@ -1532,16 +1532,10 @@ export interface components {
              * @default 0
              */
             jerk: number;
-            /** @default aborting */
-            buffer_mode: components["schemas"]["BufferMode"];
-            /**
-             * @default {
-             *       "blending_position": null,
-             *       "enable_stop_position_monitoring": false,
-             *       "ignore_position_monitoring": false
-             *     }
-             */
-            options: components["schemas"]["MoveOptions"];
+            /** @description Default `aborting`. */
+            buffer_mode?: components["schemas"]["BufferMode"];
+            /** @description Default: none set. */
+            options?: components["schemas"]["MoveOptions"];
         };
         /**
          * @description MC_Home.
@@ -1554,22 +1548,12 @@ export interface components {
             /**
              * Format: double
              * @description None = the calibration value (#1075).
-             * @default null
              */
-            position: number | null;
-            /** @default default */
-            mode: components["schemas"]["HomingMode"];
-            /**
-             * @default {
-             *       "clear_position_lag": false,
-             *       "reference_mode": null,
-             *       "search_direction": null,
-             *       "search_velocity": null,
-             *       "sync_direction": null,
-             *       "sync_velocity": null
-             *     }
-             */
-            options: components["schemas"]["HomingOptions"];
+            position?: number | null;
+            /** @description Default `default` (the referencing sequence configured by #1076). */
+            mode?: components["schemas"]["HomingMode"];
+            /** @description Default: none set. */
+            options?: components["schemas"]["HomingOptions"];
         };
         /** @enum {string} */
         HomingMode: "default" | "direct" | "force_calibration" | "reset_calibration";
@@ -1642,10 +1626,10 @@ export interface components {
          *     }
          */
         JogBody: {
-            /** @default forward */
-            direction: components["schemas"]["JogDirection"];
-            /** @default standard_slow */
-            mode: components["schemas"]["JogMode"];
+            /** @description Default `forward`. */
+            direction?: components["schemas"]["JogDirection"];
+            /** @description Default `standard_slow`. */
+            mode?: components["schemas"]["JogMode"];
             /**
              * Format: double
              * @description Inching distance (inching modes).
@@ -2427,14 +2411,8 @@ export interface components {
          *     }
          */
         SimDriveConfig: {
-            /**
-             * @default {
-             *       "damping": 0.8,
-             *       "kind": "pt2",
-             *       "natural_frequency_hz": 50
-             *     }
-             */
-            plant: components["schemas"]["PlantModel"];
+            /** @description Closed-loop response of the position-controlled load. Default: `{"damping":0.8,"kind":"pt2","natural_frequency_hz":50.0}`. */
+            plant?: components["schemas"]["PlantModel"];
             /**
              * Format: double
              * @description Delay between a setpoint and its effect on the load (s, 0…0.1).
@@ -2478,28 +2456,12 @@ export interface components {
              * @default 1000
              */
             load_stiffness: number;
-            /**
-             * @default {
-             *       "end": 25,
-             *       "start": 20
-             *     }
-             */
-            reference_cam: null | components["schemas"]["ReferenceCam"];
-            /**
-             * @default {
-             *       "offset": 0,
-             *       "period": 10
-             *     }
-             */
-            index_pulse: null | components["schemas"]["IndexPulse"];
-            /**
-             * @default {
-             *       "fault_on_hit": false,
-             *       "negative": null,
-             *       "positive": null
-             *     }
-             */
-            limit_switches: components["schemas"]["LimitSwitches"];
+            /** @description Reference cam (homing switch); `null` for none. Default: `{"end":25.0,"start":20.0}`. */
+            reference_cam?: null | components["schemas"]["ReferenceCam"];
+            /** @description Encoder index (zero) pulse; `null` for none. Default: `{"offset":0.0,"period":10.0}`. */
+            index_pulse?: null | components["schemas"]["IndexPulse"];
+            /** @description Hardware limit switches. Default: `{"fault_on_hit":false,"negative":null,"positive":null}`. */
+            limit_switches?: components["schemas"]["LimitSwitches"];
         };
         /**
          * @description A fault or disturbance injected into the simulation (tests, demos, commissioning).
@@ -2634,14 +2596,8 @@ export interface components {
              * @default 0
              */
             jerk: number;
-            /**
-             * @default {
-             *       "blending_position": null,
-             *       "enable_stop_position_monitoring": false,
-             *       "ignore_position_monitoring": false
-             *     }
-             */
-            options: components["schemas"]["MoveOptions"];
+            /** @description Default: none set. */
+            options?: components["schemas"]["MoveOptions"];
         };
         /**
          * @description A reader's copy of a histogram's figures, in microseconds.
@@ -3634,7 +3590,12 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody?: never;
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
         responses: {
             /** @description Deleted */
             204: {
@@ -4820,7 +4781,12 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody?: never;
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
         responses: {
             /** @description Reset; the peak hold counts from `cycle` */
             200: {
@@ -4955,7 +4921,12 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody?: never;
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
         responses: {
             /** @description Released; the command as it stands */
             200: {
@@ -4984,7 +4955,12 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody?: never;
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
         responses: {
             /** @description Renewed */
             204: {
@@ -5156,7 +5132,12 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody?: never;
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
         responses: {
             /** @description Cancelled */
             200: {

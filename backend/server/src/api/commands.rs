@@ -637,6 +637,7 @@ fn slot_of(s: &AppState, id: u64) -> ApiResult<u16> {
 #[utoipa::path(delete, path = "/api/v1/commands/{id}", tag = "commands",
     summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog, a power or a gear-in-dyn",
     params(("id" = u64, Path, description = "command id")),
+    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
     responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandControlErrors))]
 pub async fn release_command(
     State(s): State<Arc<AppState>>,
@@ -657,6 +658,7 @@ pub async fn release_command(
 
 #[utoipa::path(post, path = "/api/v1/commands/{id}/keepalive", tag = "commands", summary = "Renew a jog's dead-man",
     params(("id" = u64, Path, description = "command id")),
+    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
     responses((status = 204, description = "Renewed"), CommandControlErrors))]
 pub async fn keepalive(
     State(s): State<Arc<AppState>>,

@@ -371,7 +371,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),
-    modifiers(&ForeignExamples, &ErrorResponses, &RequestChecks),
+    modifiers(&ForeignExamples, &ErrorResponses, &RequestChecks, &PlainRefs),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
@@ -467,6 +467,84 @@ impl utoipa::Modify for ForeignExamples {
             };
             slot.get_or_insert(example);
         }
+    }
+}
+
+/// Schemas of types defined outside the server (the simulated drive's configuration) as client
+/// generators take them: utoipa writes a field whose type is another schema and whose container
+/// has `#[serde(default)]` as a one-element `oneOf` with the default object beside it, which
+/// `openapi-python-client` refuses (and with it every schema and operation that uses it). Here
+/// such a field becomes a plain `$ref`, and an object or array `default` beside a `$ref` is
+/// dropped and named in the description instead. The server's own types are written so that
+/// utoipa needs none of this (`model.rs`); `openapi_json_is_current` checks the whole document.
+struct PlainRefs;
+
+/// The component schemas [`PlainRefs`] rewrites.
+const FOREIGN_WITH_DEFAULTS: &[&str] = &["SimDriveConfig"];
+
+impl utoipa::Modify for PlainRefs {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::{RefOr, schema::Schema};
+        let Some(components) = doc.components.as_mut() else {
+            return;
+        };
+        for name in FOREIGN_WITH_DEFAULTS {
+            let Some(RefOr::T(Schema::Object(schema))) = components.schemas.get_mut(*name) else {
+                continue;
+            };
+            // Property by property, so that their order stays.
+            for prop in schema.properties.values_mut() {
+                let mut v = serde_json::to_value(&*prop).expect("schemas serialise");
+                plain_ref(&mut v);
+                *prop = serde_json::from_value(v).expect("a rewritten schema is a schema");
+            }
+        }
+    }
+}
+
+/// One property: `{oneOf: [{$ref, description}], default}` → `{$ref, description}`, and an
+/// object or array `default` beside a `$ref` (also `oneOf: [null, $ref]`) → into the description.
+fn plain_ref(prop: &mut serde_json::Value) {
+    use serde_json::Value;
+    let Value::Object(m) = prop else { return };
+    let Some(Value::Array(items)) = m.get("oneOf").cloned() else {
+        return;
+    };
+    if !items.iter().any(|i| i.get("$ref").is_some()) {
+        return;
+    }
+    let default = m.remove("default");
+    let inner_description = items
+        .iter()
+        .find_map(|i| i.get("description").and_then(Value::as_str))
+        .map(str::to_owned);
+    let mut description = m
+        .get("description")
+        .and_then(Value::as_str)
+        .map(str::to_owned)
+        .or(inner_description)
+        .unwrap_or_default();
+    if let Some(d) = default.filter(|d| !d.is_null()) {
+        if !description.is_empty() {
+            description.push(' ');
+        }
+        description.push_str(&format!("Default: `{d}`."));
+    }
+    if items.len() == 1 {
+        let r = items[0]["$ref"].clone();
+        m.clear();
+        m.insert("$ref".into(), r);
+    } else {
+        // Option<T>: keep `oneOf: [null, $ref]`; the description goes to the property.
+        if let Some(Value::Array(items)) = m.get_mut("oneOf") {
+            items
+                .iter_mut()
+                .filter_map(Value::as_object_mut)
+                .for_each(|i| drop(i.remove("description")));
+        }
+    }
+    if !description.is_empty() {
+        m.insert("description".into(), Value::String(description));
     }
 }
 

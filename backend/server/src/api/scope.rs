@@ -371,6 +371,7 @@ fn to_csv(r: &ScopeRecording) -> String {
     description = "An `armed` or `recording` recording is cancelled (200 with the recording, state `cancelled`; \
 it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, `failed`) is deleted (204).",
     params(("id" = u64, Path, description = "recording id")),
+    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
     responses(
         (status = 200, description = "Cancelled", body = ScopeRecording),
         (status = 204, description = "Deleted"),
