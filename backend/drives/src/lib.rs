@@ -20,6 +20,7 @@
 //! ```
 
 pub mod bus;
+pub mod cia402;
 pub mod sim;
 
 pub use bus::{BusError, Drive, DriveBus, DriveConfig, SimBus};

@@ -1,0 +1,335 @@
+//! A CiA-402 servo drive behind the kernel's setpoint and feedback: the device state machine
+//! (statusword 0x6041 / controlword 0x6040) driven by MC_Power and MC_Reset, scaling between
+//! engineering units and the drive's increments (0x607A target, 0x6064 actual position with
+//! its 32-bit counter unwrapped), the cyclic synchronous modes CSP and CSV (0x6060 / 0x6061),
+//! the error code 0x603F, the digital inputs 0x60FD (limit and home switches) and the touch
+//! probe 0x60B8–0x60BB. Pure logic on the process data: no I/O, so it is tested without a
+//! network; an EtherCAT bus maps [`RxPdo`] / [`TxPdo`] onto a SubDevice's process image.
+
+use motion::{DriveFeedback, DriveSetpoint, LatchSource};
+use serde::{Deserialize, Serialize};
+
+use crate::sim::FieldError;
+
+/// Cyclic synchronous mode of operation (0x6060).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Cia402Mode {
+    /// Cyclic synchronous position (8): the drive closes the position loop on our setpoints.
+    #[default]
+    Csp,
+    /// Cyclic synchronous velocity (9): we close the position loop (`position_gain`) and send
+    /// the velocity with the feed-forward.
+    Csv,
+}
+
+impl Cia402Mode {
+    /// The 0x6060 value.
+    pub fn code(self) -> i8 {
+        match self {
+            Cia402Mode::Csp => 8,
+            Cia402Mode::Csv => 9,
+        }
+    }
+}
+
+/// How a CiA-402 drive is configured for one axis.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cia402Config {
+    /// Position of the drive on the bus (0 = first SubDevice).
+    pub subdevice: u16,
+    /// Position increments (0x6064 / 0x607A) per engineering unit.
+    pub increments_per_unit: f64,
+    /// Velocity increments (0x606C / 0x60FF) per engineering unit per second; the position
+    /// increments when not given.
+    #[serde(default)]
+    pub velocity_increments_per_unit: Option<f64>,
+    #[serde(default)]
+    pub mode: Cia402Mode,
+    /// CSV only: position loop gain (1/s) closed on our side.
+    #[serde(default = "default_gain")]
+    pub position_gain: f64,
+}
+
+fn default_gain() -> f64 {
+    50.0
+}
+
+impl Cia402Config {
+    /// Checks every field; errors name the field by its JSON path below the drive object.
+    pub fn validate(&self) -> Result<(), Vec<FieldError>> {
+        let mut errors = Vec::new();
+        let mut positive = |field: &str, v: f64| {
+            if !(v.is_finite() && v > 0.0) {
+                errors.push(FieldError {
+                    field: field.into(),
+                    message: "must be a finite number > 0".into(),
+                });
+            }
+        };
+        positive("increments_per_unit", self.increments_per_unit);
+        if let Some(v) = self.velocity_increments_per_unit {
+            positive("velocity_increments_per_unit", v);
+        }
+        positive("position_gain", self.position_gain);
+        if errors.is_empty() {
+            Ok(())
+        } else {
+            Err(errors)
+        }
+    }
+}
+
+/// What the drive sends each cycle (its TxPDO).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TxPdo {
+    /// 0x6041.
+    pub statusword: u16,
+    /// 0x6064, increments (a 32-bit counter that wraps).
+    pub position_actual: i32,
+    /// 0x606C, velocity increments per second.
+    pub velocity_actual: i32,
+    /// 0x6061.
+    pub mode_display: i8,
+    /// 0x603F.
+    pub error_code: u16,
+    /// 0x60FD: bit 0 negative limit switch, bit 1 positive limit switch, bit 2 home switch.
+    pub digital_inputs: u32,
+    /// 0x60B9: bit 0 probe 1 enabled, bit 1 positive edge stored, bit 2 negative edge stored.
+    pub touch_probe_status: u16,
+    /// 0x60BA: probe 1 position at the positive edge.
+    pub touch_probe_pos_edge: i32,
+    /// 0x60BB: probe 1 position at the negative edge.
+    pub touch_probe_neg_edge: i32,
+}
+
+/// What we send to the drive each cycle (its RxPDO).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RxPdo {
+    /// 0x6040.
+    pub controlword: u16,
+    /// 0x607A, increments.
+    pub target_position: i32,
+    /// 0x60FF, velocity increments per second.
+    pub target_velocity: i32,
+    /// 0x6060.
+    pub mode: i8,
+    /// 0x60B8: bit 0 enable probe 1, bit 2 source (0 probe input, 1 index pulse), bit 4
+    /// latch the positive edge, bit 5 latch the negative edge.
+    pub touch_probe_function: u16,
+}
+
+/// The CiA-402 device states (statusword bits 0–3, 5, 6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cia402State {
+    NotReadyToSwitchOn,
+    SwitchOnDisabled,
+    ReadyToSwitchOn,
+    SwitchedOn,
+    OperationEnabled,
+    QuickStopActive,
+    FaultReactionActive,
+    Fault,
+}
+
+impl Cia402State {
+    pub fn from_statusword(sw: u16) -> Cia402State {
+        use Cia402State::*;
+        match (sw & 0x4F, sw & 0x6F) {
+            (0x00, _) => NotReadyToSwitchOn,
+            (0x40, _) => SwitchOnDisabled,
+            (_, 0x21) => ReadyToSwitchOn,
+            (_, 0x23) => SwitchedOn,
+            (_, 0x27) => OperationEnabled,
+            (_, 0x07) => QuickStopActive,
+            (0x0F, _) => FaultReactionActive,
+            (0x08, _) => Fault,
+            // Undefined combinations: treat as not ready (never as enabled).
+            _ => NotReadyToSwitchOn,
+        }
+    }
+}
+
+/// Controlword commands (CiA-402 device control).
+pub mod controlword {
+    pub const DISABLE_VOLTAGE: u16 = 0x0000;
+    pub const SHUTDOWN: u16 = 0x0006;
+    pub const SWITCH_ON: u16 = 0x0007;
+    pub const ENABLE_OPERATION: u16 = 0x000F;
+    pub const FAULT_RESET: u16 = 0x0080;
+}
+
+const TP_ENABLE: u16 = 1 << 0;
+const TP_SOURCE_INDEX: u16 = 1 << 2;
+const TP_POS_EDGE: u16 = 1 << 4;
+const TP_NEG_EDGE: u16 = 1 << 5;
+const TP_STORED_POS: u16 = 1 << 1;
+const TP_STORED_NEG: u16 = 1 << 2;
+
+/// One axis's CiA-402 drive as the kernel sees it. Allocation-free.
+#[derive(Clone, Debug)]
+pub struct Cia402Drive {
+    config: Cia402Config,
+    /// The actual position unwrapped to 64 bits (increments), and the raw value it came from.
+    position: i64,
+    last_raw: i32,
+    seen: bool,
+    last: TxPdo,
+}
+
+impl Cia402Drive {
+    pub fn new(config: Cia402Config) -> Cia402Drive {
+        Cia402Drive {
+            config,
+            position: 0,
+            last_raw: 0,
+            seen: false,
+            last: TxPdo::default(),
+        }
+    }
+
+    pub fn config(&self) -> &Cia402Config {
+        &self.config
+    }
+
+    fn velocity_scale(&self) -> f64 {
+        self.config
+            .velocity_increments_per_unit
+            .unwrap_or(self.config.increments_per_unit)
+    }
+
+    /// Reads the drive's inputs of this cycle into the kernel's feedback.
+    pub fn feedback(&mut self, tx: &TxPdo) -> DriveFeedback {
+        // Unwrap the 32-bit position counter: consecutive readings differ by far less than
+        // half its range.
+        if self.seen {
+            self.position += tx.position_actual.wrapping_sub(self.last_raw) as i64;
+        } else {
+            self.position = tx.position_actual as i64;
+            self.seen = true;
+        }
+        self.last_raw = tx.position_actual;
+        self.last = *tx;
+        let state = Cia402State::from_statusword(tx.statusword);
+        let fault = matches!(state, Cia402State::Fault | Cia402State::FaultReactionActive);
+        let (latch_valid, latch_raw) = self.latched(tx);
+        let latch_position = self.position + latch_raw.wrapping_sub(tx.position_actual) as i64;
+        DriveFeedback {
+            ready: !fault && state != Cia402State::NotReadyToSwitchOn,
+            // Following our setpoints only in the mode we send them for.
+            enabled: state == Cia402State::OperationEnabled
+                && tx.mode_display == self.config.mode.code(),
+            fault,
+            fault_code: if fault { tx.error_code as u32 } else { 0 },
+            actual_position: self.position as f64 / self.config.increments_per_unit,
+            actual_velocity: tx.velocity_actual as f64 / self.velocity_scale(),
+            reference_cam: tx.digital_inputs & 0b100 != 0,
+            limit_positive: tx.digital_inputs & 0b010 != 0,
+            limit_negative: tx.digital_inputs & 0b001 != 0,
+            latch_valid,
+            latch_position: if latch_valid {
+                latch_position as f64 / self.config.increments_per_unit
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The probe's stored edge for the armed source, if it has one.
+    fn latched(&self, tx: &TxPdo) -> (bool, i32) {
+        let s = tx.touch_probe_status;
+        if s & TP_ENABLE == 0 {
+            return (false, 0);
+        }
+        if s & TP_STORED_POS != 0 {
+            (true, tx.touch_probe_pos_edge)
+        } else if s & TP_STORED_NEG != 0 {
+            (true, tx.touch_probe_neg_edge)
+        } else {
+            (false, 0)
+        }
+    }
+
+    /// The outputs for the kernel's setpoint of this cycle, given the inputs last read
+    /// ([`Cia402Drive::feedback`]): one step of the device state machine towards what MC_Power
+    /// asks (enable: operation enabled; disable: ready to switch on, power stage off), fault
+    /// reset on the kernel's edge, and the setpoint scaled to increments.
+    pub fn outputs(&self, sp: &DriveSetpoint) -> RxPdo {
+        use Cia402State::*;
+        use controlword::*;
+        let tx = &self.last;
+        let state = Cia402State::from_statusword(tx.statusword);
+        let controlword = match state {
+            Fault | FaultReactionActive => {
+                if sp.fault_reset {
+                    FAULT_RESET
+                } else {
+                    DISABLE_VOLTAGE
+                }
+            }
+            NotReadyToSwitchOn => DISABLE_VOLTAGE,
+            SwitchOnDisabled => {
+                if sp.enable {
+                    SHUTDOWN
+                } else {
+                    DISABLE_VOLTAGE
+                }
+            }
+            ReadyToSwitchOn => {
+                if sp.enable {
+                    SWITCH_ON
+                } else {
+                    SHUTDOWN
+                }
+            }
+            SwitchedOn | OperationEnabled => {
+                if sp.enable {
+                    ENABLE_OPERATION
+                } else {
+                    SHUTDOWN
+                }
+            }
+            // A quick stop (the drive's own, or its stop input) ends in switch on disabled; a
+            // new enable starts the sequence again from there.
+            QuickStopActive => DISABLE_VOLTAGE,
+        };
+        let following = state == OperationEnabled && tx.mode_display == self.config.mode.code();
+        // Until the drive follows, it is told to stay where it is: no jump when it enables.
+        let (target, velocity) = if following {
+            let target = (sp.position * self.config.increments_per_unit).round() as i64;
+            let velocity = match self.config.mode {
+                Cia402Mode::Csp => sp.velocity,
+                Cia402Mode::Csv => {
+                    let actual = self.position as f64 / self.config.increments_per_unit;
+                    sp.velocity + self.config.position_gain * (sp.position - actual)
+                }
+            };
+            (target, velocity)
+        } else {
+            (self.position, 0.0)
+        };
+        let touch_probe_function = if sp.latch_enable {
+            TP_ENABLE
+                | match sp.latch_source {
+                    LatchSource::IndexPulse => TP_SOURCE_INDEX | TP_POS_EDGE,
+                    LatchSource::CamRising => TP_POS_EDGE,
+                    LatchSource::CamFalling => TP_NEG_EDGE,
+                }
+        } else {
+            0
+        };
+        RxPdo {
+            controlword,
+            // The drive's counter wraps like ours: the low 32 bits are its target.
+            target_position: target as i32,
+            target_velocity: (velocity * self.velocity_scale())
+                .round()
+                .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            mode: self.config.mode.code(),
+            touch_probe_function,
+        }
+    }
+}
