@@ -19,11 +19,19 @@ fn setpoint(k: usize) -> DriveSetpoint {
 #[test]
 fn the_exchange_is_the_drive_stepped_by_hand() {
     let mut bus = SimBus::new(3);
-    assert!(bus.attach(1, DriveConfig::default().build(DT)).unwrap().is_none());
+    assert!(
+        bus.attach(1, DriveConfig::default().build(DT))
+            .unwrap()
+            .is_none()
+    );
     let mut by_hand = SimDrive::new(SimDriveConfig::default(), DT);
     let mut fb = vec![DriveFeedback::default(); 3];
     for k in 0..600 {
-        let sp = [DriveSetpoint::default(), setpoint(k), DriveSetpoint::default()];
+        let sp = [
+            DriveSetpoint::default(),
+            setpoint(k),
+            DriveSetpoint::default(),
+        ];
         bus.exchange(&sp, &mut fb);
         by_hand.apply(&sp[1]);
         assert_eq!(fb[1], by_hand.feedback(), "cycle {k}");
@@ -40,8 +48,16 @@ fn attach_detach_and_fault_injection_act_on_their_slot_only() {
     // A slot that does not exist gives the drive back.
     assert!(bus.attach(2, DriveConfig::default().build(DT)).is_err());
     assert_eq!(bus.inject(0, SimFault::Clear), Err(BusError::NoDrive));
-    assert!(bus.attach(0, DriveConfig::default().build(DT)).unwrap().is_none());
-    assert!(bus.attach(1, DriveConfig::default().build(DT)).unwrap().is_none());
+    assert!(
+        bus.attach(0, DriveConfig::default().build(DT))
+            .unwrap()
+            .is_none()
+    );
+    assert!(
+        bus.attach(1, DriveConfig::default().build(DT))
+            .unwrap()
+            .is_none()
+    );
     // Replacing hands the old drive back (to be freed off the cycle thread).
     let old = bus.attach(1, DriveConfig::default().build(DT)).unwrap();
     assert!(matches!(old, Some(Drive::Simulated(_))));
