@@ -203,6 +203,144 @@ async fn invalid_requests_are_problems_and_keep_no_command() {
     assert_eq!(get(&s, "/api/v1/system").await.status, 200);
 }
 
+/// A 422 names the JSON path of the field at fault: nested, in an array, unknown, missing or of
+/// the wrong type; relative moves take a `distance` and refuse the old `position` by name. None of
+/// the refused requests leaves anything behind.
+#[tokio::test(flavor = "multi_thread")]
+async fn validation_errors_name_the_json_path_of_the_field() {
+    let s = Server::start();
+    let axes_before = get(&s, "/api/v1/axes").await.json;
+    let field_of = |r: &Resp| {
+        r.json["errors"][0]["field"]
+            .as_str()
+            .unwrap_or_default()
+            .to_owned()
+    };
+    let cases = [
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0, "velocity": 5.0, "options": {"blending_position": "far"}}),
+            "options.blending_position",
+            "invalid type",
+        ),
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0, "velocity": 5.0, "options": {"blend": 3.0}}),
+            "options.blend",
+            "unknown field",
+        ),
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0, "velocity": 5.0, "speed": 3}),
+            "speed",
+            "unknown field",
+        ),
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0, "velocity": "fast"}),
+            "velocity",
+            "invalid type",
+        ),
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0}),
+            "velocity",
+            "missing field",
+        ),
+        (
+            "/api/v1/axes/x/move-absolute",
+            json!({"position": 1.0, "velocity": 5.0, "buffer_mode": "later"}),
+            "buffer_mode",
+            "unknown variant",
+        ),
+        (
+            "/api/v1/axes/x/home",
+            json!({"options": {"search_velocity": true}}),
+            "options.search_velocity",
+            "invalid type",
+        ),
+        (
+            "/api/v1/scope/recordings",
+            json!({"channels": [{"axis": "x", "signal": "set_position"}, {"axis": "y", "signal": "set_position"},
+                                {"axis": true, "signal": "set_position"}], "duration_s": 1.0}),
+            "channels[2].axis",
+            "did not match",
+        ),
+        (
+            "/api/v1/scope/recordings",
+            json!({"channels": [{"axis": "x", "signal": "set_position"}, {"axis": "y"}], "duration_s": 1.0}),
+            "channels[1].signal",
+            "missing field",
+        ),
+        (
+            "/api/v1/axes",
+            json!({"name": "z", "unit": "mm", "dynamics": {"max_velocity": 100.0, "acceleration": 1000.0,
+                   "deceleration": 1000.0, "jerk": "high", "jog_velocity_slow": 5.0, "jog_velocity_fast": 50.0}}),
+            "dynamics.jerk",
+            "invalid type",
+        ),
+        (
+            "/api/v1/axes/x/move-relative",
+            json!({"position": 5.0, "velocity": 5.0}),
+            "position",
+            "renamed to `distance`",
+        ),
+        (
+            "/api/v1/axes/x/move-additive",
+            json!({"position": 5.0, "velocity": 5.0}),
+            "position",
+            "renamed to `distance`",
+        ),
+        (
+            "/api/v1/axes/x/move-continuous-relative",
+            json!({"position": 5.0, "velocity": 5.0, "end_velocity": 1.0}),
+            "position",
+            "renamed to `distance`",
+        ),
+        (
+            "/api/v1/axes/x/move-relative",
+            json!({"velocity": 5.0}),
+            "distance",
+            "missing field",
+        ),
+    ];
+    for (path, body, field, message) in cases {
+        let r = post(&s, path, body.clone()).await;
+        assert_problem(&r, 422, "validation_failed");
+        assert_eq!(field_of(&r), field, "{path} {body}: {}", r.text);
+        let m = r.json["errors"][0]["message"].as_str().unwrap_or_default();
+        assert!(m.contains(message), "{path} {body}: {}", r.text);
+    }
+    // A parameter write's value of the wrong type, with PUT.
+    let r = put(
+        &s,
+        "/api/v1/axes/x/parameters/AxisVeloMax",
+        json!({"value": [1]}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(field_of(&r), "value", "{}", r.text);
+    // Nothing was done.
+    assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
+    assert_eq!(get(&s, "/api/v1/scope/recordings").await.json, json!([]));
+    assert_eq!(get(&s, "/api/v1/axes").await.json, axes_before);
+    // The new names work.
+    power_on(&s, "x").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-relative?wait=true",
+        json!({"distance": 7.5, "velocity": 50.0}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(r.json["parameters"]["distance"], 7.5, "{}", r.text);
+    let st = status(&s, "x").await;
+    assert!(
+        (st["status"]["set_position"].as_f64().unwrap() - 7.5).abs() < 1e-9,
+        "{st}"
+    );
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn stop_locks_the_axis_until_released() {
     let s = Server::start();
@@ -236,7 +374,7 @@ async fn stop_locks_the_axis_until_released() {
     let r = post(
         &s,
         "/api/v1/axes/y/move-relative",
-        json!({"position": 5.0, "velocity": 10.0}),
+        json!({"distance": 5.0, "velocity": 10.0}),
     )
     .await;
     assert_problem(&r, 409, "axis_cannot_be_started");
@@ -248,7 +386,7 @@ async fn stop_locks_the_axis_until_released() {
     let r = post(
         &s,
         "/api/v1/axes/y/move-relative?wait=true",
-        json!({"position": 5.0, "velocity": 10.0}),
+        json!({"distance": 5.0, "velocity": 10.0}),
     )
     .await;
     assert_eq!(r.status, 202, "{}", r.text);
@@ -749,12 +887,13 @@ fn check_generator_friendly(v: &Value, at: &str) {
                 assert!(items.len() > 1, "{at}: a oneOf of one schema");
             }
             let has_ref = m.contains_key("$ref")
-                || m.get("oneOf").and_then(Value::as_array).is_some_and(|items| {
-                    items.iter().any(|i| i.get("$ref").is_some())
-                });
+                || m.get("oneOf")
+                    .and_then(Value::as_array)
+                    .is_some_and(|items| items.iter().any(|i| i.get("$ref").is_some()));
             if has_ref {
                 assert!(
-                    !m.get("default").is_some_and(|d| d.is_object() || d.is_array()),
+                    !m.get("default")
+                        .is_some_and(|d| d.is_object() || d.is_array()),
                     "{at}: an object default beside a $ref"
                 );
             }
@@ -1080,7 +1219,7 @@ async fn an_injected_drive_fault_stops_the_axis_until_cleared_and_reset() {
     let r = post(
         &s,
         "/api/v1/axes/x/move-relative",
-        json!({"position": 5.0, "velocity": 10.0}),
+        json!({"distance": 5.0, "velocity": 10.0}),
     )
     .await;
     assert_problem(&r, 409, "axis_cannot_be_started");
@@ -1095,7 +1234,7 @@ async fn an_injected_drive_fault_stops_the_axis_until_cleared_and_reset() {
     let r = post(
         &s,
         "/api/v1/axes/x/move-relative?wait=true",
-        json!({"position": 5.0, "velocity": 10.0}),
+        json!({"distance": 5.0, "velocity": 10.0}),
     )
     .await;
     assert_eq!(
@@ -1192,7 +1331,7 @@ async fn the_audit_log_shows_changes_and_motion_commands_with_their_client() {
     let mv = post(
         &s,
         "/api/v1/axes/y/move-relative?wait=true",
-        json!({"position": 2.0, "velocity": 20.0}),
+        json!({"distance": 2.0, "velocity": 20.0}),
     )
     .await;
     assert_eq!(mv.json["state"], "done", "{}", mv.text);
@@ -1231,7 +1370,7 @@ async fn the_audit_log_shows_changes_and_motion_commands_with_their_client() {
     assert_eq!(c["target"], "y", "{c}");
     assert_eq!(c["outcome"], "accepted", "{c}");
     let m = find("command.move-relative");
-    assert_eq!(m["detail"]["position"], 2.0, "{m}");
+    assert_eq!(m["detail"]["distance"], 2.0, "{m}");
     // Its end comes after its submission.
     let fin = entries
         .iter()

@@ -87,7 +87,7 @@ async fn a_homing_search_past_the_cam_fails_at_the_limit_switch_which_then_block
     let r = post(
         &s,
         "/api/v1/axes/y/move-relative?wait=true&timeout_ms=20000",
-        json!({"position": -100.0, "velocity": 200.0}),
+        json!({"distance": -100.0, "velocity": 200.0}),
     )
     .await;
     assert_eq!(r.json["state"], "done", "{}", r.text);

@@ -144,11 +144,19 @@ async fn a_triggered_recording_puts_the_crossing_at_t_zero_after_its_pre_trigger
     assert_eq!(r.json["pre_trigger_samples"].as_u64(), Some(pre as u64));
     // The trigger looks for crossings once the pre-trigger history is full: wait for the
     // cycles (not for time, which a loaded machine stretches).
-    let armed_at = get(&s, "/api/v1/system").await.json["cycle"].as_u64().unwrap();
+    let armed_at = get(&s, "/api/v1/system").await.json["cycle"]
+        .as_u64()
+        .unwrap();
     let deadline = std::time::Instant::now() + Duration::from_secs(30);
-    while get(&s, "/api/v1/system").await.json["cycle"].as_u64().unwrap() < armed_at + pre as u64 + 10
+    while get(&s, "/api/v1/system").await.json["cycle"]
+        .as_u64()
+        .unwrap()
+        < armed_at + pre as u64 + 10
     {
-        assert!(std::time::Instant::now() < deadline, "the cycle does not advance");
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the cycle does not advance"
+        );
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
     let armed = get(&s, &format!("{RECORDINGS}/{id}")).await;
@@ -267,9 +275,9 @@ async fn invalid_recordings_are_422_naming_the_field() {
         ),
         (
             json!({"channels": [ch("x", "set_position")], "duration_s": 1.0, "rate": 2}),
-            "body",
+            "rate",
         ),
-        (json!({"duration_s": 1.0}), "body"),
+        (json!({"duration_s": 1.0}), "channels"),
     ];
     for (body, field) in cases {
         let r = post(&s, RECORDINGS, body.clone()).await;
@@ -380,7 +388,7 @@ async fn the_actual_acceleration_is_the_recorded_actual_velocity_differentiated(
     let m = post(
         &s,
         "/api/v1/axes/x/move-relative",
-        json!({"position": 40.0, "velocity": 300.0}),
+        json!({"distance": 40.0, "velocity": 300.0}),
     )
     .await;
     assert_eq!(m.status, 202, "{}", m.text);

@@ -450,3 +450,73 @@ async fn an_axis_subscription_ends_when_its_axis_is_deleted() {
     // nothing more for it
     assert!(next(&mut ws, Duration::from_millis(300)).await.is_none());
 }
+
+/// Command params are read like REST bodies: an invalid one is -32602 whose `data` is the 422
+/// problem, naming the JSON path of the field; relative moves take a `distance`.
+#[tokio::test(flavor = "multi_thread")]
+async fn command_params_errors_name_the_json_path_and_relative_moves_take_a_distance() {
+    let s = Server::start();
+    let mut ws = connect(&s).await;
+    let cases = [
+        (
+            "move-absolute",
+            json!({"axis": "x", "position": 1.0, "velocity": 5.0, "options": {"blending_position": "far"}}),
+            "options.blending_position",
+        ),
+        (
+            "move-absolute",
+            json!({"axis": "x", "position": 1.0, "velocity": 5.0, "options": {"blend": 1}}),
+            "options.blend",
+        ),
+        (
+            "move-absolute",
+            json!({"axis": "x", "position": 1.0}),
+            "velocity",
+        ),
+        (
+            "move-absolute",
+            json!({"axis": "x", "position": [1.0], "velocity": 5.0}),
+            "position",
+        ),
+        (
+            "move-relative",
+            json!({"axis": "x", "position": 1.0, "velocity": 5.0}),
+            "position",
+        ),
+        (
+            "move-continuous-relative",
+            json!({"axis": "x", "position": 1.0, "velocity": 5.0, "end_velocity": 0.0}),
+            "position",
+        ),
+    ];
+    for (k, (method, params, field)) in cases.into_iter().enumerate() {
+        let id = 100 + k as u64;
+        send(&mut ws, id, method, params.clone()).await;
+        let (r, _) = response(&mut ws, id).await;
+        assert_eq!(r["error"]["code"], -32602, "{params}: {r}");
+        assert_eq!(
+            r["error"]["data"]["errors"][0]["field"], field,
+            "{params}: {r}"
+        );
+    }
+    assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
+    send(&mut ws, 1, "power", json!({"axis": "x", "wait": true})).await;
+    assert_eq!(
+        response(&mut ws, 1).await.0["result"]["outputs"]["status"],
+        true
+    );
+    send(
+        &mut ws,
+        2,
+        "move-relative",
+        json!({"axis": "x", "distance": 4.0, "velocity": 50.0, "wait": true}),
+    )
+    .await;
+    let (r, _) = response(&mut ws, 2).await;
+    assert_eq!(r["result"]["state"], "done", "{r}");
+    let st = status(&s, "x").await;
+    assert!(
+        (st["status"]["set_position"].as_f64().unwrap() - 4.0).abs() < 1e-9,
+        "{st}"
+    );
+}

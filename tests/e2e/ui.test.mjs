@@ -146,7 +146,7 @@ describe('commissioning UI', () => {
     assert.equal((await drawn()).points, 0);
     await page.click('button[name="trend-pause"]');
     await page.waitForSelector('[data-testid="trend"][data-paused="0"]');
-    assert.equal((await rest(stack.api, 'POST', `/axes/${AXIS}/move-relative`, { position: 2, velocity: 10 })).status, 202);
+    assert.equal((await rest(stack.api, 'POST', `/axes/${AXIS}/move-relative`, { distance: 2, velocity: 10 })).status, 202);
     await until(async () => (await drawn()).points >= 5, { what: 'the trend to draw again after resume' });
     await atRest();
     await page.close();
@@ -309,7 +309,7 @@ describe('commissioning UI', () => {
     }, { what: 'stopped and locked' });
     assert.equal(await page.locator('[data-testid="axis-state"]').textContent(), 'Stopping');
     await page.click('[data-move="move-relative"]');
-    await page.fill('input[name="position"]', '10');
+    await page.fill('input[name="distance"]', '10');
     await page.click('button[name="start"]');
     await page.waitForSelector('[data-testid="command-log"] tr[data-state="rejected"][data-command="move-relative"]');
     await page.click('button[name="release-stop"]');

@@ -442,12 +442,12 @@ pub struct SetOverrideBody {
     pub velocity_factor: f64,
 }
 
-/// MC_MoveAbsolute / MC_MoveModulo target, or MC_MoveRelative / MC_MoveAdditive distance.
+/// MC_MoveAbsolute / MC_MoveModulo: a target position.
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"position": 250.0, "velocity": 200.0}))]
 pub struct MoveBody {
-    /// Target position (absolute, modulo) or distance (relative, additive).
+    /// Target position (a modulo target ≥ 0 for move-modulo).
     pub position: f64,
     /// > 0, units/s.
     pub velocity: f64,
@@ -466,7 +466,51 @@ pub struct MoveBody {
     pub direction: Option<Direction>,
 }
 
-/// MC_MoveContinuousAbsolute / MC_MoveContinuousRelative.
+/// MC_MoveRelative / MC_MoveAdditive: a distance (PLCopen's `Distance`), from the set position
+/// (relative) or added to the running target (additive).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"distance": 50.0, "velocity": 200.0}))]
+pub struct MoveRelativeBody {
+    /// Signed distance, units.
+    pub distance: f64,
+    /// > 0, units/s.
+    pub velocity: f64,
+    #[serde(default)]
+    pub acceleration: f64,
+    #[serde(default)]
+    pub deceleration: f64,
+    #[serde(default)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+}
+
+/// MC_MoveContinuousRelative: a distance, then `end_velocity`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"distance": 100.0, "velocity": 200.0, "end_velocity": 50.0}))]
+pub struct MoveContinuousRelativeBody {
+    /// Signed distance, units.
+    pub distance: f64,
+    pub velocity: f64,
+    /// Velocity kept after the target (signed).
+    pub end_velocity: f64,
+    #[serde(default)]
+    pub acceleration: f64,
+    #[serde(default)]
+    pub deceleration: f64,
+    #[serde(default)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+}
+
+/// MC_MoveContinuousAbsolute: a target position, then `end_velocity`.
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"position": 500.0, "velocity": 200.0, "end_velocity": 50.0}))]

@@ -202,7 +202,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_MoveAdditive (`position` is the distance added to the running target) */
+        /** MC_MoveAdditive: add `distance` to the running target */
         post: operations["move_additive"];
         delete?: never;
         options?: never;
@@ -270,7 +270,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_MoveRelative (`position` is the distance) */
+        /** MC_MoveRelative: move `distance` from the set position */
         post: operations["move_relative"];
         delete?: never;
         options?: never;
@@ -1770,7 +1770,7 @@ export interface components {
             period: number;
         };
         /**
-         * @description MC_MoveAbsolute / MC_MoveModulo target, or MC_MoveRelative / MC_MoveAdditive distance.
+         * @description MC_MoveAbsolute / MC_MoveModulo: a target position.
          * @example {
          *       "position": 250,
          *       "velocity": 200
@@ -1779,7 +1779,7 @@ export interface components {
         MoveBody: {
             /**
              * Format: double
-             * @description Target position (absolute, modulo) or distance (relative, additive).
+             * @description Target position (a modulo target ≥ 0 for move-modulo).
              */
             position: number;
             /**
@@ -1798,7 +1798,7 @@ export interface components {
             direction?: null | components["schemas"]["Direction"];
         };
         /**
-         * @description MC_MoveContinuousAbsolute / MC_MoveContinuousRelative.
+         * @description MC_MoveContinuousAbsolute: a target position, then `end_velocity`.
          * @example {
          *       "end_velocity": 50,
          *       "position": 500,
@@ -1808,6 +1808,36 @@ export interface components {
         MoveContinuousBody: {
             /** Format: double */
             position: number;
+            /** Format: double */
+            velocity: number;
+            /**
+             * Format: double
+             * @description Velocity kept after the target (signed).
+             */
+            end_velocity: number;
+            /** Format: double */
+            acceleration?: number;
+            /** Format: double */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
+            buffer_mode?: components["schemas"]["BufferMode"];
+            options?: components["schemas"]["MoveOptions"];
+        };
+        /**
+         * @description MC_MoveContinuousRelative: a distance, then `end_velocity`.
+         * @example {
+         *       "distance": 100,
+         *       "end_velocity": 50,
+         *       "velocity": 200
+         *     }
+         */
+        MoveContinuousRelativeBody: {
+            /**
+             * Format: double
+             * @description Signed distance, units.
+             */
+            distance: number;
             /** Format: double */
             velocity: number;
             /**
@@ -1849,6 +1879,34 @@ export interface components {
              * @default false
              */
             enable_stop_position_monitoring: boolean;
+        };
+        /**
+         * @description MC_MoveRelative / MC_MoveAdditive: a distance (PLCopen's `Distance`), from the set position
+         *     (relative) or added to the running target (additive).
+         * @example {
+         *       "distance": 50,
+         *       "velocity": 200
+         *     }
+         */
+        MoveRelativeBody: {
+            /**
+             * Format: double
+             * @description Signed distance, units.
+             */
+            distance: number;
+            /**
+             * Format: double
+             * @description > 0, units/s.
+             */
+            velocity: number;
+            /** Format: double */
+            acceleration?: number;
+            /** Format: double */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
+            buffer_mode?: components["schemas"]["BufferMode"];
+            options?: components["schemas"]["MoveOptions"];
         };
         /**
          * @description MC_MoveSuperImposed: a relative motion laid over the running one.
@@ -4054,7 +4112,7 @@ export interface operations {
         };
         requestBody: {
             content: {
-                "application/json": components["schemas"]["MoveBody"];
+                "application/json": components["schemas"]["MoveRelativeBody"];
             };
         };
         responses: {
@@ -4158,7 +4216,7 @@ export interface operations {
         };
         requestBody: {
             content: {
-                "application/json": components["schemas"]["MoveContinuousBody"];
+                "application/json": components["schemas"]["MoveContinuousRelativeBody"];
             };
         };
         responses: {
@@ -4262,7 +4320,7 @@ export interface operations {
         };
         requestBody: {
             content: {
-                "application/json": components["schemas"]["MoveBody"];
+                "application/json": components["schemas"]["MoveRelativeBody"];
             };
         };
         responses: {

@@ -117,10 +117,15 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       deceleration: parseNum(decel, 0),
       jerk: parseNum(jerk, 0),
     };
-    const position = { 'move-absolute': target, 'move-relative': distance, 'move-modulo': moduloTarget, 'move-velocity': null }[moveKind];
+    // A relative move's input is its distance (PLCopen's name), the others' a target position.
+    const position = { 'move-absolute': target, 'move-modulo': moduloTarget, 'move-relative': null, 'move-velocity': null }[moveKind];
     if (position !== null) {
-      if (position.trim() === '') errs.position = moveKind === 'move-relative' ? 'enter a distance' : 'enter a target position';
+      if (position.trim() === '') errs.position = 'enter a target position';
       body.position = parseNum(position);
+    }
+    if (moveKind === 'move-relative') {
+      if (distance.trim() === '') errs.distance = 'enter a distance';
+      body.distance = parseNum(distance);
     }
     if (moveKind === 'move-velocity') body.direction = direction;
     if (moveKind === 'move-modulo') body.direction = moduloDir;
@@ -349,8 +354,8 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
                 </Field>
               )}
               {moveKind === 'move-relative' && (
-                <Field label={`Distance (${u})`} error={moveErrors.position} name="position">
-                  <NumberInput name="position" value={distance} onValue={setDistance} />
+                <Field label={`Distance (${u})`} error={moveErrors.distance} name="distance">
+                  <NumberInput name="distance" value={distance} onValue={setDistance} />
                 </Field>
               )}
               {moveKind === 'move-modulo' && (

@@ -113,26 +113,45 @@ impl CommandBody for SetOverrideBody {
     }
 }
 
+/// The inputs every positioning block shares, checked, as the kernel's `Positioning`
+/// (`field`: the body's name of the target or distance; the kernel calls both `position`).
+fn positioning(
+    c: &mut Check,
+    (field, position): (&str, f64),
+    velocity: f64,
+    (acceleration, deceleration, jerk): (f64, f64, f64),
+    buffer_mode: motion::BufferMode,
+    options: motion::MoveOptions,
+) -> Positioning {
+    c.finite(field, position);
+    c.positive("velocity", velocity);
+    c.non_negative("acceleration", acceleration);
+    c.non_negative("deceleration", deceleration);
+    c.non_negative("jerk", jerk);
+    c.options(&options);
+    Positioning {
+        position,
+        velocity,
+        dynamics: dynamics(acceleration, deceleration, jerk),
+        buffer_mode,
+        options,
+    }
+}
+
 impl CommandBody for MoveBody {
     fn to_kind(&self, name: &str, _: &Registry, axis: &AxisEntry) -> ApiResult<CommandKind> {
         let mut c = Check::default();
-        c.finite("position", self.position);
-        c.positive("velocity", self.velocity);
-        c.non_negative("acceleration", self.acceleration);
-        c.non_negative("deceleration", self.deceleration);
-        c.non_negative("jerk", self.jerk);
-        c.options(&self.options);
-        let p = Positioning {
-            position: self.position,
-            velocity: self.velocity,
-            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
-            buffer_mode: self.buffer_mode,
-            options: self.options,
-        };
+        let dyn_ = (self.acceleration, self.deceleration, self.jerk);
+        let p = positioning(
+            &mut c,
+            ("position", self.position),
+            self.velocity,
+            dyn_,
+            self.buffer_mode,
+            self.options,
+        );
         let kind = match name {
             "move-absolute" => CommandKind::MoveAbsolute(p),
-            "move-relative" => CommandKind::MoveRelative(p),
-            "move-additive" => CommandKind::MoveAdditive(p),
             _ => {
                 if axis.config.modulo.is_none() {
                     c.fail("axis", "move-modulo needs a modulo axis");
@@ -153,33 +172,62 @@ impl CommandBody for MoveBody {
     }
 }
 
-impl CommandBody for MoveContinuousBody {
+impl CommandBody for MoveRelativeBody {
     fn to_kind(&self, name: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
         let mut c = Check::default();
-        c.finite("position", self.position);
-        c.positive("velocity", self.velocity);
-        c.finite("end_velocity", self.end_velocity);
-        c.non_negative("acceleration", self.acceleration);
-        c.non_negative("deceleration", self.deceleration);
-        c.non_negative("jerk", self.jerk);
-        c.options(&self.options);
-        let move_ = Positioning {
-            position: self.position,
-            velocity: self.velocity,
-            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
-            buffer_mode: self.buffer_mode,
-            options: self.options,
-        };
-        c.done(if name == "move-continuous-absolute" {
-            CommandKind::MoveContinuousAbsolute {
-                move_,
-                end_velocity: self.end_velocity,
-            }
+        let dyn_ = (self.acceleration, self.deceleration, self.jerk);
+        let p = positioning(
+            &mut c,
+            ("distance", self.distance),
+            self.velocity,
+            dyn_,
+            self.buffer_mode,
+            self.options,
+        );
+        c.done(if name == "move-additive" {
+            CommandKind::MoveAdditive(p)
         } else {
-            CommandKind::MoveContinuousRelative {
-                move_,
-                end_velocity: self.end_velocity,
-            }
+            CommandKind::MoveRelative(p)
+        })
+    }
+}
+
+impl CommandBody for MoveContinuousRelativeBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        let dyn_ = (self.acceleration, self.deceleration, self.jerk);
+        let move_ = positioning(
+            &mut c,
+            ("distance", self.distance),
+            self.velocity,
+            dyn_,
+            self.buffer_mode,
+            self.options,
+        );
+        c.finite("end_velocity", self.end_velocity);
+        c.done(CommandKind::MoveContinuousRelative {
+            move_,
+            end_velocity: self.end_velocity,
+        })
+    }
+}
+
+impl CommandBody for MoveContinuousBody {
+    fn to_kind(&self, _: &str, _: &Registry, _: &AxisEntry) -> ApiResult<CommandKind> {
+        let mut c = Check::default();
+        let dyn_ = (self.acceleration, self.deceleration, self.jerk);
+        let move_ = positioning(
+            &mut c,
+            ("position", self.position),
+            self.velocity,
+            dyn_,
+            self.buffer_mode,
+            self.options,
+        );
+        c.finite("end_velocity", self.end_velocity);
+        c.done(CommandKind::MoveContinuousAbsolute {
+            move_,
+            end_velocity: self.end_velocity,
         })
     }
 }
@@ -459,15 +507,15 @@ command_endpoint!(
     move_relative,
     "/api/v1/axes/{axis}/move-relative",
     "move-relative",
-    MoveBody,
-    "MC_MoveRelative (`position` is the distance)"
+    MoveRelativeBody,
+    "MC_MoveRelative: move `distance` from the set position"
 );
 command_endpoint!(
     move_additive,
     "/api/v1/axes/{axis}/move-additive",
     "move-additive",
-    MoveBody,
-    "MC_MoveAdditive (`position` is the distance added to the running target)"
+    MoveRelativeBody,
+    "MC_MoveAdditive: add `distance` to the running target"
 );
 command_endpoint!(
     move_modulo,
@@ -494,7 +542,7 @@ command_endpoint!(
     move_continuous_relative,
     "/api/v1/axes/{axis}/move-continuous-relative",
     "move-continuous-relative",
-    MoveContinuousBody,
+    MoveContinuousRelativeBody,
     "MC_MoveContinuousRelative (wait returns at in_end_velocity)"
 );
 command_endpoint!(

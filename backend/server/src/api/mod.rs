@@ -64,9 +64,44 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
         if !value.is_object() {
             return Err(not_an_object(&value));
         }
-        let t = T::deserialize(&value).map_err(|e| ApiError::field("body", &e.to_string()))?;
+        let t = from_value(&value)?;
         Ok(JsonBody(t, value))
     }
+}
+
+/// Reads a body (or websocket `params`) that is a JSON object; a 422 names the JSON path of the
+/// field at fault (`options.blending_position`, `channels[2].axis`), also of an unknown or a
+/// missing one.
+pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, ApiError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let message = e.inner().to_string();
+        let mut path = e.path().to_string();
+        if path == "." {
+            path.clear();
+        }
+        // serde names a missing field in its message, and the path is the object lacking it.
+        if let Some(name) = message
+            .strip_prefix("missing field `")
+            .and_then(|m| m.strip_suffix('`'))
+        {
+            if !path.is_empty() {
+                path.push('.');
+            }
+            path.push_str(name);
+        }
+        if path.is_empty() {
+            path.push_str("body");
+        }
+        // The old name of a relative move's distance (renamed to PLCopen's `distance`).
+        let renamed =
+            message.starts_with("unknown field `position`") && message.contains("`distance`");
+        let message = if renamed {
+            format!("renamed to `distance`: {message}")
+        } else {
+            message
+        };
+        ApiError::field(&path, &message)
+    })
 }
 
 /// 422 for a body that is JSON but not an object.

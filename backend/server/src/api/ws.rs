@@ -501,8 +501,7 @@ async fn typed<B: CommandBody>(
     client: ClientInfo,
     wait: Option<Duration>,
 ) -> Result<CommandResource, ApiError> {
-    let body: B = serde_json::from_value(raw.clone())
-        .map_err(|e| ApiError::field("params", &e.to_string()))?;
+    let body: B = super::from_value(&raw)?;
     run_command(s, axis, name, body, raw, client, wait).await
 }
 
@@ -521,12 +520,18 @@ async fn dispatch(
         }
         "set-position" => typed::<SetPositionBody>(s, name, axis, raw, client, wait).await,
         "set-override" => typed::<SetOverrideBody>(s, name, axis, raw, client, wait).await,
-        "move-absolute" | "move-relative" | "move-additive" | "move-modulo" => {
+        "move-absolute" | "move-modulo" => {
             typed::<MoveBody>(s, name, axis, raw, client, wait).await
         }
+        "move-relative" | "move-additive" => {
+            typed::<MoveRelativeBody>(s, name, axis, raw, client, wait).await
+        }
         "move-velocity" => typed::<MoveVelocityBody>(s, name, axis, raw, client, wait).await,
-        "move-continuous-absolute" | "move-continuous-relative" => {
+        "move-continuous-absolute" => {
             typed::<MoveContinuousBody>(s, name, axis, raw, client, wait).await
+        }
+        "move-continuous-relative" => {
+            typed::<MoveContinuousRelativeBody>(s, name, axis, raw, client, wait).await
         }
         "halt" => typed::<HaltBody>(s, name, axis, raw, client, wait).await,
         "stop" => typed::<StopBody>(s, name, axis, raw, client, wait).await,
