@@ -29,3 +29,13 @@ command -v chromium >/dev/null 2>&1 || (apt-get update && apt-get install -y chr
 # The browser tests start target/debug/motiond (the workspace target/, whatever the caller's CARGO_TARGET_DIR).
 env -u CARGO_TARGET_DIR cargo build -p motiond 2>&1
 (cd tests/e2e && npm ci --no-audit --no-fund && env -u CARGO_TARGET_DIR npm test)
+
+# --- Client generation (tests/client/) -----------------------------------------------------
+# openapi-python-client and openapi-typescript (pinned) generate clients from
+# openapi/openapi.json: no warning, no operation missing. Then an MES script drives the real
+# motiond (target/debug/motiond, built above) through the generated Python client.
+if ! command -v python3 >/dev/null 2>&1; then
+    echo "test-all: python3 not found; install Python 3.10 or newer" >&2
+    exit 1
+fi
+./tests/client/check.sh
