@@ -825,18 +825,6 @@ async fn openapi_json_is_current() {
     );
     let doc: Value = serde_json::from_str(&generated).unwrap();
     // Every $ref resolves (the frontend generates its API types from this document).
-    fn refs<'a>(v: &'a Value, out: &mut Vec<&'a str>) {
-        match v {
-            Value::Object(m) => {
-                if let Some(Value::String(r)) = m.get("$ref") {
-                    out.push(r);
-                }
-                m.values().for_each(|v| refs(v, out));
-            }
-            Value::Array(a) => a.iter().for_each(|v| refs(v, out)),
-            _ => {}
-        }
-    }
     let mut all = Vec::new();
     refs(&doc, &mut all);
     for r in all {
@@ -875,6 +863,135 @@ async fn openapi_json_is_current() {
     assert_eq!(paths.len(), 37, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
+}
+
+/// Every `$ref` in `v`.
+fn refs<'a>(v: &'a Value, out: &mut Vec<&'a str>) {
+    match v {
+        Value::Object(m) => {
+            if let Some(Value::String(r)) = m.get("$ref") {
+                out.push(r);
+            }
+            m.values().for_each(|v| refs(v, out));
+        }
+        Value::Array(a) => a.iter().for_each(|v| refs(v, out)),
+        _ => {}
+    }
+}
+
+/// The websocket's AsyncAPI document is the binary's and is served; every `$ref` resolves, and it
+/// has an operation for every request and notification, the command methods' params being their
+/// REST bodies (same properties and required ones) with `axis`, `wait` and `timeout_ms`.
+#[tokio::test(flavor = "multi_thread")]
+async fn asyncapi_json_is_current() {
+    let out = bin().arg("asyncapi").output().unwrap();
+    assert!(out.status.success());
+    let generated = String::from_utf8(out.stdout).unwrap();
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/openapi/asyncapi.json");
+    if std::env::var_os("UPDATE_OPENAPI").is_some() {
+        std::fs::write(path, &generated).unwrap();
+    }
+    let stored = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        stored == generated,
+        "openapi/asyncapi.json is stale: regenerate with `cargo run -- asyncapi > openapi/asyncapi.json` (or UPDATE_OPENAPI=1 cargo test --test api asyncapi)"
+    );
+    let doc: Value = serde_json::from_str(&generated).unwrap();
+    assert_eq!(doc["asyncapi"], "3.0.0");
+    let mut all = Vec::new();
+    refs(&doc, &mut all);
+    for r in all {
+        let pointer = r
+            .strip_prefix('#')
+            .unwrap_or_else(|| panic!("external $ref {r}"));
+        assert!(doc.pointer(pointer).is_some(), "$ref {r} does not resolve");
+    }
+    // Every operation by its JSON-RPC method (`title`).
+    let ops: std::collections::BTreeMap<&str, &Value> = doc["operations"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|o| (o["title"].as_str().unwrap(), o))
+        .collect();
+    for m in ["subscribe", "unsubscribe", "keepalive", "release"] {
+        assert_eq!(ops[m]["action"], "receive", "{m}");
+        assert_eq!(
+            ops[m]["reply"]["messages"].as_array().unwrap().len(),
+            2,
+            "{m}"
+        );
+    }
+    for m in [
+        "update",
+        "command_event",
+        "commands_lagged",
+        "subscription_ended",
+    ] {
+        assert_eq!(
+            ops.get(m).map(|o| &o["action"]),
+            Some(&json!("send")),
+            "{m}"
+        );
+    }
+    // The command methods are the REST command endpoints, their params the REST bodies.
+    let openapi: Value = serde_json::from_str(
+        &String::from_utf8(bin().arg("openapi").output().unwrap().stdout).unwrap(),
+    )
+    .unwrap();
+    let schemas = &doc["components"]["schemas"];
+    let mut commands = 0;
+    for (p, item) in openapi["paths"].as_object().unwrap() {
+        let Some(method) = p.strip_prefix("/api/v1/axes/{axis}/") else {
+            continue;
+        };
+        if item["post"]["tags"][0] != "commands" {
+            continue;
+        }
+        commands += 1;
+        let op = ops
+            .get(method)
+            .unwrap_or_else(|| panic!("no websocket method {method}"));
+        let key = op["messages"][0]["$ref"]
+            .as_str()
+            .unwrap()
+            .rsplit('/')
+            .next()
+            .unwrap();
+        let params = &doc["components"]["messages"][key]["payload"]["properties"]["params"];
+        let body_ref = item["post"]["requestBody"]["content"]["application/json"]["schema"]["$ref"]
+            .as_str()
+            .unwrap();
+        let body = &schemas[body_ref.rsplit('/').next().unwrap()];
+        let names = |s: &Value| {
+            let mut v: Vec<String> = s["properties"]
+                .as_object()
+                .map_or(vec![], |m| m.keys().cloned().collect());
+            v.sort();
+            v
+        };
+        let mut expected = names(body);
+        expected.extend(["axis".to_string(), "timeout_ms".into(), "wait".into()]);
+        expected.sort();
+        assert_eq!(names(params), expected, "{method}");
+        let mut required: Vec<Value> = body["required"].as_array().cloned().unwrap_or_default();
+        required.insert(0, json!("axis"));
+        assert_eq!(params["required"], Value::Array(required), "{method}");
+        let reply = ops[method]["reply"]["messages"][0]["$ref"]
+            .as_str()
+            .unwrap();
+        let reply = &doc["components"]["messages"][reply.rsplit('/').next().unwrap()];
+        assert_eq!(
+            reply["payload"]["properties"]["result"]["$ref"],
+            "#/components/schemas/CommandResource",
+            "{method}"
+        );
+    }
+    assert_eq!(commands, 20);
+    let s = Server::start();
+    let served = get(&s, "/asyncapi.json").await;
+    assert_eq!(served.status, 200);
+    assert_eq!(served.content_type, "application/json");
+    assert_eq!(served.json, doc);
 }
 
 /// What client generators refuse (openapi-python-client drops every schema and operation that

@@ -520,3 +520,90 @@ async fn command_params_errors_name_the_json_path_and_relative_moves_take_a_dist
         "{st}"
     );
 }
+
+/// A raw websocket client (handshake and unmasked server frames by hand), so that nothing answers
+/// a Ping behind the test's back.
+async fn raw_ws(s: &Server) -> tokio::net::TcpStream {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let mut tcp = tokio::net::TcpStream::connect(&s.addr).await.unwrap();
+    let req = format!(
+        "GET /api/v1/ws HTTP/1.1\r\nHost: {}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+         Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n",
+        s.addr
+    );
+    tcp.write_all(req.as_bytes()).await.unwrap();
+    let mut head = Vec::new();
+    while !head.ends_with(b"\r\n\r\n") {
+        head.push(tcp.read_u8().await.unwrap());
+    }
+    let head = String::from_utf8_lossy(&head);
+    assert!(head.starts_with("HTTP/1.1 101"), "{head}");
+    tcp
+}
+
+/// The next frame from the server: (opcode, payload), or None at end of stream.
+async fn raw_frame(tcp: &mut tokio::net::TcpStream) -> Option<(u8, Vec<u8>)> {
+    use tokio::io::AsyncReadExt;
+    let b0 = tcp.read_u8().await.ok()?;
+    let b1 = tcp.read_u8().await.ok()?;
+    let len = match b1 & 0x7f {
+        126 => tcp.read_u16().await.ok()? as usize,
+        127 => tcp.read_u64().await.ok()? as usize,
+        n => n as usize,
+    };
+    let mut payload = vec![0; len];
+    tcp.read_exact(&mut payload).await.ok()?;
+    Some((b0 & 0x0f, payload))
+}
+
+/// The server pings a socket it has heard nothing from for `--ws-ping-s`, and closes it (4408)
+/// when the client does not answer within as long again. No sleeps: the test waits for the
+/// frames themselves (a generous bound only against a hang).
+#[tokio::test(flavor = "multi_thread")]
+async fn an_idle_socket_is_pinged_and_closed_when_its_client_does_not_answer() {
+    let s = Server::start_with(":memory:", &["--ws-ping-s", "0.3"]);
+    let mut tcp = raw_ws(&s).await;
+    let frames = async {
+        let mut seen = Vec::new();
+        while let Some(f) = raw_frame(&mut tcp).await {
+            seen.push(f);
+        }
+        seen
+    };
+    let seen = tokio::time::timeout(Duration::from_secs(20), frames)
+        .await
+        .expect("the server closes a socket that does not answer its ping");
+    let ops: Vec<u8> = seen.iter().map(|f| f.0).collect();
+    assert_eq!(ops, vec![0x9, 0x8], "a ping, then a close: {seen:?}");
+    let close = &seen[1].1;
+    assert_eq!(u16::from_be_bytes([close[0], close[1]]), 4408, "{seen:?}");
+}
+
+/// A client that answers the ping (tungstenite sends the Pong) keeps its socket: the server
+/// pings it again after the next idle period instead of closing it.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_client_that_answers_pings_keeps_its_socket() {
+    let s = Server::start_with(":memory:", &["--ws-ping-s", "0.3"]);
+    let mut ws = connect(&s).await;
+    let mut pings = 0;
+    let run = async {
+        while pings < 3 {
+            match ws.next().await {
+                Some(Ok(Message::Ping(_))) => {
+                    pings += 1;
+                    // Sends the Pong tungstenite has queued.
+                    ws.flush().await.unwrap();
+                }
+                Some(Ok(Message::Close(c))) => panic!("closed after {pings} pings: {c:?}"),
+                Some(Ok(_)) => {}
+                other => panic!("socket ended after {pings} pings: {other:?}"),
+            }
+        }
+    };
+    tokio::time::timeout(Duration::from_secs(20), run)
+        .await
+        .expect("three pings");
+    // And it still works.
+    send(&mut ws, 1, "unsubscribe", json!({"topic": "system"})).await;
+    assert_eq!(response(&mut ws, 1).await.0["result"], false);
+}

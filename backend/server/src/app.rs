@@ -147,8 +147,9 @@ impl CommandStore {
     }
 }
 
-/// A change of a command's outputs, for websocket subscribers and waiters.
-#[derive(Clone, Debug, Serialize)]
+/// A change of a command's outputs, for websocket subscribers and waiters (the websocket's
+/// `command_event` notification).
+#[derive(Clone, Debug, Serialize, utoipa::ToSchema)]
 pub struct CommandNotice {
     pub command: CommandId,
     pub axis: String,

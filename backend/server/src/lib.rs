@@ -47,6 +47,8 @@ pub enum Cmd {
     Serve,
     /// Print the OpenAPI document (what `openapi/openapi.json` must contain).
     Openapi,
+    /// Print the websocket's AsyncAPI document (what `openapi/asyncapi.json` must contain).
+    Asyncapi,
 }
 
 /// The options of `serve`. Global, so that `motiond --db m.db serve` and
@@ -73,6 +75,10 @@ pub struct ServeArgs {
     /// Cycle time in microseconds.
     #[arg(long, global = true, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(250..=10_000))]
     pub cycle_us: u32,
+    /// Seconds without anything from a websocket client before it is pinged, and then before
+    /// its socket is closed if it does not answer (0.05–3600).
+    #[arg(long = "ws-ping-s", global = true, value_name = "SECONDS", default_value_t = api::ws::DEFAULT_PING_S, value_parser = parse_ping)]
+    pub ws_ping_s: f64,
     /// Do not create the demo axes on a new database.
     #[arg(long, global = true)]
     pub no_demo: bool,
@@ -105,12 +111,26 @@ fn parse_listen(s: &str) -> Result<SocketAddr, String> {
         .ok_or_else(|| format!("{host} does not resolve to a loopback address"))
 }
 
+/// `--ws-ping-s`: 0.05–3600 seconds.
+fn parse_ping(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.05..=3600.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "{s:?} is not a number of seconds from 0.05 to 3600"
+        )),
+    }
+}
+
 /// Entry point of the `motiond` binary.
 pub fn run() {
     let cli = Cli::parse();
     let args = match cli.command {
         Some(Cmd::Openapi) => {
             print!("{}", api::openapi_json());
+            return;
+        }
+        Some(Cmd::Asyncapi) => {
+            print!("{}", api::asyncapi::asyncapi_json());
             return;
         }
         Some(Cmd::Serve) | None => cli.serve,
@@ -311,7 +331,10 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
             guard.allowed_origins.join(", ")
         );
     }
-    let app = api::router(state.clone(), Arc::new(guard))
+    let ws = api::ws::Settings {
+        ping_after: std::time::Duration::from_secs_f64(args.ws_ping_s),
+    };
+    let app = api::router(state.clone(), Arc::new(guard), ws)
         .into_make_service_with_connect_info::<SocketAddr>();
     let (stopping_tx, mut stopping) = tokio::sync::watch::channel(false);
     let server = axum::serve(listener, app).with_graceful_shutdown(async move {

@@ -1,5 +1,6 @@
 //! HTTP API (DESIGN §4): router, extractors, OpenAPI document.
 
+pub mod asyncapi;
 pub mod audit;
 pub mod axes;
 pub mod commands;
@@ -171,7 +172,7 @@ pub struct WaitQuery {
 }
 
 /// The API, the documentation and the UI behind the request checks of [`guard`].
-pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>) -> Router {
+pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) -> Router {
     let api = Router::new()
         .route("/axes", get(axes::list_axes).post(axes::create_axis))
         .route(
@@ -245,6 +246,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>) -> Router {
         .route("/config", get(axes::export_config).put(axes::import_config))
         .route("/ws", get(websocket))
         .fallback(not_found)
+        .layer(axum::Extension(ws))
         // Origin and Content-Type, before routing: a POST that is not JSON is a 415 whatever
         // its path (404) or method (405) would have been.
         .layer(axum::middleware::from_fn_with_state(
@@ -255,6 +257,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>) -> Router {
         .nest("/api/v1", api)
         .route("/metrics", get(system::metrics))
         .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::openapi()))
+        .route("/asyncapi.json", get(asyncapi_document))
         // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
         .fallback(crate::ui::serve)
         .layer(axum::middleware::from_fn(problem_errors))
@@ -265,6 +268,13 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>) -> Router {
             guard::check_host,
         ))
         .with_state(state)
+}
+
+/// `GET /asyncapi.json`: the websocket's AsyncAPI document (as `openapi/asyncapi.json`).
+async fn asyncapi_document() -> Response {
+    static DOC: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    let body = DOC.get_or_init(asyncapi::asyncapi_json).clone();
+    ([(header::CONTENT_TYPE, "application/json")], body).into_response()
 }
 
 /// Every error is problem+json, also those axum answers by itself: a method the route does not
@@ -338,10 +348,11 @@ async fn websocket(
     state: State<Arc<AppState>>,
     addr: ConnectInfo<SocketAddr>,
     headers: HeaderMap,
+    settings: ws::Settings,
 ) -> Response {
     use WebSocketUpgradeRejection as R;
     let e = match ws {
-        Ok(ws) => return ws::upgrade(ws, state, addr, headers).await,
+        Ok(ws) => return ws::upgrade(ws, state, addr, headers, settings).await,
         Err(e) => e,
     };
     match e {

@@ -14,11 +14,13 @@ use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::extract::{ConnectInfo, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
+use serde::Serialize;
 use serde_json::{Map, Value, json};
 use tokio::sync::{broadcast, mpsc};
 use tokio::time::Instant;
+use utoipa::ToSchema;
 
-use super::commands::{CommandBody, run_command};
+use super::commands::run_command;
 use crate::app::AppState;
 use crate::error::ApiError;
 use crate::model::*;
@@ -29,8 +31,139 @@ pub const MAX_RATE_HZ: f64 = 100.0;
 pub const MIN_RATE_HZ: f64 = 0.1;
 /// Commands, keepalives and releases of one socket whose responses are still outstanding: a
 /// client that sends faster than it reads is refused instead of queued without bound.
-const MAX_IN_FLIGHT: usize = 32;
+pub const MAX_IN_FLIGHT: usize = 32;
+/// Seconds without anything from the client before the server pings it, and again before it
+/// closes a socket whose client did not answer (`--ws-ping-s`).
+pub const DEFAULT_PING_S: f64 = 30.0;
+/// The close code for a client that did not answer a ping (private range: an HTTP 408 in
+/// websocket terms).
+pub const PING_TIMEOUT_CLOSE: u16 = 4408;
+
+/// How the server watches idle sockets.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Silence from the client (no message, no Pong) after which it is pinged, and then the time
+    /// it has to send anything before the socket is closed.
+    pub ping_after: Duration,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            ping_after: Duration::from_secs_f64(DEFAULT_PING_S),
+        }
+    }
+}
 const TICK: Duration = Duration::from_millis(5);
+
+// ---------------------------------------------------------------------------------------------
+// The messages, as types: the session serialises these, and `super::asyncapi` describes the
+// socket with their schemas (and the command bodies'), so that the AsyncAPI document cannot
+// drift from what is sent.
+
+/// `subscribe` params.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"topic": "axes/x/status", "rate_hz": 25.0}))]
+pub struct SubscribeParams {
+    /// `axes/{axis}/status` (axis id or name), `commands` or `system`.
+    pub topic: String,
+    /// Updates per second, 0.1–100 (more is capped); default 10. Not used by `commands`
+    /// (every change is sent).
+    #[schema(minimum = 0.1)]
+    pub rate_hz: Option<f64>,
+}
+
+/// `subscribe` result.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"topic": "axes/x/status", "rate_hz": 25.0}))]
+pub struct SubscribeResult {
+    /// The topic as given.
+    pub topic: String,
+    /// The rate in effect (capped at 100).
+    pub rate_hz: f64,
+}
+
+/// `unsubscribe` params. The result is `true` if there was such a subscription.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"topic": "axes/x/status"}))]
+pub struct UnsubscribeParams {
+    /// The topic as subscribed.
+    pub topic: String,
+}
+
+/// `keepalive` (renew a jog's dead-man) and `release` (falling edge of Execute/Enable) params.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"command": 42}))]
+pub struct CommandRef {
+    /// Command id.
+    pub command: u64,
+}
+
+/// `keepalive` / `release` result.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"command": 42, "cycle": 1873}))]
+pub struct ControlResult {
+    pub command: u64,
+    /// The kernel cycle it took effect in.
+    pub cycle: u64,
+}
+
+/// `update` notification params: a subscription's data, stamped with the kernel cycle.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"topic": "axes/x/status", "cycle": 2009, "full": false,
+    "data": {"set_position": 64.111, "actual_position": 64.109}}))]
+pub struct UpdateParams {
+    pub topic: String,
+    pub cycle: u64,
+    /// `true`: `data` is the whole object (the first update of a subscription, and after the
+    /// axis was replaced); `false`: only the fields that changed since the previous update.
+    pub full: bool,
+    /// `axes/{axis}/status`: a `LiveStatus`; `system`: a `SystemResource` (whole or in part).
+    #[schema(value_type = Object)]
+    pub data: Map<String, Value>,
+}
+
+/// `commands_lagged` notification params: the socket fell behind the command notices.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"missed": 12}))]
+pub struct CommandsLagged {
+    /// How many `command_event`s it missed.
+    pub missed: u64,
+}
+
+/// Why the server ended a subscription.
+#[derive(Clone, Copy, Debug, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum EndReason {
+    /// The axis was deleted, or an import left no axis with its id.
+    AxisRemoved,
+}
+
+/// `subscription_ended` notification params.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"topic": "axes/y/status", "reason": "axis_removed"}))]
+pub struct SubscriptionEnded {
+    pub topic: String,
+    pub reason: EndReason,
+}
+
+/// A JSON-RPC error object.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"code": -32602, "message": "velocity: must be > 0", "data": {
+    "type": "urn:motiond:problem:validation_failed", "title": "Invalid request", "status": 422,
+    "detail": "velocity: must be > 0", "code": "validation_failed",
+    "errors": [{"field": "velocity", "message": "must be > 0"}]}}))]
+pub struct RpcError {
+    /// -32700 parse error, -32600 invalid request, -32601 method not found, -32602 invalid
+    /// params (a 400/422 of the REST API), -32000 any other refusal (409, 404, 503 …).
+    pub code: i64,
+    pub message: String,
+    /// The REST API's problem for the same refusal (`code`, `error_id`, `errors[].field`), or
+    /// `{"code": "too_many_in_flight"}`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<Object>)]
+    pub data: Option<Value>,
+}
 
 #[utoipa::path(get, path = "/api/v1/ws", tag = "system", summary = "Websocket: JSON-RPC 2.0 subscriptions and commands",
     description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
@@ -42,13 +175,16 @@ then only changed fields; `command_event` {cycle, command, axis, name, state, fi
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
 closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). \
-A request without an id is a notification: carried out, never answered.",
+A request without an id is a notification: carried out, never answered. \
+Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has \
+heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again.",
     responses((status = 101, description = "Switching protocols"), super::errors::WebsocketErrors))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
     State(s): State<Arc<AppState>>,
     ConnectInfo(addr): ConnectInfo<SocketAddr>,
     headers: HeaderMap,
+    settings: Settings,
 ) -> Response {
     let client = ClientInfo {
         addr: addr.to_string(),
@@ -59,7 +195,22 @@ pub async fn upgrade(
         via: "websocket",
     };
     ws.max_message_size(256 * 1024)
-        .on_upgrade(move |socket| session(s, socket, client))
+        .on_upgrade(move |socket| session(s, socket, client, settings))
+}
+
+impl<S: Send + Sync> axum::extract::FromRequestParts<S> for Settings {
+    type Rejection = std::convert::Infallible;
+
+    async fn from_request_parts(
+        parts: &mut axum::http::request::Parts,
+        _: &S,
+    ) -> Result<Self, Self::Rejection> {
+        Ok(parts
+            .extensions
+            .get::<Settings>()
+            .copied()
+            .unwrap_or_default())
+    }
 }
 
 enum Topic {
@@ -86,11 +237,12 @@ fn rpc_result(id: &Value, result: Value) -> String {
 }
 
 fn rpc_error(id: &Value, code: i64, message: &str, data: Option<Value>) -> String {
-    let mut e = json!({"code": code, "message": message});
-    if let Some(d) = data {
-        e["data"] = d;
-    }
-    json!({"jsonrpc": "2.0", "id": id, "error": e}).to_string()
+    let error = RpcError {
+        code,
+        message: message.to_owned(),
+        data,
+    };
+    json!({"jsonrpc": "2.0", "id": id, "error": error}).to_string()
 }
 
 fn api_error(id: &Value, e: ApiError) -> String {
@@ -106,11 +258,11 @@ fn api_error(id: &Value, e: ApiError) -> String {
     )
 }
 
-fn notify(method: &str, params: Value) -> String {
+fn notify(method: &str, params: impl Serialize) -> String {
     json!({"jsonrpc": "2.0", "method": method, "params": params}).to_string()
 }
 
-async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
+async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, settings: Settings) {
     let mut subs: Vec<Sub> = Vec::new();
     let mut notices: Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>> = None;
     let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
@@ -118,18 +270,46 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo) {
     let in_flight = Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT));
     let mut tick = tokio::time::interval(TICK);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    // Idle watch: a Ping after `ping_after` without anything from the client, then the socket
+    // is closed if nothing arrives within `ping_after` (a dead peer or a frozen client).
+    let mut heard = Instant::now();
+    let mut pinged: Option<Instant> = None;
     loop {
+        let idle_deadline = match pinged {
+            None => heard + settings.ping_after,
+            Some(at) => at + settings.ping_after,
+        };
         let outgoing: Vec<String> = tokio::select! {
-            msg = socket.recv() => match msg {
-                Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
-                Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
-                Some(Ok(_)) => vec![],
-                _ => break,
+            msg = socket.recv() => {
+                if matches!(msg, Some(Ok(_))) {
+                    (heard, pinged) = (Instant::now(), None);
+                }
+                match msg {
+                    Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
+                    Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
+                    Some(Ok(_)) => vec![],
+                    _ => break,
+                }
+            },
+            _ = tokio::time::sleep_until(idle_deadline) => {
+                if pinged.is_some() {
+                    let close = axum::extract::ws::CloseFrame {
+                        code: PING_TIMEOUT_CLOSE,
+                        reason: "no answer to ping".into(),
+                    };
+                    let _ = socket.send(Message::Close(Some(close))).await;
+                    break;
+                }
+                pinged = Some(Instant::now());
+                if socket.send(Message::Ping(Default::default())).await.is_err() {
+                    break;
+                }
+                vec![]
             },
             Some(m) = out_rx.recv() => vec![m],
             n = async { match notices.as_mut() { Some(rx) => rx.recv().await, None => std::future::pending().await } } => match n {
-                Ok(n) => vec![notify("command_event", serde_json::to_value(&*n).unwrap_or_default())],
-                Err(broadcast::error::RecvError::Lagged(k)) => vec![notify("commands_lagged", json!({"missed": k}))],
+                Ok(n) => vec![notify("command_event", &*n)],
+                Err(broadcast::error::RecvError::Lagged(k)) => vec![notify("commands_lagged", CommandsLagged { missed: k })],
                 Err(broadcast::error::RecvError::Closed) => vec![],
             },
             _ = tick.tick() => {
@@ -164,7 +344,10 @@ fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
             None => {
                 out.push(notify(
                     "subscription_ended",
-                    json!({"topic": sub.key, "reason": "axis_removed"}),
+                    SubscriptionEnded {
+                        topic: sub.key.clone(),
+                        reason: EndReason::AxisRemoved,
+                    },
                 ));
                 false
             }
@@ -223,7 +406,12 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, now: Instant) -> Vec<String> {
         sub.last = Some(map);
         out.push(notify(
             "update",
-            json!({"topic": sub.key, "cycle": cycle, "full": full, "data": data}),
+            UpdateParams {
+                topic: sub.key.clone(),
+                cycle,
+                full,
+                data,
+            },
         ));
     }
     out
@@ -335,7 +523,11 @@ fn handle(
                 due: Instant::now(),
                 last: None,
             });
-            Some(rpc_result(&id, json!({"topic": key, "rate_hz": rate})))
+            let result = SubscribeResult {
+                topic: key,
+                rate_hz: rate,
+            };
+            Some(rpc_result(&id, json!(result)))
         }
         "unsubscribe" => {
             let key = params
@@ -376,9 +568,13 @@ fn handle(
                             s.release(slot, cmd, &client).await
                         };
                         match r {
-                            Ok(Ok(cycle)) => {
-                                rpc_result(&id, json!({"command": cmd, "cycle": cycle}))
-                            }
+                            Ok(Ok(cycle)) => rpc_result(
+                                &id,
+                                json!(ControlResult {
+                                    command: cmd,
+                                    cycle
+                                }),
+                            ),
                             Ok(Err(e)) => api_error(&id, ApiError::rejected(e)),
                             Err(e) => api_error(&id, e),
                         }
@@ -470,78 +666,58 @@ fn too_many_in_flight(id: &Value) -> String {
     )
 }
 
-pub const COMMANDS: &[&str] = &[
-    "power",
-    "reset",
-    "set-position",
-    "set-override",
-    "move-absolute",
-    "move-relative",
-    "move-additive",
-    "move-modulo",
-    "move-velocity",
-    "move-continuous-absolute",
-    "move-continuous-relative",
-    "halt",
-    "stop",
-    "jog",
-    "home",
-    "gear-in",
-    "gear-in-dyn",
-    "gear-out",
-    "move-superimposed",
-    "abort-superposition",
-];
+/// The command methods: name (the REST endpoint's) and the REST body their params are read as.
+/// One table for `COMMANDS`, `dispatch` and the AsyncAPI document (`body_schema`).
+macro_rules! command_methods {
+    ($($name:literal => $body:ident),+ $(,)?) => {
+        pub const COMMANDS: &[&str] = &[$($name),+];
 
-async fn typed<B: CommandBody>(
-    s: &AppState,
-    name: &'static str,
-    axis: &str,
-    raw: Value,
-    client: ClientInfo,
-    wait: Option<Duration>,
-) -> Result<CommandResource, ApiError> {
-    let body: B = super::from_value(&raw)?;
-    run_command(s, axis, name, body, raw, client, wait).await
+        /// The schema name of the REST body a command method's params are read as.
+        pub fn body_schema(method: &str) -> Option<&'static str> {
+            match method {
+                $($name => Some(stringify!($body)),)+
+                _ => None,
+            }
+        }
+
+        async fn dispatch(
+            s: &AppState,
+            name: &'static str,
+            axis: &str,
+            raw: Value,
+            client: ClientInfo,
+            wait: Option<Duration>,
+        ) -> Result<CommandResource, ApiError> {
+            match name {
+                $($name => {
+                    let body: $body = super::from_value(&raw)?;
+                    run_command(s, axis, name, body, raw, client, wait).await
+                })+
+                _ => Err(ApiError::not_found("method", name)),
+            }
+        }
+    };
 }
 
-async fn dispatch(
-    s: &AppState,
-    name: &'static str,
-    axis: &str,
-    raw: Value,
-    client: ClientInfo,
-    wait: Option<Duration>,
-) -> Result<CommandResource, ApiError> {
-    match name {
-        "power" => typed::<PowerBody>(s, name, axis, raw, client, wait).await,
-        "reset" | "gear-out" | "abort-superposition" => {
-            typed::<EmptyBody>(s, name, axis, raw, client, wait).await
-        }
-        "set-position" => typed::<SetPositionBody>(s, name, axis, raw, client, wait).await,
-        "set-override" => typed::<SetOverrideBody>(s, name, axis, raw, client, wait).await,
-        "move-absolute" | "move-modulo" => {
-            typed::<MoveBody>(s, name, axis, raw, client, wait).await
-        }
-        "move-relative" | "move-additive" => {
-            typed::<MoveRelativeBody>(s, name, axis, raw, client, wait).await
-        }
-        "move-velocity" => typed::<MoveVelocityBody>(s, name, axis, raw, client, wait).await,
-        "move-continuous-absolute" => {
-            typed::<MoveContinuousBody>(s, name, axis, raw, client, wait).await
-        }
-        "move-continuous-relative" => {
-            typed::<MoveContinuousRelativeBody>(s, name, axis, raw, client, wait).await
-        }
-        "halt" => typed::<HaltBody>(s, name, axis, raw, client, wait).await,
-        "stop" => typed::<StopBody>(s, name, axis, raw, client, wait).await,
-        "jog" => typed::<JogBody>(s, name, axis, raw, client, wait).await,
-        "home" => typed::<HomeBody>(s, name, axis, raw, client, wait).await,
-        "gear-in" => typed::<GearInBody>(s, name, axis, raw, client, wait).await,
-        "gear-in-dyn" => typed::<GearInDynBody>(s, name, axis, raw, client, wait).await,
-        "move-superimposed" => {
-            typed::<MoveSuperImposedBody>(s, name, axis, raw, client, wait).await
-        }
-        _ => Err(ApiError::not_found("method", name)),
-    }
+command_methods! {
+    "power" => PowerBody,
+    "reset" => EmptyBody,
+    "set-position" => SetPositionBody,
+    "set-override" => SetOverrideBody,
+    "move-absolute" => MoveBody,
+    "move-relative" => MoveRelativeBody,
+    "move-additive" => MoveRelativeBody,
+    "move-modulo" => MoveBody,
+    "move-velocity" => MoveVelocityBody,
+    "move-continuous-absolute" => MoveContinuousBody,
+    "move-continuous-relative" => MoveContinuousRelativeBody,
+    "halt" => HaltBody,
+    "stop" => StopBody,
+    "jog" => JogBody,
+    "home" => HomeBody,
+    "gear-in" => GearInBody,
+    "gear-in-dyn" => GearInDynBody,
+    "gear-out" => EmptyBody,
+    "move-superimposed" => MoveSuperImposedBody,
+    "abort-superposition" => EmptyBody,
 }
