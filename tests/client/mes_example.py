@@ -10,14 +10,16 @@ into target/client/python and runs this against a fresh motiond). Exits non-zero
 import sys
 
 from motiond_client import Client
-from motiond_client.api.axes import axis_status
+from motiond_client.api.axes import axis_status, reset_following_error_peak
 from motiond_client.api.commands import home, move_absolute, move_relative, power
 from motiond_client.models import (
     CommandResource,
     CommandState,
+    EmptyBody,
     HomeBody,
     MoveBody,
     MoveRelativeBody,
+    PeakResetResource,
     PowerBody,
     StatusResource,
 )
@@ -52,6 +54,11 @@ def main(base_url: str) -> None:
             move_relative.sync(axis="x", client=client, body=MoveRelativeBody(distance=-50.0, velocity=200.0), wait=True, timeout_ms=20000),
         )
         assert r.state == CommandState.DONE, f"move-relative: {r.state}"
+
+        # An operation without parameters: its `{}` body makes the request application/json.
+        peak = reset_following_error_peak.sync(axis="x", client=client, body=EmptyBody())
+        if not isinstance(peak, PeakResetResource):
+            sys.exit(f"mes-example: peak reset refused: {peak}")
 
         st = axis_status.sync(axis="x", client=client)
         if not isinstance(st, StatusResource):
