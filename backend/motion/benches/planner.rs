@@ -52,6 +52,26 @@ fn plan(c: &mut Criterion) {
                 .unwrap()
         })
     });
+    // A blending or continuous end velocity that 20 mm cannot reach: the bisection for the
+    // best reachable one (the rare, dear case of plan_position_towards).
+    g.bench_function("towards_unreachable_end_velocity", |b| {
+        b.iter(|| {
+            p.plan_position_towards(black_box(REST), black_box(2.0), 100.0, black_box(&LIMITS))
+                .unwrap()
+        })
+    });
+    // Above the velocity limit (an override lowered to 10 %): braked on the velocity
+    // interface, then positioned.
+    g.bench_function("position_over_the_limit", |b| {
+        let slow = Limits {
+            velocity: 10.0,
+            ..LIMITS
+        };
+        b.iter(|| {
+            p.plan_position(black_box(MOVING), black_box(100.0), 0.0, black_box(&slow))
+                .unwrap()
+        })
+    });
     g.bench_function("velocity_halt_from_moving", |b| {
         b.iter(|| {
             p.plan_velocity(black_box(MOVING), black_box(0.0), black_box(&LIMITS))

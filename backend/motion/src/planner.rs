@@ -153,9 +153,11 @@ impl Planner {
         // turn) to the limit on the velocity interface instead, which ends with a = 0, and
         // position from there; when that is too long to stop at the target and the axis is
         // braking for it already, brake on from the present velocity, which only falls.
-        if let Ok(d) = self.plan_braked(from, target, target_velocity, limits) {
-            if self.straight(from, target, limits.jerk) {
-                return Ok(d);
+        if self.exceeds_velocity(limits.velocity) {
+            if let Ok(d) = self.plan_braked(from, target, target_velocity, limits) {
+                if self.straight(from, target, limits.jerk) {
+                    return Ok(d);
+                }
             }
         }
         let toward = from.velocity * (target - from.position) > 0.0;
@@ -171,6 +173,25 @@ impl Planner {
             }
         }
         self.plan_position_direct(from, target, target_velocity, limits)
+    }
+
+    /// The planned velocity's magnitude goes above `limit` somewhere (it started above it,
+    /// or a turn's run-up carries it there): Ruckig's brake is at work.
+    fn exceeds_velocity(&self, limit: f64) -> bool {
+        let bound = limit * (1.0 + 1e-9) + 1e-12;
+        let mut above = false;
+        self.phases(|_, v, a, j, t| {
+            let mut at = |x: f64| above |= x.abs() > bound;
+            at(v);
+            at(v + a * t + 0.5 * j * t * t);
+            if j != 0.0 {
+                let ts = -a / j;
+                if ts > 0.0 && ts < t {
+                    at(v - a * a / (2.0 * j));
+                }
+            }
+        });
+        above
     }
 
     /// The plan goes beyond `target` in direction `dir`.
@@ -368,26 +389,22 @@ impl Planner {
         }
         let towards = |me: &mut Self, u: f64| course(me, u).ok() == Some(Course::Towards);
         // Below: the highest reachable in [0, want]; above: the lowest in [want, v_free].
-        // Ruckig's time-optimal profile decides what is "reachable" (a monotonic profile to
-        // a velocity may exist where the time-optimal one dips), so both sides are searched
-        // and the nearer one taken.
-        let below = towards(self, 0.0).then(|| edge(self, 0.0, want, &towards));
-        let above =
-            (want < v_free && towards(self, v_free)).then(|| edge(self, v_free, want, &towards));
-        let best = match (below, above) {
-            (Some(b), Some(a)) => {
-                if want - b <= a - want {
-                    b
-                } else {
-                    a
-                }
-            }
-            (Some(b), None) => b,
-            (None, Some(a)) => a,
-            // It cannot avoid passing the target: at the velocity it passes through anyway
-            // (the caller hands the target over to a successor, or a continuous move goes on).
-            (None, None) => v_free.max(0.0),
+        // The side the physics points to is searched first; Ruckig's time-optimal profile
+        // decides what is "reachable" (a monotonic profile to a velocity may exist where the
+        // time-optimal one dips), so the other side is searched when the first has nothing.
+        let below = |me: &mut Self| towards(me, 0.0).then(|| edge(me, 0.0, want, &towards));
+        let above = |me: &mut Self| {
+            (want < v_free && towards(me, v_free)).then(|| edge(me, v_free, want, &towards))
         };
+        let found = if want < v_free {
+            above(self).or_else(|| below(self))
+        } else {
+            below(self)
+        };
+        // Nothing: it cannot avoid passing the target; at the velocity it passes through
+        // anyway (the caller hands the target over to a successor, or a continuous move goes
+        // on from there).
+        let best = found.unwrap_or(v_free.max(0.0));
         let lim = Limits {
             velocity: limits.velocity.max(best),
             ..*limits
@@ -785,9 +802,9 @@ impl Planner {
 }
 
 /// The last point from `ok` (where `pred` holds) towards `other` (where it does not) at which
-/// `pred` still holds, by bisection (24 steps: 6e-8 of the interval).
+/// `pred` still holds, by bisection (16 steps: 1.5e-5 of the interval).
 fn edge<P>(me: &mut P, mut ok: f64, mut other: f64, pred: &impl Fn(&mut P, f64) -> bool) -> f64 {
-    for _ in 0..24 {
+    for _ in 0..16 {
         let mid = 0.5 * (ok + other);
         if pred(me, mid) {
             ok = mid;
