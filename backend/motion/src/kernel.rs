@@ -42,14 +42,18 @@ impl Kernel {
     }
 
     /// Puts a ready-built axis into a slot and returns what was there (to be freed off the
-    /// cycle thread). Does not allocate.
+    /// cycle thread). The axis reports its commands' events under this slot from now on.
+    /// Does not allocate.
     pub fn insert_axis(
         &mut self,
         slot: AxisSlot,
-        axis: Box<Axis>,
+        mut axis: Box<Axis>,
     ) -> Result<Option<Box<Axis>>, Box<Axis>> {
         match self.axes.get_mut(slot as usize) {
-            Some(s) => Ok(s.replace(axis)),
+            Some(s) => {
+                axis.place(slot);
+                Ok(s.replace(axis))
+            }
             None => Err(axis),
         }
     }

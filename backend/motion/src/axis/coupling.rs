@@ -7,11 +7,9 @@ use super::*;
 impl Axis {
     pub(super) fn submit_gear_out(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         if self.state() != AxisState::SynchronizedMotion {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         }
@@ -20,29 +18,28 @@ impl Axis {
             // recoupled at once with the ratio it has (spec §5.5.2).
             c.slave_start = self.set.position;
             c.master_start = f64::NAN; // re-based on the next step
-            emit_once(id, DONE, slot, cycle, events);
+            cx.report(id, DONE);
             return Ok(());
         }
-        self.abort_superposition(cycle, events);
+        self.abort_superposition(cx);
         self.coupling = None;
         if let Some(mut j) = self.job.take() {
-            j.finish_aborted(slot, cycle, events);
+            j.finish_aborted(cx);
         }
-        self.continue_at_current_velocity(cycle, events);
-        emit_once(id, DONE, slot, cycle, events);
+        self.continue_at_current_velocity(cx);
+        cx.report(id, DONE);
         Ok(())
     }
 
     #[allow(clippy::too_many_arguments)]
     pub(super) fn submit_gear_in(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
         master: Option<(AxisSlot, MasterSample)>,
         numerator: f64,
         denominator: u16,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
         if denominator == 0 || !numerator.is_finite() {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
@@ -55,32 +52,20 @@ impl Axis {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         }
         let ratio = numerator / denominator as f64;
-        self.couple(
-            id,
-            master_slot,
-            &m,
-            ratio,
-            ratio,
-            f64::INFINITY,
-            0,
-            cycle,
-            events,
-        );
+        self.couple(cx, id, master_slot, &m, ratio, ratio, f64::INFINITY, 0);
         Ok(())
     }
 
     #[allow(clippy::too_many_arguments)]
     pub(super) fn submit_gear_in_dyn(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
         master: Option<(AxisSlot, MasterSample)>,
         gear_ratio: f64,
         acceleration: f64,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         if !gear_ratio.is_finite() || !acceleration.is_finite() || acceleration < 0.0 {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
@@ -110,15 +95,15 @@ impl Axis {
             if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
                 // The earlier instance hands over to this one.
                 let mut prev = Job { id: old, ..*j };
-                prev.finish_done(slot, cycle, events);
+                prev.finish_done(cx);
                 j.id = id;
                 j.out = FbOutputs::default();
-                j.activate(slot, cycle, events);
+                j.activate(cx);
                 let out = FbOutputs {
                     in_gear: (c.ratio - c.target_ratio).abs() < 1e-12,
                     ..j.out
                 };
-                j.emit(out, slot, cycle, events);
+                j.emit(cx, out);
             }
             return Ok(());
         }
@@ -137,17 +122,7 @@ impl Axis {
         } else {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         };
-        self.couple(
-            id,
-            master_slot,
-            &m,
-            start_ratio,
-            gear_ratio,
-            rate,
-            id,
-            cycle,
-            events,
-        );
+        self.couple(cx, id, master_slot, &m, start_ratio, gear_ratio, rate, id);
         Ok(())
     }
 
@@ -176,6 +151,7 @@ impl Axis {
     #[allow(clippy::too_many_arguments)]
     fn couple(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
         m: &MasterSample,
@@ -183,13 +159,10 @@ impl Axis {
         target_ratio: f64,
         ratio_rate: f64,
         dyn_command: CommandId,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) {
-        let slot = self.slot;
         let use_actual = self.p().axis_couple_slave_to_actual_values;
-        self.abort_superposition(cycle, events);
-        self.abort_all(cycle, events);
+        self.abort_superposition(cx);
+        self.abort_all(cx);
         self.coupling = Some(Coupling {
             master: master_slot,
             ratio,
@@ -204,12 +177,12 @@ impl Axis {
             slave_start: self.set.position,
         });
         let mut j = Job::new(id, JobKind::Gear);
-        j.activate(slot, cycle, events);
+        j.activate(cx);
         let out = FbOutputs {
             in_gear: (ratio - target_ratio).abs() < 1e-12,
             ..j.out
         };
-        j.emit(out, slot, cycle, events);
+        j.emit(cx, out);
         if dyn_command == 0 {
             // MC_GearIn ends once coupled (Busy falls with InGear, manual §6.5.1); the
             // coupling goes on without an owning command until GearOut or a new motion.
@@ -219,7 +192,7 @@ impl Axis {
                 done: true,
                 ..j.out
             };
-            j.emit(out, slot, cycle, events);
+            j.emit(cx, out);
             j.id = 0;
         }
         self.job = Some(j);

@@ -6,14 +6,12 @@ use super::*;
 impl Axis {
     pub(super) fn submit_home(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         position: Option<f64>,
         mode: HomingMode,
         options: HomingOptions,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         if self.state() != AxisState::Standstill {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         }
@@ -31,17 +29,17 @@ impl Axis {
                 }
                 self.set_position_offset = 0.0;
                 self.homed = true;
-                emit_once(id, DONE, slot, cycle, events);
+                cx.report(id, DONE);
                 Ok(())
             }
             HomingMode::ForceCalibration => {
                 self.homed = true;
-                emit_once(id, DONE, slot, cycle, events);
+                cx.report(id, DONE);
                 Ok(())
             }
             HomingMode::ResetCalibration => {
                 self.homed = false;
-                emit_once(id, DONE, slot, cycle, events);
+                cx.report(id, DONE);
                 Ok(())
             }
             HomingMode::Default => {
@@ -121,7 +119,7 @@ impl Axis {
                     failed: None,
                 };
                 self.homed = false;
-                self.start_job(j, cycle, events);
+                self.start_job(cx, j);
                 Ok(())
             }
         }
@@ -130,12 +128,10 @@ impl Axis {
     /// The referencing sequence of spec §5.3 against the drive's cam and latch.
     pub(super) fn step_home(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         dt: f64,
         fb: &DriveFeedback,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) {
-        let slot = self.slot;
         let Some(mut job) = self.job else { return };
         let mut h = job.home;
         let cam = fb.reference_cam;
@@ -158,7 +154,7 @@ impl Axis {
                     phase: HomingPhase::Idle,
                     ..h
                 };
-                job.finish_error(e, slot, cycle, events);
+                job.finish_error(cx, e);
                 self.job = None;
                 self.planner.clear();
                 self.set.velocity = 0.0;
@@ -243,7 +239,7 @@ impl Axis {
                     self.homed = true;
                     h.phase = HomingPhase::Idle;
                     job.home = h;
-                    job.finish_done(slot, cycle, events);
+                    job.finish_done(cx);
                     self.job = None;
                     self.planner.clear();
                     self.set.velocity = 0.0;
@@ -267,7 +263,7 @@ impl Axis {
                 ..h
             };
             self.job = Some(job);
-            self.enter_error(e, cycle, events);
+            self.enter_error(cx, e);
             return;
         }
         if let Some(e) = fail {

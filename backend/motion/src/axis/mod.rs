@@ -236,44 +236,33 @@ impl Job {
         }
     }
 
-    fn emit(&mut self, out: FbOutputs, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+    fn emit(&mut self, cx: &mut Ctx<'_, impl EventSink>, out: FbOutputs) {
         if self.id != 0 && out != self.out {
-            events.push(CommandEvent {
-                cycle,
-                command: self.id,
-                axis,
-                outputs: out,
-            });
+            cx.report(self.id, out);
         }
         self.out = out;
     }
 
-    fn activate(&mut self, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+    fn activate(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         self.phase = Phase::Moving;
         let out = FbOutputs {
             busy: true,
             active: true,
             ..self.out
         };
-        self.emit(out, axis, cycle, events);
+        self.emit(cx, out);
     }
 
-    fn finish_done(&mut self, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        self.emit(ended(self.out, End::Done), axis, cycle, events);
+    fn finish_done(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        self.emit(cx, ended(self.out, End::Done));
     }
 
-    fn finish_aborted(&mut self, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        self.emit(ended(self.out, End::Aborted), axis, cycle, events);
+    fn finish_aborted(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        self.emit(cx, ended(self.out, End::Aborted));
     }
 
-    fn finish_error(
-        &mut self,
-        e: ErrorId,
-        axis: AxisSlot,
-        cycle: u64,
-        events: &mut impl EventSink,
-    ) {
-        self.emit(ended(self.out, End::Error(e)), axis, cycle, events);
+    fn finish_error(&mut self, cx: &mut Ctx<'_, impl EventSink>, e: ErrorId) {
+        self.emit(cx, ended(self.out, End::Error(e)));
     }
 }
 
@@ -286,18 +275,13 @@ struct Held {
 }
 
 impl Held {
-    fn end(&mut self, end: End, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
-        self.emit(ended(self.out, end), axis, cycle, events);
+    fn end(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
+        self.emit(cx, ended(self.out, end));
     }
 
-    fn emit(&mut self, out: FbOutputs, axis: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+    fn emit(&mut self, cx: &mut Ctx<'_, impl EventSink>, out: FbOutputs) {
         if out != self.out {
-            events.push(CommandEvent {
-                cycle,
-                command: self.id,
-                axis,
-                outputs: out,
-            });
+            cx.report(self.id, out);
         }
         self.out = out;
     }
@@ -335,19 +319,25 @@ fn ended(out: FbOutputs, end: End) -> FbOutputs {
     }
 }
 
-fn emit_once(
-    id: CommandId,
-    out: FbOutputs,
-    axis: AxisSlot,
+/// Who reports a command's outputs (the axis's slot), when (the cycle every event is stamped
+/// with) and where to. Passed first to everything that may end or change a command, so that
+/// what a function needs to report never grows its argument list.
+struct Ctx<'a, E: EventSink> {
+    slot: AxisSlot,
     cycle: u64,
-    events: &mut impl EventSink,
-) {
-    events.push(CommandEvent {
-        cycle,
-        command: id,
-        axis,
-        outputs: out,
-    });
+    events: &'a mut E,
+}
+
+impl<E: EventSink> Ctx<'_, E> {
+    /// Pushes a change of `command`'s outputs.
+    fn report(&mut self, command: CommandId, outputs: FbOutputs) {
+        self.events.push(CommandEvent {
+            cycle: self.cycle,
+            command,
+            axis: self.slot,
+            outputs,
+        });
+    }
 }
 
 const DONE: FbOutputs = FbOutputs {
@@ -407,6 +397,7 @@ struct Superimposed {
 #[derive(Debug)]
 pub struct Axis {
     config: AxisConfig,
+    /// Set by `Kernel::insert_axis`; the `axis` of every event this axis reports.
     slot: AxisSlot,
     cycle_time: f64,
     mode: Mode,
@@ -518,6 +509,11 @@ impl Axis {
         })
     }
 
+    /// The slot the kernel keeps this axis in: the `axis` of every event it reports.
+    pub(crate) fn place(&mut self, slot: AxisSlot) {
+        self.slot = slot;
+    }
+
     pub fn status(&self) -> &AxisStatus {
         &self.status
     }
@@ -583,8 +579,12 @@ impl Axis {
         cycle: u64,
         events: &mut impl EventSink,
     ) -> Verdict {
-        self.slot = cmd.axis;
-        match self.try_submit(cmd, master, cycle, events) {
+        let cx = &mut Ctx {
+            slot: self.slot,
+            cycle,
+            events,
+        };
+        match self.try_submit(cx, cmd, master) {
             Ok(()) => {
                 self.update_status();
                 Verdict::Accepted
@@ -595,12 +595,10 @@ impl Axis {
 
     fn try_submit(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         cmd: Command,
         master: Option<(AxisSlot, MasterSample)>,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         match cmd.kind {
             CommandKind::Power {
                 enable,
@@ -615,7 +613,7 @@ impl Axis {
                 self.enable_positive = enable_positive;
                 self.enable_negative = enable_negative;
                 if let Some(mut old) = self.power.take() {
-                    old.end(End::Aborted, slot, cycle, events);
+                    old.end(cx, End::Aborted);
                 }
                 if enable {
                     if !self.enable {
@@ -628,20 +626,18 @@ impl Axis {
                         released: false,
                     };
                     held.emit(
+                        cx,
                         FbOutputs {
                             busy: true,
                             active: true,
                             status: self.status.power_status,
                             ..FbOutputs::default()
                         },
-                        slot,
-                        cycle,
-                        events,
                     );
                     self.power = Some(held);
                 } else {
-                    self.disable(cycle, events);
-                    emit_once(cmd.id, DONE, slot, cycle, events);
+                    self.disable(cx);
+                    cx.report(cmd.id, DONE);
                 }
                 Ok(())
             }
@@ -650,7 +646,7 @@ impl Axis {
                     // The axis is still on its error-stop ramp: the reset waits for standstill
                     // (no velocity step with the drive enabled); a newer reset replaces it.
                     if let Some(mut old) = self.pending_reset.take() {
-                        old.end(End::Aborted, slot, cycle, events);
+                        old.end(cx, End::Aborted);
                     }
                     let mut held = Held {
                         id: cmd.id,
@@ -658,19 +654,17 @@ impl Axis {
                         released: false,
                     };
                     held.emit(
+                        cx,
                         FbOutputs {
                             busy: true,
                             ..FbOutputs::default()
                         },
-                        slot,
-                        cycle,
-                        events,
                     );
                     self.pending_reset = Some(held);
                     return Ok(());
                 }
-                self.reset(cycle, events);
-                emit_once(cmd.id, DONE, slot, cycle, events);
+                self.reset(cx);
+                cx.report(cmd.id, DONE);
                 Ok(())
             }
             CommandKind::SetOverride { velocity_factor } => {
@@ -678,7 +672,7 @@ impl Axis {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
                 self.override_factor = velocity_factor;
-                emit_once(cmd.id, DONE, slot, cycle, events);
+                cx.report(cmd.id, DONE);
                 Ok(())
             }
             CommandKind::SetPosition {
@@ -713,7 +707,7 @@ impl Axis {
                         self.plan_job_now();
                     }
                 }
-                emit_once(cmd.id, DONE, slot, cycle, events);
+                cx.report(cmd.id, DONE);
                 Ok(())
             }
             CommandKind::WriteParameter { number, value } => {
@@ -722,10 +716,10 @@ impl Axis {
                 // directly would step the slave's velocity; MC_GearInDyn changes it with a
                 // limited acceleration.
                 self.config.parameters.write(number, value)?;
-                emit_once(cmd.id, DONE, slot, cycle, events);
+                cx.report(cmd.id, DONE);
                 Ok(())
             }
-            CommandKind::Release { target } => self.release(target, cycle, events),
+            CommandKind::Release { target } => self.release(cx, target),
             CommandKind::Keepalive { target } => {
                 for j in [self.job.as_mut(), self.next.as_mut()]
                     .into_iter()
@@ -753,9 +747,9 @@ impl Axis {
                     _ => {}
                 }
                 let (dec, jk) = self.stop_dynamics(deceleration, jerk);
-                self.abort_all(cycle, events);
+                self.abort_all(cx);
                 if let Some(mut old) = self.stop.take() {
-                    old.end(End::Aborted, slot, cycle, events);
+                    old.end(cx, End::Aborted);
                 }
                 self.coupling = None;
                 self.mode = Mode::Stopping;
@@ -765,14 +759,12 @@ impl Axis {
                     released: false,
                 };
                 held.emit(
+                    cx,
                     FbOutputs {
                         busy: true,
                         active: true,
                         ..FbOutputs::default()
                     },
-                    slot,
-                    cycle,
-                    events,
                 );
                 self.stop = Some(held);
                 let mut j = Job::new(0, JobKind::Halt);
@@ -781,68 +773,55 @@ impl Axis {
                 j.acc = dec.max(self.p().axis_acc);
                 j.jerk = jk;
                 j.velocity = self.set.velocity.abs().max(EPS_V);
-                self.start_job(j, cycle, events);
+                self.start_job(cx, j);
                 Ok(())
             }
-            CommandKind::GearOut => self.submit_gear_out(cmd.id, cycle, events),
+            CommandKind::GearOut => self.submit_gear_out(cx, cmd.id),
             CommandKind::GearIn {
                 master: master_slot,
                 ratio_numerator,
                 ratio_denominator,
             } => self.submit_gear_in(
+                cx,
                 cmd.id,
                 master_slot,
                 master,
                 ratio_numerator,
                 ratio_denominator,
-                cycle,
-                events,
             ),
             CommandKind::GearInDyn {
                 master: master_slot,
                 gear_ratio,
                 acceleration,
-            } => self.submit_gear_in_dyn(
-                cmd.id,
-                master_slot,
-                master,
-                gear_ratio,
-                acceleration,
-                cycle,
-                events,
-            ),
-            CommandKind::MoveSuperImposed(sp) => {
-                self.submit_superposition(cmd.id, sp, cycle, events)
-            }
+            } => self.submit_gear_in_dyn(cx, cmd.id, master_slot, master, gear_ratio, acceleration),
+            CommandKind::MoveSuperImposed(sp) => self.submit_superposition(cx, cmd.id, sp),
             CommandKind::AbortSuperposition => {
-                self.abort_superposition(cycle, events);
-                emit_once(cmd.id, DONE, slot, cycle, events);
+                self.abort_superposition(cx);
+                cx.report(cmd.id, DONE);
                 Ok(())
             }
             CommandKind::Home {
                 position,
                 mode,
                 options,
-            } => self.submit_home(cmd.id, position, mode, options, cycle, events),
-            _ => self.submit_motion(cmd, cycle, events),
+            } => self.submit_home(cx, cmd.id, position, mode, options),
+            _ => self.submit_motion(cx, cmd),
         }
     }
 
     /// Falling edge of Execute/Enable.
     fn release(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         target: CommandId,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         if let Some(s) = self.stop.as_mut().filter(|s| s.id == target) {
             s.released = true;
-            self.try_unlock(cycle, events);
+            self.try_unlock(cx);
             return Ok(());
         }
         if self.power.as_ref().is_some_and(|p| p.id == target) {
-            self.disable(cycle, events);
+            self.disable(cx);
             return Ok(());
         }
         if let Some(c) = self
@@ -861,7 +840,7 @@ impl Axis {
                     in_gear: true,
                     ..j.out
                 };
-                j.emit(out, slot, cycle, events);
+                j.emit(cx, out);
                 j.id = 0;
             }
             return Ok(());
@@ -874,7 +853,7 @@ impl Axis {
                     in_velocity: false,
                     ..j.out
                 };
-                j.emit(out, slot, cycle, events);
+                j.emit(cx, out);
                 self.plan_job_now();
             }
             // Other Execute-type commands run on (§3.2).
@@ -890,11 +869,10 @@ impl Axis {
     }
 
     /// Note 6: MC_Stop done and released → Standstill.
-    fn try_unlock(&mut self, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    fn try_unlock(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if let Some(mut s) = self.stop {
             if s.released && s.out.done && self.job.is_none() {
-                s.end(End::Done, slot, cycle, events);
+                s.end(cx, End::Done);
                 self.stop = None;
                 if self.mode == Mode::Stopping {
                     self.mode = Mode::Enabled;
@@ -906,13 +884,12 @@ impl Axis {
     }
 
     /// Aborts the running and the buffered job (CommandAborted).
-    fn abort_all(&mut self, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    fn abort_all(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if let Some(mut n) = self.next.take() {
-            n.finish_aborted(slot, cycle, events);
+            n.finish_aborted(cx);
         }
         if let Some(mut j) = self.job.take() {
-            j.finish_aborted(slot, cycle, events);
+            j.finish_aborted(cx);
         }
         self.coupling = None;
     }
@@ -949,7 +926,6 @@ impl Axis {
         cycle: u64,
         events: &mut impl EventSink,
     ) -> DriveSetpoint {
-        let slot = self.slot;
         if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
             // A drive that reports no number is a faulty drive; keep the last good values.
             let fb = DriveFeedback {
@@ -960,6 +936,11 @@ impl Axis {
             };
             return self.step(dt, &fb, master, cycle, events);
         }
+        let cx = &mut Ctx {
+            slot: self.slot,
+            cycle,
+            events,
+        };
         self.act_pos = fb.actual_position + self.offset;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
@@ -977,7 +958,7 @@ impl Axis {
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
         // Power and drive readiness (notes 1, 2, 5).
-        self.step_power(dt, fb, cycle, events);
+        self.step_power(cx, dt, fb);
 
         // Disabled: the setpoint follows the actual position.
         if self.mode == Mode::Disabled || (self.mode == Mode::ErrorStop && !fb.enabled) {
@@ -993,27 +974,27 @@ impl Axis {
             // Coupled slave losing its master.
             if let Some(None) = master {
                 if self.coupling.is_some() {
-                    self.enter_error(ErrorId::MASTER_LOST, cycle, events);
+                    self.enter_error(cx, ErrorId::MASTER_LOST);
                 }
             }
             if let Some(Some(m)) = master {
                 if m.error && self.coupling.is_some() {
-                    self.enter_error(ErrorId::MASTER_LOST, cycle, events);
+                    self.enter_error(cx, ErrorId::MASTER_LOST);
                 }
             }
-            self.step_feed_enables(cycle, events);
-            self.step_job(dt, fb, master.flatten(), cycle, events);
-            self.step_superposition(dt, cycle, events);
-            self.step_soft_limits(dt, cycle, events);
-            self.step_following_error(dt, cycle, events);
+            self.step_feed_enables(cx);
+            self.step_job(cx, dt, fb, master.flatten());
+            self.step_superposition(cx, dt);
+            self.step_soft_limits(cx, dt);
+            self.step_following_error(cx, dt);
         }
         if self.mode == Mode::ErrorStop && self.job.is_none() {
             if let Some(mut r) = self.pending_reset.take() {
-                self.reset(cycle, events);
-                r.end(End::Done, self.slot, cycle, events);
+                self.reset(cx);
+                r.end(cx, End::Done);
             }
         }
-        self.try_unlock(cycle, events);
+        self.try_unlock(cx);
         // InTargetPosition's dwell counts cycles (not status updates: submits update too).
         let lag = (self.act_pos - self.set.position).abs();
         if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {
@@ -1029,7 +1010,6 @@ impl Axis {
         s.following_error_max = s.following_error_max.max(s.following_error);
         self.sent_position = self.set.position;
         self.prev_cam = fb.reference_cam;
-        let _ = slot;
         DriveSetpoint {
             enable: self.enable
                 && !(self.mode == Mode::ErrorStop && self.error == ErrorId::DRIVE_FAULT),

@@ -5,17 +5,16 @@ use super::*;
 
 impl Axis {
     /// Note 2: Enable FALSE → Disabled (ErrorStop stays ErrorStop).
-    pub(super) fn disable(&mut self, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    pub(super) fn disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         self.enable = false;
         self.last_target = None;
-        self.abort_superposition(cycle, events);
-        self.abort_all(cycle, events);
+        self.abort_superposition(cx);
+        self.abort_all(cx);
         if let Some(mut s) = self.stop.take() {
-            s.end(End::Aborted, slot, cycle, events);
+            s.end(cx, End::Aborted);
         }
         if let Some(mut p) = self.power.take() {
-            p.end(End::Done, slot, cycle, events);
+            p.end(cx, End::Done);
         }
         self.planner.clear();
         if self.mode != Mode::ErrorStop {
@@ -28,11 +27,10 @@ impl Axis {
     }
 
     /// MC_Reset: clears ErrorStop (notes 3/4) and the MC_Stop lock; takes actual as set.
-    pub(super) fn reset(&mut self, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
-        self.abort_superposition(cycle, events);
+    pub(super) fn reset(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        self.abort_superposition(cx);
         if let Some(mut s) = self.stop.take() {
-            s.end(End::Aborted, slot, cycle, events);
+            s.end(cx, End::Aborted);
             if self.mode == Mode::Stopping && self.job.is_none() {
                 self.mode = Mode::Enabled;
             }
@@ -45,7 +43,7 @@ impl Axis {
             self.reset_grace = 3;
             self.error = ErrorId(0);
             self.lag_timer = 0.0;
-            self.abort_all(cycle, events);
+            self.abort_all(cx);
             self.planner.clear();
             self.set = Kinematics {
                 position: self.act_pos,
@@ -61,21 +59,20 @@ impl Axis {
 
     /// Note 1: axis error → ErrorStop; every command reports the error; the setpoint stops
     /// on a fast ramp (or follows the actual position when the drive is off).
-    pub(super) fn enter_error(&mut self, e: ErrorId, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    pub(super) fn enter_error(&mut self, cx: &mut Ctx<'_, impl EventSink>, e: ErrorId) {
         if self.mode == Mode::ErrorStop {
             return;
         }
         self.error = e;
         if let Some(mut sp) = self.superimposed.take() {
-            sp.cmd.end(End::Error(e), slot, cycle, events);
+            sp.cmd.end(cx, End::Error(e));
         }
         for j in [self.next.take(), self.job.take()].into_iter().flatten() {
             let mut j = j;
-            j.finish_error(e, slot, cycle, events);
+            j.finish_error(cx, e);
         }
         if let Some(mut s) = self.stop.take() {
-            s.end(End::Error(e), slot, cycle, events);
+            s.end(cx, End::Error(e));
         }
         self.coupling = None;
         self.mode = Mode::ErrorStop;
@@ -98,26 +95,24 @@ impl Axis {
 
     pub(super) fn step_power(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         dt: f64,
         fb: &DriveFeedback,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) {
-        let slot = self.slot;
         self.reset_grace = self.reset_grace.saturating_sub(1);
         if fb.fault
             && self.reset_grace == 0
             && self.mode != Mode::ErrorStop
             && (self.enable || self.mode != Mode::Disabled)
         {
-            self.enter_error(ErrorId::DRIVE_FAULT, cycle, events);
+            self.enter_error(cx, ErrorId::DRIVE_FAULT);
         }
         let status = self.enable && fb.enabled && fb.ready && !fb.fault;
         if self.enable && !status && self.mode == Mode::Disabled {
             self.power_on_timer += dt;
             if self.power_on_timer > POWER_ON_TIMEOUT {
                 if let Some(mut p) = self.power.take() {
-                    p.end(End::Error(ErrorId::DRIVE_NOT_READY), slot, cycle, events);
+                    p.end(cx, End::Error(ErrorId::DRIVE_NOT_READY));
                 }
                 self.enable = false;
             }
@@ -140,27 +135,25 @@ impl Axis {
             && matches!(self.mode, Mode::Enabled | Mode::Stopping)
         {
             // The drive dropped out by itself.
-            self.enter_error(ErrorId::DRIVE_NOT_READY, cycle, events);
+            self.enter_error(cx, ErrorId::DRIVE_NOT_READY);
         }
         self.status.power_status = status;
         if let Some(mut p) = self.power {
             p.emit(
+                cx,
                 FbOutputs {
                     busy: true,
                     active: true,
                     status,
                     ..FbOutputs::default()
                 },
-                slot,
-                cycle,
-                events,
             );
             self.power = Some(p);
         }
     }
 
     /// A feed enable dropping while moving in its direction stops the axis (controlled).
-    pub(super) fn step_feed_enables(&mut self, cycle: u64, events: &mut impl EventSink) {
+    pub(super) fn step_feed_enables(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if self.mode != Mode::Enabled {
             return;
         }
@@ -176,9 +169,9 @@ impl Axis {
         if (v > EPS_V && self.limit_positive) || (v < -EPS_V && self.limit_negative) {
             // A hardware limit switch in the direction of travel is an end of travel: an
             // axis error, stopped with the fast-stop dynamics (#1053/#1054) in ErrorStop.
-            self.enter_error(ErrorId::LIMIT_SWITCH, cycle, events);
+            self.enter_error(cx, ErrorId::LIMIT_SWITCH);
         } else if (v > EPS_V && !self.enable_positive) || (v < -EPS_V && !self.enable_negative) {
-            self.stop_internally(ErrorId::FEED_ENABLE_MISSING, false, cycle, events);
+            self.stop_internally(cx, ErrorId::FEED_ENABLE_MISSING, false);
         }
     }
 
@@ -186,12 +179,10 @@ impl Axis {
     /// axis error: the axis ends in Standstill).
     pub(super) fn stop_internally(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         e: ErrorId,
         fast: bool,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) {
-        let slot = self.slot;
         let p = self.p();
         let (mut dec, mut jerk) = if fast {
             (
@@ -202,12 +193,12 @@ impl Axis {
             (p.axis_dec, p.axis_jerk)
         };
         if let Some(mut n) = self.next.take() {
-            n.finish_error(e, slot, cycle, events);
+            n.finish_error(cx, e);
         }
         if let Some(mut j) = self.job.take() {
             dec = dec.max(j.dec);
             jerk = jerk.max(j.jerk);
-            j.finish_error(e, slot, cycle, events);
+            j.finish_error(cx, e);
         }
         self.coupling = None;
         let mut h = Job::new(0, JobKind::Halt);
@@ -216,13 +207,12 @@ impl Axis {
         h.jerk = jerk;
         h.velocity = self.set.velocity.abs().max(EPS_V);
         h.options.ignore_position_monitoring = true;
-        self.start_job(h, cycle, events);
+        self.start_job(cx, h);
     }
 
     /// Endless motion stops at an enabled software limit with its deceleration; a coupled
     /// slave that crosses one is an axis error.
-    pub(super) fn step_soft_limits(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    pub(super) fn step_soft_limits(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         let p = self.p();
         let Some(job) = self.job else { return };
         let v = self.set.velocity;
@@ -239,7 +229,7 @@ impl Axis {
                 && self.set.position < p.axis_min_soft_pos_limit
                 && v < -EPS_V;
             if out_max || out_min {
-                self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
+                self.enter_error(cx, ErrorId::SOFT_LIMIT_REACHED);
             }
             return;
         }
@@ -270,13 +260,13 @@ impl Axis {
         }
         if !endless && !job.is_positioning() {
             // A stop whose own ramp would cross the limit: stop harder, as an axis error.
-            self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
+            self.enter_error(cx, ErrorId::SOFT_LIMIT_REACHED);
             return;
         }
         let mut j = job;
-        j.finish_error(ErrorId::SOFT_LIMIT_REACHED, slot, cycle, events);
+        j.finish_error(cx, ErrorId::SOFT_LIMIT_REACHED);
         if let Some(mut n) = self.next.take() {
-            n.finish_aborted(slot, cycle, events);
+            n.finish_aborted(cx);
         }
         let mut h = Job::new(0, JobKind::Positioning { continuous: false });
         h.velocity = v.abs();
@@ -286,31 +276,26 @@ impl Axis {
         h.target = limit;
         h.options.ignore_position_monitoring = true;
         self.job = None;
-        self.start_job(h, cycle, events);
+        self.start_job(cx, h);
         // The main motion is being stopped (superposition abort table row 4): a superposition
         // ends unless it is to resume after a motion stop, and then too if what it still has
         // to do would carry the stop past the limit; its velocity goes into the stop.
         if let Some(sp) = self.superimposed {
             let to_come = sp.distance - sp.applied;
             if sp.option != SuperpositionAbortOption::ResumeAfterMotionStop {
-                self.abort_superposition(cycle, events);
+                self.abort_superposition(cx);
             } else if self.superposition_room(to_come) != to_come {
-                self.end_superposition_incomplete(cycle, events);
+                self.end_superposition_incomplete(cx);
             }
         }
         // If the limit cannot be reached without overshoot, the axis would end beyond it:
         // stop as hard as allowed, as an axis error (never a silent standstill outside).
         if self.planner.overshoots(limit, v.signum()) {
-            self.enter_error(ErrorId::SOFT_LIMIT_REACHED, cycle, events);
+            self.enter_error(cx, ErrorId::SOFT_LIMIT_REACHED);
         }
     }
 
-    pub(super) fn step_following_error(
-        &mut self,
-        dt: f64,
-        cycle: u64,
-        events: &mut impl EventSink,
-    ) {
+    pub(super) fn step_following_error(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         let p = self.p();
         let (enabled, max_lag, filter) = (
             p.axis_en_position_lag_monitoring,
@@ -325,7 +310,7 @@ impl Axis {
         if lag > max_lag {
             self.lag_timer += dt;
             if self.lag_timer > filter + 1e-12 {
-                self.enter_error(ErrorId::FOLLOWING_ERROR, cycle, events);
+                self.enter_error(cx, ErrorId::FOLLOWING_ERROR);
             }
         } else {
             self.lag_timer = 0.0;

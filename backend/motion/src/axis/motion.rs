@@ -151,11 +151,9 @@ impl Axis {
 
     pub(super) fn submit_motion(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         cmd: Command,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         let mut job;
         match cmd.kind {
             CommandKind::MoveAbsolute(m)
@@ -388,7 +386,7 @@ impl Axis {
         // Accepted from here on. A motion command decouples a slave (and with it ends a
         // superposition on it, abort table row 6).
         if self.coupling.is_some() {
-            self.abort_superposition(cycle, events);
+            self.abort_superposition(cx);
             self.coupling = None;
         }
         if job.is_positioning() {
@@ -401,7 +399,7 @@ impl Axis {
         job.buffer_mode = mode;
         if mode == BufferMode::Aborting {
             if let Some(mut n) = self.next.take() {
-                n.finish_aborted(slot, cycle, events);
+                n.finish_aborted(cx);
             }
             if let Some(mut j) = self.job.take() {
                 if j.kind == JobKind::Halt && job.kind == JobKind::Halt {
@@ -409,23 +407,18 @@ impl Axis {
                     job.dec = job.dec.max(j.dec);
                     job.jerk = job.jerk.max(j.jerk);
                 }
-                j.finish_aborted(slot, cycle, events);
+                j.finish_aborted(cx);
             }
-            self.start_job(job, cycle, events);
+            self.start_job(cx, job);
         } else {
             // Queued: busy, not active.
             let out = job.out;
             if job.id != 0 {
-                events.push(CommandEvent {
-                    cycle,
-                    command: job.id,
-                    axis: slot,
-                    outputs: out,
-                });
+                cx.report(job.id, out);
             }
             job.phase = Phase::Queued;
             self.next = Some(job);
-            self.prepare_blend(cycle, events);
+            self.prepare_blend();
         }
         Ok(())
     }
@@ -480,9 +473,8 @@ impl Axis {
         (d, j)
     }
 
-    pub(super) fn start_job(&mut self, mut job: Job, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
-        job.activate(slot, cycle, events);
+    pub(super) fn start_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, mut job: Job) {
+        job.activate(cx);
         job.since_keepalive = 0;
         if job.kind == (JobKind::Positioning { continuous: true }) && !job.past_target {
             // The end velocity keeps the direction from where the move really starts (a
@@ -504,13 +496,13 @@ impl Axis {
             if let Err(e) = self.check_soft_limits(target) {
                 // The oriented stop would cross a software limit: stop safely, with the
                 // error, not at the position (spec §5.1.4).
-                self.stop_internally(e, false, cycle, events);
+                self.stop_internally(cx, e, false);
                 return;
             }
             self.last_target = Some(target);
         }
         self.plan_job_now();
-        self.prepare_blend(cycle, events);
+        self.prepare_blend();
     }
 
     /// A modulo move started from motion takes the shortest path in the direction of travel
@@ -685,7 +677,7 @@ impl Axis {
 
     /// When a blending successor is queued behind a positioning job, the running job is
     /// re-planned to pass its target at the blending velocity (§3.8), as well as possible.
-    pub(super) fn prepare_blend(&mut self, _cycle: u64, _events: &mut impl EventSink) {
+    pub(super) fn prepare_blend(&mut self) {
         let ovr = self.override_ratio();
         let (Some(a), Some(b)) = (self.job.as_ref(), self.next.as_ref()) else {
             return;
@@ -802,13 +794,11 @@ impl Axis {
 
     pub(super) fn step_job(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         dt: f64,
         fb: &DriveFeedback,
         master: Option<MasterSample>,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) {
-        let slot = self.slot;
         let ovr = self.override_ratio();
         let Some(mut job) = self.job else {
             self.set.velocity = 0.0;
@@ -830,7 +820,7 @@ impl Axis {
                     warning_id: ErrorId::DEADMAN_TIMEOUT.0,
                     ..job.out
                 };
-                job.emit(out, slot, cycle, events);
+                job.emit(cx, out);
                 self.job = Some(job);
                 self.plan_job_now();
                 job = self.job.expect("set above");
@@ -873,7 +863,7 @@ impl Axis {
                             in_gear: true,
                             ..job.out
                         };
-                        job.emit(out, slot, cycle, events);
+                        job.emit(cx, out);
                     }
                 }
                 self.coupling = Some(c);
@@ -923,13 +913,13 @@ impl Axis {
                     in_velocity: false,
                     ..job.out
                 };
-                job.emit(out, slot, cycle, events);
+                job.emit(cx, out);
             }
         }
 
         if job.kind == JobKind::Home {
             self.job = Some(job);
-            self.step_home(dt, fb, cycle, events);
+            self.step_home(cx, dt, fb);
             return;
         }
 
@@ -945,19 +935,19 @@ impl Axis {
                 warning_id: w.0,
                 ..job.out
             };
-            job.emit(out, slot, cycle, events);
+            job.emit(cx, out);
         }
         // A successor with its own blending position takes over where the axis passes it.
         if let Some((bp, dir)) = self.next.as_ref().and_then(|n| n.blend_at) {
             if (self.set.position - bp) * dir >= 0.0 {
                 if self.next.as_ref().is_some_and(|n| n.blend_done) {
-                    job.finish_done(slot, cycle, events);
+                    job.finish_done(cx);
                 } else {
-                    job.finish_aborted(slot, cycle, events);
+                    job.finish_aborted(cx);
                 }
                 self.job = None;
                 if let Some(n) = self.next.take() {
-                    self.start_job(n, cycle, events);
+                    self.start_job(cx, n);
                 }
                 return;
             }
@@ -972,7 +962,7 @@ impl Axis {
                         in_velocity: reached,
                         ..job.out
                     };
-                    job.emit(out, slot, cycle, events);
+                    job.emit(cx, out);
                 }
                 job.phase = if reached {
                     Phase::Holding
@@ -1003,7 +993,7 @@ impl Axis {
                         in_end_velocity: true,
                         ..job.out
                     };
-                    job.emit(out, slot, cycle, events);
+                    job.emit(cx, out);
                 }
                 self.job = Some(job);
             }
@@ -1029,9 +1019,9 @@ impl Axis {
                     .is_some_and(|n| n.buffer_mode.is_blending())
                     && job.end_velocity != 0.0;
                 if blending_successor {
-                    job.finish_done(slot, cycle, events);
+                    job.finish_done(cx);
                     self.job = None;
-                    self.start_next(cycle, events);
+                    self.start_next(cx);
                     return;
                 }
                 let done = self.done_criterion(&mut job, dt);
@@ -1041,9 +1031,9 @@ impl Axis {
                     }
                     Some(Ok(())) => {
                         if let Some(e) = job.pending_error {
-                            job.finish_error(e, slot, cycle, events);
+                            job.finish_error(cx, e);
                         } else {
-                            job.finish_done(slot, cycle, events);
+                            job.finish_done(cx);
                         }
                         self.job = None;
                         self.planner.clear();
@@ -1053,15 +1043,13 @@ impl Axis {
                         if self.mode == Mode::Stopping {
                             if let Some(mut s) = self.stop {
                                 s.emit(
+                                    cx,
                                     FbOutputs {
                                         busy: true,
                                         active: true,
                                         done: true,
                                         ..FbOutputs::default()
                                     },
-                                    slot,
-                                    cycle,
-                                    events,
                                 );
                                 self.stop = Some(s);
                             } else {
@@ -1069,20 +1057,20 @@ impl Axis {
                                 self.mode = Mode::Enabled;
                             }
                         }
-                        self.start_next(cycle, events);
+                        self.start_next(cx);
                     }
                     Some(Err(e)) => {
-                        job.finish_error(e, slot, cycle, events);
+                        job.finish_error(cx, e);
                         self.job = None;
                         self.planner.clear();
                         if let Some(mut n) = self.next.take() {
-                            n.finish_aborted(slot, cycle, events);
+                            n.finish_aborted(cx);
                         }
                         if self.mode == Mode::Stopping {
                             // MC_Stop's own ramp missed its position window: the stop ends
                             // with the error, and with it the lock.
                             if let Some(mut s) = self.stop.take() {
-                                s.end(End::Error(e), slot, cycle, events);
+                                s.end(cx, End::Error(e));
                             }
                             self.mode = Mode::Enabled;
                         }
@@ -1139,28 +1127,27 @@ impl Axis {
     }
 
     /// Activates the buffered job when the running one has ended.
-    pub(super) fn start_next(&mut self, cycle: u64, events: &mut impl EventSink) {
+    pub(super) fn start_next(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if self.job.is_some() || self.mode != Mode::Enabled {
             return;
         }
         if let Some(mut n) = self.next.take() {
             if n.kind == JobKind::Halt {
                 // Buffered halt at standstill: nothing to stop.
-                let slot = self.slot;
-                n.activate(slot, cycle, events);
+                n.activate(cx);
                 if self.set.velocity.abs() <= EPS_V {
-                    n.finish_done(slot, cycle, events);
+                    n.finish_done(cx);
                     return;
                 }
             }
             n.since_keepalive = 0;
-            self.start_job(n, cycle, events);
+            self.start_job(cx, n);
         }
     }
 
     /// After GearOut (or when a slave loses its master while moving): keep the current
     /// velocity as an endless motion that no command owns.
-    pub(super) fn continue_at_current_velocity(&mut self, cycle: u64, events: &mut impl EventSink) {
+    pub(super) fn continue_at_current_velocity(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if self.set.velocity.abs() <= EPS_V && self.set.acceleration == 0.0 {
             self.set.velocity = 0.0;
             return;
@@ -1174,7 +1161,7 @@ impl Axis {
         j.jerk = p.axis_jerk;
         // Not scaled by the override: it continues the master's speed.
         j.planned_override = 1.0;
-        self.start_job(j, cycle, events);
+        self.start_job(cx, j);
         let ovr = self.override_ratio();
         if let Some(j) = self.job.as_mut() {
             let _ = self

@@ -20,12 +20,10 @@ const SMOOTHSTEP5_MAX_CURVATURE: f64 = 5.773_502_691_896_258;
 impl Axis {
     pub(super) fn submit_superposition(
         &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         sp: Superposition,
-        cycle: u64,
-        events: &mut impl EventSink,
     ) -> Result<(), ErrorId> {
-        let slot = self.slot;
         let p = self.p();
         let finite = [
             sp.distance,
@@ -118,7 +116,7 @@ impl Axis {
         let distance = self.superposition_room(wanted);
         let warning = d > 0.0 && (scale < 1.0 - 1e-12 || distance != wanted);
         // A new superposition replaces the running one (what it applied so far stays).
-        self.abort_superposition(cycle, events);
+        self.abort_superposition(cx);
         let out = FbOutputs {
             busy: true,
             active: true,
@@ -135,7 +133,7 @@ impl Axis {
             out: FbOutputs::default(),
             released: false,
         };
-        cmd.emit(out, slot, cycle, events);
+        cmd.emit(cx, out);
         self.superimposed = Some(Superimposed {
             cmd,
             distance,
@@ -171,25 +169,24 @@ impl Axis {
     }
 
     /// Ends a superposition with CommandAborted; what it applied stays.
-    pub(super) fn abort_superposition(&mut self, cycle: u64, events: &mut impl EventSink) {
-        self.end_superposition(End::Aborted, cycle, events);
+    pub(super) fn abort_superposition(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        self.end_superposition(cx, End::Aborted);
     }
 
     /// Ends a superposition that cannot go on within the soft limits: Done as far as it got,
     /// with Warning 0x4243 (as a superposition the parameters do not allow in full).
-    pub(super) fn end_superposition_incomplete(&mut self, cycle: u64, events: &mut impl EventSink) {
-        let slot = self.slot;
+    pub(super) fn end_superposition_incomplete(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if let Some(sp) = self.superimposed.as_mut() {
-            warn_incomplete(sp, slot, cycle, events);
+            warn_incomplete(cx, sp);
         }
-        self.end_superposition(End::Done, cycle, events);
+        self.end_superposition(cx, End::Done);
     }
 
     /// Ends a superposition; what it applied stays. The velocity it was adding is handed to
     /// the main motion's planner, which takes it away smoothly.
-    fn end_superposition(&mut self, end: End, cycle: u64, events: &mut impl EventSink) {
+    fn end_superposition(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
         if let Some(mut sp) = self.superimposed.take() {
-            sp.cmd.end(end, self.slot, cycle, events);
+            sp.cmd.end(cx, end);
             if sp.added != (0.0, 0.0)
                 && self.mode != Mode::Disabled
                 && self
@@ -218,7 +215,7 @@ impl Axis {
     /// Lays the superposition over the setpoint the job produced this cycle: the increment is
     /// folded into the running plan (and target, and coupling), so the main motion carries it
     /// from now on and its target moves by the distance (spec §5.2.1).
-    pub(super) fn step_superposition(&mut self, dt: f64, cycle: u64, events: &mut impl EventSink) {
+    pub(super) fn step_superposition(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         let Some(mut sp) = self.superimposed else {
             return;
         };
@@ -265,15 +262,15 @@ impl Axis {
             self.set_has_superposition = false;
             self.superimposed = Some(sp);
             if abort {
-                self.abort_superposition(cycle, events);
+                self.abort_superposition(cx);
             } else {
-                self.end_superposition_incomplete(cycle, events);
+                self.end_superposition_incomplete(cx);
             }
             return;
         }
         if room != to_come {
             sp.distance = sp.applied + room;
-            warn_incomplete(&mut sp, self.slot, cycle, events);
+            warn_incomplete(cx, &mut sp);
         }
         if moved != 0.0 {
             sp.last_direction = moved.signum();
@@ -338,18 +335,18 @@ impl Axis {
             sp.last_position = self.set.position;
             self.superimposed = Some(sp);
         } else {
-            sp.cmd.end(End::Done, self.slot, cycle, events);
+            sp.cmd.end(cx, End::Done);
             self.superimposed = None;
         }
     }
 }
 
 /// Warning 0x4243 on a running superposition: it does less than asked.
-fn warn_incomplete(sp: &mut Superimposed, slot: AxisSlot, cycle: u64, events: &mut impl EventSink) {
+fn warn_incomplete(cx: &mut Ctx<'_, impl EventSink>, sp: &mut Superimposed) {
     let out = FbOutputs {
         warning: true,
         warning_id: ErrorId::SUPERPOSITION_INCOMPLETE.0,
         ..sp.cmd.out
     };
-    sp.cmd.emit(out, slot, cycle, events);
+    sp.cmd.emit(cx, out);
 }
