@@ -138,11 +138,6 @@ impl Planner {
         if !target.is_finite() || !target_velocity.is_finite() {
             return Err(PlanError::InvalidInput);
         }
-        // Above the velocity limit towards the target (an override, a slower successor):
-        // Ruckig's own brake hands over with the braking acceleration still applied, so the
-        // velocity undershoots by up to a²/2j — backwards when the limit is low. Brake to the
-        // limit on the velocity interface instead (it ends with a = 0) and position from
-        // there, unless that longer braking would carry the axis past the target.
         let d = self.plan_position_direct(from, target, target_velocity, limits)?;
         if self.straight(from, target, limits.jerk) {
             return Ok(d);
@@ -153,15 +148,17 @@ impl Planner {
         // turn) to the limit on the velocity interface instead, which ends with a = 0, and
         // position from there; when that is too long to stop at the target and the axis is
         // braking for it already, brake on from the present velocity, which only falls.
-        if self.exceeds_velocity(limits.velocity) {
-            if let Ok(d) = self.plan_braked(from, target, target_velocity, limits) {
-                if self.straight(from, target, limits.jerk) {
-                    return Ok(d);
-                }
+        let toward = from.velocity * (target - from.position) > 0.0;
+        let braking_first = toward && from.velocity.abs() > limits.velocity;
+        if !self.exceeds_velocity(limits.velocity) && !braking_first {
+            return Ok(d); // not Ruckig's brake at work: its profile stands
+        }
+        if let Ok(d) = self.plan_braked(from, target, target_velocity, limits) {
+            if self.straight(from, target, limits.jerk) {
+                return Ok(d);
             }
         }
-        let toward = from.velocity * (target - from.position) > 0.0;
-        if toward && from.velocity.abs() > limits.velocity {
+        if braking_first {
             let braking = Limits {
                 velocity: from.velocity.abs(),
                 ..*limits
