@@ -1,6 +1,6 @@
 //! The kernel: a fixed number of axis slots stepped together, masters before their slaves.
 
-use crate::axis::{Axis, MasterSample};
+use crate::axis::{Axis, Master, MasterSample};
 use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};
 use crate::drive::{DriveFeedback, DriveSetpoint};
 use crate::error::ErrorId;
@@ -159,10 +159,12 @@ impl Kernel {
                     continue;
                 };
                 let master = match axis.master_slot() {
-                    None => None,
+                    None => Master::Uncoupled,
                     Some(m) => match self.axes.get(m as usize).and_then(|a| a.as_deref()) {
-                        None => Some(None), // master vanished
-                        Some(ma) if self.stepped[m as usize] => Some(Some(MasterSample::of(ma))),
+                        None => Master::Lost, // master vanished
+                        Some(ma) if self.stepped[m as usize] => {
+                            Master::Sample(MasterSample::of(ma))
+                        }
                         Some(_) => continue, // wait for the master
                     },
                 };
@@ -184,7 +186,7 @@ impl Kernel {
             if !self.stepped[i] {
                 let fb = feedback.get(i).copied().unwrap_or_default();
                 if let Some(axis) = self.axes[i].as_deref_mut() {
-                    let sp = axis.step(dt, &fb, Some(None), cycle, events);
+                    let sp = axis.step(dt, &fb, Master::Lost, cycle, events);
                     if let Some(out) = setpoints.get_mut(i) {
                         *out = sp;
                     }

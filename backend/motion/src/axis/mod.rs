@@ -44,6 +44,19 @@ pub struct MasterSample {
     pub max_velocity: f64,
 }
 
+/// A slave's master input in a cycle. The kernel steps masters before their slaves, so a
+/// sample is the master's state after its step in the same cycle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Master {
+    /// The axis follows no master.
+    Uncoupled,
+    /// The axis is coupled but its master cannot be followed: its slot is empty, or it is
+    /// part of a coupling loop. A coupled slave stops in ErrorStop (0x7043 master lost).
+    Lost,
+    /// The master, stepped in this cycle.
+    Sample(MasterSample),
+}
+
 impl MasterSample {
     pub fn of(axis: &Axis) -> Self {
         let s = axis.status();
@@ -917,12 +930,12 @@ impl Axis {
 
     // ------------------------------------------------------------------ step
 
-    /// One cycle. `master`: None = not a slave; Some(None) = master gone; Some(Some(m)).
+    /// One cycle.
     pub fn step(
         &mut self,
         dt: f64,
         fb: &DriveFeedback,
-        master: Option<Option<MasterSample>>,
+        master: Master,
         cycle: u64,
         events: &mut impl EventSink,
     ) -> DriveSetpoint {
@@ -971,19 +984,17 @@ impl Axis {
                 self.planner.clear();
             }
         } else {
-            // Coupled slave losing its master.
-            if let Some(None) = master {
-                if self.coupling.is_some() {
-                    self.enter_error(cx, ErrorId::MASTER_LOST);
-                }
-            }
-            if let Some(Some(m)) = master {
-                if m.error && self.coupling.is_some() {
-                    self.enter_error(cx, ErrorId::MASTER_LOST);
-                }
+            // A coupled slave whose master is gone or in ErrorStop.
+            let lost = match master {
+                Master::Uncoupled => false,
+                Master::Lost => true,
+                Master::Sample(m) => m.error,
+            };
+            if lost && self.coupling.is_some() {
+                self.enter_error(cx, ErrorId::MASTER_LOST);
             }
             self.step_feed_enables(cx);
-            self.step_job(cx, dt, fb, master.flatten());
+            self.step_job(cx, dt, fb, master);
             self.step_superposition(cx, dt);
             self.step_soft_limits(cx, dt);
             self.step_following_error(cx, dt);

@@ -797,7 +797,7 @@ impl Axis {
         cx: &mut Ctx<'_, impl EventSink>,
         dt: f64,
         fb: &DriveFeedback,
-        master: Option<MasterSample>,
+        master: Master,
     ) {
         let ovr = self.override_ratio();
         let Some(mut job) = self.job else {
@@ -828,7 +828,7 @@ impl Axis {
         }
 
         if job.kind == JobKind::Gear {
-            if let (Some(mut c), Some(m)) = (self.coupling, master) {
+            if let (Some(mut c), Master::Sample(m)) = (self.coupling, master) {
                 let (mp, mv, ma, mj) = if self.p().axis_couple_slave_to_actual_values {
                     (m.actual_position, m.actual_velocity, 0.0, 0.0)
                 } else {
