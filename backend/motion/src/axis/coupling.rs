@@ -1,8 +1,225 @@
-//! Gearing: MC_GearIn (fixed ratio, coupled at rest), MC_GearInDyn (ratio changeable every
-//! cycle, rate-limited, can couple onto a moving master) and MC_GearOut (the slave keeps its
-//! velocity). The slave's setpoint itself is computed in `step_job`.
+//! Couplings: a slave follows its master through a coupling law. MC_GearIn (fixed ratio,
+//! coupled at rest), MC_GearInDyn (ratio changeable every cycle, rate-limited, can couple onto
+//! a moving master) and MC_GearOut (the slave keeps its velocity).
+//!
+//! The laws are kept apart from the command protocol: a law only maps the master's motion to
+//! the slave's setpoint, so a new one (an electronic cam) is one more [`CouplingLaw`] variant
+//! and its `submit_*`, while what every coupling shares — admission, aborting what runs,
+//! InGear, losing the master, soft limits — stays as it is.
 
 use super::*;
+
+/// What a slave sees of its master in a cycle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MasterSample {
+    pub set: Kinematics,
+    pub actual_position: f64,
+    pub actual_velocity: f64,
+    pub moving: bool,
+    pub error: bool,
+    /// The master's AxisVeloMax (GearInDyn scales its ratio-change limit with it).
+    pub max_velocity: f64,
+}
+
+/// A slave's master input in a cycle. The kernel steps masters before their slaves, so a
+/// sample is the master's state after its step in the same cycle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Master {
+    /// The axis follows no master.
+    Uncoupled,
+    /// The axis is coupled but its master cannot be followed: its slot is empty, or it is
+    /// part of a coupling loop. A coupled slave stops in ErrorStop (0x7043 master lost).
+    Lost,
+    /// The master, stepped in this cycle.
+    Sample(MasterSample),
+}
+
+impl MasterSample {
+    pub fn of(axis: &Axis) -> Self {
+        let s = axis.status();
+        MasterSample {
+            set: Kinematics {
+                position: s.set_position,
+                velocity: s.set_velocity,
+                acceleration: s.set_acceleration,
+                jerk: s.set_jerk,
+            },
+            actual_position: s.actual_position,
+            actual_velocity: s.actual_velocity,
+            moving: s.moving,
+            error: s.state == AxisState::ErrorStop,
+            max_velocity: axis.parameters().axis_velo_max,
+        }
+    }
+
+    /// The master motion a slave follows: its setpoints, or with #1064
+    /// (AxisCoupleSlaveToActualValues) its actual position and velocity (no acceleration or
+    /// jerk: the actual values carry none the slave could use).
+    fn followed(&self, actual_values: bool) -> Kinematics {
+        if actual_values {
+            Kinematics {
+                position: self.actual_position,
+                velocity: self.actual_velocity,
+                acceleration: 0.0,
+                jerk: 0.0,
+            }
+        } else {
+            self.set
+        }
+    }
+}
+
+/// A slave's coupling to its master.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Coupling {
+    pub(super) master: AxisSlot,
+    pub(super) law: CouplingLaw,
+    /// The GearInDyn command that still has Enable TRUE (0 when none): a further GearInDyn to
+    /// the same master changes this coupling's ratio instead of coupling anew.
+    pub(super) dyn_command: CommandId,
+}
+
+/// How the slave's setpoint follows the master's motion.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum CouplingLaw {
+    /// MC_GearIn: a fixed ratio.
+    Gear(Gear),
+    /// MC_GearInDyn: the ratio ramps towards `target_ratio` by at most `ratio_rate` per second.
+    GearDyn {
+        gear: Gear,
+        target_ratio: f64,
+        ratio_rate: f64,
+    },
+}
+
+/// slave = slave_start + ratio · (master − master_start): the slave follows the master's
+/// travel from where both stood when they were coupled (or the ratio last changed).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Gear {
+    pub(super) ratio: f64,
+    /// NaN: taken from the master in the next cycle (re-based after a GearOut that recoupled).
+    master_start: f64,
+    slave_start: f64,
+}
+
+impl Gear {
+    /// The slave's setpoint; `ratio_change` is the ratio's rate of change in this cycle (its
+    /// share of the slave's acceleration).
+    fn follow(&self, master: &Kinematics, ratio_change: f64) -> Kinematics {
+        Kinematics {
+            position: self.slave_start + self.ratio * (master.position - self.master_start),
+            velocity: self.ratio * master.velocity,
+            acceleration: self.ratio * master.acceleration + ratio_change * master.velocity,
+            jerk: self.ratio * master.jerk,
+        }
+    }
+}
+
+impl CouplingLaw {
+    fn gear(&self) -> &Gear {
+        match self {
+            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g,
+        }
+    }
+
+    fn gear_mut(&mut self) -> &mut Gear {
+        match self {
+            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g,
+        }
+    }
+
+    /// The slave's setpoint for the master's motion in this cycle (advances a ratio ramp).
+    pub(super) fn slave_setpoint(&mut self, master: &Kinematics, dt: f64) -> Kinematics {
+        let g = self.gear_mut();
+        if g.master_start.is_nan() {
+            g.master_start = master.position;
+        }
+        match self {
+            CouplingLaw::Gear(g) => g.follow(master, 0.0),
+            CouplingLaw::GearDyn {
+                gear: g,
+                target_ratio,
+                ratio_rate,
+            } => {
+                let mut ratio_change = 0.0;
+                if g.ratio != *target_ratio {
+                    // Rate-limited, re-based so that the position stays continuous.
+                    let step = (*target_ratio - g.ratio).clamp(-*ratio_rate * dt, *ratio_rate * dt);
+                    g.slave_start += g.ratio * (master.position - g.master_start);
+                    g.master_start = master.position;
+                    let before = g.ratio;
+                    // The last step lands exactly on the target (no float residue).
+                    g.ratio = if (*target_ratio - g.ratio).abs() <= *ratio_rate * dt {
+                        *target_ratio
+                    } else {
+                        g.ratio + step
+                    };
+                    ratio_change = (g.ratio - before) / dt;
+                }
+                g.follow(master, ratio_change)
+            }
+        }
+    }
+
+    /// The ratio in force (AxisStatus::gear_ratio).
+    pub(super) fn ratio(&self) -> f64 {
+        self.gear().ratio
+    }
+
+    /// Still changing towards what it was asked for (a GearInDyn ratio ramp).
+    fn ramping(&self) -> bool {
+        match self {
+            CouplingLaw::Gear(_) => false,
+            CouplingLaw::GearDyn {
+                gear, target_ratio, ..
+            } => gear.ratio != *target_ratio,
+        }
+    }
+
+    /// What InGear reports when a command takes this coupling over.
+    fn in_gear(&self) -> bool {
+        match self {
+            CouplingLaw::Gear(_) => true,
+            CouplingLaw::GearDyn {
+                gear, target_ratio, ..
+            } => (gear.ratio - target_ratio).abs() < 1e-12,
+        }
+    }
+
+    /// A new ratio to ramp to (GearInDyn while enabled).
+    fn retarget(&mut self, ratio: f64, rate: f64) {
+        let gear = *self.gear();
+        *self = CouplingLaw::GearDyn {
+            gear,
+            target_ratio: ratio,
+            ratio_rate: rate,
+        };
+    }
+
+    /// GearInDyn's Enable fell: the ratio stays where the ramp has brought it.
+    pub(super) fn freeze(&mut self) {
+        if let CouplingLaw::GearDyn {
+            gear, target_ratio, ..
+        } = self
+        {
+            *target_ratio = gear.ratio;
+        }
+    }
+
+    /// The slave's setpoint moves by `d` relative to the master (a superposition, a cleared
+    /// position lag).
+    pub(super) fn shift_slave(&mut self, d: f64) {
+        self.gear_mut().slave_start += d;
+    }
+
+    /// Couples anew from here: the slave at `slave_position`, the master where it is in the
+    /// next cycle.
+    fn rebase(&mut self, slave_position: f64) {
+        let g = self.gear_mut();
+        g.slave_start = slave_position;
+        g.master_start = f64::NAN;
+    }
+}
 
 impl Axis {
     pub(super) fn submit_gear_out(
@@ -16,8 +233,7 @@ impl Axis {
         if let Some(c) = self.coupling.as_mut().filter(|c| c.dyn_command != 0) {
             // GearInDyn still enabled: the slave is decoupled only for an instant and
             // recoupled at once with the ratio it has (spec §5.5.2).
-            c.slave_start = self.set.position;
-            c.master_start = f64::NAN; // re-based on the next step
+            c.law.rebase(self.set.position);
             cx.report(id, DONE);
             return Ok(());
         }
@@ -31,13 +247,12 @@ impl Axis {
         Ok(())
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn submit_gear_in(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
-        master: Option<(AxisSlot, MasterSample)>,
+        master: Option<MasterSample>,
         numerator: f64,
         denominator: u16,
     ) -> Result<(), ErrorId> {
@@ -51,25 +266,24 @@ impl Axis {
         if self.set.velocity.abs() > EPS_V {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         }
-        let ratio = numerator / denominator as f64;
-        self.couple(cx, id, master_slot, &m, ratio, ratio, f64::INFINITY, 0);
+        let gear = self.gear_from_here(&m, numerator / denominator as f64);
+        self.couple(cx, id, master_slot, CouplingLaw::Gear(gear), 0);
         Ok(())
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn submit_gear_in_dyn(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
-        master: Option<(AxisSlot, MasterSample)>,
+        master: Option<MasterSample>,
         gear_ratio: f64,
         acceleration: f64,
     ) -> Result<(), ErrorId> {
         if !gear_ratio.is_finite() || !acceleration.is_finite() || acceleration < 0.0 {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
-        let Some((_, m)) = master else {
+        let Some(m) = master else {
             return Err(ErrorId::MASTER_INVALID);
         };
         if m.error {
@@ -88,8 +302,7 @@ impl Axis {
             .as_mut()
             .filter(|c| c.master == master_slot && c.dyn_command != 0)
         {
-            c.target_ratio = gear_ratio;
-            c.ratio_rate = rate;
+            c.law.retarget(gear_ratio, rate);
             let old = c.dyn_command;
             c.dyn_command = id;
             if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
@@ -100,7 +313,7 @@ impl Axis {
                 j.out = FbOutputs::default();
                 j.activate(cx);
                 let out = FbOutputs {
-                    in_gear: (c.ratio - c.target_ratio).abs() < 1e-12,
+                    in_gear: c.law.in_gear(),
                     ..j.out
                 };
                 j.emit(cx, out);
@@ -122,16 +335,18 @@ impl Axis {
         } else {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         };
-        self.couple(cx, id, master_slot, &m, start_ratio, gear_ratio, rate, id);
+        let law = CouplingLaw::GearDyn {
+            gear: self.gear_from_here(&m, start_ratio),
+            target_ratio: gear_ratio,
+            ratio_rate: rate,
+        };
+        self.couple(cx, id, master_slot, law, id);
         Ok(())
     }
 
     /// State and master checks shared by both couplings.
-    fn admit_coupling(
-        &self,
-        master: Option<(AxisSlot, MasterSample)>,
-    ) -> Result<MasterSample, ErrorId> {
-        let Some((_, m)) = master else {
+    fn admit_coupling(&self, master: Option<MasterSample>) -> Result<MasterSample, ErrorId> {
+        let Some(m) = master else {
             return Err(ErrorId::MASTER_INVALID);
         };
         match self.state() {
@@ -147,39 +362,37 @@ impl Axis {
         Ok(m)
     }
 
+    /// A gear with `ratio` that takes the slave from where it stands and the master from
+    /// where the slave follows it (its setpoint, or its actual position with #1064).
+    fn gear_from_here(&self, m: &MasterSample, ratio: f64) -> Gear {
+        let followed = m.followed(self.p().axis_couple_slave_to_actual_values);
+        Gear {
+            ratio,
+            master_start: followed.position,
+            slave_start: self.set.position,
+        }
+    }
+
     /// Aborts what runs and couples this axis to `master_slot` from here on.
-    #[allow(clippy::too_many_arguments)]
     fn couple(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
-        m: &MasterSample,
-        ratio: f64,
-        target_ratio: f64,
-        ratio_rate: f64,
+        law: CouplingLaw,
         dyn_command: CommandId,
     ) {
-        let use_actual = self.p().axis_couple_slave_to_actual_values;
         self.abort_superposition(cx);
         self.abort_all(cx);
         self.coupling = Some(Coupling {
             master: master_slot,
-            ratio,
-            target_ratio,
-            ratio_rate,
+            law,
             dyn_command,
-            master_start: if use_actual {
-                m.actual_position
-            } else {
-                m.set.position
-            },
-            slave_start: self.set.position,
         });
         let mut j = Job::new(id, JobKind::Gear);
         j.activate(cx);
         let out = FbOutputs {
-            in_gear: (ratio - target_ratio).abs() < 1e-12,
+            in_gear: law.in_gear(),
             ..j.out
         };
         j.emit(cx, out);
@@ -196,5 +409,31 @@ impl Axis {
             j.id = 0;
         }
         self.job = Some(j);
+    }
+
+    /// A coupled slave's cycle: its setpoint from the master's motion through the law; InGear
+    /// when a ratio ramp arrives. Without a master sample (lost: see `Axis::step`) it holds.
+    pub(super) fn follow_master(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        job: &mut Job,
+        master: Master,
+        dt: f64,
+    ) {
+        let (Some(mut c), Master::Sample(m)) = (self.coupling, master) else {
+            return;
+        };
+        let followed = m.followed(self.p().axis_couple_slave_to_actual_values);
+        let ramping = c.law.ramping();
+        self.set = c.law.slave_setpoint(&followed, dt);
+        self.set_has_superposition = false;
+        if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
+            let out = FbOutputs {
+                in_gear: true,
+                ..job.out
+            };
+            job.emit(cx, out);
+        }
+        self.coupling = Some(c);
     }
 }

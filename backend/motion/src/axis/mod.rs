@@ -24,56 +24,15 @@ mod monitoring;
 mod motion;
 mod superposition;
 
+use coupling::Coupling;
+pub use coupling::{Master, MasterSample};
+
 /// Static configuration of an axis (the base configuration the parameters start from).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AxisConfig {
     /// Rotary modulo axis: the modulo period is #1044 (AxisEncoderModuloValue).
     pub modulo: bool,
     pub parameters: AxisParameters,
-}
-
-/// What a slave sees of its master in a cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MasterSample {
-    pub set: Kinematics,
-    pub actual_position: f64,
-    pub actual_velocity: f64,
-    pub moving: bool,
-    pub error: bool,
-    /// The master's AxisVeloMax (GearInDyn scales its ratio-change limit with it).
-    pub max_velocity: f64,
-}
-
-/// A slave's master input in a cycle. The kernel steps masters before their slaves, so a
-/// sample is the master's state after its step in the same cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Master {
-    /// The axis follows no master.
-    Uncoupled,
-    /// The axis is coupled but its master cannot be followed: its slot is empty, or it is
-    /// part of a coupling loop. A coupled slave stops in ErrorStop (0x7043 master lost).
-    Lost,
-    /// The master, stepped in this cycle.
-    Sample(MasterSample),
-}
-
-impl MasterSample {
-    pub fn of(axis: &Axis) -> Self {
-        let s = axis.status();
-        MasterSample {
-            set: Kinematics {
-                position: s.set_position,
-                velocity: s.set_velocity,
-                acceleration: s.set_acceleration,
-                jerk: s.set_jerk,
-            },
-            actual_position: s.actual_position,
-            actual_velocity: s.actual_velocity,
-            moving: s.moving,
-            error: s.state == AxisState::ErrorStop,
-            max_velocity: axis.parameters().axis_velo_max,
-        }
-    }
 }
 
 /// Velocities below this are "at rest" (units/s); far below any real resolution.
@@ -368,20 +327,6 @@ const DONE: FbOutputs = FbOutputs {
     warning_id: 0,
 };
 
-#[derive(Clone, Copy, Debug)]
-struct Coupling {
-    master: AxisSlot,
-    /// Ratio in force (GearInDyn: ramps towards `target_ratio`).
-    ratio: f64,
-    target_ratio: f64,
-    /// Max ratio change per second (GearInDyn); infinite for MC_GearIn.
-    ratio_rate: f64,
-    /// The GearInDyn command that still has Enable TRUE (0 when none).
-    dyn_command: CommandId,
-    master_start: f64,
-    slave_start: f64,
-}
-
 /// A running MC_MoveSuperImposed: `distance` is laid over the main motion as a quintic
 /// (C² smooth) function of the main motion's travel `u` over `length` (spec §5.2.1, §6.13).
 #[derive(Clone, Copy, Debug)]
@@ -597,7 +542,7 @@ impl Axis {
             cycle,
             events,
         };
-        match self.try_submit(cx, cmd, master) {
+        match self.try_submit(cx, cmd, master.map(|(_, m)| m)) {
             Ok(()) => {
                 self.update_status();
                 Verdict::Accepted
@@ -610,7 +555,7 @@ impl Axis {
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
         cmd: Command,
-        master: Option<(AxisSlot, MasterSample)>,
+        master: Option<MasterSample>,
     ) -> Result<(), ErrorId> {
         match cmd.kind {
             CommandKind::Power {
@@ -715,7 +660,7 @@ impl Axis {
                     self.set.position = self.act_pos;
                     self.sent_position = self.act_pos;
                     if let Some(c) = self.coupling.as_mut() {
-                        c.slave_start += d;
+                        c.law.shift_slave(d);
                     } else if self.job.is_some() {
                         self.plan_job_now();
                     }
@@ -844,7 +789,7 @@ impl Axis {
         {
             // Enable FALSE after coupling: the ratio freezes where it is, the slave stays coupled.
             c.dyn_command = 0;
-            c.target_ratio = c.ratio;
+            c.law.freeze();
             if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
                 let out = FbOutputs {
                     busy: false,
@@ -1105,7 +1050,7 @@ impl Axis {
             p.axis_en_min_soft_pos_limit && set.position < p.axis_min_soft_pos_limit;
         s.coupled = self.coupling.is_some();
         s.master = self.coupling.map(|c| c.master);
-        s.gear_ratio = self.coupling.map(|c| c.ratio).unwrap_or(0.0);
+        s.gear_ratio = self.coupling.map(|c| c.law.ratio()).unwrap_or(0.0);
         s.compensating = self.superimposed.is_some();
         s.superimposed_distance = self.superimposed.map(|x| x.applied).unwrap_or(0.0);
         s.error_id = if self.mode == Mode::ErrorStop {

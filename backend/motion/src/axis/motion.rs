@@ -828,53 +828,7 @@ impl Axis {
         }
 
         if job.kind == JobKind::Gear {
-            if let (Some(mut c), Master::Sample(m)) = (self.coupling, master) {
-                let (mp, mv, ma, mj) = if self.p().axis_couple_slave_to_actual_values {
-                    (m.actual_position, m.actual_velocity, 0.0, 0.0)
-                } else {
-                    (
-                        m.set.position,
-                        m.set.velocity,
-                        m.set.acceleration,
-                        m.set.jerk,
-                    )
-                };
-                if c.master_start.is_nan() {
-                    c.master_start = mp;
-                }
-                let mut dratio = 0.0;
-                if c.ratio != c.target_ratio {
-                    // Ratio change (GearInDyn): rate-limited, re-based so that the position
-                    // stays continuous.
-                    let step =
-                        (c.target_ratio - c.ratio).clamp(-c.ratio_rate * dt, c.ratio_rate * dt);
-                    c.slave_start += c.ratio * (mp - c.master_start);
-                    c.master_start = mp;
-                    let before = c.ratio;
-                    // The last step lands exactly on the target (no float residue).
-                    c.ratio = if (c.target_ratio - c.ratio).abs() <= c.ratio_rate * dt {
-                        c.target_ratio
-                    } else {
-                        c.ratio + step
-                    };
-                    dratio = (c.ratio - before) / dt;
-                    if c.ratio == c.target_ratio && job.id != 0 && !job.out.in_gear {
-                        let out = FbOutputs {
-                            in_gear: true,
-                            ..job.out
-                        };
-                        job.emit(cx, out);
-                    }
-                }
-                self.coupling = Some(c);
-                self.set = Kinematics {
-                    position: c.slave_start + c.ratio * (mp - c.master_start),
-                    velocity: c.ratio * mv,
-                    acceleration: c.ratio * ma + dratio * mv,
-                    jerk: c.ratio * mj,
-                };
-                self.set_has_superposition = false;
-            }
+            self.follow_master(cx, &mut job, master, dt);
             self.job = Some(job);
             return;
         }

@@ -257,7 +257,7 @@ impl Axis {
                 self.planner.shift(sp.added.0 * dt);
             }
             if let Some(c) = self.coupling.as_mut() {
-                c.slave_start += sp.added.0 * dt;
+                c.law.shift_slave(sp.added.0 * dt);
             }
             self.set_has_superposition = false;
             self.superimposed = Some(sp);
@@ -317,7 +317,7 @@ impl Axis {
                 *t += delta;
             }
             if let Some(c) = self.coupling.as_mut() {
-                c.slave_start += delta;
+                c.law.shift_slave(delta);
             }
             self.set.position += delta;
         }
