@@ -13,7 +13,81 @@ pub struct Kernel {
     cycle_time: f64,
     cycle: u64,
     axes: Vec<Option<Box<Axis>>>,
-    stepped: Vec<bool>,
+    order: StepOrder,
+}
+
+/// The order the axes are stepped in: every master before its slaves, so that a slave follows
+/// the setpoint its master has in the same cycle. Couplings change only by a command or when
+/// an axis leaves one in its step, so the order is computed then (and when an axis is
+/// inserted or removed), not every cycle; its arrays are sized once, for every slot.
+struct StepOrder {
+    /// Occupied slots in stepping order: `slots[..len]`.
+    slots: Box<[AxisSlot]>,
+    len: usize,
+    /// `slots[in_loop..len]` are part of (or behind) a coupling loop: stepped last, without
+    /// their master. (Submit refuses couplings that close a loop; this keeps a cycle safe
+    /// whatever happens.)
+    in_loop: usize,
+    /// A coupling or an occupied slot changed: compute the order before the next step.
+    stale: bool,
+    /// Scratch for `compute`: the slot is in the order already.
+    placed: Box<[bool]>,
+}
+
+impl StepOrder {
+    fn new(capacity: usize) -> Self {
+        StepOrder {
+            slots: vec![0; capacity].into_boxed_slice(),
+            len: 0,
+            in_loop: 0,
+            stale: true,
+            placed: vec![false; capacity].into_boxed_slice(),
+        }
+    }
+
+    /// Masters first, then slaves whose master is placed (chains resolve in as many passes as
+    /// they are long; within a pass by slot), a slave of an empty slot as if uncoupled; what
+    /// is left is in a loop, by slot.
+    fn compute(&mut self, axes: &[Option<Box<Axis>>]) {
+        self.len = 0;
+        self.placed.iter_mut().for_each(|p| *p = false);
+        for _pass in 0..axes.len().max(1) {
+            let mut progressed = false;
+            for (i, axis) in axes.iter().enumerate() {
+                if self.placed[i] {
+                    continue;
+                }
+                let Some(axis) = axis.as_deref() else {
+                    self.placed[i] = true;
+                    continue;
+                };
+                if let Some(m) = axis.master_slot() {
+                    let master_there = axes.get(m as usize).is_some_and(|a| a.is_some());
+                    if master_there && !self.placed[m as usize] {
+                        continue; // wait for the master
+                    }
+                }
+                self.push(i);
+                progressed = true;
+            }
+            if !progressed {
+                break;
+            }
+        }
+        self.in_loop = self.len;
+        for i in 0..axes.len() {
+            if !self.placed[i] {
+                self.push(i);
+            }
+        }
+        self.stale = false;
+    }
+
+    fn push(&mut self, slot: usize) {
+        self.slots[self.len] = slot as AxisSlot;
+        self.len += 1;
+        self.placed[slot] = true;
+    }
 }
 
 impl Kernel {
@@ -24,7 +98,7 @@ impl Kernel {
             cycle_time,
             cycle: 0,
             axes: (0..max_axes).map(|_| None).collect(),
-            stepped: vec![false; max_axes],
+            order: StepOrder::new(max_axes),
         }
     }
 
@@ -52,6 +126,7 @@ impl Kernel {
         match self.axes.get_mut(slot as usize) {
             Some(s) => {
                 axis.place(slot);
+                self.order.stale = true;
                 Ok(s.replace(axis))
             }
             None => Err(axis),
@@ -61,6 +136,7 @@ impl Kernel {
     /// Takes an axis out of its slot (to be freed off the cycle thread). Slaves coupled to
     /// it lose their master at the next step.
     pub fn remove_axis(&mut self, slot: AxisSlot) -> Option<Box<Axis>> {
+        self.order.stale = true;
         self.axes.get_mut(slot as usize).and_then(|s| s.take())
     }
 
@@ -128,7 +204,14 @@ impl Kernel {
         // Stamped with the cycle the command takes effect in (the next step).
         let cycle = self.cycle + 1;
         match self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
-            Some(axis) => axis.submit(cmd, master, cycle, events),
+            Some(axis) => {
+                let coupled_to = axis.master_slot();
+                let verdict = axis.submit(cmd, master, cycle, events);
+                if axis.master_slot() != coupled_to {
+                    self.order.stale = true;
+                }
+                verdict
+            }
             None => Verdict::Rejected(ErrorId::AXIS_UNKNOWN),
         }
     }
@@ -145,53 +228,136 @@ impl Kernel {
         self.cycle += 1;
         let cycle = self.cycle;
         let dt = self.cycle_time;
-        self.stepped.iter_mut().for_each(|s| *s = false);
-        // Masters first, then slaves whose master has been stepped (chains resolve in as
-        // many passes as they are long; submit rejects couplings that would close a loop).
-        for _pass in 0..self.axes.len().max(1) {
-            let mut progressed = false;
-            for i in 0..self.axes.len() {
-                if self.stepped[i] {
-                    continue;
-                }
-                let Some(axis) = self.axes[i].as_deref() else {
-                    self.stepped[i] = true;
-                    continue;
-                };
-                let master = match axis.master_slot() {
-                    None => Master::Uncoupled,
-                    Some(m) => match self.axes.get(m as usize).and_then(|a| a.as_deref()) {
-                        None => Master::Lost, // master vanished
-                        Some(ma) if self.stepped[m as usize] => {
-                            Master::Sample(MasterSample::of(ma))
-                        }
-                        Some(_) => continue, // wait for the master
-                    },
-                };
-                let fb = feedback.get(i).copied().unwrap_or_default();
-                let axis = self.axes[i].as_deref_mut().expect("checked above");
-                let sp = axis.step(dt, &fb, master, cycle, events);
-                if let Some(out) = setpoints.get_mut(i) {
-                    *out = sp;
-                }
-                self.stepped[i] = true;
-                progressed = true;
+        if self.order.stale {
+            self.order.compute(&self.axes);
+        }
+        for k in 0..self.order.len {
+            let i = self.order.slots[k] as usize;
+            let Some(axis) = self.axes[i].as_deref() else {
+                continue;
+            };
+            let coupled_to = axis.master_slot();
+            let master = match coupled_to {
+                _ if k >= self.order.in_loop => Master::Lost,
+                None => Master::Uncoupled,
+                // Stepped before this slave in this cycle (the order sees to it).
+                Some(m) => match self.axes.get(m as usize).and_then(|a| a.as_deref()) {
+                    Some(ma) => Master::Sample(MasterSample::of(ma)),
+                    None => Master::Lost, // master vanished
+                },
+            };
+            let fb = feedback.get(i).copied().unwrap_or_default();
+            let axis = self.axes[i].as_deref_mut().expect("checked above");
+            let sp = axis.step(dt, &fb, master, cycle, events);
+            if let Some(out) = setpoints.get_mut(i) {
+                *out = sp;
             }
-            if !progressed {
-                break;
+            if axis.master_slot() != coupled_to {
+                // It left its coupling (master lost, an error, a limit): next cycle it is
+                // stepped where an uncoupled axis is.
+                self.order.stale = true;
             }
         }
-        // Anything left is part of a coupling cycle: step it without its master.
-        for i in 0..self.axes.len() {
-            if !self.stepped[i] {
-                let fb = feedback.get(i).copied().unwrap_or_default();
-                if let Some(axis) = self.axes[i].as_deref_mut() {
-                    let sp = axis.step(dt, &fb, Master::Lost, cycle, events);
-                    if let Some(out) = setpoints.get_mut(i) {
-                        *out = sp;
-                    }
-                }
-            }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command::{BufferMode, Direction, Dynamics, MoveOptions};
+    use crate::{AxisConfig, AxisParameters, AxisState, CommandEvent};
+
+    const DT: f64 = 0.001;
+
+    fn kernel(axes: usize) -> Kernel {
+        let mut k = Kernel::new(DT, axes);
+        for i in 0..axes {
+            let config = AxisConfig {
+                modulo: false,
+                parameters: AxisParameters::default(),
+            };
+            k.insert_axis(i as AxisSlot, Axis::new(config, DT)).unwrap();
         }
+        k
+    }
+
+    /// Steps with ideal drives (actual = last setpoint).
+    fn step(k: &mut Kernel, sp: &mut [DriveSetpoint], events: &mut Vec<CommandEvent>) {
+        let fb: Vec<DriveFeedback> = sp
+            .iter()
+            .map(|s| DriveFeedback {
+                ready: true,
+                enabled: s.enable,
+                actual_position: s.position,
+                ..DriveFeedback::default()
+            })
+            .collect();
+        k.step(&fb, sp, events);
+    }
+
+    fn accept(
+        k: &mut Kernel,
+        id: u64,
+        axis: AxisSlot,
+        kind: CommandKind,
+        e: &mut Vec<CommandEvent>,
+    ) {
+        let cmd = Command { id, axis, kind };
+        assert_eq!(k.submit(cmd, e), Verdict::Accepted, "{kind:?}");
+    }
+
+    fn gear_in(master: AxisSlot) -> CommandKind {
+        CommandKind::GearIn {
+            master,
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+        }
+    }
+
+    #[test]
+    fn masters_are_stepped_before_their_slaves_whatever_their_slots() {
+        let mut k = kernel(4);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 4], Vec::new());
+        for a in 0..4 {
+            let power = CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+            };
+            accept(&mut k, 1 + a as u64, a, power, &mut e);
+        }
+        for _ in 0..10 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        assert!((0..4).all(|a| k.status(a).unwrap().state == AxisState::Standstill));
+        // A chain against the slot order: 0 follows 1, which follows 3.
+        accept(&mut k, 5, 1, gear_in(3), &mut e);
+        accept(&mut k, 6, 0, gear_in(1), &mut e);
+        let velocity = CommandKind::MoveVelocity {
+            velocity: 10.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        };
+        accept(&mut k, 7, 3, velocity, &mut e);
+        for _ in 0..50 {
+            step(&mut k, &mut sp, &mut e);
+            // The whole chain follows in the cycle the master moves.
+            let master = k.status(3).unwrap().set_position;
+            assert_eq!(k.status(0).unwrap().set_position, master);
+        }
+        assert_eq!(&k.order.slots[..k.order.len], &[2, 3, 1, 0]);
+        assert_eq!(k.order.in_loop, 4);
+        assert!(k.status(3).unwrap().set_position > 0.0);
+        // The middle axis goes: its slave loses its master and is stepped as an uncoupled
+        // axis from the next cycle on.
+        drop(k.remove_axis(1));
+        step(&mut k, &mut sp, &mut e);
+        assert_eq!(k.status(0).unwrap().error_id, ErrorId::MASTER_LOST.0);
+        assert_eq!(&k.order.slots[..k.order.len], &[0, 2, 3]);
+        step(&mut k, &mut sp, &mut e);
+        assert_eq!(&k.order.slots[..k.order.len], &[0, 2, 3]);
     }
 }
