@@ -3,6 +3,21 @@
 
 use super::*;
 
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct HomeSeq {
+    pub(super) phase: HomingPhase,
+    pub(super) reference: f64,
+    pub(super) mode: ReferenceMode,
+    pub(super) search_dir: f64,
+    pub(super) search_velocity: f64,
+    pub(super) sync_dir: f64,
+    pub(super) sync_velocity: f64,
+    pub(super) latched: Option<f64>,
+    pub(super) cam_seen: bool,
+    /// The sequence failed: stopping (still Homing), then the command reports this error.
+    pub(super) failed: Option<ErrorId>,
+}
+
 impl Axis {
     pub(super) fn submit_home(
         &mut self,

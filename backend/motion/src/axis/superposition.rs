@@ -3,6 +3,30 @@
 
 use super::*;
 
+/// A running MC_MoveSuperImposed: `distance` is laid over the main motion as a quintic
+/// (C² smooth) function of the main motion's travel `u` over `length` (spec §5.2.1, §6.13).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Superimposed {
+    pub(super) cmd: Held,
+    /// Effective distance (signed, axis coordinates); reduced when infeasible (warning).
+    pub(super) distance: f64,
+    /// Main-motion travel over which it is spread.
+    pub(super) length: f64,
+    /// Main-motion travel so far.
+    pub(super) travelled: f64,
+    pub(super) applied: f64,
+    pub(super) option: SuperpositionAbortOption,
+    pub(super) last_position: f64,
+    pub(super) last_direction: f64,
+    /// Largest velocity the superposition may add (the main motion may run faster than
+    /// `velocity_process`; progress is then rate-limited instead of exceeding it).
+    pub(super) velocity_diff: f64,
+    /// Acceleration limit of the superimposed motion.
+    pub(super) acc_limit: f64,
+    /// Velocity and acceleration it added in the last cycle.
+    pub(super) added: (f64, f64),
+}
+
 /// The superposition shape and its first two derivatives on [0, 1].
 pub(super) fn smoothstep5(x: f64) -> (f64, f64, f64) {
     let x = x.clamp(0.0, 1.0);
@@ -128,12 +152,7 @@ impl Axis {
             },
             ..FbOutputs::default()
         };
-        let mut cmd = Held {
-            id,
-            out: FbOutputs::default(),
-            released: false,
-        };
-        cmd.emit(cx, out);
+        let cmd = Held::start(cx, id, out);
         self.superimposed = Some(Superimposed {
             cmd,
             distance,

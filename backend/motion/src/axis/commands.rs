@@ -1,0 +1,323 @@
+//! Submitting a command (the rising edge of a fresh FB instance): the immediate verdict; the
+//! commands that act on the axis itself at once — MC_Power, MC_Reset, MC_SetOverride,
+//! MC_SetPosition, MC_WriteParameter, MC_Stop and its lock (note 6), the falling edge of
+//! Execute/Enable, a jog's keepalive; and the dispatch of the others to their modules.
+//!
+//! Apart from the cycle because a submit acts at once (the state changes in the cycle the
+//! command is accepted) and a rejected command must leave no trace: every check comes before
+//! the first change.
+
+use super::*;
+
+impl Axis {
+    /// Offers a command; the verdict is immediate and a rejected command changes nothing.
+    pub fn submit(
+        &mut self,
+        cmd: Command,
+        master: Option<(AxisSlot, MasterSample)>,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Verdict {
+        let cx = &mut Ctx {
+            slot: self.slot,
+            cycle,
+            events,
+        };
+        match self.try_submit(cx, cmd, master.map(|(_, m)| m)) {
+            Ok(()) => {
+                self.update_status();
+                Verdict::Accepted
+            }
+            Err(e) => Verdict::Rejected(e),
+        }
+    }
+
+    fn try_submit(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        cmd: Command,
+        master: Option<MasterSample>,
+    ) -> Result<(), ErrorId> {
+        match cmd.kind {
+            CommandKind::Power {
+                enable,
+                enable_positive,
+                enable_negative,
+                override_percent,
+            } => {
+                if !(0.0..=100.0).contains(&override_percent) {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                self.power_override = override_percent;
+                self.enable_positive = enable_positive;
+                self.enable_negative = enable_negative;
+                if let Some(mut old) = self.power.take() {
+                    old.end(cx, End::Aborted);
+                }
+                if enable {
+                    if !self.enable {
+                        self.power_on_timer = 0.0;
+                    }
+                    self.enable = true;
+                    let held = Held::start(
+                        cx,
+                        cmd.id,
+                        FbOutputs {
+                            busy: true,
+                            active: true,
+                            status: self.status.power_status,
+                            ..FbOutputs::default()
+                        },
+                    );
+                    self.power = Some(held);
+                } else {
+                    self.disable(cx);
+                    cx.report(cmd.id, DONE);
+                }
+                Ok(())
+            }
+            CommandKind::Reset => {
+                if self.mode == Mode::ErrorStop && self.job.is_some() {
+                    // The axis is still on its error-stop ramp: the reset waits for standstill
+                    // (no velocity step with the drive enabled); a newer reset replaces it.
+                    if let Some(mut old) = self.pending_reset.take() {
+                        old.end(cx, End::Aborted);
+                    }
+                    let held = Held::start(
+                        cx,
+                        cmd.id,
+                        FbOutputs {
+                            busy: true,
+                            ..FbOutputs::default()
+                        },
+                    );
+                    self.pending_reset = Some(held);
+                    return Ok(());
+                }
+                self.reset(cx);
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::SetOverride { velocity_factor } => {
+                if !(0.0..=1.0).contains(&velocity_factor) {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                self.override_factor = velocity_factor;
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::SetPosition {
+                position,
+                relative,
+                clear_position_lag,
+            } => {
+                if !position.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                match self.state() {
+                    AxisState::Disabled | AxisState::Standstill | AxisState::ErrorStop => {}
+                    AxisState::DiscreteMotion | AxisState::ContinuousMotion if relative => {}
+                    _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
+                }
+                let shift = if relative {
+                    position
+                } else {
+                    position - self.act_pos
+                };
+                self.shift_coordinates(shift);
+                self.set_position_offset += shift;
+                if clear_position_lag {
+                    // set = actual; a running motion continues from there (re-planned, or
+                    // the coupling re-based) so the next sample does not bring the lag back.
+                    let d = self.act_pos - self.set.position;
+                    self.set.position = self.act_pos;
+                    self.sent_position = self.act_pos;
+                    if let Some(c) = self.coupling.as_mut() {
+                        c.law.shift_slave(d);
+                    } else if self.job.is_some() {
+                        self.plan_job_now();
+                    }
+                }
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::WriteParameter { number, value } => {
+                // Checked here as well: a bad value must never reach an axis, whoever submits
+                // it. #3000 AxisGearRatio is read-only like in the table: a ratio written
+                // directly would step the slave's velocity; MC_GearInDyn changes it with a
+                // limited acceleration.
+                self.config.parameters.write(number, value)?;
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::Release { target } => self.release(cx, target),
+            CommandKind::Keepalive { target } => {
+                for j in [self.job.as_mut(), self.next.as_mut()]
+                    .into_iter()
+                    .flatten()
+                {
+                    if j.id == target {
+                        j.since_keepalive = 0;
+                        return Ok(());
+                    }
+                }
+                Err(ErrorId::COMMAND_UNKNOWN)
+            }
+            CommandKind::Stop {
+                deceleration,
+                jerk,
+                options,
+            } => {
+                if !deceleration.is_finite() || !jerk.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                match self.mode {
+                    Mode::Disabled | Mode::ErrorStop => {
+                        return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
+                    }
+                    _ => {}
+                }
+                let (dec, jk) = self.stop_dynamics(deceleration, jerk);
+                self.abort_all(cx);
+                if let Some(mut old) = self.stop.take() {
+                    old.end(cx, End::Aborted);
+                }
+                self.coupling = None;
+                self.mode = Mode::Stopping;
+                let held = Held::start(
+                    cx,
+                    cmd.id,
+                    FbOutputs {
+                        busy: true,
+                        active: true,
+                        ..FbOutputs::default()
+                    },
+                );
+                self.stop = Some(held);
+                let mut j = Job::new(0, JobKind::Halt);
+                j.options = options;
+                j.dec = dec;
+                j.acc = dec.max(self.p().axis_acc);
+                j.jerk = jk;
+                j.velocity = self.set.velocity.abs().max(EPS_V);
+                self.start_job(cx, j);
+                Ok(())
+            }
+            CommandKind::GearOut => self.submit_gear_out(cx, cmd.id),
+            CommandKind::GearIn {
+                master: master_slot,
+                ratio_numerator,
+                ratio_denominator,
+            } => self.submit_gear_in(
+                cx,
+                cmd.id,
+                master_slot,
+                master,
+                ratio_numerator,
+                ratio_denominator,
+            ),
+            CommandKind::GearInDyn {
+                master: master_slot,
+                gear_ratio,
+                acceleration,
+            } => self.submit_gear_in_dyn(cx, cmd.id, master_slot, master, gear_ratio, acceleration),
+            CommandKind::MoveSuperImposed(sp) => self.submit_superposition(cx, cmd.id, sp),
+            CommandKind::AbortSuperposition => {
+                self.abort_superposition(cx);
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::Home {
+                position,
+                mode,
+                options,
+            } => self.submit_home(cx, cmd.id, position, mode, options),
+            _ => self.submit_motion(cx, cmd),
+        }
+    }
+
+    /// Falling edge of Execute/Enable.
+    pub(super) fn release(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        target: CommandId,
+    ) -> Result<(), ErrorId> {
+        if let Some(s) = self.stop.as_mut().filter(|s| s.id == target) {
+            s.released = true;
+            self.try_unlock(cx);
+            return Ok(());
+        }
+        if self.power.as_ref().is_some_and(|p| p.id == target) {
+            self.disable(cx);
+            return Ok(());
+        }
+        if let Some(c) = self
+            .coupling
+            .as_mut()
+            .filter(|c| c.dyn_command == target && target != 0)
+        {
+            // Enable FALSE after coupling: the ratio freezes where it is, the slave stays coupled.
+            c.dyn_command = 0;
+            c.law.freeze();
+            if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
+                let out = FbOutputs {
+                    busy: false,
+                    active: false,
+                    done: true,
+                    in_gear: true,
+                    ..j.out
+                };
+                j.emit(cx, out);
+                j.id = 0;
+            }
+            return Ok(());
+        }
+        if let Some(j) = self.job.as_mut().filter(|j| j.id == target) {
+            if let JobKind::JogHeld { released: false } = j.kind {
+                // Button released: ramp down now.
+                j.kind = JobKind::JogHeld { released: true };
+                let out = FbOutputs {
+                    in_velocity: false,
+                    ..j.out
+                };
+                j.emit(cx, out);
+                self.plan_job_now();
+            }
+            // Other Execute-type commands run on (§3.2).
+            return Ok(());
+        }
+        if let Some(j) = self.next.as_mut().filter(|j| j.id == target) {
+            if let JobKind::JogHeld { released } = &mut j.kind {
+                *released = true;
+            }
+            return Ok(());
+        }
+        Err(ErrorId::COMMAND_UNKNOWN)
+    }
+
+    /// Note 6: MC_Stop done and released → Standstill.
+    pub(super) fn try_unlock(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        if let Some(mut s) = self.stop {
+            if s.released && s.out.done && self.job.is_none() {
+                s.end(cx, End::Done);
+                self.stop = None;
+                if self.mode == Mode::Stopping {
+                    self.mode = Mode::Enabled;
+                }
+            } else {
+                self.stop = Some(s);
+            }
+        }
+    }
+
+    /// Aborts the running and the buffered job (CommandAborted).
+    pub(super) fn abort_all(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        if let Some(mut n) = self.next.take() {
+            n.finish_aborted(cx);
+        }
+        if let Some(mut j) = self.job.take() {
+            j.finish_aborted(cx);
+        }
+        self.coupling = None;
+    }
+}

@@ -1,0 +1,403 @@
+//! One cycle of an axis: [`Axis::step`] in the order of `docs/ARCHITECTURE.md` (feedback
+//! → power → feed enables → the job → superposition → soft limits → following error →
+//! unlock → status → setpoint); the running job's step (dead-man, a coupled slave, override
+//! re-plan, the planner sample, a blending hand-over, milestones and its end); the done
+//! criterion (§3.11). Kept in one place so that a cycle can be read top to bottom.
+
+use super::*;
+
+impl Axis {
+    /// One cycle, from the drive's feedback to its setpoint. `master`: what the kernel saw of
+    /// this axis's master after stepping it in this cycle.
+    pub fn step(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        master: Master,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> DriveSetpoint {
+        if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
+            // A drive that reports no number is a faulty drive; keep the last good values.
+            let fb = DriveFeedback {
+                fault: true,
+                actual_position: self.act_pos - self.offset,
+                actual_velocity: 0.0,
+                ..*fb
+            };
+            return self.step(dt, &fb, master, cycle, events);
+        }
+        let cx = &mut Ctx {
+            slot: self.slot,
+            cycle,
+            events,
+        };
+        self.act_pos = fb.actual_position + self.offset;
+        self.limit_positive = fb.limit_positive;
+        self.limit_negative = fb.limit_negative;
+        if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {
+            // Whatever ended a homing run (stop, power off, error, reset) disarms its latch.
+            self.latch = None;
+        }
+        self.act_acc = if self.fed {
+            (fb.actual_velocity - self.act_vel) / dt
+        } else {
+            0.0
+        };
+        self.fed = true;
+        self.act_vel = fb.actual_velocity;
+        let fault_reset = core::mem::take(&mut self.fault_reset);
+
+        // Power and drive readiness (notes 1, 2, 5).
+        self.step_power(cx, dt, fb);
+
+        // Disabled: the setpoint follows the actual position.
+        if self.mode == Mode::Disabled || (self.mode == Mode::ErrorStop && !fb.enabled) {
+            self.set = Kinematics {
+                position: self.act_pos,
+                ..Kinematics::default()
+            };
+            if self.mode == Mode::ErrorStop && self.job.is_some() {
+                self.job = None;
+                self.planner.clear();
+            }
+        } else {
+            // A coupled slave whose master is gone or in ErrorStop.
+            let lost = match master {
+                Master::Uncoupled => false,
+                Master::Lost => true,
+                Master::Sample(m) => m.error,
+            };
+            if lost && self.coupling.is_some() {
+                self.enter_error(cx, ErrorId::MASTER_LOST);
+            }
+            self.step_feed_enables(cx);
+            self.step_job(cx, dt, fb, master);
+            self.step_superposition(cx, dt);
+            self.step_soft_limits(cx, dt);
+            self.step_following_error(cx, dt);
+        }
+        if self.mode == Mode::ErrorStop && self.job.is_none() {
+            if let Some(mut r) = self.pending_reset.take() {
+                self.reset(cx);
+                r.end(cx, End::Done);
+            }
+        }
+        self.try_unlock(cx);
+        // InTargetPosition's dwell counts cycles (not status updates: submits update too).
+        let lag = (self.act_pos - self.set.position).abs();
+        if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {
+            self.in_window_timer += dt;
+        } else {
+            self.in_window_timer = 0.0;
+        }
+        self.update_status();
+        // The peak hold counts cycles only: a submit's status update sees the setpoint the
+        // drive has not answered yet. NaN feedback cannot stick (f64::min/max skip NaN).
+        let s = &mut self.status;
+        s.following_error_min = s.following_error_min.min(s.following_error);
+        s.following_error_max = s.following_error_max.max(s.following_error);
+        self.sent_position = self.set.position;
+        self.prev_cam = fb.reference_cam;
+        DriveSetpoint {
+            enable: self.enable
+                && !(self.mode == Mode::ErrorStop && self.error == ErrorId::DRIVE_FAULT),
+            fault_reset,
+            position: self.set.position - self.offset,
+            velocity: self.set.velocity,
+            acceleration: self.set.acceleration,
+            latch_enable: self.latch.is_some(),
+            latch_source: self.latch.unwrap_or_default(),
+        }
+    }
+
+    /// The running job's step: the setpoint it gives in this cycle, its milestones, and its
+    /// end (the buffered job starts in the same cycle).
+    pub(super) fn step_job(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        dt: f64,
+        fb: &DriveFeedback,
+        master: Master,
+    ) {
+        let ovr = self.override_ratio();
+        let Some(mut job) = self.job else {
+            self.set.velocity = 0.0;
+            self.set.acceleration = 0.0;
+            self.set.jerk = 0.0;
+            return;
+        };
+
+        // Jog dead-man.
+        if let JobKind::JogHeld { released: false } = job.kind {
+            job.since_keepalive = job.since_keepalive.saturating_add(1);
+            if job.deadman_cycles > 0 && job.since_keepalive >= job.deadman_cycles {
+                job.kind = JobKind::JogHeld { released: true };
+                job.pending_error = Some(ErrorId::DEADMAN_TIMEOUT);
+                // Reported in the cycle it fires (the command ends with the error at rest).
+                let out = FbOutputs {
+                    in_velocity: false,
+                    warning: true,
+                    warning_id: ErrorId::DEADMAN_TIMEOUT.0,
+                    ..job.out
+                };
+                job.emit(cx, out);
+                self.job = Some(job);
+                self.plan_job_now();
+                job = self.job.expect("set above");
+            }
+        }
+
+        if job.kind == JobKind::Gear {
+            self.follow_master(cx, &mut job, master, dt);
+            self.job = Some(job);
+            return;
+        }
+
+        // Override changes re-plan (never a velocity jump).
+        let endless_holding =
+            job.phase == Phase::Holding && job.kind == JobKind::Positioning { continuous: true };
+        if job.planned_override != ovr
+            && job.phase != Phase::Queued
+            && !matches!(
+                job.kind,
+                JobKind::Halt | JobKind::JogHeld { released: true }
+            )
+            && !matches!(job.phase, Phase::Settling { .. })
+        {
+            self.job = Some(job);
+            if endless_holding {
+                // Continue at end velocity × override.
+                let j = self.job.as_mut().expect("set");
+                j.planned_override = ovr;
+                let v = j.end_velocity * ovr;
+                let _ = self
+                    .planner
+                    .plan_velocity(self.set, v, &j.limits_passing(1.0, v));
+            } else {
+                self.plan_job_now();
+                // Re-planning restarts the milestone.
+                let j = self.job.as_mut().expect("set");
+                if j.phase == Phase::Holding {
+                    j.phase = Phase::Moving;
+                }
+            }
+            job = self.job.expect("set above");
+            if job.out.in_velocity {
+                let out = FbOutputs {
+                    in_velocity: false,
+                    ..job.out
+                };
+                job.emit(cx, out);
+            }
+        }
+
+        if job.kind == JobKind::Home {
+            self.job = Some(job);
+            self.step_home(cx, dt, fb);
+            return;
+        }
+
+        if let Some(k) = self.planner.step(dt) {
+            self.set = k;
+            self.set_has_superposition = false;
+        }
+        // An end or blending velocity that could not be reached moving only towards the
+        // target was adjusted to the best reachable one: say so.
+        if let Some(w) = job.warn.take() {
+            let out = FbOutputs {
+                warning: true,
+                warning_id: w.0,
+                ..job.out
+            };
+            job.emit(cx, out);
+        }
+        // A successor with its own blending position takes over where the axis passes it.
+        if let Some((bp, dir)) = self.next.as_ref().and_then(|n| n.blend_at) {
+            if (self.set.position - bp) * dir >= 0.0 {
+                if self.next.as_ref().is_some_and(|n| n.blend_done) {
+                    job.finish_done(cx);
+                } else {
+                    job.finish_aborted(cx);
+                }
+                self.job = None;
+                if let Some(n) = self.next.take() {
+                    self.start_job(cx, n);
+                }
+                return;
+            }
+        }
+        let finished = self.planner.finished();
+
+        match job.kind {
+            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+                let reached = finished && ovr > 0.0 && job.planned_override == ovr;
+                if reached != job.out.in_velocity {
+                    let out = FbOutputs {
+                        in_velocity: reached,
+                        ..job.out
+                    };
+                    job.emit(cx, out);
+                }
+                job.phase = if reached {
+                    Phase::Holding
+                } else {
+                    Phase::Moving
+                };
+                self.job = Some(job);
+            }
+            JobKind::Positioning { continuous: true } => {
+                let short = (job.planned_end - job.end_velocity).abs()
+                    > 1e-9 * (1.0 + job.end_velocity.abs());
+                if finished
+                    && job.phase == Phase::Moving
+                    && job.planned_override > 0.0
+                    && !job.past_target
+                    && short
+                {
+                    // Passed the target slower than the end velocity: now run up to it.
+                    job.past_target = true;
+                    self.job = Some(job);
+                    self.plan_job_now();
+                    return;
+                }
+                if finished && job.phase == Phase::Moving && job.planned_override > 0.0 {
+                    job.past_target = true;
+                    job.phase = Phase::Holding;
+                    let out = FbOutputs {
+                        in_end_velocity: true,
+                        ..job.out
+                    };
+                    job.emit(cx, out);
+                }
+                self.job = Some(job);
+            }
+            JobKind::Positioning { continuous: false }
+            | JobKind::Halt
+            | JobKind::JogHeld { released: true } => {
+                if !finished
+                    || (job.kind == JobKind::Positioning { continuous: false }
+                        && job.planned_override <= 0.0)
+                {
+                    self.job = Some(job);
+                    return;
+                }
+                // Logical end of positioning: the setpoint stands exactly on the target.
+                if job.kind == (JobKind::Positioning { continuous: false })
+                    && job.end_velocity == 0.0
+                {
+                    self.set.position = job.target;
+                }
+                let blending_successor = self
+                    .next
+                    .as_ref()
+                    .is_some_and(|n| n.buffer_mode.is_blending())
+                    && job.end_velocity != 0.0;
+                if blending_successor {
+                    job.finish_done(cx);
+                    self.job = None;
+                    self.start_next(cx);
+                    return;
+                }
+                let done = self.done_criterion(&mut job, dt);
+                match done {
+                    None => {
+                        self.job = Some(job);
+                    }
+                    Some(Ok(())) => {
+                        if let Some(e) = job.pending_error {
+                            job.finish_error(cx, e);
+                        } else {
+                            job.finish_done(cx);
+                        }
+                        self.job = None;
+                        self.planner.clear();
+                        self.set.velocity = 0.0;
+                        self.set.acceleration = 0.0;
+                        self.set.jerk = 0.0;
+                        if self.mode == Mode::Stopping {
+                            if let Some(mut s) = self.stop {
+                                s.emit(
+                                    cx,
+                                    FbOutputs {
+                                        busy: true,
+                                        active: true,
+                                        done: true,
+                                        ..FbOutputs::default()
+                                    },
+                                );
+                                self.stop = Some(s);
+                            } else {
+                                // The lock was removed by MC_Reset during the ramp.
+                                self.mode = Mode::Enabled;
+                            }
+                        }
+                        self.start_next(cx);
+                    }
+                    Some(Err(e)) => {
+                        job.finish_error(cx, e);
+                        self.job = None;
+                        self.planner.clear();
+                        if let Some(mut n) = self.next.take() {
+                            n.finish_aborted(cx);
+                        }
+                        if self.mode == Mode::Stopping {
+                            // MC_Stop's own ramp missed its position window: the stop ends
+                            // with the error, and with it the lock.
+                            if let Some(mut s) = self.stop.take() {
+                                s.end(cx, End::Error(e));
+                            }
+                            self.mode = Mode::Enabled;
+                        }
+                    }
+                }
+            }
+            JobKind::Home | JobKind::Gear => unreachable!(),
+        }
+    }
+
+    /// §3.11: None = still waiting; Some(Ok) = done; Some(Err) = in-target timeout.
+    pub(super) fn done_criterion(&mut self, job: &mut Job, dt: f64) -> Option<Result<(), ErrorId>> {
+        let p = self.p();
+        let stop_like = job.kind != (JobKind::Positioning { continuous: false });
+        let monitor = if stop_like {
+            job.options.enable_stop_position_monitoring
+        } else {
+            !job.options.ignore_position_monitoring
+        };
+        if !monitor || self.mode == Mode::ErrorStop {
+            return Some(Ok(()));
+        }
+        let target = if stop_like {
+            self.set.position
+        } else {
+            job.target
+        };
+        let dev = (self.act_pos - target).abs();
+        let (mut in_window, mut total) = match job.phase {
+            Phase::Settling { in_window, total } => (in_window, total),
+            _ => (0.0, 0.0),
+        };
+        total += dt;
+        let reached = if p.axis_en_target_position_monitoring {
+            if dev <= p.axis_target_position_window {
+                in_window += dt;
+            } else {
+                in_window = 0.0;
+            }
+            in_window + 1e-12 >= p.axis_target_position_monitoring_time
+        } else if p.axis_en_position_range_monitoring {
+            dev <= p.axis_position_range_window
+        } else {
+            true
+        };
+        job.phase = Phase::Settling { in_window, total };
+        if reached {
+            return Some(Ok(()));
+        }
+        if p.axis_en_in_target_timeout && total > p.axis_in_target_timeout {
+            return Some(Err(ErrorId::IN_TARGET_TIMEOUT));
+        }
+        None
+    }
+}

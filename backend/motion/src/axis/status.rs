@@ -1,0 +1,92 @@
+//! The status snapshot (`AxisStatus`): everything a reader may ask, derived after every cycle
+//! and every accepted submit, so that reading never computes and never disagrees with the
+//! axis. The following-error peak hold counts cycles only (see `Axis::step`).
+
+use super::*;
+
+impl Axis {
+    /// Starts a new following-error peak hold from the present following error.
+    pub fn reset_following_error_peak(&mut self) {
+        let s = &mut self.status;
+        s.following_error_min = s.following_error;
+        s.following_error_max = s.following_error;
+    }
+
+    pub(super) fn update_status(&mut self) {
+        let p = &self.config.parameters;
+        let state = self.state();
+        let s = &mut self.status;
+        let set = self.set;
+        s.state = state;
+        s.set_position = set.position;
+        s.set_velocity = set.velocity;
+        s.set_acceleration = set.acceleration;
+        s.set_jerk = set.jerk;
+        s.actual_position = self.act_pos;
+        s.actual_velocity = self.act_vel;
+        s.actual_acceleration = self.act_acc;
+        s.following_error = self.sent_position - self.act_pos;
+        let period = p.axis_encoder_modulo_value;
+        if self.config.modulo && period > 0.0 {
+            s.modulo_set_position = set.position.rem_euclid(period);
+            s.modulo_actual_position = self.act_pos.rem_euclid(period);
+            s.modulo_set_turns = (set.position / period).floor() as i64;
+        } else {
+            s.modulo_set_position = set.position;
+            s.modulo_actual_position = self.act_pos;
+            s.modulo_set_turns = 0;
+        }
+        let job = self.job.as_ref();
+        s.target_position = match job {
+            Some(j) if j.is_positioning() => j.target,
+            _ => set.position,
+        };
+        s.remaining_distance = (s.target_position - set.position).abs();
+        s.remaining_time = if job.is_some() {
+            self.planner.remaining_time()
+        } else {
+            0.0
+        };
+        s.override_percent = self.power_override * self.override_factor;
+        s.power_override_percent = self.power_override;
+        s.set_override_factor = self.override_factor;
+        s.enable_positive = self.enable_positive;
+        s.enable_negative = self.enable_negative;
+        s.homed = self.homed;
+        s.homing_phase = job
+            .filter(|j| j.kind == JobKind::Home)
+            .map(|j| j.home.phase)
+            .unwrap_or_default();
+        s.has_job = job.is_some();
+        s.command_buffered = self.next.is_some();
+        s.motion_commands_locked = self.stop.is_some();
+        s.moving = set.velocity.abs() > EPS_V;
+        s.moving_forward = set.velocity > EPS_V;
+        s.moving_backward = set.velocity < -EPS_V;
+        s.accelerating = s.moving && set.acceleration * set.velocity > 0.0;
+        s.decelerating = s.moving && set.acceleration * set.velocity < 0.0;
+        s.constant_velocity = s.moving && set.acceleration == 0.0;
+        s.in_target_position = !s.moving
+            && self.in_window_timer + 1e-12 >= p.axis_target_position_monitoring_time
+            && state != AxisState::Disabled;
+        s.in_position_area =
+            (self.act_pos - s.target_position).abs() <= p.axis_position_range_window;
+        s.soft_limit_max_exceeded =
+            p.axis_en_max_soft_pos_limit && set.position > p.axis_max_soft_pos_limit;
+        s.soft_limit_min_exceeded =
+            p.axis_en_min_soft_pos_limit && set.position < p.axis_min_soft_pos_limit;
+        s.coupled = self.coupling.is_some();
+        s.master = self.coupling.map(|c| c.master);
+        s.gear_ratio = self.coupling.map(|c| c.law.ratio()).unwrap_or(0.0);
+        s.compensating = self.superimposed.is_some();
+        s.superimposed_distance = self.superimposed.map(|x| x.applied).unwrap_or(0.0);
+        s.error_id = if self.mode == Mode::ErrorStop {
+            self.error.0
+        } else {
+            0
+        };
+        s.drive_fault = self.error == ErrorId::DRIVE_FAULT && self.mode == Mode::ErrorStop;
+        s.set_position_offset = self.set_position_offset;
+        s.active_command = job.map(|j| j.id).unwrap_or(0);
+    }
+}
