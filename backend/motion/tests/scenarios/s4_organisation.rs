@@ -1,0 +1,297 @@
+//! §4 Organisation FBs: MC_Power (override), MC_Reset, MC_SetPosition, MC_WriteParameter
+//! (§11a item 34).
+
+use super::*;
+
+#[test]
+fn s11a_34_override_range() {
+    let mut r = Rig::new(1);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.5
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: -0.1
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    power(&mut r);
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+        },
+    );
+    let v = r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 100.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.until(1.0, |r| r.out(v).in_velocity);
+    assert!((r.st(0).set_velocity - 50.0).abs() < 1e-9);
+    // Override 0 stops the axis without aborting the command.
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 0.0,
+        },
+    );
+    r.run(1.0);
+    assert!(r.st(0).set_velocity.abs() < 1e-9);
+    assert!(r.out(v).busy && !r.out(v).command_aborted);
+}
+
+#[test]
+fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+        },
+    );
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
+    r.until(10.0, |r| {
+        let v = r.st(0).set_velocity.abs();
+        assert!(v <= 100.0 + 1e-9, "{v} > 200 × 50 %");
+        !r.out(a).busy
+    });
+    // Second run: override changed mid-move.
+    let b = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 200.0)));
+    r.run(0.5);
+    r.ok(
+        0,
+        CommandKind::SetOverride {
+            velocity_factor: 0.4,
+        },
+    );
+    let v_before = r.st(0).set_velocity.abs();
+    r.step();
+    assert!(
+        (r.st(0).set_velocity.abs() - v_before).abs() < 1000.0 * DT + 1e-9,
+        "velocity jumped on override"
+    );
+    r.run(0.3);
+    r.until(10.0, |r| {
+        assert!(r.st(0).set_velocity.abs() <= 40.0 + 1e-9);
+        !r.out(b).busy
+    });
+    assert!(r.out(b).done);
+}
+
+/// MC_WriteParameter is checked by the kernel with the parameter table (params.rs), whoever
+/// submits it: unknown and read-only numbers, NaN, ±∞, values out of range, a BOOL other than
+/// 0/1, a fractional DWORD, and a write that breaks the relations of a consistent set are
+/// refused with their error numbers and change nothing (the rig checks that a rejected
+/// command changes nothing and emits nothing).
+#[test]
+fn write_parameter_is_validated_by_the_kernel() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let before = r.k.parameters(0).unwrap().clone();
+    let write = |number: u16, value: f64| CommandKind::WriteParameter { number, value };
+    for (number, value, error) in [
+        (999, 1.0, ErrorId::PARAMETER_UNKNOWN),
+        (5000, 1.0, ErrorId::PARAMETER_UNKNOWN),
+        (1, 5.0, ErrorId::PARAMETER_READ_ONLY),
+        (2000, 5.0, ErrorId::PARAMETER_READ_ONLY),
+        (1000, 7.0, ErrorId::PARAMETER_READ_ONLY),
+        (1050, 0.002, ErrorId::PARAMETER_READ_ONLY),
+        (4000, 0.002, ErrorId::PARAMETER_READ_ONLY),
+        (1003, f64::NAN, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, f64::INFINITY, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, 0.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, -500.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1026, -0.1, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1018, 0.5, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1018, f64::NAN, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1062, 2.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1062, 0.5, ErrorId::COMMAND_NOT_PERMITTED),
+        // Relations: AxisAcc above AxisMaximumAcceleration (5000), a jog velocity above
+        // AxisVeloMax (500), the soft limits crossed while both are enabled.
+        (1004, 6000.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1001, 600.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+        (1003, 1.0, ErrorId::PARAMETER_OUT_OF_RANGE),
+    ] {
+        assert_eq!(
+            r.rejected(0, write(number, value)),
+            error,
+            "#{number} = {value}"
+        );
+        assert_eq!(r.k.parameters(0).unwrap(), &before, "#{number} = {value}");
+    }
+    // 3000 (AxisGearRatio) is read-only (MC_GearInDyn changes a ratio, acceleration-limited).
+    assert_eq!(
+        r.rejected(0, write(3000, 2.0)),
+        ErrorId::PARAMETER_READ_ONLY
+    );
+    // Valid writes, BOOL as 0/1, aliases (#2 = #1019) share their storage.
+    // AxisVeloMax below the rapid traverse velocity (500) breaks a relation: lower that first.
+    assert_eq!(
+        r.rejected(0, write(1003, 400.0)),
+        ErrorId::PARAMETER_OUT_OF_RANGE
+    );
+    r.ok(0, write(1009, 300.0));
+    r.ok(0, write(1003, 400.0));
+    r.ok(0, write(1018, 1.0));
+    r.ok(0, write(2, 50.0));
+    let p = r.k.parameters(0).unwrap();
+    assert_eq!(p.axis_velo_max, 400.0);
+    assert!(p.axis_en_max_soft_pos_limit);
+    assert_eq!(p.axis_max_soft_pos_limit, 50.0);
+    assert_eq!(
+        r.rejected(0, CommandKind::MoveAbsolute(mv(60.0, 100.0))),
+        ErrorId::TARGET_ABOVE_SOFT_LIMIT
+    );
+    r.ok(0, write(1016, 1.0));
+    r.ok(0, write(1017, -50.0));
+    assert_eq!(
+        r.rejected(0, write(1017, 50.0)),
+        ErrorId::PARAMETER_OUT_OF_RANGE,
+        "min limit not below max"
+    );
+}
+
+#[test]
+fn set_position_during_motion_shifts_coordinates_not_the_motion() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    r.run(0.3);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::SetPosition {
+                position: 0.0,
+                relative: false,
+                clear_position_lag: false
+            }
+        ),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 1000.0,
+            relative: true,
+            clear_position_lag: false,
+        },
+    );
+    r.until(5.0, |r| r.out(m).done);
+    assert!((r.st(0).set_position - 1100.0).abs() < 1e-9);
+    assert!((r.plants[0].pos - 100.0).abs() < 0.01);
+}
+
+#[test]
+fn set_position_with_clear_lag_during_motion_clears_it_for_good() {
+    let mut p = params();
+    p.axis_en_position_lag_monitoring = false;
+    let mut r = Rig::with(vec![(false, p)]);
+    r.power_on(0);
+    r.plants[0].tau = 0.05; // a drive that lags (2.5 mm at 50 mm/s)
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 50.0)));
+    r.run(0.5);
+    let before = r.st(0);
+    assert!(before.following_error > 1.0);
+    r.ok(
+        0,
+        CommandKind::SetPosition {
+            position: 0.0,
+            relative: true,
+            clear_position_lag: true,
+        },
+    );
+    let after = r.st(0);
+    assert_eq!(after.set_position, after.actual_position);
+    r.step();
+    // The motion continues from the actual position (the next sample does not bring the old
+    // set position back).
+    let s = r.st(0);
+    assert!(
+        (s.set_position - after.actual_position).abs() < 0.2,
+        "{} vs {}",
+        s.set_position,
+        after.actual_position
+    );
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(m).done);
+}
+
+#[test]
+fn reset_during_the_error_stop_ramp_waits_for_standstill() {
+    let mut r = Rig::new(1);
+    r.power_on(0);
+    r.ok(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 400.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    r.run(1.0);
+    r.plants[0].load_lag = 5.0;
+    r.until(1.0, |r| r.st(0).state == AxisState::ErrorStop);
+    r.plants[0].load_lag = 0.0;
+    assert!(r.st(0).moving);
+    let reset = r.ok(0, CommandKind::Reset);
+    assert!(r.out(reset).busy);
+    // The rig checks every cycle that the velocity does not jump.
+    r.until(2.0, |r| !r.out(reset).busy);
+    assert!(r.out(reset).done);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
+}
+
+#[test]
+fn repeated_fault_and_reset_rounds_can_always_be_re_enabled() {
+    let mut r = Rig::new(1);
+    r.plants[0].enable_delay_cycles = 300; // a slow drive (0.3 s)
+    r.ok(
+        0,
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+        },
+    );
+    for _ in 0..5 {
+        r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+        r.plants[0].fault = true;
+        r.until(0.1, |r| r.st(0).state == AxisState::ErrorStop);
+        r.plants[0].fault = false;
+        r.ok(0, CommandKind::Reset);
+    }
+}
