@@ -55,16 +55,7 @@ fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error()
 fn s11a_03_power_off_from_motion_disables_and_aborts() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let m = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let m = r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.1);
     r.ok(
         0,
@@ -132,16 +123,7 @@ fn s11a_05_state_changes_in_the_cycle_the_command_is_accepted() {
     power(&mut r);
     r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 10.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(10.0, Direction::Positive));
     assert_eq!(r.st(0).state, AxisState::ContinuousMotion);
     r.ok(
         0,

@@ -40,16 +40,7 @@ fn s11a_34_override_range() {
             override_percent: 50.0,
         },
     );
-    let v = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let v = r.ok(0, velocity(100.0, Direction::Positive));
     r.until(1.0, |r| r.out(v).in_velocity);
     assert!((r.st(0).set_velocity - 50.0).abs() < 1e-9);
     // Override 0 stops the axis without aborting the command.
@@ -251,16 +242,7 @@ fn set_position_with_clear_lag_during_motion_clears_it_for_good() {
 fn reset_during_the_error_stop_ramp_waits_for_standstill() {
     let mut r = Rig::new(1);
     r.power_on(0);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 400.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(400.0, Direction::Positive));
     r.run(1.0);
     r.plants[0].load_lag = 5.0;
     r.until(1.0, |r| r.st(0).state == AxisState::ErrorStop);

@@ -25,16 +25,7 @@ fn s11a_17_move_additive_after_an_endless_motion_starts_from_the_set_position() 
     r.power_on(0);
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 300.0)));
     r.until(3.0, |r| r.out(a).done);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(100.0, Direction::Positive));
     r.run(1.0);
     let h = r.ok(
         0,
@@ -89,16 +80,7 @@ fn jerk_and_acceleration_limits_hold_for_an_aborting_reversal() {
 fn s11a_20_move_velocity_in_velocity_and_stays_busy() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let v = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 120.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Negative,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let v = r.ok(0, velocity(120.0, Direction::Negative));
     r.until(1.0, |r| r.out(v).in_velocity);
     assert!((r.st(0).set_velocity + 120.0).abs() < 1e-9);
     r.run(0.5);
@@ -241,16 +223,7 @@ fn s11a_22_move_modulo_from_standstill_uses_the_table_algorithm() {
 fn move_modulo_from_motion_keeps_direction_and_ignores_extra_turns() {
     let mut r = Rig::with(vec![(true, params())]);
     power(&mut r);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 200.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(200.0, Direction::Positive));
     r.run(0.5);
     let m = r.ok(
         0,
@@ -276,25 +249,10 @@ fn move_modulo_from_motion_keeps_direction_and_ignores_extra_turns() {
 #[test]
 fn buffered_move_modulo_behind_endless_motion_resolves_from_motion_like_aborting() {
     let endless: [(&str, CommandKind); 4] = [
-        (
-            "move velocity",
-            CommandKind::MoveVelocity {
-                velocity: 300.0,
-                dynamics: Dynamics::default(),
-                direction: Direction::Positive,
-                buffer_mode: BufferMode::Aborting,
-                options: MoveOptions::default(),
-            },
-        ),
+        ("move velocity", velocity(300.0, Direction::Positive)),
         (
             "move velocity negative",
-            CommandKind::MoveVelocity {
-                velocity: 300.0,
-                dynamics: Dynamics::default(),
-                direction: Direction::Negative,
-                buffer_mode: BufferMode::Aborting,
-                options: MoveOptions::default(),
-            },
+            velocity(300.0, Direction::Negative),
         ),
         (
             "continuous jog",
@@ -404,16 +362,7 @@ fn move_modulo_from_motion_refuses_reversal_and_respects_soft_limits() {
     p.axis_max_soft_pos_limit = 400.0;
     let mut r = Rig::with(vec![(true, p)]);
     r.power_on(0);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 200.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(200.0, Direction::Positive));
     r.until(3.0, |r| r.st(0).set_position > 300.0);
     assert_eq!(
         r.rejected(
@@ -476,16 +425,7 @@ fn s11a_23_halt_has_no_lock_and_never_weaker_dynamics() {
 fn s11a_24_stop_locks_until_released_done_while_busy() {
     let mut r = Rig::new(1);
     power(&mut r);
-    let a = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let a = r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.2);
     let s = r.ok(
         0,
@@ -538,16 +478,7 @@ fn a_stop_whose_position_window_times_out_ends_with_the_error_and_unlocks() {
     p.axis_en_position_lag_monitoring = false;
     let mut r = Rig::with(vec![(false, p)]);
     r.power_on(0);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.3);
     r.plants[0].load_lag = 0.5;
     let s = r.ok(

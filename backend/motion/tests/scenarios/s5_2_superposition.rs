@@ -294,16 +294,7 @@ fn s11a_31_superposition_abort_options() {
         assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
         if survives {
             // Resumes with the next motion and completes.
-            r.ok(
-                0,
-                CommandKind::MoveVelocity {
-                    velocity: 200.0,
-                    dynamics: Dynamics::default(),
-                    direction: Direction::Positive,
-                    buffer_mode: BufferMode::Aborting,
-                    options: MoveOptions::default(),
-                },
-            );
+            r.ok(0, velocity(200.0, Direction::Positive));
             r.until(5.0, |r| !r.out(s).busy);
             assert!(r.out(s).done);
         }
@@ -313,16 +304,7 @@ fn s11a_31_superposition_abort_options() {
         let mut r = conveyor(200.0);
         let s = r.ok(0, CommandKind::MoveSuperImposed(sp(opt)));
         r.run(0.1);
-        r.ok(
-            0,
-            CommandKind::MoveVelocity {
-                velocity: 200.0,
-                dynamics: Dynamics::default(),
-                direction: Direction::Negative,
-                buffer_mode: BufferMode::Aborting,
-                options: MoveOptions::default(),
-            },
-        );
+        r.ok(0, velocity(200.0, Direction::Negative));
         r.run(0.6);
         assert_eq!(r.out(s).command_aborted, !survives, "{opt:?}");
     }

@@ -72,16 +72,7 @@ fn s11a_28_gear_out_in_motion_keeps_constant_velocity() {
             ratio_denominator: 1,
         },
     );
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 50.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(50.0, Direction::Positive));
     r.run(1.0);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
     // MC_GearIn ended with InGear once coupled; GearOut has nothing to abort.
@@ -122,16 +113,7 @@ fn s11a_29_gear_in_dyn_release_freezes_ratio_gear_out_while_enabled_recouples() 
         },
     );
     assert!(r.out(g).in_gear && r.out(g).busy);
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.5);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
     // A new ratio while enabled: ramps (acceleration-limited), in_gear when reached.
@@ -191,16 +173,7 @@ fn gear_coupling_to_the_masters_actual_values_with_parameter_1064() {
     );
     r.bounds[1].jerk = 1e12; // an actual value is not jerk-limited
     r.bounds[1].acceleration = 1e12;
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.3);
     let (m, s) = (r.st(0), r.st(1));
     // The slave follows the master's actual position (one cycle late), not its setpoint.
@@ -272,16 +245,7 @@ fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
         ErrorId::MASTER_INVALID
     );
     // A chain follows in one cycle (masters are stepped first).
-    r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 10.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    r.ok(0, velocity(10.0, Direction::Positive));
     r.run(0.2);
     assert_eq!(r.st(2).set_position, r.st(0).set_position);
     // The master faults: its slaves go to ErrorStop with master_lost.

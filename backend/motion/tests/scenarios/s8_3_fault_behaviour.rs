@@ -20,16 +20,7 @@ fn soft_limits_reject_targets_and_stop_endless_motion_at_the_limit() {
         r.rejected(0, CommandKind::MoveRelative(mv(-11.0, 10.0))),
         ErrorId::TARGET_BELOW_SOFT_LIMIT
     );
-    let v = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 300.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let v = r.ok(0, velocity(300.0, Direction::Positive));
     r.until(3.0, |r| !r.out(v).busy);
     assert_eq!(r.out(v).error_id, ErrorId::SOFT_LIMIT_REACHED.0);
     r.until(3.0, |r| r.st(0).state == AxisState::Standstill);
@@ -155,16 +146,7 @@ fn feed_enable_missing_rejects_and_stops() {
         r.rejected(0, CommandKind::MoveAbsolute(mv(-5.0, 10.0))),
         ErrorId::FEED_ENABLE_MISSING
     );
-    let v = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 100.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let v = r.ok(0, velocity(100.0, Direction::Positive));
     r.run(0.3);
     r.ok(
         0,
@@ -184,16 +166,7 @@ fn feed_enable_missing_rejects_and_stops() {
 fn hardware_limit_switch_stops_fast_and_blocks_that_direction_only() {
     let mut r = Rig::new(1);
     r.power_on(0);
-    let v = r.ok(
-        0,
-        CommandKind::MoveVelocity {
-            velocity: 200.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        },
-    );
+    let v = r.ok(0, velocity(200.0, Direction::Positive));
     r.run(0.5);
     r.plants[0].limit_positive = true;
     r.step();
