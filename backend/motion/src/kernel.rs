@@ -1,4 +1,6 @@
 //! The kernel: a fixed number of axis slots stepped together, masters before their slaves.
+//! It holds what no single axis can see — the slots, the couplings between them and the order
+//! they are stepped in; everything else is the axis's (`axis/`).
 
 use crate::axis::{Axis, Master, MasterSample};
 use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};

@@ -1,5 +1,6 @@
 //! MC_Home: direct, force/reset calibration, and the referencing sequence of spec §5.3
-//! against the drive's reference cam and latch.
+//! against the drive's reference cam and latch. Apart because the sequence is a state machine
+//! of its own (phases, a latch armed and read across cycles) that runs inside one job.
 
 use super::*;
 

@@ -1,5 +1,7 @@
 //! Power, errors and monitoring: MC_Power/notes 1–5, MC_Reset, ErrorStop, feed enables,
-//! software limits for endless motion and following-error monitoring.
+//! software limits for endless motion and following-error monitoring. Together because each
+//! ends what runs when the axis may not go on, or lets it go on again: the way into ErrorStop
+//! (`enter_error`) and out of it (`reset`) are here.
 
 use super::*;
 

@@ -1,5 +1,6 @@
 //! MC_MoveSuperImposed / MC_AbortSuperposition (spec §5.2, §6.13): a distance laid over the
-//! running motion as a function of its travel.
+//! running motion as a function of its travel. Apart from the jobs because it outlives them
+//! (ResumeAfterMotionStop) and lays its increment on whatever setpoint the job gave.
 
 use super::*;
 
