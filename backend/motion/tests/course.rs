@@ -324,7 +324,7 @@ fn kind(s: &Successor) -> CommandKind {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("MOTION_PROP_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200), ..ProptestConfig::default() })]
+    #![proptest_config(prop_config(200))]
 
     /// Random commands at random moments (during acceleration, cruise, braking, settling)
     /// with random velocities and buffer modes, on an axis with software limits 0–1000: the

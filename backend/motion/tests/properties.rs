@@ -105,7 +105,7 @@ fn action() -> impl Strategy<Value = Action> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("MOTION_PROP_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(1000), ..ProptestConfig::default() })]
+    #![proptest_config(prop_config(1000))]
 
     #[test]
     fn random_command_sequences_keep_every_invariant(actions in prop::collection::vec(action(), 1..40)) {
@@ -194,7 +194,7 @@ fn move_from_rest() -> impl Strategy<Value = CommandKind> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("MOTION_PROP_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(300), ..ProptestConfig::default() })]
+    #![proptest_config(prop_config(300))]
 
     /// A move started from rest and left alone keeps, in every cycle, its own velocity ×
     /// override, acceleration (speeding up), deceleration (slowing down) and jerk: the rig

@@ -853,3 +853,24 @@ pub fn halt() -> CommandKind {
         options: MoveOptions::default(),
     }
 }
+
+/// The property tests' configuration: `default_cases` cases (`MOTION_PROP_CASES` overrides)
+/// from a fixed seed, so that the suite is the same on every run (`MOTION_PROP_SEED=<u64>`
+/// explores another part of the space, `MOTION_PROP_SEED=random` a new one each run).
+pub fn prop_config(default_cases: u32) -> proptest::test_runner::Config {
+    use proptest::test_runner::{Config, RngSeed};
+    let cases = std::env::var("MOTION_PROP_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default_cases);
+    let rng_seed = match std::env::var("MOTION_PROP_SEED").ok().as_deref() {
+        Some("random") => RngSeed::Random,
+        Some(v) => RngSeed::Fixed(v.parse().expect("MOTION_PROP_SEED: a u64 or random")),
+        None => RngSeed::Fixed(20_261_123),
+    };
+    Config {
+        cases,
+        rng_seed,
+        ..Config::default()
+    }
+}
