@@ -678,6 +678,24 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
         assert!(fields.contains(&f), "{f} not reported: {fields:?}");
     }
     assert!(fields.iter().any(|f| f.starts_with("drive.")), "{fields:?}");
+    // A wrong type inside the drive is named by its path, with or without the drive's kind;
+    // an unknown kind is refused (only `simulated` exists).
+    for drive in [
+        json!({"kind": "simulated", "dead_time": "x"}),
+        json!({"dead_time": "x", "kind": "simulated"}),
+        json!({"dead_time": "x"}),
+    ] {
+        let mut bad = cfg.clone();
+        bad["drive"] = drive;
+        let r = post(&s, "/api/v1/axes", bad).await;
+        assert_problem(&r, 422, "validation_failed");
+        assert_eq!(r.json["errors"][0]["field"], "drive.dead_time", "{}", r.json);
+    }
+    let mut bad = cfg.clone();
+    bad["drive"] = json!({"kind": "cia402"});
+    let r = post(&s, "/api/v1/axes", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "drive", "{}", r.json);
     let mut unknown = cfg.clone();
     unknown["colour"] = json!("red");
     assert_problem(

@@ -12,9 +12,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
 
-/// How an axis's drive is configured. Only simulated drives exist yet; CiA-402 drives on
-/// EtherCAT will be a variant beside it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// How an axis's drive is configured: an object whose `kind` names the drive (`simulated`, the
+/// only one yet; CiA-402 drives on EtherCAT will be a variant beside it) and whose other
+/// fields are that drive's. A configuration without `kind` is a simulated drive: axes stored
+/// before drives had kinds read as they were written.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum DriveConfig {
     /// The simulated servo drive (plant model, cam, index pulse, limit switches, faults).
@@ -43,6 +45,107 @@ impl DriveConfig {
                 Drive::Simulated(Box::new(SimDrive::new(c.clone(), cycle_time_s)))
             }
         }
+    }
+}
+
+/// Reads the object's fields in place (no buffering), so that an error inside a drive's fields
+/// keeps its JSON path (`drive.plant.damping`) for whoever tracks it.
+impl<'de> Deserialize<'de> for DriveConfig {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Object;
+        impl<'de> serde::de::Visitor<'de> for Object {
+            type Value = DriveConfig;
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str("a drive configuration object")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<DriveConfig, A::Error> {
+                let fields = serde::de::value::MapAccessDeserializer::new(WithoutKind(map));
+                SimDriveConfig::deserialize(fields).map(DriveConfig::Simulated)
+            }
+        }
+        d.deserialize_map(Object)
+    }
+}
+
+/// The kinds of drive there are, as `kind` names them.
+const KINDS: &[&str] = &["simulated"];
+
+/// A drive object's fields without its `kind` (checked on the way: with a single kind, the
+/// fields that follow are that kind's wherever `kind` stands).
+struct WithoutKind<A>(A);
+
+impl<'de, A: serde::de::MapAccess<'de>> serde::de::MapAccess<'de> for WithoutKind<A> {
+    type Error = A::Error;
+
+    fn next_key_seed<K: serde::de::DeserializeSeed<'de>>(
+        &mut self,
+        seed: K,
+    ) -> Result<Option<K::Value>, A::Error> {
+        use serde::de::{Error, IntoDeserializer};
+        loop {
+            let Some(key) = self.0.next_key::<String>()? else {
+                return Ok(None);
+            };
+            if key != "kind" {
+                return seed.deserialize(key.into_deserializer()).map(Some);
+            }
+            let kind: String = self.0.next_value()?;
+            if !KINDS.contains(&kind.as_str()) {
+                return Err(A::Error::unknown_variant(&kind, KINDS));
+            }
+        }
+    }
+
+    fn next_value_seed<V: serde::de::DeserializeSeed<'de>>(
+        &mut self,
+        seed: V,
+    ) -> Result<V::Value, A::Error> {
+        self.0.next_value_seed(seed)
+    }
+}
+
+/// The schema: the simulated drive's object with `kind` in front (a `oneOf` over the kinds
+/// once there is more than one).
+#[cfg(feature = "schema")]
+impl utoipa::PartialSchema for DriveConfig {
+    fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
+        use utoipa::openapi::RefOr;
+        use utoipa::openapi::schema::{Object, Schema, SchemaType, Type};
+        let mut schema = <SimDriveConfig as utoipa::PartialSchema>::schema();
+        if let RefOr::T(Schema::Object(o)) = &mut schema {
+            let kind = Object::builder()
+                .schema_type(SchemaType::Type(Type::String))
+                .enum_values(Some(KINDS.iter().copied()))
+                .default(Some("simulated".into()))
+                .description(Some(
+                    "The kind of drive; `simulated` (the default) is the only one yet.",
+                ))
+                .build();
+            let mut properties = std::mem::take(&mut o.properties);
+            o.properties.insert("kind".into(), kind.into());
+            o.properties.append(&mut properties);
+            o.description = Some(
+                "An axis's drive: `kind` and that drive's fields. A simulated drive: a model of \
+                 a servo drive (times in seconds, positions in the axis's units)."
+                    .into(),
+            );
+        }
+        schema
+    }
+}
+
+#[cfg(feature = "schema")]
+impl utoipa::ToSchema for DriveConfig {
+    fn schemas(
+        schemas: &mut Vec<(
+            String,
+            utoipa::openapi::RefOr<utoipa::openapi::schema::Schema>,
+        )>,
+    ) {
+        <SimDriveConfig as utoipa::ToSchema>::schemas(schemas);
     }
 }
 
@@ -154,5 +257,40 @@ impl DriveBus for SimBus {
             }
             None => Err(BusError::NoDrive),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_drive_object_names_its_kind_and_reads_without_one_as_simulated() {
+        let sim = DriveConfig::Simulated(SimDriveConfig {
+            dead_time: 0.002,
+            ..SimDriveConfig::default()
+        });
+        let written = serde_json::to_value(&sim).unwrap();
+        assert_eq!(written["kind"], "simulated");
+        let read: DriveConfig = serde_json::from_value(written.clone()).unwrap();
+        assert_eq!(read, sim);
+        // Stored before drives had kinds; and `kind` wherever it stands.
+        let legacy: DriveConfig = serde_json::from_str(r#"{"dead_time": 0.002}"#).unwrap();
+        assert_eq!(legacy, sim);
+        let last: DriveConfig =
+            serde_json::from_str(r#"{"dead_time": 0.002, "kind": "simulated"}"#).unwrap();
+        assert_eq!(last, sim);
+        let empty: DriveConfig = serde_json::from_str("{}").unwrap();
+        assert_eq!(empty, DriveConfig::default());
+    }
+
+    #[test]
+    fn an_unknown_kind_or_field_is_refused() {
+        let e = serde_json::from_str::<DriveConfig>(r#"{"kind": "cia402"}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown variant `cia402`"), "{e}");
+        let e = serde_json::from_str::<DriveConfig>(r#"{"dead_tme": 0.1}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown field `dead_tme`"), "{e}");
+        let e = serde_json::from_str::<DriveConfig>("[]").unwrap_err();
+        assert!(e.to_string().contains("drive configuration object"), "{e}");
     }
 }

@@ -1,8 +1,27 @@
 //! motiond, the appliance: the cycle thread, the REST + websocket API and the SQLite store.
 //!
 //! Map: [`cycle`] (the real-time thread and its queues), [`app`] (the async side's state and
-//! the pump between the two), [`api`] (HTTP and websocket), [`store`] (SQLite), [`model`]
-//! (DTOs), [`sim`] / [`params`] (adapters to `drives` and `motion::params`).
+//! the pump between the two), [`api`] (HTTP and websocket; [`api::blocks`] is the catalogue of
+//! function blocks), [`service`] (the rules of each request), [`store`] (SQLite), [`error`]
+//! (`AppError`), [`model`] (DTOs), [`sim`] / [`params`] (adapters to `drives` and
+//! `motion::params`).
+//!
+//! Every function block an axis takes is a catalogue entry; the REST endpoint, the websocket
+//! method and the OpenAPI operation all come from it:
+//!
+//! ```
+//! use server::api::blocks::{self, Role};
+//!
+//! let block = blocks::find("move-absolute").expect("MC_MoveAbsolute is in the catalogue");
+//! assert_eq!(block.path, "/api/v1/axes/{axis}/move-absolute");
+//! assert_eq!(block.role, Role::Operator);
+//!
+//! // The OpenAPI document served at /openapi.json has its operation, body and all.
+//! let doc: serde_json::Value = serde_json::from_str(&server::api::openapi_json()).unwrap();
+//! let op = &doc["paths"][block.path]["post"];
+//! assert_eq!(op["summary"], block.summary);
+//! assert_eq!(op["x-motiond-block"]["milestone"], "done");
+//! ```
 
 pub mod api;
 pub mod app;
@@ -11,6 +30,7 @@ pub mod error;
 pub mod model;
 pub mod params;
 pub mod scope;
+pub mod service;
 pub mod sim;
 pub mod stats;
 pub mod store;
@@ -27,6 +47,7 @@ use crate::app::{AppState, AxisEntry, SystemInfo};
 use crate::model::{AxisConfigDto, AxisDynamics, ModuloConfig, SoftLimits};
 use crate::params::ParamValue;
 use crate::sim::{LimitSwitches, SimDriveConfig};
+use drives::DriveConfig;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -168,14 +189,14 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             "AxisTargetPositionWindow".to_string(),
             ParamValue::Number(0.01),
         )]),
-        drive: SimDriveConfig {
+        drive: DriveConfig::Simulated(SimDriveConfig {
             limit_switches: LimitSwitches {
                 negative: Some(switches.0),
                 positive: Some(switches.1),
                 fault_on_hit: false,
             },
             ..SimDriveConfig::default()
-        },
+        }),
     };
     vec![
         // Travel 0–1000 mm (software limits), switches 5 mm beyond.
@@ -203,7 +224,7 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
                 jog_velocity_fast: 720.0,
             },
             parameters: BTreeMap::new(),
-            drive: SimDriveConfig::default(),
+            drive: DriveConfig::default(),
         },
     ]
 }
@@ -394,9 +415,9 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
                     client_id: Some("demo".into()),
                     ..Default::default()
                 };
-                api::axes::create(state, config, None, audit)
+                service::axes::create(state, config, None, audit)
                     .await
-                    .map_err(|e| format!("cannot create demo axis {name}: {}", e.0.detail))?;
+                    .map_err(|e| format!("cannot create demo axis {name}: {}", e))?;
             }
             tracing::info!(
                 "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°)"
@@ -426,10 +447,10 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
             .build_axis(a.id, &config, &overlay)
             .map_err(|e| format!("axis {} in the database is invalid: {e:?}", a.name))?;
         let slot = slot as u16;
-        match state.install_axis(slot, axis, drive, false).await {
-            Ok(Ok(())) => {}
-            _ => return Err(format!("cannot install axis {}", a.name)),
-        }
+        state
+            .install_axis(slot, axis, drive, false)
+            .await
+            .map_err(|e| format!("cannot install axis {}: {e}", a.name))?;
         state.registry.write().unwrap().axes.insert(
             a.id,
             AxisEntry {

@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::params::{self, ParamValue};
-use crate::sim::{FieldError, SimDriveConfig};
+use crate::scope::{ScopeSignal, TriggerEdge};
+use crate::sim::FieldError;
+use drives::DriveConfig;
 
 fn is_false(b: &bool) -> bool {
     !*b
@@ -86,9 +88,9 @@ pub struct AxisConfigDto {
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     #[schema(value_type = Object)]
     pub parameters: BTreeMap<String, ParamValue>,
-    /// Model of the simulated drive.
+    /// The axis's drive: `kind` (default `simulated`) and that drive's fields.
     #[serde(default)]
-    pub drive: SimDriveConfig,
+    pub drive: DriveConfig,
 }
 
 pub const UNITS: &[&str] = &["mm", "m", "um", "deg", "rad", "rev", "in", "inc"];
@@ -786,4 +788,98 @@ pub(crate) mod examples {
         v["master"] = Value::Null;
         v
     }
+}
+
+/// Live status of an axis.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"axis": "x", "axis_id": 1, "cycle": 2009, "unit": "mm",
+                          "status": crate::model::examples::live_status()}))]
+pub struct StatusResource {
+    pub axis: String,
+    pub axis_id: i64,
+    /// The cycle the snapshot was taken in.
+    pub cycle: u64,
+    pub unit: String,
+    pub status: LiveStatus,
+}
+
+/// When the following-error peak hold counts from.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"axis": "x", "cycle": 120345}))]
+pub struct PeakResetResource {
+    pub axis: String,
+    /// The first cycle of the new peak hold.
+    pub cycle: u64,
+}
+
+// --- Scope recording requests -------------------------------------------------------------
+
+/// An axis by id (number or digits) or by name.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(untagged)]
+pub enum AxisKey {
+    Id(i64),
+    Name(String),
+}
+
+impl AxisKey {
+    pub fn key(&self) -> String {
+        match self {
+            AxisKey::Id(i) => i.to_string(),
+            AxisKey::Name(s) => s.clone(),
+        }
+    }
+}
+
+/// One signal of one axis.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"axis": "x", "signal": "set_position"}))]
+pub struct ChannelRequest {
+    /// Axis id or name.
+    #[schema(value_type = String, example = "x")]
+    pub axis: AxisKey,
+    #[schema(value_type = ScopeSignal)]
+    pub signal: String,
+}
+
+/// Start the recording when `channels[channel]` crosses `level` in the direction of `edge`.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002}))]
+pub struct TriggerRequest {
+    /// Index into `channels`.
+    #[schema(value_type = usize)]
+    pub channel: i64,
+    pub level: f64,
+    /// `rising` (previous < level ≤ sample, the default), `falling` (previous > level ≥
+    /// sample) or `either`.
+    #[serde(default = "rising")]
+    #[schema(value_type = TriggerEdge)]
+    pub edge: String,
+    /// History before the trigger sample (s, 0 … duration_s, default 0).
+    #[serde(default)]
+    pub pre_trigger_s: f64,
+}
+
+fn rising() -> String {
+    "rising".into()
+}
+
+/// `POST /scope/recordings`.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "channels": [{"axis": "x", "signal": "set_position"}, {"axis": "x", "signal": "set_velocity"}],
+    "duration_s": 2.0,
+    "trigger": {"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.2}
+}))]
+pub struct RecordingRequest {
+    /// 1 to 8 signals.
+    pub channels: Vec<ChannelRequest>,
+    /// Length of the recording (s): round(duration_s / cycle time) samples, at most 600 000.
+    pub duration_s: f64,
+    /// `null` (or absent): record from the next cycle on.
+    #[serde(default)]
+    pub trigger: Option<TriggerRequest>,
 }

@@ -740,8 +740,8 @@ export interface components {
             dynamics: components["schemas"]["AxisDynamics"];
             /** @description Further base values of MC_AxisParameter entries, by name (or number). */
             parameters?: Record<string, never>;
-            /** @description Model of the simulated drive. */
-            drive?: components["schemas"]["SimDriveConfig"];
+            /** @description The axis's drive: `kind` (default `simulated`) and that drive's fields. */
+            drive?: components["schemas"]["DriveConfig"];
         };
         /**
          * @description Default dynamics of the axis (used when a command passes 0).
@@ -806,6 +806,7 @@ export interface components {
          *             "offset": 0,
          *             "period": 10
          *           },
+         *           "kind": "simulated",
          *           "limit_switches": {
          *             "fault_on_hit": false,
          *             "negative": -5,
@@ -1200,6 +1201,7 @@ export interface components {
          *             "offset": 0,
          *             "period": 10
          *           },
+         *           "kind": "simulated",
          *           "limit_switches": {
          *             "fault_on_hit": false,
          *             "negative": -5,
@@ -1264,6 +1266,7 @@ export interface components {
          *                 "offset": 0,
          *                 "period": 10
          *               },
+         *               "kind": "simulated",
          *               "limit_switches": {
          *                 "fault_on_hit": false,
          *                 "negative": -5,
@@ -1316,6 +1319,7 @@ export interface components {
          *                 "offset": 0,
          *                 "period": 10
          *               },
+         *               "kind": "simulated",
          *               "limit_switches": {
          *                 "fault_on_hit": false,
          *                 "negative": -1005,
@@ -1362,6 +1366,7 @@ export interface components {
          *                 "offset": 0,
          *                 "period": 10
          *               },
+         *               "kind": "simulated",
          *               "limit_switches": {
          *                 "fault_on_hit": false,
          *                 "negative": null,
@@ -1411,6 +1416,96 @@ export interface components {
         };
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
+        /**
+         * @description An axis's drive: `kind` and that drive's fields. A simulated drive: a model of a servo drive (times in seconds, positions in the axis's units).
+         * @example {
+         *       "acceleration_feed_forward": 0,
+         *       "coast_deceleration": 10000,
+         *       "dead_time": 0.001,
+         *       "dead_time_compensation": true,
+         *       "enable_delay": 0.005,
+         *       "index_pulse": {
+         *         "offset": 0,
+         *         "period": 10
+         *       },
+         *       "kind": "simulated",
+         *       "limit_switches": {
+         *         "fault_on_hit": false,
+         *         "negative": -5,
+         *         "positive": 1005
+         *       },
+         *       "load_stiffness": 1000,
+         *       "plant": {
+         *         "damping": 0.8,
+         *         "kind": "pt2",
+         *         "natural_frequency_hz": 50
+         *       },
+         *       "reference_cam": {
+         *         "end": 25,
+         *         "start": 20
+         *       },
+         *       "velocity_feed_forward": 1
+         *     }
+         */
+        DriveConfig: {
+            /**
+             * @description The kind of drive; `simulated` (the default) is the only one yet.
+             * @default simulated
+             * @enum {string}
+             */
+            kind: "simulated";
+            /** @description Closed-loop response of the position-controlled load. Default: `{"damping":0.8,"kind":"pt2","natural_frequency_hz":50.0}`. */
+            plant?: components["schemas"]["PlantModel"];
+            /**
+             * Format: double
+             * @description Delay between a setpoint and its effect on the load (s, 0…0.1).
+             * @default 0.001
+             */
+            dead_time: number;
+            /**
+             * @description Extrapolate the delayed setpoint over the dead time with its feed-forward velocity and
+             *     acceleration, as a "lagless" CSP drive does.
+             * @default true
+             */
+            dead_time_compensation: boolean;
+            /**
+             * Format: double
+             * @description Weight of the setpoint's velocity feed-forward (0…2; 1 = full).
+             * @default 1
+             */
+            velocity_feed_forward: number;
+            /**
+             * Format: double
+             * @description Weight of the setpoint's acceleration feed-forward (0…2; PT2 only).
+             * @default 0
+             */
+            acceleration_feed_forward: number;
+            /**
+             * Format: double
+             * @description Time from the enable request to "operation enabled" (s, 0…10).
+             * @default 0.005
+             */
+            enable_delay: number;
+            /**
+             * Format: double
+             * @description Deceleration of the load while the power stage is off (units/s², > 0).
+             * @default 10000
+             */
+            coast_deceleration: number;
+            /**
+             * Format: double
+             * @description Static stiffness of the position loop against a load force (force units per position
+             *     unit, > 0): a force F gives a following error F / load_stiffness.
+             * @default 1000
+             */
+            load_stiffness: number;
+            /** @description Reference cam (homing switch); `null` for none. Default: `{"end":25.0,"start":20.0}`. */
+            reference_cam?: null | components["schemas"]["ReferenceCam"];
+            /** @description Encoder index (zero) pulse; `null` for none. Default: `{"offset":0.0,"period":10.0}`. */
+            index_pulse?: null | components["schemas"]["IndexPulse"];
+            /** @description Hardware limit switches. Default: `{"fault_on_hit":false,"negative":null,"positive":null}`. */
+            limit_switches?: components["schemas"]["LimitSwitches"];
+        };
         /**
          * @description MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
          * @example {}
@@ -2437,89 +2532,6 @@ export interface components {
             position: number;
             relative?: boolean;
             clear_position_lag?: boolean;
-        };
-        /**
-         * @description Model of the simulated servo drive. Times in seconds, positions in the axis's units.
-         * @example {
-         *       "acceleration_feed_forward": 0,
-         *       "coast_deceleration": 10000,
-         *       "dead_time": 0.001,
-         *       "dead_time_compensation": true,
-         *       "enable_delay": 0.005,
-         *       "index_pulse": {
-         *         "offset": 0,
-         *         "period": 10
-         *       },
-         *       "limit_switches": {
-         *         "fault_on_hit": false,
-         *         "negative": -5,
-         *         "positive": 1005
-         *       },
-         *       "load_stiffness": 1000,
-         *       "plant": {
-         *         "damping": 0.8,
-         *         "kind": "pt2",
-         *         "natural_frequency_hz": 50
-         *       },
-         *       "reference_cam": {
-         *         "end": 25,
-         *         "start": 20
-         *       },
-         *       "velocity_feed_forward": 1
-         *     }
-         */
-        SimDriveConfig: {
-            /** @description Closed-loop response of the position-controlled load. Default: `{"damping":0.8,"kind":"pt2","natural_frequency_hz":50.0}`. */
-            plant?: components["schemas"]["PlantModel"];
-            /**
-             * Format: double
-             * @description Delay between a setpoint and its effect on the load (s, 0…0.1).
-             * @default 0.001
-             */
-            dead_time: number;
-            /**
-             * @description Extrapolate the delayed setpoint over the dead time with its feed-forward velocity and
-             *     acceleration, as a "lagless" CSP drive does.
-             * @default true
-             */
-            dead_time_compensation: boolean;
-            /**
-             * Format: double
-             * @description Weight of the setpoint's velocity feed-forward (0…2; 1 = full).
-             * @default 1
-             */
-            velocity_feed_forward: number;
-            /**
-             * Format: double
-             * @description Weight of the setpoint's acceleration feed-forward (0…2; PT2 only).
-             * @default 0
-             */
-            acceleration_feed_forward: number;
-            /**
-             * Format: double
-             * @description Time from the enable request to "operation enabled" (s, 0…10).
-             * @default 0.005
-             */
-            enable_delay: number;
-            /**
-             * Format: double
-             * @description Deceleration of the load while the power stage is off (units/s², > 0).
-             * @default 10000
-             */
-            coast_deceleration: number;
-            /**
-             * Format: double
-             * @description Static stiffness of the position loop against a load force (force units per position
-             *     unit, > 0): a force F gives a following error F / load_stiffness.
-             * @default 1000
-             */
-            load_stiffness: number;
-            /** @description Reference cam (homing switch); `null` for none. Default: `{"end":25.0,"start":20.0}`. */
-            reference_cam?: null | components["schemas"]["ReferenceCam"];
-            /** @description Encoder index (zero) pulse; `null` for none. Default: `{"offset":0.0,"period":10.0}`. */
-            index_pulse?: null | components["schemas"]["IndexPulse"];
-            /** @description Hardware limit switches. Default: `{"fault_on_hit":false,"negative":null,"positive":null}`. */
-            limit_switches?: components["schemas"]["LimitSwitches"];
         };
         /**
          * @description A fault or disturbance injected into the simulation (tests, demos, commissioning).

@@ -26,7 +26,9 @@ export type MoveBody = S['MoveBody'];
 export type MoveVelocityBody = S['MoveVelocityBody'];
 export type HomeBody = S['HomeBody'];
 export type Direction = S['Direction'];
-export type SimDriveConfig = S['SimDriveConfig'];
+export type DriveConfig = S['DriveConfig'];
+/** The simulated drive's configuration: the only kind of drive yet. */
+export type SimDriveConfig = DriveConfig;
 export type PlantModel = S['PlantModel'];
 
 /** A `command_event` notification of the `commands` websocket topic. */

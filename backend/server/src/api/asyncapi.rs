@@ -228,7 +228,7 @@ impl Builder {
 /// The document.
 pub fn document() -> Value {
     let mut schemas: Map<String, Value> = Map::new();
-    for doc in [super::ApiDoc::openapi(), WsSchemas::openapi()] {
+    for doc in [super::ApiDoc::document(), WsSchemas::openapi()] {
         let v = serde_json::to_value(doc.components.expect("components")).expect("serialises");
         if let Some(Value::Object(m)) = v.get("schemas") {
             schemas.extend(m.clone());
@@ -267,15 +267,12 @@ pub fn document() -> Value {
         "Release a command (falling edge of Execute/Enable)",
         "Unlocks an MC_Stop, ends a jog, a power or a gear-in-dyn (as `DELETE /api/v1/commands/{id}`).",
     );
-    for method in ws::COMMANDS {
+    for block in super::blocks::BLOCKS {
         d.rpc(
-            method,
-            command_params(
-                ws::body_schema(method).expect("every command method has a body"),
-                &schemas,
-            ),
+            block.name,
+            command_params(block.body, &schemas),
             schema_ref("CommandResource"),
-            &format!("The command `POST /api/v1/axes/{{axis}}/{method}`"),
+            &format!("The command `POST {}`", block.path),
             "Validated, submitted and answered as over REST: the result is the command resource (final, or at its \
              milestone with `wait`); a refusal is an error whose `data` is the REST API's problem. A jog sent over \
              the socket is also released when the socket closes.",

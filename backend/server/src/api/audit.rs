@@ -10,7 +10,7 @@ use utoipa::{IntoParams, ToSchema};
 use super::Q;
 use super::errors::AuditErrors;
 use crate::app::AppState;
-use crate::error::{ApiError, ApiResult};
+use crate::error::{AppError, AppResult};
 use crate::store;
 
 /// Largest `limit` of one request.
@@ -68,16 +68,16 @@ milliseconds later, so that a slow disk never delays a command.",
 pub async fn audit_log(
     State(s): State<Arc<AppState>>,
     Q(q): Q<AuditQuery>,
-) -> ApiResult<Json<Vec<AuditRecord>>> {
+) -> AppResult<Json<Vec<AuditRecord>>> {
     let limit = q.limit.unwrap_or(100);
     if !(1..=MAX_LIMIT).contains(&limit) {
-        return Err(ApiError::field("limit", "must be between 1 and 1000"));
+        return Err(AppError::field("limit", "must be between 1 and 1000"));
     }
     let rows = store::read_audit(&s.db, limit, q.since_id.unwrap_or(0))
         .await
         .map_err(|e| {
             tracing::error!("database: {e}");
-            ApiError::unavailable(
+            AppError::unavailable(
                 "storage_unavailable",
                 format!("the audit log could not be read: {e}"),
             )

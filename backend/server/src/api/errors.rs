@@ -2,8 +2,8 @@
 //! component (`#/components/responses/…`) with its description and examples; each kind of
 //! endpoint has a set that names, per status, the response it can answer (and only those).
 //!
-//! The examples are built by the constructors the handlers use (`ApiError::not_found`,
-//! `ApiError::rejected` …), so their `type`, `title` and `code` are exactly what the server sends;
+//! The examples are built by the constructors the handlers use (`AppError::not_found`,
+//! `AppError::rejected` …), so their `type`, `title` and `code` are exactly what the server sends;
 //! only the details name example values. `tests/api.rs` checks that every code in the document
 //! is one the server emits.
 
@@ -11,49 +11,49 @@ use motion::ErrorId;
 use utoipa::{IntoResponses, ToResponse};
 
 use super::{BODY_LIMIT, guard};
-use crate::error::{ApiError, Problem};
+use crate::error::{AppError, Problem};
 
 /// The body the server sends for `e`.
-fn p(e: ApiError) -> Problem {
-    *e.0
+fn p(e: AppError) -> Problem {
+    e.problem()
 }
 
 // Examples used by several responses.
 
 fn malformed_json() -> Problem {
-    p(ApiError::bad_json(
+    p(AppError::bad_json(
         "EOF while parsing a value at line 1 column 15",
     ))
 }
 fn axis_not_found() -> Problem {
-    p(ApiError::not_found("axis", "z"))
+    p(AppError::not_found("axis", "z"))
 }
 fn axis_not_disabled() -> Problem {
-    p(ApiError::conflict(
+    p(AppError::conflict(
         "axis_not_disabled",
         "axis 'x' is not disabled: switch it off (DELETE its power command) first",
     ))
 }
 fn axis_name_taken() -> Problem {
-    p(ApiError::conflict(
+    p(AppError::conflict(
         "axis_name_taken",
         "an axis named 'y' exists",
     ))
 }
 fn queue_full() -> Problem {
-    p(ApiError::unavailable(
+    p(AppError::unavailable(
         "command_queue_full",
         "the command queue to the cycle thread is full; try again",
     ))
 }
 fn cycle_unavailable() -> Problem {
-    p(ApiError::unavailable(
+    p(AppError::unavailable(
         "cycle_unavailable",
         "the cycle thread did not answer",
     ))
 }
 fn storage_unavailable() -> Problem {
-    p(ApiError::unavailable(
+    p(AppError::unavailable(
         "storage_unavailable",
         "the database did not accept the write: database is locked",
     ))
@@ -118,9 +118,9 @@ problem_responses! {
     /// done.
     CrossOriginForbidden(examples(
         ("origin" = (summary = "A page of another origin",
-            value = json!(p(ApiError::cross_origin(guard::foreign_origin("http://evil.example", Some("127.0.0.1:8080"))))))),
+            value = json!(p(AppError::cross_origin(guard::foreign_origin("http://evil.example", Some("127.0.0.1:8080"))))))),
         ("sec_fetch_site" = (summary = "A request the browser marks as from another site",
-            value = json!(p(ApiError::cross_origin(guard::foreign_site("cross-site"))))))));
+            value = json!(p(AppError::cross_origin(guard::foreign_site("cross-site"))))))));
 
     // 404
 
@@ -130,13 +130,13 @@ problem_responses! {
     /// No such axis or parameter.
     AxisOrParameterNotFound(examples(
         ("axis_not_found" = (value = json!(axis_not_found()))),
-        ("parameter_not_found" = (value = json!(p(ApiError::not_found("parameter", "AxisVeloMaximum")))))));
+        ("parameter_not_found" = (value = json!(p(AppError::not_found("parameter", "AxisVeloMaximum")))))));
 
     /// No such command (never accepted, or no longer among the last 2000).
-    CommandNotFound(example = json!(p(ApiError::not_found("command", "12345"))));
+    CommandNotFound(example = json!(p(AppError::not_found("command", "12345"))));
 
     /// No such recording (never made, deleted, or evicted).
-    RecordingNotFound(example = json!(p(ApiError::not_found("recording", "7"))));
+    RecordingNotFound(example = json!(p(AppError::not_found("recording", "7"))));
 
     // 409
 
@@ -144,17 +144,17 @@ problem_responses! {
     /// `code` its name (docs/errors.md). No command is kept.
     CommandRejected(examples(
         ("axis_cannot_be_started" = (summary = "A move on a disabled axis",
-            value = json!(p(ApiError::rejected(ErrorId::AXIS_CANNOT_BE_STARTED))))),
+            value = json!(p(AppError::rejected(ErrorId::AXIS_CANNOT_BE_STARTED))))),
         ("feed_enable_missing" = (summary = "A jog without its direction's feed enable",
-            value = json!(p(ApiError::rejected(ErrorId::FEED_ENABLE_MISSING)))))));
+            value = json!(p(AppError::rejected(ErrorId::FEED_ENABLE_MISSING)))))));
 
     /// The axis no longer runs the command (it has ended or was replaced): `command_unknown`.
-    CommandUnknown(example = json!(p(ApiError::rejected(ErrorId::COMMAND_UNKNOWN))));
+    CommandUnknown(example = json!(p(AppError::rejected(ErrorId::COMMAND_UNKNOWN))));
 
     /// The name is taken, or all 64 axis slots are used.
     AxisCreateConflict(examples(
         ("axis_name_taken" = (value = json!(axis_name_taken()))),
-        ("no_free_slot" = (value = json!(p(ApiError::conflict("no_free_slot", "all axis slots are used")))))));
+        ("no_free_slot" = (value = json!(p(AppError::conflict("no_free_slot", "all axis slots are used")))))));
 
     /// The axis is not disabled, or another axis has the name.
     AxisReplaceConflict(examples(
@@ -167,45 +167,45 @@ problem_responses! {
     /// The active recordings already use the scope's 8 signals (`scope_channels_busy`), or 8
     /// recordings are active or their memory is used up (`scope_busy`).
     ScopeBusy(examples(
-        ("scope_channels_busy" = (value = json!(p(ApiError::conflict("scope_channels_busy",
+        ("scope_channels_busy" = (value = json!(p(AppError::conflict("scope_channels_busy",
             "the scope samples at most 8 signals at once: 7 are in use by active recordings and this one \
              needs 2 more; cancel one or wait until it is done"))))),
-        ("scope_busy" = (value = json!(p(ApiError::conflict("scope_busy",
+        ("scope_busy" = (value = json!(p(AppError::conflict("scope_busy",
             "too many active recordings (at most 8 recordings and 9600000 values are kept); cancel one or \
              wait until it is done")))))));
 
     /// CSV of a recording that is not done.
-    RecordingNotDone(example = json!(p(ApiError::conflict(
+    RecordingNotDone(example = json!(p(AppError::conflict(
         "recording_not_done", "recording 7 is armed; CSV is available when it is done"))));
 
     // 413
 
     /// The body is larger than 2 MiB.
-    PayloadTooLarge(example = json!(p(ApiError::too_large(BODY_LIMIT))));
+    PayloadTooLarge(example = json!(p(AppError::too_large(BODY_LIMIT))));
 
     // 415
 
     /// The request is not declared `Content-Type: application/json`, which every POST, PUT,
     /// PATCH and DELETE must be, also one without a body. Nothing was done.
-    UnsupportedMediaType(example = json!(p(ApiError::unsupported_media_type(guard::not_json(
+    UnsupportedMediaType(example = json!(p(AppError::unsupported_media_type(guard::not_json(
         "Content-Type \"text/plain\" is not application/json")))));
 
     // 421
 
     /// `Host` is not a name this server serves (loopback names and addresses, `--public-name`):
     /// a page of another site whose name resolves to this machine (DNS rebinding). Any request.
-    MisdirectedRequest(example = json!(p(ApiError::misdirected(guard::not_served("attacker.example:8080")))));
+    MisdirectedRequest(example = json!(p(AppError::misdirected(guard::not_served("attacker.example:8080")))));
 
     // 422
 
     /// Invalid parameters (wrong type, unknown or missing field, out of range) or query;
     /// `errors` lists every invalid field. No command is kept.
     CommandInvalid(examples(
-        ("body" = (summary = "An invalid field", value = json!(p(ApiError::field("velocity", "must be > 0"))))),
-        ("query" = (summary = "An invalid query", value = json!(p(ApiError::field("timeout_ms", "at most 600000")))))));
+        ("body" = (summary = "An invalid field", value = json!(p(AppError::field("velocity", "must be > 0"))))),
+        ("query" = (summary = "An invalid query", value = json!(p(AppError::field("timeout_ms", "at most 600000")))))));
 
     /// An invalid or unknown query parameter.
-    QueryInvalid(example = json!(p(ApiError::field("query",
+    QueryInvalid(example = json!(p(AppError::field("query",
         "Failed to deserialize query string: state: unknown variant `running`, expected one of \
          `busy`, `active`, `done`, `aborted`, `error`"))));
 
@@ -218,24 +218,24 @@ problem_responses! {
             value = json!(p(parameter_refused(ErrorId::PARAMETER_OUT_OF_RANGE)))))));
 
     /// The configuration is invalid; `errors` lists every invalid field. Nothing was changed.
-    ConfigInvalid(example = json!(p(ApiError::field("dynamics.jerk", "must be a finite number > 0"))));
+    ConfigInvalid(example = json!(p(AppError::field("dynamics.jerk", "must be a finite number > 0"))));
 
     /// The document is invalid; `errors` lists every invalid field (`axes[i].config.…`).
-    ImportInvalid(example = json!(p(ApiError::field("axes[1].config.name", "duplicate name"))));
+    ImportInvalid(example = json!(p(AppError::field("axes[1].config.name", "duplicate name"))));
 
     /// Not a fault: unknown `kind`, missing or wrong fields.
-    FaultInvalid(example = json!(p(ApiError::field("body",
+    FaultInvalid(example = json!(p(AppError::field("body",
         "unknown variant `meltdown`, expected one of `drive_fault`, `load`, `limit_switch`, `clear`"))));
 
     /// `limit` out of range, or an unknown query parameter.
-    AuditInvalid(example = json!(p(ApiError::field("limit", "must be between 1 and 1000"))));
+    AuditInvalid(example = json!(p(AppError::field("limit", "must be between 1 and 1000"))));
 
     /// Invalid request; `errors` names every invalid field (`channels[1].axis` for an unknown
     /// axis, `trigger.pre_trigger_s` …).
-    ScopeInvalid(example = json!(p(ApiError::field("channels[0].axis", "no axis 'z'"))));
+    ScopeInvalid(example = json!(p(AppError::field("channels[0].axis", "no axis 'z'"))));
 
     /// Unknown `format` or query parameter.
-    RecordingQueryInvalid(example = json!(p(ApiError::field("query",
+    RecordingQueryInvalid(example = json!(p(AppError::field("query",
         "Failed to deserialize query string: format: unknown variant `xml`, expected `json` or `csv`"))));
 
     // 426
@@ -261,7 +261,7 @@ problem_responses! {
     CommandUnavailable(examples(
         ("command_queue_full" = (value = json!(queue_full()))),
         ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
-        ("command_forgotten" = (value = json!(p(ApiError::unavailable(
+        ("command_forgotten" = (value = json!(p(AppError::unavailable(
             "command_forgotten", "the command left the history before it could be shown")))))));
 
     /// The database did not accept the write (`storage_unavailable`: locked, full, I/O error),
@@ -277,11 +277,11 @@ problem_responses! {
     ParameterWriteUnavailable(examples(
         ("command_queue_full" = (value = json!(queue_full()))),
         ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
-        ("storage_unavailable" = (value = json!(p(ApiError::unavailable("storage_unavailable",
+        ("storage_unavailable" = (value = json!(p(AppError::unavailable("storage_unavailable",
             "the value is active but was NOT persisted: database is locked")))))));
 
     /// The audit log could not be read.
-    AuditUnavailable(example = json!(p(ApiError::unavailable(
+    AuditUnavailable(example = json!(p(AppError::unavailable(
         "storage_unavailable", "the audit log could not be read: database is locked"))));
 
     /// The cycle thread did not take the new sampling configuration or did not answer, or the
@@ -289,17 +289,15 @@ problem_responses! {
     ScopeUnavailable(examples(
         ("command_queue_full" = (value = json!(queue_full()))),
         ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
-        ("scope_unavailable" = (value = json!(p(ApiError::unavailable("scope_unavailable", "the recording was evicted")))))));
+        ("scope_unavailable" = (value = json!(p(AppError::unavailable("scope_unavailable", "the recording was evicted")))))));
 
     /// The recording could not be written out.
-    RecordingUnavailable(example = json!(p(ApiError::unavailable("internal", "the recording could not be written"))));
+    RecordingUnavailable(example = json!(p(AppError::unavailable("internal", "the recording could not be written"))));
 }
 
 /// A parameter value refused with its kernel error number, as `write_parameter` answers.
-fn parameter_refused(id: ErrorId) -> ApiError {
-    let mut e = ApiError::field("value", id.text());
-    e.0.error_id = Some(id.0);
-    e
+fn parameter_refused(id: ErrorId) -> AppError {
+    AppError::refused("value", id, id.text())
 }
 
 error_sets! {

@@ -23,7 +23,7 @@ use axum::http::{HeaderMap, header};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 
-use crate::error::ApiError;
+use crate::error::AppError;
 
 /// The names motiond serves besides loopback ones, and the foreign origins it trusts.
 #[derive(Clone, Debug, Default)]
@@ -92,7 +92,7 @@ impl Guard {
 /// 421 for a request to a host name this server does not serve (every request).
 pub async fn check_host(State(g): State<Arc<Guard>>, req: Request, next: Next) -> Response {
     match g.misdirected(&req) {
-        Some(detail) => ApiError::misdirected(detail).into_response(),
+        Some(detail) => AppError::misdirected(detail).into_response(),
         None => next.run(req).await,
     }
 }
@@ -104,12 +104,12 @@ pub async fn check_request(State(g): State<Arc<Guard>>, req: Request, next: Next
     let upgrade = req.headers().contains_key(header::UPGRADE);
     if changes || upgrade {
         if let Some(detail) = g.cross_origin(req.headers()) {
-            return ApiError::cross_origin(detail).into_response();
+            return AppError::cross_origin(detail).into_response();
         }
     }
     if changes {
         if let Err(detail) = json_content_type(req.headers()) {
-            return ApiError::unsupported_media_type(detail).into_response();
+            return AppError::unsupported_media_type(detail).into_response();
         }
     }
     next.run(req).await

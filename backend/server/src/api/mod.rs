@@ -3,6 +3,7 @@
 pub mod asyncapi;
 pub mod audit;
 pub mod axes;
+pub mod blocks;
 pub mod commands;
 pub mod errors;
 pub mod guard;
@@ -30,7 +31,7 @@ use serde::de::DeserializeOwned;
 use utoipa::{IntoParams, OpenApi};
 
 use crate::app::AppState;
-use crate::error::ApiError;
+use crate::error::AppError;
 use crate::model::ClientInfo;
 use errors::{ErrorResponses, RequestChecks};
 
@@ -43,16 +44,16 @@ pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
 pub struct JsonBody<T>(pub T, pub serde_json::Value);
 
 impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
-    type Rejection = ApiError;
+    type Rejection = AppError;
 
-    async fn from_request(req: Request, state: &S) -> Result<Self, ApiError> {
+    async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
         let bytes = axum::body::Bytes::from_request(req, state)
             .await
             .map_err(|e| {
                 if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
-                    ApiError::too_large(BODY_LIMIT)
+                    AppError::too_large(BODY_LIMIT)
                 } else {
-                    ApiError::bad_json(format!("cannot read the body: {e}"))
+                    AppError::bad_json(format!("cannot read the body: {e}"))
                 }
             })?;
         let bytes: &[u8] = if bytes.iter().all(|b| b.is_ascii_whitespace()) {
@@ -61,7 +62,7 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
             &bytes
         };
         let value: serde_json::Value =
-            serde_json::from_slice(bytes).map_err(|e| ApiError::bad_json(e.to_string()))?;
+            serde_json::from_slice(bytes).map_err(|e| AppError::bad_json(e.to_string()))?;
         if !value.is_object() {
             return Err(not_an_object(&value));
         }
@@ -73,7 +74,7 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
 /// Reads a body (or websocket `params`) that is a JSON object; a 422 names the JSON path of the
 /// field at fault (`options.blending_position`, `channels[2].axis`), also of an unknown or a
 /// missing one.
-pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, ApiError> {
+pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, AppError> {
     serde_path_to_error::deserialize(value).map_err(|e| {
         let message = e.inner().to_string();
         let mut path = e.path().to_string();
@@ -101,12 +102,12 @@ pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Resu
         } else {
             message
         };
-        ApiError::field(&path, &message)
+        AppError::field(&path, &message)
     })
 }
 
 /// 422 for a body that is JSON but not an object.
-fn not_an_object(value: &serde_json::Value) -> ApiError {
+fn not_an_object(value: &serde_json::Value) -> AppError {
     use serde_json::Value;
     let what = match value {
         Value::Array(_) => "an array",
@@ -116,7 +117,7 @@ fn not_an_object(value: &serde_json::Value) -> ApiError {
         Value::Null => "null",
         Value::Object(_) => "an object",
     };
-    ApiError::field("body", &format!("must be a JSON object, not {what}"))
+    AppError::field("body", &format!("must be a JSON object, not {what}"))
 }
 
 /// Who sent the request: remote address and the optional `X-Client-Id` header.
@@ -148,12 +149,12 @@ impl<S: Send + Sync> FromRequestParts<S> for Client {
 pub struct Q<T>(pub T);
 
 impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for Q<T> {
-    type Rejection = ApiError;
+    type Rejection = AppError;
 
-    async fn from_request_parts(parts: &mut Parts, state: &S) -> Result<Self, ApiError> {
+    async fn from_request_parts(parts: &mut Parts, state: &S) -> Result<Self, AppError> {
         let q: Result<Query<T>, QueryRejection> = Query::from_request_parts(parts, state).await;
         q.map(|q| Q(q.0))
-            .map_err(|e| ApiError::field("query", &e.body_text()))
+            .map_err(|e| AppError::field("query", &e.body_text()))
     }
 }
 
@@ -173,7 +174,7 @@ pub struct WaitQuery {
 
 /// The API, the documentation and the UI behind the request checks of [`guard`].
 pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) -> Router {
-    let api = Router::new()
+    let api = blocks::routes(Router::new())
         .route("/axes", get(axes::list_axes).post(axes::create_axis))
         .route(
             "/axes/{axis}",
@@ -190,38 +191,6 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
         .route(
             "/axes/{axis}/parameters/{parameter}",
             get(axes::get_parameter).put(axes::write_parameter),
-        )
-        .route("/axes/{axis}/power", post(commands::power))
-        .route("/axes/{axis}/reset", post(commands::reset))
-        .route("/axes/{axis}/set-position", post(commands::set_position))
-        .route("/axes/{axis}/set-override", post(commands::set_override))
-        .route("/axes/{axis}/move-absolute", post(commands::move_absolute))
-        .route("/axes/{axis}/move-relative", post(commands::move_relative))
-        .route("/axes/{axis}/move-additive", post(commands::move_additive))
-        .route("/axes/{axis}/move-modulo", post(commands::move_modulo))
-        .route("/axes/{axis}/move-velocity", post(commands::move_velocity))
-        .route(
-            "/axes/{axis}/move-continuous-absolute",
-            post(commands::move_continuous_absolute),
-        )
-        .route(
-            "/axes/{axis}/move-continuous-relative",
-            post(commands::move_continuous_relative),
-        )
-        .route("/axes/{axis}/halt", post(commands::halt))
-        .route("/axes/{axis}/stop", post(commands::stop))
-        .route("/axes/{axis}/jog", post(commands::jog))
-        .route("/axes/{axis}/home", post(commands::home))
-        .route("/axes/{axis}/gear-in", post(commands::gear_in))
-        .route("/axes/{axis}/gear-in-dyn", post(commands::gear_in_dyn))
-        .route("/axes/{axis}/gear-out", post(commands::gear_out))
-        .route(
-            "/axes/{axis}/move-superimposed",
-            post(commands::move_superimposed),
-        )
-        .route(
-            "/axes/{axis}/abort-superposition",
-            post(commands::abort_superposition),
         )
         .route(
             "/axes/{axis}/simulation/fault",
@@ -256,7 +225,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
     Router::new()
         .nest("/api/v1", api)
         .route("/metrics", get(system::metrics))
-        .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::openapi()))
+        .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::document()))
         .route("/asyncapi.json", get(asyncapi_document))
         // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
         .fallback(crate::ui::serve)
@@ -293,15 +262,15 @@ async fn problem_errors(req: Request, next: Next) -> Response {
     }
     let (parts, body) = resp.into_parts();
     let error = match status {
-        StatusCode::METHOD_NOT_ALLOWED => ApiError::method_not_allowed(method.as_str(), &path),
-        StatusCode::PAYLOAD_TOO_LARGE => ApiError::too_large(BODY_LIMIT),
+        StatusCode::METHOD_NOT_ALLOWED => AppError::method_not_allowed(method.as_str(), &path),
+        StatusCode::PAYLOAD_TOO_LARGE => AppError::too_large(BODY_LIMIT),
         _ => {
             let text = axum::body::to_bytes(body, 4096).await.unwrap_or_default();
             let text = String::from_utf8_lossy(&text).trim().to_owned();
             let reason = status.canonical_reason().unwrap_or("Error");
             let title = reason[..1].to_owned() + &reason[1..].to_lowercase();
             let code = reason.to_lowercase().replace([' ', '-'], "_");
-            ApiError::new(
+            AppError::new(
                 status,
                 &code,
                 &title,
@@ -323,8 +292,8 @@ async fn problem_errors(req: Request, next: Next) -> Response {
 }
 
 /// 426 for a request to `/ws` that is not a websocket upgrade at all.
-pub(crate) fn upgrade_required(detail: &str) -> ApiError {
-    ApiError::new(
+pub(crate) fn upgrade_required(detail: &str) -> AppError {
+    AppError::new(
         StatusCode::UPGRADE_REQUIRED,
         "websocket_upgrade_required",
         "Upgrade required",
@@ -333,8 +302,8 @@ pub(crate) fn upgrade_required(detail: &str) -> ApiError {
 }
 
 /// 400 for a websocket upgrade request that is malformed (no `Sec-WebSocket-Key` …).
-pub(crate) fn handshake_invalid(detail: &str) -> ApiError {
-    ApiError::new(
+pub(crate) fn handshake_invalid(detail: &str) -> AppError {
+    AppError::new(
         StatusCode::BAD_REQUEST,
         "websocket_handshake_invalid",
         "Invalid websocket handshake",
@@ -375,7 +344,7 @@ async fn websocket(
 }
 
 pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
-    ApiError::new(
+    AppError::new(
         StatusCode::NOT_FOUND,
         "route_not_found",
         "Not found",
@@ -406,18 +375,12 @@ until the command finishes. Authentication is not implemented yet: motiond only 
     paths(
         axes::list_axes, axes::create_axis, axes::get_axis, axes::replace_axis, axes::delete_axis,
         axes::axis_status, axes::reset_following_error_peak, axes::list_parameters, axes::get_parameter, axes::write_parameter,
-        commands::power, commands::reset, commands::set_position, commands::set_override,
-        commands::move_absolute, commands::move_relative, commands::move_additive, commands::move_modulo,
-        commands::move_velocity, commands::move_continuous_absolute, commands::move_continuous_relative,
-        commands::halt, commands::stop, commands::jog, commands::home, commands::gear_in, commands::gear_in_dyn, commands::gear_out,
-        commands::move_superimposed, commands::abort_superposition,
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
         simulation::inject_fault,
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),
-    modifiers(&ForeignExamples, &ErrorResponses, &RequestChecks, &PlainRefs),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
@@ -429,6 +392,25 @@ until the command finishes. Authentication is not implemented yet: motiond only 
 )]
 pub struct ApiDoc;
 
+impl ApiDoc {
+    /// The whole document: the operations above and the catalogue's (`blocks::BlockDoc`), then
+    /// the examples, error responses and request checks laid over all of them.
+    pub fn document() -> utoipa::openapi::OpenApi {
+        let mut doc = ApiDoc::openapi();
+        doc.merge(blocks::BlockDoc::openapi());
+        let modifiers: [&dyn utoipa::Modify; 4] = [
+            &ForeignExamples,
+            &ErrorResponses,
+            &RequestChecks,
+            &PlainRefs,
+        ];
+        for m in modifiers {
+            m.modify(&mut doc);
+        }
+        doc
+    }
+}
+
 /// Examples for the schemas of types defined outside the API (kernel, simulated drive, cycle
 /// statistics): real values of those types, serialised. A schema with its own example keeps it.
 struct ForeignExamples;
@@ -437,7 +419,7 @@ impl utoipa::Modify for ForeignExamples {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
         use serde_json::{json, to_value};
         use utoipa::openapi::{RefOr, schema::Schema};
-        let drive = crate::demo_axes().remove(0).drive;
+        let drives::DriveConfig::Simulated(drive) = crate::demo_axes().remove(0).drive;
         let examples = [
             (
                 "FbOutputs",
@@ -467,7 +449,10 @@ impl utoipa::Modify for ForeignExamples {
                     message: "must be a finite number > 0".into(),
                 }),
             ),
-            ("SimDriveConfig", to_value(&drive)),
+            (
+                "DriveConfig",
+                to_value(drives::DriveConfig::Simulated(drive.clone())),
+            ),
             ("PlantModel", to_value(drive.plant)),
             ("ReferenceCam", to_value(drive.reference_cam)),
             ("IndexPulse", to_value(drive.index_pulse)),
@@ -526,7 +511,7 @@ impl utoipa::Modify for ForeignExamples {
 struct PlainRefs;
 
 /// The component schemas [`PlainRefs`] rewrites.
-const FOREIGN_WITH_DEFAULTS: &[&str] = &["SimDriveConfig"];
+const FOREIGN_WITH_DEFAULTS: &[&str] = &["DriveConfig"];
 
 impl utoipa::Modify for PlainRefs {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
@@ -596,7 +581,7 @@ fn plain_ref(prop: &mut serde_json::Value) {
 
 /// The OpenAPI document as written to `openapi/openapi.json`.
 pub fn openapi_json() -> String {
-    let mut s = ApiDoc::openapi()
+    let mut s = ApiDoc::document()
         .to_pretty_json()
         .expect("openapi serialises");
     s.push('\n');

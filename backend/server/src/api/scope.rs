@@ -13,199 +13,10 @@ use utoipa::{IntoParams, ToSchema};
 use super::errors::{ScopeCreateErrors, ScopeDeleteErrors, ScopeGetErrors};
 use super::{JsonBody, Q};
 use crate::app::AppState;
-use crate::error::{ApiError, ApiResult};
-use crate::scope::{
-    MAX_SAMPLES, NewRecording, RecordingState, SCOPE_CHANNELS, ScopeChannel, ScopeRecording,
-    ScopeSignal, ScopeTrigger, TriggerEdge,
-};
-use crate::sim::FieldError;
-
-/// An axis by id (number or digits) or by name.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
-#[serde(untagged)]
-pub enum AxisKey {
-    Id(i64),
-    Name(String),
-}
-
-impl AxisKey {
-    fn key(&self) -> String {
-        match self {
-            AxisKey::Id(i) => i.to_string(),
-            AxisKey::Name(s) => s.clone(),
-        }
-    }
-}
-
-/// One signal of one axis.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(example = json!({"axis": "x", "signal": "set_position"}))]
-pub struct ChannelRequest {
-    /// Axis id or name.
-    #[schema(value_type = String, example = "x")]
-    pub axis: AxisKey,
-    #[schema(value_type = ScopeSignal)]
-    pub signal: String,
-}
-
-/// Start the recording when `channels[channel]` crosses `level` in the direction of `edge`.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(example = json!({"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002}))]
-pub struct TriggerRequest {
-    /// Index into `channels`.
-    #[schema(value_type = usize)]
-    pub channel: i64,
-    pub level: f64,
-    /// `rising` (previous < level ≤ sample, the default), `falling` (previous > level ≥
-    /// sample) or `either`.
-    #[serde(default = "rising")]
-    #[schema(value_type = TriggerEdge)]
-    pub edge: String,
-    /// History before the trigger sample (s, 0 … duration_s, default 0).
-    #[serde(default)]
-    pub pre_trigger_s: f64,
-}
-
-fn rising() -> String {
-    "rising".into()
-}
-
-/// `POST /scope/recordings`.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(example = json!({
-    "channels": [{"axis": "x", "signal": "set_position"}, {"axis": "x", "signal": "set_velocity"}],
-    "duration_s": 2.0,
-    "trigger": {"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.2}
-}))]
-pub struct RecordingRequest {
-    /// 1 to 8 signals.
-    pub channels: Vec<ChannelRequest>,
-    /// Length of the recording (s): round(duration_s / cycle time) samples, at most 600 000.
-    pub duration_s: f64,
-    /// `null` (or absent): record from the next cycle on.
-    #[serde(default)]
-    pub trigger: Option<TriggerRequest>,
-}
-
-fn validate(s: &AppState, body: RecordingRequest) -> ApiResult<NewRecording> {
-    let mut errors = Vec::new();
-    let mut fail = |field: String, message: String| errors.push(FieldError { field, message });
-    let n = body.channels.len();
-    if n == 0 || n > SCOPE_CHANNELS {
-        fail(
-            "channels".into(),
-            format!("must have 1 to {SCOPE_CHANNELS} channels"),
-        );
-    }
-    let mut channels = Vec::with_capacity(n);
-    {
-        let reg = s.registry.read().unwrap();
-        for (i, c) in body.channels.iter().enumerate() {
-            let signal = ScopeSignal::parse(&c.signal);
-            if signal.is_none() {
-                fail(
-                    format!("channels[{i}].signal"),
-                    format!(
-                        "unknown signal '{}'; one of {}",
-                        c.signal,
-                        ScopeSignal::ALL.map(ScopeSignal::name).join(", ")
-                    ),
-                );
-            }
-            let key = c.axis.key();
-            let axis = reg.find(&key);
-            if axis.is_none() {
-                fail(format!("channels[{i}].axis"), format!("no axis '{key}'"));
-            }
-            if let (Some(a), Some(signal)) = (axis, signal) {
-                channels.push((
-                    a.slot,
-                    ScopeChannel {
-                        axis: a.name.clone(),
-                        axis_id: a.id,
-                        signal,
-                        unit: signal.unit(&a.config.unit),
-                    },
-                ));
-            }
-        }
-    }
-    let cycle = s.info.cycle_time_s;
-    let samples = body.duration_s / cycle;
-    let samples = if body.duration_s.is_finite() && body.duration_s > 0.0 {
-        samples.round()
-    } else {
-        0.0
-    };
-    if !(samples >= 1.0 && samples <= MAX_SAMPLES as f64) {
-        fail(
-            "duration_s".into(),
-            format!(
-                "must be > 0 and at most {MAX_SAMPLES} cycles ({} s at the cycle time of {cycle} s)",
-                MAX_SAMPLES as f64 * cycle
-            ),
-        );
-    }
-    let samples = samples as usize;
-    let mut trigger = None;
-    let mut pre_trigger_samples = 0;
-    if let Some(t) = &body.trigger {
-        if t.channel < 0 || t.channel as usize >= n.max(1) {
-            fail(
-                "trigger.channel".into(),
-                format!("must be the index of a channel (0 … {})", n.max(1) - 1),
-            );
-        }
-        if !t.level.is_finite() {
-            fail("trigger.level".into(), "must be a finite number".into());
-        }
-        let edge = match t.edge.as_str() {
-            "rising" => Some(TriggerEdge::Rising),
-            "falling" => Some(TriggerEdge::Falling),
-            "either" => Some(TriggerEdge::Either),
-            other => {
-                fail(
-                    "trigger.edge".into(),
-                    format!("unknown edge '{other}'; one of rising, falling, either"),
-                );
-                None
-            }
-        };
-        if !(t.pre_trigger_s.is_finite()
-            && t.pre_trigger_s >= 0.0
-            && t.pre_trigger_s <= body.duration_s)
-        {
-            fail(
-                "trigger.pre_trigger_s".into(),
-                "must be ≥ 0 and ≤ duration_s".into(),
-            );
-        }
-        if let Some(edge) = edge {
-            trigger = Some(ScopeTrigger {
-                channel: t.channel.max(0) as usize,
-                level: t.level,
-                edge,
-                pre_trigger_s: t.pre_trigger_s,
-            });
-            // The trigger sample is always part of the recording.
-            pre_trigger_samples =
-                ((t.pre_trigger_s / cycle).round() as usize).min(samples.saturating_sub(1));
-        }
-    }
-    if !errors.is_empty() {
-        return Err(ApiError::invalid(errors));
-    }
-    Ok(NewRecording {
-        channels,
-        duration_s: body.duration_s,
-        samples,
-        trigger,
-        pre_trigger_samples,
-    })
-}
+use crate::error::{AppError, AppResult};
+use crate::model::RecordingRequest;
+use crate::scope::{RecordingState, ScopeRecording};
+use crate::service::scope;
 
 fn location(id: u64) -> String {
     format!("/api/v1/scope/recordings/{id}")
@@ -228,8 +39,8 @@ finished ones are dropped first) and at most 9 600 000 values.",
 pub async fn create_recording(
     State(s): State<Arc<AppState>>,
     JsonBody(body, _): JsonBody<RecordingRequest>,
-) -> ApiResult<Response> {
-    let new = validate(&s, body)?;
+) -> AppResult<Response> {
+    let new = scope::recording(&s, body)?;
     let r = s.create_recording(new).await?;
     let mut resp = (StatusCode::CREATED, Json(&r)).into_response();
     resp.headers_mut().insert(
@@ -264,8 +75,8 @@ pub struct RecordingQuery {
     pub format: Option<RecordingFormat>,
 }
 
-fn id_of(id: &str) -> ApiResult<u64> {
-    id.parse().map_err(|_| ApiError::not_found("recording", id))
+fn id_of(id: &str) -> AppResult<u64> {
+    id.parse().map_err(|_| AppError::not_found("recording", id))
 }
 
 #[utoipa::path(get, path = "/api/v1/scope/recordings/{id}", tag = "scope",
@@ -285,7 +96,7 @@ pub async fn get_recording(
     Path(id): Path<String>,
     Q(q): Q<RecordingQuery>,
     headers: HeaderMap,
-) -> ApiResult<Response> {
+) -> AppResult<Response> {
     let id = id_of(&id)?;
     let csv = match q.format {
         Some(RecordingFormat::Csv) => true,
@@ -300,10 +111,10 @@ pub async fn get_recording(
         .lock()
         .unwrap()
         .get(id, true)
-        .ok_or_else(|| ApiError::not_found("recording", &id.to_string()))?;
+        .ok_or_else(|| AppError::not_found("recording", &id.to_string()))?;
     if csv && r.state != RecordingState::Done {
         let state = serde_json::to_value(r.state).unwrap_or_default();
-        return Err(ApiError::conflict(
+        return Err(AppError::conflict(
             "recording_not_done",
             format!(
                 "recording {id} is {}; CSV is available when it is done",
@@ -320,7 +131,7 @@ pub async fn get_recording(
         }
     })
     .await
-    .map_err(|_| ApiError::unavailable("internal", "the recording could not be written"))?;
+    .map_err(|_| AppError::unavailable("internal", "the recording could not be written"))?;
     let mut resp = body.into_response();
     let h = resp.headers_mut();
     if csv {
@@ -379,10 +190,10 @@ it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, 
 pub async fn delete_recording(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
-) -> ApiResult<Response> {
+) -> AppResult<Response> {
     let id = id_of(&id)?;
     match s.scope.lock().unwrap().delete(id) {
-        None => Err(ApiError::not_found("recording", &id.to_string())),
+        None => Err(AppError::not_found("recording", &id.to_string())),
         Some(Some(cancelled)) => Ok(Json(cancelled).into_response()),
         Some(None) => Ok(StatusCode::NO_CONTENT.into_response()),
     }

@@ -8,9 +8,9 @@ use axum::http::StatusCode;
 use super::errors::FaultErrors;
 use super::{Client, JsonBody};
 use crate::app::AppState;
-use crate::error::{ApiError, ApiResult};
+use crate::error::AppResult;
+use crate::service::simulation;
 use crate::sim::SimFault;
-use crate::store::{self, AuditEntry};
 
 #[utoipa::path(post, path = "/api/v1/axes/{axis}/simulation/fault", tag = "simulation",
     summary = "Inject a fault or disturbance into the axis's simulated drive",
@@ -31,38 +31,7 @@ pub async fn inject_fault(
     Path(axis): Path<String>,
     client: Client,
     JsonBody(fault, raw): JsonBody<SimFault>,
-) -> ApiResult<StatusCode> {
-    // serde ignores extra fields on a unit variant of an internally tagged enum (`clear`):
-    // whatever the fault does not read back is an unknown field.
-    let canonical = serde_json::to_value(fault).unwrap_or_default();
-    if let (Some(given), Some(known)) = (raw.as_object(), canonical.as_object()) {
-        if let Some(k) = given.keys().find(|k| !known.contains_key(*k)) {
-            return Err(ApiError::field(k, "unknown field"));
-        }
-    }
-    if let SimFault::Load { force } = fault {
-        if !force.is_finite() {
-            return Err(ApiError::field("force", "must be a finite number"));
-        }
-    }
-    let (slot, name) = s.axis_slot(&axis)?;
-    let result = s.inject_fault(slot, fault).await?;
-    s.audit(AuditEntry {
-        at: store::now_rfc3339(),
-        client_addr: Some(client.0.addr.clone()),
-        client_id: client.0.id.clone(),
-        action: "simulation.fault".into(),
-        target: Some(name),
-        command_id: None,
-        detail: raw.to_string(),
-        outcome: Some(match result {
-            Ok(_) => "applied".into(),
-            Err(e) => format!("rejected:{}", e.code()),
-        }),
-    });
-    match result {
-        Ok(_) => Ok(StatusCode::NO_CONTENT),
-        // The axis was removed between the look-up and the cycle thread.
-        Err(_) => Err(ApiError::not_found("axis", &axis)),
-    }
+) -> AppResult<StatusCode> {
+    simulation::inject_fault(&s, &axis, fault, &raw, &client.0).await?;
+    Ok(StatusCode::NO_CONTENT)
 }

@@ -20,10 +20,11 @@ use tokio::sync::{broadcast, mpsc};
 use tokio::time::Instant;
 use utoipa::ToSchema;
 
-use super::commands::run_command;
+use super::blocks;
 use crate::app::AppState;
-use crate::error::ApiError;
+use crate::error::AppError;
 use crate::model::*;
+use crate::service::commands;
 
 /// Highest subscription rate.
 pub const MAX_RATE_HZ: f64 = 100.0;
@@ -245,16 +246,16 @@ fn rpc_error(id: &Value, code: i64, message: &str, data: Option<Value>) -> Strin
     json!({"jsonrpc": "2.0", "id": id, "error": error}).to_string()
 }
 
-fn api_error(id: &Value, e: ApiError) -> String {
-    let code = match e.0.status {
+fn api_error(id: &Value, e: AppError) -> String {
+    let code = match e.status().as_u16() {
         422 | 400 => -32602,
         _ => -32000,
     };
     rpc_error(
         id,
         code,
-        &e.0.detail.clone(),
-        serde_json::to_value(&*e.0).ok(),
+        &e.to_string(),
+        serde_json::to_value(e.problem()).ok(),
     )
 }
 
@@ -326,9 +327,9 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     }
     // The socket is gone: release its jogs (a jog held on a socket stops when it closes).
     let held: Vec<(u16, u64)> = std::mem::take(&mut *jogs.lock().unwrap());
-    for (slot, id) in held {
-        if s.command(id).is_some_and(|c| !c.is_final) {
-            let _ = s.release(slot, id, &client).await;
+    for (_, id) in held {
+        if commands::get(&s, id).is_some_and(|c| !c.is_final) {
+            let _ = commands::release(&s, id, &client).await;
         }
     }
 }
@@ -557,28 +558,20 @@ fn handle(
             let out = out_tx.clone();
             let client = client.clone();
             tokio::spawn(async move {
-                let slot = s.commands.lock().unwrap().map.get(&cmd).map(|r| r.slot);
-                let msg = match slot {
-                    None => api_error(&id, ApiError::not_found("command", &cmd.to_string())),
-                    Some(slot) => {
-                        let r = if method == "keepalive" {
-                            let kind = motion::CommandKind::Keepalive { target: cmd };
-                            s.kernel_command(slot, kind).await
-                        } else {
-                            s.release(slot, cmd, &client).await
-                        };
-                        match r {
-                            Ok(Ok(cycle)) => rpc_result(
-                                &id,
-                                json!(ControlResult {
-                                    command: cmd,
-                                    cycle
-                                }),
-                            ),
-                            Ok(Err(e)) => api_error(&id, ApiError::rejected(e)),
-                            Err(e) => api_error(&id, e),
-                        }
-                    }
+                let r = if method == "keepalive" {
+                    commands::keepalive(&s, cmd).await
+                } else {
+                    commands::release(&s, cmd, &client).await
+                };
+                let msg = match r {
+                    Ok(cycle) => rpc_result(
+                        &id,
+                        json!(ControlResult {
+                            command: cmd,
+                            cycle
+                        }),
+                    ),
+                    Err(e) => api_error(&id, e),
                 };
                 if !notification {
                     let _ = out.send(msg).await;
@@ -588,7 +581,7 @@ fn handle(
             None
         }
         name => {
-            let Some(name) = COMMANDS.iter().copied().find(|c| *c == name) else {
+            let Some(block) = blocks::find(name) else {
                 return Some(rpc_error(
                     &id,
                     -32601,
@@ -617,7 +610,7 @@ fn handle(
                     ));
                 }
             };
-            let wait = match super::commands::wait_duration(&query) {
+            let wait = match commands::wait_duration(query.wait, query.timeout_ms) {
                 Ok(w) => w,
                 Err(e) => return Some(api_error(&id, e)),
             };
@@ -631,14 +624,18 @@ fn handle(
             let jogs = jogs.clone();
             tokio::spawn(async move {
                 let raw = Value::Object(params);
-                let r = dispatch(&s, name, &axis, raw, client, wait).await;
+                let r = blocks::dispatch(&s, block.name, &axis, raw, client, wait)
+                    .await
+                    .expect("a block of the catalogue");
                 let msg = match r {
                     Ok(v) => {
-                        if name == "jog" {
+                        if block.name == "jog" {
                             let slot = s.registry.read().unwrap().find(&axis).map(|e| e.slot);
                             if let Some(slot) = slot {
                                 let mut held = jogs.lock().unwrap();
-                                held.retain(|(_, id)| s.command(*id).is_some_and(|c| !c.is_final));
+                                held.retain(|(_, id)| {
+                                    commands::get(&s, *id).is_some_and(|c| !c.is_final)
+                                });
                                 held.push((slot, v.id));
                             }
                         }
@@ -664,60 +661,4 @@ fn too_many_in_flight(id: &Value) -> String {
         &format!("too many requests in flight ({MAX_IN_FLIGHT}): read their responses first"),
         Some(json!({"code": "too_many_in_flight"})),
     )
-}
-
-/// The command methods: name (the REST endpoint's) and the REST body their params are read as.
-/// One table for `COMMANDS`, `dispatch` and the AsyncAPI document (`body_schema`).
-macro_rules! command_methods {
-    ($($name:literal => $body:ident),+ $(,)?) => {
-        pub const COMMANDS: &[&str] = &[$($name),+];
-
-        /// The schema name of the REST body a command method's params are read as.
-        pub fn body_schema(method: &str) -> Option<&'static str> {
-            match method {
-                $($name => Some(stringify!($body)),)+
-                _ => None,
-            }
-        }
-
-        async fn dispatch(
-            s: &AppState,
-            name: &'static str,
-            axis: &str,
-            raw: Value,
-            client: ClientInfo,
-            wait: Option<Duration>,
-        ) -> Result<CommandResource, ApiError> {
-            match name {
-                $($name => {
-                    let body: $body = super::from_value(&raw)?;
-                    run_command(s, axis, name, body, raw, client, wait).await
-                })+
-                _ => Err(ApiError::not_found("method", name)),
-            }
-        }
-    };
-}
-
-command_methods! {
-    "power" => PowerBody,
-    "reset" => EmptyBody,
-    "set-position" => SetPositionBody,
-    "set-override" => SetOverrideBody,
-    "move-absolute" => MoveBody,
-    "move-relative" => MoveRelativeBody,
-    "move-additive" => MoveRelativeBody,
-    "move-modulo" => MoveBody,
-    "move-velocity" => MoveVelocityBody,
-    "move-continuous-absolute" => MoveContinuousBody,
-    "move-continuous-relative" => MoveContinuousRelativeBody,
-    "halt" => HaltBody,
-    "stop" => StopBody,
-    "jog" => JogBody,
-    "home" => HomeBody,
-    "gear-in" => GearInBody,
-    "gear-in-dyn" => GearInDynBody,
-    "gear-out" => EmptyBody,
-    "move-superimposed" => MoveSuperImposedBody,
-    "abort-superposition" => EmptyBody,
 }

@@ -1,0 +1,249 @@
+//! The function-block catalogue: one entry per PLCopen block that an axis takes as a command.
+//!
+//! An entry names the block's endpoint (`/api/v1/axes/{axis}/<name>`, which is also its
+//! websocket method), its body type, how the body becomes a kernel `CommandKind`, the role a
+//! client needs to send it, its milestone (where `?wait=true` answers) and its summary. From
+//! the entries `catalogue!` derives the REST handlers, their routes, their OpenAPI operations
+//! ([`BlockDoc`], nested into the document), the websocket's methods ([`dispatch`]) and the
+//! list the AsyncAPI document and the tests read ([`BLOCKS`]). Adding a block — `cam-in`,
+//! `touch-probe` — is one entry here plus its body type (in `model.rs`) and its conversion (in
+//! `service::commands`).
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use axum::Json;
+use axum::Router;
+use axum::extract::{Path, State};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use axum::routing::post;
+use motion::CommandKind;
+use serde::Serialize;
+use serde_json::Value;
+
+use super::{Client, JsonBody, Q, WaitQuery};
+use crate::app::{AppState, Milestone};
+use crate::error::AppResult;
+use crate::model::*;
+use crate::service::commands::{self, Submission};
+
+/// What a client must be allowed to do to send a block. Shown in the OpenAPI document
+/// (`x-motiond-block.role`); enforced once clients authenticate (the security issue).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// Reads status, configuration and recordings.
+    Viewer,
+    /// Moves axes: every motion and coupling block, power, reset.
+    Operator,
+    /// Changes what the machine is: configuration, parameters, fault injection.
+    Engineer,
+    /// Users and tokens.
+    Admin,
+}
+
+/// A catalogue entry as data.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Block {
+    /// The endpoint's last segment and the websocket method.
+    pub name: &'static str,
+    /// The REST path.
+    pub path: &'static str,
+    /// The schema name of its body (REST body = websocket params without `axis`).
+    pub body: &'static str,
+    pub role: Role,
+    pub milestone: Milestone,
+    pub summary: &'static str,
+}
+
+/// The REST answer to an accepted command: 202 with the command resource and its location.
+fn accepted(view: CommandResource) -> Response {
+    let loc = format!("/api/v1/commands/{}", view.id);
+    let mut r = (StatusCode::ACCEPTED, Json(view)).into_response();
+    r.headers_mut().insert(
+        header::LOCATION,
+        HeaderValue::from_str(&loc).expect("ascii"),
+    );
+    r
+}
+
+macro_rules! catalogue {
+    ($(
+        $fn:ident: $name:literal, $body:ty, $to_kind:expr, $role:ident, $milestone:ident,
+            $summary:literal;
+    )+) => {
+        /// The entries' positions in [`BLOCKS`].
+        #[allow(non_camel_case_types, clippy::enum_variant_names)]
+        enum Entry { $($fn),+ }
+
+        /// Every block of the catalogue, in the order of the document.
+        pub const BLOCKS: &[Block] = &[$(Block {
+            name: $name,
+            path: concat!("/api/v1/axes/{axis}/", $name),
+            body: stringify!($body),
+            role: Role::$role,
+            milestone: Milestone::$milestone,
+            summary: $summary,
+        }),+];
+
+        $(
+            #[utoipa::path(post, path = concat!("/api/v1/axes/{axis}/", $name), tag = "commands", summary = $summary,
+                params(("axis" = String, Path, description = "axis id or name", example = "x"), WaitQuery),
+                request_body = $body,
+                responses(
+                    (status = 202, description = "Accepted: the command resource (final or at its milestone when waited for)",
+                        body = CommandResource, headers(("Location" = String, description = "/api/v1/commands/{id}"))),
+                    super::errors::CommandErrors),
+                extensions(("x-motiond-block" = json!({"role": Role::$role, "milestone": Milestone::$milestone}))))]
+            pub async fn $fn(
+                State(s): State<Arc<AppState>>,
+                Path(axis): Path<String>,
+                client: Client,
+                Q(q): Q<WaitQuery>,
+                JsonBody(body, raw): JsonBody<$body>,
+            ) -> AppResult<Response> {
+                let wait = commands::wait_duration(q.wait, q.timeout_ms)?;
+                let block = &BLOCKS[Entry::$fn as usize];
+                let sub = Submission {
+                    name: block.name,
+                    milestone: block.milestone,
+                    to_kind: $to_kind,
+                    axis: &axis,
+                    body,
+                    raw,
+                    client: client.0,
+                };
+                Ok(accepted(commands::run(&s, sub, wait).await?))
+            }
+        )+
+
+        /// The routes of every block (under `/api/v1`).
+        pub fn routes(r: Router<Arc<AppState>>) -> Router<Arc<AppState>> {
+            r$(.route(concat!("/axes/{axis}/", $name), post($fn)))+
+        }
+
+        /// The blocks' OpenAPI operations, nested into `ApiDoc`.
+        #[derive(utoipa::OpenApi)]
+        #[openapi(paths($($fn),+))]
+        pub struct BlockDoc;
+
+        /// A block sent over the websocket: `params` read as its body; `None` for a method
+        /// that is not a block.
+        pub async fn dispatch(
+            s: &AppState,
+            method: &str,
+            axis: &str,
+            raw: Value,
+            client: ClientInfo,
+            wait: Option<Duration>,
+        ) -> Option<AppResult<CommandResource>> {
+            Some(match method {
+                $($name => {
+                    let block = &BLOCKS[Entry::$fn as usize];
+                    match super::from_value::<$body>(&raw) {
+                        Err(e) => Err(e),
+                        Ok(body) => {
+                            let sub = Submission {
+                                name: block.name,
+                                milestone: block.milestone,
+                                to_kind: $to_kind,
+                                axis,
+                                body,
+                                raw,
+                                client,
+                            };
+                            commands::run(s, sub, wait).await
+                        }
+                    }
+                })+
+                _ => return None,
+            })
+        }
+    };
+}
+
+catalogue! {
+    power: "power", PowerBody, PowerBody::to_kind, Operator, Status,
+        "MC_Power: enable (stays active until released with DELETE /commands/{id} or a power with enable=false)";
+    reset: "reset", EmptyBody, |_, _, _| Ok(CommandKind::Reset), Operator, Done,
+        "MC_Reset: clear an axis error";
+    set_position: "set-position", SetPositionBody, SetPositionBody::to_kind, Operator, Done,
+        "MC_SetPosition";
+    set_override: "set-override", SetOverrideBody, SetOverrideBody::to_kind, Operator, Done,
+        "MC_SetOverride";
+    move_absolute: "move-absolute", MoveBody, MoveBody::absolute, Operator, Done,
+        "MC_MoveAbsolute";
+    move_relative: "move-relative", MoveRelativeBody, MoveRelativeBody::relative, Operator, Done,
+        "MC_MoveRelative: move `distance` from the set position";
+    move_additive: "move-additive", MoveRelativeBody, MoveRelativeBody::additive, Operator, Done,
+        "MC_MoveAdditive: add `distance` to the running target";
+    move_modulo: "move-modulo", MoveBody, MoveBody::modulo, Operator, Done,
+        "MC_MoveModulo (modulo axes)";
+    move_velocity: "move-velocity", MoveVelocityBody, MoveVelocityBody::to_kind, Operator, InVelocity,
+        "MC_MoveVelocity (wait returns at in_velocity)";
+    move_continuous_absolute: "move-continuous-absolute", MoveContinuousBody, MoveContinuousBody::to_kind, Operator, InEndVelocity,
+        "MC_MoveContinuousAbsolute (wait returns at in_end_velocity)";
+    move_continuous_relative: "move-continuous-relative", MoveContinuousRelativeBody, MoveContinuousRelativeBody::to_kind, Operator, InEndVelocity,
+        "MC_MoveContinuousRelative (wait returns at in_end_velocity)";
+    halt: "halt", HaltBody, HaltBody::to_kind, Operator, Done,
+        "MC_Halt";
+    stop: "stop", StopBody, StopBody::to_kind, Operator, Done,
+        "MC_Stop: stops and locks the axis until released with DELETE /commands/{id}";
+    jog: "jog", JogBody, JogBody::to_kind, Operator, InVelocity,
+        "MC_Jog: runs while renewed with POST /commands/{id}/keepalive within deadman_timeout; DELETE releases";
+    home: "home", HomeBody, HomeBody::to_kind, Operator, Done,
+        "MC_Home";
+    gear_in: "gear-in", GearInBody, GearInBody::to_kind, Operator, InGear,
+        "MC_GearIn: couple to a master (wait returns at in_gear)";
+    gear_in_dyn: "gear-in-dyn", GearInDynBody, GearInDynBody::to_kind, Operator, InGear,
+        "MC_GearInDyn: couple with a ratio that may change while enabled (a further gear-in-dyn to the same master changes it; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratio frozen, still coupled)";
+    gear_out: "gear-out", EmptyBody, |_, _, _| Ok(CommandKind::GearOut), Operator, Done,
+        "MC_GearOut";
+    move_superimposed: "move-superimposed", MoveSuperImposedBody, MoveSuperImposedBody::to_kind, Operator, Done,
+        "MC_MoveSuperImposed: lay a relative distance over the running motion (409 axis_not_moving at standstill; warning 0x4243 when it can only be done in part)";
+    abort_superposition: "abort-superposition", EmptyBody, |_, _, _| Ok(CommandKind::AbortSuperposition), Operator, Done,
+        "MC_AbortSuperposition: end a running superposition (what it applied so far stays)";
+}
+
+/// The catalogue entry of a block (websocket method) name.
+pub fn find(name: &str) -> Option<&'static Block> {
+    BLOCKS.iter().find(|b| b.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_is_unique_and_routed_under_its_name() {
+        for (i, b) in BLOCKS.iter().enumerate() {
+            assert_eq!(b.path, format!("/api/v1/axes/{{axis}}/{}", b.name));
+            assert!(
+                BLOCKS[..i].iter().all(|o| o.name != b.name),
+                "{} twice",
+                b.name
+            );
+            assert!(b.summary.starts_with("MC_"), "{}: {}", b.name, b.summary);
+        }
+    }
+
+    #[test]
+    fn the_document_has_one_operation_per_block_with_its_role() {
+        let doc = serde_json::to_value(super::super::ApiDoc::document()).unwrap();
+        for b in BLOCKS {
+            let op = &doc["paths"][b.path]["post"];
+            let ext = &op["x-motiond-block"];
+            assert_eq!(ext["role"], json!(b.role), "{}", b.name);
+            assert_eq!(ext["milestone"], json!(b.milestone), "{}", b.name);
+            assert_eq!(
+                op["requestBody"]["content"]["application/json"]["schema"]["$ref"],
+                format!("#/components/schemas/{}", b.body),
+                "{}",
+                b.name
+            );
+        }
+    }
+
+    use serde_json::json;
+}

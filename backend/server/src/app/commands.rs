@@ -1,0 +1,180 @@
+//! The command history: each tracked command's record, its events and its end, as the pump
+//! applies the cycle thread's events.
+
+use std::collections::{HashMap, VecDeque};
+
+use motion::{AxisSlot, CommandEvent, CommandId, ErrorId, FbOutputs};
+use serde::Serialize;
+
+use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState};
+use crate::store::{self, AuditEntry};
+
+/// How many commands `GET /commands` remembers.
+pub const HISTORY: usize = 2000;
+const EVENTS_PER_COMMAND: usize = 64;
+
+pub struct CommandRecord {
+    pub id: CommandId,
+    pub axis_id: i64,
+    pub axis_name: String,
+    pub slot: AxisSlot,
+    pub name: &'static str,
+    /// Where a `?wait=true` answers (the catalogue entry's).
+    pub milestone: Milestone,
+    pub parameters: serde_json::Value,
+    pub client: ClientInfo,
+    pub submitted_at: String,
+    pub accepted: bool,
+    pub accepted_cycle: u64,
+    pub outputs: FbOutputs,
+    pub last_cycle: u64,
+    pub finished_at: Option<String>,
+    pub events: VecDeque<CommandEventDto>,
+    /// The audit entry of its end, when it ended before its acceptance was recorded.
+    pub final_audit: Option<AuditEntry>,
+}
+
+impl CommandRecord {
+    pub fn is_final(&self) -> bool {
+        !self.outputs.busy && !self.events.is_empty()
+    }
+    pub fn view(&self) -> CommandResource {
+        let o = &self.outputs;
+        CommandResource {
+            id: self.id,
+            axis: self.axis_name.clone(),
+            axis_id: self.axis_id,
+            command: self.name,
+            parameters: self.parameters.clone(),
+            state: CommandState::of(o),
+            is_final: self.is_final(),
+            outputs: *o,
+            error_code: (o.error_id != 0).then(|| ErrorId(o.error_id).code()),
+            accepted_cycle: self.accepted_cycle,
+            last_cycle: self.last_cycle,
+            submitted_at: self.submitted_at.clone(),
+            finished_at: self.finished_at.clone(),
+            client: self.client.clone(),
+            events: self.events.iter().copied().collect(),
+        }
+    }
+}
+
+#[derive(Default)]
+pub struct CommandStore {
+    pub map: HashMap<CommandId, CommandRecord>,
+    pub order: VecDeque<CommandId>,
+}
+
+impl CommandStore {
+    pub(crate) fn insert(&mut self, r: CommandRecord) {
+        while self.map.len() >= HISTORY {
+            // Forget the oldest finished command (or the oldest at all if none has finished).
+            let pos = self
+                .order
+                .iter()
+                .position(|id| self.map.get(id).is_none_or(|r| r.is_final()))
+                .unwrap_or(0);
+            if let Some(id) = self.order.remove(pos) {
+                self.map.remove(&id);
+            } else {
+                break;
+            }
+        }
+        self.order.push_back(r.id);
+        self.map.insert(r.id, r);
+    }
+    pub(crate) fn remove(&mut self, id: CommandId) {
+        if self.map.remove(&id).is_some() {
+            self.order.retain(|x| *x != id);
+        }
+    }
+}
+
+/// A change of a command's outputs, for websocket subscribers and waiters (the websocket's
+/// `command_event` notification).
+#[derive(Clone, Debug, Serialize, utoipa::ToSchema)]
+pub struct CommandNotice {
+    pub command: CommandId,
+    pub axis: String,
+    pub name: &'static str,
+    pub cycle: u64,
+    pub state: CommandState,
+    #[serde(rename = "final")]
+    pub is_final: bool,
+    pub outputs: FbOutputs,
+}
+
+/// The audit entry of a command that has ended, naming the client as its submission does.
+pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry {
+    AuditEntry {
+        at: store::now_rfc3339(),
+        client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
+        client_id: client.id.clone(),
+        action: "command.final".into(),
+        target: Some(n.axis.clone()),
+        command_id: Some(n.command),
+        detail: serde_json::to_string(n).unwrap_or_default(),
+        outcome: Some(match n.state {
+            CommandState::Error => format!("error:{}", ErrorId(n.outputs.error_id).code()),
+            s => serde_json::to_value(s)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
+        }),
+    }
+}
+
+/// Where a `?wait=true` request answers for a command that stays busy (besides its end:
+/// Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
+/// InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Milestone {
+    /// Only its end (Done, Error, CommandAborted).
+    Done,
+    InVelocity,
+    InGear,
+    InEndVelocity,
+    /// MC_Power's Status: the axis is enabled.
+    Status,
+}
+
+impl Milestone {
+    /// Whether outputs `o` are at this milestone or the command's end.
+    pub fn reached(self, o: &FbOutputs) -> bool {
+        let arrived = match self {
+            Milestone::Done => false,
+            Milestone::InVelocity => o.in_velocity,
+            Milestone::InGear => o.in_gear,
+            Milestone::InEndVelocity => o.in_end_velocity,
+            Milestone::Status => o.status,
+        };
+        o.done || o.error || o.command_aborted || arrived
+    }
+}
+
+pub(super) fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option<CommandNotice> {
+    let r = store.map.get_mut(&ev.command)?;
+    r.outputs = ev.outputs;
+    r.last_cycle = ev.cycle;
+    if r.events.len() == EVENTS_PER_COMMAND {
+        r.events.pop_front();
+    }
+    r.events.push_back(CommandEventDto {
+        cycle: ev.cycle,
+        outputs: ev.outputs,
+    });
+    if r.is_final() && r.finished_at.is_none() {
+        r.finished_at = Some(store::now_rfc3339());
+    }
+    Some(CommandNotice {
+        command: r.id,
+        axis: r.axis_name.clone(),
+        name: r.name,
+        cycle: ev.cycle,
+        state: CommandState::of(&ev.outputs),
+        is_final: !ev.outputs.busy,
+        outputs: ev.outputs,
+    })
+}

@@ -1,0 +1,223 @@
+//! The async side's link to the cycle thread: a request with a ticket, answered by the
+//! cycle thread's verdict (which the pump hands over), for commands, axes, faults and scope
+//! configurations.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use motion::{Axis, AxisConfig, AxisParameters, AxisSlot, Command, CommandKind};
+use tokio::sync::oneshot;
+
+use super::AppState;
+use crate::cycle::{Reply, Request};
+use crate::error::{AppError, AppResult};
+use crate::model::AxisConfigDto;
+use crate::params::{self, ParamValue};
+use crate::scope::{NewRecording, ScopeBusy, ScopeRecording};
+use crate::sim::FieldError;
+use drives::Drive;
+
+/// How long the async side waits for the cycle thread's verdict.
+const VERDICT_TIMEOUT: Duration = Duration::from_secs(2);
+/// How long a request may wait in the queue before the cycle thread drops it undone: shorter
+/// than `VERDICT_TIMEOUT` by far more than the pump's period, so that a verdict the cycle thread
+/// gives always reaches its waiting requester.
+const REQUEST_TTL: Duration = Duration::from_millis(1500);
+
+impl AppState {
+    pub(crate) async fn request(&self, ticket: u64, req: Request) -> AppResult<Reply> {
+        let (tx, rx) = oneshot::channel();
+        self.pending.lock().unwrap().insert(ticket, tx);
+        // Expires well before we stop waiting: a request we answer 503 for never acts later.
+        if self.shared.push_expiring(req, REQUEST_TTL).is_err() {
+            self.pending.lock().unwrap().remove(&ticket);
+            return Err(AppError::unavailable(
+                "command_queue_full",
+                "the command queue to the cycle thread is full; try again",
+            ));
+        }
+        match tokio::time::timeout(VERDICT_TIMEOUT, rx).await {
+            Ok(Ok(r)) => Ok(r),
+            _ => {
+                self.pending.lock().unwrap().remove(&ticket);
+                Err(AppError::unavailable(
+                    "cycle_unavailable",
+                    "the cycle thread did not answer",
+                ))
+            }
+        }
+    }
+
+    /// Creates a scope recording: allocates its channels, hands the new sampling configuration
+    /// to the cycle thread and waits until it is in effect (the recording's first cycle).
+    pub async fn create_recording(&self, r: NewRecording) -> AppResult<ScopeRecording> {
+        let ticket = self.next_id();
+        let (tx, rx) = oneshot::channel();
+        let id = {
+            let mut scope = self.scope.lock().unwrap();
+            let (id, config) = scope.create(r).map_err(|e| match e {
+                ScopeBusy::Channels { in_use, needed } => AppError::conflict(
+                    "scope_channels_busy",
+                    format!(
+                        "the scope samples at most {} signals at once: {in_use} are in use by \
+                         active recordings and this one needs {needed} more; cancel one or \
+                         wait until it is done",
+                        crate::scope::SCOPE_CHANNELS
+                    ),
+                ),
+                ScopeBusy::Recordings => AppError::conflict(
+                    "scope_busy",
+                    format!(
+                        "too many active recordings (at most {} recordings and {} values are \
+                         kept); cancel one or wait until it is done",
+                        crate::scope::MAX_RECORDINGS,
+                        crate::scope::MAX_VALUES
+                    ),
+                ),
+            })?;
+            // Pushed under the scope lock so that configurations reach the cycle thread in the
+            // order of their generations.
+            self.pending.lock().unwrap().insert(ticket, tx);
+            if self
+                .shared
+                .push(Request::ScopeConfig { ticket, config })
+                .is_err()
+            {
+                self.pending.lock().unwrap().remove(&ticket);
+                scope.abandon(id);
+                return Err(AppError::unavailable(
+                    "command_queue_full",
+                    "the command queue to the cycle thread is full; try again",
+                ));
+            }
+            id
+        };
+        match tokio::time::timeout(VERDICT_TIMEOUT, rx).await {
+            Ok(Ok(reply)) => {
+                let mut scope = self.scope.lock().unwrap();
+                scope.started(id, reply.cycle);
+                scope.get(id, false).ok_or_else(|| {
+                    AppError::unavailable("scope_unavailable", "the recording was evicted")
+                })
+            }
+            _ => {
+                self.pending.lock().unwrap().remove(&ticket);
+                self.scope.lock().unwrap().abandon(id);
+                Err(AppError::unavailable(
+                    "cycle_unavailable",
+                    "the cycle thread did not answer",
+                ))
+            }
+        }
+    }
+
+    /// Sends a kernel command and waits for its verdict (not tracked as a command resource).
+    pub async fn kernel_command(&self, slot: AxisSlot, kind: CommandKind) -> AppResult<u64> {
+        let r = self.command_request(self.next_id(), slot, kind).await?;
+        r.result.map(|_| r.cycle).map_err(AppError::Rejected)
+    }
+
+    /// Sends kernel command `id` and waits for the cycle thread's reply, whatever its verdict.
+    pub(crate) async fn command_request(
+        &self,
+        id: u64,
+        slot: AxisSlot,
+        kind: CommandKind,
+    ) -> AppResult<Reply> {
+        let command = Command {
+            id,
+            axis: slot,
+            kind,
+        };
+        self.request(id, Request::Command(command)).await
+    }
+
+    /// Hands a ready axis to the cycle thread.
+    pub async fn install_axis(
+        &self,
+        slot: AxisSlot,
+        axis: Box<Axis>,
+        drive: Drive,
+        require_disabled: bool,
+    ) -> AppResult<()> {
+        self.ticketed(|ticket| Request::InsertAxis {
+            ticket,
+            slot,
+            axis,
+            drive,
+            require_disabled,
+        })
+        .await
+        .map(drop)
+    }
+
+    /// Takes an axis out of the cycle thread.
+    pub async fn uninstall_axis(&self, slot: AxisSlot, require_disabled: bool) -> AppResult<()> {
+        self.ticketed(|ticket| Request::RemoveAxis {
+            ticket,
+            slot,
+            require_disabled,
+        })
+        .await?;
+        // The pump hands the smaller sampling configuration over.
+        self.scope.lock().unwrap().axis_removed(slot);
+        Ok(())
+    }
+
+    /// Releases a command (the falling edge of Execute/Enable) and audits it.
+    /// Hands a fault or disturbance to the simulated drive of a slot.
+    pub async fn inject_fault(
+        &self,
+        slot: AxisSlot,
+        fault: crate::sim::SimFault,
+    ) -> AppResult<u64> {
+        self.ticketed(|ticket| Request::InjectFault {
+            ticket,
+            slot,
+            fault,
+        })
+        .await
+    }
+
+    /// Restarts the following-error peak hold of a slot; the cycle it counts from.
+    pub async fn reset_following_error_peak(&self, slot: AxisSlot) -> AppResult<u64> {
+        self.ticketed(|ticket| Request::ResetFollowingErrorPeak { ticket, slot })
+            .await
+    }
+
+    /// A request that only needs its verdict and the cycle it takes effect in.
+    async fn ticketed(&self, make: impl FnOnce(u64) -> Request) -> AppResult<u64> {
+        let ticket = self.next_id();
+        let r = self.request(ticket, make(ticket)).await?;
+        r.result.map(|_| r.cycle).map_err(AppError::Rejected)
+    }
+
+    /// Builds the kernel's axis and drive for a configuration plus its persistent overlay.
+    pub fn build_axis(
+        &self,
+        id: i64,
+        config: &AxisConfigDto,
+        persistent: &BTreeMap<u16, ParamValue>,
+    ) -> Result<(AxisParameters, Box<Axis>, Drive), Vec<FieldError>> {
+        let ct = self.info.cycle_time_s;
+        let mut p = config.to_parameters(id, ct)?;
+        for (n, v) in persistent {
+            if let Err(e) = params::set(&mut p, *n, *v) {
+                tracing::warn!(
+                    "axis {}: persistent parameter {n} not applied: {}",
+                    config.name,
+                    e.text()
+                );
+            }
+        }
+        let axis = Axis::new(
+            AxisConfig {
+                modulo: config.modulo.is_some(),
+                parameters: p.clone(),
+            },
+            ct,
+        );
+        let drive = config.drive.build(ct);
+        Ok((p, axis, drive))
+    }
+}

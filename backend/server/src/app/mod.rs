@@ -1,0 +1,154 @@
+//! The async side's shared state ([`AppState`]): the axis registry, the command history, the
+//! link to the cycle thread, the pump that drains its queues and the audit writer. The rules
+//! (what a request may do, transactions) are the service layer's (`crate::service`); this is
+//! the machinery they use.
+
+mod commands;
+mod link;
+mod pump;
+mod registry;
+
+pub use commands::{CommandNotice, CommandRecord, CommandStore, HISTORY, Milestone};
+pub use pump::{audit_writer, pump};
+pub use registry::{AxisEntry, Registry};
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::{Arc, Mutex, RwLock};
+use std::time::Instant;
+
+use motion::{AxisSlot, AxisStatus};
+use sqlx::SqlitePool;
+use tokio::sync::{broadcast, mpsc, oneshot};
+
+use crate::cycle::{MAX_AXES, RealtimeGrant, Reply, Shared, Snapshot};
+use crate::error::{AppError, AppResult};
+use crate::scope::Recordings;
+use crate::store::AuditEntry;
+
+pub struct SystemInfo {
+    pub version: &'static str,
+    pub cycle_time_s: f64,
+    pub listen: String,
+    pub db: String,
+    pub realtime: RealtimeGrant,
+    pub started: Instant,
+    /// Where the commissioning UI's built files are (`--ui-dir`).
+    pub ui_dir: std::path::PathBuf,
+}
+
+/// A status as a JSON object, shared by every websocket subscriber of that cycle.
+pub type StatusJson = Arc<serde_json::Map<String, serde_json::Value>>;
+
+pub struct AppState {
+    pub shared: Arc<Shared>,
+    snapshot: Mutex<triple_buffer::Output<Snapshot>>,
+    /// Per slot: the status of the latest cycle already turned into JSON.
+    status_json: Mutex<Vec<Option<(u64, StatusJson)>>>,
+    pub registry: RwLock<Registry>,
+    /// Serialises configuration changes (axes, parameters, import).
+    pub config_lock: tokio::sync::Mutex<()>,
+    pub commands: Mutex<CommandStore>,
+    pending: Mutex<HashMap<u64, oneshot::Sender<Reply>>>,
+    pub notices: broadcast::Sender<Arc<CommandNotice>>,
+    next_id: AtomicU64,
+    pub db: SqlitePool,
+    audit_tx: mpsc::Sender<AuditEntry>,
+    /// Audit rows lost (queue full, or not written after retries); shared with the writer.
+    pub audit_dropped: Arc<AtomicU64>,
+    pub info: SystemInfo,
+    /// Scope recordings and the channel layout the cycle thread samples.
+    pub scope: Mutex<Recordings>,
+}
+
+impl AppState {
+    pub fn new(
+        shared: Arc<Shared>,
+        snapshot: triple_buffer::Output<Snapshot>,
+        db: SqlitePool,
+        first_command_id: u64,
+        info: SystemInfo,
+    ) -> (Arc<AppState>, mpsc::Receiver<AuditEntry>) {
+        let (audit_tx, audit_rx) = mpsc::channel(8192);
+        let scope = Mutex::new(Recordings::new(info.cycle_time_s, shared.period_ns));
+        let state = AppState {
+            scope,
+            shared,
+            snapshot: Mutex::new(snapshot),
+            status_json: Mutex::new(vec![None; MAX_AXES]),
+            registry: RwLock::new(Registry::default()),
+            config_lock: tokio::sync::Mutex::new(()),
+            commands: Mutex::new(CommandStore::default()),
+            pending: Mutex::new(HashMap::new()),
+            notices: broadcast::channel(4096).0,
+            next_id: AtomicU64::new(first_command_id.max(1)),
+            db,
+            audit_tx,
+            audit_dropped: Arc::new(AtomicU64::new(0)),
+            info,
+        };
+        (Arc::new(state), audit_rx)
+    }
+
+    pub fn next_id(&self) -> u64 {
+        self.next_id.fetch_add(1, Relaxed)
+    }
+
+    /// The latest published snapshot: its cycle and the status of one slot.
+    pub fn status(&self, slot: AxisSlot) -> (u64, Option<AxisStatus>) {
+        let mut out = self.snapshot.lock().unwrap();
+        let s = out.read();
+        (s.cycle, s.axes.get(slot as usize).copied().flatten())
+    }
+
+    /// The slot and name of an axis given by id or name (404 when there is none).
+    pub fn axis_slot(&self, key: &str) -> AppResult<(AxisSlot, String)> {
+        let reg = self.registry.read().unwrap();
+        let e = reg
+            .find(key)
+            .ok_or_else(|| AppError::not_found("axis", key))?;
+        Ok((e.slot, e.name.clone()))
+    }
+
+    /// A kernel status as the API shows it: the master named by its axis, not its slot.
+    pub fn status_view(&self, status: AxisStatus) -> crate::model::LiveStatus {
+        let master = status.master.and_then(|slot| {
+            let reg = self.registry.read().unwrap();
+            reg.by_slot(slot).map(|e| e.name.clone())
+        });
+        crate::model::LiveStatus { status, master }
+    }
+
+    /// The latest status of a slot as JSON, serialised once per cycle whoever asks.
+    pub fn status_json(&self, slot: AxisSlot) -> Option<(u64, StatusJson)> {
+        let (cycle, status) = self.status(slot);
+        let status = status?;
+        let mut cache = self.status_json.lock().unwrap();
+        let entry = cache.get_mut(slot as usize)?;
+        if let Some((c, j)) = entry {
+            if *c == cycle {
+                return Some((cycle, j.clone()));
+            }
+        }
+        let view = self.status_view(status);
+        let serde_json::Value::Object(map) = serde_json::to_value(view).ok()? else {
+            return None;
+        };
+        let j = Arc::new(map);
+        *entry = Some((cycle, j.clone()));
+        Some((cycle, j))
+    }
+
+    pub fn with_snapshot<R>(&self, f: impl FnOnce(&Snapshot) -> R) -> R {
+        let mut out = self.snapshot.lock().unwrap();
+        f(out.read())
+    }
+
+    /// Queues an audit entry for the batching writer (motion commands are not delayed by the
+    /// disk; configuration changes write their audit row in their own transaction instead).
+    pub fn audit(&self, e: AuditEntry) {
+        if self.audit_tx.try_send(e).is_err() {
+            self.audit_dropped.fetch_add(1, Relaxed);
+        }
+    }
+}

@@ -1,0 +1,118 @@
+//! The pump: moves what the cycle thread produced (verdicts, command events, scope frames,
+//! garbage) to where it is awaited; and the audit writer.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::time::Duration;
+
+use sqlx::SqlitePool;
+
+use tokio::sync::mpsc;
+
+use super::AppState;
+use super::commands::{apply_event, final_audit};
+use crate::cycle::Request;
+use crate::store::{self, AuditEntry};
+
+impl AppState {
+    /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
+    pub fn drain(&self) {
+        // Replies are taken first but completed only after the events: the cycle thread pushes
+        // a submit's events before its reply, so a handler woken by its reply sees them.
+        let mut replies = Vec::new();
+        while let Some(r) = self.shared.replies.pop() {
+            replies.push(r);
+        }
+        let mut notices = Vec::new();
+        let mut audits = Vec::new();
+        {
+            let mut store = self.commands.lock().unwrap();
+            while let Some(ev) = self.shared.events.pop() {
+                let Some(n) = apply_event(&mut store, &ev) else {
+                    continue;
+                };
+                if n.is_final {
+                    if let Some(r) = store.map.get_mut(&n.command) {
+                        let entry = final_audit(&n, &r.client);
+                        if r.accepted {
+                            audits.push(entry);
+                        } else {
+                            // Ended before its verdict was handled: `submit` writes this entry
+                            // after the one of the submission.
+                            r.final_audit = Some(entry);
+                        }
+                    }
+                }
+                notices.push(n);
+            }
+        }
+        for e in audits {
+            self.audit(e);
+        }
+        {
+            let mut scope = self.scope.lock().unwrap();
+            scope.feed(std::iter::from_fn(|| self.shared.scope_frames.pop()));
+            if let Some(config) = scope.take_dirty() {
+                // Nobody waits for this reply (ticket 0); a full queue is retried next time.
+                let req = Request::ScopeConfig { ticket: 0, config };
+                if self.shared.push(req).is_err() {
+                    scope.handover_failed();
+                }
+            }
+        }
+        for n in notices {
+            let _ = self.notices.send(Arc::new(n));
+        }
+        for r in replies {
+            if let Some(tx) = self.pending.lock().unwrap().remove(&r.ticket) {
+                let _ = tx.send(r);
+            }
+        }
+        while let Some(g) = self.shared.garbage.pop() {
+            drop(g);
+        }
+    }
+}
+
+/// Drains the cycle thread's queues every millisecond.
+pub async fn pump(state: Arc<AppState>) {
+    let mut tick = tokio::time::interval(Duration::from_millis(1));
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    loop {
+        tick.tick().await;
+        state.drain();
+    }
+}
+
+/// Writes queued audit entries in batches, one transaction per batch. A batch that cannot be
+/// written (database locked past its busy timeout, disk full) is tried again a few times; what
+/// is still not written is logged and counted in `lost` (`audit_dropped` in /system, /metrics).
+pub async fn audit_writer(
+    db: SqlitePool,
+    mut rx: mpsc::Receiver<AuditEntry>,
+    lost: Arc<AtomicU64>,
+) {
+    const TRIES: u32 = 3;
+    let mut batch = Vec::with_capacity(256);
+    while rx.recv_many(&mut batch, 256).await > 0 {
+        for attempt in 1..=TRIES {
+            let result = async {
+                let mut tx = db.begin().await?;
+                for e in &batch {
+                    store::audit(&mut *tx, e).await?;
+                }
+                tx.commit().await
+            }
+            .await;
+            match result {
+                Ok(()) => break,
+                Err(e) if attempt == TRIES => {
+                    tracing::error!("audit log: {} entries not written: {e}", batch.len());
+                    lost.fetch_add(batch.len() as u64, Relaxed);
+                }
+                Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
+            }
+        }
+        batch.clear();
+    }
+}

@@ -1,0 +1,643 @@
+//! Commands: a function block's body checked and turned into a kernel command, submitted to
+//! the cycle thread, tracked, waited for, released, renewed. REST and websocket both come here
+//! (through the catalogue, `api::blocks`), so a rule holds whatever the transport.
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+use motion::{
+    AxisSlot, CommandId, CommandKind, Direction, FbOutputs, JogMode, Positioning, Superposition,
+};
+
+use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Milestone, Registry};
+use crate::error::{AppError, AppResult};
+use crate::model::*;
+use crate::sim::FieldError;
+use crate::store::{self, AuditEntry};
+
+/// Collects invalid fields of a command body.
+#[derive(Default)]
+pub struct Check(Vec<FieldError>);
+
+impl Check {
+    fn fail(&mut self, field: &str, message: &str) {
+        self.0.push(FieldError {
+            field: field.into(),
+            message: message.into(),
+        });
+    }
+    fn finite(&mut self, field: &str, v: f64) {
+        if !v.is_finite() {
+            self.fail(field, "must be a finite number");
+        }
+    }
+    fn positive(&mut self, field: &str, v: f64) {
+        if !(v.is_finite() && v > 0.0) {
+            self.fail(field, "must be > 0");
+        }
+    }
+    fn non_negative(&mut self, field: &str, v: f64) {
+        if !(v.is_finite() && v >= 0.0) {
+            self.fail(field, "must be ≥ 0 (0 = axis default)");
+        }
+    }
+    fn options(&mut self, o: &motion::MoveOptions) {
+        if let Some(b) = o.blending_position {
+            self.finite("options.blending_position", b);
+        }
+    }
+    fn done<T>(self, t: T) -> AppResult<T> {
+        if self.0.is_empty() {
+            Ok(t)
+        } else {
+            Err(AppError::invalid(self.0))
+        }
+    }
+}
+
+impl PowerBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.override_percent.is_finite() && (0.0..=100.0).contains(&self.override_percent)) {
+            c.fail("override_percent", "must be between 0 and 100");
+        }
+        c.done(CommandKind::Power {
+            enable: self.enable,
+            enable_positive: self.enable_positive,
+            enable_negative: self.enable_negative,
+            override_percent: self.override_percent,
+        })
+    }
+}
+
+impl SetPositionBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("position", self.position);
+        c.done(CommandKind::SetPosition {
+            position: self.position,
+            relative: self.relative,
+            clear_position_lag: self.clear_position_lag,
+        })
+    }
+}
+
+impl SetOverrideBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.velocity_factor.is_finite() && (0.0..=1.0).contains(&self.velocity_factor)) {
+            c.fail("velocity_factor", "must be between 0 and 1");
+        }
+        c.done(CommandKind::SetOverride {
+            velocity_factor: self.velocity_factor,
+        })
+    }
+}
+
+/// The inputs every positioning block shares, checked, as the kernel's `Positioning`
+/// (`field`: the body's name of the target or distance; the kernel calls both `position`).
+fn positioning(
+    c: &mut Check,
+    (field, position): (&str, f64),
+    velocity: f64,
+    (acceleration, deceleration, jerk): (f64, f64, f64),
+    buffer_mode: motion::BufferMode,
+    options: motion::MoveOptions,
+) -> Positioning {
+    c.finite(field, position);
+    c.positive("velocity", velocity);
+    c.non_negative("acceleration", acceleration);
+    c.non_negative("deceleration", deceleration);
+    c.non_negative("jerk", jerk);
+    c.options(&options);
+    Positioning {
+        position,
+        velocity,
+        dynamics: dynamics(acceleration, deceleration, jerk),
+        buffer_mode,
+        options,
+    }
+}
+
+/// `positioning` for the bodies of the positioning blocks; `$target` is the body's name of its
+/// target or distance.
+macro_rules! positioning_inputs {
+    ($($body:ty => $target:ident),+ $(,)?) => {$(
+        impl $body {
+            fn positioning(&self, c: &mut Check) -> Positioning {
+                positioning(
+                    c,
+                    (stringify!($target), self.$target),
+                    self.velocity,
+                    (self.acceleration, self.deceleration, self.jerk),
+                    self.buffer_mode,
+                    self.options,
+                )
+            }
+        }
+    )+};
+}
+
+positioning_inputs! {
+    MoveBody => position,
+    MoveRelativeBody => distance,
+    MoveContinuousBody => position,
+    MoveContinuousRelativeBody => distance,
+}
+
+impl MoveBody {
+    /// MC_MoveAbsolute.
+    pub fn absolute(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let p = self.positioning(&mut c);
+        if self.direction.is_some() {
+            c.fail("direction", "only move-modulo takes a direction");
+        }
+        c.done(CommandKind::MoveAbsolute(p))
+    }
+
+    /// MC_MoveModulo: only on a modulo axis, with a target within one turn's range.
+    pub fn modulo(&self, _: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let p = self.positioning(&mut c);
+        if axis.config.modulo.is_none() {
+            c.fail("axis", "move-modulo needs a modulo axis");
+        }
+        if self.position < 0.0 {
+            c.fail("position", "a modulo target must be ≥ 0");
+        }
+        c.done(CommandKind::MoveModulo {
+            move_: p,
+            direction: self.direction.unwrap_or(Direction::Positive),
+        })
+    }
+}
+
+impl MoveRelativeBody {
+    /// MC_MoveRelative: `distance` from the set position.
+    pub fn relative(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let p = self.positioning(&mut c);
+        c.done(CommandKind::MoveRelative(p))
+    }
+
+    /// MC_MoveAdditive: `distance` added to the running target.
+    pub fn additive(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let p = self.positioning(&mut c);
+        c.done(CommandKind::MoveAdditive(p))
+    }
+}
+
+impl MoveContinuousRelativeBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let move_ = self.positioning(&mut c);
+        c.finite("end_velocity", self.end_velocity);
+        c.done(CommandKind::MoveContinuousRelative {
+            move_,
+            end_velocity: self.end_velocity,
+        })
+    }
+}
+
+impl MoveContinuousBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let move_ = self.positioning(&mut c);
+        c.finite("end_velocity", self.end_velocity);
+        c.done(CommandKind::MoveContinuousAbsolute {
+            move_,
+            end_velocity: self.end_velocity,
+        })
+    }
+}
+
+impl MoveVelocityBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.positive("velocity", self.velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::MoveVelocity {
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            direction: self.direction,
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        })
+    }
+}
+
+impl HaltBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::Halt {
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+            buffer_mode: self.buffer_mode,
+            options: self.options,
+        })
+    }
+}
+
+impl StopBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.options(&self.options);
+        c.done(CommandKind::Stop {
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+            options: self.options,
+        })
+    }
+}
+
+impl JogBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.deadman_timeout.is_finite() && (0.05..=10.0).contains(&self.deadman_timeout)) {
+            c.fail("deadman_timeout", "must be between 0.05 and 10 s");
+        }
+        c.non_negative("velocity", self.velocity);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.non_negative("position", self.position);
+        match self.mode {
+            JogMode::Continuous if self.velocity <= 0.0 => {
+                c.fail("velocity", "continuous jog needs a velocity > 0")
+            }
+            JogMode::Inching | JogMode::InchingModulo if self.position <= 0.0 => {
+                c.fail("position", "inching needs a distance > 0")
+            }
+            _ => {}
+        }
+        c.done(CommandKind::Jog {
+            mode: self.mode,
+            forward: self.direction == JogDirection::Forward,
+            position: self.position,
+            velocity: self.velocity,
+            dynamics: dynamics(self.acceleration, self.deceleration, self.jerk),
+            deadman: self.deadman_timeout,
+        })
+    }
+}
+
+impl HomeBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if let Some(p) = self.position {
+            c.finite("position", p);
+        }
+        for (f, v) in [
+            ("options.search_velocity", self.options.search_velocity),
+            ("options.sync_velocity", self.options.sync_velocity),
+        ] {
+            if let Some(v) = v {
+                c.positive(f, v);
+            }
+        }
+        c.done(CommandKind::Home {
+            position: self.position,
+            mode: self.mode,
+            options: self.options,
+        })
+    }
+}
+
+/// The master of a coupling: an axis other than the slave.
+fn master_slot(c: &mut Check, reg: &Registry, axis: &AxisEntry, master: &str) -> AxisSlot {
+    match reg.find(master) {
+        None => {
+            c.fail("master", "no such axis");
+            0
+        }
+        Some(m) if m.id == axis.id => {
+            c.fail("master", "an axis cannot be its own master");
+            0
+        }
+        Some(m) => m.slot,
+    }
+}
+
+impl GearInBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        if !(self.ratio_numerator.is_finite() && self.ratio_numerator != 0.0) {
+            c.fail("ratio_numerator", "must be a finite number other than 0");
+        }
+        if self.ratio_denominator == 0 {
+            c.fail("ratio_denominator", "must be ≥ 1");
+        }
+        c.done(CommandKind::GearIn {
+            master,
+            ratio_numerator: self.ratio_numerator,
+            ratio_denominator: self.ratio_denominator,
+        })
+    }
+}
+
+impl GearInDynBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        c.finite("gear_ratio", self.gear_ratio);
+        c.non_negative("acceleration", self.acceleration);
+        c.done(CommandKind::GearInDyn {
+            master,
+            gear_ratio: self.gear_ratio,
+            acceleration: self.acceleration,
+        })
+    }
+}
+
+impl MoveSuperImposedBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("distance", self.distance);
+        c.positive("velocity_diff", self.velocity_diff);
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.positive("velocity_process", self.velocity_process);
+        c.positive("length", self.length);
+        c.done(CommandKind::MoveSuperImposed(Superposition {
+            mode: self.mode,
+            distance: self.distance,
+            velocity_diff: self.velocity_diff,
+            acceleration: self.acceleration,
+            deceleration: self.deceleration,
+            velocity_process: self.velocity_process,
+            length: self.length,
+            abort_option: self.abort_option,
+        }))
+    }
+}
+
+/// Validates, submits and (optionally) waits: shared by all command endpoints and the websocket.
+/// How a catalogue entry turns its body into a kernel command.
+pub type ToKind<B> = fn(&B, &Registry, &AxisEntry) -> AppResult<CommandKind>;
+
+/// A function block as the catalogue hands it over: its name, its milestone and its body's
+/// conversion.
+pub struct Submission<'a, B> {
+    pub name: &'static str,
+    pub milestone: Milestone,
+    pub to_kind: ToKind<B>,
+    pub axis: &'a str,
+    pub body: B,
+    /// The body as sent, kept with the command and in the audit log.
+    pub raw: serde_json::Value,
+    pub client: ClientInfo,
+}
+
+/// Checks, submits and (with `wait`) waits for a command: what every command endpoint and
+/// websocket method does.
+pub async fn run<B>(
+    s: &AppState,
+    sub: Submission<'_, B>,
+    wait: Option<Duration>,
+) -> AppResult<CommandResource> {
+    let Submission {
+        name,
+        milestone,
+        to_kind,
+        axis,
+        body,
+        raw,
+        client,
+    } = sub;
+    let id = submit(s, axis, (name, milestone), raw, client, |reg, e| {
+        to_kind(&body, reg, e)
+    })
+    .await?;
+    let view = match wait {
+        Some(t) => wait_for(s, id, t).await,
+        None => get(s, id),
+    };
+    view.ok_or_else(|| {
+        AppError::unavailable(
+            "command_forgotten",
+            "the command left the history before it could be shown",
+        )
+    })
+}
+
+/// `?wait=true&timeout_ms=N` as a duration to wait (`None`: answer at once).
+pub fn wait_duration(wait: bool, timeout_ms: Option<u64>) -> AppResult<Option<Duration>> {
+    match (wait, timeout_ms) {
+        (_, Some(t)) if t > 600_000 => Err(AppError::field("timeout_ms", "at most 600000")),
+        (true, t) => Ok(Some(Duration::from_millis(t.unwrap_or(10_000)))),
+        // A timeout without a wait is a client that meant to wait: say so instead of not waiting.
+        (false, Some(_)) => Err(AppError::field("timeout_ms", "only with wait=true")),
+        (false, None) => Ok(None),
+    }
+}
+
+/// Submits a tracked command. Returns its id once the cycle thread accepted it; a refusal is
+/// audited and forgotten.
+async fn submit(
+    s: &AppState,
+    axis_key: &str,
+    (name, milestone): (&'static str, Milestone),
+    parameters: serde_json::Value,
+    client: ClientInfo,
+    build: impl FnOnce(&Registry, &AxisEntry) -> AppResult<CommandKind>,
+) -> AppResult<CommandId> {
+    let (slot, axis_id, axis_name, kind) = {
+        let reg = s.registry.read().unwrap();
+        let e = reg
+            .find(axis_key)
+            .ok_or_else(|| AppError::not_found("axis", axis_key))?;
+        (e.slot, e.id, e.name.clone(), build(&reg, e)?)
+    };
+    let id = s.next_id();
+    let submitted_at = store::now_rfc3339();
+    let audit = AuditEntry {
+        at: submitted_at.clone(),
+        client_addr: Some(client.addr.clone()),
+        client_id: client.id.clone(),
+        action: format!("command.{name}"),
+        target: Some(axis_name.clone()),
+        command_id: Some(id),
+        detail: parameters.to_string(),
+        outcome: None,
+    };
+    s.commands.lock().unwrap().insert(CommandRecord {
+        id,
+        axis_id,
+        axis_name,
+        slot,
+        name,
+        milestone,
+        parameters,
+        client,
+        submitted_at,
+        accepted: false,
+        accepted_cycle: 0,
+        outputs: FbOutputs::default(),
+        last_cycle: 0,
+        finished_at: None,
+        events: VecDeque::new(),
+        final_audit: None,
+    });
+    let reply = match s.command_request(id, slot, kind).await {
+        Ok(r) => r,
+        Err(e) => {
+            s.commands.lock().unwrap().remove(id);
+            return Err(e);
+        }
+    };
+    match reply.result {
+        Ok(()) => {
+            let final_audit = s.commands.lock().unwrap().map.get_mut(&id).and_then(|r| {
+                r.accepted = true;
+                r.accepted_cycle = reply.cycle;
+                if r.finished_at.is_none() && r.is_final() {
+                    r.finished_at = Some(store::now_rfc3339());
+                }
+                r.final_audit.take()
+            });
+            s.audit(AuditEntry {
+                outcome: Some("accepted".into()),
+                ..audit
+            });
+            if let Some(e) = final_audit {
+                s.audit(e);
+            }
+            Ok(id)
+        }
+        Err(e) => {
+            s.commands.lock().unwrap().remove(id);
+            s.audit(AuditEntry {
+                outcome: Some(format!("rejected:{}", e.code())),
+                ..audit
+            });
+            Err(AppError::rejected(e))
+        }
+    }
+}
+
+/// An accepted command as it stands.
+pub fn get(s: &AppState, id: CommandId) -> Option<CommandResource> {
+    s.commands
+        .lock()
+        .unwrap()
+        .map
+        .get(&id)
+        .filter(|r| r.accepted)
+        .map(|r| r.view())
+}
+
+/// An accepted command, or 404.
+pub fn find(s: &AppState, id: CommandId) -> AppResult<CommandResource> {
+    get(s, id).ok_or_else(|| AppError::not_found("command", &id.to_string()))
+}
+
+/// Waits until the command is final or reaches its milestone, or the timeout.
+pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<CommandResource> {
+    let deadline = tokio::time::Instant::now() + timeout;
+    let mut rx = s.notices.subscribe();
+    loop {
+        let (view, milestone) = {
+            let store = s.commands.lock().unwrap();
+            let r = store.map.get(&id).filter(|r| r.accepted)?;
+            (r.view(), r.milestone)
+        };
+        if view.is_final || milestone.reached(&view.outputs) {
+            return Some(view);
+        }
+        match tokio::time::timeout_at(deadline, rx.recv()).await {
+            Err(_) => return get(s, id),
+            Ok(Err(tokio::sync::broadcast::error::RecvError::Closed)) => return get(s, id),
+            Ok(_) => {}
+        }
+    }
+}
+
+/// `GET /commands` filters.
+pub struct ListFilter<'a> {
+    pub axis: Option<&'a str>,
+    pub state: Option<CommandState>,
+    pub limit: Option<usize>,
+}
+
+/// Accepted commands, newest first.
+pub fn list(s: &AppState, f: ListFilter<'_>) -> AppResult<Vec<CommandResource>> {
+    let axis_id = match f.axis {
+        Some(a) => Some(
+            s.registry
+                .read()
+                .unwrap()
+                .find(a)
+                .map(|e| e.id)
+                .ok_or_else(|| AppError::not_found("axis", a))?,
+        ),
+        None => None,
+    };
+    let limit = f.limit.unwrap_or(100).min(HISTORY);
+    let store = s.commands.lock().unwrap();
+    Ok(store
+        .order
+        .iter()
+        .rev()
+        .filter_map(|id| store.map.get(id))
+        .filter(|r| r.accepted)
+        .filter(|r| axis_id.is_none_or(|a| r.axis_id == a))
+        .map(|r| r.view())
+        .filter(|v| f.state.is_none_or(|st| v.state == st))
+        .take(limit)
+        .collect())
+}
+
+/// The slot of an accepted command (404 for an unknown one).
+pub fn slot_of(s: &AppState, id: CommandId) -> AppResult<AxisSlot> {
+    let store = s.commands.lock().unwrap();
+    store
+        .map
+        .get(&id)
+        .filter(|r| r.accepted)
+        .map(|r| r.slot)
+        .ok_or_else(|| AppError::not_found("command", &id.to_string()))
+}
+
+/// Releases a command (the falling edge of Execute/Enable) and audits it; the cycle it took
+/// effect in.
+pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppResult<u64> {
+    let slot = slot_of(s, id)?;
+    let result = s
+        .kernel_command(slot, CommandKind::Release { target: id })
+        .await;
+    let outcome = match &result {
+        Ok(_) => "accepted".to_owned(),
+        Err(AppError::Rejected(e)) => format!("rejected:{}", e.code()),
+        // The cycle thread did not answer: nothing was released, nothing to audit.
+        Err(_) => return result,
+    };
+    s.audit(AuditEntry {
+        at: store::now_rfc3339(),
+        client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
+        client_id: client.id.clone(),
+        action: "command.release".into(),
+        target: Some(id.to_string()),
+        command_id: Some(id),
+        detail: serde_json::json!({"via": client.via}).to_string(),
+        outcome: Some(outcome),
+    });
+    result
+}
+
+/// Renews a jog's dead-man; the cycle it took effect in.
+pub async fn keepalive(s: &AppState, id: CommandId) -> AppResult<u64> {
+    let slot = slot_of(s, id)?;
+    s.kernel_command(slot, CommandKind::Keepalive { target: id })
+        .await
+}

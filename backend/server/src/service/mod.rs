@@ -1,0 +1,8 @@
+//! The service layer: the rules of each request and its transactions, for every transport.
+//! Handlers (`crate::api`) parse and answer; these functions decide and act, on the state of
+//! `crate::app`, the SQL of `crate::store` and the cycle thread; errors are `AppError`.
+
+pub mod axes;
+pub mod commands;
+pub mod scope;
+pub mod simulation;

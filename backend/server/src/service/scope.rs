@@ -1,0 +1,128 @@
+//! Scope recordings: a request checked against the axes and the scope's limits, then handed to
+//! the recorder (`crate::scope`, sampled by the cycle thread).
+
+use crate::app::AppState;
+use crate::error::{AppError, AppResult};
+use crate::model::RecordingRequest;
+use crate::scope::{
+    MAX_SAMPLES, NewRecording, SCOPE_CHANNELS, ScopeChannel, ScopeSignal, ScopeTrigger, TriggerEdge,
+};
+use crate::sim::FieldError;
+
+/// Checks a recording request: every field at fault is named (`channels[2].axis`).
+pub fn recording(s: &AppState, body: RecordingRequest) -> AppResult<NewRecording> {
+    let mut errors = Vec::new();
+    let mut fail = |field: String, message: String| errors.push(FieldError { field, message });
+    let n = body.channels.len();
+    if n == 0 || n > SCOPE_CHANNELS {
+        fail(
+            "channels".into(),
+            format!("must have 1 to {SCOPE_CHANNELS} channels"),
+        );
+    }
+    let mut channels = Vec::with_capacity(n);
+    {
+        let reg = s.registry.read().unwrap();
+        for (i, c) in body.channels.iter().enumerate() {
+            let signal = ScopeSignal::parse(&c.signal);
+            if signal.is_none() {
+                fail(
+                    format!("channels[{i}].signal"),
+                    format!(
+                        "unknown signal '{}'; one of {}",
+                        c.signal,
+                        ScopeSignal::ALL.map(ScopeSignal::name).join(", ")
+                    ),
+                );
+            }
+            let key = c.axis.key();
+            let axis = reg.find(&key);
+            if axis.is_none() {
+                fail(format!("channels[{i}].axis"), format!("no axis '{key}'"));
+            }
+            if let (Some(a), Some(signal)) = (axis, signal) {
+                channels.push((
+                    a.slot,
+                    ScopeChannel {
+                        axis: a.name.clone(),
+                        axis_id: a.id,
+                        signal,
+                        unit: signal.unit(&a.config.unit),
+                    },
+                ));
+            }
+        }
+    }
+    let cycle = s.info.cycle_time_s;
+    let samples = body.duration_s / cycle;
+    let samples = if body.duration_s.is_finite() && body.duration_s > 0.0 {
+        samples.round()
+    } else {
+        0.0
+    };
+    if !(samples >= 1.0 && samples <= MAX_SAMPLES as f64) {
+        fail(
+            "duration_s".into(),
+            format!(
+                "must be > 0 and at most {MAX_SAMPLES} cycles ({} s at the cycle time of {cycle} s)",
+                MAX_SAMPLES as f64 * cycle
+            ),
+        );
+    }
+    let samples = samples as usize;
+    let mut trigger = None;
+    let mut pre_trigger_samples = 0;
+    if let Some(t) = &body.trigger {
+        if t.channel < 0 || t.channel as usize >= n.max(1) {
+            fail(
+                "trigger.channel".into(),
+                format!("must be the index of a channel (0 … {})", n.max(1) - 1),
+            );
+        }
+        if !t.level.is_finite() {
+            fail("trigger.level".into(), "must be a finite number".into());
+        }
+        let edge = match t.edge.as_str() {
+            "rising" => Some(TriggerEdge::Rising),
+            "falling" => Some(TriggerEdge::Falling),
+            "either" => Some(TriggerEdge::Either),
+            other => {
+                fail(
+                    "trigger.edge".into(),
+                    format!("unknown edge '{other}'; one of rising, falling, either"),
+                );
+                None
+            }
+        };
+        if !(t.pre_trigger_s.is_finite()
+            && t.pre_trigger_s >= 0.0
+            && t.pre_trigger_s <= body.duration_s)
+        {
+            fail(
+                "trigger.pre_trigger_s".into(),
+                "must be ≥ 0 and ≤ duration_s".into(),
+            );
+        }
+        if let Some(edge) = edge {
+            trigger = Some(ScopeTrigger {
+                channel: t.channel.max(0) as usize,
+                level: t.level,
+                edge,
+                pre_trigger_s: t.pre_trigger_s,
+            });
+            // The trigger sample is always part of the recording.
+            pre_trigger_samples =
+                ((t.pre_trigger_s / cycle).round() as usize).min(samples.saturating_sub(1));
+        }
+    }
+    if !errors.is_empty() {
+        return Err(AppError::invalid(errors));
+    }
+    Ok(NewRecording {
+        channels,
+        duration_s: body.duration_s,
+        samples,
+        trigger,
+        pre_trigger_samples,
+    })
+}
