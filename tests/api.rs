@@ -689,7 +689,11 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
         bad["drive"] = drive;
         let r = post(&s, "/api/v1/axes", bad).await;
         assert_problem(&r, 422, "validation_failed");
-        assert_eq!(r.json["errors"][0]["field"], "drive.dead_time", "{}", r.json);
+        assert_eq!(
+            r.json["errors"][0]["field"], "drive.dead_time",
+            "{}",
+            r.json
+        );
     }
     let mut bad = cfg.clone();
     bad["drive"] = json!({"kind": "cia402"});
