@@ -185,7 +185,13 @@ fn a_load_the_drive_cannot_hold_trips_following_error_monitoring() {
     assert_eq!(m.st().error_id, ErrorId::FOLLOWING_ERROR.0);
     assert_eq!(m.out(a).error_id, ErrorId::FOLLOWING_ERROR.0);
     m.drive.inject(SimFault::Load { force: 0.0 });
-    m.until(1.0, |m| !m.st().moving);
+    // The axis brakes on its fast-stop ramp with the drive still enabled (TwinCAT would
+    // switch it off and let the load coast).
+    m.until(1.0, |m| {
+        assert!(m.st().power_status, "drive disabled while braking");
+        !m.st().moving
+    });
+    assert!(m.st().power_status);
     m.ok(CommandKind::Reset);
     m.until(0.5, |m| m.st().state == AxisState::Standstill);
 }

@@ -70,7 +70,7 @@ fn command() -> impl Strategy<Value = CommandKind> {
         1 => (-100.0..100.0f64, any::<bool>(), any::<bool>()).prop_map(|(position, relative, clear_position_lag)| CommandKind::SetPosition { position, relative, clear_position_lag }),
         1 => (0.0..=1.0f64).prop_map(|velocity_factor| CommandKind::SetOverride { velocity_factor }),
         1 => prop_oneof![Just(HomingMode::Direct), Just(HomingMode::ForceCalibration), Just(HomingMode::ResetCalibration), Just(HomingMode::Default)].prop_map(|mode| CommandKind::Home { position: Some(0.0), mode, options: HomingOptions::default() }),
-        1 => (-3.0..3.0f64, 1u16..4).prop_map(|(n, d)| CommandKind::GearIn { master: 0, ratio_numerator: n, ratio_denominator: d }),
+        1 => (-3.0..3.0f64, 1u16..4).prop_map(|(n, d)| gear_in(0, n, d)),
         1 => Just(CommandKind::GearOut),
         1 => (-3.0..3.0f64, 0.0..3000.0f64).prop_map(|(gear_ratio, acceleration)| CommandKind::GearInDyn { master: 0, gear_ratio, acceleration }),
         1 => (0usize..6, -100.0..100.0f64, 1.0..500.0f64, 1.0..500.0f64, 1.0..1000.0f64, 0usize..3).prop_map(|(m, distance, velocity_diff, velocity_process, length, o)| CommandKind::MoveSuperImposed(Superposition {

@@ -49,15 +49,7 @@ fn the_peak_hold_is_the_extreme_of_every_cycle_and_restarts_on_reset() {
 #[test]
 fn the_status_shows_the_power_override_and_the_set_override_factor() {
     let mut r = Rig::new(1);
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 50.0,
-        },
-    );
+    r.ok(0, power_with_override(50.0));
     r.ok(
         0,
         CommandKind::SetOverride {

@@ -394,15 +394,7 @@ impl Rig {
 
     /// MC_Power with both feed enables and the given override; waits for Standstill.
     pub fn power_on_with_override(&mut self, axis: u16, override_percent: f64) -> CommandId {
-        let id = self.ok(
-            axis,
-            CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent,
-            },
-        );
+        let id = self.ok(axis, power_with_override(override_percent));
         self.until(0.1, |r| r.st(axis).state == AxisState::Standstill);
         id
     }
@@ -832,6 +824,25 @@ pub fn params_with_soft_limits(min: f64, max: f64) -> AxisParameters {
     p.axis_en_max_soft_pos_limit = true;
     p.axis_max_soft_pos_limit = max;
     p
+}
+
+/// MC_GearIn of the slave to `master` with ratio numerator / denominator.
+pub fn gear_in(master: u16, ratio_numerator: f64, ratio_denominator: u16) -> CommandKind {
+    CommandKind::GearIn {
+        master,
+        ratio_numerator,
+        ratio_denominator,
+    }
+}
+
+/// MC_Power Enable TRUE with both feed enables and the given override.
+pub fn power_with_override(override_percent: f64) -> CommandKind {
+    CommandKind::Power {
+        enable: true,
+        enable_positive: true,
+        enable_negative: true,
+        override_percent,
+    }
 }
 
 /// MC_Power Enable FALSE.

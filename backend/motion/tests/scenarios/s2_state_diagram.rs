@@ -20,15 +20,7 @@ fn s11a_01_fresh_axis_is_disabled_and_rejects_moves() {
 #[test]
 fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error() {
     let mut r = Rig::new(1);
-    let p = r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 100.0,
-        },
-    );
+    let p = r.ok(0, power_with_override(100.0));
     assert!(r.out(p).busy && !r.out(p).status);
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
     assert!(r.out(p).status && r.out(p).busy && r.out(p).active);
@@ -37,15 +29,7 @@ fn s11a_02_power_enable_goes_to_standstill_with_status_or_errorstop_with_error()
     // With a drive fault pending: ErrorStop.
     let mut r = Rig::new(1);
     r.plants[0].fault = true;
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 100.0,
-        },
-    );
+    r.ok(0, power_with_override(100.0));
     r.step();
     assert_eq!(r.st(0).state, AxisState::ErrorStop);
     assert_eq!(r.st(0).error_id, ErrorId::DRIVE_FAULT.0);

@@ -10,22 +10,8 @@ fn s11a_16_slave_motion_commands_decouple_only_when_allowed_and_aborting() {
     r.power_on(0);
     r.power_on(1);
     r.power_on(2);
-    r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 1.0,
-            ratio_denominator: 1,
-        },
-    );
-    r.ok(
-        2,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 1.0,
-            ratio_denominator: 1,
-        },
-    );
+    r.ok(1, gear_in(0, 1.0, 1));
+    r.ok(2, gear_in(0, 1.0, 1));
     assert_eq!(
         r.rejected(1, CommandKind::MoveAbsolute(mv(10.0, 10.0))),
         ErrorId::SLAVE_COMMAND_NOT_ALLOWED

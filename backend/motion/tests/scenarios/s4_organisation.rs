@@ -7,52 +7,23 @@ use super::*;
 fn s11a_34_override_range() {
     let mut r = Rig::new(1);
     assert_eq!(
-        r.rejected(
-            0,
-            CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent: 100.5
-            }
-        ),
+        r.rejected(0, power_with_override(100.5)),
         ErrorId::PARAMETER_NOT_CORRECT
     );
     assert_eq!(
-        r.rejected(
-            0,
-            CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent: -0.1
-            }
-        ),
+        r.rejected(0, power_with_override(-0.1)),
         ErrorId::PARAMETER_NOT_CORRECT
     );
     power(&mut r);
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 50.0,
-        },
-    );
+    r.ok(0, power_with_override(50.0));
     let v = r.ok(0, velocity(100.0, Direction::Positive));
     r.until(1.0, |r| r.out(v).in_velocity);
     assert!((r.st(0).set_velocity - 50.0).abs() < 1e-9);
-    // Override 0 stops the axis without aborting the command.
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 0.0,
-        },
-    );
+    // Override 0 stops the axis without aborting the command; the change drops InVelocity
+    // in the next cycle (the velocity is re-planned, no longer reached).
+    r.ok(0, power_with_override(0.0));
+    r.step();
+    assert!(!r.out(v).in_velocity && r.out(v).busy);
     r.run(1.0);
     assert!(r.st(0).set_velocity.abs() < 1e-9);
     assert!(r.out(v).busy && !r.out(v).command_aborted);
@@ -62,15 +33,7 @@ fn s11a_34_override_range() {
 fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
     let mut r = Rig::new(1);
     power(&mut r);
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 50.0,
-        },
-    );
+    r.ok(0, power_with_override(50.0));
     let a = r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
     r.until(10.0, |r| {
         let v = r.st(0).set_velocity.abs();
@@ -260,15 +223,7 @@ fn reset_during_the_error_stop_ramp_waits_for_standstill() {
 fn repeated_fault_and_reset_rounds_can_always_be_re_enabled() {
     let mut r = Rig::new(1);
     r.plants[0].enable_delay_cycles = 300; // a slow drive (0.3 s)
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 100.0,
-        },
-    );
+    r.ok(0, power_with_override(100.0));
     for _ in 0..5 {
         r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
         r.plants[0].fault = true;

@@ -152,14 +152,7 @@ fn s11a_31_superposition_abort_table_every_row_and_column() {
             r.power_on(0);
             r.power_on(1);
             if slave {
-                r.ok(
-                    1,
-                    CommandKind::GearIn {
-                        master: 0,
-                        ratio_numerator: 1.0,
-                        ratio_denominator: 1,
-                    },
-                );
+                r.ok(1, gear_in(0, 1.0, 1));
                 r.ok(0, velocity(200.0, Direction::Positive));
             } else if event == ReachedTarget {
                 r.ok(1, CommandKind::MoveAbsolute(mv(200.0, 200.0)));
@@ -559,15 +552,7 @@ fn superposition_across_a_blend_handoff_stays_continuous() {
     let mut r = Rig::new(1);
     r.bounds[0].jerk = 1e12;
     r.bounds[0].acceleration *= 2.0;
-    r.ok(
-        0,
-        CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 65.0,
-        },
-    );
+    r.ok(0, power_with_override(65.0));
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
     r.ok(0, CommandKind::MoveRelative(mv(173.0, 467.0)));
     let b = r.ok(

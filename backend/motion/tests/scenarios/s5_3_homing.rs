@@ -375,3 +375,31 @@ fn homing_is_refused_only_for_a_direction_the_run_will_travel() {
         }
     }
 }
+
+/// A cam narrower than the search velocity's braking distance: the axis stops beyond it, and
+/// the run ends with why (0x7032, could not stop on the cam).
+#[test]
+fn homing_that_cannot_stop_on_the_cam_says_so() {
+    let mut r = Rig::new(1);
+    r.plants[0].cam = Some((50.0, 50.5));
+    r.plants[0].index_period = Some(8.0);
+    r.power_on(0);
+    let h = r.ok(
+        0,
+        CommandKind::Home {
+            position: Some(0.0),
+            mode: HomingMode::Default,
+            options: HomingOptions {
+                search_velocity: Some(300.0),
+                ..HomingOptions::default()
+            },
+        },
+    );
+    r.until(5.0, |r| !r.out(h).busy);
+    assert_eq!(r.out(h).error_id, ErrorId::HOMING_CAM_OVERRUN.0);
+    assert!(!r.out(h).done && !r.st(0).homed);
+    assert!(r.plants[0].pos > 50.5, "{}", r.plants[0].pos);
+    // An FB error, not an axis error: the axis stands where it stopped, ready for a new run.
+    r.until(1.0, |r| !r.st(0).moving);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
+}

@@ -10,32 +10,11 @@ fn s11a_27_gear_ratio_forms_give_identical_slaves_denominator_zero_rejected() {
         r.power_on(a);
     }
     assert_eq!(
-        r.rejected(
-            1,
-            CommandKind::GearIn {
-                master: 0,
-                ratio_numerator: 1.0,
-                ratio_denominator: 0
-            }
-        ),
+        r.rejected(1, gear_in(0, 1.0, 0)),
         ErrorId::PARAMETER_NOT_CORRECT
     );
-    let g1 = r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 1.0,
-            ratio_denominator: 4,
-        },
-    );
-    let g2 = r.ok(
-        2,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 0.25,
-            ratio_denominator: 1,
-        },
-    );
+    let g1 = r.ok(1, gear_in(0, 1.0, 4));
+    let g2 = r.ok(2, gear_in(0, 0.25, 1));
     assert!(r.out(g1).in_gear && r.out(g2).in_gear);
     assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 200.0)));
@@ -46,14 +25,7 @@ fn s11a_27_gear_ratio_forms_give_identical_slaves_denominator_zero_rejected() {
     let mut r = Rig::new(2);
     r.power_on(0);
     r.power_on(1);
-    r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: -2.0,
-            ratio_denominator: 1,
-        },
-    );
+    r.ok(1, gear_in(0, -2.0, 1));
     let m = r.ok(0, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
     r.until(3.0, |r| r.out(m).done);
     assert!((r.st(1).set_position + 20.0).abs() < 1e-9);
@@ -64,14 +36,7 @@ fn s11a_28_gear_out_in_motion_keeps_constant_velocity() {
     let mut r = Rig::new(2);
     r.power_on(0);
     r.power_on(1);
-    let g = r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 2.0,
-            ratio_denominator: 1,
-        },
-    );
+    let g = r.ok(1, gear_in(0, 2.0, 1));
     r.ok(0, velocity(50.0, Direction::Positive));
     r.run(1.0);
     assert!((r.st(1).set_velocity - 100.0).abs() < 1e-6);
@@ -163,14 +128,7 @@ fn gear_coupling_to_the_masters_actual_values_with_parameter_1064() {
     r.plants[0].tau = 0.02; // the master lags behind its setpoint (2 mm at 100 mm/s)
     r.power_on(0);
     r.power_on(1);
-    r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 1.0,
-            ratio_denominator: 1,
-        },
-    );
+    r.ok(1, gear_in(0, 1.0, 1));
     r.bounds[1].jerk = 1e12; // an actual value is not jerk-limited
     r.bounds[1].acceleration = 1e12;
     r.ok(0, velocity(100.0, Direction::Positive));
@@ -195,55 +153,11 @@ fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
     for a in 0..3 {
         r.power_on(a);
     }
-    assert_eq!(
-        r.rejected(
-            0,
-            CommandKind::GearIn {
-                master: 0,
-                ratio_numerator: 1.0,
-                ratio_denominator: 1
-            }
-        ),
-        ErrorId::MASTER_INVALID
-    );
-    assert_eq!(
-        r.rejected(
-            0,
-            CommandKind::GearIn {
-                master: 9,
-                ratio_numerator: 1.0,
-                ratio_denominator: 1
-            }
-        ),
-        ErrorId::MASTER_INVALID
-    );
-    r.ok(
-        1,
-        CommandKind::GearIn {
-            master: 0,
-            ratio_numerator: 1.0,
-            ratio_denominator: 1,
-        },
-    );
-    r.ok(
-        2,
-        CommandKind::GearIn {
-            master: 1,
-            ratio_numerator: 1.0,
-            ratio_denominator: 1,
-        },
-    );
-    assert_eq!(
-        r.rejected(
-            0,
-            CommandKind::GearIn {
-                master: 2,
-                ratio_numerator: 1.0,
-                ratio_denominator: 1
-            }
-        ),
-        ErrorId::MASTER_INVALID
-    );
+    assert_eq!(r.rejected(0, gear_in(0, 1.0, 1)), ErrorId::MASTER_INVALID);
+    assert_eq!(r.rejected(0, gear_in(9, 1.0, 1)), ErrorId::MASTER_INVALID);
+    r.ok(1, gear_in(0, 1.0, 1));
+    r.ok(2, gear_in(1, 1.0, 1));
+    assert_eq!(r.rejected(0, gear_in(2, 1.0, 1)), ErrorId::MASTER_INVALID);
     // A chain follows in one cycle (masters are stepped first).
     r.ok(0, velocity(10.0, Direction::Positive));
     r.run(0.2);
@@ -253,4 +167,31 @@ fn coupling_loops_and_self_coupling_are_rejected_master_loss_is_an_error() {
     r.run(0.01);
     assert_eq!(r.st(1).state, AxisState::ErrorStop);
     assert_eq!(r.st(1).error_id, ErrorId::MASTER_LOST.0);
+}
+
+/// MC_GearIn couples only master and slave at rest (a moving master: 0x7042, a moving
+/// slave: 0x4B01) and changes nothing when refused; MC_GearInDyn is the block that couples
+/// onto motion.
+#[test]
+fn gear_in_needs_master_and_slave_at_rest() {
+    let mut r = Rig::new(2);
+    r.power_on(0);
+    r.power_on(1);
+    let m = r.ok(0, velocity(50.0, Direction::Positive));
+    r.until(1.0, |r| r.out(m).in_velocity);
+    assert_eq!(r.rejected(1, gear_in(0, 1.0, 1)), ErrorId::MASTER_MOVING);
+    assert_eq!(r.st(1).state, AxisState::Standstill);
+    r.ok(0, halt());
+    r.until(2.0, |r| !r.st(0).moving);
+    let s = r.ok(1, velocity(20.0, Direction::Negative));
+    r.until(1.0, |r| r.out(s).in_velocity);
+    assert_eq!(
+        r.rejected(1, gear_in(0, 1.0, 1)),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+    assert!(r.out(s).busy && !r.out(s).command_aborted);
+    r.ok(1, halt());
+    r.until(2.0, |r| !r.st(1).moving);
+    let g = r.ok(1, gear_in(0, 1.0, 1));
+    assert!(r.out(g).in_gear && r.out(g).done);
 }

@@ -52,14 +52,7 @@ fn a_gear_slave_crossing_a_soft_limit_decouples_and_stops_fast_in_error_stop() {
                 },
             )
         } else {
-            r.ok(
-                1,
-                CommandKind::GearIn {
-                    master: 0,
-                    ratio_numerator: 2.0,
-                    ratio_denominator: 1,
-                },
-            )
+            r.ok(1, gear_in(0, 2.0, 1))
         };
         r.ok(0, velocity(100.0, dir));
         let limit: f64 = if dir == Direction::Positive {
