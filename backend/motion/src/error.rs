@@ -99,6 +99,29 @@ error_table! {
     DEADMAN_TIMEOUT = 0x7061, "deadman_timeout", "jog dead-man timeout";
     /// The axis slot does not exist.
     AXIS_UNKNOWN = 0x7070, "axis_unknown", "unknown axis";
+    /// Cam table: wrong size of the data (MC_ERROR_ARRAYSIZE_INVALID; e.g. too many rows).
+    CAM_ARRAYSIZE_INVALID = 0x4B31, "cam_arraysize_invalid", "cam table: invalid size of the data";
+    /// Cam table: unknown table or an id outside what is allowed (MC_ERROR_CAMTABLEID_INVALID).
+    CAM_TABLE_ID_INVALID = 0x4B32, "cam_table_id_invalid", "cam table: invalid or unknown table id";
+    /// Motion function: point indices not > 0, not rising without gaps, or a next-point link
+    /// that skips a point that is not IGNORE (MC_ERROR_POINTID_INVALID).
+    CAM_POINT_ID_INVALID = 0x4B33, "cam_point_id_invalid", "motion function: invalid point index or next-point link";
+    /// Too few points (fewer than two valid ones) (MC_ERROR_NUMPOINTS_INVALID).
+    CAM_NUMPOINTS_INVALID = 0x4B34, "cam_numpoints_invalid", "cam table: invalid number of points";
+    /// Unknown table type, or an interpolation or motion law motiond does not offer
+    /// (MC_ERROR_MCTABLETYPE_INVALID).
+    CAM_TABLE_TYPE_INVALID = 0x4B35, "cam_table_type_invalid", "cam table: invalid table type, interpolation or motion law";
+    /// Sampling increment not > 0, or too many samples (MC_ERROR_INCREMENT_INVALID).
+    CAM_INCREMENT_INVALID = 0x4B38, "cam_increment_invalid", "cam table: invalid sampling increment";
+    /// Master positions not strictly increasing (or an equidistant table that is not).
+    CAM_MASTER_NOT_MONOTONE = 0x7080, "cam_master_not_monotone", "cam table: master positions must rise strictly";
+    /// The first or the last point of a motion function is IGNORE (Tc2_MC2_Camming safety rule).
+    CAM_IGNORE_AT_END = 0x7081, "cam_ignore_at_end", "motion function: the first and last point must not be IGNORE";
+    /// A motion law's boundary values do not match its points (e.g. a rest-to-rest law at a
+    /// VELOCITY point, a law that cannot reach its end velocity).
+    CAM_BOUNDARY_MISMATCH = 0x7082, "cam_boundary_mismatch", "motion function: the law does not match its points' boundary conditions";
+    /// A value that is not a finite number (NaN, ±∞) or a scaling of 0.
+    CAM_VALUE_INVALID = 0x7083, "cam_value_invalid", "cam table: value not a finite number";
 }
 
 impl fmt::Display for ErrorId {

@@ -61,6 +61,7 @@
 //! ```
 
 pub mod axis;
+pub mod cam;
 pub mod command;
 pub mod drive;
 pub mod error;

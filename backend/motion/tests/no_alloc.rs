@@ -228,3 +228,62 @@ fn step_and_replanning_allocate_nothing() {
     );
     assert!(k.status(2).unwrap().set_position < -100.0);
 }
+
+/// Evaluating a built cam — a motion function of every kind of law and a large spline
+/// table, periodic — allocates nothing (it runs in the cycle).
+#[test]
+fn evaluating_a_cam_allocates_nothing() {
+    use motion::cam::*;
+    let point = |i: u32, law, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: law,
+        point_type: MotionPointType::Motion,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 0.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    use MotionFunctionType::*;
+    let laws = [
+        Polynom5,
+        Bestehorn,
+        ModSinuslinie,
+        BeschlTrapez,
+        HarmonicKombiRt,
+        HarmonicKombiTr,
+        Polynom7Mm,
+        Polynom1,
+    ];
+    let mut points: Vec<_> = laws
+        .iter()
+        .enumerate()
+        .map(|(i, &l)| point(i as u32 + 1, l, i as f64 * 10.0, (i % 2) as f64 * 5.0))
+        .collect();
+    points.push(point(
+        laws.len() as u32 + 1,
+        Polynom1,
+        laws.len() as f64 * 10.0,
+        0.0,
+    ));
+    let mut mf = CamTableData::motion_function(points);
+    mf.periodic = true;
+    let rows: Vec<[f64; 2]> = (0..10_000)
+        .map(|i| [i as f64, (i as f64 * 0.01).sin()])
+        .collect();
+    let mut table = CamTableData::positions(rows, false);
+    table.periodic = true;
+    table.interpolation = InterpolationType::Spline;
+    let cams = [Cam::build(&mf).unwrap(), Cam::build(&table).unwrap()];
+    let before = allocations();
+    let mut sum = 0.0;
+    for cam in &cams {
+        for i in 0..20_000 {
+            let v = cam.eval(i as f64 * 0.731 - 3000.0);
+            sum += v.position + v.velocity + v.acceleration + v.jerk;
+        }
+    }
+    assert!(sum.is_finite());
+    assert_eq!(allocations() - before, 0, "cam evaluation allocated");
+}
