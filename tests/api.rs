@@ -879,10 +879,16 @@ async fn openapi_json_is_current() {
         "/api/v1/scope/recordings",
         "/api/v1/scope/recordings/{id}",
         "/api/v1/axes/{axis}/status/following-error-peak/reset",
+        "/api/v1/cam-tables",
+        "/api/v1/cam-tables/{table}",
+        "/api/v1/cam-tables/{table}/characteristics",
+        "/api/v1/cam-tables/{table}/slave-dynamics",
+        "/api/v1/cam-tables/{table}/master-position",
+        "/api/v1/cam-tables/{table}/values",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 37, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 43, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -1900,10 +1906,21 @@ async fn a_body_over_the_limit_is_a_413_problem() {
         "{}",
         r.json
     );
+    // Cam tables and the configuration document (which carries them) take up to 64 MiB: just
+    // over 2 MiB is read (and refused for what it says), just over 64 MiB is a 413 naming it.
     // (Only just over: a body far beyond what the server reads is cut off by its close, and
     // the client may see the reset before the response.)
     let r = send("/api/v1/config", reqwest::Method::PUT, padded(over + 1)).await;
+    assert_problem(&r, 422, "validation_failed");
+    let big = 64 * 1024 * 1024 + 1;
+    let r = send("/api/v1/cam-tables", reqwest::Method::POST, padded(big)).await;
     assert_problem(&r, 413, "payload_too_large");
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("67108864"),
+        "{}",
+        r.json
+    );
+    assert_eq!(get(&s, "/api/v1/cam-tables").await.json, json!([]));
     assert_eq!(get(&s, "/api/v1/commands").await.json, json!([]));
     // Just under the limit the body is read: the move is refused by the disabled axis.
     let r = send(

@@ -45,7 +45,7 @@ pub enum AppError {
     /// 422 `validation_failed` for one field whose value the kernel's parameter table refuses,
     /// with the kernel's error number.
     Refused {
-        field: &'static str,
+        field: std::borrow::Cow<'static, str>,
         message: String,
         id: ErrorId,
     },
@@ -139,9 +139,13 @@ impl AppError {
         AppError::Rejected(id)
     }
     /// A value the kernel's parameter table refuses: a 422 on `field` with the error number.
-    pub fn refused(field: &'static str, id: ErrorId, message: impl Into<String>) -> Self {
+    pub fn refused(
+        field: impl Into<std::borrow::Cow<'static, str>>,
+        id: ErrorId,
+        message: impl Into<String>,
+    ) -> Self {
         AppError::Refused {
-            field,
+            field: field.into(),
             message: message.into(),
             id,
         }
@@ -217,7 +221,7 @@ impl AppError {
         let errors = match self {
             Invalid(errors) => errors.clone(),
             Refused { field, message, .. } => vec![FieldError {
-                field: (*field).into(),
+                field: field.to_string(),
                 message: message.clone(),
             }],
             _ => Vec::new(),

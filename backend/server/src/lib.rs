@@ -333,6 +333,10 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     ));
 
     load_axes(&state, args.no_demo).await?;
+    let cams = service::cams::load(&state).await?;
+    if cams > 0 {
+        tracing::info!("{cams} cam tables loaded");
+    }
 
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await

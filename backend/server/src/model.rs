@@ -114,14 +114,7 @@ impl AxisConfigDto {
             })
         };
         let n = &self.name;
-        let name_ok = !n.is_empty()
-            && n.len() <= 64
-            && n.chars()
-                .next()
-                .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-            && n.chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
-        if !name_ok {
+        if !valid_name(n) {
             err(
                 "name",
                 "must start with a letter or '_' and contain only letters, digits, '_' or '-' (at most 64)",
@@ -252,6 +245,10 @@ pub struct ConfigDocument {
     #[schema(example = 1)]
     pub version: u32,
     pub axes: Vec<ConfigAxis>,
+    /// The cam tables with their ids. An import without this field leaves the stored cam
+    /// tables as they are; with it (also `[]`) they are replaced.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cam_tables: Option<Vec<CamTableBody>>,
 }
 
 /// One axis of the configuration document.
@@ -882,4 +879,177 @@ pub struct RecordingRequest {
     /// `null` (or absent): record from the next cycle on.
     #[serde(default)]
     pub trigger: Option<TriggerRequest>,
+}
+
+/// A name of an axis or a cam table: a letter or `_`, then letters, digits, `_` or `-` (at most
+/// 64). Never all digits, so that a path segment is an id or a name, never both.
+pub fn valid_name(n: &str) -> bool {
+    !n.is_empty()
+        && n.len() <= 64
+        && n.chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && n.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;
+/// also an entry of the configuration document. Position tables have `rows`, motion functions
+/// `points`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "name": "knife", "table_type": "motion_function", "periodic": true,
+    "points": [
+        {"point_index": 1, "function_type": "polynom1", "point_type": "velocity", "master_pos": 0.0, "slave_pos": 0.0, "slave_velo": 1.0},
+        {"point_index": 2, "function_type": "polynom5_mm", "point_type": "velocity", "master_pos": 30.0, "slave_pos": 30.0, "slave_velo": 1.0},
+        {"point_index": 3, "function_type": "polynom1", "point_type": "velocity", "master_pos": 330.0, "slave_pos": 330.0, "slave_velo": 1.0},
+        {"point_index": 4, "function_type": "polynom1", "point_type": "velocity", "master_pos": 360.0, "slave_pos": 360.0, "slave_velo": 1.0}
+    ]
+}))]
+pub struct CamTableBody {
+    /// MC_CAM_ID, 1..255 (`POST`: the lowest free one when left out; `PUT`: the table's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<u32>,
+    /// Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64).
+    pub name: String,
+    pub table_type: motion::cam::TableType,
+    /// Repeats cyclically; the stroke (last minus first slave position) is added per cycle.
+    #[serde(default)]
+    pub periodic: bool,
+    /// How a position table is interpolated (ignored for motion functions).
+    #[serde(default)]
+    pub interpolation: motion::cam::InterpolationType,
+    /// Position tables: `[master, slave]` rows, masters strictly rising.
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "cam_rows"
+    )]
+    #[schema(value_type = Vec<Vec<f64>>, example = json!([[0.0, 0.0], [180.0, 100.0], [360.0, 0.0]]))]
+    pub rows: Vec<[f64; 2]>,
+    /// Motion functions: `MC_MotionFunctionPoint`s, indices from 1 without gaps.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub points: Vec<motion::cam::MotionFunctionPoint>,
+}
+
+impl CamTableBody {
+    pub fn data(&self) -> motion::cam::CamTableData {
+        motion::cam::CamTableData {
+            table_type: self.table_type,
+            periodic: self.periodic,
+            interpolation: self.interpolation,
+            rows: self.rows.clone(),
+            points: self.points.clone(),
+        }
+    }
+}
+
+/// A stored cam table: what it is and its range (`GET /cam-tables/{table}` adds its rows or
+/// points).
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "id": 1, "name": "p5", "version": 1, "table_type": "motion_function", "periodic": false,
+    "interpolation": "linear", "row_count": 2, "master_start": 0.0, "master_end": 200.0,
+    "slave_start": 0.0, "slave_end": 100.0, "master_period": 200.0, "slave_stroke": 100.0,
+    "updated_at": "2026-11-25T11:10:20.502Z"
+}))]
+pub struct CamTableResource {
+    pub id: u32,
+    pub name: String,
+    /// Rises by 1 with every `PUT`.
+    pub version: i64,
+    pub table_type: motion::cam::TableType,
+    pub periodic: bool,
+    pub interpolation: motion::cam::InterpolationType,
+    /// Number of rows or points.
+    pub row_count: usize,
+    /// Raw master position of the first and the last row or point.
+    pub master_start: f64,
+    pub master_end: f64,
+    /// Raw slave position of the first and the last row or point.
+    pub slave_start: f64,
+    pub slave_end: f64,
+    /// Raw master period (last minus first master position).
+    pub master_period: f64,
+    /// Raw slave stroke (last minus first slave position).
+    pub slave_stroke: f64,
+    pub updated_at: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<Vec<Vec<f64>>>)]
+    pub rows: Option<Vec<[f64; 2]>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<motion::cam::MotionFunctionPoint>>,
+}
+
+/// MC_ReadCamTableSlaveDynamics: raw slave values at a raw master position. As in TwinCAT, a
+/// motion function gives position, velocity and acceleration, an equidistant table position
+/// and velocity, a non-equidistant one the position only (the others 0).
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"master_position": 50.0, "slave_position": 10.3515625,
+    "slave_velocity": 0.52734375, "slave_acceleration": 0.0140625}))]
+pub struct SlaveDynamicsResource {
+    pub master_position: f64,
+    pub slave_position: f64,
+    pub slave_velocity: f64,
+    pub slave_acceleration: f64,
+}
+
+/// MC_ReadCamTableMasterPosition: the nearest solutions at or below and at or above the start.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "master_low": {"valid": false, "master_axis_position": 0.0, "master_cam_position": 0.0, "slave_offset": 0.0},
+    "master_high": {"valid": true, "master_axis_position": 100.0, "master_cam_position": 100.0, "slave_offset": 0.0}
+}))]
+pub struct MasterPositionResource {
+    pub master_low: motion::cam::CamMasterData,
+    pub master_high: motion::cam::CamMasterData,
+}
+
+/// MC_ReadMotionFunctionValues: one row per sample, columns as named.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"columns": ["master", "position", "velocity"], "rows": [[0.0, 0.0, 0.0], [50.0, 10.3515625, 0.52734375]]}))]
+pub struct CamValuesResource {
+    /// `master`, then the selected values in the order position, velocity, acceleration, jerk.
+    pub columns: Vec<&'static str>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+/// Position-table rows: each exactly `[master, slave]`; a row of another length is a 422 at
+/// `rows[i]` (serde's fixed-size arrays would call it malformed JSON).
+fn cam_rows<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    struct Row([f64; 2]);
+    impl<'de> Deserialize<'de> for Row {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Row, D::Error> {
+            struct V;
+            impl<'de> serde::de::Visitor<'de> for V {
+                type Value = Row;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("a row [master, slave] of two numbers")
+                }
+                fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                    self,
+                    mut a: A,
+                ) -> Result<Row, A::Error> {
+                    use serde::de::Error;
+                    let wrong = |n: usize| {
+                        A::Error::invalid_length(n, &"a row [master, slave] of two numbers")
+                    };
+                    let m: f64 = a.next_element()?.ok_or_else(|| wrong(0))?;
+                    let s: f64 = a.next_element()?.ok_or_else(|| wrong(1))?;
+                    let mut n = 2;
+                    while a.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                        n += 1;
+                    }
+                    if n != 2 {
+                        return Err(wrong(n));
+                    }
+                    Ok(Row([m, s]))
+                }
+            }
+            d.deserialize_seq(V)
+        }
+    }
+    let rows: Vec<Row> = Deserialize::deserialize(d)?;
+    Ok(rows.into_iter().map(|r| r.0).collect())
 }

@@ -489,6 +489,114 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/cam-tables": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** List the cam tables (without their rows or points) */
+        get: operations["list_cam_tables"];
+        put?: never;
+        /**
+         * Store a cam table (MC_CamTableSelect): a position table or a motion function
+         * @description Validated with MC_TableErrorCodes (`error_id` 0x4B31…0x4B38) and motiond's cam errors (0x7080…0x7083): `errors[].field` names the row or point at fault. Bodies up to 64 MiB (a million rows).
+         */
+        post: operations["create_cam_table"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** One cam table with its rows or points */
+        get: operations["get_cam_table"];
+        /** Replace a cam table (same id, version + 1) */
+        put: operations["replace_cam_table"];
+        post?: never;
+        /** Delete a cam table */
+        delete: operations["delete_cam_table"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/characteristics": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_ReadCamTableCharacteristics: start and end values and the extremes of one cycle */
+        get: operations["characteristics"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/master-position": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_ReadCamTableMasterPosition: the nearest master positions below and above a start for a slave position */
+        get: operations["master_position"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/slave-dynamics": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_ReadCamTableSlaveDynamics: raw slave position, velocity and acceleration at a master position */
+        get: operations["slave_dynamics"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/values": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_ReadMotionFunctionValues: position, velocity, acceleration, jerk sampled over a master range */
+        get: operations["values"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/commands": {
         parameters: {
             query?: never;
@@ -550,7 +658,10 @@ export interface paths {
         };
         /** Export the whole configuration */
         get: operations["export_config"];
-        /** Import a whole configuration (replaces every axis; all axes must be disabled) */
+        /**
+         * Import a whole configuration (replaces every axis, and the cam tables if the document has them; all axes must be disabled)
+         * @description Bodies up to 64 MiB (cam tables of a million rows). The audit row records the document with each cam table's rows and points counted, not copied.
+         */
         put: operations["import_config"];
         post?: never;
         delete?: never;
@@ -1038,6 +1149,200 @@ export interface components {
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
         /**
+         * @description `ST_CamMasterData`: one solution.
+         * @example {
+         *       "master_axis_position": 100.00000031664968,
+         *       "master_cam_position": 100.00000031664968,
+         *       "slave_offset": 0,
+         *       "valid": true
+         *     }
+         */
+        CamMasterData: {
+            valid: boolean;
+            /**
+             * Format: double
+             * @description Absolute master axis position.
+             */
+            master_axis_position: number;
+            /**
+             * Format: double
+             * @description Raw master position within the cam's cycle.
+             */
+            master_cam_position: number;
+            /**
+             * Format: double
+             * @description The slave offset that belongs to that position (strokes of the cycles passed included).
+             */
+            slave_offset: number;
+        };
+        /**
+         * @description A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;
+         *     also an entry of the configuration document. Position tables have `rows`, motion functions
+         *     `points`.
+         * @example {
+         *       "name": "knife",
+         *       "periodic": true,
+         *       "points": [
+         *         {
+         *           "function_type": "polynom1",
+         *           "master_pos": 0,
+         *           "point_index": 1,
+         *           "point_type": "velocity",
+         *           "slave_pos": 0,
+         *           "slave_velo": 1
+         *         },
+         *         {
+         *           "function_type": "polynom5_mm",
+         *           "master_pos": 30,
+         *           "point_index": 2,
+         *           "point_type": "velocity",
+         *           "slave_pos": 30,
+         *           "slave_velo": 1
+         *         },
+         *         {
+         *           "function_type": "polynom1",
+         *           "master_pos": 330,
+         *           "point_index": 3,
+         *           "point_type": "velocity",
+         *           "slave_pos": 330,
+         *           "slave_velo": 1
+         *         },
+         *         {
+         *           "function_type": "polynom1",
+         *           "master_pos": 360,
+         *           "point_index": 4,
+         *           "point_type": "velocity",
+         *           "slave_pos": 360,
+         *           "slave_velo": 1
+         *         }
+         *       ],
+         *       "table_type": "motion_function"
+         *     }
+         */
+        CamTableBody: {
+            /**
+             * Format: int32
+             * @description MC_CAM_ID, 1..255 (`POST`: the lowest free one when left out; `PUT`: the table's own).
+             */
+            id?: number | null;
+            /** @description Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64). */
+            name: string;
+            table_type: components["schemas"]["TableType"];
+            /** @description Repeats cyclically; the stroke (last minus first slave position) is added per cycle. */
+            periodic?: boolean;
+            /** @description How a position table is interpolated (ignored for motion functions). */
+            interpolation?: components["schemas"]["InterpolationType"];
+            /**
+             * @description Position tables: `[master, slave]` rows, masters strictly rising.
+             * @example [
+             *       [
+             *         0,
+             *         0
+             *       ],
+             *       [
+             *         180,
+             *         100
+             *       ],
+             *       [
+             *         360,
+             *         0
+             *       ]
+             *     ]
+             */
+            rows?: number[][];
+            /** @description Motion functions: `MC_MotionFunctionPoint`s, indices from 1 without gaps. */
+            points?: components["schemas"]["MotionFunctionPoint"][];
+        };
+        /**
+         * @description A stored cam table: what it is and its range (`GET /cam-tables/{table}` adds its rows or
+         *     points).
+         * @example {
+         *       "id": 1,
+         *       "interpolation": "linear",
+         *       "master_end": 200,
+         *       "master_period": 200,
+         *       "master_start": 0,
+         *       "name": "p5",
+         *       "periodic": false,
+         *       "row_count": 2,
+         *       "slave_end": 100,
+         *       "slave_start": 0,
+         *       "slave_stroke": 100,
+         *       "table_type": "motion_function",
+         *       "updated_at": "2026-11-25T11:10:20.502Z",
+         *       "version": 1
+         *     }
+         */
+        CamTableResource: {
+            /** Format: int32 */
+            id: number;
+            name: string;
+            /**
+             * Format: int64
+             * @description Rises by 1 with every `PUT`.
+             */
+            version: number;
+            table_type: components["schemas"]["TableType"];
+            periodic: boolean;
+            interpolation: components["schemas"]["InterpolationType"];
+            /** @description Number of rows or points. */
+            row_count: number;
+            /**
+             * Format: double
+             * @description Raw master position of the first and the last row or point.
+             */
+            master_start: number;
+            /** Format: double */
+            master_end: number;
+            /**
+             * Format: double
+             * @description Raw slave position of the first and the last row or point.
+             */
+            slave_start: number;
+            /** Format: double */
+            slave_end: number;
+            /**
+             * Format: double
+             * @description Raw master period (last minus first master position).
+             */
+            master_period: number;
+            /**
+             * Format: double
+             * @description Raw slave stroke (last minus first slave position).
+             */
+            slave_stroke: number;
+            updated_at: string;
+            rows?: number[][] | null;
+            points?: components["schemas"]["MotionFunctionPoint"][] | null;
+        };
+        /**
+         * @description MC_ReadMotionFunctionValues: one row per sample, columns as named.
+         * @example {
+         *       "columns": [
+         *         "master",
+         *         "position",
+         *         "velocity"
+         *       ],
+         *       "rows": [
+         *         [
+         *           0,
+         *           0,
+         *           0
+         *         ],
+         *         [
+         *           50,
+         *           10.3515625,
+         *           0.52734375
+         *         ]
+         *       ]
+         *     }
+         */
+        CamValuesResource: {
+            /** @description `master`, then the selected values in the order position, velocity, acceleration, jerk. */
+            columns: string[];
+            rows: number[][];
+        };
+        /**
          * @description One signal of one axis.
          * @example {
          *       "axis": "x",
@@ -1051,6 +1356,122 @@ export interface components {
              */
             axis: string;
             signal: components["schemas"]["ScopeSignal"];
+        };
+        /**
+         * @description `MC_TableCharacValues`: start and end values and the extremes of one cycle of the table, with
+         *     the master positions where they occur (per raw master unit, master velocity normed to 1).
+         * @example {
+         *       "m_pos_at_s_acc_max": 42.26497317433396,
+         *       "m_pos_at_s_acc_min": 157.73502589422475,
+         *       "m_pos_at_s_jerk_max": 0,
+         *       "m_pos_at_s_jerk_min": 99.99999959131162,
+         *       "m_pos_at_s_pos_max": 200,
+         *       "m_pos_at_s_pos_min": 0,
+         *       "m_pos_at_s_velo_max": 99.99999998036839,
+         *       "m_pos_at_s_velo_min": 0,
+         *       "master_pos_end": 200,
+         *       "master_pos_start": 0,
+         *       "master_velo_nom": 1,
+         *       "s_velo_at_s_acc_max": 0.41666666801328617,
+         *       "s_velo_at_s_acc_min": 0.4166666814574845,
+         *       "slave_acc_eff": 0.010350976913489329,
+         *       "slave_acc_end": 0,
+         *       "slave_acc_max": 0.014433756729740642,
+         *       "slave_acc_min": -0.014433756729740614,
+         *       "slave_acc_start": 0,
+         *       "slave_dyn_mom_max": 0.008367835909369731,
+         *       "slave_dyn_mom_min": -0.008367835909369733,
+         *       "slave_jerk_end": 0.00075,
+         *       "slave_jerk_max": 0.00075,
+         *       "slave_jerk_min": -0.00037500000000000017,
+         *       "slave_jerk_start": 0.00075,
+         *       "slave_pos_end": 100,
+         *       "slave_pos_max": 100,
+         *       "slave_pos_min": 0,
+         *       "slave_pos_start": 0,
+         *       "slave_velo_end": 0,
+         *       "slave_velo_max": 0.9375000000000003,
+         *       "slave_velo_mean": 0.4999999701976776,
+         *       "slave_velo_min": 0,
+         *       "slave_velo_start": 0
+         *     }
+         */
+        Characteristics: {
+            /** Format: double */
+            master_velo_nom: number;
+            /** Format: double */
+            master_pos_start: number;
+            /** Format: double */
+            slave_pos_start: number;
+            /** Format: double */
+            slave_velo_start: number;
+            /** Format: double */
+            slave_acc_start: number;
+            /** Format: double */
+            slave_jerk_start: number;
+            /** Format: double */
+            master_pos_end: number;
+            /** Format: double */
+            slave_pos_end: number;
+            /** Format: double */
+            slave_velo_end: number;
+            /** Format: double */
+            slave_acc_end: number;
+            /** Format: double */
+            slave_jerk_end: number;
+            /** Format: double */
+            m_pos_at_s_pos_min: number;
+            /** Format: double */
+            slave_pos_min: number;
+            /** Format: double */
+            m_pos_at_s_velo_min: number;
+            /** Format: double */
+            slave_velo_min: number;
+            /** Format: double */
+            m_pos_at_s_acc_min: number;
+            /** Format: double */
+            slave_acc_min: number;
+            /** Format: double */
+            s_velo_at_s_acc_min: number;
+            /** Format: double */
+            m_pos_at_s_jerk_min: number;
+            /** Format: double */
+            slave_jerk_min: number;
+            /**
+             * Format: double
+             * @description Minimum of v·a (the dynamic moment's shape for a unit mass).
+             */
+            slave_dyn_mom_min: number;
+            /** Format: double */
+            m_pos_at_s_pos_max: number;
+            /** Format: double */
+            slave_pos_max: number;
+            /** Format: double */
+            m_pos_at_s_velo_max: number;
+            /** Format: double */
+            slave_velo_max: number;
+            /** Format: double */
+            m_pos_at_s_acc_max: number;
+            /** Format: double */
+            slave_acc_max: number;
+            /** Format: double */
+            s_velo_at_s_acc_max: number;
+            /** Format: double */
+            m_pos_at_s_jerk_max: number;
+            /** Format: double */
+            slave_jerk_max: number;
+            /** Format: double */
+            slave_dyn_mom_max: number;
+            /**
+             * Format: double
+             * @description Mean of |v| over the cycle.
+             */
+            slave_velo_mean: number;
+            /**
+             * Format: double
+             * @description Root mean square of the acceleration over the cycle.
+             */
+            slave_acc_eff: number;
         };
         /**
          * @description Where a command came from.
@@ -1413,6 +1834,11 @@ export interface components {
              */
             version: number;
             axes: components["schemas"]["ConfigAxis"][];
+            /**
+             * @description The cam tables with their ids. An import without this field leaves the stored cam
+             *     tables as they are; with it (also `[]`) they are replaced.
+             */
+            cam_tables?: components["schemas"]["CamTableBody"][] | null;
         };
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
@@ -1713,6 +2139,11 @@ export interface components {
             offset?: number;
         };
         /**
+         * @description `MC_InterpolationType` of a position table (ignored for motion functions).
+         * @enum {string}
+         */
+        InterpolationType: "linear" | "4point" | "spline" | "sliding_spline";
+        /**
          * @description MC_Jog: a press of JogForward / JogBackwards; held by keepalives (dead-man).
          * @example {
          *       "deadman_timeout": 0.5,
@@ -1851,6 +2282,27 @@ export interface components {
             master?: string | null;
         };
         /**
+         * @description MC_ReadCamTableMasterPosition: the nearest solutions at or below and at or above the start.
+         * @example {
+         *       "master_high": {
+         *         "master_axis_position": 100,
+         *         "master_cam_position": 100,
+         *         "slave_offset": 0,
+         *         "valid": true
+         *       },
+         *       "master_low": {
+         *         "master_axis_position": 0,
+         *         "master_cam_position": 0,
+         *         "slave_offset": 0,
+         *         "valid": false
+         *       }
+         *     }
+         */
+        MasterPositionResource: {
+            master_low: components["schemas"]["CamMasterData"];
+            master_high: components["schemas"]["CamMasterData"];
+        };
+        /**
          * @description Modulo (rotary) axis: positions wrap at `period`.
          * @example {
          *       "period": 360
@@ -1864,6 +2316,58 @@ export interface components {
              */
             period: number;
         };
+        /**
+         * @description `MC_MotionFunctionPoint`: the start of a segment (slave velocity, acceleration and jerk per
+         *     master unit: the function is normalised to master velocity 1).
+         * @example {
+         *       "function_type": "polynom5",
+         *       "master_pos": 200,
+         *       "point_index": 2,
+         *       "point_type": "rest",
+         *       "rel_index_next_point": 1,
+         *       "slave_acc": 0,
+         *       "slave_jerk": 0,
+         *       "slave_pos": 100,
+         *       "slave_velo": 0
+         *     }
+         */
+        MotionFunctionPoint: {
+            /**
+             * Format: int32
+             * @description Absolute index: > 0, rising by 1 from point to point.
+             */
+            point_index: number;
+            /** @description The law from this point to the next valid one. */
+            function_type: components["schemas"]["MotionFunctionType"];
+            point_type?: components["schemas"]["MotionPointType"];
+            /**
+             * Format: int32
+             * @description The next valid point, relative (1 unless IGNORE points follow).
+             */
+            rel_index_next_point?: number;
+            /** Format: double */
+            master_pos: number;
+            /** Format: double */
+            slave_pos: number;
+            /** Format: double */
+            slave_velo?: number;
+            /** Format: double */
+            slave_acc?: number;
+            /** Format: double */
+            slave_jerk?: number;
+        };
+        /**
+         * @description `MC_MotionFunctionType`: the law from a point to the next (TwinCAT's numbers in `value`).
+         * @enum {string}
+         */
+        MotionFunctionType: "notdef" | "polynom1" | "polynom3" | "polynom5" | "polynom7" | "polynom8" | "polynom9" | "sinuslinie" | "mod_sinuslinie" | "bestehorn" | "beschl_trapez" | "polynom5_mm" | "harmonic_kombi_rt" | "harmonic_kombi_tr" | "harmonic_kombi_vt" | "harmonic_kombi_tv" | "beschl_trapez_rt" | "beschl_trapez_tr" | "mod_sinuslinie_vv" | "polynom7_mm" | "beschl_trapez_rv" | "beschl_trapez_vr" | "polynom3_vv" | "polynom11" | "peisekah11" | "spline" | "spline_natural" | "spline_tangential" | "spline_periodic" | "spline_linear";
+        /**
+         * @description `MC_MotionPointType`: what kind of point this is, checked against the laws at the point
+         *     (REST and TURN: v = 0; VELOCITY: a = 0; MOTION: anything). ADD and ACTIVATION constrain
+         *     nothing.
+         * @enum {string}
+         */
+        MotionPointType: "ignore" | "rest" | "velocity" | "turn" | "motion" | "add" | "activation";
         /**
          * @description MC_MoveAbsolute / MC_MoveModulo: a target position.
          * @example {
@@ -2560,6 +3064,27 @@ export interface components {
             kind: "clear";
         };
         /**
+         * @description MC_ReadCamTableSlaveDynamics: raw slave values at a raw master position. As in TwinCAT, a
+         *     motion function gives position, velocity and acceleration, an equidistant table position
+         *     and velocity, a non-equidistant one the position only (the others 0).
+         * @example {
+         *       "master_position": 50,
+         *       "slave_acceleration": 0.0140625,
+         *       "slave_position": 10.3515625,
+         *       "slave_velocity": 0.52734375
+         *     }
+         */
+        SlaveDynamicsResource: {
+            /** Format: double */
+            master_position: number;
+            /** Format: double */
+            slave_position: number;
+            /** Format: double */
+            slave_velocity: number;
+            /** Format: double */
+            slave_acceleration: number;
+        };
+        /**
          * @description Software end positions (#1016–#1019); both are enabled when present.
          * @example {
          *       "max": 1000,
@@ -2787,6 +3312,11 @@ export interface components {
             timing: components["schemas"]["Timing"];
         };
         /**
+         * @description `MC_TableType`.
+         * @enum {string}
+         */
+        TableType: "equidistant" | "non_equidistant" | "motion_function";
+        /**
          * @description Timing of the cycle thread, measured by itself.
          * @example {
          *       "audit_dropped": 0,
@@ -3000,6 +3530,73 @@ export interface components {
                 [name: string]: unknown;
             };
             content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description An invalid or missing query parameter (`errors[].field` names it), or values the analysis
+         *     refuses (`error_id` 0x4B38 for an increment that is not > 0 or gives too many rows).
+         */
+        CamQueryInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "increment: the increment must be > 0, is 0",
+                 *       "error_id": 19256,
+                 *       "errors": [
+                 *         {
+                 *           "field": "increment",
+                 *           "message": "the increment must be > 0, is 0"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The name or the id is taken, or all 255 cam table ids are used. */
+        CamTableConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The table is refused: `error_id` says why (MC_TableErrorCodes 0x4B31…0x4B38, motiond's
+         *     0x7080…0x7083), `errors` names the row or point at fault. Nothing was stored.
+         */
+        CamTableInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such cam table. */
+        CamTableNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "cam_table_not_found",
+                 *       "detail": "no cam_table 'knife'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:cam_table_not_found"
+                 *     }
+                 */
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -4924,6 +5521,304 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    list_cam_tables: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description All cam tables, by id */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"][];
+                };
+            };
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    create_cam_table: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamTableBody"];
+            };
+        };
+        responses: {
+            /** @description Stored */
+            201: {
+                headers: {
+                    /** @description /api/v1/cam-tables/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            409: components["responses"]["CamTableConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamTableInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    get_cam_table: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The table */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    replace_cam_table: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamTableBody"];
+            };
+        };
+        responses: {
+            /** @description Replaced */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["CamTableNotFound"];
+            409: components["responses"]["CamTableConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamTableInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    delete_cam_table: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Deleted */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["CamTableNotFound"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    characteristics: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Per raw master unit (master velocity normed to 1) */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Characteristics"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    master_position: {
+        parameters: {
+            query: {
+                /** @description The slave axis position to find master positions for. */
+                slave_position: number;
+                /** @description Master offset of the coupling (default 0). */
+                master_offset?: number;
+                /** @description Slave offset of the coupling (default 0). */
+                slave_offset?: number;
+                /** @description Master scaling of the coupling (default 1). */
+                master_scaling?: number;
+                /** @description Slave scaling of the coupling (default 1). */
+                slave_scaling?: number;
+                /** @description Master axis position the search starts from (default 0). */
+                master_start_position?: number;
+                /** @description Accuracy of the master positions found, axis units (default 1e-9 of the period). */
+                master_accuracy?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description `valid` is false where there is no solution */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MasterPositionResource"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamQueryInvalid"];
+        };
+    };
+    slave_dynamics: {
+        parameters: {
+            query: {
+                /** @description Raw master position in the table's coordinates (no coupling offset or scaling). */
+                master_position: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Raw table values */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SlaveDynamicsResource"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamQueryInvalid"];
+        };
+    };
+    values: {
+        parameters: {
+            query: {
+                /** @description Raw master position of the first sample. */
+                start: number;
+                /** @description Raw master position of the last sample (at most). */
+                end: number;
+                /** @description Master step (> 0; at most 100 000 rows). */
+                increment: number;
+                /** @description Comma-separated: `position`, `velocity`, `acceleration`, `jerk` (default all four). */
+                values?: string;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Rows from `start` by `increment` */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamValuesResource"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamQueryInvalid"];
         };
     };
     list_commands: {

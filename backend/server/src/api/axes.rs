@@ -162,13 +162,33 @@ pub async fn export_config(State(s): State<Arc<AppState>>) -> Json<ConfigDocumen
 }
 
 #[utoipa::path(put, path = "/api/v1/config", tag = "system",
-    summary = "Import a whole configuration (replaces every axis; all axes must be disabled)",
+    summary = "Import a whole configuration (replaces every axis, and the cam tables if the document has them; all axes must be disabled)",
+    description = "Bodies up to 64 MiB (cam tables of a million rows). The audit row records the document with each cam \
+table's rows and points counted, not copied.",
     request_body = ConfigDocument,
     responses((status = 200, description = "Imported; the configuration as now active", body = ConfigDocument), super::errors::ImportErrors))]
 pub async fn import_config(
     State(s): State<Arc<AppState>>,
     client: Client,
-    JsonBody(doc, raw): JsonBody<ConfigDocument>,
+    super::cams::LargeJsonBody(doc): super::cams::LargeJsonBody<ConfigDocument>,
 ) -> AppResult<Json<ConfigDocument>> {
+    let raw = audit_view(&doc);
     Ok(Json(axes::import(&s, doc, &raw, &client.0).await?))
+}
+
+/// The document as the audit log keeps it: cam tables with their rows and points counted.
+fn audit_view(doc: &ConfigDocument) -> serde_json::Value {
+    let mut v = serde_json::json!({ "version": doc.version, "axes": doc.axes });
+    if let Some(tables) = &doc.cam_tables {
+        v["cam_tables"] = tables
+            .iter()
+            .map(|t| {
+                serde_json::json!({
+                    "id": t.id, "name": t.name, "table_type": t.table_type, "periodic": t.periodic,
+                    "interpolation": t.interpolation, "row_count": t.rows.len() + t.points.len(),
+                })
+            })
+            .collect();
+    }
+    v
 }

@@ -135,6 +135,9 @@ problem_responses! {
     /// No such command (never accepted, or no longer among the last 2000).
     CommandNotFound(example = json!(p(AppError::not_found("command", "12345"))));
 
+    /// No such cam table.
+    CamTableNotFound(example = json!(p(AppError::not_found("cam_table", "knife"))));
+
     /// No such recording (never made, deleted, or evicted).
     RecordingNotFound(example = json!(p(AppError::not_found("recording", "7"))));
 
@@ -173,6 +176,13 @@ problem_responses! {
         ("scope_busy" = (value = json!(p(AppError::conflict("scope_busy",
             "too many active recordings (at most 8 recordings and 9600000 values are kept); cancel one or \
              wait until it is done")))))));
+
+    /// The name or the id is taken, or all 255 cam table ids are used.
+    CamTableConflict(examples(
+        ("cam_table_name_taken" = (value = json!(p(AppError::conflict("cam_table_name_taken", "a cam table named 'knife' exists"))))),
+        ("cam_table_id_taken" = (value = json!(p(AppError::conflict("cam_table_id_taken",
+            "cam table 3 exists: PUT /api/v1/cam-tables/3 replaces it"))))),
+        ("no_free_cam_table_id" = (value = json!(p(AppError::conflict("no_free_cam_table_id", "all 255 cam table ids are used")))))));
 
     /// CSV of a recording that is not done.
     RecordingNotDone(example = json!(p(AppError::conflict(
@@ -222,6 +232,24 @@ problem_responses! {
 
     /// The document is invalid; `errors` lists every invalid field (`axes[i].config.…`).
     ImportInvalid(example = json!(p(AppError::field("axes[1].config.name", "duplicate name"))));
+
+    /// The table is refused: `error_id` says why (MC_TableErrorCodes 0x4B31…0x4B38, motiond's
+    /// 0x7080…0x7083), `errors` names the row or point at fault. Nothing was stored.
+    CamTableInvalid(examples(
+        ("cam_master_not_monotone" = (summary = "Master positions not rising",
+            value = json!(p(AppError::refused("rows[2][0]", ErrorId::CAM_MASTER_NOT_MONOTONE,
+                "master positions must rise strictly: row 2 (90) after row 1 (100)"))))),
+        ("cam_ignore_at_end" = (summary = "An IGNORE point first or last (unintended motion)",
+            value = json!(p(AppError::refused("points[0].point_type", ErrorId::CAM_IGNORE_AT_END,
+                "the first and the last point must not be IGNORE: the axis could move unintendedly"))))),
+        ("cam_boundary_mismatch" = (summary = "A law that does not fit its points",
+            value = json!(p(AppError::refused("points[0].point_type", ErrorId::CAM_BOUNDARY_MISMATCH,
+                "point 0 needs v = 0 (REST), but Polynom1 from point 0 gives v = 0.5, a = 0 there")))))));
+
+    /// An invalid or missing query parameter (`errors[].field` names it), or values the analysis
+    /// refuses (`error_id` 0x4B38 for an increment that is not > 0 or gives too many rows).
+    CamQueryInvalid(example = json!(p(AppError::refused("increment", ErrorId::CAM_INCREMENT_INVALID,
+        "the increment must be > 0, is 0"))));
 
     /// Not a fault: unknown `kind`, missing or wrong fields.
     FaultInvalid(example = json!(p(AppError::field("body",
@@ -345,6 +373,22 @@ error_sets! {
         400: MalformedJson, 404: AxisNotFound, 413: PayloadTooLarge, 422: FaultInvalid,
         503: CycleUnavailable,
     }
+    /// `GET /cam-tables/{table}`, its characteristics.
+    CamTableReadErrors { 404: CamTableNotFound }
+    /// The cam analysis queries.
+    CamTableQueryErrors { 404: CamTableNotFound, 422: CamQueryInvalid }
+    /// `POST /cam-tables`.
+    CamTableCreateErrors {
+        400: MalformedJson, 409: CamTableConflict, 413: PayloadTooLarge, 422: CamTableInvalid,
+        503: WriteUnavailable,
+    }
+    /// `PUT /cam-tables/{table}`.
+    CamTableReplaceErrors {
+        400: MalformedJson, 404: CamTableNotFound, 409: CamTableConflict, 413: PayloadTooLarge,
+        422: CamTableInvalid, 503: WriteUnavailable,
+    }
+    /// `DELETE /cam-tables/{table}`.
+    CamTableDeleteErrors { 404: CamTableNotFound, 503: WriteUnavailable }
     /// `GET /audit`.
     AuditErrors { 422: AuditInvalid, 503: AuditUnavailable }
     /// `GET /ws`: not a websocket handshake, or one from another origin.

@@ -4,6 +4,7 @@ pub mod asyncapi;
 pub mod audit;
 pub mod axes;
 pub mod blocks;
+pub mod cams;
 pub mod commands;
 pub mod errors;
 pub mod guard;
@@ -107,7 +108,7 @@ pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Resu
 }
 
 /// 422 for a body that is JSON but not an object.
-fn not_an_object(value: &serde_json::Value) -> AppError {
+pub(crate) fn not_an_object(value: &serde_json::Value) -> AppError {
     use serde_json::Value;
     let what = match value {
         Value::Array(_) => "an array",
@@ -210,9 +211,40 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             "/scope/recordings/{id}",
             get(scope::get_recording).delete(scope::delete_recording),
         )
+        .route(
+            "/cam-tables",
+            get(cams::list_cam_tables)
+                .post(cams::create_cam_table)
+                .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
+        )
+        .route(
+            "/cam-tables/{table}",
+            get(cams::get_cam_table)
+                .put(cams::replace_cam_table)
+                .delete(cams::delete_cam_table)
+                .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
+        )
+        .route(
+            "/cam-tables/{table}/characteristics",
+            get(cams::characteristics),
+        )
+        .route(
+            "/cam-tables/{table}/slave-dynamics",
+            get(cams::slave_dynamics),
+        )
+        .route(
+            "/cam-tables/{table}/master-position",
+            get(cams::master_position),
+        )
+        .route("/cam-tables/{table}/values", get(cams::values))
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
-        .route("/config", get(axes::export_config).put(axes::import_config))
+        .route(
+            "/config",
+            get(axes::export_config)
+                .put(axes::import_config)
+                .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
+        )
         .route("/ws", get(websocket))
         .fallback(not_found)
         .layer(axum::Extension(ws))
@@ -360,7 +392,7 @@ pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
         description = "Motion controller appliance: PLCopen (TwinCAT NC / Tc2_MC2) axes over REST and websocket.\n\n\
 Errors are `application/problem+json` (RFC 9457) with a stable `code` and, for errors of the motion kernel, \
 the PLCopen `error_id`. Besides the errors listed for each operation, any route answers a method it does not take \
-with 405 `method_not_allowed` (the `Allow` header lists those it takes), a body over 2 MiB with 413 \
+with 405 `method_not_allowed` (the `Allow` header lists those it takes), a body over 2 MiB (64 MiB for cam tables and the configuration document) with 413 \
 `payload_too_large` and a path that is not UTF-8 with 400 `bad_request`.\n\n\
 Requests from web pages of other sites are refused: a `Host` that is not a loopback name or address or a name \
 given with `--public-name` is a 421 `misdirected_request` (any request); a request that changes something \
@@ -378,6 +410,8 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
         simulation::inject_fault,
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
+        cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
+        cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),
@@ -385,6 +419,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
         (name = "commands", description = "One endpoint per function block; command resources"),
+        (name = "cams", description = "Cam tables (TwinCAT NC Camming): position tables and motion functions, and their analysis"),
         (name = "simulation", description = "Fault injection into the simulated drives"),
         (name = "scope", description = "Recordings of axis signals at the cycle rate, optionally triggered"),
         (name = "system", description = "Version, cycle timing, metrics, configuration export/import, audit log"),
@@ -415,6 +450,25 @@ impl ApiDoc {
 /// statistics): real values of those types, serialised. A schema with its own example keeps it.
 struct ForeignExamples;
 
+/// The documentation's example cam: POLYNOM5 rest to rest from (0, 0) to (200, 100).
+fn example_cam() -> (motion::cam::Cam, Vec<motion::cam::MotionFunctionPoint>) {
+    use motion::cam::*;
+    let point = |i: u32, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: MotionFunctionType::Polynom5,
+        point_type: MotionPointType::Rest,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 0.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    let points = vec![point(1, 0.0, 0.0), point(2, 200.0, 100.0)];
+    let cam = Cam::build(&CamTableData::motion_function(points.clone())).expect("a valid cam");
+    (cam, points)
+}
+
 impl utoipa::Modify for ForeignExamples {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
         use serde_json::{json, to_value};
@@ -442,6 +496,30 @@ impl utoipa::Modify for ForeignExamples {
                 to_value(motion::params::lookup("AxisCtrlVelocityPreCtrlWeight")),
             ),
             ("ParamValue", Ok(json!(90.0))),
+            ("MotionFunctionPoint", to_value(example_cam().1[1])),
+            (
+                "Characteristics",
+                to_value(motion::cam::characteristics(&example_cam().0)),
+            ),
+            (
+                "CamMasterData",
+                to_value(
+                    motion::cam::master_position(
+                        &example_cam().0,
+                        &motion::cam::MasterSearch {
+                            slave_position: 50.0,
+                            master_offset: 0.0,
+                            slave_offset: 0.0,
+                            master_scaling: 1.0,
+                            slave_scaling: 1.0,
+                            master_start_position: 10.0,
+                            master_accuracy: 1e-6,
+                        },
+                    )
+                    .expect("valid search")
+                    .1,
+                ),
+            ),
             (
                 "FieldError",
                 to_value(crate::sim::FieldError {

@@ -10,7 +10,7 @@ mod registry;
 
 pub use commands::{CommandNotice, CommandRecord, CommandStore, HISTORY, Milestone};
 pub use pump::{audit_writer, pump};
-pub use registry::{AxisEntry, Registry};
+pub use registry::{AxisEntry, CamEntry, Registry};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};

@@ -22,6 +22,19 @@ pub struct AxisEntry {
 #[derive(Default)]
 pub struct Registry {
     pub axes: BTreeMap<i64, AxisEntry>,
+    /// Cam tables by id (MC_CAM_ID).
+    pub cams: BTreeMap<u32, CamEntry>,
+}
+
+/// A stored cam table: its definition and the cam built from it (shared with couplings).
+#[derive(Clone, Debug)]
+pub struct CamEntry {
+    pub id: u32,
+    pub name: String,
+    pub version: i64,
+    pub data: std::sync::Arc<motion::cam::CamTableData>,
+    pub cam: std::sync::Arc<motion::cam::Cam>,
+    pub updated_at: String,
 }
 
 impl Registry {
@@ -36,6 +49,13 @@ impl Registry {
         match key.parse::<i64>() {
             Ok(id) => self.axes.get_mut(&id),
             Err(_) => self.axes.values_mut().find(|a| a.name == key),
+        }
+    }
+    /// A cam table by id (all digits) or by name.
+    pub fn find_cam(&self, key: &str) -> Option<&CamEntry> {
+        match key.parse::<u32>() {
+            Ok(id) => self.cams.get(&id),
+            Err(_) => self.cams.values().find(|c| c.name == key),
         }
     }
     pub fn by_slot(&self, slot: AxisSlot) -> Option<&AxisEntry> {

@@ -28,7 +28,13 @@ fn resource(s: &AppState, e: &AxisEntry) -> AxisResource {
     }
 }
 
-fn audit_entry(client: &ClientInfo, action: &str, target: &str, detail: String) -> AuditEntry {
+/// An audit row of a configuration change by `client`, committed with the change.
+pub(super) fn audit_entry(
+    client: &ClientInfo,
+    action: &str,
+    target: &str,
+    detail: String,
+) -> AuditEntry {
     AuditEntry {
         at: store::now_rfc3339(),
         client_addr: Some(client.addr.clone()),
@@ -409,9 +415,11 @@ pub async fn write_parameter(
 
 /// The whole configuration: axes with their persistent parameters.
 pub fn export(s: &AppState) -> ConfigDocument {
+    let cam_tables = Some(super::cams::export(s));
     let reg = s.registry.read().unwrap();
     ConfigDocument {
         version: 1,
+        cam_tables,
         axes: reg
             .axes
             .values()
@@ -460,6 +468,16 @@ pub async fn import(
             message: format!("at most {} axes", crate::cycle::MAX_AXES),
         });
     }
+    let cams = match &doc.cam_tables {
+        None => None,
+        Some(tables) => match super::cams::prepare_import(tables).await {
+            Ok(entries) => Some(entries),
+            Err(e) => {
+                errs.extend(e);
+                None
+            }
+        },
+    };
     let mut built = Vec::new();
     for (i, a) in doc.axes.iter().enumerate() {
         if a.id <= 0 {
@@ -553,6 +571,9 @@ pub async fn import(
             store::axes::upsert_persistent(&mut tx, a.id, *n, &value, &now).await?;
         }
     }
+    if let Some(entries) = &cams {
+        super::cams::store_import(&mut tx, entries).await?;
+    }
     store::audit(
         &mut *tx,
         &audit_entry(client, "config.import", "config", raw.to_string()),
@@ -632,6 +653,9 @@ pub async fn import(
     {
         let mut reg = s.registry.write().unwrap();
         reg.axes = entries.into_iter().map(|e| (e.id, e)).collect();
+        if let Some(cams) = cams {
+            reg.cams = cams.into_iter().map(|e| (e.id, e)).collect();
+        }
     }
     Ok(export(s))
 }

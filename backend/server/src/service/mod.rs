@@ -3,6 +3,7 @@
 //! `crate::app`, the SQL of `crate::store` and the cycle thread; errors are `AppError`.
 
 pub mod axes;
+pub mod cams;
 pub mod commands;
 pub mod scope;
 pub mod simulation;

@@ -1,12 +1,13 @@
 //! SQLite store (DESIGN §5): WAL, synchronous=FULL, one writer connection. All SQL lives in
 //! this module, one submodule per table group ([`axes`]: axes and their persistent
-//! parameters; [`audit`]: the audit log); the service decides what goes into a transaction.
+//! parameters; [`cams`]: cam tables; [`audit`]: the audit log); the service decides what goes into a transaction.
 //!
 //! The database is opened with `locking_mode=EXCLUSIVE`, so a second motiond on the same
 //! file fails at start-up with "database is locked" instead of two processes writing.
 
 pub mod audit;
 pub mod axes;
+pub mod cams;
 
 pub use audit::{AuditEntry, AuditRow, audit, read_audit};
 pub use axes::{StoredAxis, load_axes, load_persistent};

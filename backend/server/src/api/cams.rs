@@ -1,0 +1,272 @@
+//! Cam tables and the cam analysis FBs: the HTTP side (the rules are `service::cams`).
+
+use std::sync::Arc;
+
+use axum::Json;
+use axum::extract::{FromRequest, Path, Request, State};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use motion::cam::{Characteristics, MasterSearch, ValueSelect};
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use utoipa::IntoParams;
+
+use super::{Client, Q};
+use crate::app::AppState;
+use crate::error::{AppError, AppResult};
+use crate::model::{
+    CamTableBody, CamTableResource, CamValuesResource, MasterPositionResource,
+    SlaveDynamicsResource,
+};
+use crate::service::cams;
+
+/// The largest cam table body: a million rows of JSON numbers is about 40 MB.
+pub const CAM_BODY_LIMIT: usize = 64 * 1024 * 1024;
+
+/// A large JSON object body read straight into `T` (no `serde_json::Value` tree: a million
+/// rows would cost hundreds of megabytes), with the same problem+json answers as `JsonBody`.
+pub struct LargeJsonBody<T>(pub T);
+
+impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for LargeJsonBody<T> {
+    type Rejection = AppError;
+
+    async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
+        let bytes = axum::body::Bytes::from_request(req, state)
+            .await
+            .map_err(|e| {
+                if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
+                    AppError::too_large(CAM_BODY_LIMIT)
+                } else {
+                    AppError::bad_json(format!("cannot read the body: {e}"))
+                }
+            })?;
+        match bytes.iter().find(|b| !b.is_ascii_whitespace()) {
+            Some(b'{') => {}
+            None => return Err(AppError::field("body", "a cam table is required")),
+            Some(_) => {
+                // Not an object: malformed JSON is a 400, any other JSON value a 422.
+                let v: serde_json::Value = serde_json::from_slice(&bytes)
+                    .map_err(|e| AppError::bad_json(e.to_string()))?;
+                return Err(super::not_an_object(&v));
+            }
+        }
+        let mut de = serde_json::Deserializer::from_slice(&bytes);
+        let t = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let inner = e.inner();
+            if inner.is_syntax() || inner.is_eof() {
+                return AppError::bad_json(inner.to_string());
+            }
+            let mut path = e.path().to_string();
+            let message = inner.to_string();
+            if let Some(name) = message
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split('`').next())
+            {
+                path = if path == "." {
+                    name.to_string()
+                } else {
+                    format!("{path}.{name}")
+                };
+            }
+            if path == "." {
+                path = "body".into();
+            }
+            AppError::field(&path, &message)
+        })?;
+        de.end().map_err(|e| AppError::bad_json(e.to_string()))?;
+        Ok(LargeJsonBody(t))
+    }
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables", tag = "cams", summary = "List the cam tables (without their rows or points)",
+    responses((status = 200, description = "All cam tables, by id", body = Vec<CamTableResource>)))]
+pub async fn list_cam_tables(State(s): State<Arc<AppState>>) -> Json<Vec<CamTableResource>> {
+    Json(cams::list(&s))
+}
+
+#[utoipa::path(post, path = "/api/v1/cam-tables", tag = "cams",
+    summary = "Store a cam table (MC_CamTableSelect): a position table or a motion function",
+    description = "Validated with MC_TableErrorCodes (`error_id` 0x4B31…0x4B38) and motiond's cam errors \
+(0x7080…0x7083): `errors[].field` names the row or point at fault. Bodies up to 64 MiB (a million rows).",
+    request_body = CamTableBody,
+    responses((status = 201, description = "Stored", body = CamTableResource,
+        headers(("Location" = String, description = "/api/v1/cam-tables/{id}"))), super::errors::CamTableCreateErrors))]
+pub async fn create_cam_table(
+    State(s): State<Arc<AppState>>,
+    client: Client,
+    LargeJsonBody(body): LargeJsonBody<CamTableBody>,
+) -> AppResult<Response> {
+    let r = cams::create(&s, body, &client.0).await?;
+    let loc = format!("/api/v1/cam-tables/{}", r.id);
+    let mut resp = (StatusCode::CREATED, Json(r)).into_response();
+    resp.headers_mut().insert(
+        header::LOCATION,
+        HeaderValue::from_str(&loc).expect("ascii"),
+    );
+    Ok(resp)
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}", tag = "cams", summary = "One cam table with its rows or points",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    responses((status = 200, description = "The table", body = CamTableResource), super::errors::CamTableReadErrors))]
+pub async fn get_cam_table(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+) -> AppResult<Json<CamTableResource>> {
+    Ok(Json(cams::get(&s, &table)?))
+}
+
+#[utoipa::path(put, path = "/api/v1/cam-tables/{table}", tag = "cams", summary = "Replace a cam table (same id, version + 1)",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    request_body = CamTableBody,
+    responses((status = 200, description = "Replaced", body = CamTableResource), super::errors::CamTableReplaceErrors))]
+pub async fn replace_cam_table(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    client: Client,
+    LargeJsonBody(body): LargeJsonBody<CamTableBody>,
+) -> AppResult<Json<CamTableResource>> {
+    Ok(Json(cams::replace(&s, &table, body, &client.0).await?))
+}
+
+#[utoipa::path(delete, path = "/api/v1/cam-tables/{table}", tag = "cams", summary = "Delete a cam table",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    responses((status = 204, description = "Deleted"), super::errors::CamTableDeleteErrors))]
+pub async fn delete_cam_table(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    client: Client,
+) -> AppResult<StatusCode> {
+    cams::delete(&s, &table, &client.0).await?;
+    Ok(StatusCode::NO_CONTENT)
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/characteristics", tag = "cams",
+    summary = "MC_ReadCamTableCharacteristics: start and end values and the extremes of one cycle",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    responses((status = 200, description = "Per raw master unit (master velocity normed to 1)", body = Characteristics), super::errors::CamTableReadErrors))]
+pub async fn characteristics(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+) -> AppResult<Json<Characteristics>> {
+    Ok(Json(cams::characteristics(&s, &table).await?))
+}
+
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct SlaveDynamicsQuery {
+    /// Raw master position in the table's coordinates (no coupling offset or scaling).
+    pub master_position: f64,
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/slave-dynamics", tag = "cams",
+    summary = "MC_ReadCamTableSlaveDynamics: raw slave position, velocity and acceleration at a master position",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife"), SlaveDynamicsQuery),
+    responses((status = 200, description = "Raw table values", body = SlaveDynamicsResource), super::errors::CamTableQueryErrors))]
+pub async fn slave_dynamics(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    Q(q): Q<SlaveDynamicsQuery>,
+) -> AppResult<Json<SlaveDynamicsResource>> {
+    Ok(Json(cams::slave_dynamics(&s, &table, q.master_position)?))
+}
+
+/// MC_ReadCamTableMasterPosition's inputs (axis coordinates and the coupling's offsets and
+/// scalings).
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct MasterPositionQuery {
+    /// The slave axis position to find master positions for.
+    pub slave_position: f64,
+    /// Master offset of the coupling (default 0).
+    pub master_offset: Option<f64>,
+    /// Slave offset of the coupling (default 0).
+    pub slave_offset: Option<f64>,
+    /// Master scaling of the coupling (default 1).
+    pub master_scaling: Option<f64>,
+    /// Slave scaling of the coupling (default 1).
+    pub slave_scaling: Option<f64>,
+    /// Master axis position the search starts from (default 0).
+    pub master_start_position: Option<f64>,
+    /// Accuracy of the master positions found, axis units (default 1e-9 of the period).
+    pub master_accuracy: Option<f64>,
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/master-position", tag = "cams",
+    summary = "MC_ReadCamTableMasterPosition: the nearest master positions below and above a start for a slave position",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife"), MasterPositionQuery),
+    responses((status = 200, description = "`valid` is false where there is no solution", body = MasterPositionResource), super::errors::CamTableQueryErrors))]
+pub async fn master_position(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    Q(q): Q<MasterPositionQuery>,
+) -> AppResult<Json<MasterPositionResource>> {
+    let search = MasterSearch {
+        slave_position: q.slave_position,
+        master_offset: q.master_offset.unwrap_or(0.0),
+        slave_offset: q.slave_offset.unwrap_or(0.0),
+        master_scaling: q.master_scaling.unwrap_or(1.0),
+        slave_scaling: q.slave_scaling.unwrap_or(1.0),
+        master_start_position: q.master_start_position.unwrap_or(0.0),
+        master_accuracy: q.master_accuracy.unwrap_or(0.0),
+    };
+    Ok(Json(cams::master_position(&s, &table, search).await?))
+}
+
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct ValuesQuery {
+    /// Raw master position of the first sample.
+    pub start: f64,
+    /// Raw master position of the last sample (at most).
+    pub end: f64,
+    /// Master step (> 0; at most 100 000 rows).
+    pub increment: f64,
+    /// Comma-separated: `position`, `velocity`, `acceleration`, `jerk` (default all four).
+    pub values: Option<String>,
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/values", tag = "cams",
+    summary = "MC_ReadMotionFunctionValues: position, velocity, acceleration, jerk sampled over a master range",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife"), ValuesQuery),
+    responses((status = 200, description = "Rows from `start` by `increment`", body = CamValuesResource), super::errors::CamTableQueryErrors))]
+pub async fn values(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    Q(q): Q<ValuesQuery>,
+) -> AppResult<Json<CamValuesResource>> {
+    let mut select = Vec::new();
+    for v in q
+        .values
+        .as_deref()
+        .unwrap_or("")
+        .split(',')
+        .map(str::trim)
+        .filter(|v| !v.is_empty())
+    {
+        select.push(
+            serde_json::from_value::<ValueSelect>(serde_json::Value::String(v.into())).map_err(
+                |_| {
+                    AppError::field(
+                        "values",
+                        &format!(
+                            "unknown value `{v}`: expected position, velocity, acceleration or jerk"
+                        ),
+                    )
+                },
+            )?,
+        );
+    }
+    Ok(Json(cams::values(
+        &s,
+        &table,
+        q.start,
+        q.end,
+        q.increment,
+        &select,
+    )?))
+}

@@ -1,0 +1,464 @@
+//! Cam tables (TwinCAT NC Camming): create, replace, delete, export and import with the
+//! configuration, and the analysis FBs. A table is validated and built on a blocking thread
+//! (a million-row spline takes tens of milliseconds), stored in one transaction with its audit
+//! row, and only then put in the registry.
+
+use std::sync::Arc;
+
+use motion::cam::{self, Cam, CamError, CamTableData, MasterSearch, TableType, ValueSelect};
+
+use super::axes::audit_entry;
+use crate::app::{AppState, CamEntry};
+use crate::error::{AppError, AppResult};
+use crate::model::{
+    CamTableBody, CamTableResource, CamValuesResource, ClientInfo, MasterPositionResource,
+    SlaveDynamicsResource, valid_name,
+};
+use crate::sim::FieldError;
+use crate::store;
+
+/// MC_CAM_ID: 1..255.
+pub const MAX_CAM_ID: u32 = 255;
+/// The most rows MC_ReadMotionFunctionValues answers with in one response.
+pub const MAX_VALUE_ROWS: usize = 100_000;
+
+fn refused(e: CamError) -> AppError {
+    AppError::refused(e.field, e.id, e.message)
+}
+
+fn resource(e: &CamEntry, with_data: bool) -> CamTableResource {
+    let (master_start, master_end) = e.cam.master_range();
+    let (slave_start, slave_end) = e.cam.slave_range();
+    CamTableResource {
+        id: e.id,
+        name: e.name.clone(),
+        version: e.version,
+        table_type: e.data.table_type,
+        periodic: e.data.periodic,
+        interpolation: e.data.interpolation,
+        row_count: e.data.len(),
+        master_start,
+        master_end,
+        slave_start,
+        slave_end,
+        master_period: e.cam.period(),
+        slave_stroke: e.cam.stroke(),
+        updated_at: e.updated_at.clone(),
+        rows: (with_data && !e.data.rows.is_empty()).then(|| e.data.rows.clone()),
+        points: (with_data && !e.data.points.is_empty()).then(|| e.data.points.clone()),
+    }
+}
+
+fn entry(s: &AppState, key: &str) -> AppResult<CamEntry> {
+    s.registry
+        .read()
+        .unwrap()
+        .find_cam(key)
+        .cloned()
+        .ok_or_else(|| AppError::not_found("cam_table", key))
+}
+
+pub fn list(s: &AppState) -> Vec<CamTableResource> {
+    s.registry
+        .read()
+        .unwrap()
+        .cams
+        .values()
+        .map(|e| resource(e, false))
+        .collect()
+}
+
+pub fn get(s: &AppState, key: &str) -> AppResult<CamTableResource> {
+    Ok(resource(&entry(s, key)?, true))
+}
+
+/// The table's own checks (name, id range), with the JSON path prefix of where it was sent.
+fn check(body: &CamTableBody, prefix: &str) -> Vec<FieldError> {
+    let mut errs = Vec::new();
+    if !valid_name(&body.name) {
+        errs.push(FieldError {
+            field: format!("{prefix}name"),
+            message: "must start with a letter or '_' and contain only letters, digits, '_' or '-' (at most 64)".into(),
+        });
+    }
+    if let Some(id) = body.id {
+        if !(1..=MAX_CAM_ID).contains(&id) {
+            errs.push(FieldError {
+                field: format!("{prefix}id"),
+                message: format!("a cam table id (MC_CAM_ID) is 1..{MAX_CAM_ID}"),
+            });
+        }
+    }
+    errs
+}
+
+/// Validates and builds the cam off the async workers.
+async fn build(data: CamTableData) -> AppResult<(CamTableData, Cam)> {
+    tokio::task::spawn_blocking(move || Cam::build(&data).map(|cam| (data, cam)))
+        .await
+        .map_err(|e| AppError::unavailable("internal", format!("building the cam failed: {e}")))?
+        .map_err(refused)
+}
+
+fn audit_detail(id: u32, name: &str, version: i64, data: &CamTableData) -> String {
+    serde_json::json!({
+        "id": id, "name": name, "version": version, "table_type": data.table_type,
+        "periodic": data.periodic, "interpolation": data.interpolation, "row_count": data.len(),
+    })
+    .to_string()
+}
+
+fn name_taken(s: &AppState, name: &str, except: Option<u32>) -> AppResult<()> {
+    if s.registry
+        .read()
+        .unwrap()
+        .cams
+        .values()
+        .any(|c| c.name == name && Some(c.id) != except)
+    {
+        return Err(AppError::conflict(
+            "cam_table_name_taken",
+            format!("a cam table named '{name}' exists"),
+        ));
+    }
+    Ok(())
+}
+
+/// Stores a new table (`POST /cam-tables`). Nothing is changed unless all of it commits.
+pub async fn create(
+    s: &AppState,
+    body: CamTableBody,
+    client: &ClientInfo,
+) -> AppResult<CamTableResource> {
+    let errs = check(&body, "");
+    if !errs.is_empty() {
+        return Err(AppError::Invalid(errs));
+    }
+    let (data, cam) = build(body.data()).await?;
+    let _guard = s.config_lock.lock().await;
+    name_taken(s, &body.name, None)?;
+    let id = {
+        let reg = s.registry.read().unwrap();
+        match body.id {
+            Some(id) if reg.cams.contains_key(&id) => {
+                return Err(AppError::conflict(
+                    "cam_table_id_taken",
+                    format!("cam table {id} exists: PUT /api/v1/cam-tables/{id} replaces it"),
+                ));
+            }
+            Some(id) => id,
+            None => (1..=MAX_CAM_ID)
+                .find(|id| !reg.cams.contains_key(id))
+                .ok_or_else(|| {
+                    AppError::conflict("no_free_cam_table_id", "all 255 cam table ids are used")
+                })?,
+        }
+    };
+    store_and_register(s, id, &body.name, 1, data, cam, client, "cam_table.create").await
+}
+
+/// Replaces a table (`PUT /cam-tables/{table}`): same id, version + 1.
+pub async fn replace(
+    s: &AppState,
+    key: &str,
+    body: CamTableBody,
+    client: &ClientInfo,
+) -> AppResult<CamTableResource> {
+    let errs = check(&body, "");
+    if !errs.is_empty() {
+        return Err(AppError::Invalid(errs));
+    }
+    let (data, cam) = build(body.data()).await?;
+    let _guard = s.config_lock.lock().await;
+    let old = entry(s, key)?;
+    if body.id.is_some_and(|id| id != old.id) {
+        return Err(AppError::field(
+            "id",
+            &format!(
+                "the table's id is {}; a table keeps its id (create a new one with POST)",
+                old.id
+            ),
+        ));
+    }
+    name_taken(s, &body.name, Some(old.id))?;
+    store_and_register(
+        s,
+        old.id,
+        &body.name,
+        old.version + 1,
+        data,
+        cam,
+        client,
+        "cam_table.replace",
+    )
+    .await
+}
+
+#[allow(clippy::too_many_arguments)]
+async fn store_and_register(
+    s: &AppState,
+    id: u32,
+    name: &str,
+    version: i64,
+    data: CamTableData,
+    cam: Cam,
+    client: &ClientInfo,
+    action: &str,
+) -> AppResult<CamTableResource> {
+    let now = store::now_rfc3339();
+    let mut tx = s.db.begin().await?;
+    store::cams::upsert_cam_table(&mut tx, id, name, version, &data, &now).await?;
+    store::audit(
+        &mut *tx,
+        &audit_entry(client, action, name, audit_detail(id, name, version, &data)),
+    )
+    .await?;
+    tx.commit().await?;
+    let e = CamEntry {
+        id,
+        name: name.to_string(),
+        version,
+        data: Arc::new(data),
+        cam: Arc::new(cam),
+        updated_at: now,
+    };
+    let r = resource(&e, false);
+    s.registry.write().unwrap().cams.insert(id, e);
+    Ok(r)
+}
+
+/// Deletes a table (`DELETE /cam-tables/{table}`).
+pub async fn delete(s: &AppState, key: &str, client: &ClientInfo) -> AppResult<()> {
+    let _guard = s.config_lock.lock().await;
+    let e = entry(s, key)?;
+    let mut tx = s.db.begin().await?;
+    store::cams::delete_cam_table(&mut tx, e.id).await?;
+    store::audit(
+        &mut *tx,
+        &audit_entry(
+            client,
+            "cam_table.delete",
+            &e.name,
+            audit_detail(e.id, &e.name, e.version, &e.data),
+        ),
+    )
+    .await?;
+    tx.commit().await?;
+    s.registry.write().unwrap().cams.remove(&e.id);
+    Ok(())
+}
+
+/// Loads the stored tables at start-up (building each; a table that no longer builds is
+/// reported and skipped rather than stopping motiond).
+pub async fn load(s: &AppState) -> Result<usize, String> {
+    let stored = store::cams::load_cam_tables(&s.db)
+        .await
+        .map_err(|e| format!("cannot read cam tables: {e}"))?;
+    let mut n = 0;
+    for t in stored {
+        match build(t.data).await {
+            Ok((data, cam)) => {
+                s.registry.write().unwrap().cams.insert(
+                    t.id,
+                    CamEntry {
+                        id: t.id,
+                        name: t.name,
+                        version: t.version,
+                        data: Arc::new(data),
+                        cam: Arc::new(cam),
+                        updated_at: t.updated_at,
+                    },
+                );
+                n += 1;
+            }
+            Err(e) => tracing::error!(
+                "cam table {} '{}' is stored but does not build: {e}",
+                t.id,
+                t.name
+            ),
+        }
+    }
+    Ok(n)
+}
+
+/// The tables for the configuration document, with their ids.
+pub fn export(s: &AppState) -> Vec<CamTableBody> {
+    s.registry
+        .read()
+        .unwrap()
+        .cams
+        .values()
+        .map(|e| CamTableBody {
+            id: Some(e.id),
+            name: e.name.clone(),
+            table_type: e.data.table_type,
+            periodic: e.data.periodic,
+            interpolation: e.data.interpolation,
+            rows: e.data.rows.clone(),
+            points: e.data.points.clone(),
+        })
+        .collect()
+}
+
+/// The cam tables of an import, validated and built (before anything is changed); errors name
+/// `cam_tables[i].…`.
+pub async fn prepare_import(tables: &[CamTableBody]) -> Result<Vec<CamEntry>, Vec<FieldError>> {
+    let mut errs = Vec::new();
+    let mut entries = Vec::new();
+    let now = store::now_rfc3339();
+    for (i, t) in tables.iter().enumerate() {
+        let prefix = format!("cam_tables[{i}].");
+        errs.extend(check(t, &prefix));
+        match t.id {
+            None => errs.push(FieldError {
+                field: format!("{prefix}id"),
+                message: "required in a configuration document".into(),
+            }),
+            Some(id) if tables[..i].iter().any(|o| o.id == Some(id)) => errs.push(FieldError {
+                field: format!("{prefix}id"),
+                message: "duplicate id".into(),
+            }),
+            _ => {}
+        }
+        if tables[..i].iter().any(|o| o.name == t.name) {
+            errs.push(FieldError {
+                field: format!("{prefix}name"),
+                message: "duplicate name".into(),
+            });
+        }
+        match build(t.data()).await {
+            Ok((data, cam)) => entries.push(CamEntry {
+                id: t.id.unwrap_or(0),
+                name: t.name.clone(),
+                version: 1,
+                data: Arc::new(data),
+                cam: Arc::new(cam),
+                updated_at: now.clone(),
+            }),
+            Err(AppError::Refused { field, message, id }) => errs.push(FieldError {
+                field: format!("{prefix}{field}"),
+                message: format!("{message} ({id})"),
+            }),
+            Err(e) => errs.push(FieldError {
+                field: format!("{prefix}table_type"),
+                message: e.to_string(),
+            }),
+        }
+    }
+    if errs.is_empty() {
+        Ok(entries)
+    } else {
+        Err(errs)
+    }
+}
+
+/// Replaces the stored tables within an import's transaction.
+pub async fn store_import(
+    tx: &mut sqlx::SqliteConnection,
+    entries: &[CamEntry],
+) -> Result<(), sqlx::Error> {
+    store::cams::delete_all_cam_tables(tx).await?;
+    for e in entries {
+        store::cams::upsert_cam_table(tx, e.id, &e.name, e.version, &e.data, &e.updated_at).await?;
+    }
+    Ok(())
+}
+
+/// MC_ReadCamTableCharacteristics.
+pub async fn characteristics(s: &AppState, key: &str) -> AppResult<cam::Characteristics> {
+    let e = entry(s, key)?;
+    tokio::task::spawn_blocking(move || cam::characteristics(&e.cam))
+        .await
+        .map_err(|e| AppError::unavailable("internal", format!("the analysis failed: {e}")))
+}
+
+/// MC_ReadCamTableSlaveDynamics at a raw master position (the table's own coordinates).
+pub fn slave_dynamics(
+    s: &AppState,
+    key: &str,
+    master_position: f64,
+) -> AppResult<SlaveDynamicsResource> {
+    let e = entry(s, key)?;
+    if !master_position.is_finite() {
+        return Err(AppError::field(
+            "master_position",
+            "must be a finite number",
+        ));
+    }
+    let v = e.cam.eval(master_position);
+    let (velocity, acceleration) = match e.data.table_type {
+        TableType::MotionFunction => (v.velocity, v.acceleration),
+        TableType::Equidistant => (v.velocity, 0.0),
+        TableType::NonEquidistant => (0.0, 0.0),
+    };
+    Ok(SlaveDynamicsResource {
+        master_position,
+        slave_position: v.position,
+        slave_velocity: velocity,
+        slave_acceleration: acceleration,
+    })
+}
+
+/// MC_ReadCamTableMasterPosition.
+pub async fn master_position(
+    s: &AppState,
+    key: &str,
+    q: MasterSearch,
+) -> AppResult<MasterPositionResource> {
+    let e = entry(s, key)?;
+    let (low, high) = tokio::task::spawn_blocking(move || cam::master_position(&e.cam, &q))
+        .await
+        .map_err(|e| AppError::unavailable("internal", format!("the search failed: {e}")))?
+        .map_err(refused)?;
+    Ok(MasterPositionResource {
+        master_low: low,
+        master_high: high,
+    })
+}
+
+/// MC_ReadMotionFunctionValues (also for position tables: the cam editor plots both).
+pub fn values(
+    s: &AppState,
+    key: &str,
+    start: f64,
+    end: f64,
+    increment: f64,
+    select: &[ValueSelect],
+) -> AppResult<CamValuesResource> {
+    let e = entry(s, key)?;
+    let rows = cam::sample(&e.cam, start, end, increment, MAX_VALUE_ROWS).map_err(refused)?;
+    let order = [
+        ValueSelect::Position,
+        ValueSelect::Velocity,
+        ValueSelect::Acceleration,
+        ValueSelect::Jerk,
+    ];
+    let chosen: Vec<ValueSelect> = order
+        .into_iter()
+        .filter(|v| select.is_empty() || select.contains(v))
+        .collect();
+    let mut columns = vec!["master"];
+    columns.extend(chosen.iter().map(|v| match v {
+        ValueSelect::Position => "position",
+        ValueSelect::Velocity => "velocity",
+        ValueSelect::Acceleration => "acceleration",
+        ValueSelect::Jerk => "jerk",
+    }));
+    Ok(CamValuesResource {
+        columns,
+        rows: rows
+            .into_iter()
+            .map(|(x, v)| {
+                let mut row = Vec::with_capacity(chosen.len() + 1);
+                row.push(x);
+                row.extend(chosen.iter().map(|c| match c {
+                    ValueSelect::Position => v.position,
+                    ValueSelect::Velocity => v.velocity,
+                    ValueSelect::Acceleration => v.acceleration,
+                    ValueSelect::Jerk => v.jerk,
+                }));
+                row
+            })
+            .collect(),
+    })
+}

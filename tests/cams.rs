@@ -1,0 +1,370 @@
+//! Cam tables over HTTP against the real binary: upload, read back, analysis, validation
+//! errors, restart, export/import (spec camming-tf5050.md; issue "Electronic cams").
+
+mod common;
+
+use common::*;
+use serde_json::{Value, json};
+
+fn polynom5() -> Value {
+    json!({"name": "p5", "table_type": "motion_function", "points": [
+        {"point_index": 1, "function_type": "polynom5", "point_type": "rest", "master_pos": 0.0, "slave_pos": 0.0},
+        {"point_index": 2, "function_type": "polynom5", "point_type": "rest", "master_pos": 200.0, "slave_pos": 100.0}
+    ]})
+}
+
+/// The inverse-lookup table of the spec (§5.3).
+fn symmetric(periodic: bool) -> Value {
+    json!({"name": if periodic { "sym_periodic" } else { "sym" }, "table_type": "non_equidistant", "periodic": periodic,
+        "rows": [[0.0, 0.0], [135.0, 80.0], [180.0, 100.0], [225.0, 80.0], [360.0, 0.0]]})
+}
+
+fn close(v: &Value, want: f64) -> bool {
+    (v.as_f64().unwrap_or(f64::NAN) - want).abs() < 1e-6 * (1.0 + want.abs())
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn cam_tables_are_stored_read_back_and_analysed() {
+    let s = Server::start();
+    let r = post(&s, "/api/v1/cam-tables", polynom5()).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.location.as_deref(), Some("/api/v1/cam-tables/1"));
+    assert_eq!(r.json["version"], 1);
+    assert_eq!(r.json["master_period"], 200.0);
+    assert!(r.json.get("points").is_none(), "the answer is the summary");
+
+    let one = get(&s, "/api/v1/cam-tables/p5").await;
+    assert_eq!(one.status, 200);
+    assert_eq!(one.json["points"].as_array().unwrap().len(), 2);
+    assert_eq!(
+        one.json["points"][0]["rel_index_next_point"], 1,
+        "defaults are filled in"
+    );
+    assert_eq!(
+        get(&s, "/api/v1/cam-tables/1").await.json,
+        one.json,
+        "by id or name"
+    );
+
+    let c = get(&s, "/api/v1/cam-tables/p5/characteristics").await;
+    assert_eq!(c.status, 200);
+    assert!(close(&c.json["slave_velo_max"], 0.9375), "{}", c.text);
+    assert!(close(&c.json["m_pos_at_s_acc_max"], 42.26497), "{}", c.text);
+    assert!(close(&c.json["slave_jerk_start"], 0.00075));
+
+    let v = get(
+        &s,
+        "/api/v1/cam-tables/p5/values?start=0&end=200&increment=50&values=position,velocity",
+    )
+    .await;
+    assert_eq!(v.status, 200, "{}", v.text);
+    assert_eq!(v.json["columns"], json!(["master", "position", "velocity"]));
+    assert_eq!(v.json["rows"][1], json!([50.0, 10.3515625, 0.52734375]));
+    assert_eq!(v.json["rows"].as_array().unwrap().len(), 5);
+
+    // MC_ReadCamTableSlaveDynamics: what each table type gives (§2.16).
+    let d = get(
+        &s,
+        "/api/v1/cam-tables/p5/slave-dynamics?master_position=50",
+    )
+    .await;
+    assert_eq!(
+        d.json,
+        json!({"master_position": 50.0, "slave_position": 10.3515625,
+        "slave_velocity": 0.52734375, "slave_acceleration": 0.0140625})
+    );
+    assert_eq!(
+        post(&s, "/api/v1/cam-tables", symmetric(false))
+            .await
+            .status,
+        201
+    );
+    let d = get(
+        &s,
+        "/api/v1/cam-tables/sym/slave-dynamics?master_position=90",
+    )
+    .await;
+    assert_eq!(
+        (
+            d.json["slave_velocity"].as_f64(),
+            d.json["slave_acceleration"].as_f64()
+        ),
+        (Some(0.0), Some(0.0))
+    );
+    assert!(close(&d.json["slave_position"], 80.0 * 90.0 / 135.0));
+    let eq = json!({"name": "eq", "table_type": "equidistant", "rows": [[0.0, 0.0], [10.0, 5.0], [20.0, 5.0]]});
+    assert_eq!(post(&s, "/api/v1/cam-tables", eq).await.status, 201);
+    let d = get(&s, "/api/v1/cam-tables/eq/slave-dynamics?master_position=5").await;
+    assert_eq!(
+        (
+            d.json["slave_velocity"].as_f64(),
+            d.json["slave_acceleration"].as_f64()
+        ),
+        (Some(0.5), Some(0.0))
+    );
+
+    // MC_ReadCamTableMasterPosition with the manual's numbers.
+    let m = get(
+        &s,
+        "/api/v1/cam-tables/sym/master-position?slave_position=80&master_start_position=180",
+    )
+    .await;
+    assert_eq!(m.status, 200, "{}", m.text);
+    assert!(
+        close(&m.json["master_low"]["master_axis_position"], 135.0),
+        "{}",
+        m.text
+    );
+    assert!(
+        close(&m.json["master_high"]["master_axis_position"], 225.0),
+        "{}",
+        m.text
+    );
+    assert_eq!(
+        post(&s, "/api/v1/cam-tables", symmetric(true)).await.status,
+        201
+    );
+    let m = get(&s, "/api/v1/cam-tables/sym_periodic/master-position?slave_position=80&master_start_position=90").await;
+    assert!(
+        close(&m.json["master_low"]["master_axis_position"], -135.0),
+        "{}",
+        m.text
+    );
+    assert!(
+        close(&m.json["master_high"]["master_axis_position"], 135.0),
+        "{}",
+        m.text
+    );
+    let m = get(
+        &s,
+        "/api/v1/cam-tables/sym/master-position?slave_position=80&master_start_position=90",
+    )
+    .await;
+    assert_eq!(m.json["master_low"]["valid"], false);
+    assert_eq!(m.json["master_high"]["valid"], true);
+
+    let list = get(&s, "/api/v1/cam-tables").await;
+    let names: Vec<&str> = list
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["p5", "sym", "eq", "sym_periodic"]);
+    assert!(list.json[0].get("points").is_none());
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn bad_tables_and_queries_are_refused_and_change_nothing() {
+    let s = Server::start();
+    let refused = |body: Value| {
+        let s = &s;
+        async move {
+            let r = post(s, "/api/v1/cam-tables", body).await;
+            assert_eq!(r.status, 422, "{}", r.text);
+            assert_eq!(r.content_type, "application/problem+json");
+            (
+                r.json["error_id"].as_u64(),
+                r.json["errors"][0]["field"]
+                    .as_str()
+                    .unwrap_or("")
+                    .to_string(),
+            )
+        }
+    };
+    let rows = |rows: Value| json!({"name": "t", "table_type": "non_equidistant", "rows": rows});
+    assert_eq!(
+        refused(rows(json!([[0, 0], [100, 1], [90, 2]]))).await,
+        (Some(0x7080), "rows[2][0]".into())
+    );
+    assert_eq!(
+        refused(rows(json!([[0, 0], [100, 1, 3]]))).await,
+        (None, "rows[1]".into())
+    );
+    assert_eq!(
+        refused(rows(json!([[0, 0]]))).await,
+        (Some(0x4B34), "rows".into())
+    );
+    let mut p = polynom5();
+    p["points"][1]["point_type"] = json!("ignore");
+    assert_eq!(
+        refused(p).await,
+        (Some(0x7081), "points[1].point_type".into())
+    );
+    let mut p = polynom5();
+    p["points"][1]["point_index"] = json!(3);
+    assert_eq!(
+        refused(p).await,
+        (Some(0x4B33), "points[1].point_index".into())
+    );
+    let mut p = polynom5();
+    p["points"][0]["function_type"] = json!("polynom1");
+    assert_eq!(
+        refused(p).await,
+        (Some(0x7082), "points[0].point_type".into())
+    );
+    let mut p = polynom5();
+    p["points"][0]["function_type"] = json!("no_such_law");
+    assert_eq!(refused(p).await.1, "points[0].function_type");
+    let mut p = polynom5();
+    p["name"] = json!("123");
+    assert_eq!(refused(p).await, (None, "name".into()));
+    let mut p = polynom5();
+    p["id"] = json!(256);
+    assert_eq!(refused(p).await, (None, "id".into()));
+    let mut t = rows(json!([[0, 0], [1, 1]]));
+    t["interpolation"] = json!("4point");
+    assert_eq!(refused(t).await, (Some(0x4B35), "interpolation".into()));
+    assert_eq!(
+        get(&s, "/api/v1/cam-tables").await.json,
+        json!([]),
+        "nothing was stored"
+    );
+
+    assert_eq!(post(&s, "/api/v1/cam-tables", polynom5()).await.status, 201);
+    let r = post(&s, "/api/v1/cam-tables", polynom5()).await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_table_name_taken"))
+    );
+    let mut other = polynom5();
+    other["name"] = json!("other");
+    other["id"] = json!(1);
+    let r = post(&s, "/api/v1/cam-tables", other).await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_table_id_taken"))
+    );
+    for q in [
+        "values?start=0&end=200&increment=0",
+        "values?start=0&end=200&increment=0.0001",
+        "values?start=0&end=1",
+    ] {
+        let r = get(&s, &format!("/api/v1/cam-tables/p5/{q}")).await;
+        assert_eq!(r.status, 422, "{q}: {}", r.text);
+    }
+    let r = get(
+        &s,
+        "/api/v1/cam-tables/p5/values?start=0&end=1&increment=1&values=speed",
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["errors"][0]["field"].as_str()),
+        (422, Some("values"))
+    );
+    let r = get(&s, "/api/v1/cam-tables/nope").await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (404, Some("cam_table_not_found"))
+    );
+    let r = req(reqwest::Method::POST, &s.url("/api/v1/cam-tables"), None).await;
+    assert_eq!(r.status, 422, "an empty body: {}", r.text);
+    // Replacing keeps the id and counts versions; a body naming another id is refused.
+    let mut p = polynom5();
+    p["points"][1]["slave_pos"] = json!(120.0);
+    let r = put(&s, "/api/v1/cam-tables/p5", p.clone()).await;
+    assert_eq!(
+        (
+            r.status,
+            r.json["version"].as_i64(),
+            r.json["slave_end"].as_f64()
+        ),
+        (200, Some(2), Some(120.0)),
+        "{}",
+        r.text
+    );
+    p["id"] = json!(7);
+    assert_eq!(put(&s, "/api/v1/cam-tables/p5", p).await.status, 422);
+    assert_eq!(delete(&s, "/api/v1/cam-tables/p5").await.status, 204);
+    assert_eq!(get(&s, "/api/v1/cam-tables/p5").await.status, 404);
+    let audit = get(&s, "/api/v1/audit?limit=10").await;
+    let actions: Vec<&str> = audit
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["action"].as_str().unwrap())
+        .collect();
+    for a in ["cam_table.create", "cam_table.replace", "cam_table.delete"] {
+        assert!(actions.contains(&a), "{a} in {actions:?}");
+    }
+}
+
+/// Tables live in the database: a restart finds them (and only them); the configuration
+/// document carries them to another machine, and an import without `cam_tables` keeps them.
+#[tokio::test(flavor = "multi_thread")]
+async fn cam_tables_survive_a_restart_and_travel_with_the_configuration() {
+    let dir = temp_dir();
+    let db = dir.join("cams.db");
+    let db = db.to_str().unwrap();
+    let a = Server::start_with(db, &[]);
+    assert_eq!(post(&a, "/api/v1/cam-tables", polynom5()).await.status, 201);
+    // A million rows (spec: uploads as JSON, built off the cycle thread).
+    let rows: Vec<Value> = (0..1_000_000)
+        .map(|i| json!([i as f64 * 0.00036, (i as f64 * 0.00036).to_radians().sin()]))
+        .collect();
+    let big = json!({"name": "big", "table_type": "equidistant", "periodic": true, "interpolation": "spline", "rows": rows});
+    let r = post(&a, "/api/v1/cam-tables", big).await;
+    assert_eq!(
+        (r.status, r.json["row_count"].as_u64()),
+        (201, Some(1_000_000)),
+        "{}",
+        r.text
+    );
+    let before = get(&a, "/api/v1/cam-tables").await;
+    let exported = get(&a, "/api/v1/config").await;
+    assert_eq!(exported.json["cam_tables"].as_array().unwrap().len(), 2);
+    a.stop();
+
+    let a = Server::start_with(db, &[]);
+    assert_eq!(get(&a, "/api/v1/cam-tables").await.json, before.json);
+    let d = get(
+        &a,
+        "/api/v1/cam-tables/big/slave-dynamics?master_position=90",
+    )
+    .await;
+    assert!(close(&d.json["slave_position"], 1.0), "{}", d.text);
+    a.stop();
+
+    let dir = temp_dir();
+    let db2 = dir.join("fresh.db");
+    let b = Server::start_with(db2.to_str().unwrap(), &[]);
+    let r = put(&b, "/api/v1/config", exported.json.clone()).await;
+    assert_eq!(r.status, 200, "{}", &r.text[..r.text.len().min(500)]);
+    let names: Vec<String> = get(&b, "/api/v1/cam-tables")
+        .await
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["name"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(names, ["p5", "big"]);
+    let mut without = exported.json.clone();
+    without.as_object_mut().unwrap().remove("cam_tables");
+    assert_eq!(put(&b, "/api/v1/config", without).await.status, 200);
+    assert_eq!(
+        get(&b, "/api/v1/cam-tables")
+            .await
+            .json
+            .as_array()
+            .unwrap()
+            .len(),
+        2,
+        "kept"
+    );
+    let mut bad = exported.json.clone();
+    bad["cam_tables"][0]["points"][0]["point_type"] = json!("ignore");
+    let r = put(&b, "/api/v1/config", bad).await;
+    assert_eq!(
+        (r.status, r.json["errors"][0]["field"].as_str()),
+        (422, Some("cam_tables[0].points[0].point_type")),
+        "{}",
+        r.text
+    );
+    let mut none = exported.json.clone();
+    none["cam_tables"] = json!([]);
+    assert_eq!(put(&b, "/api/v1/config", none).await.status, 200);
+    assert_eq!(get(&b, "/api/v1/cam-tables").await.json, json!([]));
+}
