@@ -321,6 +321,12 @@ pub enum CommandKind {
     },
     /// MC_GearOut.
     GearOut,
+    /// MC_CamIn: couple this axis to a master through a cam table, or switch the cam.
+    CamIn(crate::cam::CamIn),
+    /// MC_CamOut: decouple; the slave keeps its velocity.
+    CamOut,
+    /// MC_CamScaling: new offsets and scalings of the cam coupling.
+    CamScaling(crate::cam::CamScaling),
     /// MC_MoveSuperImposed: a relative motion laid over the running one.
     MoveSuperImposed(Superposition),
     /// MC_AbortSuperposition.
@@ -364,6 +370,9 @@ impl CommandKind {
             CommandKind::GearIn { .. } => "gear-in",
             CommandKind::GearInDyn { .. } => "gear-in-dyn",
             CommandKind::GearOut => "gear-out",
+            CommandKind::CamIn(_) => "cam-in",
+            CommandKind::CamOut => "cam-out",
+            CommandKind::CamScaling(_) => "cam-scaling",
             CommandKind::MoveSuperImposed(_) => "move-superimposed",
             CommandKind::AbortSuperposition => "abort-superposition",
             CommandKind::WriteParameter { .. } => "write-parameter",
@@ -405,6 +414,8 @@ pub struct FbOutputs {
     pub in_velocity: bool,
     /// GearIn: coupled.
     pub in_gear: bool,
+    /// CamIn: coupled and the cam active (a queued cam switch: once it has taken effect).
+    pub in_sync: bool,
     /// MoveContinuous*: target reached, running at end velocity.
     pub in_end_velocity: bool,
     /// Power: axis ready for operation.

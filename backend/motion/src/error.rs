@@ -122,6 +122,17 @@ error_table! {
     CAM_BOUNDARY_MISMATCH = 0x7082, "cam_boundary_mismatch", "motion function: the law does not match its points' boundary conditions";
     /// A value that is not a finite number (NaN, ±∞) or a scaling of 0.
     CAM_VALUE_INVALID = 0x7083, "cam_value_invalid", "cam table: value not a finite number";
+    /// The cam would make the slave jump: its position (or velocity) where the cam takes
+    /// effect differs from the slave's by more than the target window (the acceleration of one
+    /// cycle). Pre-position the slave (MC_ReadCamTableSlaveDynamics), or use AUTOOFFSET.
+    CAM_SLAVE_WOULD_JUMP = 0x7084, "cam_slave_would_jump", "the cam would make the slave jump: pre-position it or use autooffset";
+    /// The cam table is coupled (or queued): it cannot be replaced or deleted now.
+    CAM_TABLE_IN_USE = 0x7085, "cam_table_in_use", "the cam table is in use by a coupling";
+    /// An activation mode, start mode or scaling mode combination the block does not allow
+    /// (spec §1.6–§1.8), or NEXTCYCLEONCE.
+    CAM_MODE_INVALID = 0x7086, "cam_mode_invalid", "activation, start or scaling mode not allowed here";
+    /// The axis is not coupled through a cam (MC_CamOut, MC_CamScaling, MC_CamInfo).
+    CAM_NOT_COUPLED = 0x7087, "cam_not_coupled", "the axis is not coupled through a cam";
 }
 
 impl fmt::Display for ErrorId {

@@ -3,6 +3,7 @@
 //! they are stepped in; everything else is the axis's (`axis/`).
 
 use crate::axis::{Axis, Master, MasterSample};
+use crate::cam::{Cam, CamStore};
 use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};
 use crate::drive::{DriveFeedback, DriveSetpoint};
 use crate::error::ErrorId;
@@ -16,6 +17,7 @@ pub struct Kernel {
     cycle: u64,
     axes: Vec<Option<Box<Axis>>>,
     order: StepOrder,
+    cams: CamStore,
 }
 
 /// The order the axes are stepped in: every master before its slaves, so that a slave follows
@@ -101,6 +103,7 @@ impl Kernel {
             cycle: 0,
             axes: (0..max_axes).map(|_| None).collect(),
             order: StepOrder::new(max_axes),
+            cams: CamStore::default(),
         }
     }
 
@@ -142,6 +145,30 @@ impl Kernel {
         self.axes.get_mut(slot as usize).and_then(|s| s.take())
     }
 
+    /// Puts a ready-built cam under its table id (1..255), handing back the one it replaces
+    /// (to be freed off the cycle thread). Refused — the cam comes back — while an axis is
+    /// coupled through that table or waits to be (a coupled table changes only by the online
+    /// change rules, never by a jump), or for an id outside 1..255.
+    pub fn insert_cam(&mut self, id: u32, cam: Box<Cam>) -> Result<Option<Box<Cam>>, Box<Cam>> {
+        if self.cam_in_use(id) {
+            return Err(cam);
+        }
+        self.cams.insert(id, cam)
+    }
+
+    /// Takes a cam out (to be freed off the cycle thread); refused while it is in use.
+    pub fn remove_cam(&mut self, id: u32) -> Result<Option<Box<Cam>>, ErrorId> {
+        if self.cam_in_use(id) {
+            return Err(ErrorId::CAM_TABLE_IN_USE);
+        }
+        Ok(self.cams.remove(id))
+    }
+
+    /// An axis is coupled through cam table `id`, or waits to be (a queued coupling or switch).
+    pub fn cam_in_use(&self, id: u32) -> bool {
+        self.axes.iter().flatten().any(|a| a.uses_cam(id))
+    }
+
     pub fn axis(&self, slot: AxisSlot) -> Option<&Axis> {
         self.axes.get(slot as usize).and_then(|a| a.as_deref())
     }
@@ -181,7 +208,9 @@ impl Kernel {
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
         let slot = cmd.axis as usize;
         let master = match cmd.kind {
-            CommandKind::GearIn { master, .. } | CommandKind::GearInDyn { master, .. } => {
+            CommandKind::GearIn { master, .. }
+            | CommandKind::GearInDyn { master, .. }
+            | CommandKind::CamIn(crate::cam::CamIn { master, .. }) => {
                 if master as usize == slot {
                     return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }
@@ -208,7 +237,7 @@ impl Kernel {
         match self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
             Some(axis) => {
                 let coupled_to = axis.master_slot();
-                let verdict = axis.submit(cmd, master, cycle, events);
+                let verdict = axis.submit(cmd, master, &self.cams, cycle, events);
                 if axis.master_slot() != coupled_to {
                     self.order.stale = true;
                 }
@@ -250,7 +279,7 @@ impl Kernel {
             };
             let fb = feedback.get(i).copied().unwrap_or_default();
             let axis = self.axes[i].as_deref_mut().expect("checked above");
-            let sp = axis.step(dt, &fb, master, cycle, events);
+            let sp = axis.step(dt, &fb, master, &self.cams, cycle, events);
             if let Some(out) = setpoints.get_mut(i) {
                 *out = sp;
             }

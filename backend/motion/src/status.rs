@@ -140,4 +140,12 @@ pub struct AxisStatus {
     pub set_position_offset: f64,
     /// Command that is executing (NcToPlc CmdNo), 0 when none.
     pub active_command: u64,
+    /// A cam switch (MC_CamIn while coupled) waits for its activation.
+    pub cam_table_queued: bool,
+    /// An MC_CamScaling waits for its activation.
+    pub cam_scaling_pending: bool,
+    /// Written motion-function data waits to take effect (online change).
+    pub cam_data_queued: bool,
+    /// MC_CamInfo: the cam coupling (`cam_table_id` 0 when not coupled through a cam).
+    pub cam: crate::cam::CamInfo,
 }

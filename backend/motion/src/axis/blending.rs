@@ -99,6 +99,7 @@ impl Axis {
             self.abort_superposition(cx);
             self.coupling = None;
         }
+        self.cancel_cam_in(cx, End::Aborted);
         if job.is_positioning() {
             self.last_target = Some(job.target);
         }

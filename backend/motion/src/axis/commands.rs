@@ -15,6 +15,7 @@ impl Axis {
         &mut self,
         cmd: Command,
         master: Option<(AxisSlot, MasterSample)>,
+        cams: &crate::cam::CamStore,
         cycle: u64,
         events: &mut impl EventSink,
     ) -> Verdict {
@@ -22,9 +23,11 @@ impl Axis {
             slot: self.slot,
             cycle,
             events,
+            cams,
         };
         match self.try_submit(cx, cmd, master.map(|(_, m)| m)) {
             Ok(()) => {
+                self.settle_cam(cx);
                 self.update_status();
                 Verdict::Accepted
             }
@@ -221,6 +224,9 @@ impl Axis {
                 gear_ratio,
                 acceleration,
             } => self.submit_gear_in_dyn(cx, cmd.id, master_slot, master, gear_ratio, acceleration),
+            CommandKind::CamIn(ci) => self.submit_cam_in(cx, cmd.id, ci, master),
+            CommandKind::CamOut => self.submit_cam_out(cx, cmd.id),
+            CommandKind::CamScaling(sc) => self.submit_cam_scaling(cx, cmd.id, sc),
             CommandKind::MoveSuperImposed(sp) => self.submit_superposition(cx, cmd.id, sp),
             CommandKind::AbortSuperposition => {
                 self.abort_superposition(cx);
@@ -319,5 +325,7 @@ impl Axis {
             j.finish_aborted(cx);
         }
         self.coupling = None;
+        self.cancel_cam_in(cx, End::Aborted);
+        self.settle_cam(cx);
     }
 }

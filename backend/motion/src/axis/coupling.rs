@@ -90,6 +90,8 @@ pub(super) enum CouplingLaw {
         target_ratio: f64,
         ratio_rate: f64,
     },
+    /// MC_CamIn: through a cam table (`axis/camming.rs`).
+    Cam(super::camming::CamLaw),
 }
 
 /// slave = slave_start + ratio · (master − master_start): the slave follows the master's
@@ -116,25 +118,28 @@ impl Gear {
 }
 
 impl CouplingLaw {
-    fn gear(&self) -> &Gear {
+    fn gear_mut(&mut self) -> Option<&mut Gear> {
         match self {
-            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g,
-        }
-    }
-
-    fn gear_mut(&mut self) -> &mut Gear {
-        match self {
-            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g,
+            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => Some(g),
+            CouplingLaw::Cam(_) => None,
         }
     }
 
     /// The slave's setpoint for the master's motion in this cycle (advances a ratio ramp).
-    pub(super) fn slave_setpoint(&mut self, master: &Kinematics, dt: f64) -> Kinematics {
-        let g = self.gear_mut();
-        if g.master_start.is_nan() {
-            g.master_start = master.position;
+    /// `cam`: the cam of a cam law (`None` only if it left the store: the slave holds).
+    pub(super) fn slave_setpoint(
+        &mut self,
+        master: &Kinematics,
+        dt: f64,
+        cam: Option<&crate::cam::Cam>,
+    ) -> Option<Kinematics> {
+        if let Some(g) = self.gear_mut() {
+            if g.master_start.is_nan() {
+                g.master_start = master.position;
+            }
         }
-        match self {
+        Some(match self {
+            CouplingLaw::Cam(law) => law.eval(cam?, master),
             CouplingLaw::Gear(g) => g.follow(master, 0.0),
             CouplingLaw::GearDyn {
                 gear: g,
@@ -158,18 +163,21 @@ impl CouplingLaw {
                 }
                 g.follow(master, ratio_change)
             }
-        }
+        })
     }
 
     /// The ratio in force (AxisStatus::gear_ratio).
     pub(super) fn ratio(&self) -> f64 {
-        self.gear().ratio
+        match self {
+            CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g.ratio,
+            CouplingLaw::Cam(_) => 0.0,
+        }
     }
 
     /// Still changing towards what it was asked for (a GearInDyn ratio ramp).
     fn ramping(&self) -> bool {
         match self {
-            CouplingLaw::Gear(_) => false,
+            CouplingLaw::Gear(_) | CouplingLaw::Cam(_) => false,
             CouplingLaw::GearDyn {
                 gear, target_ratio, ..
             } => gear.ratio != *target_ratio,
@@ -179,7 +187,7 @@ impl CouplingLaw {
     /// What InGear reports when a command takes this coupling over.
     fn in_gear(&self) -> bool {
         match self {
-            CouplingLaw::Gear(_) => true,
+            CouplingLaw::Gear(_) | CouplingLaw::Cam(_) => true,
             CouplingLaw::GearDyn {
                 gear, target_ratio, ..
             } => (gear.ratio - target_ratio).abs() < 1e-12,
@@ -188,7 +196,9 @@ impl CouplingLaw {
 
     /// A new ratio to ramp to (GearInDyn while enabled).
     fn retarget(&mut self, ratio: f64, rate: f64) {
-        let gear = *self.gear();
+        let Some(&mut gear) = self.gear_mut() else {
+            return;
+        };
         *self = CouplingLaw::GearDyn {
             gear,
             target_ratio: ratio,
@@ -209,15 +219,23 @@ impl CouplingLaw {
     /// The slave's setpoint moves by `d` relative to the master (a superposition, a cleared
     /// position lag).
     pub(super) fn shift_slave(&mut self, d: f64) {
-        self.gear_mut().slave_start += d;
+        match self {
+            CouplingLaw::Cam(law) => law.shift_slave(d),
+            _ => {
+                if let Some(g) = self.gear_mut() {
+                    g.slave_start += d;
+                }
+            }
+        }
     }
 
     /// Couples anew from here: the slave at `slave_position`, the master where it is in the
     /// next cycle.
     fn rebase(&mut self, slave_position: f64) {
-        let g = self.gear_mut();
-        g.slave_start = slave_position;
-        g.master_start = f64::NAN;
+        if let Some(g) = self.gear_mut() {
+            g.slave_start = slave_position;
+            g.master_start = f64::NAN;
+        }
     }
 }
 
@@ -229,6 +247,16 @@ impl Axis {
     ) -> Result<(), ErrorId> {
         if self.state() != AxisState::SynchronizedMotion {
             return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
+        }
+        if matches!(
+            self.coupling,
+            Some(Coupling {
+                law: CouplingLaw::Cam(_),
+                ..
+            })
+        ) {
+            // A cam slave is decoupled by MC_CamOut.
+            return Err(ErrorId::COMMAND_NOT_PERMITTED);
         }
         if let Some(c) = self.coupling.as_mut().filter(|c| c.dyn_command != 0) {
             // GearInDyn still enabled: the slave is decoupled only for an instant and
@@ -345,7 +373,10 @@ impl Axis {
     }
 
     /// State and master checks shared by both couplings.
-    fn admit_coupling(&self, master: Option<MasterSample>) -> Result<MasterSample, ErrorId> {
+    pub(super) fn admit_coupling(
+        &self,
+        master: Option<MasterSample>,
+    ) -> Result<MasterSample, ErrorId> {
         let Some(m) = master else {
             return Err(ErrorId::MASTER_INVALID);
         };
@@ -423,9 +454,20 @@ impl Axis {
         let (Some(mut c), Master::Sample(m)) = (self.coupling, master) else {
             return;
         };
-        let followed = m.followed(self.p().axis_couple_slave_to_actual_values);
+        // A cam follows the master's set values (TwinCAT: never its actual ones).
+        let cam = match c.law {
+            CouplingLaw::Cam(l) => Some(cx.cams.get(l.table)),
+            _ => None,
+        };
+        let followed = if cam.is_some() {
+            m.set
+        } else {
+            m.followed(self.p().axis_couple_slave_to_actual_values)
+        };
         let ramping = c.law.ramping();
-        self.set = c.law.slave_setpoint(&followed, dt);
+        if let Some(set) = c.law.slave_setpoint(&followed, dt, cam.flatten()) {
+            self.set = set;
+        }
         self.set_has_superposition = false;
         if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
             let out = FbOutputs {

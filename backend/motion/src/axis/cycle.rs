@@ -14,6 +14,7 @@ impl Axis {
         dt: f64,
         fb: &DriveFeedback,
         master: Master,
+        cams: &crate::cam::CamStore,
         cycle: u64,
         events: &mut impl EventSink,
     ) -> DriveSetpoint {
@@ -25,12 +26,13 @@ impl Axis {
                 actual_velocity: 0.0,
                 ..*fb
             };
-            return self.step(dt, &fb, master, cycle, events);
+            return self.step(dt, &fb, master, cams, cycle, events);
         }
         let cx = &mut Ctx {
             slot: self.slot,
             cycle,
             events,
+            cams,
         };
         self.act_pos = fb.actual_position + self.offset;
         self.limit_positive = fb.limit_positive;
@@ -71,6 +73,7 @@ impl Axis {
             if lost && self.coupling.is_some() {
                 self.enter_error(cx, ErrorId::MASTER_LOST);
             }
+            self.step_cam_activations(cx, master);
             self.step_feed_enables(cx);
             self.step_job(cx, dt, fb, master);
             self.step_superposition(cx, dt);
@@ -84,6 +87,7 @@ impl Axis {
             }
         }
         self.try_unlock(cx);
+        self.settle_cam(cx);
         // InTargetPosition's dwell counts cycles (not status updates: submits update too).
         let lag = (self.act_pos - self.set.position).abs();
         if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {

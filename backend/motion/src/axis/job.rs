@@ -15,6 +15,8 @@ pub(super) struct Ctx<'a, E: EventSink> {
     pub(super) slot: AxisSlot,
     pub(super) cycle: u64,
     pub(super) events: &'a mut E,
+    /// The cams a cam coupling follows (the kernel's store).
+    pub(super) cams: &'a crate::cam::CamStore,
 }
 
 impl<E: EventSink> Ctx<'_, E> {
@@ -262,6 +264,7 @@ fn ended(out: FbOutputs, end: End) -> FbOutputs {
         error_id: error,
         in_velocity: out.in_velocity && ok,
         in_gear: out.in_gear && ok,
+        in_sync: out.in_sync && ok,
         in_end_velocity: out.in_end_velocity && ok,
         status: false,
         warning: out.warning && error == 0,
@@ -278,6 +281,7 @@ pub(super) const DONE: FbOutputs = FbOutputs {
     error_id: 0,
     in_velocity: false,
     in_gear: false,
+    in_sync: false,
     in_end_velocity: false,
     status: false,
     warning: false,

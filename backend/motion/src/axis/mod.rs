@@ -26,6 +26,7 @@ use crate::planner::{Kinematics, Limits, Planner, sign, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
 
 mod blending;
+mod camming;
 mod commands;
 mod coupling;
 mod cycle;
@@ -122,6 +123,14 @@ pub struct Axis {
     set_has_superposition: bool,
     latch: Option<LatchSource>,
     prev_cam: bool,
+    /// MC_CamIn waiting for its activation (the axis is not coupled yet).
+    cam_in: Option<camming::PendingCamIn>,
+    /// MC_CamIn on a cam slave waiting for its activation (CamTableQueued).
+    cam_switch: Option<camming::PendingChange<crate::cam::CamIn>>,
+    /// MC_CamScaling waiting for its activation (CamScalingPending).
+    cam_scaling: Option<camming::PendingChange<crate::cam::CamScaling>>,
+    /// The master's set values in the latest cycle (a scaling at once uses them).
+    last_master: Kinematics,
 }
 
 impl Axis {
@@ -179,6 +188,10 @@ impl Axis {
             set_has_superposition: false,
             latch: None,
             prev_cam: false,
+            cam_in: None,
+            cam_switch: None,
+            cam_scaling: None,
+            last_master: Kinematics::default(),
         })
     }
 
@@ -205,7 +218,7 @@ impl Axis {
     }
 
     pub fn master_slot(&self) -> Option<AxisSlot> {
-        self.coupling.map(|c| c.master)
+        self.coupling.map(|c| c.master).or(self.cam_master())
     }
 
     /// The PLCopen state, derived from the mode and the active job.

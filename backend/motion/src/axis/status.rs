@@ -88,5 +88,10 @@ impl Axis {
         s.drive_fault = self.error == ErrorId::DRIVE_FAULT && self.mode == Mode::ErrorStop;
         s.set_position_offset = self.set_position_offset;
         s.active_command = job.map(|j| j.id).unwrap_or(0);
+        let (cam, queued, scaling) = self.cam_status();
+        let s = &mut self.status;
+        s.cam = cam;
+        s.cam_table_queued = queued;
+        s.cam_scaling_pending = scaling;
     }
 }

@@ -28,6 +28,7 @@
 //! ```
 
 mod analysis;
+mod coupling;
 mod function;
 mod law;
 mod shape;
@@ -37,6 +38,10 @@ mod table;
 pub use analysis::{
     CamMasterData, Characteristics, MasterSearch, ValueSelect, characteristics, master_position,
     sample,
+};
+pub use coupling::{
+    CamActivationMode, CamIn, CamInfo, CamScaling, CamScalingMode, CamStore, MAX_CAM_TABLE_ID,
+    StartMode,
 };
 pub use function::{MotionFunction, MotionFunctionPoint, Segment};
 pub use law::{MotionFunctionType, MotionPointType};

@@ -280,6 +280,15 @@ impl Rig {
         }
     }
 
+    /// Builds a cam table and hands it to the kernel under `id`.
+    pub fn cam(&mut self, id: u32, table: &motion::cam::CamTableData) {
+        let cam = motion::cam::Cam::build(table).expect("a valid cam table");
+        assert!(
+            self.k.insert_cam(id, Box::new(cam)).is_ok(),
+            "cam {id} not taken"
+        );
+    }
+
     pub fn cmd(&mut self, axis: u16, kind: CommandKind) -> (CommandId, Verdict) {
         let id = self.next_id;
         self.next_id += 1;
@@ -660,13 +669,19 @@ impl Rig {
                 stop_locked || (a <= 1 && b <= 1),
                 "exclusivity violated: {e:?}"
             );
-            assert!(a >= 1, "no output set: {e:?}");
+            // A coupling FB ends with InSync instead of Done (Tc2_MC2_Camming §2.0).
+            assert!(a >= 1 || o.in_sync, "no output set: {e:?}");
             assert!(
-                !(o.error && (o.in_velocity || o.in_gear || o.in_end_velocity)),
+                !(o.in_sync && (o.busy || o.active || o.done)),
+                "InSync is a completion output: {e:?}"
+            );
+            assert!(
+                !(o.error && (o.in_velocity || o.in_gear || o.in_sync || o.in_end_velocity)),
                 "success flag with error: {e:?}"
             );
             assert!(
-                !(o.command_aborted && (o.in_velocity || o.in_gear || o.in_end_velocity)),
+                !(o.command_aborted
+                    && (o.in_velocity || o.in_gear || o.in_sync || o.in_end_velocity)),
                 "success flag with command_aborted: {e:?}"
             );
             assert_eq!(

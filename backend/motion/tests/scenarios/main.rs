@@ -8,6 +8,7 @@
 #[path = "../rig/mod.rs"]
 mod rig;
 
+mod cam_couplings;
 mod rig_checks;
 mod s2_state_diagram;
 mod s3_10_slave_axes;

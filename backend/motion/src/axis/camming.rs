@@ -1,0 +1,806 @@
+//! Cam couplings (TwinCAT NC Camming, spec camming-tf5050.md): MC_CamIn (couple, or switch the
+//! cam of a coupled slave), MC_CamOut, MC_CamScaling, their activation modes, autooffset, and
+//! MC_CamInfo. The law — slave = (f((m + MO)/MS) + strokes)·SS + SO, on the master's set
+//! values — is a [`CouplingLaw`] like the gears, so admission, losing the master and the soft
+//! limits of a coupled slave are shared with them.
+//!
+//! A cam never makes the slave jump: where it takes effect (coupling, switch, scaling) the
+//! slave's position must match within the target window (#1026) and its velocity within one
+//! cycle's acceleration (#1004), else the command ends with 0x7084 and nothing changes.
+
+use super::coupling::{Coupling, CouplingLaw};
+use super::*;
+use crate::cam::{Cam, CamActivationMode as Act, CamIn, CamInfo, CamScaling, CamScalingMode};
+
+/// The cam law in force.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CamLaw {
+    pub(super) table: u32,
+    pub(super) mo: f64,
+    pub(super) so: f64,
+    pub(super) ms: f64,
+    pub(super) ss: f64,
+    /// The cycle of a periodic cam the coupling counts strokes from (its base cycle).
+    k_base: i64,
+    master_absolute: bool,
+    slave_absolute: bool,
+    master_coupling_pos: f64,
+    slave_coupling_pos: f64,
+    /// Superimposed distance laid onto the slave (MC_MoveSuperImposed), in `so` as well.
+    superimposed: f64,
+    /// The table's start, period and stroke (MC_CamInfo).
+    cam_start: (f64, f64),
+    cam_period: f64,
+    cam_stroke: f64,
+    periodic: bool,
+    // Of the latest evaluation (MC_CamInfo):
+    x_local: f64,
+    y_local: f64,
+    strokes: f64,
+    master_pos: f64,
+}
+
+impl CamLaw {
+    /// Raw cam master coordinate of a master axis position.
+    fn raw(&self, m: f64) -> f64 {
+        (m + self.mo) / self.ms
+    }
+
+    /// The slave's setpoint for the master's motion (chain rule through the scalings).
+    pub(super) fn eval(&mut self, cam: &Cam, m: &Kinematics) -> Kinematics {
+        let x = self.raw(m.position);
+        let (k, xl) = cam.cycle_of(x);
+        let f = if cam.periodic {
+            cam.eval_in_range(xl)
+        } else {
+            cam.eval(x)
+        };
+        let strokes = if cam.periodic {
+            (k - self.k_base) as f64 * cam.stroke()
+        } else {
+            0.0
+        };
+        self.x_local = xl;
+        self.y_local = f.position;
+        self.strokes = strokes;
+        self.master_pos = m.position;
+        let (ss, ms) = (self.ss, self.ms);
+        let (vm, am, jm) = (m.velocity, m.acceleration, m.jerk);
+        Kinematics {
+            position: (f.position + strokes) * ss + self.so,
+            velocity: ss / ms * f.velocity * vm,
+            acceleration: ss / (ms * ms) * f.acceleration * vm * vm + ss / ms * f.velocity * am,
+            jerk: ss / (ms * ms * ms) * f.jerk * vm * vm * vm
+                + 3.0 * ss / (ms * ms) * f.acceleration * vm * am
+                + ss / ms * f.velocity * jm,
+        }
+    }
+
+    pub(super) fn shift_slave(&mut self, d: f64) {
+        self.so += d;
+        self.superimposed += d;
+    }
+
+    fn info(&self, master: AxisSlot, slave_pos: f64) -> CamInfo {
+        let ((x0, y0), p, h, periodic) = (
+            self.cam_start,
+            self.cam_period,
+            self.cam_stroke,
+            self.periodic,
+        );
+        CamInfo {
+            cam_table_id: self.table,
+            periodic,
+            master_axis: master,
+            master_cam_start_pos: x0,
+            slave_cam_start_pos: y0,
+            raw_master_period: p,
+            raw_slave_stroke: h,
+            master_axis_coupling_pos: self.master_coupling_pos,
+            slave_axis_coupling_pos: self.slave_coupling_pos,
+            master_absolute: self.master_absolute,
+            slave_absolute: self.slave_absolute,
+            master_offset: self.mo,
+            slave_offset: self.so,
+            master_scaling: self.ms,
+            slave_scaling: self.ss,
+            sum_of_slave_strokes: self.strokes * self.ss,
+            sum_of_superposition_distance: self.superimposed,
+            actual_master_axis_pos: self.master_pos,
+            actual_slave_axis_pos: slave_pos,
+            actual_master_cam_pos: self.x_local,
+            actual_slave_cam_pos: self.y_local,
+            ..CamInfo::default()
+        }
+    }
+}
+
+/// When a queued coupling, switch or scaling takes effect, and the master positions it last
+/// saw (to find a crossing between two cycles).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Activation {
+    mode: Act,
+    position: f64,
+    prev_axis: f64,
+    prev_raw: f64,
+}
+
+/// Whether going from `a` to `b` passes `t` (or `t` + n·`period`): `t` in (a, b] or [b, a).
+fn crossed(a: f64, b: f64, t: f64, period: Option<f64>) -> bool {
+    if a == b {
+        return false;
+    }
+    match period {
+        None => (a < t && t <= b) || (b <= t && t < a),
+        Some(p) if b > a => t + ((a - t) / p).floor().mul_add(p, p) <= b,
+        Some(p) => t + (((a - t) / p).ceil() - 1.0) * p >= b,
+    }
+}
+
+impl Activation {
+    fn new(mode: Act, position: f64, m_axis: f64, raw: f64) -> Self {
+        Activation {
+            mode,
+            position,
+            prev_axis: m_axis,
+            prev_raw: raw,
+        }
+    }
+
+    /// Taken effect now? `m_axis` the master axis position, `raw` its raw position in the cam
+    /// the mode refers to (`cam`).
+    fn reached(&mut self, m_axis: f64, raw: f64, cam: &Cam) -> bool {
+        let (a, b) = (self.prev_axis, m_axis);
+        let (ra, rb) = (self.prev_raw, raw);
+        self.prev_axis = m_axis;
+        self.prev_raw = raw;
+        let period = cam.periodic.then(|| cam.period());
+        match self.mode {
+            Act::Instantaneous => true,
+            Act::AtMasterAxisPos => crossed(a, b, self.position, None),
+            Act::AtMasterAxisPosPositiveDirection => b > a && crossed(a, b, self.position, None),
+            Act::AtMasterAxisPosNegativeDirection => b < a && crossed(a, b, self.position, None),
+            Act::AtMasterCamPos => crossed(ra, rb, self.position, period),
+            Act::NextCycle => {
+                let (x0, xn) = cam.master_range();
+                match period {
+                    Some(p) => crossed(ra, rb, x0, Some(p)),
+                    None => crossed(ra, rb, x0, None) || crossed(ra, rb, xn, None),
+                }
+            }
+            _ => false,
+        }
+    }
+
+    /// Already there when asked: a master standing exactly on the activation position.
+    fn at_once(&self, m_axis: f64, raw: f64) -> bool {
+        match self.mode {
+            Act::Instantaneous => true,
+            Act::AtMasterAxisPos
+            | Act::AtMasterAxisPosPositiveDirection
+            | Act::AtMasterAxisPosNegativeDirection => m_axis == self.position,
+            Act::AtMasterCamPos => raw == self.position,
+            _ => false,
+        }
+    }
+}
+
+/// A coupling that waits for its activation (MC_CamIn on an uncoupled axis).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PendingCamIn {
+    pub(super) cmd: Held,
+    pub(super) master: AxisSlot,
+    ci: CamIn,
+    act: Activation,
+}
+
+/// A cam switch (MC_CamIn on a cam slave) or a scaling that waits for its activation.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PendingChange<T> {
+    cmd: Held,
+    what: T,
+    act: Activation,
+}
+
+fn finite_scaling(v: f64) -> bool {
+    v.is_finite() && v != 0.0
+}
+
+impl Axis {
+    /// The slave's master while coupled through a cam, or waiting to be.
+    pub(super) fn cam_master(&self) -> Option<AxisSlot> {
+        self.cam_in.map(|p| p.master)
+    }
+
+    /// Coupled through cam `id`, or waiting for it.
+    pub fn uses_cam(&self, id: u32) -> bool {
+        let coupled = matches!(self.coupling, Some(Coupling { law: CouplingLaw::Cam(l), .. }) if l.table == id);
+        coupled
+            || self.cam_in.is_some_and(|p| p.ci.cam_table == id)
+            || self.cam_switch.is_some_and(|p| p.what.cam_table == id)
+    }
+
+    fn cam_law(&self) -> Option<CamLaw> {
+        match self.coupling {
+            Some(Coupling {
+                law: CouplingLaw::Cam(l),
+                ..
+            }) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// The law a CamIn gives with the master at `m` and the slave at `s` (its set position);
+    /// `before` is the law in force for a switch (autooffset and OFF refer to it).
+    fn law_for(
+        &self,
+        ci: &CamIn,
+        cam: &Cam,
+        m: f64,
+        s: f64,
+        before: Option<(CamLaw, &Cam)>,
+    ) -> CamLaw {
+        let (mut mo, mut ms) = (ci.master_offset, ci.master_scaling);
+        let (mut so, mut ss) = (ci.slave_offset, ci.slave_scaling);
+        match (ci.master_scaling_mode, before) {
+            (CamScalingMode::Off, Some((b, _))) => (mo, ms) = (b.mo, b.ms),
+            (CamScalingMode::Off, None) => (mo, ms) = (0.0, 1.0),
+            (CamScalingMode::AutoOffset, Some((b, old))) => {
+                // Keep the relative position in the cycle (spec §1.8).
+                let r = (b.x_local - old.master_range().0) / old.period();
+                let x_new = cam.master_range().0 + r * cam.period();
+                mo = ms * x_new - m;
+            }
+            _ if ci.start_mode.master_relative() => mo -= m,
+            _ => {}
+        }
+        if ci.slave_scaling_mode == CamScalingMode::Off {
+            (so, ss) = before.map_or((0.0, 1.0), |(b, _)| (b.so, b.ss));
+        } else if ci.start_mode.slave_relative() {
+            so += s;
+        }
+        let x = (m + mo) / ms;
+        let k_base = if cam.periodic { cam.cycle_of(x).0 } else { 0 };
+        let mut law = CamLaw {
+            table: ci.cam_table,
+            mo,
+            so,
+            ms,
+            ss,
+            k_base,
+            master_absolute: !ci.start_mode.master_relative(),
+            slave_absolute: !ci.start_mode.slave_relative(),
+            master_coupling_pos: m,
+            slave_coupling_pos: s,
+            superimposed: before.map_or(0.0, |(b, _)| b.superimposed),
+            cam_start: (cam.master_range().0, cam.slave_range().0),
+            cam_period: cam.period(),
+            cam_stroke: cam.stroke(),
+            periodic: cam.periodic,
+            x_local: 0.0,
+            y_local: 0.0,
+            strokes: 0.0,
+            master_pos: m,
+        };
+        if ci.slave_scaling_mode == CamScalingMode::AutoOffset {
+            // The slave stays where it is (spec §1.8: no jump in position).
+            let at = law.eval(
+                cam,
+                &Kinematics {
+                    position: m,
+                    ..Kinematics::default()
+                },
+            );
+            law.so += s - at.position;
+        }
+        law
+    }
+
+    /// 0x7084 when following `law` from now on would step the slave's position or velocity
+    /// away from `from` (where the slave is, or where the law in force puts it in this cycle).
+    fn check_no_jump(
+        &self,
+        law: &mut CamLaw,
+        cam: &Cam,
+        m: &Kinematics,
+        from: Kinematics,
+    ) -> Result<(), ErrorId> {
+        let at = law.eval(cam, m);
+        let p = self.p();
+        let window = p.axis_target_position_window.max(1e-9);
+        let dv = p.axis_acc * self.cycle_time * (1.0 + 1e-9) + 1e-9;
+        if (at.position - from.position).abs() > window || (at.velocity - from.velocity).abs() > dv
+        {
+            return Err(ErrorId::CAM_SLAVE_WOULD_JUMP);
+        }
+        Ok(())
+    }
+
+    /// MC_CamIn.
+    pub(super) fn submit_cam_in(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        ci: CamIn,
+        master: Option<MasterSample>,
+    ) -> Result<(), ErrorId> {
+        let Some(cam) = cx.cams.get(ci.cam_table) else {
+            return Err(ErrorId::CAM_TABLE_ID_INVALID);
+        };
+        for v in [ci.master_offset, ci.slave_offset, ci.activation_position] {
+            if !v.is_finite() {
+                return Err(ErrorId::PARAMETER_NOT_CORRECT);
+            }
+        }
+        if !finite_scaling(ci.master_scaling) || !finite_scaling(ci.slave_scaling) {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        let law_now = self.cam_law();
+        let switching = law_now.is_some() && self.master_slot() == Some(ci.master);
+        // Modes the manual allows (spec §1.6–§1.8).
+        match ci.activation_mode {
+            Act::NextCycleOnce | Act::AsSoonAsPossible | Act::Off => {
+                return Err(ErrorId::CAM_MODE_INVALID);
+            }
+            Act::DeleteQueuedData if !switching => return Err(ErrorId::CAM_MODE_INVALID),
+            Act::AtMasterCamPos | Act::NextCycle
+                if !switching && ci.start_mode.master_relative() =>
+            {
+                return Err(ErrorId::CAM_MODE_INVALID);
+            }
+            _ => {}
+        }
+        if ci.master_scaling_mode == CamScalingMode::AutoOffset
+            && (!switching || ci.start_mode.master_relative())
+        {
+            return Err(ErrorId::CAM_MODE_INVALID);
+        }
+        let m = self.admit_coupling(master)?;
+        if switching {
+            let law = law_now.expect("switching");
+            if ci.activation_mode == Act::DeleteQueuedData {
+                if let Some(mut q) = self.cam_switch.take() {
+                    q.cmd.end(cx, End::Aborted);
+                }
+                let mut h = Held::start(
+                    cx,
+                    id,
+                    FbOutputs {
+                        busy: true,
+                        ..FbOutputs::default()
+                    },
+                );
+                h.end(cx, End::Done);
+                return Ok(());
+            }
+            let old = cx
+                .cams
+                .get(law.table)
+                .expect("coupled tables stay in the store");
+            let act = Activation::new(
+                ci.activation_mode,
+                ci.activation_position,
+                m.set.position,
+                law.raw(m.set.position),
+            );
+            if let Some(mut q) = self.cam_switch.take() {
+                // A newer switch replaces a queued one.
+                q.cmd.end(cx, End::Aborted);
+            }
+            let cmd = Held::start(
+                cx,
+                id,
+                FbOutputs {
+                    busy: true,
+                    active: true,
+                    ..FbOutputs::default()
+                },
+            );
+            let mut pending = PendingChange { cmd, what: ci, act };
+            if act.at_once(m.set.position, law.raw(m.set.position)) {
+                let mut probe = law;
+                let now = probe.eval(old, &m.set);
+                let mut new =
+                    self.law_for(&ci, cam, m.set.position, now.position, Some((probe, old)));
+                match self.check_no_jump(&mut new, cam, &m.set, now) {
+                    Ok(()) => {
+                        self.set_cam_law(new);
+                        pending.cmd.emit(
+                            cx,
+                            FbOutputs {
+                                busy: false,
+                                active: false,
+                                in_sync: true,
+                                ..pending.cmd.out
+                            },
+                        );
+                    }
+                    Err(e) => {
+                        // The switch refused at once: nothing changes, the old cam runs on.
+                        pending.cmd.end(cx, End::Error(e));
+                    }
+                }
+            } else {
+                self.cam_switch = Some(pending);
+            }
+            return Ok(());
+        }
+        // First coupling.
+        let mut law = self.law_for(&ci, cam, m.set.position, self.set.position, None);
+        let act = Activation::new(
+            ci.activation_mode,
+            ci.activation_position,
+            m.set.position,
+            law.raw(m.set.position),
+        );
+        if act.at_once(m.set.position, law.raw(m.set.position)) {
+            self.check_no_jump(&mut law, cam, &m.set, self.set)?;
+            self.cancel_cam_in(cx, End::Aborted);
+            let cmd = Held::start(
+                cx,
+                id,
+                FbOutputs {
+                    busy: true,
+                    ..FbOutputs::default()
+                },
+            );
+            self.start_cam_coupling(cx, ci.master, law, cmd);
+        } else {
+            self.cancel_cam_in(cx, End::Aborted);
+            let cmd = Held::start(
+                cx,
+                id,
+                FbOutputs {
+                    busy: true,
+                    active: true,
+                    ..FbOutputs::default()
+                },
+            );
+            self.cam_in = Some(PendingCamIn {
+                cmd,
+                master: ci.master,
+                ci,
+                act,
+            });
+        }
+        Ok(())
+    }
+
+    /// Couples now: aborts what runs, the coupling job takes over, the command ends InSync.
+    fn start_cam_coupling(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        master: AxisSlot,
+        law: CamLaw,
+        mut cmd: Held,
+    ) {
+        self.abort_superposition(cx);
+        self.abort_all(cx);
+        self.coupling = Some(Coupling {
+            master,
+            law: CouplingLaw::Cam(law),
+            dyn_command: 0,
+        });
+        cmd.emit(
+            cx,
+            FbOutputs {
+                busy: false,
+                active: false,
+                in_sync: true,
+                ..cmd.out
+            },
+        );
+        // The coupling goes on without an owning command until CamOut or a new motion.
+        let mut j = Job::new(0, JobKind::Gear);
+        j.out = FbOutputs {
+            busy: true,
+            ..FbOutputs::default()
+        };
+        self.job = Some(j);
+    }
+
+    fn set_cam_law(&mut self, law: CamLaw) {
+        if let Some(c) = self.coupling.as_mut() {
+            c.law = CouplingLaw::Cam(law);
+        }
+    }
+
+    /// Ends a coupling that waits for its activation (a new command took the axis, an error).
+    pub(super) fn cancel_cam_in(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
+        if let Some(mut p) = self.cam_in.take() {
+            p.cmd.end(cx, end);
+        }
+    }
+
+    /// Ends the queued switch and scaling of a coupling that is gone.
+    pub(super) fn settle_cam(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        if self.cam_law().is_some() {
+            return;
+        }
+        let end = if self.mode == Mode::ErrorStop {
+            End::Error(self.error)
+        } else {
+            End::Aborted
+        };
+        if let Some(mut q) = self.cam_switch.take() {
+            q.cmd.end(cx, end);
+        }
+        if let Some(mut q) = self.cam_scaling.take() {
+            q.cmd.end(cx, end);
+        }
+        if self.mode == Mode::ErrorStop || self.mode == Mode::Disabled {
+            self.cancel_cam_in(cx, end);
+        }
+    }
+
+    /// MC_CamOut: decouple; the slave keeps its velocity (as after GearOut). A coupling that
+    /// still waits for its activation is dropped.
+    pub(super) fn submit_cam_out(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+    ) -> Result<(), ErrorId> {
+        if self.cam_law().is_none() {
+            if self.cam_in.is_none() {
+                return Err(ErrorId::CAM_NOT_COUPLED);
+            }
+            self.cancel_cam_in(cx, End::Aborted);
+        } else {
+            self.abort_superposition(cx);
+            self.coupling = None;
+            if let Some(mut j) = self.job.take() {
+                j.finish_aborted(cx);
+            }
+            self.settle_cam(cx);
+            self.continue_at_current_velocity(cx);
+        }
+        cx.report(id, DONE);
+        Ok(())
+    }
+
+    /// MC_CamScaling.
+    pub(super) fn submit_cam_scaling(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        sc: CamScaling,
+    ) -> Result<(), ErrorId> {
+        let Some(law) = self.cam_law() else {
+            return Err(ErrorId::CAM_NOT_COUPLED);
+        };
+        for v in [sc.master_offset, sc.slave_offset, sc.activation_position] {
+            if !v.is_finite() {
+                return Err(ErrorId::PARAMETER_NOT_CORRECT);
+            }
+        }
+        if !finite_scaling(sc.master_scaling) || !finite_scaling(sc.slave_scaling) {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        match sc.activation_mode {
+            Act::Instantaneous
+            | Act::AtMasterCamPos
+            | Act::AtMasterAxisPos
+            | Act::AtMasterAxisPosPositiveDirection
+            | Act::AtMasterAxisPosNegativeDirection
+            | Act::NextCycle => {}
+            Act::Off => {
+                // No scaling is done (spec §1.7).
+                cx.report(id, DONE);
+                return Ok(());
+            }
+            _ => return Err(ErrorId::CAM_MODE_INVALID),
+        }
+        if let Some(mut q) = self.cam_scaling.take() {
+            q.cmd.end(cx, End::Aborted);
+        }
+        let m = law.master_pos;
+        let act = Activation::new(sc.activation_mode, sc.activation_position, m, law.raw(m));
+        let cmd = Held::start(
+            cx,
+            id,
+            FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            },
+        );
+        self.cam_scaling = Some(PendingChange { cmd, what: sc, act });
+        if act.at_once(m, law.raw(m)) {
+            let cam = cx
+                .cams
+                .get(law.table)
+                .expect("coupled tables stay in the store");
+            let master = Kinematics {
+                position: m,
+                velocity: self.last_master.velocity,
+                acceleration: self.last_master.acceleration,
+                jerk: 0.0,
+            };
+            self.apply_scaling(cx, cam, &master);
+        }
+        Ok(())
+    }
+
+    /// The scaling's new law from here (autooffset keeps the slave and the master's phase).
+    fn scaled(&self, law: CamLaw, sc: &CamScaling, cam: &Cam, m: f64) -> CamLaw {
+        let mut new = law;
+        match sc.master_scaling_mode {
+            CamScalingMode::Off => {}
+            CamScalingMode::UserDefined => (new.mo, new.ms) = (sc.master_offset, sc.master_scaling),
+            CamScalingMode::AutoOffset => {
+                // The same raw position in the cam (and so the same phase) after the change.
+                new.ms = sc.master_scaling;
+                new.mo = law.raw(m) * new.ms - m;
+            }
+        }
+        match sc.slave_scaling_mode {
+            CamScalingMode::Off => {}
+            CamScalingMode::UserDefined => {
+                (new.so, new.ss) = (sc.slave_offset + law.superimposed, sc.slave_scaling)
+            }
+            CamScalingMode::AutoOffset => {
+                new.ss = sc.slave_scaling;
+                let mut probe = new;
+                let at = probe.eval(
+                    cam,
+                    &Kinematics {
+                        position: m,
+                        ..Kinematics::default()
+                    },
+                );
+                let before = law.clone().eval(
+                    cam,
+                    &Kinematics {
+                        position: m,
+                        ..Kinematics::default()
+                    },
+                );
+                new.so += before.position - at.position;
+            }
+        }
+        new
+    }
+
+    fn apply_scaling(&mut self, cx: &mut Ctx<'_, impl EventSink>, cam: &Cam, master: &Kinematics) {
+        let (Some(law), Some(mut q)) = (self.cam_law(), self.cam_scaling.take()) else {
+            return;
+        };
+        let mut new = self.scaled(law, &q.what, cam, master.position);
+        let now = law.clone().eval(cam, master);
+        match self.check_no_jump(&mut new, cam, master, now) {
+            Ok(()) => {
+                self.set_cam_law(new);
+                q.cmd.end(cx, End::Done);
+            }
+            Err(e) => q.cmd.end(cx, End::Error(e)),
+        }
+    }
+
+    /// Each cycle before the coupling's setpoint: a queued coupling, switch or scaling takes
+    /// effect when its activation is reached.
+    pub(super) fn step_cam_activations(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        master: Master,
+    ) {
+        let Master::Sample(m) = master else {
+            if let (Some(_), Master::Lost) = (self.cam_in, master) {
+                self.cancel_cam_in(cx, End::Error(ErrorId::MASTER_LOST));
+            }
+            return;
+        };
+        self.last_master = m.set;
+        if let Some(mut p) = self.cam_in.take() {
+            if m.error {
+                p.cmd.end(cx, End::Error(ErrorId::MASTER_INVALID));
+            } else if let Some(cam) = cx.cams.get(p.ci.cam_table) {
+                let law = self.law_for(&p.ci, cam, m.set.position, self.set.position, None);
+                if p.act.reached(m.set.position, law.raw(m.set.position), cam) {
+                    // Coupled from the slave's and the master's positions at activation.
+                    let mut law = self.law_for(&p.ci, cam, m.set.position, self.set.position, None);
+                    match self.check_no_jump(&mut law, cam, &m.set, self.set) {
+                        Ok(()) => self.start_cam_coupling(cx, p.master, law, p.cmd),
+                        Err(e) => p.cmd.end(cx, End::Error(e)),
+                    }
+                } else {
+                    self.cam_in = Some(p);
+                }
+            } else {
+                p.cmd.end(cx, End::Error(ErrorId::CAM_TABLE_ID_INVALID));
+            }
+        }
+        let Some(law) = self.cam_law() else {
+            return;
+        };
+        let Some(cam) = cx.cams.get(law.table) else {
+            return;
+        };
+        let raw = law.raw(m.set.position);
+        if let Some(mut q) = self.cam_switch.take() {
+            if q.act.reached(m.set.position, raw, cam) {
+                match cx.cams.get(q.what.cam_table) {
+                    Some(new_cam) => {
+                        // Where the cam in force puts the slave in this cycle: the switch joins it there.
+                        let mut probe = law;
+                        let now = probe.eval(cam, &m.set);
+                        let mut new = self.law_for(
+                            &q.what,
+                            new_cam,
+                            m.set.position,
+                            now.position,
+                            Some((probe, cam)),
+                        );
+                        match self.check_no_jump(&mut new, new_cam, &m.set, now) {
+                            Ok(()) => {
+                                self.set_cam_law(new);
+                                q.cmd.emit(
+                                    cx,
+                                    FbOutputs {
+                                        busy: false,
+                                        active: false,
+                                        in_sync: true,
+                                        ..q.cmd.out
+                                    },
+                                );
+                            }
+                            Err(e) => q.cmd.end(cx, End::Error(e)),
+                        }
+                    }
+                    None => q.cmd.end(cx, End::Error(ErrorId::CAM_TABLE_ID_INVALID)),
+                }
+            } else {
+                self.cam_switch = Some(q);
+            }
+        }
+        if let Some(mut q) = self.cam_scaling {
+            if q.act.reached(m.set.position, raw, cam) {
+                self.apply_scaling(cx, cam, &m.set);
+            } else {
+                self.cam_scaling = Some(q);
+            }
+        }
+    }
+
+    /// MC_CamInfo and the camming status flags.
+    pub(super) fn cam_status(&self) -> (CamInfo, bool, bool) {
+        let mut info = match (self.cam_law(), self.master_slot()) {
+            (Some(l), Some(master)) => l.info(master, self.set.position),
+            _ => CamInfo::default(),
+        };
+        if let Some(q) = &self.cam_scaling {
+            info.scaling_pending = true;
+            info.scaling_activation_mode = q.act.mode;
+            info.scaling_activation_pos = q.act.position;
+        }
+        if let Some(q) = &self.cam_switch {
+            info.cam_table_queued = true;
+            info.cam_exchange_cam_table_id = q.what.cam_table;
+            info.cam_exchange_activation_mode = q.act.mode;
+            info.cam_exchange_activation_pos = q.act.position;
+        }
+        (info, self.cam_switch.is_some(), self.cam_scaling.is_some())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::crossed;
+
+    #[test]
+    fn crossings_are_found_between_two_cycles_in_either_direction() {
+        assert!(crossed(499.0, 500.0, 500.0, None));
+        assert!(
+            !crossed(500.0, 501.0, 500.0, None),
+            "from the position itself is not a crossing"
+        );
+        assert!(crossed(501.0, 499.0, 500.0, None));
+        assert!(!crossed(499.0, 499.5, 500.0, None));
+        // Periodic: any occurrence t + n·P.
+        assert!(crossed(710.0, 730.0, 0.0, Some(360.0)));
+        assert!(crossed(-10.0, 10.0, 0.0, Some(360.0)));
+        assert!(crossed(370.0, 350.0, 0.0, Some(360.0)));
+        assert!(!crossed(10.0, 350.0, 0.0, Some(360.0)));
+        assert!(crossed(10.0, 100.0, 90.0, Some(360.0)));
+        assert!(crossed(1000.0, 1200.0, 90.0, Some(360.0)));
+    }
+}

@@ -1,0 +1,511 @@
+//! Cam couplings (spec camming-tf5050.md §1.4–§1.8, §2.2–§2.4, §5): MC_CamIn, MC_CamOut,
+//! MC_CamScaling cycle by cycle, with the rig's FB-protocol checks in every cycle.
+
+use super::*;
+use motion::cam::*;
+
+const T_LINE: u32 = 1;
+const T_HALF: u32 = 2;
+
+/// (0, 0) – (360, 360), linear interpolation: one stroke of 360 per period when periodic.
+fn line(periodic: bool) -> CamTableData {
+    let mut t = CamTableData::positions(vec![[0.0, 0.0], [360.0, 360.0]], true);
+    t.periodic = periodic;
+    t
+}
+
+fn cam_in(master: u16, table: u32) -> CamIn {
+    CamIn {
+        master,
+        cam_table: table,
+        master_offset: 0.0,
+        slave_offset: 0.0,
+        master_scaling: 1.0,
+        slave_scaling: 1.0,
+        start_mode: StartMode::Absolute,
+        activation_mode: CamActivationMode::Instantaneous,
+        activation_position: 0.0,
+        master_scaling_mode: CamScalingMode::UserDefined,
+        slave_scaling_mode: CamScalingMode::UserDefined,
+    }
+}
+
+/// Two axes powered, the master (0) and the slave (1) moved to their positions; the slave's
+/// dynamics bounds opened (it follows its master through the cam).
+fn rig_at(master: f64, slave: f64) -> Rig {
+    let mut p = params();
+    p.axis_velo_max = 2000.0;
+    let mut r = Rig::with(vec![(false, p.clone()), (false, p)]);
+    r.bounds[1].velocity = 1e9;
+    r.bounds[1].acceleration = 1e9;
+    r.bounds[1].jerk = 1e12;
+    r.power_on(0);
+    r.power_on(1);
+    for (axis, to) in [(0, master), (1, slave)] {
+        if to != 0.0 {
+            let m = r.ok(axis, CommandKind::MoveAbsolute(mv(to, 1000.0)));
+            r.until(10.0, |r| r.out(m).done);
+        }
+    }
+    r
+}
+
+fn move_master(r: &mut Rig, to: f64, v: f64, mut each: impl FnMut(&Rig)) {
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(to, v)));
+    r.until(30.0, |r| {
+        each(r);
+        r.out(m).done
+    });
+}
+
+/// Spec §5.3 / §1.4: a periodic cam with stroke couples in its base cycle (master at 1000 →
+/// slave at 280, not 1000), adds a stroke per cycle forwards and takes it back backwards.
+#[test]
+fn a_periodic_cam_couples_in_the_base_cycle_and_counts_strokes() {
+    let mut r = rig_at(1000.0, 280.0);
+    r.cam(T_LINE, &line(true));
+    let c = r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    // Coupled in the cycle it is accepted: InSync ends the command.
+    assert!(r.out(c).in_sync && !r.out(c).busy && !r.out(c).error);
+    assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
+    assert_eq!(r.st(1).cam.cam_table_id, T_LINE);
+    let follows = |r: &Rig| {
+        let m = r.st(0).set_position;
+        let want = m - 720.0; // the base cycle is the master's third: strokes count from it
+        assert!(
+            (r.st(1).set_position - want).abs() < 1e-9,
+            "master {m}: slave {} ≠ {want}",
+            r.st(1).set_position
+        );
+        assert!((r.st(1).set_velocity - r.st(0).set_velocity).abs() < 1e-9);
+    };
+    move_master(&mut r, 1100.0, 200.0, follows);
+    assert!((r.st(1).set_position - 380.0).abs() < 1e-9);
+    assert!(
+        (r.st(1).cam.sum_of_slave_strokes - 360.0).abs() < 1e-9,
+        "{:?}",
+        r.st(1).cam
+    );
+    move_master(&mut r, 1000.0, 200.0, follows);
+    assert!((r.st(1).set_position - 280.0).abs() < 1e-9);
+    move_master(&mut r, 700.0, 300.0, follows);
+    assert!((r.st(1).set_position + 20.0).abs() < 1e-9);
+    assert!((r.st(1).cam.sum_of_slave_strokes + 360.0).abs() < 1e-9);
+    assert!((r.st(1).cam.actual_master_cam_pos - 340.0).abs() < 1e-9);
+}
+
+/// A cam that would make the slave jump is refused (0x7084) and changes nothing; the same
+/// cam with the slave pre-positioned couples, also relatively.
+#[test]
+fn coupling_never_makes_the_slave_jump() {
+    let mut r = rig_at(90.0, 0.0);
+    r.cam(T_LINE, &line(false));
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(cam_in(0, T_LINE))),
+        ErrorId::CAM_SLAVE_WOULD_JUMP
+    );
+    assert_eq!(r.st(1).state, AxisState::Standstill);
+    // Slave relative: the cam's origin is where the slave stands; master relative too.
+    let rel = CamIn {
+        start_mode: StartMode::Relative,
+        ..cam_in(0, T_LINE)
+    };
+    let c = r.ok(1, CommandKind::CamIn(rel));
+    assert!(r.out(c).in_sync);
+    let info = r.st(1).cam;
+    assert!(!info.master_absolute && !info.slave_absolute);
+    assert_eq!(
+        (info.master_axis_coupling_pos, info.slave_axis_coupling_pos),
+        (90.0, 0.0)
+    );
+    move_master(&mut r, 150.0, 100.0, |_| {});
+    assert!((r.st(1).set_position - 60.0).abs() < 1e-9);
+    // A table in use cannot leave the kernel.
+    assert!(r.k.remove_cam(T_LINE).is_err());
+    assert!(r.k.cam_in_use(T_LINE));
+}
+
+/// Spec §5.3 "activation at an axis position": pending (Busy, Active) until the master
+/// passes 500, InSync in that cycle; with _POSITVEDIRECTION a master dithering around 500
+/// does not trigger until it crosses upwards.
+#[test]
+fn coupling_at_a_master_axis_position_waits_for_the_crossing() {
+    let mut r = rig_at(400.0, 0.0);
+    // A cam at rest up to 550: the slave can couple while the master moves.
+    let mut t = CamTableData::positions(vec![[0.0, 0.0], [550.0, 0.0], [600.0, 50.0]], false);
+    t.periodic = false;
+    r.cam(T_HALF, &t);
+    let ci = CamIn {
+        activation_mode: CamActivationMode::AtMasterAxisPosPositiveDirection,
+        activation_position: 500.0,
+        ..cam_in(0, T_HALF)
+    };
+    let c = r.ok(1, CommandKind::CamIn(ci));
+    assert!(r.out(c).busy && r.out(c).active && !r.out(c).in_sync);
+    assert_eq!(r.st(1).state, AxisState::Standstill);
+    // The master goes to 499.999 and back a little: nothing.
+    move_master(&mut r, 499.999, 100.0, |_| {});
+    move_master(&mut r, 499.5, 100.0, |_| {});
+    assert!(r.out(c).busy && r.out(c).active);
+    // Upwards across 500: InSync in the cycle the master passes it.
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(560.0, 100.0)));
+    r.until(5.0, |r| {
+        let p = r.st(0).set_position;
+        if p < 500.0 {
+            assert!(r.out(c).busy, "coupled before the master reached 500 ({p})");
+        } else {
+            assert!(r.out(c).in_sync && !r.out(c).busy, "not coupled at {p}");
+        }
+        r.out(m).done
+    });
+    assert!((r.st(1).set_position - 10.0).abs() < 1e-9);
+}
+
+/// A periodic motion function with stroke 240 that runs synchronously (slope 1) at both ends
+/// of its cycle: it joins the 1:1 line at a cycle border without a velocity step.
+fn slower_in_the_middle() -> CamTableData {
+    use MotionFunctionType::*;
+    let point = |i: u32, law, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: law,
+        point_type: MotionPointType::Velocity,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 1.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    let mut t = CamTableData::motion_function(vec![
+        point(1, Polynom1, 0.0, 0.0),
+        point(2, Polynom5Mm, 60.0, 60.0),
+        point(3, Polynom1, 300.0, 180.0),
+        point(4, Polynom1, 360.0, 240.0),
+    ]);
+    t.periodic = true;
+    t
+}
+
+/// Spec §5.1 step 3: switching cams at the next cycle with slave autooffset: CamTableQueued
+/// and Active until the master crosses the period border, then InSync, no jump in position
+/// or velocity. DELETEQUEUEDDATA drops a queued switch.
+#[test]
+fn a_cam_switch_at_the_next_cycle_is_queued_and_seamless() {
+    let mut r = rig_at(100.0, 100.0);
+    r.cam(T_LINE, &line(true));
+    r.cam(T_HALF, &slower_in_the_middle());
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    let switch = CamIn {
+        activation_mode: CamActivationMode::NextCycle,
+        slave_scaling_mode: CamScalingMode::AutoOffset,
+        ..cam_in(0, T_HALF)
+    };
+    let s = r.ok(1, CommandKind::CamIn(switch));
+    assert!(r.out(s).active && r.st(1).cam_table_queued);
+    assert_eq!(r.st(1).cam.cam_exchange_cam_table_id, T_HALF);
+    // DELETEQUEUEDDATA drops it; a new one queues again.
+    let d = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::DeleteQueuedData,
+            ..switch
+        }),
+    );
+    assert!(r.out(s).command_aborted && r.out(d).done && !r.st(1).cam_table_queued);
+    let s = r.ok(1, CommandKind::CamIn(switch));
+    let (mut prev, mut prev_v) = (r.st(1).set_position, r.st(1).set_velocity);
+    move_master(&mut r, 700.0, 200.0, |r| {
+        let p = r.st(0).set_position;
+        let (slave, v) = (r.st(1).set_position, r.st(1).set_velocity);
+        assert!(
+            (slave - prev).abs() <= 200.0 * DT + 1e-9,
+            "slave jumped {prev} → {slave}"
+        );
+        assert!(
+            (v - prev_v).abs() <= 2500.0 * DT + 1e-6,
+            "velocity stepped {prev_v} → {v} at {p}"
+        );
+        assert!(!r.out(s).error, "{:?}", r.out(s));
+        if p < 360.0 {
+            assert!(
+                r.st(1).cam_table_queued && r.out(s).active,
+                "switched early at {p}"
+            );
+            assert_eq!(r.st(1).cam.cam_table_id, T_LINE);
+        } else {
+            assert!(
+                !r.st(1).cam_table_queued && r.out(s).in_sync,
+                "not switched at {p}"
+            );
+            assert_eq!(r.st(1).cam.cam_table_id, T_HALF);
+        }
+        (prev, prev_v) = (slave, v);
+    });
+    // 340 into the new cam's cycle: 240 − 20 of its stroke, counted from the switch.
+    let want = 360.0 + 220.0;
+    assert!(
+        (r.st(1).set_position - want).abs() < 0.05,
+        "{} ≠ {want}",
+        r.st(1).set_position
+    );
+}
+
+/// Spec §5.1 step 5: scaling the slave ×2 with AUTOOFFSET at rest keeps its position; the
+/// next travel is doubled. A USERDEFINED scaling that would jump ends with 0x7084, so does
+/// one that would step the velocity of a moving slave (the manual: scale at rest); at a
+/// master position the scaling waits (CamScalingPending, Active).
+#[test]
+fn scaling_with_autooffset_keeps_the_slave_where_it_is() {
+    let mut r = rig_at(50.0, 50.0);
+    // 1:1 up to 100, at rest from 100 to 200.
+    let t = CamTableData::positions(vec![[0.0, 0.0], [100.0, 100.0], [200.0, 100.0]], false);
+    r.cam(T_LINE, &t);
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    let scaling = CamScaling {
+        activation_mode: CamActivationMode::Instantaneous,
+        activation_position: 0.0,
+        master_scaling_mode: CamScalingMode::Off,
+        slave_scaling_mode: CamScalingMode::AutoOffset,
+        master_offset: 0.0,
+        slave_offset: 0.0,
+        master_scaling: 1.0,
+        slave_scaling: 2.0,
+    };
+    let s = r.ok(1, CommandKind::CamScaling(scaling));
+    assert!(r.out(s).done && !r.st(1).cam_scaling_pending);
+    assert_eq!(r.st(1).set_position, 50.0);
+    assert_eq!(
+        (r.st(1).cam.slave_scaling, r.st(1).cam.slave_offset),
+        (2.0, -50.0)
+    );
+    move_master(&mut r, 60.0, 100.0, |_| {});
+    assert!((r.st(1).set_position - 70.0).abs() < 1e-9);
+    let jump = CamScaling {
+        slave_scaling_mode: CamScalingMode::UserDefined,
+        slave_scaling: 3.0,
+        ..scaling
+    };
+    let j = r.ok(1, CommandKind::CamScaling(jump));
+    assert_eq!(r.out(j).error_id, ErrorId::CAM_SLAVE_WOULD_JUMP.0);
+    assert_eq!(r.st(1).cam.slave_scaling, 2.0, "unchanged");
+    // Back to 1 when the master passes 80: the slave moves there (velocity step): refused.
+    let at = |position: f64| CamScaling {
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: position,
+        slave_scaling: 1.0,
+        ..scaling
+    };
+    let l = r.ok(1, CommandKind::CamScaling(at(80.0)));
+    assert!(r.out(l).active && r.st(1).cam_scaling_pending);
+    move_master(&mut r, 90.0, 100.0, |_| {});
+    assert_eq!(r.out(l).error_id, ErrorId::CAM_SLAVE_WOULD_JUMP.0);
+    assert_eq!(r.st(1).cam.slave_scaling, 2.0);
+    // At 150 the slave rests (the cam's flat part): scaled there, no jump.
+    let l = r.ok(1, CommandKind::CamScaling(at(150.0)));
+    let mut prev = r.st(1).set_position;
+    move_master(&mut r, 180.0, 100.0, |r| {
+        let p = r.st(0).set_position;
+        assert_eq!(r.out(l).active, p < 150.0, "at {p}");
+        assert!((r.st(1).set_position - prev).abs() <= 2.0 * 100.0 * DT + 1e-9);
+        prev = r.st(1).set_position;
+    });
+    assert!(r.out(l).done && !r.st(1).cam_scaling_pending);
+    assert_eq!(r.st(1).cam.slave_scaling, 1.0);
+    assert!(
+        (r.st(1).set_position - 150.0).abs() < 1e-9,
+        "{}",
+        r.st(1).set_position
+    );
+}
+
+/// Spec §2.2: after MC_CamOut in motion the slave keeps its velocity with no acceleration.
+/// MC_GearOut does not decouple a cam slave; another motion command does.
+#[test]
+fn cam_out_in_motion_keeps_the_velocity() {
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &line(true));
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    assert_eq!(
+        r.rejected(1, CommandKind::GearOut),
+        ErrorId::COMMAND_NOT_PERMITTED
+    );
+    let v = r.ok(0, velocity(100.0, Direction::Positive));
+    r.until(2.0, |r| r.out(v).in_velocity);
+    r.run(0.1);
+    let o = r.ok(1, CommandKind::CamOut);
+    assert!(r.out(o).done);
+    assert_eq!(r.st(1).state, AxisState::ContinuousMotion);
+    assert_eq!(r.st(1).cam.cam_table_id, 0);
+    r.run(0.5);
+    assert!((r.st(1).set_velocity - 100.0).abs() < 1e-9);
+    assert_eq!(r.st(1).set_acceleration, 0.0);
+    assert_eq!(r.rejected(1, CommandKind::CamOut), ErrorId::CAM_NOT_COUPLED);
+}
+
+/// Linear cams hold the first or last slave value outside their range (spec §1.4).
+#[test]
+fn a_linear_cam_holds_its_end_values_outside_its_range() {
+    let mut r = rig_at(0.0, 0.0);
+    let t = CamTableData::positions(vec![[0.0, 0.0], [100.0, 50.0], [200.0, 50.0]], false);
+    r.cam(T_HALF, &t);
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_HALF)));
+    move_master(&mut r, 300.0, 200.0, |_| {});
+    assert_eq!(r.st(1).set_position, 50.0);
+    assert_eq!(r.st(1).set_velocity, 0.0);
+}
+
+/// The rotary knife (spec §5.2): synchronous at the cut (30° either side), one stroke of
+/// 360 per product; after N products SumOfSlaveStrokes = N·360.
+#[test]
+fn rotary_knife_one_stroke_per_product() {
+    use MotionFunctionType::*;
+    let point = |i: u32, law, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: law,
+        point_type: MotionPointType::Velocity,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 1.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    // A knife that waits between the cuts: slower in the middle, synchronous at the cut.
+    let mut knife = CamTableData::motion_function(vec![
+        point(1, Polynom1, 0.0, 0.0),
+        point(2, Polynom5Mm, 30.0, 30.0),
+        point(3, Polynom1, 330.0, 330.0),
+        point(4, Polynom1, 360.0, 360.0),
+    ]);
+    knife.periodic = true;
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &knife);
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    let v = r.ok(0, velocity(360.0, Direction::Positive));
+    r.until(2.0, |r| r.out(v).in_velocity);
+    let mut cuts = 0;
+    let mut prev = r.st(1).cam.actual_master_cam_pos;
+    r.until(20.0, |r| {
+        let info = r.st(1).cam;
+        if info.actual_master_cam_pos < prev {
+            cuts += 1;
+        }
+        prev = info.actual_master_cam_pos;
+        let xl = info.actual_master_cam_pos;
+        if !(30.0..=330.0).contains(&xl) {
+            // In the synchronous window the knife runs with the web.
+            assert!(
+                (r.st(1).set_velocity - r.st(0).set_velocity).abs() < 1e-6,
+                "at {xl}"
+            );
+        }
+        cuts == 5
+    });
+    let info = r.st(1).cam;
+    let k = ((r.st(0).set_position) / 360.0).floor();
+    assert!(
+        (info.sum_of_slave_strokes - k * 360.0).abs() < 1e-9,
+        "{info:?}"
+    );
+}
+
+/// Modes the manual does not allow are refused (spec §1.6–§1.8): relative master with an
+/// activation in cam coordinates or at the next cycle, NEXTCYCLEONCE, master autooffset at
+/// the first coupling, a table that is not there.
+#[test]
+fn cam_modes_the_manual_forbids_are_refused() {
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &line(true));
+    for ci in [
+        CamIn {
+            start_mode: StartMode::Relative,
+            activation_mode: CamActivationMode::AtMasterCamPos,
+            ..cam_in(0, T_LINE)
+        },
+        CamIn {
+            start_mode: StartMode::MasterRelSlaveAbs,
+            activation_mode: CamActivationMode::NextCycle,
+            ..cam_in(0, T_LINE)
+        },
+        CamIn {
+            activation_mode: CamActivationMode::NextCycleOnce,
+            ..cam_in(0, T_LINE)
+        },
+        CamIn {
+            activation_mode: CamActivationMode::DeleteQueuedData,
+            ..cam_in(0, T_LINE)
+        },
+        CamIn {
+            master_scaling_mode: CamScalingMode::AutoOffset,
+            ..cam_in(0, T_LINE)
+        },
+    ] {
+        assert_eq!(
+            r.rejected(1, CommandKind::CamIn(ci)),
+            ErrorId::CAM_MODE_INVALID,
+            "{ci:?}"
+        );
+    }
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(cam_in(0, 9))),
+        ErrorId::CAM_TABLE_ID_INVALID
+    );
+    assert_eq!(
+        r.rejected(
+            1,
+            CommandKind::CamIn(CamIn {
+                slave_scaling: 0.0,
+                ..cam_in(0, T_LINE)
+            })
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(cam_in(1, T_LINE))),
+        ErrorId::MASTER_INVALID
+    );
+}
+
+/// A cam slave is a coupled slave: one that crosses its soft limit is decoupled and stopped
+/// in ErrorStop (0x7003), a queued switch ends with the error; a pending coupling ends when a
+/// motion command takes the axis.
+#[test]
+fn a_cam_slave_at_its_soft_limit_stops_and_queued_changes_end() {
+    let mut p = params_with_soft_limits(-1000.0, 300.0);
+    p.axis_velo_max = 2000.0;
+    let mut r = Rig::with(vec![(false, params()), (false, p)]);
+    r.bounds[1].acceleration = 1e9;
+    r.bounds[1].jerk = 1e12;
+    r.power_on(0);
+    r.power_on(1);
+    r.cam(T_LINE, &line(true));
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    let queued = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::AtMasterAxisPos,
+            activation_position: 900.0,
+            ..cam_in(0, T_LINE)
+        }),
+    );
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(500.0, 200.0)));
+    r.until(10.0, |r| r.st(1).state == AxisState::ErrorStop);
+    assert_eq!(r.st(1).error_id, ErrorId::SOFT_LIMIT_REACHED.0);
+    assert_eq!(r.out(queued).error_id, ErrorId::SOFT_LIMIT_REACHED.0);
+    assert!(!r.st(1).coupled);
+    r.until(10.0, |r| r.out(m).done);
+    // A pending coupling ends when another command takes the axis.
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &line(true));
+    let pending = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::AtMasterAxisPos,
+            activation_position: 100.0,
+            ..cam_in(0, T_LINE)
+        }),
+    );
+    r.ok(1, CommandKind::MoveAbsolute(mv(10.0, 100.0)));
+    assert!(r.out(pending).command_aborted);
+    assert!(!r.k.cam_in_use(T_LINE));
+}
