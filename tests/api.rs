@@ -885,10 +885,13 @@ async fn openapi_json_is_current() {
         "/api/v1/cam-tables/{table}/slave-dynamics",
         "/api/v1/cam-tables/{table}/master-position",
         "/api/v1/cam-tables/{table}/values",
+        "/api/v1/axes/{axis}/cam-in",
+        "/api/v1/axes/{axis}/cam-out",
+        "/api/v1/axes/{axis}/cam-scaling",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 43, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 46, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -1014,7 +1017,7 @@ async fn asyncapi_json_is_current() {
             "{method}"
         );
     }
-    assert_eq!(commands, 20);
+    assert_eq!(commands, 23);
     let s = Server::start();
     let served = get(&s, "/asyncapi.json").await;
     assert_eq!(served.status, 200);

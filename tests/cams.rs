@@ -368,3 +368,104 @@ async fn cam_tables_survive_a_restart_and_travel_with_the_configuration() {
     assert_eq!(put(&b, "/api/v1/config", none).await.status, 200);
     assert_eq!(get(&b, "/api/v1/cam-tables").await.json, json!([]));
 }
+
+/// The README's cam tour: upload, couple `y` to `x`, move `x`, read the slave (MC_CamInfo in
+/// its status); a coupled table cannot be replaced or deleted; after a restart the table is
+/// there and the coupling is not (couplings end with the process).
+#[tokio::test(flavor = "multi_thread")]
+async fn a_cam_couples_y_to_x_over_http_and_only_the_table_survives_a_restart() {
+    let dir = temp_dir();
+    let db = dir.join("couple.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    assert_eq!(post(&s, "/api/v1/cam-tables", polynom5()).await.status, 201);
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    // Not at the cam's position: refused, nothing coupled.
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 100.0, "velocity": 200.0}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "x", "cam_table": "p5"}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_slave_would_jump")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 0.0, "velocity": 200.0}),
+    )
+    .await;
+    assert_eq!(r.status, 202);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in?wait=true",
+        json!({"master": "x", "cam_table": "p5"}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    assert_eq!(r.json["final"], true);
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 150.0, "velocity": 200.0}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["done"], true, "{}", r.text);
+    let y = status(&s, "y").await;
+    assert!(close(&y["status"]["set_position"], 89.6484375), "{y}");
+    assert_eq!(y["status"]["state"], "synchronized_motion");
+    let cam = &y["status"]["cam"];
+    assert_eq!(cam["cam_table_id"], 1);
+    assert!(
+        close(&cam["actual_master_cam_pos"], 150.0)
+            && close(&cam["actual_slave_cam_pos"], 89.6484375),
+        "{cam}"
+    );
+    let r = put(&s, "/api/v1/cam-tables/p5", polynom5()).await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_table_in_use"))
+    );
+    let r = delete(&s, "/api/v1/cam-tables/p5").await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_table_in_use"))
+    );
+    // A scaling with autooffset keeps the slave where it is.
+    let r = post(&s, "/api/v1/axes/y/cam-scaling?wait=true", json!({"slave_scaling": 2.0, "slave_scaling_mode": "auto_offset", "master_scaling_mode": "off"})).await;
+    assert_eq!(r.json["outputs"]["done"], true, "{}", r.text);
+    assert!(close(
+        &status(&s, "y").await["status"]["set_position"],
+        89.6484375
+    ));
+    assert_eq!(
+        post(&s, "/api/v1/axes/y/cam-out", json!({})).await.status,
+        202
+    );
+    assert_eq!(status(&s, "y").await["status"]["cam"]["cam_table_id"], 0);
+    assert_eq!(
+        put(&s, "/api/v1/cam-tables/p5", polynom5()).await.status,
+        200,
+        "free again"
+    );
+    s.stop();
+
+    let s = Server::start_with(db, &[]);
+    assert_eq!(get(&s, "/api/v1/cam-tables/p5").await.json["version"], 2);
+    let y = status(&s, "y").await;
+    assert_eq!(y["status"]["coupled"], false);
+    assert_eq!(y["status"]["cam"]["cam_table_id"], 0);
+}

@@ -3,6 +3,8 @@
 //! they are stepped in; everything else is the axis's (`axis/`).
 
 use crate::axis::{Axis, Master, MasterSample};
+use std::sync::Arc;
+
 use crate::cam::{Cam, CamStore};
 use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};
 use crate::drive::{DriveFeedback, DriveSetpoint};
@@ -149,7 +151,7 @@ impl Kernel {
     /// (to be freed off the cycle thread). Refused — the cam comes back — while an axis is
     /// coupled through that table or waits to be (a coupled table changes only by the online
     /// change rules, never by a jump), or for an id outside 1..255.
-    pub fn insert_cam(&mut self, id: u32, cam: Box<Cam>) -> Result<Option<Box<Cam>>, Box<Cam>> {
+    pub fn insert_cam(&mut self, id: u32, cam: Arc<Cam>) -> Result<Option<Arc<Cam>>, Arc<Cam>> {
         if self.cam_in_use(id) {
             return Err(cam);
         }
@@ -157,7 +159,7 @@ impl Kernel {
     }
 
     /// Takes a cam out (to be freed off the cycle thread); refused while it is in use.
-    pub fn remove_cam(&mut self, id: u32) -> Result<Option<Box<Cam>>, ErrorId> {
+    pub fn remove_cam(&mut self, id: u32) -> Result<Option<Arc<Cam>>, ErrorId> {
         if self.cam_in_use(id) {
             return Err(ErrorId::CAM_TABLE_IN_USE);
         }

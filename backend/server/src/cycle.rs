@@ -57,6 +57,18 @@ pub enum Request {
         ticket: u64,
         slot: AxisSlot,
     },
+    /// Put a built cam under its table id (refused while the table is in use: a coupled
+    /// table is never swapped under its slave).
+    InsertCam {
+        ticket: u64,
+        id: u32,
+        cam: Arc<motion::cam::Cam>,
+    },
+    /// Take a cam out (refused while in use).
+    RemoveCam {
+        ticket: u64,
+        id: u32,
+    },
     /// What the scope samples from the cycle this is drained in (see `scope.rs`).
     ScopeConfig {
         ticket: u64,
@@ -78,6 +90,7 @@ pub struct Reply {
 pub enum Garbage {
     Axis(#[allow(dead_code)] Box<Axis>),
     Drive(#[allow(dead_code)] Drive),
+    Cam(#[allow(dead_code)] Arc<motion::cam::Cam>),
 }
 
 /// Status of every slot at the end of one cycle.
@@ -355,9 +368,15 @@ impl CycleThread {
                     // Its requester has given up (503): acting now would be a command nobody
                     // tracks. Boxes go back to be freed off the thread; no reply is awaited.
                     shared.stats.requests_expired.fetch_add(1, Relaxed);
-                    if let Request::InsertAxis { axis, drive, .. } = req {
-                        let _ = shared.garbage.push(Garbage::Axis(axis));
-                        let _ = shared.garbage.push(Garbage::Drive(drive));
+                    match req {
+                        Request::InsertAxis { axis, drive, .. } => {
+                            let _ = shared.garbage.push(Garbage::Axis(axis));
+                            let _ = shared.garbage.push(Garbage::Drive(drive));
+                        }
+                        Request::InsertCam { cam, .. } => {
+                            let _ = shared.garbage.push(Garbage::Cam(cam));
+                        }
+                        _ => {}
                     }
                     continue;
                 }
@@ -475,6 +494,37 @@ impl CycleThread {
                         false => Err(ErrorId::AXIS_UNKNOWN),
                     },
                 },
+                Request::InsertCam { ticket, id, cam } => {
+                    let result = match self.kernel.insert_cam(id, cam) {
+                        Ok(old) => {
+                            if let Some(old) = old {
+                                self.discard(Garbage::Cam(old));
+                            }
+                            Ok(())
+                        }
+                        Err(cam) => {
+                            self.discard(Garbage::Cam(cam));
+                            Err(ErrorId::CAM_TABLE_IN_USE)
+                        }
+                    };
+                    Reply {
+                        ticket,
+                        cycle,
+                        result,
+                    }
+                }
+                Request::RemoveCam { ticket, id } => {
+                    let result = self.kernel.remove_cam(id).map(|old| {
+                        if let Some(old) = old {
+                            self.discard(Garbage::Cam(old));
+                        }
+                    });
+                    Reply {
+                        ticket,
+                        cycle,
+                        result,
+                    }
+                }
                 Request::ScopeConfig { ticket, config } => {
                     self.scope = config;
                     Reply {

@@ -325,7 +325,7 @@ impl CommandState {
 /// A change of a command's outputs.
 #[derive(Clone, Copy, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
-    "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+    "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
     "warning": false, "warning_id": 0}}))]
 pub struct CommandEventDto {
     /// The kernel cycle it happened in.
@@ -352,13 +352,13 @@ pub struct ClientInfo {
     "parameters": {"position": 100.0, "velocity": 200.0},
     "state": "done", "final": true,
     "outputs": {"busy": false, "active": false, "done": true, "command_aborted": false, "error": false,
-                "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+                "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
                 "warning": false, "warning_id": 0},
     "accepted_cycle": 1200, "last_cycle": 1873,
     "submitted_at": "2025-01-01T12:00:00.000Z", "finished_at": "2025-01-01T12:00:00.673Z",
     "client": {"addr": "127.0.0.1:50312", "via": "rest"},
     "events": [{"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
-                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_end_velocity": false, "status": false,
+                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
                 "warning": false, "warning_id": 0}}]
 }))]
 pub struct CommandResource {
@@ -692,6 +692,88 @@ pub struct GearInDynBody {
     /// units/s² (0 = the slave's AxisAcc #1004).
     #[serde(default)]
     pub acceleration: f64,
+}
+
+/// MC_CamIn: couple this axis (the slave) to `master` through a cam table, or — on a slave
+/// already coupled to that master through a cam — switch to another cam. The slave must stand
+/// where the cam puts it (`GET /cam-tables/{table}/slave-dynamics`), or use a relative start
+/// mode or slave autooffset: a cam that would make it jump is refused (0x7084).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "cam_table": "knife", "start_mode": "absolute", "activation_mode": "instantaneous"}))]
+pub struct CamInBody {
+    /// Master axis id or name.
+    pub master: String,
+    /// Cam table id (1..255) or name.
+    pub cam_table: String,
+    /// Added to the master position before scaling (spec §1.5). Default 0.
+    #[serde(default)]
+    pub master_offset: f64,
+    /// Added to the scaled slave cam position. Default 0.
+    #[serde(default)]
+    pub slave_offset: f64,
+    /// Default 1 (not 0).
+    #[serde(default = "one")]
+    #[schema(default = 1.0)]
+    pub master_scaling: f64,
+    /// Default 1 (not 0).
+    #[serde(default = "one")]
+    #[schema(default = 1.0)]
+    pub slave_scaling: f64,
+    /// Default `absolute`.
+    #[serde(default)]
+    pub start_mode: motion::cam::StartMode,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// For the position modes: master axis position, or raw cam position for
+    /// `at_master_cam_pos`. Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// Default `user_defined`.
+    #[serde(default)]
+    pub master_scaling_mode: motion::cam::CamScalingMode,
+    /// Default `user_defined`.
+    #[serde(default)]
+    pub slave_scaling_mode: motion::cam::CamScalingMode,
+}
+
+/// MC_CamScaling: new offsets and scalings of the cam coupling (the raw table stays).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"slave_scaling": 2.0, "slave_scaling_mode": "auto_offset", "master_scaling_mode": "off"}))]
+pub struct CamScalingBody {
+    /// Default `instantaneous` (also `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`,
+    /// `off`).
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// Default `user_defined`.
+    #[serde(default)]
+    pub master_scaling_mode: motion::cam::CamScalingMode,
+    /// Default `user_defined`.
+    #[serde(default)]
+    pub slave_scaling_mode: motion::cam::CamScalingMode,
+    /// Default 0.
+    #[serde(default)]
+    pub master_offset: f64,
+    /// Default 0.
+    #[serde(default)]
+    pub slave_offset: f64,
+    /// Default 1.
+    #[serde(default = "one")]
+    #[schema(default = 1.0)]
+    pub master_scaling: f64,
+    /// Default 1.
+    #[serde(default = "one")]
+    #[schema(default = 1.0)]
+    pub slave_scaling: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// MC_MoveSuperImposed: a relative motion laid over the running one.

@@ -42,4 +42,8 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28801, "cam_ignore_at_end", "motion function: the first and last point must not be IGNORE"],
   [28802, "cam_boundary_mismatch", "motion function: the law does not match its points' boundary conditions"],
   [28803, "cam_value_invalid", "cam table: value not a finite number"],
+  [28804, "cam_slave_would_jump", "the cam would make the slave jump: pre-position it or use autooffset"],
+  [28805, "cam_table_in_use", "the cam table is in use by a coupling"],
+  [28806, "cam_mode_invalid", "activation, start or scaling mode not allowed here"],
+  [28807, "cam_not_coupled", "the axis is not coupled through a cam"],
 ];

@@ -74,6 +74,57 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/cam-in": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamIn: couple to a master through a cam table, or switch the cam of a coupled slave (active while it waits for its activation; wait returns at in_sync; 409 cam_slave_would_jump unless the slave stands where the cam puts it) */
+        post: operations["cam_in"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/cam-out": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamOut: decouple a cam slave; it keeps its velocity */
+        post: operations["cam_out"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/cam-scaling": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamScaling: new offsets and scalings of the cam coupling (auto_offset: no position jump) */
+        post: operations["cam_scaling"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/gear-in": {
         parameters: {
             query?: never;
@@ -985,6 +1036,39 @@ export interface components {
          *       "actual_acceleration": 0,
          *       "actual_position": 64.109,
          *       "actual_velocity": 199.98,
+         *       "cam": {
+         *         "actual_master_axis_pos": 0,
+         *         "actual_master_cam_pos": 0,
+         *         "actual_slave_axis_pos": 0,
+         *         "actual_slave_cam_pos": 0,
+         *         "cam_data_queued": false,
+         *         "cam_exchange_activation_mode": "instantaneous",
+         *         "cam_exchange_activation_pos": 0,
+         *         "cam_exchange_cam_table_id": 0,
+         *         "cam_table_id": 0,
+         *         "cam_table_queued": false,
+         *         "master_absolute": false,
+         *         "master_axis_coupling_pos": 0,
+         *         "master_cam_start_pos": 0,
+         *         "master_offset": 0,
+         *         "master_scaling": 0,
+         *         "periodic": false,
+         *         "raw_master_period": 0,
+         *         "raw_slave_stroke": 0,
+         *         "scaling_activation_mode": "instantaneous",
+         *         "scaling_activation_pos": 0,
+         *         "scaling_pending": false,
+         *         "slave_absolute": false,
+         *         "slave_axis_coupling_pos": 0,
+         *         "slave_cam_start_pos": 0,
+         *         "slave_offset": 0,
+         *         "slave_scaling": 0,
+         *         "sum_of_slave_strokes": 0,
+         *         "sum_of_superposition_distance": 0
+         *       },
+         *       "cam_data_queued": false,
+         *       "cam_scaling_pending": false,
+         *       "cam_table_queued": false,
          *       "command_buffered": false,
          *       "compensating": false,
          *       "constant_velocity": true,
@@ -1145,9 +1229,169 @@ export interface components {
              * @description Command that is executing (NcToPlc CmdNo), 0 when none.
              */
             active_command: number;
+            /** @description A cam switch (MC_CamIn while coupled) waits for its activation. */
+            cam_table_queued: boolean;
+            /** @description An MC_CamScaling waits for its activation. */
+            cam_scaling_pending: boolean;
+            /** @description Written motion-function data waits to take effect (online change). */
+            cam_data_queued: boolean;
+            /** @description MC_CamInfo: the cam coupling (`cam_table_id` 0 when not coupled through a cam). */
+            cam: components["schemas"]["CamInfo"];
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
+        /**
+         * @description `MC_CamActivationMode` (spec §1.7): when a coupling, a cam switch or a scaling takes effect.
+         * @enum {string}
+         */
+        CamActivationMode: "instantaneous" | "at_master_cam_pos" | "at_master_axis_pos" | "next_cycle" | "next_cycle_once" | "as_soon_as_possible" | "off" | "delete_queued_data" | "at_master_axis_pos_positive_direction" | "at_master_axis_pos_negative_direction";
+        /**
+         * @description MC_CamIn: couple this axis (the slave) to `master` through a cam table, or — on a slave
+         *     already coupled to that master through a cam — switch to another cam. The slave must stand
+         *     where the cam puts it (`GET /cam-tables/{table}/slave-dynamics`), or use a relative start
+         *     mode or slave autooffset: a cam that would make it jump is refused (0x7084).
+         * @example {
+         *       "activation_mode": "instantaneous",
+         *       "cam_table": "knife",
+         *       "master": "x",
+         *       "start_mode": "absolute"
+         *     }
+         */
+        CamInBody: {
+            /** @description Master axis id or name. */
+            master: string;
+            /** @description Cam table id (1..255) or name. */
+            cam_table: string;
+            /**
+             * Format: double
+             * @description Added to the master position before scaling (spec §1.5). Default 0.
+             */
+            master_offset?: number;
+            /**
+             * Format: double
+             * @description Added to the scaled slave cam position. Default 0.
+             */
+            slave_offset?: number;
+            /**
+             * Format: double
+             * @description Default 1 (not 0).
+             * @default 1
+             */
+            master_scaling: number;
+            /**
+             * Format: double
+             * @description Default 1 (not 0).
+             * @default 1
+             */
+            slave_scaling: number;
+            /** @description Default `absolute`. */
+            start_mode?: components["schemas"]["StartMode"];
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description For the position modes: master axis position, or raw cam position for
+             *     `at_master_cam_pos`. Default 0.
+             */
+            activation_position?: number;
+            /** @description Default `user_defined`. */
+            master_scaling_mode?: components["schemas"]["CamScalingMode"];
+            /** @description Default `user_defined`. */
+            slave_scaling_mode?: components["schemas"]["CamScalingMode"];
+        };
+        /**
+         * @description MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
+         *     positions are raw (unscaled); axis positions are set positions.
+         * @example {
+         *       "actual_master_axis_pos": 100,
+         *       "actual_master_cam_pos": 100,
+         *       "actual_slave_axis_pos": 50,
+         *       "actual_slave_cam_pos": 50,
+         *       "cam_data_queued": false,
+         *       "cam_exchange_activation_mode": "instantaneous",
+         *       "cam_exchange_activation_pos": 0,
+         *       "cam_exchange_cam_table_id": 0,
+         *       "cam_table_id": 1,
+         *       "cam_table_queued": false,
+         *       "master_absolute": true,
+         *       "master_axis_coupling_pos": 0,
+         *       "master_cam_start_pos": 0,
+         *       "master_offset": 0,
+         *       "master_scaling": 1,
+         *       "periodic": false,
+         *       "raw_master_period": 200,
+         *       "raw_slave_stroke": 100,
+         *       "scaling_activation_mode": "instantaneous",
+         *       "scaling_activation_pos": 0,
+         *       "scaling_pending": false,
+         *       "slave_absolute": true,
+         *       "slave_axis_coupling_pos": 0,
+         *       "slave_cam_start_pos": 0,
+         *       "slave_offset": 0,
+         *       "slave_scaling": 1,
+         *       "sum_of_slave_strokes": 0,
+         *       "sum_of_superposition_distance": 0
+         *     }
+         */
+        CamInfo: {
+            /**
+             * Format: int32
+             * @description The active cam table (0: not coupled through a cam).
+             */
+            cam_table_id: number;
+            periodic: boolean;
+            /** Format: double */
+            master_cam_start_pos: number;
+            /** Format: double */
+            slave_cam_start_pos: number;
+            /** Format: double */
+            raw_master_period: number;
+            /** Format: double */
+            raw_slave_stroke: number;
+            /** Format: double */
+            master_axis_coupling_pos: number;
+            /** Format: double */
+            slave_axis_coupling_pos: number;
+            master_absolute: boolean;
+            slave_absolute: boolean;
+            /**
+             * Format: double
+             * @description Total offsets and scalings (relative start modes included).
+             */
+            master_offset: number;
+            /** Format: double */
+            slave_offset: number;
+            /** Format: double */
+            master_scaling: number;
+            /** Format: double */
+            slave_scaling: number;
+            /**
+             * Format: double
+             * @description Strokes added since the coupling's base cycle, in slave axis units.
+             */
+            sum_of_slave_strokes: number;
+            /** Format: double */
+            sum_of_superposition_distance: number;
+            /** Format: double */
+            actual_master_axis_pos: number;
+            /** Format: double */
+            actual_slave_axis_pos: number;
+            /** Format: double */
+            actual_master_cam_pos: number;
+            /** Format: double */
+            actual_slave_cam_pos: number;
+            scaling_pending: boolean;
+            scaling_activation_mode: components["schemas"]["CamActivationMode"];
+            /** Format: double */
+            scaling_activation_pos: number;
+            cam_data_queued: boolean;
+            cam_table_queued: boolean;
+            /** Format: int32 */
+            cam_exchange_cam_table_id: number;
+            cam_exchange_activation_mode: components["schemas"]["CamActivationMode"];
+            /** Format: double */
+            cam_exchange_activation_pos: number;
+        };
         /**
          * @description `ST_CamMasterData`: one solution.
          * @example {
@@ -1175,6 +1419,57 @@ export interface components {
              */
             slave_offset: number;
         };
+        /**
+         * @description MC_CamScaling: new offsets and scalings of the cam coupling (the raw table stays).
+         * @example {
+         *       "master_scaling_mode": "off",
+         *       "slave_scaling": 2,
+         *       "slave_scaling_mode": "auto_offset"
+         *     }
+         */
+        CamScalingBody: {
+            /**
+             * @description Default `instantaneous` (also `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`,
+             *     `off`).
+             */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
+            /** @description Default `user_defined`. */
+            master_scaling_mode?: components["schemas"]["CamScalingMode"];
+            /** @description Default `user_defined`. */
+            slave_scaling_mode?: components["schemas"]["CamScalingMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            master_offset?: number;
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            slave_offset?: number;
+            /**
+             * Format: double
+             * @description Default 1.
+             * @default 1
+             */
+            master_scaling: number;
+            /**
+             * Format: double
+             * @description Default 1.
+             * @default 1
+             */
+            slave_scaling: number;
+        };
+        /**
+         * @description `MC_CamScalingMode` (spec §1.8), per axis.
+         * @enum {string}
+         */
+        CamScalingMode: "user_defined" | "auto_offset" | "off";
         /**
          * @description A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;
          *     also an entry of the configuration document. Position tables have `rows`, motion functions
@@ -1502,6 +1797,7 @@ export interface components {
          *         "error_id": 0,
          *         "in_end_velocity": false,
          *         "in_gear": false,
+         *         "in_sync": false,
          *         "in_velocity": false,
          *         "status": false,
          *         "warning": false,
@@ -1539,6 +1835,7 @@ export interface components {
          *             "error_id": 0,
          *             "in_end_velocity": false,
          *             "in_gear": false,
+         *             "in_sync": false,
          *             "in_velocity": false,
          *             "status": false,
          *             "warning": false,
@@ -1559,6 +1856,7 @@ export interface components {
          *         "error_id": 0,
          *         "in_end_velocity": false,
          *         "in_gear": false,
+         *         "in_sync": false,
          *         "in_velocity": false,
          *         "status": false,
          *         "warning": false,
@@ -1948,6 +2246,7 @@ export interface components {
          *       "error_id": 0,
          *       "in_end_velocity": false,
          *       "in_gear": false,
+         *       "in_sync": false,
          *       "in_velocity": false,
          *       "status": false,
          *       "warning": false,
@@ -1969,6 +2268,8 @@ export interface components {
             in_velocity: boolean;
             /** @description GearIn: coupled. */
             in_gear: boolean;
+            /** @description CamIn: coupled and the cam active (a queued cam switch: once it has taken effect). */
+            in_sync: boolean;
             /** @description MoveContinuous*: target reached, running at end velocity. */
             in_end_velocity: boolean;
             /** @description Power: axis ready for operation. */
@@ -2230,6 +2531,39 @@ export interface components {
          *       "actual_acceleration": 0,
          *       "actual_position": 64.109,
          *       "actual_velocity": 199.98,
+         *       "cam": {
+         *         "actual_master_axis_pos": 0,
+         *         "actual_master_cam_pos": 0,
+         *         "actual_slave_axis_pos": 0,
+         *         "actual_slave_cam_pos": 0,
+         *         "cam_data_queued": false,
+         *         "cam_exchange_activation_mode": "instantaneous",
+         *         "cam_exchange_activation_pos": 0,
+         *         "cam_exchange_cam_table_id": 0,
+         *         "cam_table_id": 0,
+         *         "cam_table_queued": false,
+         *         "master_absolute": false,
+         *         "master_axis_coupling_pos": 0,
+         *         "master_cam_start_pos": 0,
+         *         "master_offset": 0,
+         *         "master_scaling": 0,
+         *         "periodic": false,
+         *         "raw_master_period": 0,
+         *         "raw_slave_stroke": 0,
+         *         "scaling_activation_mode": "instantaneous",
+         *         "scaling_activation_pos": 0,
+         *         "scaling_pending": false,
+         *         "slave_absolute": false,
+         *         "slave_axis_coupling_pos": 0,
+         *         "slave_cam_start_pos": 0,
+         *         "slave_offset": 0,
+         *         "slave_scaling": 0,
+         *         "sum_of_slave_strokes": 0,
+         *         "sum_of_superposition_distance": 0
+         *       },
+         *       "cam_data_queued": false,
+         *       "cam_scaling_pending": false,
+         *       "cam_table_queued": false,
          *       "command_buffered": false,
          *       "compensating": false,
          *       "constant_velocity": true,
@@ -3104,6 +3438,12 @@ export interface components {
             max: number;
         };
         /**
+         * @description `MC_StartMode`: absolute or relative, for master and slave (spec §1.6). Relative places the
+         *     origin of the cam's coordinates (raw 0) at the axis's position when the cam takes effect.
+         * @enum {string}
+         */
+        StartMode: "absolute" | "relative" | "master_abs_slave_rel" | "master_rel_slave_abs";
+        /**
          * @description Live status of an axis.
          * @example {
          *       "axis": "x",
@@ -3115,6 +3455,39 @@ export interface components {
          *         "actual_acceleration": 0,
          *         "actual_position": 64.109,
          *         "actual_velocity": 199.98,
+         *         "cam": {
+         *           "actual_master_axis_pos": 0,
+         *           "actual_master_cam_pos": 0,
+         *           "actual_slave_axis_pos": 0,
+         *           "actual_slave_cam_pos": 0,
+         *           "cam_data_queued": false,
+         *           "cam_exchange_activation_mode": "instantaneous",
+         *           "cam_exchange_activation_pos": 0,
+         *           "cam_exchange_cam_table_id": 0,
+         *           "cam_table_id": 0,
+         *           "cam_table_queued": false,
+         *           "master_absolute": false,
+         *           "master_axis_coupling_pos": 0,
+         *           "master_cam_start_pos": 0,
+         *           "master_offset": 0,
+         *           "master_scaling": 0,
+         *           "periodic": false,
+         *           "raw_master_period": 0,
+         *           "raw_slave_stroke": 0,
+         *           "scaling_activation_mode": "instantaneous",
+         *           "scaling_activation_pos": 0,
+         *           "scaling_pending": false,
+         *           "slave_absolute": false,
+         *           "slave_axis_coupling_pos": 0,
+         *           "slave_cam_start_pos": 0,
+         *           "slave_offset": 0,
+         *           "slave_scaling": 0,
+         *           "sum_of_slave_strokes": 0,
+         *           "sum_of_superposition_distance": 0
+         *         },
+         *         "cam_data_queued": false,
+         *         "cam_scaling_pending": false,
+         *         "cam_table_queued": false,
          *         "command_buffered": false,
          *         "compensating": false,
          *         "constant_velocity": true,
@@ -4306,6 +4679,162 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_in: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamInBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_out: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_scaling: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamScalingBody"];
             };
         };
         responses: {

@@ -1,6 +1,8 @@
 //! What the cam coupling blocks take (MC_CamIn, MC_CamScaling) and report (MC_CamInfo), and
 //! the kernel's store of built cams. The coupling law itself is `axis/camming.rs`.
 
+use std::sync::Arc;
+
 use super::Cam;
 use serde::{Deserialize, Serialize};
 
@@ -145,10 +147,11 @@ pub struct CamInfo {
     pub cam_exchange_activation_pos: f64,
 }
 
-/// The built cams the kernel couples through, by cam table id (1..255). Cams are put in and
-/// taken out off the cycle thread's hot path (a request between cycles), never freed in it.
+/// The built cams the kernel couples through, by cam table id (1..255), shared with whoever
+/// built them (the server's analysis reads the same cam). Put in and taken out by requests
+/// between cycles and handed back, so the cycle never frees one.
 pub struct CamStore {
-    slots: Vec<Option<Box<Cam>>>,
+    slots: Vec<Option<Arc<Cam>>>,
 }
 
 /// The highest cam table id (MC_CAM_ID).
@@ -169,14 +172,14 @@ impl CamStore {
 
     /// Puts a cam under `id`, handing back the one it replaces; `Err` gives it back for an
     /// id outside 1..255.
-    pub fn insert(&mut self, id: u32, cam: Box<Cam>) -> Result<Option<Box<Cam>>, Box<Cam>> {
+    pub fn insert(&mut self, id: u32, cam: Arc<Cam>) -> Result<Option<Arc<Cam>>, Arc<Cam>> {
         match self.slots.get_mut(id as usize) {
             Some(s) if id >= 1 => Ok(s.replace(cam)),
             _ => Err(cam),
         }
     }
 
-    pub fn remove(&mut self, id: u32) -> Option<Box<Cam>> {
+    pub fn remove(&mut self, id: u32) -> Option<Arc<Cam>> {
         self.slots.get_mut(id as usize).and_then(|s| s.take())
     }
 }

@@ -284,7 +284,7 @@ impl Rig {
     pub fn cam(&mut self, id: u32, table: &motion::cam::CamTableData) {
         let cam = motion::cam::Cam::build(table).expect("a valid cam table");
         assert!(
-            self.k.insert_cam(id, Box::new(cam)).is_ok(),
+            self.k.insert_cam(id, std::sync::Arc::new(cam)).is_ok(),
             "cam {id} not taken"
         );
     }

@@ -200,6 +200,12 @@ catalogue! {
         "MC_GearInDyn: couple with a ratio that may change while enabled (a further gear-in-dyn to the same master changes it; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratio frozen, still coupled)";
     gear_out: "gear-out", EmptyBody, |_, _, _| Ok(CommandKind::GearOut), Operator, Done,
         "MC_GearOut";
+    cam_in: "cam-in", CamInBody, CamInBody::to_kind, Operator, InSync,
+        "MC_CamIn: couple to a master through a cam table, or switch the cam of a coupled slave (active while it waits for its activation; wait returns at in_sync; 409 cam_slave_would_jump unless the slave stands where the cam puts it)";
+    cam_out: "cam-out", EmptyBody, |_, _, _| Ok(CommandKind::CamOut), Operator, Done,
+        "MC_CamOut: decouple a cam slave; it keeps its velocity";
+    cam_scaling: "cam-scaling", CamScalingBody, CamScalingBody::to_kind, Operator, Done,
+        "MC_CamScaling: new offsets and scalings of the cam coupling (auto_offset: no position jump)";
     move_superimposed: "move-superimposed", MoveSuperImposedBody, MoveSuperImposedBody::to_kind, Operator, Done,
         "MC_MoveSuperImposed: lay a relative distance over the running motion (409 axis_not_moving at standstill; warning 0x4243 when it can only be done in part)";
     abort_superposition: "abort-superposition", EmptyBody, |_, _, _| Ok(CommandKind::AbortSuperposition), Operator, Done,

@@ -498,6 +498,23 @@ impl utoipa::Modify for ForeignExamples {
             ("ParamValue", Ok(json!(90.0))),
             ("MotionFunctionPoint", to_value(example_cam().1[1])),
             (
+                "CamInfo",
+                to_value(motion::cam::CamInfo {
+                    cam_table_id: 1,
+                    raw_master_period: 200.0,
+                    raw_slave_stroke: 100.0,
+                    master_absolute: true,
+                    slave_absolute: true,
+                    master_scaling: 1.0,
+                    slave_scaling: 1.0,
+                    actual_master_axis_pos: 100.0,
+                    actual_slave_axis_pos: 50.0,
+                    actual_master_cam_pos: 100.0,
+                    actual_slave_cam_pos: 50.0,
+                    ..Default::default()
+                }),
+            ),
+            (
                 "Characteristics",
                 to_value(motion::cam::characteristics(&example_cam().0)),
             ),

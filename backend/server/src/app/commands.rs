@@ -135,6 +135,8 @@ pub enum Milestone {
     Done,
     InVelocity,
     InGear,
+    /// MC_CamIn: coupled and the cam active.
+    InSync,
     InEndVelocity,
     /// MC_Power's Status: the axis is enabled.
     Status,
@@ -147,6 +149,7 @@ impl Milestone {
             Milestone::Done => false,
             Milestone::InVelocity => o.in_velocity,
             Milestone::InGear => o.in_gear,
+            Milestone::InSync => o.in_sync,
             Milestone::InEndVelocity => o.in_end_velocity,
             Milestone::Status => o.status,
         };

@@ -151,6 +151,27 @@ impl AppState {
         .map(drop)
     }
 
+    /// Hands a built cam to the cycle thread under its table id; 409 `cam_table_in_use` while
+    /// an axis is coupled through that table.
+    pub async fn install_cam(
+        &self,
+        id: u32,
+        cam: std::sync::Arc<motion::cam::Cam>,
+    ) -> AppResult<()> {
+        self.ticketed(|ticket| Request::InsertCam { ticket, id, cam })
+            .await
+            .map(drop)
+            .map_err(in_use)
+    }
+
+    /// Takes a cam out of the cycle thread; 409 `cam_table_in_use` while it is coupled.
+    pub async fn uninstall_cam(&self, id: u32) -> AppResult<()> {
+        self.ticketed(|ticket| Request::RemoveCam { ticket, id })
+            .await
+            .map(drop)
+            .map_err(in_use)
+    }
+
     /// Takes an axis out of the cycle thread.
     pub async fn uninstall_axis(&self, slot: AxisSlot, require_disabled: bool) -> AppResult<()> {
         self.ticketed(|ticket| Request::RemoveAxis {
@@ -219,5 +240,15 @@ impl AppState {
         );
         let drive = config.drive.build(ct);
         Ok((p, axis, drive))
+    }
+}
+
+fn in_use(e: AppError) -> AppError {
+    match e {
+        AppError::Rejected(id) if id == motion::ErrorId::CAM_TABLE_IN_USE => AppError::conflict(
+            "cam_table_in_use",
+            "the cam table is coupled (or a coupling through it waits): decouple its slaves (cam-out) first",
+        ),
+        e => e,
     }
 }

@@ -636,8 +636,19 @@ pub async fn import(
             persistent,
         });
     }
+    let old_cams = super::cams::installed(s);
+    if failed.is_none() {
+        if let Some(entries) = &cams {
+            if let Err(e) = super::cams::install_import(s, entries).await {
+                failed = Some(e);
+            }
+        }
+    }
     if failed.is_none() {
         if let Err(e) = tx.commit().await {
+            if let Some(entries) = &cams {
+                super::cams::restore_cams(s, &old_cams, entries).await;
+            }
             failed = Some(e.into());
         }
     }

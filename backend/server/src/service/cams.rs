@@ -213,13 +213,30 @@ async fn store_and_register(
         &audit_entry(client, action, name, audit_detail(id, name, version, &data)),
     )
     .await?;
-    tx.commit().await?;
+    // The kernel takes the cam before the commit (refused while the table is coupled) and
+    // gets the old one back if the commit fails, so kernel, registry and database agree.
+    let cam = Arc::new(cam);
+    let old = s
+        .registry
+        .read()
+        .unwrap()
+        .cams
+        .get(&id)
+        .map(|e| e.cam.clone());
+    s.install_cam(id, cam.clone()).await?;
+    if let Err(e) = tx.commit().await {
+        let _ = match old {
+            Some(old) => s.install_cam(id, old).await,
+            None => s.uninstall_cam(id).await,
+        };
+        return Err(e.into());
+    }
     let e = CamEntry {
         id,
         name: name.to_string(),
         version,
         data: Arc::new(data),
-        cam: Arc::new(cam),
+        cam,
         updated_at: now,
     };
     let r = resource(&e, false);
@@ -243,7 +260,11 @@ pub async fn delete(s: &AppState, key: &str, client: &ClientInfo) -> AppResult<(
         ),
     )
     .await?;
-    tx.commit().await?;
+    s.uninstall_cam(e.id).await?;
+    if let Err(err) = tx.commit().await {
+        let _ = s.install_cam(e.id, e.cam.clone()).await;
+        return Err(err.into());
+    }
     s.registry.write().unwrap().cams.remove(&e.id);
     Ok(())
 }
@@ -258,6 +279,10 @@ pub async fn load(s: &AppState) -> Result<usize, String> {
     for t in stored {
         match build(t.data).await {
             Ok((data, cam)) => {
+                let cam = Arc::new(cam);
+                s.install_cam(t.id, cam.clone())
+                    .await
+                    .map_err(|e| format!("cam table {}: {e}", t.id))?;
                 s.registry.write().unwrap().cams.insert(
                     t.id,
                     CamEntry {
@@ -265,7 +290,7 @@ pub async fn load(s: &AppState) -> Result<usize, String> {
                         name: t.name,
                         version: t.version,
                         data: Arc::new(data),
-                        cam: Arc::new(cam),
+                        cam,
                         updated_at: t.updated_at,
                     },
                 );
@@ -350,6 +375,52 @@ pub async fn prepare_import(tables: &[CamTableBody]) -> Result<Vec<CamEntry>, Ve
     } else {
         Err(errs)
     }
+}
+
+/// Swaps the kernel's cams for an import's (its axes are new: nothing is coupled); on `Err`
+/// the old cams are back.
+pub async fn install_import(s: &AppState, entries: &[CamEntry]) -> AppResult<()> {
+    let old = installed(s);
+    let mut result = Ok(());
+    for (id, _) in &old {
+        if let Err(e) = s.uninstall_cam(*id).await {
+            result = Err(e);
+            break;
+        }
+    }
+    if result.is_ok() {
+        for e in entries {
+            if let Err(err) = s.install_cam(e.id, e.cam.clone()).await {
+                result = Err(err);
+                break;
+            }
+        }
+    }
+    if result.is_err() {
+        restore_cams(s, &old, entries).await;
+    }
+    result
+}
+
+/// Puts the cams of `old` back after a failed swap (and takes `new` out).
+pub async fn restore_cams(s: &AppState, old: &[(u32, Arc<Cam>)], new: &[CamEntry]) {
+    for e in new {
+        let _ = s.uninstall_cam(e.id).await;
+    }
+    for (id, cam) in old {
+        let _ = s.install_cam(*id, cam.clone()).await;
+    }
+}
+
+/// The kernel's cams as the registry has them (to restore after a failed import).
+pub fn installed(s: &AppState) -> Vec<(u32, Arc<Cam>)> {
+    s.registry
+        .read()
+        .unwrap()
+        .cams
+        .values()
+        .map(|e| (e.id, e.cam.clone()))
+        .collect()
 }
 
 /// Replaces the stored tables within an import's transaction.

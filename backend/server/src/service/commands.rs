@@ -41,6 +41,17 @@ impl Check {
             self.fail(field, "must be ≥ 0 (0 = axis default)");
         }
     }
+    /// A cam block's offsets and activation position (finite) and scalings (finite, not 0).
+    fn cam_coupling(&mut self, [mo, so, position]: [f64; 3], [ms, ss]: [f64; 2]) {
+        self.finite("master_offset", mo);
+        self.finite("slave_offset", so);
+        self.finite("activation_position", position);
+        for (field, v) in [("master_scaling", ms), ("slave_scaling", ss)] {
+            if !(v.is_finite() && v != 0.0) {
+                self.fail(field, "must be a finite number other than 0");
+            }
+        }
+    }
     fn options(&mut self, o: &motion::MoveOptions) {
         if let Some(b) = o.blending_position {
             self.finite("options.blending_position", b);
@@ -357,6 +368,70 @@ impl GearInDynBody {
             gear_ratio: self.gear_ratio,
             acceleration: self.acceleration,
         })
+    }
+}
+
+/// A cam table by id or name, as the kernel knows it (its id).
+fn cam_table_id(c: &mut Check, reg: &Registry, key: &str) -> u32 {
+    match reg.find_cam(key) {
+        Some(t) => t.id,
+        None => {
+            c.fail("cam_table", "no such cam table");
+            0
+        }
+    }
+}
+
+impl CamInBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        let cam_table = cam_table_id(&mut c, reg, &self.cam_table);
+        c.cam_coupling(
+            [
+                self.master_offset,
+                self.slave_offset,
+                self.activation_position,
+            ],
+            [self.master_scaling, self.slave_scaling],
+        );
+        c.done(CommandKind::CamIn(motion::cam::CamIn {
+            master,
+            cam_table,
+            master_offset: self.master_offset,
+            slave_offset: self.slave_offset,
+            master_scaling: self.master_scaling,
+            slave_scaling: self.slave_scaling,
+            start_mode: self.start_mode,
+            activation_mode: self.activation_mode,
+            activation_position: self.activation_position,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+        }))
+    }
+}
+
+impl CamScalingBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.cam_coupling(
+            [
+                self.master_offset,
+                self.slave_offset,
+                self.activation_position,
+            ],
+            [self.master_scaling, self.slave_scaling],
+        );
+        c.done(CommandKind::CamScaling(motion::cam::CamScaling {
+            activation_mode: self.activation_mode,
+            activation_position: self.activation_position,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+            master_offset: self.master_offset,
+            slave_offset: self.slave_offset,
+            master_scaling: self.master_scaling,
+            slave_scaling: self.slave_scaling,
+        }))
     }
 }
 
