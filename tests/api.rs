@@ -888,10 +888,13 @@ async fn openapi_json_is_current() {
         "/api/v1/axes/{axis}/cam-in",
         "/api/v1/axes/{axis}/cam-out",
         "/api/v1/axes/{axis}/cam-scaling",
+        "/api/v1/cam-tables/{table}/online-change-mode",
+        "/api/v1/cam-tables/{table}/points",
+        "/api/v1/cam-tables/{table}/points/{point}",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 46, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 49, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

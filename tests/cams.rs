@@ -434,11 +434,58 @@ async fn a_cam_couples_y_to_x_over_http_and_only_the_table_survives_a_restart() 
             && close(&cam["actual_slave_cam_pos"], 89.6484375),
         "{cam}"
     );
+    // New data for the coupled table: an online change (here the same data: it takes effect
+    // at once, nothing moves); one point written changes the slave only where it may.
     let r = put(&s, "/api/v1/cam-tables/p5", polynom5()).await;
     assert_eq!(
-        (r.status, r.json["code"].as_str()),
-        (409, Some("cam_table_in_use"))
+        (r.status, r.json["version"].as_i64()),
+        (200, Some(2)),
+        "{}",
+        r.text
     );
+    let mode = json!({"activation_mode": "next_cycle", "master_scaling_mode": "user_defined",
+        "slave_scaling_mode": "user_defined", "activation_position": 0.0});
+    let r = put(&s, "/api/v1/cam-tables/p5/online-change-mode", mode.clone()).await;
+    assert_eq!((r.status, &r.json), (200, &mode), "{}", r.text);
+    let mut point = polynom5()["points"][1].clone();
+    point["slave_pos"] = json!(120.0);
+    let r = put(&s, "/api/v1/cam-tables/p5/points/2", point.clone()).await;
+    assert_eq!(
+        (r.status, r.json["slave_end"].as_f64()),
+        (200, Some(120.0)),
+        "{}",
+        r.text
+    );
+    assert_eq!(
+        get(&s, "/api/v1/cam-tables/p5/points/2").await.json["slave_pos"],
+        120.0
+    );
+    // A linear cam has no next cycle at x = 150: the data waits (cam_data_queued), the slave
+    // stays where it is; a second write while it waits is refused.
+    let y = status(&s, "y").await;
+    assert_eq!(y["status"]["cam_data_queued"], true, "{y}");
+    assert!(close(&y["status"]["set_position"], 89.6484375));
+    let r = put(
+        &s,
+        "/api/v1/cam-tables/p5/points",
+        json!({"points": [point]}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_change_pending")),
+        "{}",
+        r.text
+    );
+    let r = put(
+        &s,
+        "/api/v1/cam-tables/p5/online-change-mode",
+        json!({"activation_mode": "delete_queued_data"}),
+    )
+    .await;
+    assert_eq!(r.json["activation_mode"], "next_cycle", "{}", r.text);
+    assert_eq!(status(&s, "y").await["status"]["cam_data_queued"], false);
+    assert_eq!(get(&s, "/api/v1/cam-tables/p5/points/9").await.status, 404);
     let r = delete(&s, "/api/v1/cam-tables/p5").await;
     assert_eq!(
         (r.status, r.json["code"].as_str()),
@@ -464,7 +511,7 @@ async fn a_cam_couples_y_to_x_over_http_and_only_the_table_survives_a_restart() 
     s.stop();
 
     let s = Server::start_with(db, &[]);
-    assert_eq!(get(&s, "/api/v1/cam-tables/p5").await.json["version"], 2);
+    assert_eq!(get(&s, "/api/v1/cam-tables/p5").await.json["version"], 4);
     let y = status(&s, "y").await;
     assert_eq!(y["status"]["coupled"], false);
     assert_eq!(y["status"]["cam"]["cam_table_id"], 0);

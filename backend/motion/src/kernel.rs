@@ -166,6 +166,57 @@ impl Kernel {
         Ok(self.cams.remove(id))
     }
 
+    /// Online change (MC_WriteMotionFunction on a coupled table): `cam` is the table's data from
+    /// now on — new couplings take it at once, coupled slaves when `change` says and never
+    /// with a jump. On a table nobody is coupled through it is simply put in place (the old
+    /// cam is retired). `Err` gives the cam back while an earlier change is still on its way
+    /// to a slave, or for an id that holds no cam.
+    pub fn change_cam(
+        &mut self,
+        id: u32,
+        cam: Arc<Cam>,
+        change: crate::cam::OnlineChange,
+    ) -> Result<(), Arc<Cam>> {
+        if self.cams.get(id).is_none() {
+            return Err(cam);
+        }
+        if !self.cam_in_use(id) {
+            return match self.cams.insert(id, cam) {
+                Ok(old) => {
+                    if let Some(old) = old {
+                        self.cams.retire(old);
+                    }
+                    Ok(())
+                }
+                Err(cam) => Err(cam),
+            };
+        }
+        let generation = self.cams.stage(id, cam)?;
+        for a in self.axes.iter_mut().flatten() {
+            a.queue_cam_data(id, generation, change);
+        }
+        Ok(())
+    }
+
+    /// MC_SetCamOnlineChangeMode DELETEQUEUEDDATA: data written to table `id` that has not
+    /// reached its slaves stays out of them (they run the data they have).
+    pub fn drop_cam_data(&mut self, id: u32) {
+        for a in self.axes.iter_mut().flatten() {
+            a.drop_cam_data(id);
+        }
+    }
+
+    /// An earlier online change of table `id` has not reached all its slaves yet.
+    pub fn cam_change_pending(&self, id: u32) -> bool {
+        self.cams.change_pending(id)
+    }
+
+    /// A cam the kernel no longer uses (replaced, or left by its last slave after an online
+    /// change), to be freed off the cycle thread.
+    pub fn take_retired_cam(&mut self) -> Option<Arc<Cam>> {
+        self.cams.take_retired()
+    }
+
     /// An axis is coupled through cam table `id`, or waits to be (a queued coupling or switch).
     pub fn cam_in_use(&self, id: u32) -> bool {
         self.axes.iter().flatten().any(|a| a.uses_cam(id))
@@ -291,6 +342,11 @@ impl Kernel {
                 self.order.stale = true;
             }
         }
+        // Data of an online change no slave runs any more is retired (not freed here).
+        let axes = &self.axes;
+        self.cams.retire_unused(|id, generation| {
+            axes.iter().flatten().any(|a| a.runs_cam(id, generation))
+        });
     }
 }
 

@@ -69,6 +69,23 @@ pub enum Request {
         ticket: u64,
         id: u32,
     },
+    /// New data for a table (online change when coupled: see `Kernel::change_cam`).
+    ChangeCam {
+        ticket: u64,
+        id: u32,
+        cam: Arc<motion::cam::Cam>,
+        change: motion::cam::OnlineChange,
+    },
+    /// Whether new data for a table would be taken now (no earlier change on its way).
+    ProbeCamChange {
+        ticket: u64,
+        id: u32,
+    },
+    /// DELETEQUEUEDDATA: written data not yet in effect stays out of the slaves.
+    DropCamData {
+        ticket: u64,
+        id: u32,
+    },
     /// What the scope samples from the cycle this is drained in (see `scope.rs`).
     ScopeConfig {
         ticket: u64,
@@ -373,7 +390,7 @@ impl CycleThread {
                             let _ = shared.garbage.push(Garbage::Axis(axis));
                             let _ = shared.garbage.push(Garbage::Drive(drive));
                         }
-                        Request::InsertCam { cam, .. } => {
+                        Request::InsertCam { cam, .. } | Request::ChangeCam { cam, .. } => {
                             let _ = shared.garbage.push(Garbage::Cam(cam));
                         }
                         _ => {}
@@ -525,6 +542,39 @@ impl CycleThread {
                         result,
                     }
                 }
+                Request::ChangeCam {
+                    ticket,
+                    id,
+                    cam,
+                    change,
+                } => {
+                    let result = self.kernel.change_cam(id, cam, change).map_err(|cam| {
+                        self.discard(Garbage::Cam(cam));
+                        ErrorId::CAM_TABLE_IN_USE
+                    });
+                    Reply {
+                        ticket,
+                        cycle,
+                        result,
+                    }
+                }
+                Request::ProbeCamChange { ticket, id } => Reply {
+                    ticket,
+                    cycle,
+                    result: if self.kernel.cam_change_pending(id) {
+                        Err(ErrorId::CAM_TABLE_IN_USE)
+                    } else {
+                        Ok(())
+                    },
+                },
+                Request::DropCamData { ticket, id } => {
+                    self.kernel.drop_cam_data(id);
+                    Reply {
+                        ticket,
+                        cycle,
+                        result: Ok(()),
+                    }
+                }
                 Request::ScopeConfig { ticket, config } => {
                     self.scope = config;
                     Reply {
@@ -544,6 +594,9 @@ impl CycleThread {
             .fetch_add(drained as u64, Relaxed);
 
         self.kernel.step(feedback, setpoints, &mut sink);
+        while let Some(cam) = self.kernel.take_retired_cam() {
+            self.discard(Garbage::Cam(cam));
+        }
         // Setpoints out, the drives' answers in: read by the next cycle's step.
         self.bus.exchange(setpoints, feedback);
         if sink.dropped > 0 {

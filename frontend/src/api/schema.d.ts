@@ -614,6 +614,62 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/cam-tables/{table}/online-change-mode": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** How data written to this table reaches coupled slaves (MC_SetCamOnlineChangeMode as set) */
+        get: operations["get_online_change_mode"];
+        /**
+         * MC_SetCamOnlineChangeMode: when later writes to this table reach coupled slaves
+         * @description Applies to every later write (PUT of the table, of its points). Written data reaches a coupled slave at its activation and only where it does not move the slave (`instantaneous`, `as_soon_as_possible`: the first such cycle); until then the slave's status shows `cam_data_queued`. `off`: coupled slaves keep the data they run. `delete_queued_data` drops written data that has not reached its slaves (the mode stays). Not stored: `instantaneous` after a start.
+         */
+        put: operations["set_online_change_mode"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/points": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /** MC_WriteMotionFunction: replace points (an online change on a coupled table) */
+        put: operations["write_points"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/cam-tables/{table}/points/{point}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_ReadMotionFunctionPoint */
+        get: operations["get_point"];
+        /** MC_WriteMotionFunctionPoint: replace one point (an online change on a coupled table) */
+        put: operations["write_point"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/cam-tables/{table}/slave-dynamics": {
         parameters: {
             query?: never;
@@ -2906,6 +2962,28 @@ export interface components {
             options?: components["schemas"]["MoveOptions"];
         };
         /**
+         * @description MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes
+         *     effect on its slaves, and how their offsets follow.
+         * @example {
+         *       "activation_mode": "next_cycle",
+         *       "activation_position": 0,
+         *       "master_scaling_mode": "user_defined",
+         *       "slave_scaling_mode": "user_defined"
+         *     }
+         */
+        OnlineChange: {
+            /**
+             * @description `instantaneous` and `as_soon_as_possible`: in the first cycle the new data does not
+             *     move the slave; `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`: from there
+             *     (and still only without a jump); `off`: coupled slaves keep the data they run with.
+             */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /** Format: double */
+            activation_position?: number;
+            master_scaling_mode?: components["schemas"]["CamScalingMode"];
+            slave_scaling_mode?: components["schemas"]["CamScalingMode"];
+        };
+        /**
          * @description UI group of a parameter (no meaning for the kernel).
          * @enum {string}
          */
@@ -3799,6 +3877,23 @@ export interface components {
          * @enum {string}
          */
         Unit: "none" | "position" | "velocity" | "acceleration" | "jerk" | "seconds" | "factor" | "percent" | "per_second" | "position_per_increment" | "increments" | "count" | "code";
+        /**
+         * @description MC_WriteMotionFunction: points to replace, by their `point_index`.
+         * @example {
+         *       "points": [
+         *         {
+         *           "function_type": "polynom5",
+         *           "master_pos": 200,
+         *           "point_index": 2,
+         *           "point_type": "rest",
+         *           "slave_pos": 120
+         *         }
+         *       ]
+         *     }
+         */
+        WritePointsBody: {
+            points: components["schemas"]["MotionFunctionPoint"][];
+        };
     };
     responses: {
         /** @description `limit` out of range, or an unknown query parameter. */
@@ -3934,6 +4029,18 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
+        /**
+         * @description The table is coupled (DELETE, and a cam switch's table), or data written earlier has not
+         *     reached all its slaves yet (`cam_change_pending`).
+         */
+        CamTableBusy: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
         /** @description The name or the id is taken, or all 255 cam table ids are used. */
         CamTableConflict: {
             headers: {
@@ -3970,6 +4077,15 @@ export interface components {
                  *       "type": "urn:motiond:problem:cam_table_not_found"
                  *     }
                  */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such cam table or point. */
+        CamTableOrPointNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -6203,6 +6319,7 @@ export interface operations {
             };
             403: components["responses"]["CrossOriginForbidden"];
             404: components["responses"]["CamTableNotFound"];
+            409: components["responses"]["CamTableBusy"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
             503: components["responses"]["WriteUnavailable"];
@@ -6278,6 +6395,188 @@ export interface operations {
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CamQueryInvalid"];
+        };
+    };
+    get_online_change_mode: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The mode in force (instantaneous after a start) */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["OnlineChange"];
+                };
+            };
+            404: components["responses"]["CamTableNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    set_online_change_mode: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["OnlineChange"];
+            };
+        };
+        responses: {
+            /** @description The mode now in force */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["OnlineChange"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["CamTableNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamQueryInvalid"];
+            503: components["responses"]["CycleUnavailable"];
+        };
+    };
+    write_points: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["WritePointsBody"];
+            };
+        };
+        responses: {
+            /** @description Stored (version + 1); coupled slaves take it by the online-change mode */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["CamTableNotFound"];
+            409: components["responses"]["CamTableConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamTableInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    get_point: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+                /**
+                 * @description point_index
+                 * @example 2
+                 */
+                point: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The point */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["MotionFunctionPoint"];
+                };
+            };
+            404: components["responses"]["CamTableOrPointNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    write_point: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description cam table id (1..255) or name
+                 * @example knife
+                 */
+                table: string;
+                /**
+                 * @description point_index
+                 * @example 2
+                 */
+                point: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["MotionFunctionPoint"];
+            };
+        };
+        responses: {
+            /** @description Stored (version + 1); coupled slaves take it by the online-change mode */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamTableResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["CamTableNotFound"];
+            409: components["responses"]["CamTableConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamTableInvalid"];
+            503: components["responses"]["WriteUnavailable"];
         };
     };
     slave_dynamics: {

@@ -16,6 +16,8 @@ use crate::cam::{Cam, CamActivationMode as Act, CamIn, CamInfo, CamScaling, CamS
 #[derive(Clone, Copy, Debug)]
 pub(super) struct CamLaw {
     pub(super) table: u32,
+    /// The generation of the table's data this slave runs (an online change makes a new one).
+    pub(super) generation: u32,
     pub(super) mo: f64,
     pub(super) so: f64,
     pub(super) ms: f64,
@@ -202,6 +204,18 @@ pub(super) struct PendingChange<T> {
     act: Activation,
 }
 
+/// Data written to the coupled table (an online change) that waits to take effect on this
+/// slave: the new generation, when, and how the offsets follow.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PendingData {
+    generation: u32,
+    act: Activation,
+    master_scaling_mode: CamScalingMode,
+    slave_scaling_mode: CamScalingMode,
+    /// Its activation has been reached; it takes effect in the first cycle without a jump.
+    due: bool,
+}
+
 fn finite_scaling(v: f64) -> bool {
     v.is_finite() && v != 0.0
 }
@@ -210,6 +224,45 @@ impl Axis {
     /// The slave's master while coupled through a cam, or waiting to be.
     pub(super) fn cam_master(&self) -> Option<AxisSlot> {
         self.cam_in.map(|p| p.master)
+    }
+
+    /// Runs generation `generation` of cam table `id` (the kernel retires data no slave runs).
+    pub fn runs_cam(&self, id: u32, generation: u32) -> bool {
+        self.cam_law()
+            .is_some_and(|l| l.table == id && l.generation == generation)
+    }
+
+    /// An online change of table `id` (new data in generation `generation`) is to reach this slave
+    /// as `change` says (OFF: it keeps the data it runs).
+    pub fn queue_cam_data(&mut self, id: u32, generation: u32, change: crate::cam::OnlineChange) {
+        let Some(law) = self.cam_law().filter(|l| l.table == id) else {
+            return;
+        };
+        if change.activation_mode == Act::Off {
+            return;
+        }
+        let m = law.master_pos;
+        self.cam_data = Some(PendingData {
+            generation,
+            act: Activation::new(
+                change.activation_mode,
+                change.activation_position,
+                m,
+                law.raw(m),
+            ),
+            master_scaling_mode: change.master_scaling_mode,
+            slave_scaling_mode: change.slave_scaling_mode,
+            due: false,
+        });
+        self.update_status();
+    }
+
+    /// MC_CamActivation DELETEQUEUEDDATA for table `id`: written data not yet in effect on
+    /// this slave stays out of it.
+    pub fn drop_cam_data(&mut self, id: u32) {
+        if self.cam_law().is_some_and(|l| l.table == id) && self.cam_data.take().is_some() {
+            self.update_status();
+        }
     }
 
     /// Coupled through cam `id`, or waiting for it.
@@ -235,7 +288,7 @@ impl Axis {
     fn law_for(
         &self,
         ci: &CamIn,
-        cam: &Cam,
+        (cam, generation): (&Cam, u32),
         m: f64,
         s: f64,
         before: Option<(CamLaw, &Cam)>,
@@ -263,6 +316,7 @@ impl Axis {
         let k_base = if cam.periodic { cam.cycle_of(x).0 } else { 0 };
         let mut law = CamLaw {
             table: ci.cam_table,
+            generation,
             mo,
             so,
             ms,
@@ -307,7 +361,15 @@ impl Axis {
     ) -> Result<(), ErrorId> {
         let at = law.eval(cam, m);
         let p = self.p();
-        let window = p.axis_target_position_window.max(1e-9);
+        // Written data must not move the slave at all; a coupling, switch or scaling may
+        // start within the target window (the slave was pre-positioned to it).
+        let window = if law.generation != self.cam_law().map_or(u32::MAX, |l| l.generation)
+            && self.cam_law().is_some_and(|l| l.table == law.table)
+        {
+            1e-6
+        } else {
+            p.axis_target_position_window.max(1e-9)
+        };
         let dv = p.axis_acc * self.cycle_time * (1.0 + 1e-9) + 1e-9;
         if (at.position - from.position).abs() > window || (at.velocity - from.velocity).abs() > dv
         {
@@ -327,6 +389,7 @@ impl Axis {
         let Some(cam) = cx.cams.get(ci.cam_table) else {
             return Err(ErrorId::CAM_TABLE_ID_INVALID);
         };
+        let generation = cx.cams.generation(ci.cam_table);
         for v in [ci.master_offset, ci.slave_offset, ci.activation_position] {
             if !v.is_finite() {
                 return Err(ErrorId::PARAMETER_NOT_CORRECT);
@@ -373,10 +436,10 @@ impl Axis {
                 h.end(cx, End::Done);
                 return Ok(());
             }
-            let old = cx
-                .cams
-                .get(law.table)
-                .expect("coupled tables stay in the store");
+            // Coupled tables stay in the store (the kernel refuses to take them out).
+            let Some(old) = cx.cams.get_gen(law.table, law.generation) else {
+                return Err(ErrorId::CAM_TABLE_ID_INVALID);
+            };
             let act = Activation::new(
                 ci.activation_mode,
                 ci.activation_position,
@@ -400,8 +463,13 @@ impl Axis {
             if act.at_once(m.set.position, law.raw(m.set.position)) {
                 let mut probe = law;
                 let now = probe.eval(old, &m.set);
-                let mut new =
-                    self.law_for(&ci, cam, m.set.position, now.position, Some((probe, old)));
+                let mut new = self.law_for(
+                    &ci,
+                    (cam, generation),
+                    m.set.position,
+                    now.position,
+                    Some((probe, old)),
+                );
                 match self.check_no_jump(&mut new, cam, &m.set, now) {
                     Ok(()) => {
                         self.set_cam_law(new);
@@ -426,7 +494,13 @@ impl Axis {
             return Ok(());
         }
         // First coupling.
-        let mut law = self.law_for(&ci, cam, m.set.position, self.set.position, None);
+        let mut law = self.law_for(
+            &ci,
+            (cam, generation),
+            m.set.position,
+            self.set.position,
+            None,
+        );
         let act = Activation::new(
             ci.activation_mode,
             ci.activation_position,
@@ -517,6 +591,7 @@ impl Axis {
         if self.cam_law().is_some() {
             return;
         }
+        self.cam_data = None;
         let end = if self.mode == Mode::ErrorStop {
             End::Error(self.error)
         } else {
@@ -606,10 +681,9 @@ impl Axis {
         );
         self.cam_scaling = Some(PendingChange { cmd, what: sc, act });
         if act.at_once(m, law.raw(m)) {
-            let cam = cx
-                .cams
-                .get(law.table)
-                .expect("coupled tables stay in the store");
+            let Some(cam) = cx.cams.get_gen(law.table, law.generation) else {
+                return Err(ErrorId::CAM_TABLE_ID_INVALID);
+            };
             let master = Kinematics {
                 position: m,
                 velocity: self.last_master.velocity,
@@ -694,10 +768,23 @@ impl Axis {
             if m.error {
                 p.cmd.end(cx, End::Error(ErrorId::MASTER_INVALID));
             } else if let Some(cam) = cx.cams.get(p.ci.cam_table) {
-                let law = self.law_for(&p.ci, cam, m.set.position, self.set.position, None);
+                let generation = cx.cams.generation(p.ci.cam_table);
+                let law = self.law_for(
+                    &p.ci,
+                    (cam, generation),
+                    m.set.position,
+                    self.set.position,
+                    None,
+                );
                 if p.act.reached(m.set.position, law.raw(m.set.position), cam) {
                     // Coupled from the slave's and the master's positions at activation.
-                    let mut law = self.law_for(&p.ci, cam, m.set.position, self.set.position, None);
+                    let mut law = self.law_for(
+                        &p.ci,
+                        (cam, generation),
+                        m.set.position,
+                        self.set.position,
+                        None,
+                    );
                     match self.check_no_jump(&mut law, cam, &m.set, self.set) {
                         Ok(()) => self.start_cam_coupling(cx, p.master, law, p.cmd),
                         Err(e) => p.cmd.end(cx, End::Error(e)),
@@ -712,7 +799,7 @@ impl Axis {
         let Some(law) = self.cam_law() else {
             return;
         };
-        let Some(cam) = cx.cams.get(law.table) else {
+        let Some(cam) = cx.cams.get_gen(law.table, law.generation) else {
             return;
         };
         let raw = law.raw(m.set.position);
@@ -723,9 +810,10 @@ impl Axis {
                         // Where the cam in force puts the slave in this cycle: the switch joins it there.
                         let mut probe = law;
                         let now = probe.eval(cam, &m.set);
+                        let generation = cx.cams.generation(q.what.cam_table);
                         let mut new = self.law_for(
                             &q.what,
-                            new_cam,
+                            (new_cam, generation),
                             m.set.position,
                             now.position,
                             Some((probe, cam)),
@@ -750,6 +838,48 @@ impl Axis {
                 }
             } else {
                 self.cam_switch = Some(q);
+            }
+        }
+        if let Some(mut d) = self.cam_data {
+            d.due = d.act.reached(m.set.position, raw, cam) || d.due;
+            self.cam_data = Some(d);
+            if let (true, Some(new_cam)) = (d.due, cx.cams.get_gen(law.table, d.generation)) {
+                // The same coupling on the new data; it takes effect only where it does not
+                // move the slave (spec §1.10: "no direct effect on the slave").
+                let mut probe = law;
+                let now = probe.eval(cam, &m.set);
+                let ci = CamIn {
+                    master: 0,
+                    cam_table: law.table,
+                    master_offset: law.mo,
+                    slave_offset: law.so,
+                    master_scaling: law.ms,
+                    slave_scaling: law.ss,
+                    start_mode: crate::cam::StartMode::Absolute,
+                    activation_mode: Act::Instantaneous,
+                    activation_position: 0.0,
+                    master_scaling_mode: d.master_scaling_mode,
+                    slave_scaling_mode: d.slave_scaling_mode,
+                };
+                let mut new = self.law_for(
+                    &ci,
+                    (new_cam, d.generation),
+                    m.set.position,
+                    now.position,
+                    Some((probe, cam)),
+                );
+                // Offsets as they were unless autooffset: the coupling keeps its base cycle.
+                if d.master_scaling_mode != CamScalingMode::AutoOffset {
+                    new.k_base = law.k_base;
+                }
+                new.master_absolute = law.master_absolute;
+                new.slave_absolute = law.slave_absolute;
+                new.master_coupling_pos = law.master_coupling_pos;
+                new.slave_coupling_pos = law.slave_coupling_pos;
+                if self.check_no_jump(&mut new, new_cam, &m.set, now).is_ok() {
+                    self.set_cam_law(new);
+                    self.cam_data = None;
+                }
             }
         }
         if let Some(mut q) = self.cam_scaling {
@@ -778,6 +908,7 @@ impl Axis {
             info.cam_exchange_activation_mode = q.act.mode;
             info.cam_exchange_activation_pos = q.act.position;
         }
+        info.cam_data_queued = self.cam_data.is_some();
         (info, self.cam_switch.is_some(), self.cam_scaling.is_some())
     }
 }

@@ -456,7 +456,7 @@ impl Axis {
         };
         // A cam follows the master's set values (TwinCAT: never its actual ones).
         let cam = match c.law {
-            CouplingLaw::Cam(l) => Some(cx.cams.get(l.table)),
+            CouplingLaw::Cam(l) => Some(cx.cams.get_gen(l.table, l.generation)),
             _ => None,
         };
         let followed = if cam.is_some() {

@@ -131,6 +131,8 @@ pub struct Axis {
     cam_scaling: Option<camming::PendingChange<crate::cam::CamScaling>>,
     /// The master's set values in the latest cycle (a scaling at once uses them).
     last_master: Kinematics,
+    /// Data written to the coupled table waiting to take effect here (CamDataQueued).
+    cam_data: Option<camming::PendingData>,
 }
 
 impl Axis {
@@ -192,6 +194,7 @@ impl Axis {
             cam_switch: None,
             cam_scaling: None,
             last_master: Kinematics::default(),
+            cam_data: None,
         })
     }
 

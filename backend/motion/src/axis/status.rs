@@ -93,5 +93,6 @@ impl Axis {
         s.cam = cam;
         s.cam_table_queued = queued;
         s.cam_scaling_pending = scaling;
+        s.cam_data_queued = cam.cam_data_queued;
     }
 }

@@ -147,11 +147,43 @@ pub struct CamInfo {
     pub cam_exchange_activation_pos: f64,
 }
 
+/// MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes
+/// effect on its slaves, and how their offsets follow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct OnlineChange {
+    /// `instantaneous` and `as_soon_as_possible`: in the first cycle the new data does not
+    /// move the slave; `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`: from there
+    /// (and still only without a jump); `off`: coupled slaves keep the data they run with.
+    #[serde(default)]
+    pub activation_mode: CamActivationMode,
+    #[serde(default)]
+    pub activation_position: f64,
+    #[serde(default)]
+    pub master_scaling_mode: CamScalingMode,
+    #[serde(default)]
+    pub slave_scaling_mode: CamScalingMode,
+}
+
+/// One table id's cams: the one in force (`cur`) and, after an online change, the one its
+/// slaves still run until the change takes effect on them (`old`). Each has a generation.
+#[derive(Default)]
+struct Slot {
+    cur: Option<(u32, Arc<Cam>)>,
+    old: Option<(u32, Arc<Cam>)>,
+    next_gen: u32,
+}
+
 /// The built cams the kernel couples through, by cam table id (1..255), shared with whoever
 /// built them (the server's analysis reads the same cam). Put in and taken out by requests
-/// between cycles and handed back, so the cycle never frees one.
+/// between cycles and handed back, so the cycle never frees one: a cam its last slave left is
+/// kept in `retired` until the owner of the kernel takes it.
 pub struct CamStore {
-    slots: Vec<Option<Arc<Cam>>>,
+    slots: Vec<Slot>,
+    retired: Vec<Arc<Cam>>,
+    /// Some slot holds an `old` cam (worth looking for slaves that left it).
+    has_old: bool,
 }
 
 /// The highest cam table id (MC_CAM_ID).
@@ -160,26 +192,117 @@ pub const MAX_CAM_TABLE_ID: u32 = 255;
 impl Default for CamStore {
     fn default() -> Self {
         CamStore {
-            slots: (0..=MAX_CAM_TABLE_ID).map(|_| None).collect(),
+            slots: (0..=MAX_CAM_TABLE_ID).map(|_| Slot::default()).collect(),
+            // One old cam per id at most: retiring never reallocates.
+            retired: Vec::with_capacity(MAX_CAM_TABLE_ID as usize + 1),
+            has_old: false,
         }
     }
 }
 
 impl CamStore {
+    /// The cam in force under `id`.
     pub fn get(&self, id: u32) -> Option<&Cam> {
-        self.slots.get(id as usize).and_then(|c| c.as_deref())
+        self.slots
+            .get(id as usize)
+            .and_then(|s| s.cur.as_ref())
+            .map(|(_, c)| &**c)
     }
 
-    /// Puts a cam under `id`, handing back the one it replaces; `Err` gives it back for an
-    /// id outside 1..255.
+    /// The generation of the cam in force (what a new coupling runs).
+    pub fn generation(&self, id: u32) -> u32 {
+        self.slots
+            .get(id as usize)
+            .and_then(|s| s.cur.as_ref())
+            .map_or(0, |(g, _)| *g)
+    }
+
+    /// The cam of `id` in generation `generation` (in force, or the one before an online change).
+    pub fn get_gen(&self, id: u32, generation: u32) -> Option<&Cam> {
+        let s = self.slots.get(id as usize)?;
+        [&s.cur, &s.old]
+            .into_iter()
+            .flatten()
+            .find(|(g, _)| *g == generation)
+            .map(|(_, c)| &**c)
+    }
+
+    /// Puts a cam under `id` in place of the one in force, handing that back; `Err` gives it
+    /// back for an id outside 1..255.
     pub fn insert(&mut self, id: u32, cam: Arc<Cam>) -> Result<Option<Arc<Cam>>, Arc<Cam>> {
         match self.slots.get_mut(id as usize) {
-            Some(s) if id >= 1 => Ok(s.replace(cam)),
+            Some(s) if id >= 1 => {
+                s.next_gen += 1;
+                Ok(s.cur.replace((s.next_gen, cam)).map(|(_, c)| c))
+            }
             _ => Err(cam),
         }
     }
 
+    /// Makes `cam` the one in force while the slaves of the present one keep it until the
+    /// change reaches them; `Err` while an earlier change is still on its way. Returns the
+    /// generation of the new cam.
+    pub fn stage(&mut self, id: u32, cam: Arc<Cam>) -> Result<u32, Arc<Cam>> {
+        match self.slots.get_mut(id as usize) {
+            Some(s) if id >= 1 && s.old.is_none() && s.cur.is_some() => {
+                s.next_gen += 1;
+                s.old = s.cur.replace((s.next_gen, cam));
+                self.has_old = true;
+                Ok(s.next_gen)
+            }
+            _ => Err(cam),
+        }
+    }
+
+    /// An earlier online change of `id` still runs on some slave.
+    pub fn change_pending(&self, id: u32) -> bool {
+        self.slots.get(id as usize).is_some_and(|s| s.old.is_some())
+    }
+
     pub fn remove(&mut self, id: u32) -> Option<Arc<Cam>> {
-        self.slots.get_mut(id as usize).and_then(|s| s.take())
+        let s = self.slots.get_mut(id as usize)?;
+        let old = s.old.take();
+        let cur = s.cur.take().map(|(_, c)| c);
+        if let Some((_, old)) = old {
+            self.retire(old);
+        }
+        cur
+    }
+
+    /// Retires old cams no slave runs any more (`in_use(id, generation)`); allocation-free.
+    pub fn retire_unused(&mut self, in_use: impl Fn(u32, u32) -> bool) {
+        if !self.has_old {
+            return;
+        }
+        let mut any = false;
+        for (id, s) in self.slots.iter_mut().enumerate() {
+            if let Some((generation, _)) = s.old {
+                if in_use(id as u32, generation) {
+                    any = true;
+                } else if let Some((_, c)) = s.old.take() {
+                    if self.retired.len() < self.retired.capacity() {
+                        self.retired.push(c);
+                    } else {
+                        core::mem::forget(c);
+                    }
+                }
+            }
+        }
+        self.has_old = any;
+    }
+
+    /// Keeps a cam the kernel replaced until its owner takes it.
+    pub fn retire(&mut self, cam: Arc<Cam>) {
+        if self.retired.len() < self.retired.capacity() {
+            self.retired.push(cam);
+        } else {
+            // Never free (or grow) in the cycle: the owner has not collected for a long time.
+            core::mem::forget(cam);
+        }
+    }
+
+    /// A cam the kernel no longer uses, to be freed off the cycle thread.
+    pub fn take_retired(&mut self) -> Option<Arc<Cam>> {
+        self.retired.pop()
     }
 }

@@ -41,7 +41,7 @@ pub use analysis::{
 };
 pub use coupling::{
     CamActivationMode, CamIn, CamInfo, CamScaling, CamScalingMode, CamStore, MAX_CAM_TABLE_ID,
-    StartMode,
+    OnlineChange, StartMode,
 };
 pub use function::{MotionFunction, MotionFunctionPoint, Segment};
 pub use law::{MotionFunctionType, MotionPointType};

@@ -509,3 +509,107 @@ fn a_cam_slave_at_its_soft_limit_stops_and_queued_changes_end() {
     assert!(r.out(pending).command_aborted);
     assert!(!r.k.cam_in_use(T_LINE));
 }
+
+/// Online change (spec §1.10, §2.12–§2.14; §5.1 step 4): new data for a coupled table reaches
+/// its slave when the online-change mode says — NEXTCYCLE at the period border with
+/// CamDataQueued until then — and only where it does not move the slave; INSTANTANEOUS data
+/// that differs where the master is now waits until the master is where old and new agree.
+/// The old data is retired once no slave runs it.
+#[test]
+fn written_data_reaches_a_coupled_slave_by_the_online_change_rules() {
+    use std::sync::Arc;
+    let table = |middle: f64| {
+        let mut t = slower_in_the_middle();
+        t.points[2].slave_pos = middle;
+        t
+    };
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_HALF, &table(180.0));
+    r.ok(1, CommandKind::CamIn(cam_in(0, T_HALF)));
+    let v = r.ok(0, velocity(200.0, Direction::Positive));
+    r.until(2.0, |r| r.out(v).in_velocity);
+    // Master in the first cycle's middle: new data (the middle point lower) at the next cycle.
+    r.until(2.0, |r| r.st(0).set_position > 100.0);
+    let next_cycle = OnlineChange {
+        activation_mode: CamActivationMode::NextCycle,
+        ..OnlineChange::default()
+    };
+    let new = Arc::new(Cam::build(&table(150.0)).unwrap());
+    assert!(r.k.change_cam(T_HALF, new.clone(), next_cycle).is_ok());
+    assert!(r.k.cam_change_pending(T_HALF));
+    assert!(r.st(1).cam_data_queued);
+    let mut prev = r.st(1).set_position;
+    r.until(5.0, |r| {
+        let p = r.st(0).set_position;
+        let slave = r.st(1).set_position;
+        assert!(
+            (slave - prev).abs() <= 2.5 * 200.0 * DT + 1e-9,
+            "slave jumped {prev} → {slave} at {p}"
+        );
+        prev = slave;
+        assert_eq!(r.st(1).cam_data_queued, p < 360.0, "at {p}");
+        p > 500.0
+    });
+    // In the second cycle the slave runs the new data: 240 stroke, middle point at 150.
+    let p = r.st(0).set_position;
+    let want = 240.0 + new.eval(p - 360.0).position;
+    assert!(
+        (r.st(1).set_position - want).abs() < 1e-6,
+        "{} ≠ {want}",
+        r.st(1).set_position
+    );
+    r.step();
+    assert!(!r.k.cam_change_pending(T_HALF), "the old data retired");
+    assert!(r.k.take_retired_cam().is_some());
+
+    // INSTANTANEOUS data that differs where the master is: waits until old and new agree
+    // (the last segment, 300..360, is the same in both).
+    r.until(5.0, |r| {
+        let xl = r.st(1).cam.actual_master_cam_pos;
+        (100.0..120.0).contains(&xl)
+    });
+    let newer = Arc::new(Cam::build(&table(120.0)).unwrap());
+    assert!(
+        r.k.change_cam(T_HALF, newer, OnlineChange::default())
+            .is_ok()
+    );
+    let mut prev = r.st(1).set_position;
+    r.until(5.0, |r| {
+        let xl = r.st(1).cam.actual_master_cam_pos;
+        let slave = r.st(1).set_position;
+        // The steepest segment of these tables has slope 2.5.
+        assert!(
+            (slave - prev).abs() <= 2.5 * 200.0 * DT + 1e-9,
+            "slave jumped {prev} → {slave} at {xl}"
+        );
+        prev = slave;
+        if (120.0..290.0).contains(&xl) {
+            assert!(
+                r.st(1).cam_data_queued,
+                "took effect where it moves the slave ({xl})"
+            );
+        }
+        !r.st(1).cam_data_queued
+    });
+    let xl = r.st(1).cam.actual_master_cam_pos;
+    assert!(!(60.0..300.0).contains(&xl), "took effect at {xl}");
+    // A change while the previous one is on its way is refused; DELETEQUEUEDDATA drops it.
+    assert!(
+        r.k.change_cam(
+            T_HALF,
+            Arc::new(Cam::build(&table(100.0)).unwrap()),
+            next_cycle
+        )
+        .is_ok()
+    );
+    assert!(
+        r.k.change_cam(
+            T_HALF,
+            Arc::new(Cam::build(&table(90.0)).unwrap()),
+            next_cycle
+        )
+        .is_err()
+    );
+    r.k.drop_cam_data(T_HALF);
+    assert!(!r.st(1).cam_data_queued);
+}

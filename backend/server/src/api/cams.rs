@@ -6,12 +6,12 @@ use axum::Json;
 use axum::extract::{FromRequest, Path, Request, State};
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use motion::cam::{Characteristics, MasterSearch, ValueSelect};
+use motion::cam::{Characteristics, MasterSearch, MotionFunctionPoint, OnlineChange, ValueSelect};
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 use utoipa::IntoParams;
 
-use super::{Client, Q};
+use super::{Client, JsonBody, Q};
 use crate::app::AppState;
 use crate::error::{AppError, AppResult};
 use crate::model::{
@@ -269,4 +269,100 @@ pub async fn values(
         q.increment,
         &select,
     )?))
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/online-change-mode", tag = "cams",
+    summary = "How data written to this table reaches coupled slaves (MC_SetCamOnlineChangeMode as set)",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    responses((status = 200, description = "The mode in force (instantaneous after a start)", body = OnlineChange), super::errors::CamTableReadErrors))]
+pub async fn get_online_change_mode(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+) -> AppResult<Json<OnlineChange>> {
+    Ok(Json(cams::online_change(&s, &table)?))
+}
+
+#[utoipa::path(put, path = "/api/v1/cam-tables/{table}/online-change-mode", tag = "cams",
+    summary = "MC_SetCamOnlineChangeMode: when later writes to this table reach coupled slaves",
+    description = "Applies to every later write (PUT of the table, of its points). Written data reaches a coupled \
+slave at its activation and only where it does not move the slave (`instantaneous`, `as_soon_as_possible`: the first \
+such cycle); until then the slave's status shows `cam_data_queued`. `off`: coupled slaves keep the data they run. \
+`delete_queued_data` drops written data that has not reached its slaves (the mode stays). Not stored: \
+`instantaneous` after a start.",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    request_body = OnlineChange,
+    responses((status = 200, description = "The mode now in force", body = OnlineChange), super::errors::CamOnlineModeErrors))]
+pub async fn set_online_change_mode(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    client: Client,
+    JsonBody(change, _): JsonBody<OnlineChange>,
+) -> AppResult<Json<OnlineChange>> {
+    Ok(Json(
+        cams::set_online_change(&s, &table, change, &client.0).await?,
+    ))
+}
+
+#[utoipa::path(get, path = "/api/v1/cam-tables/{table}/points/{point}", tag = "cams",
+    summary = "MC_ReadMotionFunctionPoint",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife"),
+        ("point" = u32, Path, description = "point_index", example = 2)),
+    responses((status = 200, description = "The point", body = MotionFunctionPoint), super::errors::CamPointReadErrors))]
+pub async fn get_point(
+    State(s): State<Arc<AppState>>,
+    Path((table, point)): Path<(String, String)>,
+) -> AppResult<Json<MotionFunctionPoint>> {
+    let index = point
+        .parse::<u32>()
+        .map_err(|_| AppError::not_found("point", &point))?;
+    Ok(Json(cams::point(&s, &table, index)?))
+}
+
+#[utoipa::path(put, path = "/api/v1/cam-tables/{table}/points/{point}", tag = "cams",
+    summary = "MC_WriteMotionFunctionPoint: replace one point (an online change on a coupled table)",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife"),
+        ("point" = u32, Path, description = "point_index", example = 2)),
+    request_body = MotionFunctionPoint,
+    responses((status = 200, description = "Stored (version + 1); coupled slaves take it by the online-change mode", body = CamTableResource),
+        super::errors::CamTableReplaceErrors))]
+pub async fn write_point(
+    State(s): State<Arc<AppState>>,
+    Path((table, point)): Path<(String, String)>,
+    client: Client,
+    JsonBody(p, _): JsonBody<MotionFunctionPoint>,
+) -> AppResult<Json<CamTableResource>> {
+    if point.parse::<u32>().ok() != Some(p.point_index) {
+        return Err(AppError::field(
+            "point_index",
+            &format!("must be the point of the path ({point})"),
+        ));
+    }
+    Ok(Json(
+        cams::write_points(&s, &table, vec![p], &client.0).await?,
+    ))
+}
+
+/// MC_WriteMotionFunction: points to replace, by their `point_index`.
+#[derive(Debug, Deserialize, serde::Serialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"points": [{"point_index": 2, "function_type": "polynom5", "point_type": "rest", "master_pos": 200.0, "slave_pos": 120.0}]}))]
+pub struct WritePointsBody {
+    pub points: Vec<MotionFunctionPoint>,
+}
+
+#[utoipa::path(put, path = "/api/v1/cam-tables/{table}/points", tag = "cams",
+    summary = "MC_WriteMotionFunction: replace points (an online change on a coupled table)",
+    params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
+    request_body = WritePointsBody,
+    responses((status = 200, description = "Stored (version + 1); coupled slaves take it by the online-change mode", body = CamTableResource),
+        super::errors::CamTableReplaceErrors))]
+pub async fn write_points(
+    State(s): State<Arc<AppState>>,
+    Path(table): Path<String>,
+    client: Client,
+    LargeJsonBody(body): LargeJsonBody<WritePointsBody>,
+) -> AppResult<Json<CamTableResource>> {
+    Ok(Json(
+        cams::write_points(&s, &table, body.points, &client.0).await?,
+    ))
 }

@@ -138,6 +138,11 @@ problem_responses! {
     /// No such cam table.
     CamTableNotFound(example = json!(p(AppError::not_found("cam_table", "knife"))));
 
+    /// No such cam table or point.
+    CamTableOrPointNotFound(examples(
+        ("cam_table_not_found" = (value = json!(p(AppError::not_found("cam_table", "knife"))))),
+        ("point_not_found" = (value = json!(p(AppError::not_found("point", "7")))))));
+
     /// No such recording (never made, deleted, or evicted).
     RecordingNotFound(example = json!(p(AppError::not_found("recording", "7"))));
 
@@ -177,12 +182,22 @@ problem_responses! {
             "too many active recordings (at most 8 recordings and 9600000 values are kept); cancel one or \
              wait until it is done")))))));
 
+    /// The table is coupled (DELETE, and a cam switch's table), or data written earlier has not
+    /// reached all its slaves yet (`cam_change_pending`).
+    CamTableBusy(examples(
+        ("cam_table_in_use" = (value = json!(p(AppError::conflict("cam_table_in_use",
+            "the cam table is coupled (or a coupling through it waits): decouple its slaves (cam-out) first"))))),
+        ("cam_change_pending" = (value = json!(p(AppError::conflict("cam_change_pending",
+            "data written to this cam table earlier has not reached all its slaves yet")))))));
+
     /// The name or the id is taken, or all 255 cam table ids are used.
     CamTableConflict(examples(
         ("cam_table_name_taken" = (value = json!(p(AppError::conflict("cam_table_name_taken", "a cam table named 'knife' exists"))))),
         ("cam_table_id_taken" = (value = json!(p(AppError::conflict("cam_table_id_taken",
             "cam table 3 exists: PUT /api/v1/cam-tables/3 replaces it"))))),
-        ("no_free_cam_table_id" = (value = json!(p(AppError::conflict("no_free_cam_table_id", "all 255 cam table ids are used")))))));
+        ("no_free_cam_table_id" = (value = json!(p(AppError::conflict("no_free_cam_table_id", "all 255 cam table ids are used"))))),
+        ("cam_change_pending" = (value = json!(p(AppError::conflict("cam_change_pending",
+            "data written to this cam table earlier has not reached all its slaves yet")))))));
 
     /// CSV of a recording that is not done.
     RecordingNotDone(example = json!(p(AppError::conflict(
@@ -382,13 +397,20 @@ error_sets! {
         400: MalformedJson, 409: CamTableConflict, 413: PayloadTooLarge, 422: CamTableInvalid,
         503: WriteUnavailable,
     }
-    /// `PUT /cam-tables/{table}`.
+    /// `PUT /cam-tables/{table}`, its points.
     CamTableReplaceErrors {
         400: MalformedJson, 404: CamTableNotFound, 409: CamTableConflict, 413: PayloadTooLarge,
         422: CamTableInvalid, 503: WriteUnavailable,
     }
     /// `DELETE /cam-tables/{table}`.
-    CamTableDeleteErrors { 404: CamTableNotFound, 503: WriteUnavailable }
+    CamTableDeleteErrors { 404: CamTableNotFound, 409: CamTableBusy, 503: WriteUnavailable }
+    /// `GET /cam-tables/{table}/points/{point}`.
+    CamPointReadErrors { 404: CamTableOrPointNotFound }
+    /// `PUT /cam-tables/{table}/online-change-mode`.
+    CamOnlineModeErrors {
+        400: MalformedJson, 404: CamTableNotFound, 413: PayloadTooLarge, 422: CamQueryInvalid,
+        503: CycleUnavailable,
+    }
     /// `GET /audit`.
     AuditErrors { 422: AuditInvalid, 503: AuditUnavailable }
     /// `GET /ws`: not a websocket handshake, or one from another origin.

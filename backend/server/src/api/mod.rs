@@ -237,6 +237,19 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(cams::master_position),
         )
         .route("/cam-tables/{table}/values", get(cams::values))
+        .route(
+            "/cam-tables/{table}/online-change-mode",
+            get(cams::get_online_change_mode).put(cams::set_online_change_mode),
+        )
+        .route(
+            "/cam-tables/{table}/points",
+            axum::routing::put(cams::write_points)
+                .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
+        )
+        .route(
+            "/cam-tables/{table}/points/{point}",
+            get(cams::get_point).put(cams::write_point),
+        )
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
         .route(
@@ -412,6 +425,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
+        cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),
@@ -497,6 +511,13 @@ impl utoipa::Modify for ForeignExamples {
             ),
             ("ParamValue", Ok(json!(90.0))),
             ("MotionFunctionPoint", to_value(example_cam().1[1])),
+            (
+                "OnlineChange",
+                to_value(motion::cam::OnlineChange {
+                    activation_mode: motion::cam::CamActivationMode::NextCycle,
+                    ..Default::default()
+                }),
+            ),
             (
                 "CamInfo",
                 to_value(motion::cam::CamInfo {

@@ -164,6 +164,40 @@ impl AppState {
             .map_err(in_use)
     }
 
+    /// New data for table `id`: in place at once when nothing is coupled through it, else an
+    /// online change that reaches the slaves as `change` says.
+    pub async fn change_cam(
+        &self,
+        id: u32,
+        cam: std::sync::Arc<motion::cam::Cam>,
+        change: motion::cam::OnlineChange,
+    ) -> AppResult<()> {
+        self.ticketed(|ticket| Request::ChangeCam {
+            ticket,
+            id,
+            cam,
+            change,
+        })
+        .await
+        .map(drop)
+        .map_err(change_pending)
+    }
+
+    /// 409 `cam_change_pending` while data written earlier has not reached all slaves.
+    pub async fn probe_cam_change(&self, id: u32) -> AppResult<()> {
+        self.ticketed(|ticket| Request::ProbeCamChange { ticket, id })
+            .await
+            .map(drop)
+            .map_err(change_pending)
+    }
+
+    /// DELETEQUEUEDDATA for table `id`.
+    pub async fn drop_cam_data(&self, id: u32) -> AppResult<()> {
+        self.ticketed(|ticket| Request::DropCamData { ticket, id })
+            .await
+            .map(drop)
+    }
+
     /// Takes a cam out of the cycle thread; 409 `cam_table_in_use` while it is coupled.
     pub async fn uninstall_cam(&self, id: u32) -> AppResult<()> {
         self.ticketed(|ticket| Request::RemoveCam { ticket, id })
@@ -248,6 +282,17 @@ fn in_use(e: AppError) -> AppError {
         AppError::Rejected(id) if id == motion::ErrorId::CAM_TABLE_IN_USE => AppError::conflict(
             "cam_table_in_use",
             "the cam table is coupled (or a coupling through it waits): decouple its slaves (cam-out) first",
+        ),
+        e => e,
+    }
+}
+
+fn change_pending(e: AppError) -> AppError {
+    match e {
+        AppError::Rejected(id) if id == motion::ErrorId::CAM_TABLE_IN_USE => AppError::conflict(
+            "cam_change_pending",
+            "data written to this cam table earlier has not reached all its slaves yet (see cam_data_queued \
+             in their status); write again once it has, or drop it with the online-change mode delete_queued_data",
         ),
         e => e,
     }

@@ -35,6 +35,9 @@ pub struct CamEntry {
     pub data: std::sync::Arc<motion::cam::CamTableData>,
     pub cam: std::sync::Arc<motion::cam::Cam>,
     pub updated_at: String,
+    /// MC_SetCamOnlineChangeMode: how later writes reach coupled slaves (runtime, like the
+    /// couplings; INSTANTANEOUS after a start).
+    pub online: motion::cam::OnlineChange,
 }
 
 impl Registry {

@@ -5,7 +5,10 @@
 
 use std::sync::Arc;
 
-use motion::cam::{self, Cam, CamError, CamTableData, MasterSearch, TableType, ValueSelect};
+use motion::cam::{
+    self, Cam, CamActivationMode, CamError, CamTableData, MasterSearch, MotionFunctionPoint,
+    OnlineChange, TableType, ValueSelect,
+};
 
 use super::axes::audit_entry;
 use crate::app::{AppState, CamEntry};
@@ -15,7 +18,7 @@ use crate::model::{
     SlaveDynamicsResource, valid_name,
 };
 use crate::sim::FieldError;
-use crate::store;
+use crate::store::{self, AuditEntry};
 
 /// MC_CAM_ID: 1..255.
 pub const MAX_CAM_ID: u32 = 255;
@@ -154,7 +157,7 @@ pub async fn create(
                 })?,
         }
     };
-    store_and_register(s, id, &body.name, 1, data, cam, client, "cam_table.create").await
+    store_and_register(s, id, &body.name, 1, data, cam, client, None).await
 }
 
 /// Replaces a table (`PUT /cam-tables/{table}`): same id, version + 1.
@@ -164,12 +167,21 @@ pub async fn replace(
     body: CamTableBody,
     client: &ClientInfo,
 ) -> AppResult<CamTableResource> {
+    let _guard = s.config_lock.lock().await;
+    replace_locked(s, key, body, client).await
+}
+
+/// `replace` under the configuration lock.
+async fn replace_locked(
+    s: &AppState,
+    key: &str,
+    body: CamTableBody,
+    client: &ClientInfo,
+) -> AppResult<CamTableResource> {
     let errs = check(&body, "");
     if !errs.is_empty() {
         return Err(AppError::Invalid(errs));
     }
-    let (data, cam) = build(body.data()).await?;
-    let _guard = s.config_lock.lock().await;
     let old = entry(s, key)?;
     if body.id.is_some_and(|id| id != old.id) {
         return Err(AppError::field(
@@ -181,6 +193,7 @@ pub async fn replace(
         ));
     }
     name_taken(s, &body.name, Some(old.id))?;
+    let (data, cam) = build(body.data()).await?;
     store_and_register(
         s,
         old.id,
@@ -189,11 +202,15 @@ pub async fn replace(
         data,
         cam,
         client,
-        "cam_table.replace",
+        Some(old.online),
     )
     .await
 }
 
+/// Stores a table and puts it in force. A new one (`replacing` None) goes to the kernel before
+/// the commit and out again if the commit fails. New data for an existing one goes to the kernel
+/// after the commit — checked first so that it will be taken: on a coupled table it is an
+/// online change that reaches the slaves by `replacing`'s rules, never with a jump.
 #[allow(clippy::too_many_arguments)]
 async fn store_and_register(
     s: &AppState,
@@ -203,9 +220,18 @@ async fn store_and_register(
     data: CamTableData,
     cam: Cam,
     client: &ClientInfo,
-    action: &str,
+    replacing: Option<OnlineChange>,
 ) -> AppResult<CamTableResource> {
+    let cam = Arc::new(cam);
+    if replacing.is_some() {
+        s.probe_cam_change(id).await?;
+    }
     let now = store::now_rfc3339();
+    let action = if replacing.is_some() {
+        "cam_table.replace"
+    } else {
+        "cam_table.create"
+    };
     let mut tx = s.db.begin().await?;
     store::cams::upsert_cam_table(&mut tx, id, name, version, &data, &now).await?;
     store::audit(
@@ -213,35 +239,167 @@ async fn store_and_register(
         &audit_entry(client, action, name, audit_detail(id, name, version, &data)),
     )
     .await?;
-    // The kernel takes the cam before the commit (refused while the table is coupled) and
-    // gets the old one back if the commit fails, so kernel, registry and database agree.
-    let cam = Arc::new(cam);
-    let old = s
-        .registry
-        .read()
-        .unwrap()
-        .cams
-        .get(&id)
-        .map(|e| e.cam.clone());
-    s.install_cam(id, cam.clone()).await?;
-    if let Err(e) = tx.commit().await {
-        let _ = match old {
-            Some(old) => s.install_cam(id, old).await,
-            None => s.uninstall_cam(id).await,
-        };
-        return Err(e.into());
+    match replacing {
+        None => {
+            s.install_cam(id, cam.clone()).await?;
+            if let Err(e) = tx.commit().await {
+                let _ = s.uninstall_cam(id).await;
+                return Err(e.into());
+            }
+        }
+        Some(change) => {
+            tx.commit().await?;
+            if let Err(e) = s.change_cam(id, cam.clone(), change).await {
+                // Stored, not in force: the registry follows the database (the analysis shows
+                // the new data); the cycle thread takes it at the next start.
+                tracing::error!(
+                    "cam table {id} '{name}' stored but not taken by the cycle thread: {e}"
+                );
+                register(s, id, name, version, data, cam, now, change);
+                return Err(AppError::unavailable(
+                    "cam_table_not_active",
+                    format!(
+                        "cam table '{name}' version {version} is stored, but the cycle thread did not take it ({e}); it is in force after the next start"
+                    ),
+                ));
+            }
+        }
     }
+    Ok(register(
+        s,
+        id,
+        name,
+        version,
+        data,
+        cam,
+        now,
+        replacing.unwrap_or_default(),
+    ))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn register(
+    s: &AppState,
+    id: u32,
+    name: &str,
+    version: i64,
+    data: CamTableData,
+    cam: Arc<Cam>,
+    updated_at: String,
+    online: OnlineChange,
+) -> CamTableResource {
     let e = CamEntry {
         id,
         name: name.to_string(),
         version,
         data: Arc::new(data),
         cam,
-        updated_at: now,
+        updated_at,
+        online,
     };
     let r = resource(&e, false);
     s.registry.write().unwrap().cams.insert(id, e);
-    Ok(r)
+    r
+}
+
+/// MC_SetCamOnlineChangeMode: how later writes to the table reach coupled slaves.
+/// DELETEQUEUEDDATA drops written data that has not reached them and keeps the mode.
+pub async fn set_online_change(
+    s: &AppState,
+    key: &str,
+    change: OnlineChange,
+    client: &ClientInfo,
+) -> AppResult<OnlineChange> {
+    let _guard = s.config_lock.lock().await;
+    let e = entry(s, key)?;
+    match change.activation_mode {
+        CamActivationMode::NextCycleOnce => {
+            return Err(AppError::refused(
+                "activation_mode",
+                motion::ErrorId::CAM_MODE_INVALID,
+                "next_cycle_once is not implemented (as in TwinCAT)",
+            ));
+        }
+        CamActivationMode::DeleteQueuedData => {
+            s.drop_cam_data(e.id).await?;
+        }
+        _ => {
+            if let Some(c) = s.registry.write().unwrap().cams.get_mut(&e.id) {
+                c.online = change;
+            }
+        }
+    }
+    s.audit(AuditEntry {
+        detail: serde_json::to_string(&change).unwrap_or_default(),
+        ..audit_entry(
+            client,
+            "cam_table.online_change_mode",
+            &e.name,
+            String::new(),
+        )
+    });
+    Ok(entry(s, key)?.online)
+}
+
+pub fn online_change(s: &AppState, key: &str) -> AppResult<OnlineChange> {
+    Ok(entry(s, key)?.online)
+}
+
+/// MC_ReadMotionFunctionPoint.
+pub fn point(s: &AppState, key: &str, index: u32) -> AppResult<MotionFunctionPoint> {
+    let e = entry(s, key)?;
+    e.data
+        .points
+        .iter()
+        .find(|p| p.point_index == index)
+        .copied()
+        .ok_or_else(|| AppError::not_found("point", &index.to_string()))
+}
+
+/// MC_WriteMotionFunction(Point): the points with these indices replaced (the whole table is
+/// validated again); on a coupled table an online change.
+pub async fn write_points(
+    s: &AppState,
+    key: &str,
+    points: Vec<MotionFunctionPoint>,
+    client: &ClientInfo,
+) -> AppResult<CamTableResource> {
+    let _guard = s.config_lock.lock().await;
+    let e = entry(s, key)?;
+    if e.data.table_type != TableType::MotionFunction {
+        return Err(AppError::refused(
+            "points",
+            motion::ErrorId::CAM_TABLE_TYPE_INVALID,
+            "only a motion function has points (replace a position table with PUT /cam-tables/{table})",
+        ));
+    }
+    let mut data = (*e.data).clone();
+    for (i, p) in points.iter().enumerate() {
+        match data
+            .points
+            .iter_mut()
+            .find(|q| q.point_index == p.point_index)
+        {
+            Some(q) => *q = *p,
+            None => {
+                return Err(AppError::refused(
+                    format!("points[{i}].point_index"),
+                    motion::ErrorId::CAM_POINT_ID_INVALID,
+                    format!("the table has no point {}", p.point_index),
+                ));
+            }
+        }
+    }
+    let body = CamTableBody {
+        id: Some(e.id),
+        name: e.name.clone(),
+        table_type: data.table_type,
+        periodic: data.periodic,
+        interpolation: data.interpolation,
+        rows: Vec::new(),
+        points: data.points,
+    };
+    replace_locked(s, &e.id.to_string(), body, client).await
 }
 
 /// Deletes a table (`DELETE /cam-tables/{table}`).
@@ -292,6 +450,7 @@ pub async fn load(s: &AppState) -> Result<usize, String> {
                         data: Arc::new(data),
                         cam,
                         updated_at: t.updated_at,
+                        online: OnlineChange::default(),
                     },
                 );
                 n += 1;
@@ -359,6 +518,7 @@ pub async fn prepare_import(tables: &[CamTableBody]) -> Result<Vec<CamEntry>, Ve
                 data: Arc::new(data),
                 cam: Arc::new(cam),
                 updated_at: now.clone(),
+                online: OnlineChange::default(),
             }),
             Err(AppError::Refused { field, message, id }) => errs.push(FieldError {
                 field: format!("{prefix}{field}"),
