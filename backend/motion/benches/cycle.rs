@@ -180,5 +180,133 @@ fn cycle(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, cycle);
+/// One master at constant velocity and 63 cam slaves: odd ones through a periodic 20-segment
+/// motion function, even ones through a periodic 100 000-row spline table.
+fn cam_machine() -> Machine {
+    use motion::cam::*;
+    use std::sync::Arc;
+    let mut m = Machine::new(1);
+    let n = 64;
+    let mut k = Kernel::new(0.001, n);
+    for i in 0..n {
+        let mut p = AxisParameters::default();
+        p.axis_max_pos_lag_value = 1e6;
+        p.axis_velo_max = 1e6;
+        k.insert_axis(
+            i as u16,
+            Axis::new(
+                AxisConfig {
+                    modulo: false,
+                    parameters: p,
+                },
+                0.001,
+            ),
+        )
+        .unwrap();
+    }
+    let laws = [
+        MotionFunctionType::Polynom5,
+        MotionFunctionType::Bestehorn,
+        MotionFunctionType::ModSinuslinie,
+        MotionFunctionType::Polynom7,
+    ];
+    let points: Vec<_> = (0..=20u32)
+        .map(|i| MotionFunctionPoint {
+            point_index: i + 1,
+            function_type: laws[i as usize % laws.len()],
+            point_type: MotionPointType::Rest,
+            rel_index_next_point: 1,
+            master_pos: i as f64 * 18.0,
+            slave_pos: if i % 2 == 0 { 0.0 } else { 50.0 },
+            slave_velo: 0.0,
+            slave_acc: 0.0,
+            slave_jerk: 0.0,
+        })
+        .collect();
+    let mut mf = CamTableData::motion_function(points);
+    mf.periodic = true;
+    let rows: Vec<[f64; 2]> = (0..100_000)
+        .map(|i| {
+            [
+                i as f64 * 0.0036,
+                (i as f64 * 0.0036).to_radians().sin() * 50.0,
+            ]
+        })
+        .collect();
+    let mut table = CamTableData::positions(rows, false);
+    table.periodic = true;
+    table.interpolation = InterpolationType::Spline;
+    k.insert_cam(1, Arc::new(Cam::build(&mf).unwrap())).unwrap();
+    k.insert_cam(2, Arc::new(Cam::build(&table).unwrap()))
+        .unwrap();
+    m.k = k;
+    m.fb = vec![DriveFeedback::default(); n];
+    m.sp = vec![DriveSetpoint::default(); n];
+    m.n = 0; // no command traffic in cycle_once
+    for a in 0..n as u16 {
+        m.submit(
+            a,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+            },
+        );
+    }
+    for _ in 0..10 {
+        m.cycle_once();
+    }
+    for a in 1..n as u16 {
+        let v = m.submit(
+            a,
+            CommandKind::CamIn(CamIn {
+                master: 0,
+                cam_table: 1 + (a as u32 % 2),
+                master_offset: 0.0,
+                slave_offset: 0.0,
+                master_scaling: 1.0,
+                slave_scaling: 1.0,
+                start_mode: StartMode::Absolute,
+                activation_mode: CamActivationMode::Instantaneous,
+                activation_position: 0.0,
+                master_scaling_mode: CamScalingMode::UserDefined,
+                slave_scaling_mode: CamScalingMode::UserDefined,
+            }),
+        );
+        assert_eq!(v, Verdict::Accepted);
+    }
+    m.submit(
+        0,
+        CommandKind::MoveVelocity {
+            velocity: 300.0,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    m
+}
+
+fn cams(c: &mut Criterion) {
+    let mut m = cam_machine();
+    c.bench_function("step_64_axes_63_cam_slaves", |b| {
+        b.iter(|| {
+            m.k.step(&m.fb, &mut m.sp, &mut m.events);
+            for (s, f) in m.sp.iter().zip(m.fb.iter_mut()) {
+                f.ready = true;
+                f.enabled = s.enable;
+                f.actual_position = s.position;
+                f.actual_velocity = s.velocity;
+            }
+            if m.events.len() > 60000 {
+                m.events.clear();
+            }
+        })
+    });
+    assert!(m.k.status(1).unwrap().coupled && m.k.status(2).unwrap().coupled);
+}
+
+criterion_group!(benches, cycle, cams);
 criterion_main!(benches);
