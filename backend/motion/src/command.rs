@@ -327,6 +327,10 @@ pub enum CommandKind {
     CamOut,
     /// MC_CamScaling: new offsets and scalings of the cam coupling.
     CamScaling(crate::cam::CamScaling),
+    /// MC_CamIn_V2 / MC_CamAdd / MC_CamExchange / MC_CamRemove (multi-cam).
+    CamInV2(crate::cam::CamInV2),
+    /// MC_CamScaling_V2: one cam of a multi-cam slave.
+    CamScalingV2(crate::cam::CamScalingV2),
     /// MC_MoveSuperImposed: a relative motion laid over the running one.
     MoveSuperImposed(Superposition),
     /// MC_AbortSuperposition.
@@ -373,6 +377,13 @@ impl CommandKind {
             CommandKind::CamIn(_) => "cam-in",
             CommandKind::CamOut => "cam-out",
             CommandKind::CamScaling(_) => "cam-scaling",
+            CommandKind::CamInV2(c) => match c.operation {
+                crate::cam::CamOperationMode::Default => "cam-in-v2",
+                crate::cam::CamOperationMode::Additive => "cam-add",
+                crate::cam::CamOperationMode::Exchange => "cam-exchange",
+                crate::cam::CamOperationMode::Remove => "cam-remove",
+            },
+            CommandKind::CamScalingV2(_) => "cam-scaling-v2",
             CommandKind::MoveSuperImposed(_) => "move-superimposed",
             CommandKind::AbortSuperposition => "abort-superposition",
             CommandKind::WriteParameter { .. } => "write-parameter",

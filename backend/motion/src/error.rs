@@ -133,6 +133,8 @@ error_table! {
     CAM_MODE_INVALID = 0x7086, "cam_mode_invalid", "activation, start or scaling mode not allowed here";
     /// The axis is not coupled through a cam (MC_CamOut, MC_CamScaling, MC_CamInfo).
     CAM_NOT_COUPLED = 0x7087, "cam_not_coupled", "the axis is not coupled through a cam";
+    /// MC_CamIn and MC_CamIn_V2 exclude each other on a slave (spec §1.9).
+    CAM_FAMILY_MIXED = 0x7088, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave";
 }
 
 impl fmt::Display for ErrorId {

@@ -263,7 +263,8 @@ impl Kernel {
         let master = match cmd.kind {
             CommandKind::GearIn { master, .. }
             | CommandKind::GearInDyn { master, .. }
-            | CommandKind::CamIn(crate::cam::CamIn { master, .. }) => {
+            | CommandKind::CamIn(crate::cam::CamIn { master, .. })
+            | CommandKind::CamInV2(crate::cam::CamInV2 { master, .. }) => {
                 if master as usize == slot {
                     return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }

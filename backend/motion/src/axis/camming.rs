@@ -10,7 +10,10 @@
 
 use super::coupling::{Coupling, CouplingLaw};
 use super::*;
-use crate::cam::{Cam, CamActivationMode as Act, CamIn, CamInfo, CamScaling, CamScalingMode};
+use crate::cam::{
+    Cam, CamActivationMode as Act, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling,
+    CamScalingMode, CamScalingV2, CamTerm, StartMode,
+};
 
 /// The cam law in force.
 #[derive(Clone, Copy, Debug)]
@@ -117,6 +120,72 @@ impl CamLaw {
     }
 }
 
+/// The most cams superimposed on one slave (MC_CamIn_V2, MC_CamAdd).
+pub(super) const MAX_CAMS: usize = 4;
+
+/// A slave's cams: one (MC_CamIn) or several superimposed (MC_CamIn_V2): the slave position is
+/// the sum of their contributions, each with its own offsets and scalings (spec §1.9). Terms
+/// are kept packed from index 0 (the base).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CamSet {
+    pub(super) terms: [Option<CamLaw>; MAX_CAMS],
+    /// Coupled by MC_CamIn_V2 (MC_CamIn and MC_CamIn_V2 exclude each other on a slave).
+    pub(super) v2: bool,
+}
+
+impl CamSet {
+    fn single(law: CamLaw, v2: bool) -> Self {
+        let mut terms = [None; MAX_CAMS];
+        terms[0] = Some(law);
+        CamSet { terms, v2 }
+    }
+
+    fn base(&self) -> CamLaw {
+        self.terms[0].expect("a cam set has a base")
+    }
+
+    fn count(&self) -> usize {
+        self.terms.iter().flatten().count()
+    }
+
+    /// The term running table `id`.
+    fn find(&self, id: u32) -> Option<usize> {
+        self.terms
+            .iter()
+            .position(|t| t.is_some_and(|t| t.table == id))
+    }
+
+    fn remove(&mut self, i: usize) {
+        for k in i..MAX_CAMS - 1 {
+            self.terms[k] = self.terms[k + 1];
+        }
+        self.terms[MAX_CAMS - 1] = None;
+    }
+
+    /// The sum of the terms' setpoints; `None` if a cam left the store (the slave holds).
+    pub(super) fn eval(
+        &mut self,
+        cams: &crate::cam::CamStore,
+        m: &Kinematics,
+    ) -> Option<Kinematics> {
+        let mut sum = Kinematics::default();
+        for t in self.terms.iter_mut().flatten() {
+            let k = t.eval(cams.get_gen(t.table, t.generation)?, m);
+            sum.position += k.position;
+            sum.velocity += k.velocity;
+            sum.acceleration += k.acceleration;
+            sum.jerk += k.jerk;
+        }
+        Some(sum)
+    }
+
+    pub(super) fn shift_slave(&mut self, d: f64) {
+        if let Some(b) = self.terms[0].as_mut() {
+            b.shift_slave(d);
+        }
+    }
+}
+
 /// When a queued coupling, switch or scaling takes effect, and the master positions it last
 /// saw (to find a crossing between two cycles).
 #[derive(Clone, Copy, Debug)]
@@ -194,6 +263,8 @@ pub(super) struct PendingCamIn {
     pub(super) master: AxisSlot,
     ci: CamIn,
     act: Activation,
+    /// By MC_CamIn_V2.
+    v2: bool,
 }
 
 /// A cam switch (MC_CamIn on a cam slave) or a scaling that waits for its activation.
@@ -208,6 +279,8 @@ pub(super) struct PendingChange<T> {
 /// slave: the new generation, when, and how the offsets follow.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PendingData {
+    /// The term of the slave's cams that runs the table.
+    term: usize,
     generation: u32,
     act: Activation,
     master_scaling_mode: CamScalingMode,
@@ -228,21 +301,30 @@ impl Axis {
 
     /// Runs generation `generation` of cam table `id` (the kernel retires data no slave runs).
     pub fn runs_cam(&self, id: u32, generation: u32) -> bool {
-        self.cam_law()
-            .is_some_and(|l| l.table == id && l.generation == generation)
+        self.cam_set().is_some_and(|set| {
+            set.terms
+                .iter()
+                .flatten()
+                .any(|l| l.table == id && l.generation == generation)
+        })
     }
 
     /// An online change of table `id` (new data in generation `generation`) is to reach this slave
     /// as `change` says (OFF: it keeps the data it runs).
     pub fn queue_cam_data(&mut self, id: u32, generation: u32, change: crate::cam::OnlineChange) {
-        let Some(law) = self.cam_law().filter(|l| l.table == id) else {
+        let Some(set) = self.cam_set() else {
+            return;
+        };
+        let Some(term) = set.find(id) else {
             return;
         };
         if change.activation_mode == Act::Off {
             return;
         }
+        let law = set.terms[term].expect("found");
         let m = law.master_pos;
         self.cam_data = Some(PendingData {
+            term,
             generation,
             act: Activation::new(
                 change.activation_mode,
@@ -260,27 +342,40 @@ impl Axis {
     /// MC_CamActivation DELETEQUEUEDDATA for table `id`: written data not yet in effect on
     /// this slave stays out of it.
     pub fn drop_cam_data(&mut self, id: u32) {
-        if self.cam_law().is_some_and(|l| l.table == id) && self.cam_data.take().is_some() {
+        if self.cam_set().is_some_and(|set| set.find(id).is_some())
+            && self.cam_data.take().is_some()
+        {
             self.update_status();
         }
     }
 
     /// Coupled through cam `id`, or waiting for it.
     pub fn uses_cam(&self, id: u32) -> bool {
-        let coupled = matches!(self.coupling, Some(Coupling { law: CouplingLaw::Cam(l), .. }) if l.table == id);
+        let coupled = self.cam_set().is_some_and(|set| set.find(id).is_some());
         coupled
             || self.cam_in.is_some_and(|p| p.ci.cam_table == id)
             || self.cam_switch.is_some_and(|p| p.what.cam_table == id)
     }
 
-    fn cam_law(&self) -> Option<CamLaw> {
+    /// The cams of a cam slave.
+    pub(super) fn cam_set(&self) -> Option<CamSet> {
         match self.coupling {
             Some(Coupling {
-                law: CouplingLaw::Cam(l),
+                law: CouplingLaw::Cam(set),
                 ..
-            }) => Some(l),
+            }) => Some(set),
             _ => None,
         }
+    }
+
+    /// The base cam of a cam slave (the only one of an MC_CamIn coupling).
+    fn cam_law(&self) -> Option<CamLaw> {
+        self.cam_set().map(|s| s.base())
+    }
+
+    /// Term `i` of the slave's cams.
+    fn cam_term(&self, i: usize) -> Option<CamLaw> {
+        self.cam_set().and_then(|s| s.terms[i])
     }
 
     /// The law a CamIn gives with the master at `m` and the slave at `s` (its set position);
@@ -363,9 +458,13 @@ impl Axis {
         let p = self.p();
         // Written data must not move the slave at all; a coupling, switch or scaling may
         // start within the target window (the slave was pre-positioned to it).
-        let window = if law.generation != self.cam_law().map_or(u32::MAX, |l| l.generation)
-            && self.cam_law().is_some_and(|l| l.table == law.table)
-        {
+        let runs_other_generation = self.cam_set().is_some_and(|set| {
+            set.terms
+                .iter()
+                .flatten()
+                .any(|t| t.table == law.table && t.generation != law.generation)
+        });
+        let window = if runs_other_generation {
             1e-6
         } else {
             p.axis_target_position_window.max(1e-9)
@@ -397,6 +496,9 @@ impl Axis {
         }
         if !finite_scaling(ci.master_scaling) || !finite_scaling(ci.slave_scaling) {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        if self.cam_set().is_some_and(|s| s.v2) || self.cam_in.is_some_and(|p| p.v2) {
+            return Err(ErrorId::CAM_FAMILY_MIXED);
         }
         let law_now = self.cam_law();
         let switching = law_now.is_some() && self.master_slot() == Some(ci.master);
@@ -494,6 +596,20 @@ impl Axis {
             return Ok(());
         }
         // First coupling.
+        self.couple_first(cx, id, ci, (cam, generation), &m, false)
+    }
+
+    /// A first coupling (MC_CamIn, MC_CamIn_V2 on an uncoupled axis): at once, or queued
+    /// until its activation.
+    fn couple_first(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        ci: CamIn,
+        (cam, generation): (&Cam, u32),
+        m: &MasterSample,
+        v2: bool,
+    ) -> Result<(), ErrorId> {
         let mut law = self.law_for(
             &ci,
             (cam, generation),
@@ -518,7 +634,7 @@ impl Axis {
                     ..FbOutputs::default()
                 },
             );
-            self.start_cam_coupling(cx, ci.master, law, cmd);
+            self.start_cam_coupling(cx, ci.master, law, cmd, v2);
         } else {
             self.cancel_cam_in(cx, End::Aborted);
             let cmd = Held::start(
@@ -532,6 +648,7 @@ impl Axis {
             );
             self.cam_in = Some(PendingCamIn {
                 cmd,
+                v2,
                 master: ci.master,
                 ci,
                 act,
@@ -547,12 +664,13 @@ impl Axis {
         master: AxisSlot,
         law: CamLaw,
         mut cmd: Held,
+        v2: bool,
     ) {
         self.abort_superposition(cx);
         self.abort_all(cx);
         self.coupling = Some(Coupling {
             master,
-            law: CouplingLaw::Cam(law),
+            law: CouplingLaw::Cam(CamSet::single(law, v2)),
             dyn_command: 0,
         });
         cmd.emit(
@@ -574,8 +692,16 @@ impl Axis {
     }
 
     fn set_cam_law(&mut self, law: CamLaw) {
-        if let Some(c) = self.coupling.as_mut() {
-            c.law = CouplingLaw::Cam(law);
+        self.set_cam_term(0, law);
+    }
+
+    fn set_cam_term(&mut self, i: usize, law: CamLaw) {
+        if let Some(Coupling {
+            law: CouplingLaw::Cam(set),
+            ..
+        }) = self.coupling.as_mut()
+        {
+            set.terms[i] = Some(law);
         }
     }
 
@@ -601,6 +727,9 @@ impl Axis {
             q.cmd.end(cx, end);
         }
         if let Some(mut q) = self.cam_scaling.take() {
+            q.cmd.end(cx, end);
+        }
+        if let Some(mut q) = self.cam_v2_op.take() {
             q.cmd.end(cx, end);
         }
         if self.mode == Mode::ErrorStop || self.mode == Mode::Disabled {
@@ -640,7 +769,21 @@ impl Axis {
         id: CommandId,
         sc: CamScaling,
     ) -> Result<(), ErrorId> {
-        let Some(law) = self.cam_law() else {
+        if self.cam_set().is_some_and(|s| s.v2) {
+            return Err(ErrorId::CAM_FAMILY_MIXED);
+        }
+        self.cam_scaling_term = 0;
+        self.queue_cam_scaling(cx, id, sc)
+    }
+
+    /// MC_CamScaling(_V2) of the cam `cam_scaling_term`: at once or at its activation.
+    fn queue_cam_scaling(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        sc: CamScaling,
+    ) -> Result<(), ErrorId> {
+        let Some(law) = self.cam_term(self.cam_scaling_term) else {
             return Err(ErrorId::CAM_NOT_COUPLED);
         };
         for v in [sc.master_offset, sc.slave_offset, sc.activation_position] {
@@ -681,16 +824,13 @@ impl Axis {
         );
         self.cam_scaling = Some(PendingChange { cmd, what: sc, act });
         if act.at_once(m, law.raw(m)) {
-            let Some(cam) = cx.cams.get_gen(law.table, law.generation) else {
-                return Err(ErrorId::CAM_TABLE_ID_INVALID);
-            };
             let master = Kinematics {
                 position: m,
                 velocity: self.last_master.velocity,
                 acceleration: self.last_master.acceleration,
                 jerk: 0.0,
             };
-            self.apply_scaling(cx, cam, &master);
+            self.apply_scaling(cx, &master);
         }
         Ok(())
     }
@@ -735,15 +875,21 @@ impl Axis {
         new
     }
 
-    fn apply_scaling(&mut self, cx: &mut Ctx<'_, impl EventSink>, cam: &Cam, master: &Kinematics) {
-        let (Some(law), Some(mut q)) = (self.cam_law(), self.cam_scaling.take()) else {
+    fn apply_scaling(&mut self, cx: &mut Ctx<'_, impl EventSink>, master: &Kinematics) {
+        let term = self.cam_scaling_term;
+        let (Some(law), Some(mut q)) = (self.cam_term(term), self.cam_scaling.take()) else {
+            return;
+        };
+        let Some(cam) = cx.cams.get_gen(law.table, law.generation) else {
+            q.cmd.end(cx, End::Error(ErrorId::CAM_TABLE_ID_INVALID));
             return;
         };
         let mut new = self.scaled(law, &q.what, cam, master.position);
-        let now = law.clone().eval(cam, master);
+        let mut probe = law;
+        let now = probe.eval(cam, master);
         match self.check_no_jump(&mut new, cam, master, now) {
             Ok(()) => {
-                self.set_cam_law(new);
+                self.set_cam_term(term, new);
                 q.cmd.end(cx, End::Done);
             }
             Err(e) => q.cmd.end(cx, End::Error(e)),
@@ -786,7 +932,7 @@ impl Axis {
                         None,
                     );
                     match self.check_no_jump(&mut law, cam, &m.set, self.set) {
-                        Ok(()) => self.start_cam_coupling(cx, p.master, law, p.cmd),
+                        Ok(()) => self.start_cam_coupling(cx, p.master, law, p.cmd, p.v2),
                         Err(e) => p.cmd.end(cx, End::Error(e)),
                     }
                 } else {
@@ -840,54 +986,77 @@ impl Axis {
                 self.cam_switch = Some(q);
             }
         }
+        self.step_cam_v2(cx, &m.set, raw, cam);
         if let Some(mut d) = self.cam_data {
-            d.due = d.act.reached(m.set.position, raw, cam) || d.due;
-            self.cam_data = Some(d);
-            if let (true, Some(new_cam)) = (d.due, cx.cams.get_gen(law.table, d.generation)) {
-                // The same coupling on the new data; it takes effect only where it does not
-                // move the slave (spec §1.10: "no direct effect on the slave").
-                let mut probe = law;
-                let now = probe.eval(cam, &m.set);
-                let ci = CamIn {
-                    master: 0,
-                    cam_table: law.table,
-                    master_offset: law.mo,
-                    slave_offset: law.so,
-                    master_scaling: law.ms,
-                    slave_scaling: law.ss,
-                    start_mode: crate::cam::StartMode::Absolute,
-                    activation_mode: Act::Instantaneous,
-                    activation_position: 0.0,
-                    master_scaling_mode: d.master_scaling_mode,
-                    slave_scaling_mode: d.slave_scaling_mode,
-                };
-                let mut new = self.law_for(
-                    &ci,
-                    (new_cam, d.generation),
-                    m.set.position,
-                    now.position,
-                    Some((probe, cam)),
-                );
-                // Offsets as they were unless autooffset: the coupling keeps its base cycle.
-                if d.master_scaling_mode != CamScalingMode::AutoOffset {
-                    new.k_base = law.k_base;
+            match self.cam_term(d.term) {
+                Some(term) => {
+                    let term_cam = cx.cams.get_gen(term.table, term.generation);
+                    let raw_t = term.raw(m.set.position);
+                    if let Some(tc) = term_cam {
+                        d.due = d.act.reached(m.set.position, raw_t, tc) || d.due;
+                    }
+                    self.cam_data = Some(d);
+                    if let (true, Some(tc), Some(new_cam)) =
+                        (d.due, term_cam, cx.cams.get_gen(term.table, d.generation))
+                    {
+                        self.take_cam_data(d, term, tc, new_cam, &m.set);
+                    }
                 }
-                new.master_absolute = law.master_absolute;
-                new.slave_absolute = law.slave_absolute;
-                new.master_coupling_pos = law.master_coupling_pos;
-                new.slave_coupling_pos = law.slave_coupling_pos;
-                if self.check_no_jump(&mut new, new_cam, &m.set, now).is_ok() {
-                    self.set_cam_law(new);
-                    self.cam_data = None;
-                }
+                None => self.cam_data = None,
             }
         }
         if let Some(mut q) = self.cam_scaling {
             if q.act.reached(m.set.position, raw, cam) {
-                self.apply_scaling(cx, cam, &m.set);
+                self.apply_scaling(cx, &m.set);
             } else {
                 self.cam_scaling = Some(q);
             }
+        }
+    }
+
+    /// The same coupling on the new data of an online change; it takes effect only where it
+    /// does not move the slave (spec §1.10: "no direct effect on the slave").
+    fn take_cam_data(
+        &mut self,
+        d: PendingData,
+        law: CamLaw,
+        cam: &Cam,
+        new_cam: &Cam,
+        m: &Kinematics,
+    ) {
+        let mut probe = law;
+        let now = probe.eval(cam, m);
+        let ci = CamIn {
+            master: 0,
+            cam_table: law.table,
+            master_offset: law.mo,
+            slave_offset: law.so,
+            master_scaling: law.ms,
+            slave_scaling: law.ss,
+            start_mode: crate::cam::StartMode::Absolute,
+            activation_mode: Act::Instantaneous,
+            activation_position: 0.0,
+            master_scaling_mode: d.master_scaling_mode,
+            slave_scaling_mode: d.slave_scaling_mode,
+        };
+        let mut new = self.law_for(
+            &ci,
+            (new_cam, d.generation),
+            m.position,
+            now.position,
+            Some((probe, cam)),
+        );
+        // Offsets as they were unless autooffset: the coupling keeps its base cycle.
+        if d.master_scaling_mode != CamScalingMode::AutoOffset {
+            new.k_base = law.k_base;
+        }
+        new.master_absolute = law.master_absolute;
+        new.slave_absolute = law.slave_absolute;
+        new.master_coupling_pos = law.master_coupling_pos;
+        new.slave_coupling_pos = law.slave_coupling_pos;
+        if self.check_no_jump(&mut new, new_cam, m, now).is_ok() {
+            self.set_cam_term(d.term, new);
+            self.cam_data = None;
         }
     }
 
@@ -908,8 +1077,32 @@ impl Axis {
             info.cam_exchange_activation_mode = q.act.mode;
             info.cam_exchange_activation_pos = q.act.position;
         }
+        if let Some(q) = &self.cam_v2_op {
+            info.cam_table_queued = true;
+            info.cam_exchange_cam_table_id = q.what.cam_table;
+            info.cam_exchange_activation_mode = q.act.mode;
+            info.cam_exchange_activation_pos = q.act.position;
+        }
         info.cam_data_queued = self.cam_data.is_some();
-        (info, self.cam_switch.is_some(), self.cam_scaling.is_some())
+        if let Some(set) = self.cam_set() {
+            info.multi_cam = set.v2;
+            for (k, t) in set.terms.iter().enumerate() {
+                if let Some(t) = t {
+                    info.cams[k] = CamTerm {
+                        cam_table_id: t.table,
+                        master_offset: t.mo,
+                        slave_offset: t.so,
+                        master_scaling: t.ms,
+                        slave_scaling: t.ss,
+                        actual_master_cam_pos: t.x_local,
+                        actual_slave_cam_pos: t.y_local,
+                        slave_contribution: (t.y_local + t.strokes) * t.ss + t.so,
+                    };
+                }
+            }
+        }
+        let queued = self.cam_switch.is_some() || self.cam_v2_op.is_some();
+        (info, queued, self.cam_scaling.is_some())
     }
 }
 
@@ -933,5 +1126,357 @@ mod tests {
         assert!(!crossed(10.0, 350.0, 0.0, Some(360.0)));
         assert!(crossed(10.0, 100.0, 90.0, Some(360.0)));
         assert!(crossed(1000.0, 1200.0, 90.0, Some(360.0)));
+    }
+}
+
+/// A CamIn of the first cam (or a cam to add or exchange) from MC_CamIn_V2's scaling data.
+fn as_cam_in(op: &CamInV2) -> CamIn {
+    let d = op.scaling;
+    CamIn {
+        master: op.master,
+        cam_table: op.cam_table,
+        master_offset: d.master_offset,
+        slave_offset: d.slave_offset,
+        master_scaling: d.master_scaling,
+        slave_scaling: d.slave_scaling,
+        start_mode: match (d.master_relative, d.slave_relative) {
+            (false, false) => StartMode::Absolute,
+            (true, true) => StartMode::Relative,
+            (false, true) => StartMode::MasterAbsSlaveRel,
+            (true, false) => StartMode::MasterRelSlaveAbs,
+        },
+        activation_mode: op.activation_mode,
+        activation_position: op.activation_position,
+        master_scaling_mode: d.master_scaling_mode,
+        slave_scaling_mode: d.slave_scaling_mode,
+    }
+}
+
+impl Axis {
+    /// MC_CamIn_V2, MC_CamAdd, MC_CamExchange, MC_CamRemove (spec §1.9, §2.5–§2.8).
+    pub(super) fn submit_cam_in_v2(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        op: CamInV2,
+        master: Option<MasterSample>,
+    ) -> Result<(), ErrorId> {
+        let Some(cam) = cx.cams.get(op.cam_table) else {
+            return Err(ErrorId::CAM_TABLE_ID_INVALID);
+        };
+        let d = op.scaling;
+        for v in [d.master_offset, d.slave_offset, op.activation_position] {
+            if !v.is_finite() {
+                return Err(ErrorId::PARAMETER_NOT_CORRECT);
+            }
+        }
+        if !finite_scaling(d.master_scaling) || !finite_scaling(d.slave_scaling) {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        if matches!(
+            op.activation_mode,
+            Act::NextCycleOnce | Act::AsSoonAsPossible | Act::Off
+        ) {
+            return Err(ErrorId::CAM_MODE_INVALID);
+        }
+        let ci = as_cam_in(&op);
+        let Some(set) = self.cam_set() else {
+            if self.cam_in.is_some_and(|p| !p.v2) {
+                return Err(ErrorId::CAM_FAMILY_MIXED);
+            }
+            // Not coupled: the first call couples (additive); nothing to exchange or remove.
+            return match op.operation {
+                CamOperationMode::Default | CamOperationMode::Additive => {
+                    if matches!(op.activation_mode, Act::DeleteQueuedData)
+                        || ((matches!(op.activation_mode, Act::AtMasterCamPos | Act::NextCycle)
+                            || d.master_scaling_mode == CamScalingMode::AutoOffset)
+                            && (d.master_relative
+                                || d.master_scaling_mode == CamScalingMode::AutoOffset))
+                    {
+                        return Err(ErrorId::CAM_MODE_INVALID);
+                    }
+                    let m = self.admit_coupling(master)?;
+                    let generation = cx.cams.generation(op.cam_table);
+                    self.couple_first(cx, id, ci, (cam, generation), &m, true)
+                }
+                _ => Err(ErrorId::CAM_NOT_COUPLED),
+            };
+        };
+        if !set.v2 {
+            return Err(ErrorId::CAM_FAMILY_MIXED);
+        }
+        if self.master_slot() != Some(op.master) {
+            // A multi-cam slave follows one master.
+            return Err(ErrorId::MASTER_INVALID);
+        }
+        let m = self.admit_coupling(master)?;
+        if op.activation_mode == Act::DeleteQueuedData {
+            if let Some(mut q) = self.cam_v2_op.take() {
+                q.cmd.end(cx, End::Aborted);
+            }
+            let mut h = Held::start(
+                cx,
+                id,
+                FbOutputs {
+                    busy: true,
+                    ..FbOutputs::default()
+                },
+            );
+            h.end(cx, End::Done);
+            return Ok(());
+        }
+        // Checked now, so that a queued operation can only fail for a jump at its activation.
+        self.v2_term(&set, &op)?;
+        let base = set.base();
+        let act = Activation::new(
+            op.activation_mode,
+            op.activation_position,
+            m.set.position,
+            base.raw(m.set.position),
+        );
+        if act.at_once(m.set.position, base.raw(m.set.position)) {
+            // Refused outright when it would make the slave jump: nothing changes.
+            let new = self.v2_apply(cx, &op, &m.set)?;
+            self.set_cam_set(new);
+            let mut h = Held::start(
+                cx,
+                id,
+                FbOutputs {
+                    busy: true,
+                    ..FbOutputs::default()
+                },
+            );
+            self.v2_end(cx, &mut h, &op, Ok(()));
+            return Ok(());
+        }
+        if let Some(mut q) = self.cam_v2_op.take() {
+            q.cmd.end(cx, End::Aborted);
+        }
+        let cmd = Held::start(
+            cx,
+            id,
+            FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            },
+        );
+        self.cam_v2_op = Some(PendingChange { cmd, what: op, act });
+        Ok(())
+    }
+
+    /// The term an operation works on (exchange: the reference cam; remove: the cam), or why
+    /// it cannot be done.
+    fn v2_term(&self, set: &CamSet, op: &CamInV2) -> Result<Option<usize>, ErrorId> {
+        match op.operation {
+            CamOperationMode::Default | CamOperationMode::Additive => {
+                if set.count() == MAX_CAMS {
+                    return Err(ErrorId::BUFFER_FULL);
+                }
+                if set.find(op.cam_table).is_some() {
+                    return Err(ErrorId::CAM_MODE_INVALID);
+                }
+                Ok(None)
+            }
+            CamOperationMode::Exchange => match op.reference_cam_table {
+                0 if set.count() == 1 => Ok(Some(0)),
+                0 => Err(ErrorId::CAM_MODE_INVALID), // ambiguous
+                r => set.find(r).map(Some).ok_or(ErrorId::CAM_TABLE_ID_INVALID),
+            },
+            CamOperationMode::Remove => {
+                let i = set
+                    .find(op.cam_table)
+                    .ok_or(ErrorId::CAM_TABLE_ID_INVALID)?;
+                if set.count() == 1 {
+                    // The last cam: MC_CamOut decouples.
+                    return Err(ErrorId::CAM_MODE_INVALID);
+                }
+                Ok(Some(i))
+            }
+        }
+    }
+
+    /// The slave's cams after `op` with the master at `m`; 0x7084 when it would make the
+    /// slave jump.
+    fn v2_apply(
+        &self,
+        cx: &Ctx<'_, impl EventSink>,
+        op: &CamInV2,
+        m: &Kinematics,
+    ) -> Result<CamSet, ErrorId> {
+        let mut set = self.cam_set().ok_or(ErrorId::CAM_NOT_COUPLED)?;
+        let term = self.v2_term(&set, op)?;
+        let cam = cx
+            .cams
+            .get(op.cam_table)
+            .ok_or(ErrorId::CAM_TABLE_ID_INVALID)?;
+        let generation = cx.cams.generation(op.cam_table);
+        let ci = as_cam_in(op);
+        match (op.operation, term) {
+            (CamOperationMode::Exchange, Some(i)) => {
+                let old = set.terms[i].expect("found");
+                let old_cam = cx
+                    .cams
+                    .get_gen(old.table, old.generation)
+                    .ok_or(ErrorId::CAM_TABLE_ID_INVALID)?;
+                let mut probe = old;
+                let now = probe.eval(old_cam, m);
+                let mut new = self.law_for(
+                    &ci,
+                    (cam, generation),
+                    m.position,
+                    now.position,
+                    Some((probe, old_cam)),
+                );
+                self.check_no_jump(&mut new, cam, m, now)?;
+                set.terms[i] = Some(new);
+            }
+            (CamOperationMode::Remove, Some(i)) => {
+                let mut old = set.terms[i].expect("found");
+                let old_cam = cx
+                    .cams
+                    .get_gen(old.table, old.generation)
+                    .ok_or(ErrorId::CAM_TABLE_ID_INVALID)?;
+                let now = old.eval(old_cam, m);
+                // Its position stays (folded into the base's offset); its velocity must not step.
+                let p = self.p();
+                if now.velocity.abs() > p.axis_acc * self.cycle_time * (1.0 + 1e-9) + 1e-9 {
+                    return Err(ErrorId::CAM_SLAVE_WOULD_JUMP);
+                }
+                set.remove(i);
+                if let Some(b) = set.terms[0].as_mut() {
+                    b.so += now.position;
+                }
+            }
+            _ => {
+                // An added cam: with a relative slave (or slave autooffset) its contribution
+                // starts from 0 here (its offset shifts it from there: a jump, refused like
+                // any other); absolute, its contribution must already be 0 here.
+                let start_mode = if ci.start_mode.master_relative() {
+                    StartMode::MasterRelSlaveAbs
+                } else {
+                    StartMode::Absolute
+                };
+                let ci = CamIn {
+                    start_mode,
+                    slave_scaling_mode: CamScalingMode::UserDefined,
+                    ..ci
+                };
+                let mut new = self.law_for(&ci, (cam, generation), m.position, 0.0, None);
+                if op.scaling.slave_relative
+                    || op.scaling.slave_scaling_mode == CamScalingMode::AutoOffset
+                {
+                    let mut probe = new;
+                    let at = probe.eval(
+                        cam,
+                        &Kinematics {
+                            position: m.position,
+                            ..Kinematics::default()
+                        },
+                    );
+                    new.so -= at.position - op.scaling.slave_offset;
+                }
+                self.check_no_jump(&mut new, cam, m, Kinematics::default())?;
+                let k = set.count();
+                set.terms[k] = Some(new);
+            }
+        }
+        Ok(set)
+    }
+
+    fn set_cam_set(&mut self, set: CamSet) {
+        if let Some(Coupling {
+            law: CouplingLaw::Cam(s),
+            ..
+        }) = self.coupling.as_mut()
+        {
+            *s = set;
+        }
+    }
+
+    /// How an operation ends: add and exchange with InSync, remove with Done (spec §2.8).
+    fn v2_end(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        h: &mut Held,
+        op: &CamInV2,
+        r: Result<(), ErrorId>,
+    ) {
+        match r {
+            Err(e) => h.end(cx, End::Error(e)),
+            Ok(()) if op.operation == CamOperationMode::Remove => h.end(cx, End::Done),
+            Ok(()) => h.emit(
+                cx,
+                FbOutputs {
+                    busy: false,
+                    active: false,
+                    in_sync: true,
+                    ..h.out
+                },
+            ),
+        }
+    }
+
+    /// A queued multi-cam operation takes effect at its activation.
+    fn step_cam_v2(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        m: &Kinematics,
+        raw: f64,
+        cam: &Cam,
+    ) {
+        let Some(mut q) = self.cam_v2_op.take() else {
+            return;
+        };
+        if !q.act.reached(m.position, raw, cam) {
+            self.cam_v2_op = Some(q);
+            return;
+        }
+        let r = self
+            .v2_apply(cx, &q.what, m)
+            .map(|set| self.set_cam_set(set));
+        let op = q.what;
+        self.v2_end(cx, &mut q.cmd, &op, r);
+    }
+
+    /// MC_CamScaling_V2: MC_CamScaling for one cam of the slave.
+    pub(super) fn submit_cam_scaling_v2(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        sc: CamScalingV2,
+    ) -> Result<(), ErrorId> {
+        let set = self.cam_set().ok_or(ErrorId::CAM_NOT_COUPLED)?;
+        let term = match sc.cam_table {
+            0 if set.count() == 1 => 0,
+            0 => return Err(ErrorId::CAM_MODE_INVALID),
+            t => set.find(t).ok_or(ErrorId::CAM_TABLE_ID_INVALID)?,
+        };
+        let d = sc.scaling;
+        let law = set.terms[term].expect("found");
+        let m = law.master_pos;
+        let scaling = CamScaling {
+            activation_mode: sc.activation_mode,
+            activation_position: sc.activation_position,
+            master_scaling_mode: d.master_scaling_mode,
+            slave_scaling_mode: d.slave_scaling_mode,
+            master_offset: d.master_offset - if d.master_relative { m } else { 0.0 },
+            slave_offset: d.slave_offset
+                + if d.slave_relative {
+                    self.set.position
+                } else {
+                    0.0
+                },
+            master_scaling: d.master_scaling,
+            slave_scaling: d.slave_scaling,
+        };
+        if self.cam_scaling.is_some() && self.cam_scaling_term != term {
+            // One queued scaling per slave: a new one replaces it.
+            if let Some(mut q) = self.cam_scaling.take() {
+                q.cmd.end(cx, End::Aborted);
+            }
+        }
+        self.cam_scaling_term = term;
+        self.queue_cam_scaling(cx, id, scaling)
     }
 }

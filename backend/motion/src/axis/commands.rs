@@ -227,6 +227,8 @@ impl Axis {
             CommandKind::CamIn(ci) => self.submit_cam_in(cx, cmd.id, ci, master),
             CommandKind::CamOut => self.submit_cam_out(cx, cmd.id),
             CommandKind::CamScaling(sc) => self.submit_cam_scaling(cx, cmd.id, sc),
+            CommandKind::CamInV2(op) => self.submit_cam_in_v2(cx, cmd.id, op, master),
+            CommandKind::CamScalingV2(sc) => self.submit_cam_scaling_v2(cx, cmd.id, sc),
             CommandKind::MoveSuperImposed(sp) => self.submit_superposition(cx, cmd.id, sp),
             CommandKind::AbortSuperposition => {
                 self.abort_superposition(cx);

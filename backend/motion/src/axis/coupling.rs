@@ -90,8 +90,9 @@ pub(super) enum CouplingLaw {
         target_ratio: f64,
         ratio_rate: f64,
     },
-    /// MC_CamIn: through a cam table (`axis/camming.rs`).
-    Cam(super::camming::CamLaw),
+    /// MC_CamIn, MC_CamIn_V2: through one or (multi-cam) several superimposed cam tables
+    /// (`axis/camming.rs`).
+    Cam(super::camming::CamSet),
 }
 
 /// slave = slave_start + ratio · (master − master_start): the slave follows the master's
@@ -126,12 +127,12 @@ impl CouplingLaw {
     }
 
     /// The slave's setpoint for the master's motion in this cycle (advances a ratio ramp).
-    /// `cam`: the cam of a cam law (`None` only if it left the store: the slave holds).
+    /// `None` only for a cam that left the store (the slave holds).
     pub(super) fn slave_setpoint(
         &mut self,
         master: &Kinematics,
         dt: f64,
-        cam: Option<&crate::cam::Cam>,
+        cams: &crate::cam::CamStore,
     ) -> Option<Kinematics> {
         if let Some(g) = self.gear_mut() {
             if g.master_start.is_nan() {
@@ -139,7 +140,7 @@ impl CouplingLaw {
             }
         }
         Some(match self {
-            CouplingLaw::Cam(law) => law.eval(cam?, master),
+            CouplingLaw::Cam(set) => set.eval(cams, master)?,
             CouplingLaw::Gear(g) => g.follow(master, 0.0),
             CouplingLaw::GearDyn {
                 gear: g,
@@ -220,7 +221,7 @@ impl CouplingLaw {
     /// position lag).
     pub(super) fn shift_slave(&mut self, d: f64) {
         match self {
-            CouplingLaw::Cam(law) => law.shift_slave(d),
+            CouplingLaw::Cam(set) => set.shift_slave(d),
             _ => {
                 if let Some(g) = self.gear_mut() {
                     g.slave_start += d;
@@ -454,18 +455,10 @@ impl Axis {
         let (Some(mut c), Master::Sample(m)) = (self.coupling, master) else {
             return;
         };
-        // A cam follows the master's set values (TwinCAT: never its actual ones).
-        let cam = match c.law {
-            CouplingLaw::Cam(l) => Some(cx.cams.get_gen(l.table, l.generation)),
-            _ => None,
-        };
-        let followed = if cam.is_some() {
-            m.set
-        } else {
-            m.followed(self.p().axis_couple_slave_to_actual_values)
-        };
+        // Gears and cams follow the master's set values, or its actual ones with #1064.
+        let followed = m.followed(self.p().axis_couple_slave_to_actual_values);
         let ramping = c.law.ramping();
-        if let Some(set) = c.law.slave_setpoint(&followed, dt, cam.flatten()) {
+        if let Some(set) = c.law.slave_setpoint(&followed, dt, cx.cams) {
             self.set = set;
         }
         self.set_has_superposition = false;

@@ -133,6 +133,10 @@ pub struct Axis {
     last_master: Kinematics,
     /// Data written to the coupled table waiting to take effect here (CamDataQueued).
     cam_data: Option<camming::PendingData>,
+    /// MC_CamIn_V2 / MC_CamAdd / MC_CamExchange / MC_CamRemove waiting for its activation.
+    cam_v2_op: Option<camming::PendingChange<crate::cam::CamInV2>>,
+    /// The cam (term) a queued MC_CamScaling(_V2) scales.
+    cam_scaling_term: usize,
 }
 
 impl Axis {
@@ -195,6 +199,8 @@ impl Axis {
             cam_scaling: None,
             last_master: Kinematics::default(),
             cam_data: None,
+            cam_v2_op: None,
+            cam_scaling_term: 0,
         })
     }
 

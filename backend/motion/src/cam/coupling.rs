@@ -106,6 +106,105 @@ pub struct CamScaling {
     pub slave_scaling: f64,
 }
 
+/// `MC_CamOperationMode` (spec §1.9): what MC_CamIn_V2 does on a multi-cam slave.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum CamOperationMode {
+    /// 0: as `additive`.
+    #[default]
+    Default,
+    /// 1: couples (the first call) or adds a cam.
+    Additive,
+    /// 2: replaces the reference cam.
+    Exchange,
+    /// 3: removes the cam.
+    Remove,
+}
+
+/// `ST_CamScalingData` (spec §3.19): one cam's offsets and scalings in a multi-cam coupling.
+/// Relative: from the axis position at activation (for the slave of an added cam: its
+/// contribution starts at 0 there); absolute: from axis position 0.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CamScalingData {
+    #[serde(default)]
+    pub master_scaling_mode: CamScalingMode,
+    #[serde(default)]
+    pub master_relative: bool,
+    #[serde(default)]
+    pub master_offset: f64,
+    #[serde(default = "unit")]
+    pub master_scaling: f64,
+    #[serde(default)]
+    pub slave_scaling_mode: CamScalingMode,
+    #[serde(default)]
+    pub slave_relative: bool,
+    #[serde(default)]
+    pub slave_offset: f64,
+    #[serde(default = "unit")]
+    pub slave_scaling: f64,
+}
+
+fn unit() -> f64 {
+    1.0
+}
+
+impl Default for CamScalingData {
+    fn default() -> Self {
+        CamScalingData {
+            master_scaling_mode: CamScalingMode::UserDefined,
+            master_relative: false,
+            master_offset: 0.0,
+            master_scaling: 1.0,
+            slave_scaling_mode: CamScalingMode::UserDefined,
+            slave_relative: false,
+            slave_offset: 0.0,
+            slave_scaling: 1.0,
+        }
+    }
+}
+
+/// MC_CamIn_V2 (and MC_CamAdd, MC_CamExchange, MC_CamRemove): couple with one cam, then add,
+/// exchange or remove cams superimposed on the slave.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CamInV2 {
+    pub master: crate::AxisSlot,
+    pub cam_table: u32,
+    pub activation_mode: CamActivationMode,
+    pub activation_position: f64,
+    pub scaling: CamScalingData,
+    pub operation: CamOperationMode,
+    /// The cam an exchange replaces (0: the only one).
+    pub reference_cam_table: u32,
+}
+
+/// MC_CamScaling_V2: new offsets and scalings of one cam of the slave (0: the only one).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CamScalingV2 {
+    pub cam_table: u32,
+    pub activation_mode: CamActivationMode,
+    pub activation_position: f64,
+    pub scaling: CamScalingData,
+}
+
+/// One cam of a multi-cam slave (MC_CamInfo_V2's per-cam values).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct CamTerm {
+    /// 0: no cam in this place.
+    pub cam_table_id: u32,
+    pub master_offset: f64,
+    pub slave_offset: f64,
+    pub master_scaling: f64,
+    pub slave_scaling: f64,
+    pub actual_master_cam_pos: f64,
+    pub actual_slave_cam_pos: f64,
+    /// This cam's share of the slave position (axis units).
+    pub slave_contribution: f64,
+}
+
 /// MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
 /// positions are raw (unscaled); axis positions are set positions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -145,6 +244,10 @@ pub struct CamInfo {
     pub cam_exchange_cam_table_id: u32,
     pub cam_exchange_activation_mode: CamActivationMode,
     pub cam_exchange_activation_pos: f64,
+    /// Coupled by MC_CamIn_V2 (multi-cam).
+    pub multi_cam: bool,
+    /// The cams superimposed on the slave, the base first (MC_CamIn: one).
+    pub cams: [CamTerm; 4],
 }
 
 /// MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes

@@ -40,8 +40,8 @@ pub use analysis::{
     sample,
 };
 pub use coupling::{
-    CamActivationMode, CamIn, CamInfo, CamScaling, CamScalingMode, CamStore, MAX_CAM_TABLE_ID,
-    OnlineChange, StartMode,
+    CamActivationMode, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling, CamScalingData,
+    CamScalingMode, CamScalingV2, CamStore, CamTerm, MAX_CAM_TABLE_ID, OnlineChange, StartMode,
 };
 pub use function::{MotionFunction, MotionFunctionPoint, Segment};
 pub use law::{MotionFunctionType, MotionPointType};

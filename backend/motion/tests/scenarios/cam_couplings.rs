@@ -613,3 +613,166 @@ fn written_data_reaches_a_coupled_slave_by_the_online_change_rules() {
     r.k.drop_cam_data(T_HALF);
     assert!(!r.st(1).cam_data_queued);
 }
+
+fn v2(master: u16, table: u32, operation: CamOperationMode) -> CamInV2 {
+    CamInV2 {
+        master,
+        cam_table: table,
+        activation_mode: CamActivationMode::Instantaneous,
+        activation_position: 0.0,
+        scaling: CamScalingData::default(),
+        operation,
+        reference_cam_table: 0,
+    }
+}
+
+/// Multi-cam (spec §1.9, §2.5–§2.9): MC_CamIn_V2 couples, MC_CamAdd superimposes a second cam
+/// (its contribution starting from 0 with a relative slave), queued at a master position with
+/// CamTableQueued; MC_CamExchange replaces it without a jump (slave autooffset);
+/// MC_CamScaling_V2 scales one cam; MC_CamRemove ends with Done and keeps the position; the
+/// V1 and V2 blocks do not mix, and the last cam is removed by MC_CamOut only.
+#[test]
+fn multi_cam_adds_exchanges_scales_and_removes_superimposed_cams() {
+    const T_WAVE: u32 = 3;
+    const T_WAVE2: u32 = 4;
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &line(true));
+    // A small periodic correction: 0 → 5 → 0 over 360 (rest at both ends).
+    let wave = |h: f64| {
+        let point = |i: u32, x: f64, y: f64| MotionFunctionPoint {
+            point_index: i,
+            function_type: MotionFunctionType::Polynom5,
+            point_type: MotionPointType::Rest,
+            rel_index_next_point: 1,
+            master_pos: x,
+            slave_pos: y,
+            slave_velo: 0.0,
+            slave_acc: 0.0,
+            slave_jerk: 0.0,
+        };
+        let mut t = CamTableData::motion_function(vec![
+            point(1, 0.0, 0.0),
+            point(2, 180.0, h),
+            point(3, 360.0, 0.0),
+        ]);
+        t.periodic = true;
+        t
+    };
+    r.cam(T_WAVE, &wave(5.0));
+    r.cam(T_WAVE2, &wave(8.0));
+    let c = r.ok(
+        1,
+        CommandKind::CamInV2(v2(0, T_LINE, CamOperationMode::Default)),
+    );
+    assert!(r.out(c).in_sync);
+    assert!(r.st(1).cam.multi_cam);
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(cam_in(0, T_LINE))),
+        ErrorId::CAM_FAMILY_MIXED
+    );
+    assert_eq!(
+        r.rejected(
+            1,
+            CommandKind::CamInV2(v2(0, T_LINE, CamOperationMode::Remove))
+        ),
+        ErrorId::CAM_MODE_INVALID
+    );
+    // Add the wave when the master passes 360 (a cycle border: the wave is at rest there).
+    let add = CamInV2 {
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: 360.0,
+        scaling: CamScalingData {
+            slave_relative: true,
+            ..CamScalingData::default()
+        },
+        ..v2(0, T_WAVE, CamOperationMode::Additive)
+    };
+    let a = r.ok(1, CommandKind::CamInV2(add));
+    assert!(r.out(a).active && r.st(1).cam_table_queued);
+    let mut prev = r.st(1).set_position;
+    move_master(&mut r, 540.0, 200.0, |r| {
+        let p = r.st(0).set_position;
+        let s = r.st(1).set_position;
+        assert!(
+            (s - prev).abs() <= 1.2 * 200.0 * DT + 1e-9,
+            "jump {prev} → {s} at {p}"
+        );
+        prev = s;
+        assert_eq!(r.st(1).cam_table_queued, p < 360.0, "at {p}");
+    });
+    assert!(r.out(a).in_sync && !r.out(a).busy);
+    assert_eq!(r.st(1).cam.cams[1].cam_table_id, T_WAVE);
+    // Base 540 (base cycle 0: strokes count), wave at its peak 5.
+    assert!(
+        (r.st(1).set_position - 545.0).abs() < 1e-6,
+        "{}",
+        r.st(1).set_position
+    );
+    // Exchange the wave for the bigger one at rest at the next border, slave autooffset.
+    let ex = CamInV2 {
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: 720.0,
+        scaling: CamScalingData {
+            slave_scaling_mode: CamScalingMode::AutoOffset,
+            ..CamScalingData::default()
+        },
+        reference_cam_table: T_WAVE,
+        ..v2(0, T_WAVE2, CamOperationMode::Exchange)
+    };
+    let e = r.ok(1, CommandKind::CamInV2(ex));
+    move_master(&mut r, 900.0, 200.0, |_| {});
+    assert!(r.out(e).in_sync, "{:?}", r.out(e));
+    assert_eq!(r.st(1).cam.cams[1].cam_table_id, T_WAVE2);
+    assert!(
+        (r.st(1).set_position - 908.0).abs() < 1e-6,
+        "{}",
+        r.st(1).set_position
+    );
+    // Scale the wave ×0.5 (slave scaling of that cam only, at rest at the border).
+    let sc = CamScalingV2 {
+        cam_table: T_WAVE2,
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: 1080.0,
+        scaling: CamScalingData {
+            slave_scaling: 0.5,
+            master_scaling_mode: CamScalingMode::Off,
+            ..CamScalingData::default()
+        },
+    };
+    let s = r.ok(1, CommandKind::CamScalingV2(sc));
+    assert!(r.st(1).cam_scaling_pending);
+    move_master(&mut r, 1260.0, 200.0, |_| {});
+    assert!(r.out(s).done, "{:?}", r.out(s));
+    assert!(
+        (r.st(1).set_position - 1264.0).abs() < 1e-6,
+        "{}",
+        r.st(1).set_position
+    );
+    // Remove the wave at a border (at rest, contribution 0): Done, nothing moves.
+    move_master(&mut r, 1440.0, 200.0, |_| {});
+    let before = r.st(1).set_position;
+    let rm = r.ok(
+        1,
+        CommandKind::CamInV2(v2(0, T_WAVE2, CamOperationMode::Remove)),
+    );
+    assert!(r.out(rm).done && !r.out(rm).in_sync);
+    assert_eq!(r.st(1).set_position, before);
+    assert_eq!(r.st(1).cam.cams[1].cam_table_id, 0);
+    move_master(&mut r, 1500.0, 200.0, |_| {});
+    assert!((r.st(1).set_position - 1500.0).abs() < 1e-6);
+    // Adding a cam whose contribution is not 0 here, absolutely: a jump, refused.
+    let mut r2 = rig_at(90.0, 90.0);
+    r2.cam(T_LINE, &line(true));
+    r2.cam(T_WAVE, &wave(5.0));
+    r2.ok(
+        1,
+        CommandKind::CamInV2(v2(0, T_LINE, CamOperationMode::Default)),
+    );
+    assert_eq!(
+        r2.rejected(
+            1,
+            CommandKind::CamInV2(v2(0, T_WAVE, CamOperationMode::Additive))
+        ),
+        ErrorId::CAM_SLAVE_WOULD_JUMP
+    );
+}
