@@ -891,10 +891,15 @@ async fn openapi_json_is_current() {
         "/api/v1/cam-tables/{table}/online-change-mode",
         "/api/v1/cam-tables/{table}/points",
         "/api/v1/cam-tables/{table}/points/{point}",
+        "/api/v1/axes/{axis}/cam-in-v2",
+        "/api/v1/axes/{axis}/cam-add",
+        "/api/v1/axes/{axis}/cam-exchange",
+        "/api/v1/axes/{axis}/cam-remove",
+        "/api/v1/axes/{axis}/cam-scaling-v2",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 49, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 54, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -1020,7 +1025,7 @@ async fn asyncapi_json_is_current() {
             "{method}"
         );
     }
-    assert_eq!(commands, 23);
+    assert_eq!(commands, 28);
     let s = Server::start();
     let served = get(&s, "/asyncapi.json").await;
     assert_eq!(served.status, 200);

@@ -516,3 +516,91 @@ async fn a_cam_couples_y_to_x_over_http_and_only_the_table_survives_a_restart() 
     assert_eq!(y["status"]["coupled"], false);
     assert_eq!(y["status"]["cam"]["cam_table_id"], 0);
 }
+
+/// Multi-cam over HTTP: cam-in-v2 couples, cam-add superimposes a second cam (relative
+/// slave), the status lists both, cam-remove takes it off (Done), cam-in does not mix in.
+#[tokio::test(flavor = "multi_thread")]
+async fn multi_cam_over_http() {
+    let s = Server::start();
+    let line = json!({"name": "line", "table_type": "equidistant", "periodic": true, "rows": [[0.0, 0.0], [360.0, 360.0]]});
+    let wave = json!({"name": "wave", "table_type": "motion_function", "periodic": true, "points": [
+        {"point_index": 1, "function_type": "polynom5", "point_type": "rest", "master_pos": 0.0, "slave_pos": 0.0},
+        {"point_index": 2, "function_type": "polynom5", "point_type": "rest", "master_pos": 180.0, "slave_pos": 5.0},
+        {"point_index": 3, "function_type": "polynom5", "point_type": "rest", "master_pos": 360.0, "slave_pos": 0.0}]});
+    assert_eq!(post(&s, "/api/v1/cam-tables", line).await.status, 201);
+    assert_eq!(post(&s, "/api/v1/cam-tables", wave).await.status, 201);
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in-v2?wait=true",
+        json!({"master": "x", "cam_table": "line"}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-add?wait=true",
+        json!({"master": "x", "cam_table": "wave", "scaling": {"slave_relative": true}}),
+    )
+    .await;
+    assert_eq!(
+        (
+            r.status,
+            r.json["command"].as_str(),
+            r.json["outputs"]["in_sync"].as_bool()
+        ),
+        (202, Some("cam-add"), Some(true)),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "x", "cam_table": "line"}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_family_mixed")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 180.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["done"], true);
+    let y = status(&s, "y").await;
+    assert!(close(&y["status"]["set_position"], 185.0), "{y}");
+    assert_eq!(y["status"]["cam"]["multi_cam"], true);
+    assert_eq!(y["status"]["cam"]["cams"][1]["cam_table_id"], 2);
+    assert!(close(
+        &y["status"]["cam"]["cams"][1]["slave_contribution"],
+        5.0
+    ));
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-remove?wait=true",
+        json!({"master": "x", "cam_table": "wave"}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["done"], true, "{}", r.text);
+    assert!(
+        close(&status(&s, "y").await["status"]["set_position"], 185.0),
+        "the position stays"
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-remove",
+        json!({"master": "x", "cam_table": "line"}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_mode_invalid")),
+        "the last cam goes with cam-out"
+    );
+}

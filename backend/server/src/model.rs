@@ -772,6 +772,113 @@ pub struct CamScalingBody {
     pub slave_scaling: f64,
 }
 
+/// MC_CamIn_V2: couple with one cam, then add, exchange or remove superimposed cams
+/// (`operation`). Not to be mixed with cam-in on one slave.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "cam_table": "knife", "operation": "additive"}))]
+pub struct CamInV2Body {
+    /// Master axis id or name.
+    pub master: String,
+    /// Cam table id (1..255) or name.
+    pub cam_table: String,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// This cam's offsets and scalings (default: absolute, no offset, scaling 1).
+    #[serde(default)]
+    pub scaling: motion::cam::CamScalingData,
+    /// Default `default` (= additive: the first call couples).
+    #[serde(default)]
+    pub operation: motion::cam::CamOperationMode,
+    /// For `exchange`: the cam to replace (id or name; may be left out when the slave has one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_cam_table: Option<String>,
+}
+
+/// MC_CamAdd: superimpose a cam on a multi-cam slave (the first one couples).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "cam_table": "correction", "scaling": {"slave_relative": true}}))]
+pub struct CamAddBody {
+    /// Master axis id or name.
+    pub master: String,
+    /// Cam table id (1..255) or name.
+    pub cam_table: String,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// Default: absolute, no offset, scaling 1.
+    #[serde(default)]
+    pub scaling: motion::cam::CamScalingData,
+}
+
+/// MC_CamExchange: replace one cam of a multi-cam slave.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "cam_table": "knife_long", "reference_cam_table": "knife", "scaling": {"slave_scaling_mode": "auto_offset"}}))]
+pub struct CamExchangeBody {
+    /// Master axis id or name.
+    pub master: String,
+    /// The new cam (id or name).
+    pub cam_table: String,
+    /// The cam it replaces (id or name; may be left out when the slave has one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_cam_table: Option<String>,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// Default: absolute, no offset, scaling 1.
+    #[serde(default)]
+    pub scaling: motion::cam::CamScalingData,
+}
+
+/// MC_CamRemove: take one cam off a multi-cam slave (Done once removed; the last one is
+/// removed by cam-out).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "cam_table": "correction"}))]
+pub struct CamRemoveBody {
+    /// Master axis id or name.
+    pub master: String,
+    /// The cam to remove (id or name).
+    pub cam_table: String,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+}
+
+/// MC_CamScaling_V2: new offsets and scalings of one cam of the slave.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"cam_table": "correction", "scaling": {"slave_scaling": 0.5, "master_scaling_mode": "off"}}))]
+pub struct CamScalingV2Body {
+    /// The cam to scale (id or name; may be left out when the slave has one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cam_table: Option<String>,
+    /// Default `instantaneous`.
+    #[serde(default)]
+    pub activation_mode: motion::cam::CamActivationMode,
+    /// Default 0.
+    #[serde(default)]
+    pub activation_position: f64,
+    /// Default: absolute, no offset, scaling 1.
+    #[serde(default)]
+    pub scaling: motion::cam::CamScalingData,
+}
+
 fn one() -> f64 {
     1.0
 }

@@ -46,4 +46,5 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28805, "cam_table_in_use", "the cam table is in use by a coupling"],
   [28806, "cam_mode_invalid", "activation, start or scaling mode not allowed here"],
   [28807, "cam_not_coupled", "the axis is not coupled through a cam"],
+  [28808, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave"],
 ];

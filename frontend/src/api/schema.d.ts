@@ -74,6 +74,40 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/cam-add": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamAdd: superimpose a cam on a multi-cam slave (relative slave: its share starts from 0) */
+        post: operations["cam_add"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/cam-exchange": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamExchange: replace one cam of a multi-cam slave (slave auto_offset: no jump) */
+        post: operations["cam_exchange"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/cam-in": {
         parameters: {
             query?: never;
@@ -85,6 +119,23 @@ export interface paths {
         put?: never;
         /** MC_CamIn: couple to a master through a cam table, or switch the cam of a coupled slave (active while it waits for its activation; wait returns at in_sync; 409 cam_slave_would_jump unless the slave stands where the cam puts it) */
         post: operations["cam_in"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/cam-in-v2": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamIn_V2: multi-cam — couple with one cam, then add, exchange or remove superimposed cams (operation); not with cam-in on one slave */
+        post: operations["cam_in_v2"];
         delete?: never;
         options?: never;
         head?: never;
@@ -108,6 +159,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/cam-remove": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamRemove: take a cam off a multi-cam slave (its position stays; Done once removed) */
+        post: operations["cam_remove"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/cam-scaling": {
         parameters: {
             query?: never;
@@ -119,6 +187,23 @@ export interface paths {
         put?: never;
         /** MC_CamScaling: new offsets and scalings of the cam coupling (auto_offset: no position jump) */
         post: operations["cam_scaling"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/cam-scaling-v2": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_CamScaling_V2: new offsets and scalings of one cam of a multi-cam slave */
+        post: operations["cam_scaling_v2"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1103,11 +1188,54 @@ export interface components {
          *         "cam_exchange_cam_table_id": 0,
          *         "cam_table_id": 0,
          *         "cam_table_queued": false,
+         *         "cams": [
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           }
+         *         ],
          *         "master_absolute": false,
          *         "master_axis_coupling_pos": 0,
          *         "master_cam_start_pos": 0,
          *         "master_offset": 0,
          *         "master_scaling": 0,
+         *         "multi_cam": false,
          *         "periodic": false,
          *         "raw_master_period": 0,
          *         "raw_slave_stroke": 0,
@@ -1302,6 +1430,59 @@ export interface components {
          */
         CamActivationMode: "instantaneous" | "at_master_cam_pos" | "at_master_axis_pos" | "next_cycle" | "next_cycle_once" | "as_soon_as_possible" | "off" | "delete_queued_data" | "at_master_axis_pos_positive_direction" | "at_master_axis_pos_negative_direction";
         /**
+         * @description MC_CamAdd: superimpose a cam on a multi-cam slave (the first one couples).
+         * @example {
+         *       "cam_table": "correction",
+         *       "master": "x",
+         *       "scaling": {
+         *         "slave_relative": true
+         *       }
+         *     }
+         */
+        CamAddBody: {
+            /** @description Master axis id or name. */
+            master: string;
+            /** @description Cam table id (1..255) or name. */
+            cam_table: string;
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
+            /** @description Default: absolute, no offset, scaling 1. */
+            scaling?: components["schemas"]["CamScalingData"];
+        };
+        /**
+         * @description MC_CamExchange: replace one cam of a multi-cam slave.
+         * @example {
+         *       "cam_table": "knife_long",
+         *       "master": "x",
+         *       "reference_cam_table": "knife",
+         *       "scaling": {
+         *         "slave_scaling_mode": "auto_offset"
+         *       }
+         *     }
+         */
+        CamExchangeBody: {
+            /** @description Master axis id or name. */
+            master: string;
+            /** @description The new cam (id or name). */
+            cam_table: string;
+            /** @description The cam it replaces (id or name; may be left out when the slave has one). */
+            reference_cam_table?: string | null;
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
+            /** @description Default: absolute, no offset, scaling 1. */
+            scaling?: components["schemas"]["CamScalingData"];
+        };
+        /**
          * @description MC_CamIn: couple this axis (the slave) to `master` through a cam table, or — on a slave
          *     already coupled to that master through a cam — switch to another cam. The slave must stand
          *     where the cam puts it (`GET /cam-tables/{table}/slave-dynamics`), or use a relative start
@@ -1356,6 +1537,34 @@ export interface components {
             slave_scaling_mode?: components["schemas"]["CamScalingMode"];
         };
         /**
+         * @description MC_CamIn_V2: couple with one cam, then add, exchange or remove superimposed cams
+         *     (`operation`). Not to be mixed with cam-in on one slave.
+         * @example {
+         *       "cam_table": "knife",
+         *       "master": "x",
+         *       "operation": "additive"
+         *     }
+         */
+        CamInV2Body: {
+            /** @description Master axis id or name. */
+            master: string;
+            /** @description Cam table id (1..255) or name. */
+            cam_table: string;
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
+            /** @description This cam's offsets and scalings (default: absolute, no offset, scaling 1). */
+            scaling?: components["schemas"]["CamScalingData"];
+            /** @description Default `default` (= additive: the first call couples). */
+            operation?: components["schemas"]["CamOperationMode"];
+            /** @description For `exchange`: the cam to replace (id or name; may be left out when the slave has one). */
+            reference_cam_table?: string | null;
+        };
+        /**
          * @description MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
          *     positions are raw (unscaled); axis positions are set positions.
          * @example {
@@ -1369,11 +1578,54 @@ export interface components {
          *       "cam_exchange_cam_table_id": 0,
          *       "cam_table_id": 1,
          *       "cam_table_queued": false,
+         *       "cams": [
+         *         {
+         *           "actual_master_cam_pos": 0,
+         *           "actual_slave_cam_pos": 0,
+         *           "cam_table_id": 0,
+         *           "master_offset": 0,
+         *           "master_scaling": 0,
+         *           "slave_contribution": 0,
+         *           "slave_offset": 0,
+         *           "slave_scaling": 0
+         *         },
+         *         {
+         *           "actual_master_cam_pos": 0,
+         *           "actual_slave_cam_pos": 0,
+         *           "cam_table_id": 0,
+         *           "master_offset": 0,
+         *           "master_scaling": 0,
+         *           "slave_contribution": 0,
+         *           "slave_offset": 0,
+         *           "slave_scaling": 0
+         *         },
+         *         {
+         *           "actual_master_cam_pos": 0,
+         *           "actual_slave_cam_pos": 0,
+         *           "cam_table_id": 0,
+         *           "master_offset": 0,
+         *           "master_scaling": 0,
+         *           "slave_contribution": 0,
+         *           "slave_offset": 0,
+         *           "slave_scaling": 0
+         *         },
+         *         {
+         *           "actual_master_cam_pos": 0,
+         *           "actual_slave_cam_pos": 0,
+         *           "cam_table_id": 0,
+         *           "master_offset": 0,
+         *           "master_scaling": 0,
+         *           "slave_contribution": 0,
+         *           "slave_offset": 0,
+         *           "slave_scaling": 0
+         *         }
+         *       ],
          *       "master_absolute": true,
          *       "master_axis_coupling_pos": 0,
          *       "master_cam_start_pos": 0,
          *       "master_offset": 0,
          *       "master_scaling": 1,
+         *       "multi_cam": false,
          *       "periodic": false,
          *       "raw_master_period": 200,
          *       "raw_slave_stroke": 100,
@@ -1447,6 +1699,10 @@ export interface components {
             cam_exchange_activation_mode: components["schemas"]["CamActivationMode"];
             /** Format: double */
             cam_exchange_activation_pos: number;
+            /** @description Coupled by MC_CamIn_V2 (multi-cam). */
+            multi_cam: boolean;
+            /** @description The cams superimposed on the slave, the base first (MC_CamIn: one). */
+            cams: components["schemas"]["CamTerm"][];
         };
         /**
          * @description `ST_CamMasterData`: one solution.
@@ -1474,6 +1730,32 @@ export interface components {
              * @description The slave offset that belongs to that position (strokes of the cycles passed included).
              */
             slave_offset: number;
+        };
+        /**
+         * @description `MC_CamOperationMode` (spec §1.9): what MC_CamIn_V2 does on a multi-cam slave.
+         * @enum {string}
+         */
+        CamOperationMode: "default" | "additive" | "exchange" | "remove";
+        /**
+         * @description MC_CamRemove: take one cam off a multi-cam slave (Done once removed; the last one is
+         *     removed by cam-out).
+         * @example {
+         *       "cam_table": "correction",
+         *       "master": "x"
+         *     }
+         */
+        CamRemoveBody: {
+            /** @description Master axis id or name. */
+            master: string;
+            /** @description The cam to remove (id or name). */
+            cam_table: string;
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
         };
         /**
          * @description MC_CamScaling: new offsets and scalings of the cam coupling (the raw table stays).
@@ -1522,10 +1804,62 @@ export interface components {
             slave_scaling: number;
         };
         /**
+         * @description `ST_CamScalingData` (spec §3.19): one cam's offsets and scalings in a multi-cam coupling.
+         *     Relative: from the axis position at activation (for the slave of an added cam: its
+         *     contribution starts at 0 there); absolute: from axis position 0.
+         * @example {
+         *       "master_offset": 0,
+         *       "master_relative": false,
+         *       "master_scaling": 1,
+         *       "master_scaling_mode": "user_defined",
+         *       "slave_offset": 0,
+         *       "slave_relative": true,
+         *       "slave_scaling": 1,
+         *       "slave_scaling_mode": "user_defined"
+         *     }
+         */
+        CamScalingData: {
+            master_scaling_mode?: components["schemas"]["CamScalingMode"];
+            master_relative?: boolean;
+            /** Format: double */
+            master_offset?: number;
+            /** Format: double */
+            master_scaling?: number;
+            slave_scaling_mode?: components["schemas"]["CamScalingMode"];
+            slave_relative?: boolean;
+            /** Format: double */
+            slave_offset?: number;
+            /** Format: double */
+            slave_scaling?: number;
+        };
+        /**
          * @description `MC_CamScalingMode` (spec §1.8), per axis.
          * @enum {string}
          */
         CamScalingMode: "user_defined" | "auto_offset" | "off";
+        /**
+         * @description MC_CamScaling_V2: new offsets and scalings of one cam of the slave.
+         * @example {
+         *       "cam_table": "correction",
+         *       "scaling": {
+         *         "master_scaling_mode": "off",
+         *         "slave_scaling": 0.5
+         *       }
+         *     }
+         */
+        CamScalingV2Body: {
+            /** @description The cam to scale (id or name; may be left out when the slave has one). */
+            cam_table?: string | null;
+            /** @description Default `instantaneous`. */
+            activation_mode?: components["schemas"]["CamActivationMode"];
+            /**
+             * Format: double
+             * @description Default 0.
+             */
+            activation_position?: number;
+            /** @description Default: absolute, no offset, scaling 1. */
+            scaling?: components["schemas"]["CamScalingData"];
+        };
         /**
          * @description A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;
          *     also an entry of the configuration document. Position tables have `rows`, motion functions
@@ -1665,6 +1999,43 @@ export interface components {
             updated_at: string;
             rows?: number[][] | null;
             points?: components["schemas"]["MotionFunctionPoint"][] | null;
+        };
+        /**
+         * @description One cam of a multi-cam slave (MC_CamInfo_V2's per-cam values).
+         * @example {
+         *       "actual_master_cam_pos": 180,
+         *       "actual_slave_cam_pos": 5,
+         *       "cam_table_id": 3,
+         *       "master_offset": 0,
+         *       "master_scaling": 1,
+         *       "slave_contribution": 5,
+         *       "slave_offset": 0,
+         *       "slave_scaling": 1
+         *     }
+         */
+        CamTerm: {
+            /**
+             * Format: int32
+             * @description 0: no cam in this place.
+             */
+            cam_table_id: number;
+            /** Format: double */
+            master_offset: number;
+            /** Format: double */
+            slave_offset: number;
+            /** Format: double */
+            master_scaling: number;
+            /** Format: double */
+            slave_scaling: number;
+            /** Format: double */
+            actual_master_cam_pos: number;
+            /** Format: double */
+            actual_slave_cam_pos: number;
+            /**
+             * Format: double
+             * @description This cam's share of the slave position (axis units).
+             */
+            slave_contribution: number;
         };
         /**
          * @description MC_ReadMotionFunctionValues: one row per sample, columns as named.
@@ -2598,11 +2969,54 @@ export interface components {
          *         "cam_exchange_cam_table_id": 0,
          *         "cam_table_id": 0,
          *         "cam_table_queued": false,
+         *         "cams": [
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           },
+         *           {
+         *             "actual_master_cam_pos": 0,
+         *             "actual_slave_cam_pos": 0,
+         *             "cam_table_id": 0,
+         *             "master_offset": 0,
+         *             "master_scaling": 0,
+         *             "slave_contribution": 0,
+         *             "slave_offset": 0,
+         *             "slave_scaling": 0
+         *           }
+         *         ],
          *         "master_absolute": false,
          *         "master_axis_coupling_pos": 0,
          *         "master_cam_start_pos": 0,
          *         "master_offset": 0,
          *         "master_scaling": 0,
+         *         "multi_cam": false,
          *         "periodic": false,
          *         "raw_master_period": 0,
          *         "raw_slave_stroke": 0,
@@ -3544,11 +3958,54 @@ export interface components {
          *           "cam_exchange_cam_table_id": 0,
          *           "cam_table_id": 0,
          *           "cam_table_queued": false,
+         *           "cams": [
+         *             {
+         *               "actual_master_cam_pos": 0,
+         *               "actual_slave_cam_pos": 0,
+         *               "cam_table_id": 0,
+         *               "master_offset": 0,
+         *               "master_scaling": 0,
+         *               "slave_contribution": 0,
+         *               "slave_offset": 0,
+         *               "slave_scaling": 0
+         *             },
+         *             {
+         *               "actual_master_cam_pos": 0,
+         *               "actual_slave_cam_pos": 0,
+         *               "cam_table_id": 0,
+         *               "master_offset": 0,
+         *               "master_scaling": 0,
+         *               "slave_contribution": 0,
+         *               "slave_offset": 0,
+         *               "slave_scaling": 0
+         *             },
+         *             {
+         *               "actual_master_cam_pos": 0,
+         *               "actual_slave_cam_pos": 0,
+         *               "cam_table_id": 0,
+         *               "master_offset": 0,
+         *               "master_scaling": 0,
+         *               "slave_contribution": 0,
+         *               "slave_offset": 0,
+         *               "slave_scaling": 0
+         *             },
+         *             {
+         *               "actual_master_cam_pos": 0,
+         *               "actual_slave_cam_pos": 0,
+         *               "cam_table_id": 0,
+         *               "master_offset": 0,
+         *               "master_scaling": 0,
+         *               "slave_contribution": 0,
+         *               "slave_offset": 0,
+         *               "slave_scaling": 0
+         *             }
+         *           ],
          *           "master_absolute": false,
          *           "master_axis_coupling_pos": 0,
          *           "master_cam_start_pos": 0,
          *           "master_offset": 0,
          *           "master_scaling": 0,
+         *           "multi_cam": false,
          *           "periodic": false,
          *           "raw_master_period": 0,
          *           "raw_slave_stroke": 0,
@@ -4820,6 +5277,110 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    cam_add: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamAddBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_exchange: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamExchangeBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
     cam_in: {
         parameters: {
             query?: {
@@ -4847,6 +5408,58 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["CamInBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_in_v2: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamInV2Body"];
             };
         };
         responses: {
@@ -4924,6 +5537,58 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    cam_remove: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamRemoveBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
     cam_scaling: {
         parameters: {
             query?: {
@@ -4951,6 +5616,58 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["CamScalingBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            403: components["responses"]["CrossOriginForbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_scaling_v2: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
+                 *     is returned as it stands.
+                 */
+                timeout_ms?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamScalingV2Body"];
             };
         };
         responses: {

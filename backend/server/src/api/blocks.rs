@@ -204,6 +204,16 @@ catalogue! {
         "MC_CamIn: couple to a master through a cam table, or switch the cam of a coupled slave (active while it waits for its activation; wait returns at in_sync; 409 cam_slave_would_jump unless the slave stands where the cam puts it)";
     cam_out: "cam-out", EmptyBody, |_, _, _| Ok(CommandKind::CamOut), Operator, Done,
         "MC_CamOut: decouple a cam slave; it keeps its velocity";
+    cam_in_v2: "cam-in-v2", CamInV2Body, CamInV2Body::to_kind, Operator, InSync,
+        "MC_CamIn_V2: multi-cam — couple with one cam, then add, exchange or remove superimposed cams (operation); not with cam-in on one slave";
+    cam_add: "cam-add", CamAddBody, CamAddBody::to_kind, Operator, InSync,
+        "MC_CamAdd: superimpose a cam on a multi-cam slave (relative slave: its share starts from 0)";
+    cam_exchange: "cam-exchange", CamExchangeBody, CamExchangeBody::to_kind, Operator, InSync,
+        "MC_CamExchange: replace one cam of a multi-cam slave (slave auto_offset: no jump)";
+    cam_remove: "cam-remove", CamRemoveBody, CamRemoveBody::to_kind, Operator, Done,
+        "MC_CamRemove: take a cam off a multi-cam slave (its position stays; Done once removed)";
+    cam_scaling_v2: "cam-scaling-v2", CamScalingV2Body, CamScalingV2Body::to_kind, Operator, Done,
+        "MC_CamScaling_V2: new offsets and scalings of one cam of a multi-cam slave";
     cam_scaling: "cam-scaling", CamScalingBody, CamScalingBody::to_kind, Operator, Done,
         "MC_CamScaling: new offsets and scalings of the cam coupling (auto_offset: no position jump)";
     move_superimposed: "move-superimposed", MoveSuperImposedBody, MoveSuperImposedBody::to_kind, Operator, Done,

@@ -512,6 +512,25 @@ impl utoipa::Modify for ForeignExamples {
             ("ParamValue", Ok(json!(90.0))),
             ("MotionFunctionPoint", to_value(example_cam().1[1])),
             (
+                "CamScalingData",
+                to_value(motion::cam::CamScalingData {
+                    slave_relative: true,
+                    ..Default::default()
+                }),
+            ),
+            (
+                "CamTerm",
+                to_value(motion::cam::CamTerm {
+                    cam_table_id: 3,
+                    master_scaling: 1.0,
+                    slave_scaling: 1.0,
+                    actual_master_cam_pos: 180.0,
+                    actual_slave_cam_pos: 5.0,
+                    slave_contribution: 5.0,
+                    ..Default::default()
+                }),
+            ),
+            (
                 "OnlineChange",
                 to_value(motion::cam::OnlineChange {
                     activation_mode: motion::cam::CamActivationMode::NextCycle,

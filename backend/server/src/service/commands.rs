@@ -411,6 +411,127 @@ impl CamInBody {
     }
 }
 
+/// A multi-cam operation (MC_CamIn_V2 and its convenience blocks).
+#[allow(clippy::too_many_arguments)]
+fn cam_in_v2(
+    reg: &Registry,
+    axis: &AxisEntry,
+    master: &str,
+    cam_table: &str,
+    reference: Option<&str>,
+    activation: (motion::cam::CamActivationMode, f64),
+    scaling: motion::cam::CamScalingData,
+    operation: motion::cam::CamOperationMode,
+) -> AppResult<CommandKind> {
+    let mut c = Check::default();
+    let master = master_slot(&mut c, reg, axis, master);
+    let cam_table = cam_table_id(&mut c, reg, cam_table);
+    let reference_cam_table = match reference {
+        None => 0,
+        Some(r) => match reg.find_cam(r) {
+            Some(t) => t.id,
+            None => {
+                c.fail("reference_cam_table", "no such cam table");
+                0
+            }
+        },
+    };
+    c.cam_coupling(
+        [scaling.master_offset, scaling.slave_offset, activation.1],
+        [scaling.master_scaling, scaling.slave_scaling],
+    );
+    c.done(CommandKind::CamInV2(motion::cam::CamInV2 {
+        master,
+        cam_table,
+        activation_mode: activation.0,
+        activation_position: activation.1,
+        scaling,
+        operation,
+        reference_cam_table,
+    }))
+}
+
+impl CamInV2Body {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        cam_in_v2(
+            reg,
+            axis,
+            &self.master,
+            &self.cam_table,
+            self.reference_cam_table.as_deref(),
+            (self.activation_mode, self.activation_position),
+            self.scaling,
+            self.operation,
+        )
+    }
+}
+
+impl CamAddBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        cam_in_v2(
+            reg,
+            axis,
+            &self.master,
+            &self.cam_table,
+            None,
+            (self.activation_mode, self.activation_position),
+            self.scaling,
+            motion::cam::CamOperationMode::Additive,
+        )
+    }
+}
+
+impl CamExchangeBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        cam_in_v2(
+            reg,
+            axis,
+            &self.master,
+            &self.cam_table,
+            self.reference_cam_table.as_deref(),
+            (self.activation_mode, self.activation_position),
+            self.scaling,
+            motion::cam::CamOperationMode::Exchange,
+        )
+    }
+}
+
+impl CamRemoveBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        cam_in_v2(
+            reg,
+            axis,
+            &self.master,
+            &self.cam_table,
+            None,
+            (self.activation_mode, self.activation_position),
+            motion::cam::CamScalingData::default(),
+            motion::cam::CamOperationMode::Remove,
+        )
+    }
+}
+
+impl CamScalingV2Body {
+    pub fn to_kind(&self, reg: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let cam_table = match self.cam_table.as_deref() {
+            None => 0,
+            Some(t) => cam_table_id(&mut c, reg, t),
+        };
+        let d = self.scaling;
+        c.cam_coupling(
+            [d.master_offset, d.slave_offset, self.activation_position],
+            [d.master_scaling, d.slave_scaling],
+        );
+        c.done(CommandKind::CamScalingV2(motion::cam::CamScalingV2 {
+            cam_table,
+            activation_mode: self.activation_mode,
+            activation_position: self.activation_position,
+            scaling: d,
+        }))
+    }
+}
+
 impl CamScalingBody {
     pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
