@@ -896,10 +896,11 @@ async fn openapi_json_is_current() {
         "/api/v1/axes/{axis}/cam-exchange",
         "/api/v1/axes/{axis}/cam-remove",
         "/api/v1/axes/{axis}/cam-scaling-v2",
+        "/api/v1/axes/{axis}/cam-info",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 54, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 55, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -142,6 +142,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/cam-info": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_CamInfo(_V2): a cam slave's coupling, now or at a master position
+         * @description Offsets, scalings and cam positions of the coupling (each cam of a multi-cam slave in `cams`). After an error ended the coupling it is the last valid state (`active` false) — the data to couple again at the same positions; MC_CamOut clears it. 409 `cam_not_coupled` when there is none.
+         */
+        get: operations["cam_info"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/cam-out": {
         parameters: {
             query?: never;
@@ -1178,6 +1198,7 @@ export interface components {
          *       "actual_position": 64.109,
          *       "actual_velocity": 199.98,
          *       "cam": {
+         *         "active": false,
          *         "actual_master_axis_pos": 0,
          *         "actual_master_cam_pos": 0,
          *         "actual_slave_axis_pos": 0,
@@ -1197,7 +1218,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -1207,7 +1229,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -1217,7 +1240,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -1227,7 +1251,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           }
          *         ],
          *         "master_absolute": false,
@@ -1568,6 +1593,7 @@ export interface components {
          * @description MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
          *     positions are raw (unscaled); axis positions are set positions.
          * @example {
+         *       "active": false,
          *       "actual_master_axis_pos": 100,
          *       "actual_master_cam_pos": 100,
          *       "actual_slave_axis_pos": 50,
@@ -1587,7 +1613,8 @@ export interface components {
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
          *           "slave_offset": 0,
-         *           "slave_scaling": 0
+         *           "slave_scaling": 0,
+         *           "sum_of_slave_strokes": 0
          *         },
          *         {
          *           "actual_master_cam_pos": 0,
@@ -1597,7 +1624,8 @@ export interface components {
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
          *           "slave_offset": 0,
-         *           "slave_scaling": 0
+         *           "slave_scaling": 0,
+         *           "sum_of_slave_strokes": 0
          *         },
          *         {
          *           "actual_master_cam_pos": 0,
@@ -1607,7 +1635,8 @@ export interface components {
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
          *           "slave_offset": 0,
-         *           "slave_scaling": 0
+         *           "slave_scaling": 0,
+         *           "sum_of_slave_strokes": 0
          *         },
          *         {
          *           "actual_master_cam_pos": 0,
@@ -1617,7 +1646,8 @@ export interface components {
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
          *           "slave_offset": 0,
-         *           "slave_scaling": 0
+         *           "slave_scaling": 0,
+         *           "sum_of_slave_strokes": 0
          *         }
          *       ],
          *       "master_absolute": true,
@@ -1643,8 +1673,14 @@ export interface components {
          */
         CamInfo: {
             /**
+             * @description The coupling is in force. False with a `cam_table_id`: the last valid state of a
+             *     coupling that an error (or another command than MC_CamOut) ended — MC_CamInfo's data
+             *     to restore it.
+             */
+            active: boolean;
+            /**
              * Format: int32
-             * @description The active cam table (0: not coupled through a cam).
+             * @description The cam table (0: never coupled through a cam, or decoupled by MC_CamOut).
              */
             cam_table_id: number;
             periodic: boolean;
@@ -2010,7 +2046,8 @@ export interface components {
          *       "master_scaling": 1,
          *       "slave_contribution": 5,
          *       "slave_offset": 0,
-         *       "slave_scaling": 1
+         *       "slave_scaling": 1,
+         *       "sum_of_slave_strokes": 0
          *     }
          */
         CamTerm: {
@@ -2036,6 +2073,11 @@ export interface components {
              * @description This cam's share of the slave position (axis units).
              */
             slave_contribution: number;
+            /**
+             * Format: double
+             * @description Strokes this cam added since its base cycle, in slave axis units.
+             */
+            sum_of_slave_strokes: number;
         };
         /**
          * @description MC_ReadMotionFunctionValues: one row per sample, columns as named.
@@ -2959,6 +3001,7 @@ export interface components {
          *       "actual_position": 64.109,
          *       "actual_velocity": 199.98,
          *       "cam": {
+         *         "active": false,
          *         "actual_master_axis_pos": 0,
          *         "actual_master_cam_pos": 0,
          *         "actual_slave_axis_pos": 0,
@@ -2978,7 +3021,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -2988,7 +3032,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -2998,7 +3043,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           },
          *           {
          *             "actual_master_cam_pos": 0,
@@ -3008,7 +3054,8 @@ export interface components {
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
          *             "slave_offset": 0,
-         *             "slave_scaling": 0
+         *             "slave_scaling": 0,
+         *             "sum_of_slave_strokes": 0
          *           }
          *         ],
          *         "master_absolute": false,
@@ -3948,6 +3995,7 @@ export interface components {
          *         "actual_position": 64.109,
          *         "actual_velocity": 199.98,
          *         "cam": {
+         *           "active": false,
          *           "actual_master_axis_pos": 0,
          *           "actual_master_cam_pos": 0,
          *           "actual_slave_axis_pos": 0,
@@ -3967,7 +4015,8 @@ export interface components {
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
          *               "slave_offset": 0,
-         *               "slave_scaling": 0
+         *               "slave_scaling": 0,
+         *               "sum_of_slave_strokes": 0
          *             },
          *             {
          *               "actual_master_cam_pos": 0,
@@ -3977,7 +4026,8 @@ export interface components {
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
          *               "slave_offset": 0,
-         *               "slave_scaling": 0
+         *               "slave_scaling": 0,
+         *               "sum_of_slave_strokes": 0
          *             },
          *             {
          *               "actual_master_cam_pos": 0,
@@ -3987,7 +4037,8 @@ export interface components {
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
          *               "slave_offset": 0,
-         *               "slave_scaling": 0
+         *               "slave_scaling": 0,
+         *               "sum_of_slave_strokes": 0
          *             },
          *             {
          *               "actual_master_cam_pos": 0,
@@ -3997,7 +4048,8 @@ export interface components {
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
          *               "slave_offset": 0,
-         *               "slave_scaling": 0
+         *               "slave_scaling": 0,
+         *               "sum_of_slave_strokes": 0
          *             }
          *           ],
          *           "master_absolute": false,
@@ -4455,6 +4507,25 @@ export interface components {
                 [name: string]: unknown;
             };
             content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The axis is not (and was not) coupled through a cam. */
+        CamNotCoupled: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "cam_not_coupled",
+                 *       "detail": "the axis is not coupled through a cam",
+                 *       "error_id": 28807,
+                 *       "status": 409,
+                 *       "title": "Command rejected by the axis",
+                 *       "type": "urn:motiond:problem:cam_not_coupled"
+                 *     }
+                 */
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -5483,6 +5554,42 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    cam_info: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Report the coupling as it would be with the master axis here (MC_CamInfo's
+                 *     AtMasterPosition); left out: as it is.
+                 */
+                master_position?: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example y
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description MC_CamInfoData */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamInfo"];
+                };
+            };
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CamNotCoupled"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["QueryInvalid"];
         };
     };
     cam_out: {

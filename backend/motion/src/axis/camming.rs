@@ -758,6 +758,7 @@ impl Axis {
             self.settle_cam(cx);
             self.continue_at_current_velocity(cx);
         }
+        self.cam_last = CamInfo::default();
         cx.report(id, DONE);
         Ok(())
     }
@@ -1097,6 +1098,7 @@ impl Axis {
                         actual_master_cam_pos: t.x_local,
                         actual_slave_cam_pos: t.y_local,
                         slave_contribution: (t.y_local + t.strokes) * t.ss + t.so,
+                        sum_of_slave_strokes: t.strokes * t.ss,
                     };
                 }
             }

@@ -137,6 +137,8 @@ pub struct Axis {
     cam_v2_op: Option<camming::PendingChange<crate::cam::CamInV2>>,
     /// The cam (term) a queued MC_CamScaling(_V2) scales.
     cam_scaling_term: usize,
+    /// MC_CamInfo of the last cam coupling, kept after an error ended it (until MC_CamOut).
+    cam_last: crate::cam::CamInfo,
 }
 
 impl Axis {
@@ -201,6 +203,7 @@ impl Axis {
             cam_data: None,
             cam_v2_op: None,
             cam_scaling_term: 0,
+            cam_last: crate::cam::CamInfo::default(),
         })
     }
 

@@ -3,6 +3,7 @@
 //! axis. The following-error peak hold counts cycles only (see `Axis::step`).
 
 use super::*;
+use crate::cam::CamInfo;
 
 impl Axis {
     /// Starts a new following-error peak hold from the present following error.
@@ -88,7 +89,20 @@ impl Axis {
         s.drive_fault = self.error == ErrorId::DRIVE_FAULT && self.mode == Mode::ErrorStop;
         s.set_position_offset = self.set_position_offset;
         s.active_command = job.map(|j| j.id).unwrap_or(0);
-        let (cam, queued, scaling) = self.cam_status();
+        let (mut cam, queued, scaling) = self.cam_status();
+        if cam.cam_table_id != 0 {
+            cam.active = true;
+            self.cam_last = cam;
+        } else if self.cam_last.cam_table_id != 0 {
+            // Decoupled otherwise than by MC_CamOut: the last valid state stays readable.
+            cam = CamInfo {
+                active: false,
+                cam_data_queued: false,
+                cam_table_queued: false,
+                scaling_pending: false,
+                ..self.cam_last
+            };
+        }
         let s = &mut self.status;
         s.cam = cam;
         s.cam_table_queued = queued;

@@ -203,6 +203,8 @@ pub struct CamTerm {
     pub actual_slave_cam_pos: f64,
     /// This cam's share of the slave position (axis units).
     pub slave_contribution: f64,
+    /// Strokes this cam added since its base cycle, in slave axis units.
+    pub sum_of_slave_strokes: f64,
 }
 
 /// MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
@@ -210,7 +212,11 @@ pub struct CamTerm {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 pub struct CamInfo {
-    /// The active cam table (0: not coupled through a cam).
+    /// The coupling is in force. False with a `cam_table_id`: the last valid state of a
+    /// coupling that an error (or another command than MC_CamOut) ended — MC_CamInfo's data
+    /// to restore it.
+    pub active: bool,
+    /// The cam table (0: never coupled through a cam, or decoupled by MC_CamOut).
     pub cam_table_id: u32,
     pub periodic: bool,
     /// Kernel slot of the master (the server names the axis instead).

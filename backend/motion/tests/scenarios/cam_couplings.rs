@@ -776,3 +776,51 @@ fn multi_cam_adds_exchanges_scales_and_removes_superimposed_cams() {
         ErrorId::CAM_SLAVE_WOULD_JUMP
     );
 }
+
+/// Spec §2.18 / §5.3 "emergency-stop recovery": MC_CamInfo keeps the last valid coupling
+/// state after an error ended it; re-coupling with its total offsets and stroke sum puts the
+/// slave back on the cam without a jump. MC_CamOut clears it.
+#[test]
+fn cam_info_survives_an_error_and_restores_the_coupling() {
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(T_LINE, &line(true));
+    r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            slave_offset: 0.0,
+            ..cam_in(0, T_LINE)
+        }),
+    );
+    move_master(&mut r, 800.0, 400.0, |_| {});
+    let info = r.st(1).cam;
+    assert!(
+        info.active && (info.sum_of_slave_strokes - 720.0).abs() < 1e-9,
+        "{info:?}"
+    );
+    // A drive fault on the slave: ErrorStop, decoupled; the last state stays readable.
+    r.plants[1].fault = true;
+    r.until(1.0, |r| r.st(1).state == AxisState::ErrorStop);
+    assert!(!r.st(1).coupled);
+    let kept = r.st(1).cam;
+    assert!(!kept.active && kept.cam_table_id == T_LINE, "{kept:?}");
+    assert!((kept.sum_of_slave_strokes - 720.0).abs() < 1e-9);
+    r.plants[1].fault = false;
+    r.ok(1, CommandKind::Reset);
+    r.until(1.0, |r| r.st(1).state == AxisState::Standstill);
+    assert_eq!(r.st(1).cam.cam_table_id, T_LINE, "kept through the reset");
+    // Re-couple from the kept data: the strokes go into the offset (the base cycle is now).
+    let again = CamIn {
+        master_offset: kept.master_offset,
+        slave_offset: kept.slave_offset + kept.sum_of_slave_strokes,
+        master_scaling: kept.master_scaling,
+        slave_scaling: kept.slave_scaling,
+        ..cam_in(0, T_LINE)
+    };
+    let c = r.ok(1, CommandKind::CamIn(again));
+    assert!(r.out(c).in_sync && r.st(1).cam.active);
+    assert!((r.st(1).set_position - 800.0).abs() < 1e-9);
+    move_master(&mut r, 900.0, 400.0, |_| {});
+    assert!((r.st(1).set_position - 900.0).abs() < 1e-9);
+    r.ok(1, CommandKind::CamOut);
+    assert_eq!(r.st(1).cam.cam_table_id, 0, "MC_CamOut clears it");
+}

@@ -366,3 +366,27 @@ pub async fn write_points(
         cams::write_points(&s, &table, body.points, &client.0).await?,
     ))
 }
+
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct CamInfoQuery {
+    /// Report the coupling as it would be with the master axis here (MC_CamInfo's
+    /// AtMasterPosition); left out: as it is.
+    pub master_position: Option<f64>,
+}
+
+#[utoipa::path(get, path = "/api/v1/axes/{axis}/cam-info", tag = "cams",
+    summary = "MC_CamInfo(_V2): a cam slave's coupling, now or at a master position",
+    description = "Offsets, scalings and cam positions of the coupling (each cam of a multi-cam slave in `cams`). \
+After an error ended the coupling it is the last valid state (`active` false) — the data to couple again at the \
+same positions; MC_CamOut clears it. 409 `cam_not_coupled` when there is none.",
+    params(("axis" = String, Path, description = "axis id or name", example = "y"), CamInfoQuery),
+    responses((status = 200, description = "MC_CamInfoData", body = motion::cam::CamInfo), super::errors::CamInfoErrors))]
+pub async fn cam_info(
+    State(s): State<Arc<AppState>>,
+    Path(axis): Path<String>,
+    Q(q): Q<CamInfoQuery>,
+) -> AppResult<Json<motion::cam::CamInfo>> {
+    Ok(Json(cams::cam_info(&s, &axis, q.master_position)?))
+}

@@ -156,6 +156,9 @@ problem_responses! {
         ("feed_enable_missing" = (summary = "A jog without its direction's feed enable",
             value = json!(p(AppError::rejected(ErrorId::FEED_ENABLE_MISSING)))))));
 
+    /// The axis is not (and was not) coupled through a cam.
+    CamNotCoupled(example = json!(p(AppError::rejected(ErrorId::CAM_NOT_COUPLED))));
+
     /// The axis no longer runs the command (it has ended or was replaced): `command_unknown`.
     CommandUnknown(example = json!(p(AppError::rejected(ErrorId::COMMAND_UNKNOWN))));
 
@@ -404,6 +407,8 @@ error_sets! {
     }
     /// `DELETE /cam-tables/{table}`.
     CamTableDeleteErrors { 404: CamTableNotFound, 409: CamTableBusy, 503: WriteUnavailable }
+    /// `GET /axes/{axis}/cam-info`.
+    CamInfoErrors { 404: AxisNotFound, 409: CamNotCoupled, 422: QueryInvalid }
     /// `GET /cam-tables/{table}/points/{point}`.
     CamPointReadErrors { 404: CamTableOrPointNotFound }
     /// `PUT /cam-tables/{table}/online-change-mode`.

@@ -184,6 +184,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .delete(axes::delete_axis),
         )
         .route("/axes/{axis}/status", get(axes::axis_status))
+        .route("/axes/{axis}/cam-info", get(cams::cam_info))
         .route(
             "/axes/{axis}/status/following-error-peak/reset",
             post(axes::reset_following_error_peak),
@@ -425,7 +426,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
-        cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
+        cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
     ),
     components(schemas(crate::error::Problem)),

@@ -693,3 +693,76 @@ pub fn values(
             .collect(),
     })
 }
+
+/// MC_CamInfo(_V2) of a cam slave: the coupling as it is, or (`master_position`) as it would be
+/// with the master there — each cam's share from its table, offsets, scalings and the strokes
+/// counted from its base cycle. After an error ended the coupling: its last valid state.
+pub fn cam_info(s: &AppState, axis: &str, master_position: Option<f64>) -> AppResult<cam::CamInfo> {
+    let slot = {
+        let reg = s.registry.read().unwrap();
+        reg.find(axis)
+            .ok_or_else(|| AppError::not_found("axis", axis))?
+            .slot
+    };
+    let mut info = s.status(slot).1.unwrap_or_default().cam;
+    if info.cam_table_id == 0 {
+        return Err(AppError::rejected(motion::ErrorId::CAM_NOT_COUPLED));
+    }
+    let Some(m) = master_position else {
+        return Ok(info);
+    };
+    if !m.is_finite() {
+        return Err(AppError::field(
+            "master_position",
+            "must be a finite number",
+        ));
+    }
+    let reg = s.registry.read().unwrap();
+    let mut slave = 0.0;
+    for (k, t) in info.cams.iter_mut().enumerate() {
+        if t.cam_table_id == 0 {
+            continue;
+        }
+        let c = reg
+            .cams
+            .get(&t.cam_table_id)
+            .ok_or_else(|| AppError::not_found("cam_table", &t.cam_table_id.to_string()))?
+            .cam
+            .clone();
+        let stroke = c.stroke() * t.slave_scaling;
+        // The base cycle from where the master is now and the strokes counted so far.
+        let k_now = c
+            .cycle_of((info.actual_master_axis_pos + t.master_offset) / t.master_scaling)
+            .0;
+        let k_base = if c.periodic && stroke != 0.0 {
+            k_now - (t.sum_of_slave_strokes / stroke).round() as i64
+        } else {
+            k_now
+        };
+        let x = (m + t.master_offset) / t.master_scaling;
+        let (kx, xl) = c.cycle_of(x);
+        let f = if c.periodic {
+            c.eval_in_range(xl)
+        } else {
+            c.eval(x)
+        };
+        let strokes = if c.periodic {
+            (kx - k_base) as f64 * stroke
+        } else {
+            0.0
+        };
+        t.actual_master_cam_pos = if c.periodic { xl } else { x };
+        t.actual_slave_cam_pos = f.position;
+        t.sum_of_slave_strokes = strokes;
+        t.slave_contribution = f.position * t.slave_scaling + t.slave_offset + strokes;
+        slave += t.slave_contribution;
+        if k == 0 {
+            info.actual_master_cam_pos = t.actual_master_cam_pos;
+            info.actual_slave_cam_pos = f.position;
+            info.sum_of_slave_strokes = strokes;
+        }
+    }
+    info.actual_master_axis_pos = m;
+    info.actual_slave_axis_pos = slave;
+    Ok(info)
+}
