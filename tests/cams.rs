@@ -436,12 +436,24 @@ async fn a_cam_couples_y_to_x_over_http_and_only_the_table_survives_a_restart() 
     );
     // MC_CamInfo now and as it would be with x at 50.
     let info = get(&s, "/api/v1/axes/y/cam-info").await;
-    assert_eq!((info.status, info.json["active"].as_bool()), (200, Some(true)), "{}", info.text);
+    assert_eq!(
+        (info.status, info.json["active"].as_bool()),
+        (200, Some(true)),
+        "{}",
+        info.text
+    );
     let at = get(&s, "/api/v1/axes/y/cam-info?master_position=50").await;
-    assert!(close(&at.json["actual_slave_axis_pos"], 10.3515625), "{}", at.text);
+    assert!(
+        close(&at.json["actual_slave_axis_pos"], 10.3515625),
+        "{}",
+        at.text
+    );
     assert!(close(&at.json["actual_master_cam_pos"], 50.0));
     let r = get(&s, "/api/v1/axes/x/cam-info").await;
-    assert_eq!((r.status, r.json["code"].as_str()), (409, Some("cam_not_coupled")));
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("cam_not_coupled"))
+    );
     // New data for the coupled table: an online change (here the same data: it takes effect
     // at once, nothing moves); one point written changes the slave only where it may.
     let r = put(&s, "/api/v1/cam-tables/p5", polynom5()).await;

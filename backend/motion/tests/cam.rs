@@ -720,3 +720,162 @@ fn a_million_row_table_builds_and_evaluates() {
         }
     }
 }
+
+/// Golden values of every rest-to-rest law (VDI 2143 closed forms, written out here
+/// independently of the library): f, f', f'', f''' at the start, the middle and the end of a
+/// unit segment, and whether the acceleration is 0 at the ends (C² with rest neighbours) —
+/// POLYNOM3 and the sine line have acceleration steps there, the others do not.
+#[test]
+fn every_rest_to_rest_law_matches_its_closed_form_at_start_middle_and_end() {
+    use MotionFunctionType::*;
+    use core::f64::consts::PI;
+    fn poly(c: &[f64], z: f64) -> [f64; 4] {
+        let mut out = [0.0; 4];
+        for (i, ci) in c.iter().enumerate() {
+            let i = i as i32;
+            out[0] += ci * z.powi(i);
+            if i >= 1 {
+                out[1] += ci * i as f64 * z.powi(i - 1);
+            }
+            if i >= 2 {
+                out[2] += ci * (i * (i - 1)) as f64 * z.powi(i - 2);
+            }
+            if i >= 3 {
+                out[3] += ci * (i * (i - 1) * (i - 2)) as f64 * z.powi(i - 3);
+            }
+        }
+        out
+    }
+    let k = 1.0 / (4.0 + PI);
+    let a_trap = 16.0 / 3.0;
+    type Law = (MotionFunctionType, Box<dyn Fn(f64) -> [f64; 4]>, bool);
+    let laws: Vec<Law> = vec![
+        (
+            Polynom3,
+            Box::new(|z| poly(&[0.0, 0.0, 3.0, -2.0], z)),
+            false,
+        ),
+        (
+            Polynom5,
+            Box::new(|z| poly(&[0.0, 0.0, 0.0, 10.0, -15.0, 6.0], z)),
+            true,
+        ),
+        (
+            Polynom7,
+            Box::new(|z| poly(&[0.0, 0.0, 0.0, 0.0, 35.0, -84.0, 70.0, -20.0], z)),
+            true,
+        ),
+        (
+            Polynom8,
+            Box::new(|z| poly(&[0.0, 0.0, 0.0, 0.0, 0.0, 56.0, -140.0, 120.0, -35.0], z)),
+            true,
+        ),
+        (
+            Polynom9,
+            Box::new(|z| {
+                poly(
+                    &[0.0, 0.0, 0.0, 0.0, 0.0, 126.0, -420.0, 540.0, -315.0, 70.0],
+                    z,
+                )
+            }),
+            true,
+        ),
+        (
+            Polynom11,
+            Box::new(|z| {
+                poly(
+                    &[
+                        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 462.0, -1980.0, 3465.0, -3080.0, 1386.0,
+                        -252.0,
+                    ],
+                    z,
+                )
+            }),
+            true,
+        ),
+        (
+            Sinuslinie,
+            Box::new(|z| {
+                [
+                    (1.0 - (PI * z).cos()) / 2.0,
+                    PI / 2.0 * (PI * z).sin(),
+                    PI * PI / 2.0 * (PI * z).cos(),
+                    -PI.powi(3) / 2.0 * (PI * z).sin(),
+                ]
+            }),
+            false,
+        ),
+        (
+            Bestehorn,
+            Box::new(|z| {
+                [
+                    z - (2.0 * PI * z).sin() / (2.0 * PI),
+                    1.0 - (2.0 * PI * z).cos(),
+                    2.0 * PI * (2.0 * PI * z).sin(),
+                    4.0 * PI * PI * (2.0 * PI * z).cos(),
+                ]
+            }),
+            true,
+        ),
+        // At 0, 1/2 and 1 the modified sine is in its outer, middle and outer part.
+        (
+            ModSinuslinie,
+            Box::new(move |z| {
+                if z <= 0.125 || z >= 0.875 {
+                    let c = if z <= 0.125 { 0.0 } else { 4.0 };
+                    [
+                        k * (c + PI * z - 0.25 * (4.0 * PI * z).sin()),
+                        k * (PI - PI * (4.0 * PI * z).cos()),
+                        k * 4.0 * PI * PI * (4.0 * PI * z).sin(),
+                        k * 16.0 * PI.powi(3) * (4.0 * PI * z).cos(),
+                    ]
+                } else {
+                    let t = PI / 3.0 + 4.0 * PI * z / 3.0;
+                    [
+                        k * (2.0 + PI * z - 2.25 * t.sin()),
+                        k * (PI - 3.0 * PI * t.cos()),
+                        k * 4.0 * PI * PI * t.sin(),
+                        k * 16.0 * PI.powi(3) / 3.0 * t.cos(),
+                    ]
+                }
+            }),
+            true,
+        ),
+        // Linear ramps of 1/8: jerk +8A at the start, −8A through the middle, +8A at the end.
+        (
+            BeschlTrapez,
+            Box::new(move |z| match z {
+                z if z == 0.0 => [0.0, 0.0, 0.0, 8.0 * a_trap],
+                z if z == 1.0 => [1.0, 0.0, 0.0, 8.0 * a_trap],
+                _ => [0.5, 3.0 / 8.0 * a_trap, 0.0, -8.0 * a_trap],
+            }),
+            true,
+        ),
+    ];
+    for (law, f, c2) in &laws {
+        let cam = one_segment(*law, 1.0, 1.0);
+        for z in [0.0, 0.5, 1.0] {
+            let v = cam.eval_piece(0, z);
+            let want = f(z);
+            for (i, (have, want)) in [v.position, v.velocity, v.acceleration, v.jerk]
+                .into_iter()
+                .zip(want)
+                .enumerate()
+            {
+                assert!(
+                    (have - want).abs() < 1e-9 * (1.0 + want.abs()),
+                    "{law:?} derivative {i} at z = {z}: {have} ≠ {want}"
+                );
+            }
+        }
+        let ends = [
+            cam.eval_piece(0, 0.0).acceleration,
+            cam.eval_piece(0, 1.0).acceleration,
+        ];
+        assert_eq!(
+            ends.iter().all(|a| a.abs() < 1e-9),
+            *c2,
+            "{law:?}: acceleration at the ends {ends:?}"
+        );
+    }
+}

@@ -824,3 +824,152 @@ fn cam_info_survives_an_error_and_restores_the_coupling() {
     r.ok(1, CommandKind::CamOut);
     assert_eq!(r.st(1).cam.cam_table_id, 0, "MC_CamOut clears it");
 }
+
+/// Spec §5.1, the "Elektronische Kurvenscheiben" sample as a scenario: two motion functions
+/// and a position table; couple, run the master; switch at the next cycle, write one point
+/// with the online-change mode NEXTCYCLE, switch at a master axis position with slave
+/// autooffset, scale the slave ×2 with autooffset at a rest — flags, InSync and position
+/// continuity checked in every cycle.
+#[test]
+fn the_electronic_cams_sample_runs_without_a_jump() {
+    use std::sync::Arc;
+    const A: u32 = 11;
+    const B: u32 = 12;
+    const C: u32 = 13;
+    let point = |i: u32, law, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: law,
+        point_type: MotionPointType::Rest,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 0.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    use MotionFunctionType::*;
+    let mut a = CamTableData::motion_function(vec![
+        point(1, Polynom5, 0.0, 0.0),
+        point(2, Polynom5, 180.0, 100.0),
+        point(3, Polynom5, 360.0, 0.0),
+    ]);
+    a.periodic = true;
+    let b_table = |level: f64| {
+        let mut b = CamTableData::motion_function(vec![
+            point(1, ModSinuslinie, 0.0, 0.0),
+            point(2, Polynom1, 120.0, level),
+            point(3, ModSinuslinie, 240.0, level),
+            point(4, Polynom1, 360.0, 0.0),
+        ]);
+        b.periodic = true;
+        b
+    };
+    let rows: Vec<[f64; 2]> = (0..=36)
+        .map(|i| {
+            let x = i as f64 * 10.0;
+            [x, 20.0 * (1.0 - (x.to_radians()).cos())]
+        })
+        .collect();
+    let mut c = CamTableData::positions(rows, true);
+    c.periodic = true;
+    c.interpolation = InterpolationType::Spline;
+    let mut r = rig_at(0.0, 0.0);
+    r.cam(A, &a);
+    r.cam(B, &b_table(60.0));
+    r.cam(C, &c);
+    let coupled = r.ok(1, CommandKind::CamIn(cam_in(0, A)));
+    assert!(r.out(coupled).in_sync);
+    let v = r.ok(0, velocity(100.0, Direction::Positive));
+    r.until(1.0, |r| r.out(v).in_velocity);
+    let mut prev = r.st(1).set_position;
+    let mut check = |r: &Rig| {
+        let s = r.st(1).set_position;
+        assert!(
+            (s - prev).abs() < 0.15,
+            "slave jumped {prev} → {s} at master {}",
+            r.st(0).set_position
+        );
+        prev = s;
+    };
+    // 1. Switch to B at the next cycle.
+    let to_b = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::NextCycle,
+            ..cam_in(0, B)
+        }),
+    );
+    r.until(10.0, |r| {
+        check(r);
+        let m = r.st(0).set_position;
+        assert_eq!(r.st(1).cam_table_queued, m < 360.0, "at {m}");
+        m > 400.0
+    });
+    assert!(r.out(to_b).in_sync);
+    assert_eq!(r.st(1).cam.cam_table_id, B);
+    // 2. One point of B written (the rest level 60 → 50), online change at the next cycle.
+    r.k.change_cam(
+        B,
+        Arc::new(Cam::build(&b_table(50.0)).unwrap()),
+        OnlineChange {
+            activation_mode: CamActivationMode::NextCycle,
+            ..OnlineChange::default()
+        },
+    )
+    .unwrap();
+    r.until(10.0, |r| {
+        check(r);
+        let m = r.st(0).set_position;
+        assert_eq!(r.st(1).cam_data_queued, m < 720.0, "at {m}");
+        m > 900.0 - 100.0 * DT * 50.0
+    });
+    // In the third cycle's rest: the new level.
+    r.until(1.0, |r| r.st(0).set_position > 860.0);
+    assert!(
+        (r.st(1).set_position - 50.0).abs() < 1e-9,
+        "{}",
+        r.st(1).set_position
+    );
+    // 3. Switch to the position table at master 900 (B at rest there), slave autooffset.
+    let to_c = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::AtMasterAxisPos,
+            activation_position: 900.0,
+            slave_scaling_mode: CamScalingMode::AutoOffset,
+            ..cam_in(0, C)
+        }),
+    );
+    r.until(10.0, |r| {
+        check(r);
+        let m = r.st(0).set_position;
+        assert_eq!(r.out(to_c).active, m < 900.0, "at {m}");
+        m > 1000.0
+    });
+    assert!(r.out(to_c).in_sync && r.st(1).cam.cam_table_id == C);
+    // 4. Scale the slave ×2 at master 1260 (x = 180 in C: at rest), autooffset.
+    let scale = r.ok(
+        1,
+        CommandKind::CamScaling(CamScaling {
+            activation_mode: CamActivationMode::AtMasterAxisPos,
+            activation_position: 1260.0,
+            master_scaling_mode: CamScalingMode::Off,
+            slave_scaling_mode: CamScalingMode::AutoOffset,
+            master_offset: 0.0,
+            slave_offset: 0.0,
+            master_scaling: 1.0,
+            slave_scaling: 2.0,
+        }),
+    );
+    r.until(10.0, |r| {
+        check(r);
+        let m = r.st(0).set_position;
+        assert_eq!(r.st(1).cam_scaling_pending, m < 1260.0, "at {m}");
+        m > 1300.0
+    });
+    assert!(
+        r.out(scale).done && r.st(1).cam.slave_scaling == 2.0,
+        "{:?}",
+        r.out(scale)
+    );
+}
