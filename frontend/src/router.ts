@@ -5,6 +5,8 @@ export type Route =
   | { page: 'axis'; axis: string; tab: 'online' | 'parameters' | 'config' }
   | { page: 'new-axis' }
   | { page: 'scope' }
+  | { page: 'cams' }
+  | { page: 'cam'; table: string }
   | { page: 'not-found'; path: string };
 
 export function parseRoute(hash: string): Route {
@@ -12,6 +14,8 @@ export function parseRoute(hash: string): Route {
   const parts = path.split('/').filter(Boolean).map(decodeURIComponent);
   if (parts.length === 0) return { page: 'overview' };
   if (parts[0] === 'scope' && parts.length === 1) return { page: 'scope' };
+  if (parts[0] === 'cams' && parts.length === 1) return { page: 'cams' };
+  if (parts[0] === 'cams' && parts.length === 2) return { page: 'cam', table: parts[1] };
   if (parts[0] === 'new-axis' && parts.length === 1) return { page: 'new-axis' };
   if (parts[0] === 'axes' && parts.length >= 2 && parts.length <= 3) {
     const tab = parts[2] ?? 'online';
@@ -26,6 +30,10 @@ export function href(r: Route): string {
       return '#/';
     case 'scope':
       return '#/scope';
+    case 'cams':
+      return '#/cams';
+    case 'cam':
+      return `#/cams/${encodeURIComponent(r.table)}`;
     case 'new-axis':
       return '#/new-axis';
     case 'axis':

@@ -618,6 +618,7 @@ describe('commissioning UI', () => {
         ['configuration', `/axes/${AXIS}/config`],
         ['new-axis', '/new-axis'],
         ['scope', '/scope'],
+        ['cams', '/cams'],
       ];
       for (const [name, path] of pagesToSee) {
         await page.goto(`${stack.url}/#${path}`);
@@ -633,6 +634,34 @@ describe('commissioning UI', () => {
       }
     });
   }
+
+  test('cam editor: the table is plotted from the server, a point edited and saved, a bad one refused at its row', async () => {
+    const r = await rest(stack.api, 'POST', '/cam-tables', { name: 'lift', table_type: 'motion_function', points: [
+      { point_index: 1, function_type: 'polynom5', point_type: 'rest', master_pos: 0, slave_pos: 0 },
+      { point_index: 2, function_type: 'polynom5', point_type: 'rest', master_pos: 200, slave_pos: 100 } ] });
+    assert.equal(r.status, 201, JSON.stringify(r.body));
+    const page = await open('/cams');
+    await page.click('tr[data-cam="lift"] a');
+    await page.waitForSelector('#cam[data-version="1"]');
+    const chart = page.locator('[data-chart="cam"]');
+    await until(async () => Number(await chart.getAttribute('data-samples')) > 700, { what: 'the plot' });
+    assert.equal(await chart.getAttribute('data-series'), 'position,velocity,acceleration,jerk');
+    assert.equal(await page.locator('[data-charac="slave_velo_max"]').textContent(), '0.9375');
+    await shot(page, 'cam-editor');
+    // The end of the lift from 100 to 120: saved, the version rises, the plot follows.
+    await page.fill('input[name="slave_pos-2"]', '120');
+    await page.click('button[name="save-cam"]');
+    await page.waitForSelector('#cam[data-version="2"]');
+    assert.equal((await rest(stack.api, 'GET', '/cam-tables/lift')).body.slave_end, 120);
+    await until(async () => (await page.locator('[data-charac="slave_velo_max"]').textContent()) === '1.125', { what: 'new characteristics' });
+    // The first point IGNORE: the server refuses it (safety rule) and says so at the row.
+    await page.selectOption('select[name="point_type-1"]', 'ignore');
+    await page.click('button[name="save-cam"]');
+    await page.waitForSelector('tr[data-point="1"].has-error');
+    assert.match(await page.locator('tr[data-point="1"] .field-error').textContent(), /point_type: the first and the last point must not be IGNORE/);
+    assert.equal((await rest(stack.api, 'GET', '/cam-tables/lift')).body.version, 2, 'nothing stored');
+    await page.close();
+  });
 
   test('scope: a recording survives leaving the page to move the axis; the chart shows it', async () => {
     await enabled();

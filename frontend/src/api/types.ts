@@ -51,3 +51,10 @@ export interface SubscriptionEnded {
   topic: string;
   reason: 'axis_removed';
 }
+export type CamTableResource = S['CamTableResource'];
+export type CamTableBody = S['CamTableBody'];
+export type MotionFunctionPoint = S['MotionFunctionPoint'];
+export type MotionFunctionType = S['MotionFunctionType'];
+export type MotionPointType = S['MotionPointType'];
+export type CamCharacteristics = S['Characteristics'];
+export type CamValuesResource = S['CamValuesResource'];

@@ -8,6 +8,7 @@ import { Overview } from './overview';
 import { AxisPage } from './axis-page';
 import { AxisConfigPage } from './axis-config';
 import { ScopePage } from './scope';
+import { CamListPage, CamPage } from './cams';
 import type { ConnState } from '../live/client';
 
 function Connection() {
@@ -121,6 +122,12 @@ export function App() {
     case 'scope':
       page = <ScopePage />;
       break;
+    case 'cams':
+      page = <CamListPage />;
+      break;
+    case 'cam':
+      page = <CamPage key={route.table} table={route.table} />;
+      break;
     default:
       page = (
         <div class="page">
@@ -144,6 +151,7 @@ export function App() {
         <nav class="nav">
           {nav({ page: 'overview' }, 'Overview', route.page === 'overview')}
           {nav({ page: 'scope' }, 'Scope', route.page === 'scope')}
+          {nav({ page: 'cams' }, 'Cams', route.page === 'cams' || route.page === 'cam')}
           {nav({ page: 'new-axis' }, 'New axis', route.page === 'new-axis')}
         </nav>
         <div class="topbar-right">
