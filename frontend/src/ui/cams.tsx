@@ -9,17 +9,9 @@ import type { CamCharacteristics, CamTableBody, CamTableResource, CamValuesResou
 import { CamChart } from '../cams/chart';
 import { LAWS, POINT_TYPES, csvToRows, increment, nextRow, pointsOf, rowsOf, rowsToCsv, type PointRow } from '../cams/data';
 import { navigate } from '../router';
-import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf } from './common';
+import { ActionButton, ErrorBanner, Field, NumberInput, Panel, download, errorText, fieldsOf } from './common';
 import { sig } from '../format';
 
-function download(name: string, text: string): void {
-  const blob = new Blob([text], { type: 'text/csv' });
-  const a = document.createElement('a');
-  a.href = URL.createObjectURL(blob);
-  a.download = name;
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
-}
 
 /** A periodic motion function to start from: up and down again, at rest at both ends. */
 function starter(name: string): CamTableBody {

@@ -156,3 +156,13 @@ export function ErrorBanner({ error, onClose }: { error: string | null; onClose?
     </div>
   );
 }
+
+/** Offers `text` as a CSV file download. */
+export function download(name: string, text: string): void {
+  const blob = new Blob([text], { type: 'text/csv' });
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}

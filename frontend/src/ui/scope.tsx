@@ -24,17 +24,9 @@ import {
 } from '../scope/data';
 import { csvUrl, scopeAvailable } from '../scope/api';
 import { COLORS, ScopeChart } from '../scope/chart';
-import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
+import { ErrorBanner, Field, NumberInput, Panel, download, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { sig } from '../format';
 
-function download(name: string, text: string): void {
-  const blob = new Blob([text], { type: 'text/csv' });
-  const a = document.createElement('a');
-  a.href = URL.createObjectURL(blob);
-  a.download = name;
-  a.click();
-  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
-}
 
 /** Form state survives leaving the page. */
 let savedForm: ScopeForm | null = null;
