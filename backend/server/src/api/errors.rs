@@ -318,13 +318,13 @@ problem_responses! {
         ("cycle_unavailable" = (value = json!(cycle_unavailable())))));
 
     /// The cycle thread did not take the write, or the database did not accept a persistent
-    /// one: nothing was written, except when only the commit failed (the value is then active
-    /// but not persisted, as the detail says).
+    /// one: nothing was written (when only the commit failed, the old value is put back in
+    /// force; should even that fail, the detail says so).
     ParameterWriteUnavailable(examples(
         ("command_queue_full" = (value = json!(queue_full()))),
         ("cycle_unavailable" = (value = json!(cycle_unavailable()))),
         ("storage_unavailable" = (value = json!(p(AppError::unavailable("storage_unavailable",
-            "the value is active but was NOT persisted: database is locked")))))));
+            "the value was not written: the database did not take it (database or disk is full); the old value is in force")))))));
 
     /// The audit log could not be read.
     AuditUnavailable(example = json!(p(AppError::unavailable(

@@ -346,6 +346,7 @@ pub async fn write_parameter(
             .ok_or_else(|| AppError::not_found("axis", axis))?;
         (e.id, e.slot, e.name.clone(), e.params.clone())
     };
+    let before = p.clone();
     let info =
         params::lookup(parameter).ok_or_else(|| AppError::not_found("parameter", parameter))?;
     let invalid = |id: motion::ErrorId, msg: String| AppError::refused("value", id, msg);
@@ -384,16 +385,37 @@ pub async fn write_parameter(
             AppError::Rejected(id) => invalid(id, id.text().into()),
             e => e,
         })?;
-        tx.commit().await.map_err(|e| {
+        if let Err(e) = tx.commit().await {
+            // Not stored, so not acknowledged and not left active: the kernel gets the value
+            // it had back, and API, kernel and database agree.
+            let status = s.status(slot).1.unwrap_or_default();
+            let restored = match params::read(&before, info.number, &status) {
+                Ok(old) => s
+                    .kernel_command(
+                        slot,
+                        CommandKind::WriteParameter {
+                            number: info.number,
+                            value: old.as_f64(),
+                        },
+                    )
+                    .await
+                    .is_ok(),
+                Err(_) => false,
+            };
             tracing::error!(
-                "axis {name}: parameter {} applied but not persisted: {e}",
-                info.number
+                "axis {name}: parameter {} not persisted ({e}); old value {}",
+                info.number,
+                if restored { "restored" } else { "NOT restored" }
             );
-            AppError::unavailable(
+            return Err(AppError::unavailable(
                 "storage_unavailable",
-                format!("the value is active but was NOT persisted: {e}"),
-            )
-        })?;
+                if restored {
+                    format!("the value was not written: the database did not take it ({e}); the old value is in force")
+                } else {
+                    format!("the value is active but was NOT persisted, and the old value could not be restored: {e}")
+                },
+            ));
+        }
     } else {
         // The kernel checks the value with the same table (it should agree with the checks
         // above): its refusal is the same 422 with the error number.

@@ -55,6 +55,13 @@ pub async fn open(path: &str) -> Result<SqlitePool, String> {
         .idle_timeout(None)
         .max_lifetime(None)
         .acquire_timeout(Duration::from_secs(10))
+        // A write that failed (disk full, I/O error) can leave the connection inside a
+        // transaction — SQLite's, or sqlx's bookkeeping of one — and every later "commit" on it
+        // would only release a savepoint of that transaction: acknowledged and never stored.
+        // Such a connection is closed when it comes back and before it is handed out; the
+        // pool opens a fresh one.
+        .after_release(|conn, _| Box::pin(async move { clean(conn).await }))
+        .before_acquire(|conn, _| Box::pin(async move { clean(conn).await }))
         .connect_with(opts)
         .await
         .map_err(|e| format!("cannot open database {path}: {e}"))?;
@@ -76,6 +83,22 @@ pub async fn open(path: &str) -> Result<SqlitePool, String> {
         .await
         .map_err(|e| format!("cannot write database {path} (is another motiond using it?): {e}"))?;
     Ok(pool)
+}
+
+/// Whether a pooled connection holds no transaction, in sqlx's books and SQLite's.
+async fn clean(conn: &mut sqlx::SqliteConnection) -> Result<bool, sqlx::Error> {
+    use sqlx::TransactionManager;
+    if sqlx::sqlite::SqliteTransactionManager::get_transaction_depth(conn) != 0 {
+        tracing::warn!("database connection left inside a transaction after a failed write: reopened");
+        return Ok(false);
+    }
+    let mut handle = conn.lock_handle().await?;
+    // SAFETY: the handle is locked for us (the worker makes no calls meanwhile) and valid.
+    let autocommit = unsafe { libsqlite3_sys::sqlite3_get_autocommit(handle.as_raw_handle().as_ptr()) };
+    if autocommit == 0 {
+        tracing::warn!("SQLite kept a transaction open after a failed write: connection reopened");
+    }
+    Ok(autocommit != 0)
 }
 
 pub async fn meta(pool: &SqlitePool, key: &str) -> Result<Option<String>, sqlx::Error> {
