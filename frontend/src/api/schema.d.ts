@@ -4842,8 +4842,8 @@ export interface components {
         };
         /**
          * @description The cycle thread did not take the write, or the database did not accept a persistent
-         *     one: nothing was written, except when only the commit failed (the value is then active
-         *     but not persisted, as the detail says).
+         *     one: nothing was written (when only the commit failed, the old value is put back in
+         *     force; should even that fail, the detail says so).
          */
         ParameterWriteUnavailable: {
             headers: {
