@@ -68,3 +68,29 @@ async fn a_configuration_exported_from_one_machine_imports_into_a_fresh_one() {
     let p = get(&b, "/api/v1/axes/x/parameters/AxisVeloMax").await;
     assert_eq!(p.json["value"], 750.0, "{}", p.text);
 }
+
+/// Command ids never repeat across a crash: an id acknowledged before `kill -9` is never handed
+/// out again, even when its audit row had not been written yet (the reserved mark is stored
+/// before a command above it is acknowledged).
+#[tokio::test(flavor = "multi_thread")]
+async fn command_ids_never_repeat_after_a_crash() {
+    let dir = temp_dir();
+    let db = dir.join("ids.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    let mut acknowledged = Vec::new();
+    for _ in 0..5 {
+        let r = post(&s, "/api/v1/axes/x/power", json!({})).await;
+        assert_eq!(r.status, 202, "{}", r.text);
+        acknowledged.push(r.json["id"].as_u64().unwrap());
+    }
+    s.stop(); // SIGKILL, right after the last acknowledgement
+    let s = Server::start_with(db, &[]);
+    let r = post(&s, "/api/v1/axes/x/power", json!({})).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let new = r.json["id"].as_u64().unwrap();
+    assert!(
+        acknowledged.iter().all(|&id| new > id),
+        "{new} after {acknowledged:?}"
+    );
+}

@@ -54,18 +54,38 @@ async fn after_a_failed_commit_no_write_is_acknowledged_that_is_lost() {
     let failed_at = first_failure.expect("the size limit was reached");
     let last_ok = last_ok.expect("some writes were stored first");
     // Other writes: acknowledged only if stored.
-    let table = json!({"name": "t", "table_type": "non_equidistant", "rows": [[0.0, 0.0], [1.0, 1.0]]});
+    let table =
+        json!({"name": "t", "table_type": "non_equidistant", "rows": [[0.0, 0.0], [1.0, 1.0]]});
     let created = post(&s, "/api/v1/cam-tables", table.clone()).await.status;
     assert!(created == 201 || created == 503, "{created}");
     s.stop();
 
     let s = Server::start_with(db, &[]);
     let p = get(&s, path).await;
-    assert_eq!(p.json["value"].as_f64(), Some(last_ok), "after {failed_at} writes: {}", p.text);
-    let tables = get(&s, "/api/v1/cam-tables").await.json.as_array().unwrap().len();
-    assert_eq!(tables, usize::from(created == 201), "the table is there exactly if it was acknowledged");
+    assert_eq!(
+        p.json["value"].as_f64(),
+        Some(last_ok),
+        "after {failed_at} writes: {}",
+        p.text
+    );
+    let tables = get(&s, "/api/v1/cam-tables")
+        .await
+        .json
+        .as_array()
+        .unwrap()
+        .len();
+    assert_eq!(
+        tables,
+        usize::from(created == 201),
+        "the table is there exactly if it was acknowledged"
+    );
     // With room again, writes are stored.
-    assert_eq!(put(&s, path, json!({"value": 777.0, "persistent": true})).await.status, 200);
+    assert_eq!(
+        put(&s, path, json!({"value": 777.0, "persistent": true}))
+            .await
+            .status,
+        200
+    );
     s.stop();
     let s = Server::start_with(db, &[]);
     assert_eq!(get(&s, path).await.json["value"].as_f64(), Some(777.0));

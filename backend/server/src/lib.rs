@@ -297,9 +297,16 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         tracing::warn!("real-time: {n} (running without it)");
     }
 
+    // Above every id an earlier run may have acknowledged: those in the audit log and the
+    // reserved mark (an acknowledged command whose audit row died with the process is below it).
     let first_id = store::max_command_id(&db)
         .await
         .map_err(|e| format!("cannot read the audit log: {e}"))?
+        .max(
+            store::command_ids_reserved(&db)
+                .await
+                .map_err(|e| format!("cannot read the database: {e}"))?,
+        )
         + 1;
     let info = SystemInfo {
         version: env!("CARGO_PKG_VERSION"),

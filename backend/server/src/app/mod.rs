@@ -52,6 +52,9 @@ pub struct AppState {
     pending: Mutex<HashMap<u64, oneshot::Sender<Reply>>>,
     pub notices: broadcast::Sender<Arc<CommandNotice>>,
     next_id: AtomicU64,
+    /// Ids up to this are persisted as reserved (see `reserve_id`).
+    ids_reserved: AtomicU64,
+    reserve_lock: tokio::sync::Mutex<()>,
     pub db: SqlitePool,
     audit_tx: mpsc::Sender<AuditEntry>,
     /// Audit rows lost (queue full, or not written after retries); shared with the writer.
@@ -82,6 +85,8 @@ impl AppState {
             pending: Mutex::new(HashMap::new()),
             notices: broadcast::channel(4096).0,
             next_id: AtomicU64::new(first_command_id.max(1)),
+            ids_reserved: AtomicU64::new(0),
+            reserve_lock: tokio::sync::Mutex::new(()),
             db,
             audit_tx,
             audit_dropped: Arc::new(AtomicU64::new(0)),
@@ -92,6 +97,24 @@ impl AppState {
 
     pub fn next_id(&self) -> u64 {
         self.next_id.fetch_add(1, Relaxed)
+    }
+
+    /// Makes sure `id` cannot be handed out again after a crash: the reserved mark is moved
+    /// ahead (by a block, so that most commands wait for nothing) and stored before the
+    /// command can act or be acknowledged. 503 when the database does not take it.
+    pub async fn reserve_id(&self, id: u64) -> crate::error::AppResult<()> {
+        const BLOCK: u64 = 10_000;
+        if id <= self.ids_reserved.load(Relaxed) {
+            return Ok(());
+        }
+        let _g = self.reserve_lock.lock().await;
+        if id <= self.ids_reserved.load(Relaxed) {
+            return Ok(());
+        }
+        let up_to = id + BLOCK;
+        crate::store::reserve_command_ids(&self.db, up_to).await?;
+        self.ids_reserved.store(up_to, Relaxed);
+        Ok(())
     }
 
     /// The latest published snapshot: its cycle and the status of one slot.

@@ -410,9 +410,13 @@ pub async fn write_parameter(
             return Err(AppError::unavailable(
                 "storage_unavailable",
                 if restored {
-                    format!("the value was not written: the database did not take it ({e}); the old value is in force")
+                    format!(
+                        "the value was not written: the database did not take it ({e}); the old value is in force"
+                    )
                 } else {
-                    format!("the value is active but was NOT persisted, and the old value could not be restored: {e}")
+                    format!(
+                        "the value is active but was NOT persisted, and the old value could not be restored: {e}"
+                    )
                 },
             ));
         }

@@ -656,6 +656,7 @@ async fn submit(
         (e.slot, e.id, e.name.clone(), build(&reg, e)?)
     };
     let id = s.next_id();
+    s.reserve_id(id).await?;
     let submitted_at = store::now_rfc3339();
     let audit = AuditEntry {
         at: submitted_at.clone(),

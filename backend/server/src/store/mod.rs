@@ -89,12 +89,15 @@ pub async fn open(path: &str) -> Result<SqlitePool, String> {
 async fn clean(conn: &mut sqlx::SqliteConnection) -> Result<bool, sqlx::Error> {
     use sqlx::TransactionManager;
     if sqlx::sqlite::SqliteTransactionManager::get_transaction_depth(conn) != 0 {
-        tracing::warn!("database connection left inside a transaction after a failed write: reopened");
+        tracing::warn!(
+            "database connection left inside a transaction after a failed write: reopened"
+        );
         return Ok(false);
     }
     let mut handle = conn.lock_handle().await?;
     // SAFETY: the handle is locked for us (the worker makes no calls meanwhile) and valid.
-    let autocommit = unsafe { libsqlite3_sys::sqlite3_get_autocommit(handle.as_raw_handle().as_ptr()) };
+    let autocommit =
+        unsafe { libsqlite3_sys::sqlite3_get_autocommit(handle.as_raw_handle().as_ptr()) };
     if autocommit == 0 {
         tracing::warn!("SQLite kept a transaction open after a failed write: connection reopened");
     }
@@ -113,6 +116,26 @@ pub async fn max_command_id(pool: &SqlitePool) -> Result<u64, sqlx::Error> {
         .fetch_one(pool)
         .await?;
     Ok(v.unwrap_or(0) as u64)
+}
+
+/// The highest command id handed out or reserved (persisted before an id above the previous
+/// mark is acknowledged, so that ids never repeat after a crash).
+pub async fn command_ids_reserved(pool: &SqlitePool) -> Result<u64, sqlx::Error> {
+    Ok(meta(pool, "command_ids_reserved")
+        .await?
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0))
+}
+
+pub async fn reserve_command_ids(pool: &SqlitePool, up_to: u64) -> Result<(), sqlx::Error> {
+    sqlx::query(
+        "INSERT INTO meta (key, value) VALUES ('command_ids_reserved', ?) \
+         ON CONFLICT (key) DO UPDATE SET value = excluded.value",
+    )
+    .bind(up_to.to_string())
+    .execute(pool)
+    .await
+    .map(|_| ())
 }
 
 /// Records the first start of a database (the demo machine is created only then).
