@@ -100,6 +100,14 @@ pub struct ServeArgs {
     /// its socket is closed if it does not answer (0.05–3600).
     #[arg(long = "ws-ping-s", global = true, value_name = "SECONDS", default_value_t = api::ws::DEFAULT_PING_S, value_parser = parse_ping)]
     pub ws_ping_s: f64,
+    /// Seconds a client may take to send a request's headers, or its body, or to send the next
+    /// request on an idle connection, before the connection is closed (1–600).
+    #[arg(long = "read-timeout-s", global = true, value_name = "SECONDS", default_value_t = 30.0, value_parser = parse_read_timeout)]
+    pub read_timeout_s: f64,
+    /// Open HTTP connections at most (websockets included); one more is answered 503 and
+    /// closed (8–100000).
+    #[arg(long = "max-connections", global = true, value_name = "N", default_value_t = 512, value_parser = clap::value_parser!(u32).range(8..=100_000))]
+    pub max_connections: u32,
     /// Do not create the demo axes on a new database.
     #[arg(long, global = true)]
     pub no_demo: bool,
@@ -133,6 +141,13 @@ fn parse_listen(s: &str) -> Result<SocketAddr, String> {
 }
 
 /// `--ws-ping-s`: 0.05–3600 seconds.
+fn parse_read_timeout(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (1.0..=600.0).contains(&v) => Ok(v),
+        _ => Err(format!("{s:?} is not a number of seconds from 1 to 600")),
+    }
+}
+
 fn parse_ping(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if (0.05..=3600.0).contains(&v) => Ok(v),
@@ -366,20 +381,29 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let ws = api::ws::Settings {
         ping_after: std::time::Duration::from_secs_f64(args.ws_ping_s),
     };
+    let read_timeout = std::time::Duration::from_secs_f64(args.read_timeout_s);
     let app = api::router(state.clone(), Arc::new(guard), ws)
-        .into_make_service_with_connect_info::<SocketAddr>();
-    let (stopping_tx, mut stopping) = tokio::sync::watch::channel(false);
-    let server = axum::serve(listener, app).with_graceful_shutdown(async move {
+        // A body announced but not sent holds nothing for long (Content-Length: 10 GB and 14 bytes).
+        .layer(tower_http::timeout::RequestBodyTimeoutLayer::new(
+            read_timeout,
+        ));
+    let (stopping_tx, stopping) = tokio::sync::watch::channel(false);
+    tokio::spawn(async move {
         shutdown_signal().await;
         let _ = stopping_tx.send(true);
     });
-    // Open websockets would hold a graceful shutdown forever: give them 2 s.
-    tokio::select! {
-        r = std::future::IntoFuture::into_future(server) => r.map_err(|e| format!("server error: {e}"))?,
-        _ = async {
-            let _ = stopping.wait_for(|s| *s).await;
-            tokio::time::sleep(std::time::Duration::from_secs(2)).await;
-        } => tracing::warn!("closing the connections still open"),
+    let max = args.max_connections as usize;
+    let permits = Arc::new(tokio::sync::Semaphore::new(max));
+    accept_loop(listener, app, permits.clone(), read_timeout, stopping).await;
+    // The connections end gracefully; open websockets would hold them forever: 2 s at most.
+    if tokio::time::timeout(
+        std::time::Duration::from_secs(2),
+        permits.acquire_many(max as u32),
+    )
+    .await
+    .is_err()
+    {
+        tracing::warn!("closing the connections still open");
     }
     tracing::info!("shutting down");
     shared
@@ -390,6 +414,79 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     audit_task.abort();
     db.close().await;
     Ok(())
+}
+
+/// Serves connections until shutdown: at most `max` at once (one more is answered 503 and
+/// closed, so that a flood of idle connections cannot make motiond answer nobody), each closed
+/// when a client takes longer than `read_timeout` to send a request's headers or the next
+/// request. The client's address reaches the handlers as axum's `ConnectInfo`.
+async fn accept_loop(
+    listener: tokio::net::TcpListener,
+    app: axum::Router,
+    permits: Arc<tokio::sync::Semaphore>,
+    read_timeout: std::time::Duration,
+    mut stopping: tokio::sync::watch::Receiver<bool>,
+) {
+    use hyper_util::rt::{TokioIo, TokioTimer};
+    use tokio::io::AsyncWriteExt;
+    let max = permits.available_permits();
+    loop {
+        let (mut stream, addr) = tokio::select! {
+            r = listener.accept() => match r {
+                Ok(x) => x,
+                Err(e) => {
+                    // Out of file descriptors and the like: wait a moment instead of spinning.
+                    tracing::warn!("accept failed: {e}");
+                    tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+                    continue;
+                }
+            },
+            _ = async { let _ = stopping.wait_for(|s| *s).await; } => return,
+        };
+        let Ok(permit) = permits.clone().try_acquire_owned() else {
+            tokio::spawn(async move {
+                let body = format!(
+                    r#"{{"type":"urn:motiond:problem:too_many_connections","title":"Service unavailable","status":503,"detail":"motiond serves at most {max} connections at once; try again","code":"too_many_connections"}}"#
+                );
+                let head = format!(
+                    "HTTP/1.1 503 Service Unavailable\r\ncontent-type: application/problem+json\r\ncontent-length: {}\r\nretry-after: 1\r\nconnection: close\r\n\r\n",
+                    body.len()
+                );
+                let _ = stream.write_all(head.as_bytes()).await;
+                let _ = stream.write_all(body.as_bytes()).await;
+                let _ = stream.shutdown().await;
+            });
+            continue;
+        };
+        let svc = tower::ServiceExt::map_request(
+            app.clone(),
+            move |mut r: hyper::Request<hyper::body::Incoming>| {
+                r.extensions_mut().insert(axum::extract::ConnectInfo(addr));
+                r
+            },
+        );
+        let mut stop = stopping.clone();
+        tokio::spawn(async move {
+            let _permit = permit;
+            let mut http = hyper::server::conn::http1::Builder::new();
+            http.timer(TokioTimer::new())
+                .header_read_timeout(read_timeout);
+            let conn = http
+                .serve_connection(
+                    TokioIo::new(stream),
+                    hyper_util::service::TowerToHyperService::new(svc),
+                )
+                .with_upgrades();
+            let mut conn = std::pin::pin!(conn);
+            tokio::select! {
+                _ = conn.as_mut() => {}
+                _ = async { let _ = stop.wait_for(|s| *s).await; } => {
+                    conn.as_mut().graceful_shutdown();
+                    let _ = conn.await;
+                }
+            }
+        });
+    }
 }
 
 async fn shutdown_signal() {

@@ -1,0 +1,97 @@
+//! Clients that hold connections without finishing a request (issue "Security and
+//! reliability"): slow headers, a body announced and not sent, a flood of idle connections.
+//! motiond closes them after `--read-timeout-s` and answers beyond `--max-connections` with a
+//! 503 problem instead of answering nobody. No timing is asserted: each test waits for what
+//! must happen (an answer, a closed connection) with the harness's generous deadline.
+
+mod common;
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::time::Duration;
+
+use common::*;
+
+/// Reads until the server closes the connection; what it sent.
+fn read_to_close(mut s: TcpStream) -> String {
+    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+    let mut out = Vec::new();
+    let mut buf = [0u8; 4096];
+    loop {
+        match s.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => out.extend_from_slice(&buf[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => break,
+            Err(e) => panic!("the server did not close the connection: {e}"),
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn slow_headers_and_unsent_bodies_are_cut_off() {
+    let s = Server::start_with(":memory:", &["--read-timeout-s", "1"]);
+    // Headers that never end.
+    let mut slow = TcpStream::connect(&s.addr).unwrap();
+    slow.write_all(b"GET /api/v1/system HTTP/1.1\r\nHost: 127.0.0.1\r\n")
+        .unwrap();
+    let slow = std::thread::spawn(move || read_to_close(slow));
+    // A body of 10 GB announced, 14 bytes sent.
+    let mut big = TcpStream::connect(&s.addr).unwrap();
+    big.write_all(b"PUT /api/v1/config HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: 10000000000\r\n\r\n{\"version\": 1,").unwrap();
+    let big = std::thread::spawn(move || read_to_close(big));
+    // An idle connection that never sends anything.
+    let idle = TcpStream::connect(&s.addr).unwrap();
+    let idle = std::thread::spawn(move || read_to_close(idle));
+    let _ = slow.join().unwrap();
+    let answer = big.join().unwrap();
+    assert!(
+        answer.is_empty() || answer.starts_with("HTTP/1.1 4") || answer.starts_with("HTTP/1.1 5"),
+        "{answer}"
+    );
+    assert_eq!(idle.join().unwrap(), "");
+    // And the server still answers.
+    assert_eq!(get(&s, "/api/v1/system").await.status, 200);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_flood_of_idle_connections_gets_an_answer_and_clears() {
+    let s = Server::start_with(
+        ":memory:",
+        &["--read-timeout-s", "1", "--max-connections", "8"],
+    );
+    let idle: Vec<TcpStream> = (0..8)
+        .map(|_| TcpStream::connect(&s.addr).unwrap())
+        .collect();
+    // Beyond the limit: a 503 problem at once, not silence.
+    let mut extra = TcpStream::connect(&s.addr).unwrap();
+    extra
+        .write_all(b"GET /api/v1/system HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        .unwrap();
+    let answer = read_to_close(extra);
+    assert!(answer.starts_with("HTTP/1.1 503"), "{answer}");
+    assert!(
+        answer.contains("application/problem+json") && answer.contains("too_many_connections"),
+        "{answer}"
+    );
+    // The idle ones are closed after the read timeout; then requests are served again.
+    for c in idle {
+        assert_eq!(read_to_close(c), "");
+    }
+    let r = until_ok(&s).await;
+    assert_eq!(r, 200);
+}
+
+/// The first request that gets through after the idle connections were closed (their permits
+/// come back as the server finishes them).
+async fn until_ok(s: &Server) -> u16 {
+    for _ in 0..200 {
+        let r = get(s, "/api/v1/system").await;
+        if r.status == 200 {
+            return 200;
+        }
+        assert_eq!(r.status, 503, "{}", r.text);
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    panic!("never served again");
+}
