@@ -1969,3 +1969,71 @@ async fn a_plain_get_on_the_websocket_is_a_426_problem() {
     assert_eq!(response.status().as_u16(), 101);
     socket.close(None).await.unwrap();
 }
+
+/// `GET /audit` pages back with `before_id` (the smallest id of the previous page) and forward
+/// with `since_id`; negative ids are a 422 at their parameter.
+#[tokio::test(flavor = "multi_thread")]
+async fn the_audit_log_pages_back_and_forth() {
+    let s = Server::start();
+    for v in 0..12 {
+        let r = put(
+            &s,
+            "/api/v1/axes/x/parameters/AxisVeloMax",
+            json!({"value": 500.0 + v as f64, "persistent": true}),
+        )
+        .await;
+        assert_eq!(r.status, 200, "{}", r.text);
+    }
+    let ids = |r: &Resp| -> Vec<i64> {
+        r.json
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["id"].as_i64().unwrap())
+            .collect()
+    };
+    let all = ids(&get(&s, "/api/v1/audit?limit=1000").await);
+    assert!(
+        all.len() >= 12 && all.windows(2).all(|w| w[0] > w[1]),
+        "{all:?}"
+    );
+    let mut paged = Vec::new();
+    let mut before = None::<i64>;
+    loop {
+        let path = match before {
+            None => "/api/v1/audit?limit=5".to_string(),
+            Some(b) => format!("/api/v1/audit?limit=5&before_id={b}"),
+        };
+        let page = ids(&get(&s, &path).await);
+        if page.is_empty() {
+            break;
+        }
+        before = page.last().copied();
+        paged.extend(page);
+    }
+    assert_eq!(
+        paged, all,
+        "paging back gives every entry once, newest first"
+    );
+    let newer = ids(&get(&s, &format!("/api/v1/audit?since_id={}", all[3])).await);
+    assert_eq!(newer, all[..3]);
+    // A client name that is not ASCII is kept.
+    let r = reqwest::Client::new()
+        .put(s.url("/api/v1/axes/x/parameters/AxisVeloMax"))
+        .header("content-type", "application/json")
+        .header(
+            "x-client-id",
+            reqwest::header::HeaderValue::from_bytes("Presse-Süd".as_bytes()).unwrap(),
+        )
+        .body(json!({"value": 600.0, "persistent": true}).to_string())
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status().as_u16(), 200);
+    let newest = get(&s, "/api/v1/audit?limit=1").await;
+    assert_eq!(newest.json[0]["client_id"], "Presse-Süd", "{}", newest.text);
+    for q in ["since_id=-1", "before_id=0"] {
+        let r = get(&s, &format!("/api/v1/audit?{q}")).await;
+        assert_eq!(r.status, 422, "{q}: {}", r.text);
+    }
+}

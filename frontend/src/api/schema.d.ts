@@ -5118,6 +5118,11 @@ export interface operations {
                  *     newer, the newest `limit` are returned.
                  */
                 since_id?: number;
+                /**
+                 * @description Only entries with a smaller id (older than that entry): pages back through the log
+                 *     (pass the smallest id of the previous page).
+                 */
+                before_id?: number;
             };
             header?: never;
             path?: never;

@@ -55,7 +55,12 @@ pub struct AuditQuery {
     pub limit: Option<u32>,
     /// Only entries with a larger id (newer than that entry). When more than `limit` are
     /// newer, the newest `limit` are returned.
+    #[param(minimum = 0)]
     pub since_id: Option<i64>,
+    /// Only entries with a smaller id (older than that entry): pages back through the log
+    /// (pass the smallest id of the previous page).
+    #[param(minimum = 1)]
+    pub before_id: Option<i64>,
 }
 
 #[utoipa::path(get, path = "/api/v1/audit", tag = "system", summary = "The audit log, newest first",
@@ -73,15 +78,26 @@ pub async fn audit_log(
     if !(1..=MAX_LIMIT).contains(&limit) {
         return Err(AppError::field("limit", "must be between 1 and 1000"));
     }
-    let rows = store::read_audit(&s.db, limit, q.since_id.unwrap_or(0))
-        .await
-        .map_err(|e| {
-            tracing::error!("database: {e}");
-            AppError::unavailable(
-                "storage_unavailable",
-                format!("the audit log could not be read: {e}"),
-            )
-        })?;
+    if q.since_id.is_some_and(|v| v < 0) {
+        return Err(AppError::field("since_id", "must be ≥ 0"));
+    }
+    if q.before_id.is_some_and(|v| v < 1) {
+        return Err(AppError::field("before_id", "must be ≥ 1"));
+    }
+    let rows = store::read_audit(
+        &s.db,
+        limit,
+        q.since_id.unwrap_or(0),
+        q.before_id.unwrap_or(i64::MAX),
+    )
+    .await
+    .map_err(|e| {
+        tracing::error!("database: {e}");
+        AppError::unavailable(
+            "storage_unavailable",
+            format!("the audit log could not be read: {e}"),
+        )
+    })?;
     Ok(Json(
         rows.into_iter()
             .map(|r| {

@@ -133,11 +133,14 @@ impl<S: Send + Sync> FromRequestParts<S> for Client {
             .get::<ConnectInfo<SocketAddr>>()
             .map(|c| c.0.to_string())
             .unwrap_or_default();
-        let id = parts
-            .headers
-            .get("x-client-id")
-            .and_then(|v| v.to_str().ok())
-            .map(|s| s.chars().take(128).collect());
+        // Names like "Presse-Süd" arrive as UTF-8 bytes (not visible ASCII): kept, decoded
+        // (bytes that are not UTF-8 become U+FFFD), never dropped.
+        let id = parts.headers.get("x-client-id").map(|v| {
+            String::from_utf8_lossy(v.as_bytes())
+                .chars()
+                .take(128)
+                .collect()
+        });
         Ok(Client(ClientInfo {
             addr,
             id,

@@ -45,12 +45,14 @@ pub async fn read_audit(
     pool: &SqlitePool,
     limit: u32,
     since_id: i64,
+    before_id: i64,
 ) -> Result<Vec<AuditRow>, sqlx::Error> {
     let rows = sqlx::query(
         "SELECT id, at, client_addr, client_id, action, target, command_id, detail, outcome \
-         FROM audit_log WHERE id > ? ORDER BY id DESC LIMIT ?",
+         FROM audit_log WHERE id > ? AND id < ? ORDER BY id DESC LIMIT ?",
     )
     .bind(since_id)
+    .bind(before_id)
     .bind(limit as i64)
     .fetch_all(pool)
     .await?;
