@@ -4,6 +4,7 @@
 
 mod rig;
 
+use motion::cam::{CamActivationMode, CamIn, CamScaling, CamScalingMode, StartMode};
 use motion::*;
 use proptest::prelude::*;
 use rig::*;
@@ -79,7 +80,121 @@ fn command() -> impl Strategy<Value = CommandKind> {
             abort_option: [SuperpositionAbortOption::AbortAtStandstill, SuperpositionAbortOption::ResumeAfterStandstill, SuperpositionAbortOption::ResumeAfterMotionStop][o],
         })),
         1 => Just(CommandKind::AbortSuperposition),
+        2 => cam_in().prop_map(CommandKind::CamIn),
+        1 => Just(CommandKind::CamOut),
+        1 => cam_scaling().prop_map(CommandKind::CamScaling),
     ]
+}
+
+fn activation() -> impl Strategy<Value = (CamActivationMode, f64)> {
+    prop_oneof![
+        3 => Just((CamActivationMode::Instantaneous, 0.0)),
+        1 => (-200.0..400.0f64).prop_map(|p| (CamActivationMode::AtMasterAxisPos, p)),
+        1 => (-200.0..400.0f64).prop_map(|p| (CamActivationMode::AtMasterAxisPosPositiveDirection, p)),
+        1 => (0.0..360.0f64).prop_map(|p| (CamActivationMode::AtMasterCamPos, p)),
+        1 => Just((CamActivationMode::NextCycle, 0.0)),
+        1 => Just((CamActivationMode::DeleteQueuedData, 0.0)),
+    ]
+}
+
+fn scaling_mode() -> impl Strategy<Value = CamScalingMode> {
+    prop_oneof![
+        Just(CamScalingMode::UserDefined),
+        Just(CamScalingMode::AutoOffset),
+        Just(CamScalingMode::Off)
+    ]
+}
+
+/// MC_CamIn of axis 1 to axis 0 through one of the rig's two cams.
+fn cam_in() -> impl Strategy<Value = CamIn> {
+    (
+        1u32..3,
+        0usize..4,
+        activation(),
+        scaling_mode(),
+        scaling_mode(),
+        prop_oneof![Just(1.0), Just(0.5), Just(2.0)],
+    )
+        .prop_map(
+            |(
+                cam_table,
+                start,
+                (activation_mode, activation_position),
+                master_scaling_mode,
+                slave_scaling_mode,
+                slave_scaling,
+            )| CamIn {
+                master: 0,
+                cam_table,
+                master_offset: 0.0,
+                slave_offset: 0.0,
+                master_scaling: 1.0,
+                slave_scaling,
+                start_mode: [
+                    StartMode::Absolute,
+                    StartMode::Relative,
+                    StartMode::MasterAbsSlaveRel,
+                    StartMode::MasterRelSlaveAbs,
+                ][start],
+                activation_mode,
+                activation_position,
+                master_scaling_mode,
+                slave_scaling_mode,
+            },
+        )
+}
+
+fn cam_scaling() -> impl Strategy<Value = CamScaling> {
+    (
+        activation(),
+        scaling_mode(),
+        scaling_mode(),
+        prop_oneof![Just(1.0), Just(0.5), Just(2.0)],
+    )
+        .prop_map(
+            |(
+                (activation_mode, activation_position),
+                master_scaling_mode,
+                slave_scaling_mode,
+                slave_scaling,
+            )| CamScaling {
+                activation_mode,
+                activation_position,
+                master_scaling_mode,
+                slave_scaling_mode,
+                master_offset: 0.0,
+                slave_offset: 0.0,
+                master_scaling: 1.0,
+                slave_scaling,
+            },
+        )
+}
+
+/// The rig's cams: a periodic motion function up and down (stroke 0) and a periodic 1:1 line
+/// (stroke 360); gentle enough for axis 1's widened bounds.
+fn rig_cams(r: &mut Rig, middle: f64) {
+    use motion::cam::*;
+    let point = |i: u32, x: f64, y: f64| MotionFunctionPoint {
+        point_index: i,
+        function_type: MotionFunctionType::Polynom5,
+        point_type: MotionPointType::Rest,
+        rel_index_next_point: 1,
+        master_pos: x,
+        slave_pos: y,
+        slave_velo: 0.0,
+        slave_acc: 0.0,
+        slave_jerk: 0.0,
+    };
+    let mut wave = CamTableData::motion_function(vec![
+        point(1, 0.0, 0.0),
+        point(2, 180.0, middle),
+        point(3, 360.0, 0.0),
+    ]);
+    wave.periodic = true;
+    let mut line = CamTableData::positions(vec![[0.0, 0.0], [360.0, 360.0]], true);
+    line.periodic = true;
+    r.cam(1, &wave);
+    r.cam(2, &line);
 }
 
 /// What to do between commands.
@@ -90,6 +205,8 @@ enum Action {
     Release(usize),
     Run(u16),
     Fault(u16, bool),
+    /// New data for the wave cam (its middle point), as MC_WriteMotionFunction does.
+    CamData(f64, CamActivationMode),
     /// A hardware limit switch (positive or negative) goes on or off.
     Limit(u16, bool, bool),
 }
@@ -101,6 +218,7 @@ fn action() -> impl Strategy<Value = Action> {
         5 => (0u16..400).prop_map(Action::Run),
         1 => (0u16..2, any::<bool>()).prop_map(|(a, f)| Action::Fault(a, f)),
         1 => (0u16..2, any::<bool>(), any::<bool>()).prop_map(|(a, p, on)| Action::Limit(a, p, on)),
+        1 => (10.0..60.0f64, prop_oneof![Just(CamActivationMode::Instantaneous), Just(CamActivationMode::NextCycle), Just(CamActivationMode::Off)]).prop_map(|(m, a)| Action::CamData(m, a)),
     ]
 }
 
@@ -116,6 +234,7 @@ proptest! {
         let mut r = Rig::with(vec![(false, p.clone()), (true, p)]);
         r.plants[1].cam = Some((5.0, 8.0));
         r.plants[1].index_period = Some(1.0);
+        rig_cams(&mut r, 50.0);
         // Gear slaves follow the master scaled by |ratio| < 3: widen axis 1's bounds.
         r.bounds[1].velocity *= 3.0;
         r.bounds[1].acceleration *= 3.0;
@@ -130,7 +249,7 @@ proptest! {
             match a {
                 Action::Cmd(axis, kind) => {
                     // Axis 0 is the only master; it never couples to itself.
-                    let axis = if matches!(kind, CommandKind::GearIn { .. } | CommandKind::GearInDyn { .. }) { 1 } else { axis };
+                    let axis = if matches!(kind, CommandKind::GearIn { .. } | CommandKind::GearInDyn { .. } | CommandKind::CamIn(_)) { 1 } else { axis };
                     let (id, _) = r.cmd(axis, kind);
                     ids.push((axis, id));
                 }
@@ -141,6 +260,25 @@ proptest! {
                 }
                 Action::Run(c) => for _ in 0..c { r.step(); },
                 Action::Fault(axis, f) => r.plants[axis as usize].fault = f,
+                Action::CamData(middle, activation_mode) => {
+                    use motion::cam::*;
+                    let mut t = CamTableData::motion_function(Vec::new());
+                    let point = |i: u32, x: f64, y: f64| MotionFunctionPoint {
+                        point_index: i,
+                        function_type: MotionFunctionType::Polynom5,
+                        point_type: MotionPointType::Rest,
+                        rel_index_next_point: 1,
+                        master_pos: x,
+                        slave_pos: y,
+                        slave_velo: 0.0,
+                        slave_acc: 0.0,
+                        slave_jerk: 0.0,
+                    };
+                    t.points = vec![point(1, 0.0, 0.0), point(2, 180.0, middle), point(3, 360.0, 0.0)];
+                    t.periodic = true;
+                    let cam = std::sync::Arc::new(Cam::build(&t).unwrap());
+                    let _ = r.k.change_cam(1, cam, OnlineChange { activation_mode, ..OnlineChange::default() });
+                }
                 Action::Limit(axis, positive, on) => {
                     let p = &mut r.plants[axis as usize];
                     if positive { p.limit_positive = on } else { p.limit_negative = on }
