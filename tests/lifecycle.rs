@@ -69,7 +69,7 @@ async fn a_configuration_exported_from_one_machine_imports_into_a_fresh_one() {
     assert_eq!(p.json["value"], 750.0, "{}", p.text);
 }
 
-/// Command ids never repeat across a crash: an id acknowledged before `kill -9` is never handed
+/// Command ids never repeat across a crash, and acknowledged commands keep their audit row: an id acknowledged before `kill -9` is never handed
 /// out again, even when its audit row had not been written yet (the reserved mark is stored
 /// before a command above it is acknowledged).
 #[tokio::test(flavor = "multi_thread")]
@@ -86,6 +86,19 @@ async fn command_ids_never_repeat_after_a_crash() {
     }
     s.stop(); // SIGKILL, right after the last acknowledgement
     let s = Server::start_with(db, &[]);
+    // Every acknowledged command has its submission row.
+    let audit = get(&s, "/api/v1/audit?limit=1000").await;
+    for id in &acknowledged {
+        assert!(
+            audit
+                .json
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|e| e["command_id"] == *id && e["outcome"] == "accepted"),
+            "no audit row for acknowledged command {id}"
+        );
+    }
     let r = post(&s, "/api/v1/axes/x/power", json!({})).await;
     assert_eq!(r.status, 202, "{}", r.text);
     let new = r.json["id"].as_u64().unwrap();

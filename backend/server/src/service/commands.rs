@@ -695,6 +695,21 @@ async fn submit(
     };
     match reply.result {
         Ok(()) => {
+            // The submission row is stored before the command is acknowledged (about 0.1 ms:
+            // docs/decisions.md 71), so that no acknowledged command misses it after a crash;
+            // and before the command counts as accepted, so that an end row (written by the
+            // pump once it does) always comes after it. The command already acts: if the
+            // database refuses the row, that is counted and logged, and the acknowledgement
+            // still says what happened.
+            let row = AuditEntry {
+                outcome: Some("accepted".into()),
+                ..audit
+            };
+            if let Err(e) = store::audit(&s.db, &row).await {
+                tracing::error!("audit row of command {id} not stored: {e}");
+                s.audit_dropped
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
             let final_audit = s.commands.lock().unwrap().map.get_mut(&id).and_then(|r| {
                 r.accepted = true;
                 r.accepted_cycle = reply.cycle;
@@ -702,10 +717,6 @@ async fn submit(
                     r.finished_at = Some(store::now_rfc3339());
                 }
                 r.final_audit.take()
-            });
-            s.audit(AuditEntry {
-                outcome: Some("accepted".into()),
-                ..audit
             });
             if let Some(e) = final_audit {
                 s.audit(e);

@@ -60,8 +60,13 @@ pub async fn open(path: &str) -> Result<SqlitePool, String> {
         // would only release a savepoint of that transaction: acknowledged and never stored.
         // Such a connection is closed when it comes back and before it is handed out; the
         // pool opens a fresh one.
-        .after_release(|conn, _| Box::pin(async move { clean(conn).await }))
-        .before_acquire(|conn, _| Box::pin(async move { clean(conn).await }))
+        // (Not for `:memory:`: a new connection would be a new, empty database.)
+        .after_release(move |conn, _| {
+            Box::pin(async move { if memory { Ok(true) } else { clean(conn).await } })
+        })
+        .before_acquire(move |conn, _| {
+            Box::pin(async move { if memory { Ok(true) } else { clean(conn).await } })
+        })
         .connect_with(opts)
         .await
         .map_err(|e| format!("cannot open database {path}: {e}"))?;
@@ -85,23 +90,29 @@ pub async fn open(path: &str) -> Result<SqlitePool, String> {
     Ok(pool)
 }
 
-/// Whether a pooled connection holds no transaction, in sqlx's books and SQLite's.
+/// Whether a pooled connection holds no transaction, in sqlx's books and SQLite's. A
+/// transaction dropped without commit has its rollback queued on the connection's worker:
+/// taking the handle lets it run first (the worker works in order), then both are asked.
 async fn clean(conn: &mut sqlx::SqliteConnection) -> Result<bool, sqlx::Error> {
     use sqlx::TransactionManager;
-    if sqlx::sqlite::SqliteTransactionManager::get_transaction_depth(conn) != 0 {
+    let autocommit = {
+        let mut handle = conn.lock_handle().await?;
+        // SAFETY: the handle is locked for us (the worker makes no calls meanwhile) and valid.
+        unsafe { libsqlite3_sys::sqlite3_get_autocommit(handle.as_raw_handle().as_ptr()) }
+    };
+    let depth = sqlx::sqlite::SqliteTransactionManager::get_transaction_depth(conn);
+    if depth != 0 || autocommit == 0 {
         tracing::warn!(
-            "database connection left inside a transaction after a failed write: reopened"
+            "database connection left inside a transaction after a failed write (depth {depth}, SQLite {}): reopened",
+            if autocommit == 0 {
+                "in a transaction"
+            } else {
+                "not"
+            }
         );
         return Ok(false);
     }
-    let mut handle = conn.lock_handle().await?;
-    // SAFETY: the handle is locked for us (the worker makes no calls meanwhile) and valid.
-    let autocommit =
-        unsafe { libsqlite3_sys::sqlite3_get_autocommit(handle.as_raw_handle().as_ptr()) };
-    if autocommit == 0 {
-        tracing::warn!("SQLite kept a transaction open after a failed write: connection reopened");
-    }
-    Ok(autocommit != 0)
+    Ok(true)
 }
 
 pub async fn meta(pool: &SqlitePool, key: &str) -> Result<Option<String>, sqlx::Error> {
