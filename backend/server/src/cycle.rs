@@ -147,6 +147,9 @@ pub struct Shared {
     pub cycle: AtomicU64,
     pub shutdown: AtomicBool,
     pub period_ns: u64,
+    /// Touched by the cycle thread when it produced verdicts or events: the pump drains at
+    /// once.
+    pub wake: tokio::sync::Notify,
 }
 
 impl Shared {
@@ -158,6 +161,7 @@ impl Shared {
             garbage: ArrayQueue::new(4 * MAX_AXES + COMMAND_QUEUE),
             scope_frames: ArrayQueue::new(SCOPE_RING),
             stats: CycleStats::default(),
+            wake: tokio::sync::Notify::new(),
             cycle: AtomicU64::new(0),
             shutdown: AtomicBool::new(false),
             period_ns,
@@ -200,12 +204,15 @@ pub struct RealtimeGrant {
 struct RingSink<'a> {
     q: &'a ArrayQueue<CommandEvent>,
     dropped: u64,
+    pushed: u64,
 }
 
 impl EventSink for RingSink<'_> {
     fn push(&mut self, event: CommandEvent) {
         if self.q.push(event).is_err() {
             self.dropped += 1;
+        } else {
+            self.pushed += 1;
         }
     }
 }
@@ -364,6 +371,7 @@ impl CycleThread {
         let mut sink = RingSink {
             q: &shared.events,
             dropped: 0,
+            pushed: 0,
         };
         let mut drained = 0;
         // Read once per cycle, and only when something waits (a vDSO call, no syscall).
@@ -617,6 +625,11 @@ impl CycleThread {
         }
         self.snapshot.publish();
         shared.cycle.store(cycle, Relaxed);
+        // A verdict or an output change waits on the async side: wake the pump now rather
+        // than at its next millisecond (one wake-up; nothing when the cycle produced nothing).
+        if drained > 0 || sink.pushed > 0 {
+            shared.wake.notify_one();
+        }
     }
 
     fn discard(&self, g: Garbage) {

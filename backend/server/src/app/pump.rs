@@ -74,12 +74,16 @@ impl AppState {
     }
 }
 
-/// Drains the cycle thread's queues every millisecond.
+/// Drains the cycle thread's queues when it says it produced something, and every
+/// millisecond besides (scope frames and garbage come without a wake-up).
 pub async fn pump(state: Arc<AppState>) {
     let mut tick = tokio::time::interval(Duration::from_millis(1));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     loop {
-        tick.tick().await;
+        tokio::select! {
+            _ = tick.tick() => {}
+            _ = state.shared.wake.notified() => {}
+        }
         state.drain();
     }
 }
