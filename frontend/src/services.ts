@@ -182,7 +182,8 @@ function upsert(e: LogEntry): void {
     list[i] = { ...list[i], ...e, parameters: e.parameters ?? list[i].parameters, at: list[i].at || e.at };
   } else {
     list.unshift(e);
-    list.sort((a, b) => (b.id ?? Infinity) - (a.id ?? Infinity) || b.at.localeCompare(a.at));
+    // Newest first by the time it was sent (a refused command has no id but its moment).
+    list.sort((a, b) => b.at.localeCompare(a.at) || (b.id ?? 0) - (a.id ?? 0));
     if (list.length > LOG_MAX) list.length = LOG_MAX;
   }
   commandLog.emit();

@@ -3,7 +3,11 @@ import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
 
-const h = vi.hoisted(() => ({ press: vi.fn(), release: vi.fn() }));
+const h = vi.hoisted(() => ({
+  press: vi.fn(),
+  release: vi.fn(),
+  snap: { phase: 'idle', axis: null, direction: null, mode: null, command: null, lastEnd: null, error: null, lastAxis: null } as Record<string, unknown>,
+}));
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
@@ -11,7 +15,7 @@ vi.mock('../src/services', async () => {
     jog: {
       press: h.press,
       release: h.release,
-      snapshot: () => ({ phase: 'idle', axis: null, direction: null, mode: null, command: null, lastEnd: null, error: null }),
+      snapshot: () => h.snap,
       onChange: () => () => {},
     },
     live: { state: new Store({ kind: 'open', since: 0 }) },
@@ -44,6 +48,19 @@ const btn = (k: string) => root.querySelector(`[data-jog="${k}"]`) as HTMLButton
 const pointer = (el: EventTarget, type: string) => el.dispatchEvent(new PointerEvent(type, { bubbles: true, button: 0 }));
 
 describe('JogButtons', () => {
+  it("show how the last jog ended only on that jog's axis", () => {
+    h.snap = { ...h.snap, lastEnd: 'button released', lastAxis: 'y' };
+    const other = document.createElement('div');
+    act(() => render(<JogButtons axis="x" unit="mm" buttons={buttons} disabled={false} />, other));
+    expect(other.querySelector('.jog-state')!.textContent).toMatch(/hold a button/);
+    const mine = document.createElement('div');
+    act(() => render(<JogButtons axis="y" unit="mm" buttons={buttons} disabled={false} />, mine));
+    expect(mine.querySelector('.jog-state')!.textContent).toBe('released (button released)');
+    act(() => render(null, other));
+    act(() => render(null, mine));
+    h.snap = { ...h.snap, lastEnd: null, lastAxis: null };
+  });
+
   it('show the velocities from the parameters on the buttons', () => {
     expect(btn('fast-forward').textContent).toContain('100 mm/s');
     expect(btn('slow-backward').textContent).toContain('10 mm/s');

@@ -239,11 +239,26 @@ describe('commissioning UI', () => {
     // beyond the software limit: refused by the axis (409), shown in the log with its text
     await page.fill('input[name="position"]', '5000');
     await page.fill('input[name="velocity"]', '100');
+    const before = await page.locator('button[name="start"]').boundingBox();
     await page.click('button[name="start"]');
+    // The error banner floats: the Start button has not moved under the pointer.
+    await page.waitForSelector('.banner-error');
+    const after = await page.locator('button[name="start"]').boundingBox();
+    assert.deepEqual(after, before, 'the page moved when the error banner appeared');
     const row = page.locator('[data-testid="command-log"] tr[data-state="rejected"]', { hasText: 'move-absolute' }).filter({ hasText: 'position=5000' });
     const text = await row.textContent({ timeout: 10000 });
     assert.match(text, /0x7001/);
     assert.match(text, /positive software limit/);
+    // The log is in time order: a command sent after the refused one is listed above it.
+    await page.fill('input[name="position"]', '10');
+    await page.click('button[name="start"]');
+    await until(async () => {
+      const rows = await page.locator('[data-testid="command-log"] tbody tr').evaluateAll((trs) =>
+        trs.map((tr) => `${tr.getAttribute('data-state')} ${tr.textContent}`));
+      const accepted = rows.findIndex((r) => !r.startsWith('rejected') && r.includes('position=10 '));
+      const refused = rows.findIndex((r) => r.startsWith('rejected') && r.includes('position=5000'));
+      return accepted >= 0 && refused > accepted;
+    }, { what: 'the later command above the refused one' });
     await shot(page, 'online-errors');
     await page.close();
   });

@@ -36,6 +36,8 @@ export interface JogSnapshot {
   /** Why the last jog ended (release reason or error text). */
   lastEnd: string | null;
   error: string | null;
+  /** The axis the last jog was on: `lastEnd` and `error` are that axis's. */
+  lastAxis: string | null;
 }
 
 interface Hold {
@@ -54,6 +56,7 @@ export class JogController {
   private listeners = new Set<(s: JogSnapshot) => void>();
   private lastEnd: string | null = null;
   private error: string | null = null;
+  private lastAxis: string | null = null;
 
   constructor(
     private readonly t: JogTransport,
@@ -70,6 +73,7 @@ export class JogController {
       command: h?.command ?? null,
       lastEnd: this.lastEnd,
       error: this.error,
+      lastAxis: this.lastAxis,
     };
   }
 
@@ -99,6 +103,7 @@ export class JogController {
     this.hold = h;
     this.error = null;
     this.lastEnd = null;
+    this.lastAxis = axis;
     this.changed();
     const params = { direction, mode, deadman_timeout: DEADMAN_S, ...extra };
     this.t

@@ -146,7 +146,7 @@ export function ActionButton({ onClick, children, class: cls, disabled, title, n
 export function ErrorBanner({ error, onClose }: { error: string | null; onClose?: () => void }) {
   if (!error) return null;
   return (
-    <div class="banner banner-error" role="alert">
+    <div class="banner banner-error banner-float" role="alert">
       <span>{error}</span>
       {onClose && (
         <button type="button" class="banner-close" onClick={onClose} aria-label="dismiss">

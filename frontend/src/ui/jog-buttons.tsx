@@ -81,16 +81,18 @@ export function JogButtons({ axis, unit, buttons, disabled }: { axis: string; un
           </button>
         ))}
       </div>
-      <div class="jog-state muted small" data-jog-phase={s.phase}>
-        {s.phase === 'idle'
-          ? s.error
-            ? <span class="text-error">jog refused: {s.error}</span>
-            : s.lastEnd
-              ? `released (${s.lastEnd})`
-              : 'hold a button to jog (dead-man 0.5 s)'
-          : s.phase === 'starting'
+      <div class="jog-state muted small" data-jog-phase={s.axis === axis ? s.phase : 'idle'}>
+        {s.phase !== 'idle' && s.axis === axis
+          ? s.phase === 'starting'
             ? 'starting…'
-            : `jogging · command #${s.command}`}
+            : `jogging · command #${s.command}`
+          : s.phase !== 'idle'
+            ? `jogging ${s.axis}`
+            : s.lastAxis === axis && s.error
+              ? <span class="text-error">jog refused: {s.error}</span>
+              : s.lastAxis === axis && s.lastEnd
+                ? `released (${s.lastEnd})`
+                : 'hold a button to jog (dead-man 0.5 s)'}
       </div>
     </div>
   );
