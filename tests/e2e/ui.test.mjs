@@ -568,6 +568,15 @@ describe('commissioning UI', () => {
     assert.equal(server.status, 422);
     assert.ok(err.startsWith(server.body.errors[0].message), `${err} / ${server.body.errors[0].message}`);
     await shot(page, 'parameters-error');
+    // Aliases only with "aliases" ticked; a search that matches hidden ones says so.
+    await row.locator('input').fill('');
+    await page.fill('input[name="filter"]', 'MaxVelocityAppl');
+    await until(async () => /1 alias match/.test(await page.locator('.params .toolbar').first().textContent()), { what: 'the hidden alias hint' });
+    assert.equal(await page.locator('tr[data-param="MaxVelocityAppl"]').count(), 0);
+    await page.check('input[name="aliases"]');
+    await page.locator('tr[data-param="MaxVelocityAppl"]').waitFor();
+    await page.uncheck('input[name="aliases"]');
+    await page.fill('input[name="filter"]', '');
     // the online tab's jog button follows the parameter
     await page.goto(`${stack.url}/#/axes/${AXIS}`);
     await until(async () => /20 mm\/s/.test(await page.locator('[data-jog="slow-forward"]').textContent()), { what: 'jog button velocity' });

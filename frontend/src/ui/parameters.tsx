@@ -98,14 +98,16 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
 
   const { changes, invalid } = useMemo(() => diff(list ?? [], edits), [list, edits]);
   const f = filter.trim().toLowerCase();
-  // Aliases (PLCopen names sharing a TwinCAT entry's storage) only when asked for or searched.
+  // Aliases (PLCopen names sharing a TwinCAT entry's storage) only when asked for (or edited);
+  // a search that matches hidden ones says how many.
   const isAlias = (p: ParameterResource) => p.storage !== 0 && p.storage !== p.number;
-  const shown = (list ?? []).filter(
+  const matching = (list ?? []).filter(
     (p) =>
       (group === 'all' || p.group === group) &&
-      (aliases || !!f || !isAlias(p) || edits[p.number] !== undefined) &&
       (!f || p.name.toLowerCase().includes(f) || String(p.number).includes(f) || p.help.toLowerCase().includes(f)),
   );
+  const shown = matching.filter((p) => aliases || !isAlias(p) || edits[p.number] !== undefined);
+  const hiddenAliases = matching.length - shown.length;
 
   const apply = async () => {
     setApplying(true);
@@ -152,7 +154,10 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
         <label class="check" title="PLCopen names that share the storage of a TwinCAT entry (e.g. MaxVelocityAppl → #1003)">
           <input type="checkbox" name="aliases" checked={aliases} onChange={(e) => setAliases((e.target as HTMLInputElement).checked)} /> aliases
         </label>
-        <span class="muted small">{shown.length} of {list.length}</span>
+        <span class="muted small">
+          {shown.length} of {list.length}
+          {f && hiddenAliases > 0 && !aliases ? ` · ${hiddenAliases} alias${hiddenAliases > 1 ? 'es' : ''} match (tick “aliases”)` : ''}
+        </span>
         <div class="seg">
           <button type="button" class={`seg-btn ${group === 'all' ? 'active' : ''}`} onClick={() => setGroup('all')}>
             All
