@@ -624,3 +624,60 @@ async fn multi_cam_over_http() {
         "the last cam goes with cam-out"
     );
 }
+
+/// `ST_CamInOptions.InterpolationType` over HTTP: a coupling may interpolate a stored linear
+/// table with a spline of its own; MC_CamInfo says which and predicts with it; 4POINT is a
+/// 422 at `interpolation` and couples nothing.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_coupling_chooses_its_own_interpolation() {
+    let s = Server::start();
+    let table = json!({"name": "bent", "table_type": "equidistant", "periodic": true,
+        "rows": [[0.0, 0.0], [90.0, 60.0], [180.0, 180.0], [270.0, 300.0], [360.0, 360.0]]});
+    let r = post(&s, "/api/v1/cam-tables", table).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.json["interpolation"], "linear", "{}", r.text);
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "x", "cam_table": "bent", "interpolation": "4point"}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["errors"][0]["field"].as_str()),
+        (422, Some("interpolation")),
+        "{}",
+        r.text
+    );
+    assert_eq!(status(&s, "y").await["status"]["state"], "standstill");
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in?wait=true",
+        json!({"master": "x", "cam_table": "bent", "interpolation": "spline"}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true",
+        json!({"position": 45.0, "velocity": 200.0}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["done"], true, "{}", r.text);
+    let y = status(&s, "y").await;
+    let at = y["status"]["set_position"].as_f64().unwrap();
+    // The table's own (linear) interpolation would put y at 30 here.
+    assert!((at - 30.0).abs() > 0.5, "y at {at}: linear, not the spline");
+    assert_eq!(
+        y["status"]["cam"]["cams"][0]["interpolation"], "spline",
+        "{y}"
+    );
+    let info = get(&s, "/api/v1/axes/y/cam-info?master_position=45").await;
+    assert!(
+        close(&info.json["actual_slave_axis_pos"], at),
+        "{}",
+        info.text
+    );
+}

@@ -272,6 +272,7 @@ fn cam_machine() -> Machine {
                 activation_position: 0.0,
                 master_scaling_mode: CamScalingMode::UserDefined,
                 slave_scaling_mode: CamScalingMode::UserDefined,
+                interpolation: None,
             }),
         );
         assert_eq!(v, Verdict::Accepted);

@@ -4,7 +4,9 @@
 
 mod rig;
 
-use motion::cam::{CamActivationMode, CamIn, CamScaling, CamScalingMode, StartMode};
+use motion::cam::{
+    CamActivationMode, CamIn, CamScaling, CamScalingMode, InterpolationType, StartMode,
+};
 use motion::*;
 use proptest::prelude::*;
 use rig::*;
@@ -114,6 +116,12 @@ fn cam_in() -> impl Strategy<Value = CamIn> {
         scaling_mode(),
         scaling_mode(),
         prop_oneof![Just(1.0), Just(0.5), Just(2.0)],
+        prop_oneof![
+            Just(None),
+            Just(Some(InterpolationType::Linear)),
+            Just(Some(InterpolationType::Spline)),
+            Just(Some(InterpolationType::SlidingSpline)),
+        ],
     )
         .prop_map(
             |(
@@ -123,6 +131,7 @@ fn cam_in() -> impl Strategy<Value = CamIn> {
                 master_scaling_mode,
                 slave_scaling_mode,
                 slave_scaling,
+                interpolation,
             )| CamIn {
                 master: 0,
                 cam_table,
@@ -140,6 +149,7 @@ fn cam_in() -> impl Strategy<Value = CamIn> {
                 activation_position,
                 master_scaling_mode,
                 slave_scaling_mode,
+                interpolation,
             },
         )
 }
@@ -191,8 +201,7 @@ fn rig_cams(r: &mut Rig, middle: f64) {
         point(3, 360.0, 0.0),
     ]);
     wave.periodic = true;
-    let mut line = CamTableData::positions(vec![[0.0, 0.0], [360.0, 360.0]], true);
-    line.periodic = true;
+    let line = rig::bent_positions();
     r.cam(1, &wave);
     r.cam(2, &line);
 }

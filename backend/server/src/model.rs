@@ -736,6 +736,10 @@ pub struct CamInBody {
     /// Default `user_defined`.
     #[serde(default)]
     pub slave_scaling_mode: motion::cam::CamScalingMode,
+    /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
+    /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
 /// MC_CamScaling: new offsets and scalings of the cam coupling (the raw table stays).
@@ -797,6 +801,10 @@ pub struct CamInV2Body {
     /// For `exchange`: the cam to replace (id or name; may be left out when the slave has one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_cam_table: Option<String>,
+    /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
+    /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
 /// MC_CamAdd: superimpose a cam on a multi-cam slave (the first one couples).
@@ -817,6 +825,10 @@ pub struct CamAddBody {
     /// Default: absolute, no offset, scaling 1.
     #[serde(default)]
     pub scaling: motion::cam::CamScalingData,
+    /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
+    /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
 /// MC_CamExchange: replace one cam of a multi-cam slave.
@@ -840,6 +852,10 @@ pub struct CamExchangeBody {
     /// Default: absolute, no offset, scaling 1.
     #[serde(default)]
     pub scaling: motion::cam::CamScalingData,
+    /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
+    /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
 /// MC_CamRemove: take one cam off a multi-cam slave (Done once removed; the last one is

@@ -1478,6 +1478,7 @@ export interface components {
             activation_position?: number;
             /** @description Default: absolute, no offset, scaling 1. */
             scaling?: components["schemas"]["CamScalingData"];
+            interpolation?: null | components["schemas"]["InterpolationType"];
         };
         /**
          * @description MC_CamExchange: replace one cam of a multi-cam slave.
@@ -1506,6 +1507,7 @@ export interface components {
             activation_position?: number;
             /** @description Default: absolute, no offset, scaling 1. */
             scaling?: components["schemas"]["CamScalingData"];
+            interpolation?: null | components["schemas"]["InterpolationType"];
         };
         /**
          * @description MC_CamIn: couple this axis (the slave) to `master` through a cam table, or — on a slave
@@ -1560,6 +1562,7 @@ export interface components {
             master_scaling_mode?: components["schemas"]["CamScalingMode"];
             /** @description Default `user_defined`. */
             slave_scaling_mode?: components["schemas"]["CamScalingMode"];
+            interpolation?: null | components["schemas"]["InterpolationType"];
         };
         /**
          * @description MC_CamIn_V2: couple with one cam, then add, exchange or remove superimposed cams
@@ -1588,6 +1591,7 @@ export interface components {
             operation?: components["schemas"]["CamOperationMode"];
             /** @description For `exchange`: the cam to replace (id or name; may be left out when the slave has one). */
             reference_cam_table?: string | null;
+            interpolation?: null | components["schemas"]["InterpolationType"];
         };
         /**
          * @description MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam

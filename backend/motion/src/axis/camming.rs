@@ -12,7 +12,7 @@ use super::coupling::{Coupling, CouplingLaw};
 use super::*;
 use crate::cam::{
     Cam, CamActivationMode as Act, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling,
-    CamScalingMode, CamScalingV2, CamTerm, StartMode,
+    CamScalingMode, CamScalingV2, CamTerm, InterpolationType, StartMode,
 };
 
 /// The cam law in force.
@@ -25,6 +25,10 @@ pub(super) struct CamLaw {
     pub(super) so: f64,
     pub(super) ms: f64,
     pub(super) ss: f64,
+    /// The coupling's interpolation of a position table (`None`: the table's own).
+    interpolation: Option<InterpolationType>,
+    /// The table's own interpolation, for MC_CamInfo (evaluation reads it from the cam).
+    cam_interpolation: InterpolationType,
     /// The cycle of a periodic cam the coupling counts strokes from (its base cycle).
     k_base: i64,
     master_absolute: bool,
@@ -55,10 +59,11 @@ impl CamLaw {
     pub(super) fn eval(&mut self, cam: &Cam, m: &Kinematics) -> Kinematics {
         let x = self.raw(m.position);
         let (k, xl) = cam.cycle_of(x);
+        let interpolation = self.interpolation.unwrap_or(cam.interpolation);
         let f = if cam.periodic {
-            cam.eval_in_range(xl)
+            cam.eval_in_range_with(xl, interpolation)
         } else {
-            cam.eval(x)
+            cam.eval_with(x, interpolation)
         };
         let strokes = if cam.periodic {
             (k - self.k_base) as f64 * cam.stroke()
@@ -416,6 +421,8 @@ impl Axis {
             so,
             ms,
             ss,
+            interpolation: ci.interpolation,
+            cam_interpolation: cam.interpolation,
             k_base,
             master_absolute: !ci.start_mode.master_relative(),
             slave_absolute: !ci.start_mode.slave_relative(),
@@ -488,6 +495,9 @@ impl Axis {
         let Some(cam) = cx.cams.get(ci.cam_table) else {
             return Err(ErrorId::CAM_TABLE_ID_INVALID);
         };
+        if ci.interpolation == Some(InterpolationType::FourPoint) {
+            return Err(ErrorId::CAM_TABLE_TYPE_INVALID);
+        }
         let generation = cx.cams.generation(ci.cam_table);
         for v in [ci.master_offset, ci.slave_offset, ci.activation_position] {
             if !v.is_finite() {
@@ -1039,6 +1049,7 @@ impl Axis {
             activation_position: 0.0,
             master_scaling_mode: d.master_scaling_mode,
             slave_scaling_mode: d.slave_scaling_mode,
+            interpolation: law.interpolation,
         };
         let mut new = self.law_for(
             &ci,
@@ -1099,6 +1110,7 @@ impl Axis {
                         actual_slave_cam_pos: t.y_local,
                         slave_contribution: (t.y_local + t.strokes) * t.ss + t.so,
                         sum_of_slave_strokes: t.strokes * t.ss,
+                        interpolation: t.interpolation.unwrap_or(t.cam_interpolation),
                     };
                 }
             }
@@ -1151,6 +1163,7 @@ fn as_cam_in(op: &CamInV2) -> CamIn {
         activation_position: op.activation_position,
         master_scaling_mode: d.master_scaling_mode,
         slave_scaling_mode: d.slave_scaling_mode,
+        interpolation: op.interpolation,
     }
 }
 
@@ -1166,6 +1179,9 @@ impl Axis {
         let Some(cam) = cx.cams.get(op.cam_table) else {
             return Err(ErrorId::CAM_TABLE_ID_INVALID);
         };
+        if op.interpolation == Some(InterpolationType::FourPoint) {
+            return Err(ErrorId::CAM_TABLE_TYPE_INVALID);
+        }
         let d = op.scaling;
         for v in [d.master_offset, d.slave_offset, op.activation_position] {
             if !v.is_finite() {

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::Cam;
+use super::{Cam, InterpolationType};
 use serde::{Deserialize, Serialize};
 
 /// `MC_StartMode`: absolute or relative, for master and slave (spec §1.6). Relative places the
@@ -91,6 +91,9 @@ pub struct CamIn {
     pub activation_position: f64,
     pub master_scaling_mode: CamScalingMode,
     pub slave_scaling_mode: CamScalingMode,
+    /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table
+    /// (`None`: the table's own; motion functions ignore it).
+    pub interpolation: Option<InterpolationType>,
 }
 
 /// MC_CamScaling: new offsets and scalings of the coupling.
@@ -178,6 +181,8 @@ pub struct CamInV2 {
     pub operation: CamOperationMode,
     /// The cam an exchange replaces (0: the only one).
     pub reference_cam_table: u32,
+    /// `ST_CamInOptions_V2.InterpolationType` (`None`: the table's own).
+    pub interpolation: Option<InterpolationType>,
 }
 
 /// MC_CamScaling_V2: new offsets and scalings of one cam of the slave (0: the only one).
@@ -205,6 +210,9 @@ pub struct CamTerm {
     pub slave_contribution: f64,
     /// Strokes this cam added since its base cycle, in slave axis units.
     pub sum_of_slave_strokes: f64,
+    /// How this coupling interpolates its position table (its own choice or the table's;
+    /// `linear` for a motion function, whose laws decide).
+    pub interpolation: InterpolationType,
 }
 
 /// MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam

@@ -285,9 +285,15 @@ impl Cam {
 
     /// Values within the table at `x`, clamped to the table's range.
     pub fn eval_in_range(&self, x: f64) -> CamValues {
+        self.eval_in_range_with(x, self.interpolation)
+    }
+
+    /// As [`Cam::eval_in_range`], a position table interpolated with `interpolation` (a
+    /// coupling's choice; motion functions have their laws and ignore it).
+    pub fn eval_in_range_with(&self, x: f64, interpolation: InterpolationType) -> CamValues {
         let x = x.clamp(self.x0, self.xn);
         match &self.data {
-            Data::Positions(t) => t.eval(x),
+            Data::Positions(t) => t.eval_in(t.interval(x), x, interpolation),
             Data::Function(f) => f.eval(x),
         }
     }
@@ -313,6 +319,11 @@ impl Cam {
     /// outside its range (derivatives 0); a periodic cam repeats, its stroke added per cycle
     /// counted from the table's own range (cycle 0).
     pub fn eval(&self, x: f64) -> CamValues {
+        self.eval_with(x, self.interpolation)
+    }
+
+    /// As [`Cam::eval`] with a coupling's interpolation (see [`Cam::eval_in_range_with`]).
+    pub fn eval_with(&self, x: f64, interpolation: InterpolationType) -> CamValues {
         if !self.periodic {
             if x < self.x0 || x > self.xn {
                 let y = if x < self.x0 { self.y0 } else { self.yn };
@@ -321,10 +332,10 @@ impl Cam {
                     ..CamValues::default()
                 };
             }
-            return self.eval_in_range(x);
+            return self.eval_in_range_with(x, interpolation);
         }
         let (k, xl) = self.cycle_of(x);
-        let mut v = self.eval_in_range(xl);
+        let mut v = self.eval_in_range_with(xl, interpolation);
         v.position += k as f64 * self.stroke();
         v
     }
@@ -392,7 +403,7 @@ impl Cam {
     /// at a border are that interval's one-sided limits.
     pub fn eval_piece(&self, i: usize, x: f64) -> CamValues {
         match &self.data {
-            Data::Positions(t) => t.eval_in(i, x),
+            Data::Positions(t) => t.eval_in(i, x, self.interpolation),
             Data::Function(f) => f.segments[i].eval(x),
         }
     }

@@ -12,9 +12,12 @@ pub struct PositionTable {
     pub slave: Vec<f64>,
     /// `(x0, step)` when the rows are equidistant: the row is found by division.
     equidistant: Option<(f64, f64)>,
+    /// The table's own interpolation (what a coupling without one of its own uses).
     interpolation: InterpolationType,
-    /// SPLINE: second derivatives at the rows; SLIDINGSPLINE: slopes at the rows.
-    d: Vec<f64>,
+    /// SPLINE: second derivatives at the rows.
+    spline: Vec<f64>,
+    /// SLIDINGSPLINE: slopes at the rows.
+    sliding: Vec<f64>,
 }
 
 /// Relative tolerance of an equidistant table's spacing.
@@ -77,36 +80,30 @@ impl PositionTable {
         } else {
             None
         };
-        let d = match interpolation {
-            InterpolationType::Linear => Vec::new(),
-            InterpolationType::Spline => {
-                // Linear tables: tangential ends (the slopes of the first and last interval);
-                // periodic tables: cyclic ends.
-                let first = (slave[1] - slave[0]) / (master[1] - master[0]);
-                let last = (slave[n] - slave[n - 1]) / (master[n] - master[n - 1]);
-                spline::second_derivatives(
-                    &master,
-                    &slave,
-                    End::Slope(first),
-                    End::Slope(last),
-                    periodic,
-                )
-            }
-            InterpolationType::SlidingSpline => sliding_slopes(&master, &slave, periodic),
-            InterpolationType::FourPoint => {
-                return Err(CamError {
-                    id: ErrorId::CAM_TABLE_TYPE_INVALID,
-                    field: "interpolation".into(),
-                    message: "4-point interpolation is no longer supported (as in TwinCAT); use spline or sliding_spline".into(),
-                });
-            }
-        };
+        if interpolation == InterpolationType::FourPoint {
+            return Err(four_point_refused("interpolation"));
+        }
+        // Every interpolation is built here, off the cycle, so that a coupling may choose
+        // another one than the table's own (ST_CamInOptions.InterpolationType) without any
+        // work in the cycle (decision 74). Linear tables: tangential ends (the slopes of the
+        // first and last interval); periodic tables: cyclic ends.
+        let first = (slave[1] - slave[0]) / (master[1] - master[0]);
+        let last = (slave[n] - slave[n - 1]) / (master[n] - master[n - 1]);
+        let spline = spline::second_derivatives(
+            &master,
+            &slave,
+            End::Slope(first),
+            End::Slope(last),
+            periodic,
+        );
+        let sliding = sliding_slopes(&master, &slave, periodic);
         Ok(PositionTable {
             master,
             slave,
             equidistant,
             interpolation,
-            d,
+            spline,
+            sliding,
         })
     }
 
@@ -138,16 +135,17 @@ impl PositionTable {
 
     pub fn eval(&self, x: f64) -> CamValues {
         let i = self.interval(x);
-        self.eval_in(i, x)
+        self.eval_in(i, x, self.interpolation)
     }
 
-    /// Values at `x` on interval `i`.
-    pub fn eval_in(&self, i: usize, x: f64) -> CamValues {
+    /// Values at `x` on interval `i` with `interpolation` (FOURPOINT, refused when a table or a
+    /// coupling is made, reads as linear).
+    pub fn eval_in(&self, i: usize, x: f64, interpolation: InterpolationType) -> CamValues {
         let (x0, x1) = (self.master[i], self.master[i + 1]);
         let (y0, y1) = (self.slave[i], self.slave[i + 1]);
         let h = x1 - x0;
         let t = (x - x0).clamp(0.0, h);
-        match self.interpolation {
+        match interpolation {
             InterpolationType::Linear | InterpolationType::FourPoint => {
                 let slope = (y1 - y0) / h;
                 CamValues {
@@ -158,7 +156,7 @@ impl PositionTable {
                 }
             }
             InterpolationType::Spline => {
-                let (m0, m1) = (self.d[i], self.d[i + 1]);
+                let (m0, m1) = (self.spline[i], self.spline[i + 1]);
                 let slope = (y1 - y0) / h - h * (2.0 * m0 + m1) / 6.0;
                 let jerk = (m1 - m0) / h;
                 CamValues {
@@ -170,7 +168,7 @@ impl PositionTable {
             }
             InterpolationType::SlidingSpline => {
                 // Cubic Hermite with the local slopes.
-                let (d0, d1) = (self.d[i], self.d[i + 1]);
+                let (d0, d1) = (self.sliding[i], self.sliding[i + 1]);
                 let s = (y1 - y0) / h;
                 let c2 = (3.0 * s - 2.0 * d0 - d1) / h;
                 let c3 = (d0 + d1 - 2.0 * s) / (h * h);
@@ -182,6 +180,15 @@ impl PositionTable {
                 }
             }
         }
+    }
+}
+
+/// The refusal of MC_INTERPOLATIONTYPE_4POINT at `field`.
+pub(crate) fn four_point_refused(field: &str) -> CamError {
+    CamError {
+        id: ErrorId::CAM_TABLE_TYPE_INVALID,
+        field: field.into(),
+        message: "4-point interpolation is no longer supported (as in TwinCAT); use spline or sliding_spline".into(),
     }
 }
 

@@ -281,6 +281,7 @@ impl Rig {
     }
 
     /// Builds a cam table and hands it to the kernel under `id`.
+    /// (See [`bent_positions`] for a position table whose interpolations differ.)
     pub fn cam(&mut self, id: u32, table: &motion::cam::CamTableData) {
         let cam = motion::cam::Cam::build(table).expect("a valid cam table");
         assert!(
@@ -899,4 +900,22 @@ pub fn prop_config(default_cases: u32) -> proptest::test_runner::Config {
         rng_seed,
         ..Config::default()
     }
+}
+
+/// A periodic, equidistant, linearly interpolated position table whose rows bend (one stroke of
+/// 360 per 360 of master), so that a coupling's own interpolation (spline, sliding spline)
+/// differs from the table's.
+pub fn bent_positions() -> motion::cam::CamTableData {
+    let mut t = motion::cam::CamTableData::positions(
+        vec![
+            [0.0, 0.0],
+            [90.0, 60.0],
+            [180.0, 180.0],
+            [270.0, 300.0],
+            [360.0, 360.0],
+        ],
+        true,
+    );
+    t.periodic = true;
+    t
 }

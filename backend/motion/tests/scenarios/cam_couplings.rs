@@ -27,6 +27,7 @@ fn cam_in(master: u16, table: u32) -> CamIn {
         activation_position: 0.0,
         master_scaling_mode: CamScalingMode::UserDefined,
         slave_scaling_mode: CamScalingMode::UserDefined,
+        interpolation: None,
     }
 }
 
@@ -466,6 +467,70 @@ fn cam_modes_the_manual_forbids_are_refused() {
     );
 }
 
+/// `ST_CamInOptions.InterpolationType`: each coupling may interpolate a position table its own
+/// way (decision 74). Two slaves on one linear table, one with the table's own interpolation
+/// and one with a spline of its own, follow the library's values for their choice in every
+/// cycle; 4POINT is refused.
+#[test]
+fn a_coupling_interpolates_a_position_table_its_own_way() {
+    let mut p = params();
+    p.axis_velo_max = 2000.0;
+    let mut r = Rig::with(vec![(false, p.clone()), (false, p.clone()), (false, p)]);
+    for s in [1, 2] {
+        r.bounds[s].velocity = 1e9;
+        r.bounds[s].acceleration = 1e9;
+        r.bounds[s].jerk = 1e12;
+    }
+    for a in 0..3 {
+        r.power_on(a);
+    }
+    let bent = rig::bent_positions();
+    r.cam(T_LINE, &bent);
+    let cam = Cam::build(&bent).unwrap();
+    assert_eq!(cam.interpolation, InterpolationType::Linear);
+    assert_eq!(
+        r.rejected(
+            2,
+            CommandKind::CamIn(CamIn {
+                interpolation: Some(InterpolationType::FourPoint),
+                ..cam_in(0, T_LINE)
+            })
+        ),
+        ErrorId::CAM_TABLE_TYPE_INVALID
+    );
+    let own = r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    let spline = r.ok(
+        2,
+        CommandKind::CamIn(CamIn {
+            interpolation: Some(InterpolationType::Spline),
+            ..cam_in(0, T_LINE)
+        }),
+    );
+    assert!(r.out(own).in_sync && r.out(spline).in_sync);
+    let mut apart: f64 = 0.0;
+    move_master(&mut r, 450.0, 300.0, |r| {
+        let m = r.st(0).set_position;
+        for (slave, how) in [
+            (1, InterpolationType::Linear),
+            (2, InterpolationType::Spline),
+        ] {
+            let want = cam.eval_with(m, how).position;
+            let got = r.st(slave).set_position;
+            assert!(
+                (got - want).abs() < 1e-9,
+                "{how:?} at master {m}: {got} ≠ {want}"
+            );
+        }
+        apart = apart.max((r.st(1).set_position - r.st(2).set_position).abs());
+    });
+    // Between the rows the two interpolations differ; the spline's slave passes every row.
+    assert!(
+        apart > 1.0,
+        "the spline coupling followed the linear one ({apart})"
+    );
+    assert!((r.st(2).set_position - (360.0 + 60.0)).abs() < 1e-6);
+}
+
 /// A cam slave is a coupled slave: one that crosses its soft limit is decoupled and stopped
 /// in ErrorStop (0x7003), a queued switch ends with the error; a pending coupling ends when a
 /// motion command takes the axis.
@@ -623,6 +688,7 @@ fn v2(master: u16, table: u32, operation: CamOperationMode) -> CamInV2 {
         scaling: CamScalingData::default(),
         operation,
         reference_cam_table: 0,
+        interpolation: None,
     }
 }
 

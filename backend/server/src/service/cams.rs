@@ -742,9 +742,9 @@ pub fn cam_info(s: &AppState, axis: &str, master_position: Option<f64>) -> AppRe
         let x = (m + t.master_offset) / t.master_scaling;
         let (kx, xl) = c.cycle_of(x);
         let f = if c.periodic {
-            c.eval_in_range(xl)
+            c.eval_in_range_with(xl, t.interpolation)
         } else {
-            c.eval(x)
+            c.eval_with(x, t.interpolation)
         };
         let strokes = if c.periodic {
             (kx - k_base) as f64 * stroke

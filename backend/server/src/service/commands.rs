@@ -42,6 +42,15 @@ impl Check {
         }
     }
     /// A cam block's offsets and activation position (finite) and scalings (finite, not 0).
+    /// A coupling's own interpolation of a position table (4POINT is no longer supported).
+    fn interpolation(&mut self, i: Option<motion::cam::InterpolationType>) {
+        if i == Some(motion::cam::InterpolationType::FourPoint) {
+            self.fail(
+                "interpolation",
+                "4-point interpolation is no longer supported (as in TwinCAT); use linear, spline or sliding_spline",
+            );
+        }
+    }
     fn cam_coupling(&mut self, [mo, so, position]: [f64; 3], [ms, ss]: [f64; 2]) {
         self.finite("master_offset", mo);
         self.finite("slave_offset", so);
@@ -395,6 +404,7 @@ impl CamInBody {
             ],
             [self.master_scaling, self.slave_scaling],
         );
+        c.interpolation(self.interpolation);
         c.done(CommandKind::CamIn(motion::cam::CamIn {
             master,
             cam_table,
@@ -407,6 +417,7 @@ impl CamInBody {
             activation_position: self.activation_position,
             master_scaling_mode: self.master_scaling_mode,
             slave_scaling_mode: self.slave_scaling_mode,
+            interpolation: self.interpolation,
         }))
     }
 }
@@ -422,6 +433,7 @@ fn cam_in_v2(
     activation: (motion::cam::CamActivationMode, f64),
     scaling: motion::cam::CamScalingData,
     operation: motion::cam::CamOperationMode,
+    interpolation: Option<motion::cam::InterpolationType>,
 ) -> AppResult<CommandKind> {
     let mut c = Check::default();
     let master = master_slot(&mut c, reg, axis, master);
@@ -440,6 +452,7 @@ fn cam_in_v2(
         [scaling.master_offset, scaling.slave_offset, activation.1],
         [scaling.master_scaling, scaling.slave_scaling],
     );
+    c.interpolation(interpolation);
     c.done(CommandKind::CamInV2(motion::cam::CamInV2 {
         master,
         cam_table,
@@ -448,6 +461,7 @@ fn cam_in_v2(
         scaling,
         operation,
         reference_cam_table,
+        interpolation,
     }))
 }
 
@@ -462,6 +476,7 @@ impl CamInV2Body {
             (self.activation_mode, self.activation_position),
             self.scaling,
             self.operation,
+            self.interpolation,
         )
     }
 }
@@ -477,6 +492,7 @@ impl CamAddBody {
             (self.activation_mode, self.activation_position),
             self.scaling,
             motion::cam::CamOperationMode::Additive,
+            self.interpolation,
         )
     }
 }
@@ -492,6 +508,7 @@ impl CamExchangeBody {
             (self.activation_mode, self.activation_position),
             self.scaling,
             motion::cam::CamOperationMode::Exchange,
+            self.interpolation,
         )
     }
 }
@@ -507,6 +524,7 @@ impl CamRemoveBody {
             (self.activation_mode, self.activation_position),
             motion::cam::CamScalingData::default(),
             motion::cam::CamOperationMode::Remove,
+            None,
         )
     }
 }
