@@ -681,3 +681,58 @@ async fn a_coupling_chooses_its_own_interpolation() {
         info.text
     );
 }
+
+/// PLCopen ramp-in over HTTP: a slave away from its cam is refused with `absolute` and caught
+/// up with `ramp_in`; `?wait=true` answers at InSync, with the slave on the cam. A ramp-in
+/// without its velocity is a 422 at `ramp_in.velocity`.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_ramp_in_couples_a_slave_away_from_its_cam() {
+    let s = Server::start();
+    assert_eq!(post(&s, "/api/v1/cam-tables", polynom5()).await.status, 201);
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/move-absolute?wait=true",
+        json!({"position": 30.0, "velocity": 200.0}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["done"], true, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "x", "cam_table": "p5", "start_mode": "ramp_in"}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["errors"][0]["field"].as_str()),
+        (422, Some("ramp_in.velocity")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "x", "cam_table": "p5", "ramp_in": {"velocity": 50.0}}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["errors"][0]["field"].as_str()),
+        (422, Some("ramp_in")),
+        "{}",
+        r.text
+    );
+    assert_eq!(status(&s, "y").await["status"]["state"], "standstill");
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in?wait=true",
+        json!({"master": "x", "cam_table": "p5", "start_mode": "ramp_in",
+               "ramp_in": {"velocity": 50.0, "acceleration": 500.0}}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    let y = status(&s, "y").await;
+    assert!(close(&y["status"]["set_position"], 0.0), "{y}");
+    assert_eq!(y["status"]["state"], "synchronized_motion");
+}

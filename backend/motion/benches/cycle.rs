@@ -273,6 +273,7 @@ fn cam_machine() -> Machine {
                 master_scaling_mode: CamScalingMode::UserDefined,
                 slave_scaling_mode: CamScalingMode::UserDefined,
                 interpolation: None,
+                ramp_in: Default::default(),
             }),
         );
         assert_eq!(v, Verdict::Accepted);

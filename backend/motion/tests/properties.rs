@@ -111,7 +111,7 @@ fn scaling_mode() -> impl Strategy<Value = CamScalingMode> {
 fn cam_in() -> impl Strategy<Value = CamIn> {
     (
         1u32..3,
-        0usize..4,
+        0usize..7,
         activation(),
         scaling_mode(),
         scaling_mode(),
@@ -144,12 +144,19 @@ fn cam_in() -> impl Strategy<Value = CamIn> {
                     StartMode::Relative,
                     StartMode::MasterAbsSlaveRel,
                     StartMode::MasterRelSlaveAbs,
+                    StartMode::RampIn,
+                    StartMode::RampInPositive,
+                    StartMode::RampInNegative,
                 ][start],
                 activation_mode,
                 activation_position,
                 master_scaling_mode,
                 slave_scaling_mode,
                 interpolation,
+                ramp_in: motion::cam::RampIn {
+                    velocity: 100.0,
+                    ..Default::default()
+                },
             },
         )
 }

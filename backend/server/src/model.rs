@@ -740,6 +740,10 @@ pub struct CamInBody {
     /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interpolation: Option<motion::cam::InterpolationType>,
+    /// With a `ramp_in*` start mode: how the slave catches up with the cam (the limits of its
+    /// deviation from the cam; `velocity` required, the others 0 = the axis defaults).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp_in: Option<motion::cam::RampIn>,
 }
 
 /// MC_CamScaling: new offsets and scalings of the cam coupling (the raw table stays).

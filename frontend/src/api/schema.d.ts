@@ -1214,6 +1214,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -1225,6 +1226,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -1236,6 +1238,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -1247,6 +1250,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -1563,6 +1567,7 @@ export interface components {
             /** @description Default `user_defined`. */
             slave_scaling_mode?: components["schemas"]["CamScalingMode"];
             interpolation?: null | components["schemas"]["InterpolationType"];
+            ramp_in?: null | components["schemas"]["RampIn"];
         };
         /**
          * @description MC_CamIn_V2: couple with one cam, then add, exchange or remove superimposed cams
@@ -1613,6 +1618,7 @@ export interface components {
          *           "actual_master_cam_pos": 0,
          *           "actual_slave_cam_pos": 0,
          *           "cam_table_id": 0,
+         *           "interpolation": "linear",
          *           "master_offset": 0,
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
@@ -1624,6 +1630,7 @@ export interface components {
          *           "actual_master_cam_pos": 0,
          *           "actual_slave_cam_pos": 0,
          *           "cam_table_id": 0,
+         *           "interpolation": "linear",
          *           "master_offset": 0,
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
@@ -1635,6 +1642,7 @@ export interface components {
          *           "actual_master_cam_pos": 0,
          *           "actual_slave_cam_pos": 0,
          *           "cam_table_id": 0,
+         *           "interpolation": "linear",
          *           "master_offset": 0,
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
@@ -1646,6 +1654,7 @@ export interface components {
          *           "actual_master_cam_pos": 0,
          *           "actual_slave_cam_pos": 0,
          *           "cam_table_id": 0,
+         *           "interpolation": "linear",
          *           "master_offset": 0,
          *           "master_scaling": 0,
          *           "slave_contribution": 0,
@@ -2046,6 +2055,7 @@ export interface components {
          *       "actual_master_cam_pos": 180,
          *       "actual_slave_cam_pos": 5,
          *       "cam_table_id": 3,
+         *       "interpolation": "linear",
          *       "master_offset": 0,
          *       "master_scaling": 1,
          *       "slave_contribution": 5,
@@ -2082,6 +2092,11 @@ export interface components {
              * @description Strokes this cam added since its base cycle, in slave axis units.
              */
             sum_of_slave_strokes: number;
+            /**
+             * @description How this coupling interpolates its position table (its own choice or the table's;
+             *     `linear` for a motion function, whose laws decide).
+             */
+            interpolation: components["schemas"]["InterpolationType"];
         };
         /**
          * @description MC_ReadMotionFunctionValues: one row per sample, columns as named.
@@ -3021,6 +3036,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -3032,6 +3048,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -3043,6 +3060,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -3054,6 +3072,7 @@ export interface components {
          *             "actual_master_cam_pos": 0,
          *             "actual_slave_cam_pos": 0,
          *             "cam_table_id": 0,
+         *             "interpolation": "linear",
          *             "master_offset": 0,
          *             "master_scaling": 0,
          *             "slave_contribution": 0,
@@ -3656,6 +3675,33 @@ export interface components {
             errors?: components["schemas"]["FieldError"][];
         };
         /**
+         * @description How a ramp-in start mode catches the slave up with its cam: limits of the slave's deviation
+         *     from the cam position (relative to the cam's own motion). `velocity` must be given for a
+         *     ramp-in; acceleration, deceleration and jerk 0 mean the axis defaults (#1004–#1006).
+         */
+        RampIn: {
+            /**
+             * Format: double
+             * @default 0
+             */
+            velocity: number;
+            /**
+             * Format: double
+             * @default 0
+             */
+            acceleration: number;
+            /**
+             * Format: double
+             * @default 0
+             */
+            deceleration: number;
+            /**
+             * Format: double
+             * @default 0
+             */
+            jerk: number;
+        };
+        /**
          * @description What real-time facilities the OS granted.
          * @example {
          *       "cpu_dma_latency_zero": true,
@@ -3985,7 +4031,7 @@ export interface components {
          *     origin of the cam's coordinates (raw 0) at the axis's position when the cam takes effect.
          * @enum {string}
          */
-        StartMode: "absolute" | "relative" | "master_abs_slave_rel" | "master_rel_slave_abs";
+        StartMode: "absolute" | "relative" | "master_abs_slave_rel" | "master_rel_slave_abs" | "ramp_in" | "ramp_in_positive" | "ramp_in_negative";
         /**
          * @description Live status of an axis.
          * @example {
@@ -4015,6 +4061,7 @@ export interface components {
          *               "actual_master_cam_pos": 0,
          *               "actual_slave_cam_pos": 0,
          *               "cam_table_id": 0,
+         *               "interpolation": "linear",
          *               "master_offset": 0,
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
@@ -4026,6 +4073,7 @@ export interface components {
          *               "actual_master_cam_pos": 0,
          *               "actual_slave_cam_pos": 0,
          *               "cam_table_id": 0,
+         *               "interpolation": "linear",
          *               "master_offset": 0,
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
@@ -4037,6 +4085,7 @@ export interface components {
          *               "actual_master_cam_pos": 0,
          *               "actual_slave_cam_pos": 0,
          *               "cam_table_id": 0,
+         *               "interpolation": "linear",
          *               "master_offset": 0,
          *               "master_scaling": 0,
          *               "slave_contribution": 0,
@@ -4048,6 +4097,7 @@ export interface components {
          *               "actual_master_cam_pos": 0,
          *               "actual_slave_cam_pos": 0,
          *               "cam_table_id": 0,
+         *               "interpolation": "linear",
          *               "master_offset": 0,
          *               "master_scaling": 0,
          *               "slave_contribution": 0,

@@ -12,7 +12,7 @@ use super::coupling::{Coupling, CouplingLaw};
 use super::*;
 use crate::cam::{
     Cam, CamActivationMode as Act, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling,
-    CamScalingMode, CamScalingV2, CamTerm, InterpolationType, StartMode,
+    CamScalingMode, CamScalingV2, CamTerm, InterpolationType, RampIn, StartMode,
 };
 
 /// The cam law in force.
@@ -136,13 +136,20 @@ pub(super) struct CamSet {
     pub(super) terms: [Option<CamLaw>; MAX_CAMS],
     /// Coupled by MC_CamIn_V2 (MC_CamIn and MC_CamIn_V2 exclude each other on a slave).
     pub(super) v2: bool,
+    /// A ramp-in runs: the axis's planner (idle while coupled) carries the slave's deviation
+    /// from the cam down to 0, laid over the cams' setpoint; InSync when it arrives.
+    pub(super) ramp: bool,
 }
 
 impl CamSet {
     fn single(law: CamLaw, v2: bool) -> Self {
         let mut terms = [None; MAX_CAMS];
         terms[0] = Some(law);
-        CamSet { terms, v2 }
+        CamSet {
+            terms,
+            v2,
+            ramp: false,
+        }
     }
 
     fn base(&self) -> CamLaw {
@@ -452,6 +459,108 @@ impl Axis {
         law
     }
 
+    /// Where a coupling joins its cam: without a jump (else 0x7084, see [`Axis::check_no_jump`]),
+    /// or with a ramp-in start mode by catching up. Then the slave's deviation from the cam
+    /// (position, velocity, acceleration) is planned down to 0 on the axis's planner, which
+    /// is idle while the axis is coupled; `ramp_in_positive`/`_negative` first take the cam
+    /// position modulo AxisEncoderModuloValue so that the catch-up runs that way and is shorter
+    /// than one period. `stepped`: the master sample is this cycle's (an activation), the
+    /// slave's setpoint still the last cycle's. True when a ramp-in was planned.
+    fn join_cam(
+        &mut self,
+        ci: &CamIn,
+        law: &mut CamLaw,
+        cam: &Cam,
+        m: &Kinematics,
+        stepped: bool,
+    ) -> Result<bool, ErrorId> {
+        if !ci.start_mode.ramp_in() {
+            self.check_no_jump(law, cam, m, self.set)?;
+            return Ok(false);
+        }
+        let mut probe = *law;
+        let mut at = probe.eval(cam, m);
+        if stepped {
+            // The deviation is planned from the slave's last setpoint: compare it with where
+            // the cam was then (one cycle back along its own motion), so that the first
+            // sample of the ramp, laid over this cycle's cam, continues the slave's motion.
+            let dt = self.cycle_time;
+            at = Kinematics {
+                position: at.position - at.velocity * dt + 0.5 * at.acceleration * dt * dt,
+                velocity: at.velocity - at.acceleration * dt,
+                ..at
+            };
+        }
+        let p = self.p();
+        let mut deviation = self.set.position - at.position;
+        let period = p.axis_encoder_modulo_value;
+        let turns = match ci.start_mode {
+            StartMode::RampInPositive => (deviation / period).ceil(),
+            StartMode::RampInNegative => (deviation / period).floor(),
+            _ => 0.0,
+        };
+        law.so += turns * period;
+        deviation -= turns * period;
+        let (acc, dec, jerk) = self.dynamics(Dynamics {
+            acceleration: ci.ramp_in.acceleration,
+            deceleration: ci.ramp_in.deceleration,
+            jerk: ci.ramp_in.jerk,
+        })?;
+        let from = Kinematics {
+            position: deviation,
+            velocity: self.set.velocity - at.velocity,
+            acceleration: self.set.acceleration - at.acceleration,
+            jerk: 0.0,
+        };
+        let limits = Limits {
+            velocity: ci.ramp_in.velocity,
+            acceleration: acc,
+            deceleration: dec,
+            jerk,
+        };
+        self.planner
+            .plan_position(from, 0.0, 0.0, &limits)
+            .map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
+        Ok(true)
+    }
+
+    /// A ramp-in's cycle: its deviation laid over the cams' setpoint `set`; InSync (and the
+    /// MC_CamIn ends) when it has run down to 0.
+    pub(super) fn step_ramp_in(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        job: &mut Job,
+        cams: &mut CamSet,
+        dt: f64,
+    ) {
+        if !cams.ramp {
+            return;
+        }
+        if let Some(e) = self.planner.step(dt) {
+            self.set.position += e.position;
+            self.set.velocity += e.velocity;
+            self.set.acceleration += e.acceleration;
+            self.set.jerk += e.jerk;
+        }
+        if self.planner.finished() {
+            cams.ramp = false;
+            self.planner.clear();
+            let out = FbOutputs {
+                busy: false,
+                active: false,
+                in_sync: true,
+                ..job.out
+            };
+            job.emit(cx, out);
+            // The coupling goes on without an owning command, as after an immediate one.
+            job.id = 0;
+            job.out = FbOutputs {
+                busy: true,
+                ..FbOutputs::default()
+            };
+        }
+    }
+
     /// 0x7084 when following `law` from now on would step the slave's position or velocity
     /// away from `from` (where the slave is, or where the law in force puts it in this cycle).
     fn check_no_jump(
@@ -512,6 +621,18 @@ impl Axis {
         }
         let law_now = self.cam_law();
         let switching = law_now.is_some() && self.master_slot() == Some(ci.master);
+        if ci.start_mode.ramp_in() {
+            // A ramp-in couples; a switch must join the cam in force without a jump.
+            if switching {
+                return Err(ErrorId::CAM_MODE_INVALID);
+            }
+            self.check_velocity(ci.ramp_in.velocity)?;
+            self.dynamics(Dynamics {
+                acceleration: ci.ramp_in.acceleration,
+                deceleration: ci.ramp_in.deceleration,
+                jerk: ci.ramp_in.jerk,
+            })?;
+        }
         // Modes the manual allows (spec §1.6–§1.8).
         match ci.activation_mode {
             Act::NextCycleOnce | Act::AsSoonAsPossible | Act::Off => {
@@ -634,7 +755,7 @@ impl Axis {
             law.raw(m.set.position),
         );
         if act.at_once(m.set.position, law.raw(m.set.position)) {
-            self.check_no_jump(&mut law, cam, &m.set, self.set)?;
+            let ramp = self.join_cam(&ci, &mut law, cam, &m.set, false)?;
             self.cancel_cam_in(cx, End::Aborted);
             let cmd = Held::start(
                 cx,
@@ -644,7 +765,7 @@ impl Axis {
                     ..FbOutputs::default()
                 },
             );
-            self.start_cam_coupling(cx, ci.master, law, cmd, v2);
+            self.start_cam_coupling(cx, ci.master, law, cmd, v2, ramp);
         } else {
             self.cancel_cam_in(cx, End::Aborted);
             let cmd = Held::start(
@@ -675,14 +796,30 @@ impl Axis {
         law: CamLaw,
         mut cmd: Held,
         v2: bool,
+        ramp: bool,
     ) {
         self.abort_superposition(cx);
         self.abort_all(cx);
+        let mut set = CamSet::single(law, v2);
+        set.ramp = ramp;
         self.coupling = Some(Coupling {
             master,
-            law: CouplingLaw::Cam(CamSet::single(law, v2)),
+            law: CouplingLaw::Cam(set),
             dyn_command: 0,
         });
+        if ramp {
+            // The command keeps the axis (Active) until the slave has caught up (InSync).
+            let out = FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            };
+            cmd.emit(cx, out);
+            let mut j = Job::new(cmd.id, JobKind::Gear);
+            j.out = out;
+            self.job = Some(j);
+            return;
+        }
         cmd.emit(
             cx,
             FbOutputs {
@@ -942,8 +1079,8 @@ impl Axis {
                         self.set.position,
                         None,
                     );
-                    match self.check_no_jump(&mut law, cam, &m.set, self.set) {
-                        Ok(()) => self.start_cam_coupling(cx, p.master, law, p.cmd, p.v2),
+                    match self.join_cam(&p.ci, &mut law, cam, &m.set, true) {
+                        Ok(ramp) => self.start_cam_coupling(cx, p.master, law, p.cmd, p.v2, ramp),
                         Err(e) => p.cmd.end(cx, End::Error(e)),
                     }
                 } else {
@@ -1050,6 +1187,7 @@ impl Axis {
             master_scaling_mode: d.master_scaling_mode,
             slave_scaling_mode: d.slave_scaling_mode,
             interpolation: law.interpolation,
+            ramp_in: RampIn::default(),
         };
         let mut new = self.law_for(
             &ci,
@@ -1164,6 +1302,7 @@ fn as_cam_in(op: &CamInV2) -> CamIn {
         master_scaling_mode: d.master_scaling_mode,
         slave_scaling_mode: d.slave_scaling_mode,
         interpolation: op.interpolation,
+        ramp_in: RampIn::default(),
     }
 }
 

@@ -461,6 +461,9 @@ impl Axis {
         if let Some(set) = c.law.slave_setpoint(&followed, dt, cx.cams) {
             self.set = set;
         }
+        if let CouplingLaw::Cam(cams) = &mut c.law {
+            self.step_ramp_in(cx, job, cams, dt);
+        }
         self.set_has_superposition = false;
         if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
             let out = FbOutputs {

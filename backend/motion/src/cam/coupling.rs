@@ -21,6 +21,15 @@ pub enum StartMode {
     MasterAbsSlaveRel,
     /// 4: master relative, slave absolute.
     MasterRelSlaveAbs,
+    /// PLCopen `ramp_in` (not in TwinCAT's MC_StartMode): master and slave absolute; a slave
+    /// that is not where the cam puts it catches up with the `ramp_in` dynamics instead of
+    /// being refused (decision 75).
+    RampIn,
+    /// PLCopen `ramp_in_pos`: as `ramp_in`, catching up forwards only (the cam position taken
+    /// modulo AxisEncoderModuloValue ahead of the slave).
+    RampInPositive,
+    /// PLCopen `ramp_in_neg`: as `ramp_in`, catching up backwards only.
+    RampInNegative,
 }
 
 impl StartMode {
@@ -30,6 +39,26 @@ impl StartMode {
     pub fn slave_relative(self) -> bool {
         matches!(self, StartMode::Relative | StartMode::MasterAbsSlaveRel)
     }
+    /// The slave ramps in to the cam (PLCopen ramp-in start modes).
+    pub fn ramp_in(self) -> bool {
+        matches!(
+            self,
+            StartMode::RampIn | StartMode::RampInPositive | StartMode::RampInNegative
+        )
+    }
+}
+
+/// How a ramp-in start mode catches the slave up with its cam: limits of the slave's deviation
+/// from the cam position (relative to the cam's own motion). `velocity` must be given for a
+/// ramp-in; acceleration, deceleration and jerk 0 mean the axis defaults (#1004–#1006).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct RampIn {
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
 }
 
 /// `MC_CamActivationMode` (spec §1.7): when a coupling, a cam switch or a scaling takes effect.
@@ -94,6 +123,8 @@ pub struct CamIn {
     /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table
     /// (`None`: the table's own; motion functions ignore it).
     pub interpolation: Option<InterpolationType>,
+    /// The catch-up of a ramp-in start mode (ignored by the others).
+    pub ramp_in: RampIn,
 }
 
 /// MC_CamScaling: new offsets and scalings of the coupling.

@@ -41,7 +41,8 @@ pub use analysis::{
 };
 pub use coupling::{
     CamActivationMode, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling, CamScalingData,
-    CamScalingMode, CamScalingV2, CamStore, CamTerm, MAX_CAM_TABLE_ID, OnlineChange, StartMode,
+    CamScalingMode, CamScalingV2, CamStore, CamTerm, MAX_CAM_TABLE_ID, OnlineChange, RampIn,
+    StartMode,
 };
 pub use function::{MotionFunction, MotionFunctionPoint, Segment};
 pub use law::{MotionFunctionType, MotionPointType};

@@ -28,6 +28,7 @@ fn cam_in(master: u16, table: u32) -> CamIn {
         master_scaling_mode: CamScalingMode::UserDefined,
         slave_scaling_mode: CamScalingMode::UserDefined,
         interpolation: None,
+        ramp_in: RampIn::default(),
     }
 }
 
@@ -529,6 +530,120 @@ fn a_coupling_interpolates_a_position_table_its_own_way() {
         "the spline coupling followed the linear one ({apart})"
     );
     assert!((r.st(2).set_position - (360.0 + 60.0)).abs() < 1e-6);
+}
+
+/// PLCopen ramp-in start modes (decision 75): a slave that is not where the cam puts it is
+/// not refused but catches up — its deviation from the cam run down to 0 within the ramp-in
+/// velocity, acceleration and jerk, continuous from its own motion — the MC_CamIn Busy and
+/// Active until InSync, the slave exactly on the cam from then on. `ramp_in_positive` takes
+/// the cam position modulo 360 ahead of the slave and never moves it backwards.
+#[test]
+fn a_ramp_in_catches_the_slave_up_with_its_cam() {
+    for mode in [StartMode::RampIn, StartMode::RampInPositive] {
+        let mut r = rig_at(0.0, 50.0);
+        r.cam(T_LINE, &line(true));
+        assert_eq!(
+            r.rejected(1, CommandKind::CamIn(cam_in(0, T_LINE))),
+            ErrorId::CAM_SLAVE_WOULD_JUMP
+        );
+        let ramp = CamIn {
+            start_mode: mode,
+            ramp_in: RampIn {
+                velocity: 200.0,
+                acceleration: 1000.0,
+                deceleration: 1000.0,
+                jerk: 10000.0,
+            },
+            ..cam_in(0, T_LINE)
+        };
+        // A ramp-in needs its velocity.
+        let mut slow = ramp;
+        slow.ramp_in.velocity = 0.0;
+        assert_eq!(
+            r.rejected(1, CommandKind::CamIn(slow)),
+            ErrorId::PARAMETER_NOT_CORRECT
+        );
+        // The master runs at 100 mm/s; the slave stands at 50.
+        r.ok(0, velocity(100.0, Direction::Positive));
+        r.until(1.0, |r| r.st(0).set_velocity >= 100.0);
+        r.run(0.1);
+        let c = r.ok(1, CommandKind::CamIn(ramp));
+        assert!(r.out(c).busy && r.out(c).active && !r.out(c).in_sync);
+        assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
+        let (mut p0, mut v0) = (r.st(1).set_position, r.st(1).set_velocity);
+        let target = |m: f64| {
+            if mode == StartMode::RampInPositive {
+                m + 360.0
+            } else {
+                m
+            }
+        };
+        let cycles = r.until(5.0, |r| {
+            let s = r.st(1);
+            // Continuous: no velocity step beyond the ramp's and the cam's acceleration.
+            assert!(
+                (s.set_velocity - v0).abs() <= 1000.0 * DT + 1e-6,
+                "{} after {v0}",
+                s.set_velocity
+            );
+            assert!((s.set_position - p0 - s.set_velocity * DT).abs() < 1e-3);
+            // The deviation's rate stays within the ramp-in velocity.
+            assert!((s.set_velocity - r.st(0).set_velocity).abs() <= 200.0 + 1e-6);
+            if mode == StartMode::RampInPositive {
+                assert!(s.set_velocity >= -1e-9, "backwards at {}", s.set_velocity);
+            }
+            (p0, v0) = (s.set_position, s.set_velocity);
+            r.out(c).in_sync
+        });
+        assert!(cycles > 10, "{mode:?}: in sync after {cycles} cycles");
+        let o = r.out(c);
+        assert!(!o.busy && !o.active && !o.error, "{o:?}");
+        r.run(0.2);
+        let (m, s) = (r.st(0).set_position, r.st(1).set_position);
+        assert!(
+            (s - target(m)).abs() < 1e-9,
+            "{mode:?}: slave {s}, master {m}"
+        );
+        assert_eq!(r.st(1).state, AxisState::SynchronizedMotion);
+    }
+}
+
+/// MC_CamOut during the ramp-in aborts the MC_CamIn and lets the slave go on at the velocity
+/// the ramp gave it, without a jump; a ramp-in while coupled (a switch) is refused.
+#[test]
+fn a_ramp_in_is_aborted_like_any_coupling() {
+    let mut r = rig_at(0.0, 50.0);
+    r.cam(T_LINE, &line(true));
+    let ramp = CamIn {
+        start_mode: StartMode::RampIn,
+        ramp_in: RampIn {
+            velocity: 20.0,
+            ..RampIn::default()
+        },
+        ..cam_in(0, T_LINE)
+    };
+    let c = r.ok(1, CommandKind::CamIn(ramp));
+    r.run(0.5);
+    assert!(r.out(c).busy);
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(ramp)),
+        ErrorId::CAM_MODE_INVALID
+    );
+    let (p, v) = (r.st(1).set_position, r.st(1).set_velocity);
+    assert!(p < 50.0 - 5.0 && p > 0.0, "ramping down from 50: {p}");
+    assert!(v < -1.0, "{v}");
+    // MC_CamOut: the slave keeps the velocity the ramp gave it; the MC_CamIn is aborted.
+    let o = r.ok(1, CommandKind::CamOut);
+    assert!(r.out(c).command_aborted && !r.out(c).busy, "{:?}", r.out(c));
+    assert!(r.out(o).done);
+    r.step();
+    assert_eq!(r.st(1).state, AxisState::ContinuousMotion);
+    assert!(
+        (r.st(1).set_velocity - v).abs() < 1e-6,
+        "{} after {v}",
+        r.st(1).set_velocity
+    );
+    assert!((r.st(1).set_position - (p + v * DT)).abs() < 1e-6);
 }
 
 /// A cam slave is a coupled slave: one that crosses its soft limit is decoupled and stopped

@@ -405,6 +405,26 @@ impl CamInBody {
             [self.master_scaling, self.slave_scaling],
         );
         c.interpolation(self.interpolation);
+        let ramp_in = self.ramp_in.unwrap_or_default();
+        if self.start_mode.ramp_in() {
+            if !(ramp_in.velocity > 0.0 && ramp_in.velocity.is_finite()) {
+                c.fail(
+                    "ramp_in.velocity",
+                    "a ramp-in start mode needs its velocity (> 0)",
+                );
+            }
+            for (field, v) in [
+                ("ramp_in.acceleration", ramp_in.acceleration),
+                ("ramp_in.deceleration", ramp_in.deceleration),
+                ("ramp_in.jerk", ramp_in.jerk),
+            ] {
+                if !(v >= 0.0 && v.is_finite()) {
+                    c.fail(field, "must be a finite number ≥ 0 (0: the axis default)");
+                }
+            }
+        } else if self.ramp_in.is_some() {
+            c.fail("ramp_in", "only with a ramp_in start mode");
+        }
         c.done(CommandKind::CamIn(motion::cam::CamIn {
             master,
             cam_table,
@@ -418,6 +438,7 @@ impl CamInBody {
             master_scaling_mode: self.master_scaling_mode,
             slave_scaling_mode: self.slave_scaling_mode,
             interpolation: self.interpolation,
+            ramp_in,
         }))
     }
 }
