@@ -644,12 +644,7 @@ async fn a_coupling_chooses_its_own_interpolation() {
         json!({"master": "x", "cam_table": "bent", "interpolation": "4point"}),
     )
     .await;
-    assert_eq!(
-        (r.status, r.json["errors"][0]["field"].as_str()),
-        (422, Some("interpolation")),
-        "{}",
-        r.text
-    );
+    assert_eq!(r.field_error(), (422, Some("interpolation")), "{}", r.text);
     assert_eq!(status(&s, "y").await["status"]["state"], "standstill");
     let r = post(
         &s,
@@ -704,24 +699,14 @@ async fn a_ramp_in_couples_a_slave_away_from_its_cam() {
         json!({"master": "x", "cam_table": "p5", "start_mode": "ramp_in"}),
     )
     .await;
-    assert_eq!(
-        (r.status, r.json["errors"][0]["field"].as_str()),
-        (422, Some("ramp_in.velocity")),
-        "{}",
-        r.text
-    );
+    assert_eq!(r.field_error(), (422, Some("ramp_in.velocity")), "{}", r.text);
     let r = post(
         &s,
         "/api/v1/axes/y/cam-in",
         json!({"master": "x", "cam_table": "p5", "ramp_in": {"velocity": 50.0}}),
     )
     .await;
-    assert_eq!(
-        (r.status, r.json["errors"][0]["field"].as_str()),
-        (422, Some("ramp_in")),
-        "{}",
-        r.text
-    );
+    assert_eq!(r.field_error(), (422, Some("ramp_in")), "{}", r.text);
     assert_eq!(status(&s, "y").await["status"]["state"], "standstill");
     let r = post(
         &s,

@@ -119,6 +119,13 @@ pub struct Resp {
     pub json: Value,
 }
 
+impl Resp {
+    /// The status and the JSON path of the first field a 422 names.
+    pub fn field_error(&self) -> (u16, Option<&str>) {
+        (self.status, self.json["errors"][0]["field"].as_str())
+    }
+}
+
 /// Sends a request as a well-behaved client does: a POST, PUT or DELETE is declared JSON, also
 /// without a body (motiond answers 415 otherwise).
 pub async fn req(method: reqwest::Method, url: &str, body: Option<Value>) -> Resp {
