@@ -65,9 +65,8 @@ async fn ws_client(addr: String, axes: Vec<String>, rate: f64, secs: f64) -> (u6
     while let Ok(Some(Ok(m))) = tokio::time::timeout_at(end.into(), ws.next()).await {
         if let Message::Text(t) = m {
             bytes += t.len() as u64;
-            if t.contains("\"update\"") {
-                updates += 1;
-            }
+            // One message per tick: the updates due together come as a JSON-RPC batch.
+            updates += t.matches("\"method\":\"update\"").count() as u64;
         }
     }
     let _ = ws.close(None).await;

@@ -699,7 +699,12 @@ async fn a_ramp_in_couples_a_slave_away_from_its_cam() {
         json!({"master": "x", "cam_table": "p5", "start_mode": "ramp_in"}),
     )
     .await;
-    assert_eq!(r.field_error(), (422, Some("ramp_in.velocity")), "{}", r.text);
+    assert_eq!(
+        r.field_error(),
+        (422, Some("ramp_in.velocity")),
+        "{}",
+        r.text
+    );
     let r = post(
         &s,
         "/api/v1/axes/y/cam-in",

@@ -9,14 +9,39 @@ use futures_util::{SinkExt, StreamExt};
 use serde_json::{Value, json};
 use tokio_tungstenite::tungstenite::Message;
 
-type Ws =
+type Stream =
     tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
 
+/// A socket and the JSON-RPC messages of a batch (a JSON array) not read yet.
+struct Ws {
+    stream: Stream,
+    queue: std::collections::VecDeque<Value>,
+    /// Batches received (messages that were JSON arrays).
+    batches: usize,
+}
+
+impl std::ops::Deref for Ws {
+    type Target = Stream;
+    fn deref(&self) -> &Stream {
+        &self.stream
+    }
+}
+
+impl std::ops::DerefMut for Ws {
+    fn deref_mut(&mut self) -> &mut Stream {
+        &mut self.stream
+    }
+}
+
 async fn connect(s: &Server) -> Ws {
-    let (ws, _) = tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
+    let (stream, _) = tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
         .await
         .expect("websocket connects");
-    ws
+    Ws {
+        stream,
+        queue: Default::default(),
+        batches: 0,
+    }
 }
 
 async fn send(ws: &mut Ws, id: u64, method: &str, params: Value) {
@@ -24,11 +49,21 @@ async fn send(ws: &mut Ws, id: u64, method: &str, params: Value) {
     ws.send(Message::Text(m.to_string().into())).await.unwrap();
 }
 
-/// Next JSON message, or None after `timeout`.
+/// Next JSON-RPC message (one of a batch in turn), or None after `timeout`.
 async fn next(ws: &mut Ws, timeout: Duration) -> Option<Value> {
     loop {
-        match tokio::time::timeout(timeout, ws.next()).await {
-            Ok(Some(Ok(Message::Text(t)))) => return Some(serde_json::from_str(&t).unwrap()),
+        if let Some(m) = ws.queue.pop_front() {
+            return Some(m);
+        }
+        match tokio::time::timeout(timeout, ws.stream.next()).await {
+            Ok(Some(Ok(Message::Text(t)))) => match serde_json::from_str(&t).unwrap() {
+                Value::Array(batch) => {
+                    assert!(batch.len() > 1, "a batch of one: {t}");
+                    ws.batches += 1;
+                    ws.queue.extend(batch);
+                }
+                m => return Some(m),
+            },
             Ok(Some(Ok(_))) => continue,
             _ => return None,
         }
@@ -606,4 +641,84 @@ async fn a_client_that_answers_pings_keeps_its_socket() {
     // And it still works.
     send(&mut ws, 1, "unsubscribe", json!({"topic": "system"})).await;
     assert_eq!(response(&mut ws, 1).await.0["result"], false);
+}
+
+/// A socket subscribed to several axes gets one message per tick: the updates due together
+/// come as one JSON-RPC batch (an array), each a delta of its own topic; two sockets on the
+/// same axis at the same rate get the same updates.
+#[tokio::test(flavor = "multi_thread")]
+async fn updates_due_together_come_as_one_batch() {
+    let s = Server::start();
+    let mut a = connect(&s).await;
+    let mut b = connect(&s).await;
+    for (i, axis) in ["x", "y"].iter().enumerate() {
+        let id = 10 + i as u64;
+        send(&mut a, id, "power", json!({"axis": axis, "wait": true})).await;
+        let (r, _) = response(&mut a, id).await;
+        assert_eq!(r["result"]["outputs"]["status"], true, "{r}");
+    }
+    for (id, topic) in [(1, "axes/x/status"), (2, "axes/y/status")] {
+        send(
+            &mut a,
+            id,
+            "subscribe",
+            json!({"topic": topic, "rate_hz": 50}),
+        )
+        .await;
+        response(&mut a, id).await;
+    }
+    send(
+        &mut b,
+        1,
+        "subscribe",
+        json!({"topic": "axes/x/status", "rate_hz": 50}),
+    )
+    .await;
+    response(&mut b, 1).await;
+    for (id, axis) in [(20, "x"), (21, "y")] {
+        send(
+            &mut a,
+            id,
+            "move-velocity",
+            json!({"axis": axis, "velocity": 20.0}),
+        )
+        .await;
+        let (r, _) = response(&mut a, id).await;
+        assert!(r["error"].is_null(), "{r}");
+    }
+    // Read a second of updates on both sockets.
+    let (mut on_a, mut on_b) = (Vec::new(), Vec::new());
+    for (ws, seen) in [(&mut a, &mut on_a), (&mut b, &mut on_b)] {
+        let end = tokio::time::Instant::now() + Duration::from_secs(1);
+        while tokio::time::Instant::now() < end {
+            match next(ws, Duration::from_secs(5)).await {
+                Some(m) if m["method"] == "update" => seen.push(m["params"].clone()),
+                Some(_) => {}
+                None => break,
+            }
+        }
+    }
+    assert!(a.batches > 0, "no batch on a socket with two moving axes");
+    assert_eq!(b.batches, 0, "a socket with one subscription got a batch");
+    for topic in ["axes/x/status", "axes/y/status"] {
+        let moving = on_a
+            .iter()
+            .filter(|u| u["topic"] == topic && u["data"]["set_position"].is_number())
+            .count();
+        assert!(moving > 5, "{topic}: {moving} position updates");
+    }
+    // b's updates of x, by cycle, are the ones a got for the same cycles.
+    let mut same = 0;
+    for u in on_b.iter().filter(|u| u["full"] == false) {
+        if let Some(v) = on_a.iter().find(|v| {
+            v["topic"] == "axes/x/status" && v["cycle"] == u["cycle"] && v["full"] == false
+        }) {
+            assert_eq!(u["data"], v["data"]);
+            same += 1;
+        }
+    }
+    assert!(same > 0, "no common cycle between the two sockets");
+    for ws in [&mut a, &mut b] {
+        send(ws, 99, "stop", json!({"axis": "x"})).await;
+    }
 }

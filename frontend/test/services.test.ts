@@ -76,6 +76,24 @@ describe('status stream', () => {
     expect(t.broken).toBe(true);
     expect(statuses.get().get('tx')!.stale).toBe(true);
   });
+
+  it('takes a batch (the updates of one tick as a JSON-RPC array) update by update', async () => {
+    serve((u) =>
+      u.endsWith('/axes')
+        ? [
+            { id: 1, state: 'standstill', config: { name: 'bx', unit: 'mm' } },
+            { id: 2, state: 'standstill', config: { name: 'by', unit: 'mm' } },
+          ]
+        : [],
+    );
+    await refreshAxes();
+    const update = (topic: string, cycle: number, full: boolean, data: object) => ({ jsonrpc: '2.0', method: 'update', params: { topic, cycle, full, data } });
+    const batch = (...m: object[]) => (live as unknown as { onMessage(t: string): void }).onMessage(JSON.stringify(m));
+    batch(update('axes/bx/status', 200, true, status(1, 0)), update('axes/by/status', 200, true, status(2, 0)));
+    batch(update('axes/bx/status', 210, false, { set_velocity: 3 }), update('axes/by/status', 210, false, { set_velocity: 4 }));
+    expect(statuses.get().get('bx')).toMatchObject({ cycle: 210, status: { set_velocity: 3, actual_velocity: 0 } });
+    expect(statuses.get().get('by')).toMatchObject({ cycle: 210, status: { set_velocity: 4, actual_velocity: 1 } });
+  });
 });
 
 describe('a subscription the server ends', () => {

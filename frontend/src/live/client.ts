@@ -166,6 +166,15 @@ export class LiveClient {
     } catch {
       return;
     }
+    // The server sends the updates due in one tick as a JSON-RPC batch (an array).
+    if (Array.isArray(msg)) {
+      for (const m of msg) this.onRpc(m);
+    } else {
+      this.onRpc(msg);
+    }
+  }
+
+  private onRpc(msg: any): void {
     if (msg && msg.id !== undefined && msg.id !== null && ('result' in msg || 'error' in msg)) {
       const p = this.pending.get(msg.id);
       if (!p) return;

@@ -314,7 +314,9 @@ pub fn document() -> Value {
     REST API. Text messages only (a binary one is an error), at most 256 KiB. At most {} requests per socket may \
     await their responses; more are refused (-32000, data.code `too_many_in_flight`). The server sends a websocket \
     Ping when it has received nothing from the client for {} s and closes the socket when nothing (no Pong, no \
-    message) arrives within {} s after it (`--ws-ping-s`). The same checks as for REST apply to the upgrade request \
+    message) arrives within {} s after it (`--ws-ping-s`). Notifications due in the same tick of the server's 5 ms \
+    grid (the updates of several subscriptions) are sent as one JSON-RPC 2.0 batch: a JSON array of the \
+    notifications described here; a subscription is due on the same ticks in every socket. The same checks as for REST apply to the upgrade request \
     (Host, Origin; see the OpenAPI document's `GET /api/v1/ws`).",
                 ws::MAX_IN_FLIGHT, ws::DEFAULT_PING_S, ws::DEFAULT_PING_S
             ),

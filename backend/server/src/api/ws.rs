@@ -55,7 +55,7 @@ impl Default for Settings {
         }
     }
 }
-const TICK: Duration = Duration::from_millis(5);
+use crate::app::feed::TICK;
 
 // ---------------------------------------------------------------------------------------------
 // The messages, as types: the session serialises these, and `super::asyncapi` describes the
@@ -177,6 +177,8 @@ the client's to renew whatever the transport (`keepalive` within its `deadman_ti
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
 closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). \
 A request without an id is a notification: carried out, never answered. \
+The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of \
+several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. \
 Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has \
 heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again.",
     responses((status = 101, description = "Switching protocols"), super::errors::WebsocketErrors))]
@@ -227,9 +229,13 @@ enum Topic {
 
 struct Sub {
     key: String,
+    /// `key` as a JSON string (written into every update).
+    key_json: String,
     topic: Topic,
-    every: Duration,
-    due: Instant,
+    /// The rate, in feed ticks; due on the ticks that are multiples of it (the same ticks in
+    /// every socket, so that subscribers share the feed's deltas).
+    every: u64,
+    due: u64,
     last: Option<crate::app::StatusJson>,
 }
 
@@ -269,7 +275,7 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
     let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
     let in_flight = Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT));
-    let mut tick = tokio::time::interval(TICK);
+    let mut tick = tokio::time::interval_at(s.feed.next_tick_at(Instant::now()), TICK);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     // Idle watch: a Ping after `ping_after` without anything from the client, then the socket
     // is closed if nothing arrives within `ping_after` (a dead peer or a frozen client).
@@ -313,10 +319,22 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                 Err(broadcast::error::RecvError::Lagged(k)) => vec![notify("commands_lagged", CommandsLagged { missed: k })],
                 Err(broadcast::error::RecvError::Closed) => vec![],
             },
-            _ = tick.tick() => {
+            at = tick.tick() => {
                 // Socket jogs are not renewed here: only the client's keepalives renew them,
                 // so a client whose script hangs with the socket open still stops the axis.
-                updates(&s, &mut subs, Instant::now())
+                let mut due = updates(&s, &mut subs, s.feed.tick_of(at));
+                if due.len() > 1 {
+                    // One message per tick: a JSON-RPC batch of the notifications.
+                    let len = due.iter().map(|m| m.len() + 1).sum::<usize>() + 1;
+                    let mut batch = String::with_capacity(len);
+                    for (i, m) in due.iter().enumerate() {
+                        batch.push(if i == 0 { '[' } else { ',' });
+                        batch.push_str(m);
+                    }
+                    batch.push(']');
+                    due = vec![batch];
+                }
+                due
             }
         };
         for m in outgoing {
@@ -364,58 +382,73 @@ fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
     });
 }
 
-fn updates(s: &AppState, subs: &mut Vec<Sub>, now: Instant) -> Vec<String> {
+fn updates(s: &AppState, subs: &mut Vec<Sub>, tick: u64) -> Vec<String> {
     let mut out = Vec::new();
     if subs
         .iter()
-        .any(|x| now >= x.due && matches!(x.topic, Topic::Axis { .. }))
+        .any(|x| tick >= x.due && matches!(x.topic, Topic::Axis { .. }))
     {
         follow_axes(s, subs, &mut out);
     }
-    for sub in subs.iter_mut().filter(|x| now >= x.due) {
-        // Keep the rate's grid; a client that fell behind skips what it missed.
-        sub.due += sub.every;
-        if sub.due <= now {
-            sub.due = now + sub.every;
-        }
-        let (cycle, map) = match &sub.topic {
-            Topic::Commands => continue,
-            Topic::Axis { slot, .. } => match s.status_json(*slot) {
-                Some(x) => x,
-                None => continue,
-            },
-            Topic::System => {
-                let sys = super::system::system_resource(s);
-                let Ok(Value::Object(m)) = serde_json::to_value(&sys) else {
+    for sub in subs.iter_mut().filter(|x| tick >= x.due) {
+        // The rate's grid; a socket that fell behind skips what it missed.
+        sub.due = (tick / sub.every + 1) * sub.every;
+        match &sub.topic {
+            Topic::Commands => {}
+            Topic::Axis { slot, .. } => {
+                let Some(p) = s.feed.piece(s, *slot, tick, sub.last.as_ref()) else {
                     continue;
                 };
-                (sys.cycle, Arc::new(m))
+                sub.last = Some(p.map);
+                if let Some(data) = p.data {
+                    out.push(update_message(&sub.key_json, p.cycle, p.full, &data));
+                }
             }
-        };
-        let data: Map<String, Value> = match &sub.last {
-            None => (*map).clone(),
-            Some(last) => map
-                .iter()
-                .filter(|(k, v)| last.get(*k) != Some(v))
-                .map(|(k, v)| (k.clone(), v.clone()))
-                .collect(),
-        };
-        let full = sub.last.is_none();
-        if !full && data.is_empty() {
-            continue;
+            Topic::System => {
+                let sys = super::system::system_resource(s);
+                let Ok(Value::Object(map)) = serde_json::to_value(&sys) else {
+                    continue;
+                };
+                let data = match &sub.last {
+                    None => map.clone(),
+                    Some(last) => crate::app::feed::delta(last, &map),
+                };
+                let full = sub.last.is_none();
+                sub.last = Some(Arc::new(map));
+                if full || !data.is_empty() {
+                    out.push(notify(
+                        "update",
+                        UpdateParams {
+                            topic: sub.key.clone(),
+                            cycle: sys.cycle,
+                            full,
+                            data,
+                        },
+                    ));
+                }
+            }
         }
-        sub.last = Some(map);
-        out.push(notify(
-            "update",
-            UpdateParams {
-                topic: sub.key.clone(),
-                cycle,
-                full,
-                data,
-            },
-        ));
     }
     out
+}
+
+/// An `update` notification (as `UpdateParams` serialises) from the feed's ready JSON.
+fn update_message(topic_json: &str, cycle: u64, full: bool, data: &str) -> String {
+    use std::fmt::Write;
+    const HEAD: &str = r#"{"jsonrpc":"2.0","method":"update","params":{"topic":"#;
+    let mut m = String::with_capacity(HEAD.len() + topic_json.len() + data.len() + 48);
+    m.push_str(HEAD);
+    m.push_str(topic_json);
+    m.push_str(r#","cycle":"#);
+    let _ = write!(m, "{cycle}");
+    m.push_str(if full {
+        r#","full":true,"data":"#
+    } else {
+        r#","full":false,"data":"#
+    });
+    m.push_str(data);
+    m.push_str("}}");
+    m
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -517,11 +550,13 @@ fn handle(
                 _ => key.clone(),
             };
             subs.retain(|x| x.key != canonical && x.key != key);
+            let every = (1.0 / (rate * TICK.as_secs_f64())).round().max(1.0) as u64;
             subs.push(Sub {
+                key_json: serde_json::to_string(&key).unwrap_or_default(),
                 key: key.clone(),
                 topic,
-                every: Duration::from_secs_f64(1.0 / rate),
-                due: Instant::now(),
+                every,
+                due: 0,
                 last: None,
             });
             let result = SubscribeResult {
@@ -661,4 +696,37 @@ fn too_many_in_flight(id: &Value) -> String {
         &format!("too many requests in flight ({MAX_IN_FLIGHT}): read their responses first"),
         Some(json!({"code": "too_many_in_flight"})),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The update written from the feed's ready JSON is the `UpdateParams` notification the
+    /// AsyncAPI document describes (the same JSON value; members in another order).
+    #[test]
+    fn an_update_from_the_feed_is_the_described_notification() {
+        let mut data = Map::new();
+        data.insert("set_position".into(), json!(12.5));
+        data.insert("state".into(), json!("discrete_motion"));
+        for (topic, full) in [("axes/x/status", false), ("axes/\"q\"/status", true)] {
+            let typed = notify(
+                "update",
+                UpdateParams {
+                    topic: topic.into(),
+                    cycle: 4711,
+                    full,
+                    data: data.clone(),
+                },
+            );
+            let fast = update_message(
+                &serde_json::to_string(topic).unwrap(),
+                4711,
+                full,
+                &serde_json::to_string(&data).unwrap(),
+            );
+            let parse = |t: &str| serde_json::from_str::<Value>(t).unwrap();
+            assert_eq!(parse(&fast), parse(&typed), "{fast}");
+        }
+    }
 }

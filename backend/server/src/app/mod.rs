@@ -4,6 +4,7 @@
 //! the machinery they use.
 
 mod commands;
+pub mod feed;
 mod link;
 mod pump;
 mod registry;
@@ -45,6 +46,8 @@ pub struct AppState {
     snapshot: Mutex<triple_buffer::Output<Snapshot>>,
     /// Per slot: the status of the latest cycle already turned into JSON.
     status_json: Mutex<Vec<Option<(u64, StatusJson)>>>,
+    /// The websocket status feed (deltas made once per tick for every subscriber).
+    pub feed: feed::Feed,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -79,6 +82,7 @@ impl AppState {
             shared,
             snapshot: Mutex::new(snapshot),
             status_json: Mutex::new(vec![None; MAX_AXES]),
+            feed: feed::Feed::new(MAX_AXES),
             registry: RwLock::new(Registry::default()),
             config_lock: tokio::sync::Mutex::new(()),
             commands: Mutex::new(CommandStore::default()),
