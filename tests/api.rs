@@ -2037,3 +2037,147 @@ async fn the_audit_log_pages_back_and_forth() {
         assert_eq!(r.status, 422, "{q}: {}", r.text);
     }
 }
+
+/// `/metrics` (issue 13): ~20 buckets per timing histogram (all of them with `buckets=fine`),
+/// `motiond_build_info`, process figures, per-axis gauges, and submitted commands counted by
+/// block and verdict; the classic text format is well formed (every sample belongs to the family
+/// its `# TYPE` names, counters end in `_total`, buckets rise to `+Inf` = `_count`), small, and
+/// OpenMetrics is served to whoever asks for it.
+#[tokio::test(flavor = "multi_thread")]
+async fn metrics_count_commands_and_describe_axes_and_process() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 5000.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_eq!(r.status, 409, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 5.0, "velocity": -1.0}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    let m = get(&s, "/metrics").await;
+    assert_eq!(m.status, 200);
+    assert!(
+        m.content_type.starts_with("text/plain; version=0.0.4"),
+        "{}",
+        m.content_type
+    );
+    let t = &m.text;
+    assert!(t.len() < 10_000, "{} bytes", t.len());
+    for line in [
+        "motiond_commands_total{block=\"power\",verdict=\"accepted\"} 1",
+        "motiond_commands_total{block=\"move-absolute\",verdict=\"rejected\"} 1",
+        "motiond_commands_total{block=\"move-absolute\",verdict=\"invalid\"} 1",
+        "motiond_axis_state{axis=\"x\"} 1",
+        "motiond_axis_error_id{axis=\"y\"} 0",
+    ] {
+        assert!(
+            t.lines().any(|l| l.starts_with(line)),
+            "{line} missing:\n{t}"
+        );
+    }
+    for name in [
+        "motiond_build_info{version=",
+        "process_resident_memory_bytes ",
+        "process_cpu_seconds_total ",
+        "process_open_fds ",
+        "motiond_axis_following_error_peak{axis=\"x\"}",
+        "motiond_cycle_requests_total ",
+    ] {
+        assert!(t.contains(name), "{name} missing");
+    }
+    // Well formed: each sample's family is the last `# TYPE`.
+    let mut family = String::new();
+    let mut kind = String::new();
+    let mut buckets: Vec<(String, u64)> = Vec::new();
+    let mut count = None;
+    let mut histograms = 0;
+    let mut end_of = |family: &str, buckets: &mut Vec<(String, u64)>, count: &mut Option<u64>| {
+        if let Some(n) = count.take() {
+            assert_eq!(
+                buckets.last().map(|b| (b.0.as_str(), b.1)),
+                Some(("+Inf", n)),
+                "{family}"
+            );
+            assert!(
+                (18..=26).contains(&buckets.len()),
+                "{family}: {} buckets",
+                buckets.len()
+            );
+            histograms += 1;
+        }
+        buckets.clear();
+    };
+    for line in t.lines() {
+        if let Some(rest) = line.strip_prefix("# TYPE ") {
+            end_of(&family, &mut buckets, &mut count);
+            let (f, k) = rest.split_once(' ').unwrap();
+            (family, kind) = (f.to_string(), k.to_string());
+            assert!(kind != "counter" || family.ends_with("_total"), "{line}");
+            continue;
+        }
+        if line.starts_with('#') {
+            assert!(line.starts_with("# HELP "), "{line}");
+            continue;
+        }
+        let name = line.split(['{', ' ']).next().unwrap();
+        if kind == "histogram" {
+            let suffix = name
+                .strip_prefix(family.as_str())
+                .unwrap_or_else(|| panic!("{line} not in {family}"));
+            assert!(["_bucket", "_sum", "_count"].contains(&suffix), "{line}");
+            let v = line.rsplit(' ').next().unwrap();
+            if suffix == "_bucket" {
+                let le = line
+                    .split("le=\"")
+                    .nth(1)
+                    .unwrap()
+                    .split('"')
+                    .next()
+                    .unwrap();
+                buckets.push((le.to_string(), v.parse().unwrap()));
+                assert!(
+                    buckets.windows(2).all(|w| w[0].1 <= w[1].1),
+                    "{family}: not cumulative"
+                );
+            } else if suffix == "_count" {
+                count = Some(v.parse().unwrap());
+            }
+        } else {
+            assert_eq!(name, family, "{line}");
+        }
+    }
+    end_of(&family, &mut buckets, &mut count);
+    assert_eq!(histograms, 3);
+    let fine = get(&s, "/metrics?buckets=fine").await;
+    let n = fine
+        .text
+        .lines()
+        .filter(|l| l.starts_with("motiond_cycle_compute_seconds_bucket"))
+        .count();
+    assert!(n > 300, "{n} fine buckets");
+    let r = get(&s, "/metrics?buckets=coarse").await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    let om = reqwest::Client::new()
+        .get(s.url("/metrics"))
+        .header(
+            "accept",
+            "application/openmetrics-text;version=1.0.0,text/plain;q=0.5",
+        )
+        .send()
+        .await
+        .unwrap();
+    assert!(
+        om.headers()["content-type"]
+            .to_str()
+            .unwrap()
+            .starts_with("application/openmetrics-text")
+    );
+    assert!(om.text().await.unwrap().ends_with("# EOF\n"));
+}

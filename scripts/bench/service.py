@@ -29,7 +29,7 @@ def http(method, path, body=None):
 
 
 def metrics():
-    _, text = http("GET", "/metrics")
+    _, text = http("GET", "/metrics?buckets=fine")
     hist, counters = {}, {}
     for line in text.splitlines():
         m = re.match(r'(\w+)_bucket\{le="([^"]+)"\} (\d+)', line)

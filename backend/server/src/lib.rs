@@ -27,6 +27,7 @@ pub mod api;
 pub mod app;
 pub mod cycle;
 pub mod error;
+pub mod metrics;
 pub mod model;
 pub mod params;
 pub mod scope;

@@ -114,22 +114,14 @@ impl Histogram {
         }
     }
 
-    /// Prometheus histogram lines (seconds), cumulative at the fixed bucket bounds.
-    pub fn prometheus(&self, name: &str, help: &str, out: &mut String) {
-        use std::fmt::Write;
-        let counts = self.counts();
-        let _ = writeln!(out, "# HELP {name} {help}\n# TYPE {name} histogram");
-        // Every bucket bound (≈6 % steps) so that windowed quantiles can be computed from two
-        // scrapes; the set of bounds is fixed, as Prometheus requires.
-        let mut cumulative = 0u64;
-        for (i, c) in counts.iter().enumerate() {
-            cumulative += c;
-            let le = upper(i) as f64 / 1e9;
-            let _ = writeln!(out, "{name}_bucket{{le=\"{le:e}\"}} {cumulative}");
-        }
-        let _ = writeln!(out, "{name}_bucket{{le=\"+Inf\"}} {cumulative}");
-        let _ = writeln!(out, "{name}_sum {}", self.sum.load(Relaxed) as f64 / 1e9);
-        let _ = writeln!(out, "{name}_count {cumulative}");
+    /// The upper bounds (ns, exclusive) of the buckets, in the order of [`Histogram::counts`].
+    pub fn bounds_ns() -> impl Iterator<Item = u64> {
+        (0..BUCKETS).map(upper)
+    }
+
+    /// The sum of the samples (ns).
+    pub fn sum_ns(&self) -> u64 {
+        self.sum.load(Relaxed)
     }
 }
 

@@ -971,7 +971,10 @@ export interface paths {
             path?: never;
             cookie?: never;
         };
-        /** Prometheus metrics (text format 0.0.4) */
+        /**
+         * Metrics for Prometheus
+         * @description OpenMetrics text when the request accepts `application/openmetrics-text` (as Prometheus does), else the Prometheus text format 0.0.4. Cycle timing histograms, cycle and service counters, submitted commands by function block and verdict (`motiond_commands_total{block, verdict}`), per-axis gauges (state, error id, following error and its peak), `motiond_build_info` and the process's figures (`process_*`).
+         */
         get: operations["metrics"];
         put?: never;
         post?: never;
@@ -3678,6 +3681,10 @@ export interface components {
          * @description How a ramp-in start mode catches the slave up with its cam: limits of the slave's deviation
          *     from the cam position (relative to the cam's own motion). `velocity` must be given for a
          *     ramp-in; acceleration, deceleration and jerk 0 mean the axis defaults (#1004–#1006).
+         * @example {
+         *       "acceleration": 500,
+         *       "velocity": 50
+         *     }
          */
         RampIn: {
             /**
@@ -4856,6 +4863,30 @@ export interface components {
                  *       "status": 400,
                  *       "title": "Malformed JSON",
                  *       "type": "urn:motiond:problem:malformed_json"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Unknown `buckets` value or query parameter. */
+        MetricsQueryInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "query: Failed to deserialize query string: buckets: unknown variant `coarse`, expected `fine`",
+                 *       "errors": [
+                 *         {
+                 *           "field": "query",
+                 *           "message": "Failed to deserialize query string: buckets: unknown variant `coarse`, expected `fine`"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -7882,7 +7913,13 @@ export interface operations {
     };
     metrics: {
         parameters: {
-            query?: never;
+            query?: {
+                /**
+                 * @description `fine`: every bucket (≈6 % steps, 400 bounds) of the cycle timing histograms, for
+                 *     windowed quantiles between two scrapes; default: 22 bounds from 2 µs to 1 s.
+                 */
+                buckets?: "fine";
+            };
             header?: never;
             path?: never;
             cookie?: never;
@@ -7896,27 +7933,23 @@ export interface operations {
                 };
                 content: {
                     /**
-                     * @example # HELP motiond_cycle_compute_seconds Work per cycle.
+                     * @example # HELP motiond_cycle_compute_seconds Work per cycle
                      *     # TYPE motiond_cycle_compute_seconds histogram
-                     *     motiond_cycle_compute_seconds_bucket{le="6.4e-6"} 2871
-                     *     …
-                     *     motiond_cycle_compute_seconds_bucket{le="+Inf"} 5750
                      *     motiond_cycle_compute_seconds_sum 0.0522
                      *     motiond_cycle_compute_seconds_count 5750
-                     *     # HELP motiond_cycles_total Cycles run.
-                     *     # TYPE motiond_cycles_total counter
-                     *     motiond_cycles_total 5750
-                     *     # HELP motiond_cycle_overruns_total Deadlines missed.
-                     *     # TYPE motiond_cycle_overruns_total counter
-                     *     motiond_cycle_overruns_total 14
-                     *     # HELP motiond_axes Configured axes.
-                     *     # TYPE motiond_axes gauge
-                     *     motiond_axes 3
+                     *     motiond_cycle_compute_seconds_bucket{le="0.000002048"} 2871
+                     *     …
+                     *     motiond_cycle_compute_seconds_bucket{le="+Inf"} 5750
+                     *     # HELP motiond_commands_total Motion commands submitted, by function block and verdict
+                     *     # TYPE motiond_commands_total counter
+                     *     motiond_commands_total{block="move-absolute",verdict="accepted"} 12
+                     *     …
                      */
                     "text/plain": string;
                 };
             };
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["MetricsQueryInvalid"];
         };
     };
 }

@@ -53,6 +53,7 @@ impl StartMode {
 /// ramp-in; acceleration, deceleration and jerk 0 mean the axis defaults (#1004–#1006).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"velocity": 50.0, "acceleration": 500.0})))]
 #[serde(default, deny_unknown_fields)]
 pub struct RampIn {
     pub velocity: f64,

@@ -276,6 +276,10 @@ problem_responses! {
     /// `limit` out of range, or an unknown query parameter.
     AuditInvalid(example = json!(p(AppError::field("limit", "must be between 1 and 1000"))));
 
+    /// Unknown `buckets` value or query parameter.
+    MetricsQueryInvalid(example = json!(p(AppError::field("query",
+        "Failed to deserialize query string: buckets: unknown variant `coarse`, expected `fine`"))));
+
     /// Invalid request; `errors` names every invalid field (`channels[1].axis` for an unknown
     /// axis, `trigger.pre_trigger_s` …).
     ScopeInvalid(example = json!(p(AppError::field("channels[0].axis", "no axis 'z'"))));
@@ -418,6 +422,8 @@ error_sets! {
     }
     /// `GET /audit`.
     AuditErrors { 422: AuditInvalid, 503: AuditUnavailable }
+    /// `GET /metrics`.
+    MetricsErrors { 422: MetricsQueryInvalid }
     /// `GET /ws`: not a websocket handshake, or one from another origin.
     WebsocketErrors {
         400: WebsocketHandshakeInvalid, 403: CrossOriginForbidden, 426: WebsocketUpgradeRequired,

@@ -1,6 +1,5 @@
 //! `GET /system`, `/metrics`.
 
-use std::fmt::Write;
 use std::sync::Arc;
 use std::sync::atomic::Ordering::Relaxed;
 
@@ -111,86 +110,63 @@ pub async fn system(State(s): State<Arc<AppState>>) -> Json<SystemResource> {
     Json(system_resource(&s))
 }
 
-#[utoipa::path(get, path = "/metrics", tag = "system", summary = "Prometheus metrics (text format 0.0.4)",
+/// `/metrics` query.
+#[derive(Debug, Default, serde::Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct MetricsQuery {
+    /// `fine`: every bucket (≈6 % steps, 400 bounds) of the cycle timing histograms, for
+    /// windowed quantiles between two scrapes; default: 22 bounds from 2 µs to 1 s.
+    #[serde(default)]
+    #[param(inline)]
+    pub buckets: Option<MetricsBuckets>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MetricsBuckets {
+    Fine,
+}
+
+#[utoipa::path(get, path = "/metrics", tag = "system", summary = "Metrics for Prometheus",
+    description = "OpenMetrics text when the request accepts `application/openmetrics-text` (as Prometheus does), \
+else the Prometheus text format 0.0.4. Cycle timing histograms, cycle and service counters, submitted commands by function block and \
+verdict (`motiond_commands_total{block, verdict}`), per-axis gauges (state, error id, following error and its peak), \
+`motiond_build_info` and the process's figures (`process_*`).",
+    params(MetricsQuery),
     responses((status = 200, description = "Metrics", content_type = "text/plain", body = String,
-        example = "# HELP motiond_cycle_compute_seconds Work per cycle.\n# TYPE motiond_cycle_compute_seconds histogram\n\
-motiond_cycle_compute_seconds_bucket{le=\"6.4e-6\"} 2871\n…\nmotiond_cycle_compute_seconds_bucket{le=\"+Inf\"} 5750\n\
+        example = "# HELP motiond_cycle_compute_seconds Work per cycle\n# TYPE motiond_cycle_compute_seconds histogram\n\
 motiond_cycle_compute_seconds_sum 0.0522\nmotiond_cycle_compute_seconds_count 5750\n\
-# HELP motiond_cycles_total Cycles run.\n# TYPE motiond_cycles_total counter\nmotiond_cycles_total 5750\n\
-# HELP motiond_cycle_overruns_total Deadlines missed.\n# TYPE motiond_cycle_overruns_total counter\nmotiond_cycle_overruns_total 14\n\
-# HELP motiond_axes Configured axes.\n# TYPE motiond_axes gauge\nmotiond_axes 3\n")))]
-pub async fn metrics(State(s): State<Arc<AppState>>) -> impl IntoResponse {
-    let st = &s.shared.stats;
-    let mut out = String::with_capacity(16 * 1024);
-    st.wakeup_latency.prometheus(
-        "motiond_cycle_wakeup_latency_seconds",
-        "Wake-up time of the cycle thread minus its deadline.",
-        &mut out,
-    );
-    st.compute
-        .prometheus("motiond_cycle_compute_seconds", "Work per cycle.", &mut out);
-    st.period.prometheus(
-        "motiond_cycle_period_seconds",
-        "Time between consecutive wake-ups of the cycle thread.",
-        &mut out,
-    );
-    let counters = [
+motiond_cycle_compute_seconds_bucket{le=\"0.000002048\"} 2871\n…\nmotiond_cycle_compute_seconds_bucket{le=\"+Inf\"} 5750\n\
+# HELP motiond_commands_total Motion commands submitted, by function block and verdict\n# TYPE motiond_commands_total counter\n\
+motiond_commands_total{block=\"move-absolute\",verdict=\"accepted\"} 12\n…\n"), super::errors::MetricsErrors))]
+pub async fn metrics(
+    State(s): State<Arc<AppState>>,
+    headers: axum::http::HeaderMap,
+    super::Q(q): super::Q<MetricsQuery>,
+) -> impl IntoResponse {
+    let out = crate::metrics::render(&s, q.buckets == Some(MetricsBuckets::Fine));
+    // OpenMetrics for those that ask for it (Prometheus does), else the classic text format.
+    let openmetrics = headers
+        .get_all(header::ACCEPT)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .any(|v| v.contains("application/openmetrics-text"));
+    if openmetrics {
         (
-            "motiond_cycles_total",
-            "Cycles run.",
-            st.cycles.load(Relaxed),
-        ),
-        (
-            "motiond_cycle_overruns_total",
-            "Deadlines missed.",
-            st.overruns.load(Relaxed),
-        ),
-        (
-            "motiond_events_dropped_total",
-            "Command events lost (event ring full).",
-            st.events_dropped.load(Relaxed),
-        ),
-        (
-            "motiond_commands_total",
-            "Requests taken by the cycle thread.",
-            st.commands_drained.load(Relaxed),
-        ),
-        (
-            "motiond_scope_frames_dropped_total",
-            "Scope frames lost (scope ring full).",
-            st.scope_frames_dropped.load(Relaxed),
-        ),
-        (
-            "motiond_audit_dropped_total",
-            "Audit entries lost (queue full or write failed).",
-            s.audit_dropped.load(Relaxed),
-        ),
-        (
-            "motiond_requests_expired_total",
-            "Requests dropped undone after their requester had answered 503.",
-            st.requests_expired.load(Relaxed),
-        ),
-    ];
-    for (name, help, v) in counters {
-        let _ = writeln!(
+            [(
+                header::CONTENT_TYPE,
+                "application/openmetrics-text; version=1.0.0; charset=utf-8",
+            )],
             out,
-            "# HELP {name} {help}\n# TYPE {name} counter\n{name} {v}"
-        );
+        )
+    } else {
+        (
+            [(
+                header::CONTENT_TYPE,
+                "text/plain; version=0.0.4; charset=utf-8",
+            )],
+            crate::metrics::to_prometheus_text(&out),
+        )
     }
-    let _ = writeln!(
-        out,
-        "# HELP motiond_cycle_time_seconds Configured cycle time.\n# TYPE motiond_cycle_time_seconds gauge\nmotiond_cycle_time_seconds {}",
-        s.info.cycle_time_s
-    );
-    let _ = writeln!(
-        out,
-        "# HELP motiond_axes Configured axes.\n# TYPE motiond_axes gauge\nmotiond_axes {}",
-        s.registry.read().unwrap().axes.len()
-    );
-    let _ = writeln!(
-        out,
-        "# HELP motiond_realtime_granted SCHED_FIFO granted (1) or not (0).\n# TYPE motiond_realtime_granted gauge\nmotiond_realtime_granted {}",
-        s.info.realtime.sched_fifo as u8
-    );
-    ([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], out)
 }

@@ -48,6 +48,8 @@ pub struct AppState {
     status_json: Mutex<Vec<Option<(u64, StatusJson)>>>,
     /// The websocket status feed (deltas made once per tick for every subscriber).
     pub feed: feed::Feed,
+    /// Counters for `/metrics` (the rest is read at scrape time).
+    pub metrics: crate::metrics::Metrics,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -83,6 +85,7 @@ impl AppState {
             snapshot: Mutex::new(snapshot),
             status_json: Mutex::new(vec![None; MAX_AXES]),
             feed: feed::Feed::new(MAX_AXES),
+            metrics: Default::default(),
             registry: RwLock::new(Registry::default()),
             config_lock: tokio::sync::Mutex::new(()),
             commands: Mutex::new(CommandStore::default()),

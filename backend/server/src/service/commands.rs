@@ -11,6 +11,7 @@ use motion::{
 
 use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Milestone, Registry};
 use crate::error::{AppError, AppResult};
+use crate::metrics::Verdict;
 use crate::model::*;
 use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
@@ -689,10 +690,19 @@ async fn submit(
 ) -> AppResult<CommandId> {
     let (slot, axis_id, axis_name, kind) = {
         let reg = s.registry.read().unwrap();
+        let invalid = |e| {
+            s.metrics.command(name, Verdict::invalid);
+            e
+        };
         let e = reg
             .find(axis_key)
-            .ok_or_else(|| AppError::not_found("axis", axis_key))?;
-        (e.slot, e.id, e.name.clone(), build(&reg, e)?)
+            .ok_or_else(|| invalid(AppError::not_found("axis", axis_key)))?;
+        (
+            e.slot,
+            e.id,
+            e.name.clone(),
+            build(&reg, e).map_err(invalid)?,
+        )
     };
     let id = s.next_id();
     s.reserve_id(id).await?;
@@ -732,6 +742,14 @@ async fn submit(
             return Err(e);
         }
     };
+    s.metrics.command(
+        name,
+        if reply.result.is_ok() {
+            Verdict::accepted
+        } else {
+            Verdict::rejected
+        },
+    );
     match reply.result {
         Ok(()) => {
             // The submission row is stored before the command is acknowledged (about 0.1 ms:
