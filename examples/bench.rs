@@ -52,7 +52,7 @@ async fn rtt(base: &str, n: usize) {
     );
 }
 
-async fn ws_client(addr: String, axes: Vec<String>, rate: f64, secs: f64) -> (u64, u64) {
+async fn ws_client(addr: String, axes: Vec<String>, rate: f64, secs: f64) -> (u64, u64, u64) {
     let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/api/v1/ws"))
         .await
         .expect("ws connect");
@@ -61,16 +61,17 @@ async fn ws_client(addr: String, axes: Vec<String>, rate: f64, secs: f64) -> (u6
         ws.send(Message::Text(m.to_string().into())).await.unwrap();
     }
     let end = Instant::now() + Duration::from_secs_f64(secs);
-    let (mut updates, mut bytes) = (0u64, 0u64);
+    let (mut updates, mut bytes, mut messages) = (0u64, 0u64, 0u64);
     while let Ok(Some(Ok(m))) = tokio::time::timeout_at(end.into(), ws.next()).await {
         if let Message::Text(t) = m {
             bytes += t.len() as u64;
+            messages += 1;
             // One message per tick: the updates due together come as a JSON-RPC batch.
             updates += t.matches("\"method\":\"update\"").count() as u64;
         }
     }
     let _ = ws.close(None).await;
-    (updates, bytes)
+    (updates, bytes, messages)
 }
 
 #[tokio::main]
@@ -88,19 +89,21 @@ async fn main() {
                 .map(|_| tokio::spawn(ws_client(addr.clone(), axes.clone(), rate, secs)))
                 .collect();
             let mut per_client = Vec::new();
-            let mut bytes = 0;
+            let (mut bytes, mut messages) = (0, 0);
             for t in tasks {
-                let (u, b) = t.await.unwrap();
+                let (u, b, m) = t.await.unwrap();
                 per_client.push(u);
                 bytes += b;
+                messages += m;
             }
             per_client.sort_unstable();
             let total: u64 = per_client.iter().sum();
             let expected = rate * secs * axes.len() as f64;
             println!(
-                "{{\"clients\": {clients}, \"axes\": {}, \"rate_hz\": {rate}, \"seconds\": {secs}, \"updates_total\": {total}, \"updates_per_s\": {:.0}, \"mb_per_s\": {:.2}, \"per_client_min\": {}, \"per_client_max\": {}, \"expected_per_client_max\": {expected:.0}}}",
+                "{{\"clients\": {clients}, \"axes\": {}, \"rate_hz\": {rate}, \"seconds\": {secs}, \"updates_total\": {total}, \"updates_per_s\": {:.0}, \"messages_per_s\": {:.0}, \"mb_per_s\": {:.2}, \"per_client_min\": {}, \"per_client_max\": {}, \"expected_per_client_max\": {expected:.0}}}",
                 axes.len(),
                 total as f64 / secs,
+                messages as f64 / secs,
                 bytes as f64 / secs / 1e6,
                 per_client[0],
                 per_client[per_client.len() - 1]

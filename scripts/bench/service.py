@@ -4,17 +4,22 @@
 1. Wake-up latency of the idle cycle thread over a window (from /metrics deltas).
 2. POST move-absolute -> 202 round trip at 1 kHz cycle (examples/bench.rs rtt).
 3. 100 websocket clients x 16 axes at 50 Hz while all axes move: overruns and CPU.
-4. cyclictest (Debian rt-tests) on the same CPU, priority and interval, same run.
+4. The same with 64 moving axes, and 1000 clients x 4 axes.
+5. POST -> 202 at a 250 us cycle (another motiond).
+6. Footprint: ready time and RSS of motiond restarted on a database with 64 axes; /metrics size.
+7. cyclictest (Debian rt-tests) on the same CPU, priority and interval, same run.
 
 Usage: service.py MOTIOND BENCH OUTDIR [--quick]
 """
-import json, os, re, subprocess, sys, time, urllib.request
+import json, os, re, resource, subprocess, sys, time, urllib.request
 
 MOTIOND, BENCH, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
 QUICK = "--quick" in sys.argv
 WINDOW = 10 if QUICK else 30
 PORT = 18181
 BASE = f"http://127.0.0.1:{PORT}"
+# 1000 websocket clients: motiond and the load generator each hold ~1000 sockets.
+resource.setrlimit(resource.RLIMIT_NOFILE, (65536, 65536))
 TICK = os.sysconf("SC_CLK_TCK")
 
 
@@ -73,21 +78,72 @@ def cpu_ticks(pid):
     return ticks(f"/proc/{pid}/stat"), threads
 
 
+def start(args, log):
+    """motiond on PORT with `args`; returns (process, seconds until /api/v1/system answered)."""
+    t0 = time.monotonic()
+    proc = subprocess.Popen([MOTIOND, "--listen", f"127.0.0.1:{PORT}"] + args, stdout=log, stderr=subprocess.STDOUT)
+    while True:
+        try:
+            if http("GET", "/api/v1/system")[0] == 200:
+                return proc, time.monotonic() - t0
+        except Exception:
+            time.sleep(0.002)
+        assert proc.poll() is None, "motiond ended"
+
+
+def stop(proc):
+    proc.terminate()
+    proc.wait()
+
+
+def rss_mb(proc):
+    for line in open(f"/proc/{proc.pid}/status"):
+        if line.startswith("VmRSS"):
+            return round(int(line.split()[1]) / 1024, 1)
+
+
+def ws_load(proc, name, clients, axes):
+    """`clients` websocket clients on `axes` at 50 Hz for WINDOW s: updates, CPU, overruns."""
+    m0 = metrics(); c0 = cpu_ticks(proc.pid); t0 = time.time(); ch0 = os.times()
+    out = subprocess.run([BENCH, "ws", f"127.0.0.1:{PORT}", str(clients), "50", str(WINDOW)] + axes, capture_output=True, text=True, check=True).stdout
+    ch1 = os.times(); t1 = time.time(); c1 = cpu_ticks(proc.pid); m1 = metrics()
+    el = t1 - t0
+    ws = json.loads(out)
+    ws["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
+    ws["wakeup_latency"] = window_quantiles(m0, m1, "motiond_cycle_wakeup_latency_seconds")
+    ws["compute"] = window_quantiles(m0, m1, "motiond_cycle_compute_seconds")
+    ws["motiond_cpu_percent"] = round(100 * (c1[0] - c0[0]) / TICK / el, 1)
+    ws["motiond_cpu_percent_by_thread"] = {k: round(100 * (v - c0[1].get(k, 0)) / TICK / el, 1) for k, v in c1[1].items()}
+    ws["load_generator_cpu_percent"] = round(100 * ((ch1.children_user - ch0.children_user) + (ch1.children_system - ch0.children_system)) / el, 1)
+    print(name, json.dumps(ws), flush=True)
+    return ws
+
+
+def rtt(n):
+    st, body = http("POST", "/api/v1/axes/y/power?wait=true", {})
+    assert st == 202, body
+    m0 = metrics()
+    out = subprocess.run([BENCH, "rtt", BASE, str(n)], capture_output=True, text=True, check=True).stdout
+    m1 = metrics()
+    r = json.loads(out)
+    r["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
+    return r
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     log = open(os.path.join(OUT, "motiond.log"), "w")
-    proc = subprocess.Popen([MOTIOND, "--db", ":memory:", "--listen", f"127.0.0.1:{PORT}"], stdout=log, stderr=subprocess.STDOUT)
+    db = os.path.join(OUT, "bench.db")
+    for f in (db, db + "-wal", db + "-shm"):
+        if os.path.exists(f):
+            os.remove(f)
+    proc, _ = start(["--db", db, "--max-connections", "4000"], log)
     results = {"machine": {"cpus": os.cpu_count(), "kernel": os.uname().release}}
     try:
-        for _ in range(200):
-            try:
-                if http("GET", "/api/v1/system")[0] == 200:
-                    break
-            except Exception:
-                time.sleep(0.05)
         system = json.loads(http("GET", "/api/v1/system")[1])
         results["realtime"] = system["realtime"]
         time.sleep(2)  # start-up done
+        results["metrics_bytes_demo"] = len(http("GET", "/metrics")[1].encode())
 
         # 1. idle wake-up latency
         m0 = metrics(); time.sleep(WINDOW); m1 = metrics()
@@ -100,47 +156,54 @@ def main():
         print("idle", json.dumps(results["idle"]), flush=True)
 
         # 2. POST -> 202 round trip
-        st, body = http("POST", "/api/v1/axes/y/power?wait=true", {})
-        assert st == 202, body
-        m0 = metrics()
-        out = subprocess.run([BENCH, "rtt", BASE, "2000" if QUICK else "10000"], capture_output=True, text=True, check=True).stdout
-        m1 = metrics()
-        results["rtt"] = json.loads(out)
-        results["rtt"]["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
+        results["rtt"] = rtt(2000 if QUICK else 10000)
         print("rtt", json.dumps(results["rtt"]), flush=True)
 
-        # 3. 16 moving axes, 100 websocket clients at 50 Hz each on all 16
+        # 3. 16 moving axes, 100 websocket clients at 50 Hz each on all 16; 4. 64 axes, and
+        # 1000 clients on 4 of them
         axes = ["x", "y", "spindle"]
         cfg = {"unit": "mm", "dynamics": {"max_velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0, "jerk": 25000.0, "jog_velocity_slow": 10.0, "jog_velocity_fast": 100.0}}
-        for i in range(13):
-            st, body = http("POST", "/api/v1/axes", dict(cfg, name=f"a{i}"))
-            assert st == 201, body
-            axes.append(f"a{i}")
-        for a in axes:
-            st, body = http("POST", f"/api/v1/axes/{a}/power?wait=true", {})
-            assert st == 202, body
-            st, body = http("POST", f"/api/v1/axes/{a}/move-velocity", {"velocity": 20.0 if a != "spindle" else 360.0})
-            assert st == 202, body
-        time.sleep(1)
-        secs = WINDOW
-        m0 = metrics(); c0 = cpu_ticks(proc.pid); t0 = time.time(); ch0 = os.times()
-        out = subprocess.run([BENCH, "ws", f"127.0.0.1:{PORT}", "100", "50", str(secs)] + axes, capture_output=True, text=True, check=True).stdout
-        ch1 = os.times(); t1 = time.time(); c1 = cpu_ticks(proc.pid); m1 = metrics()
-        el = t1 - t0
-        ws = json.loads(out)
-        ws["overruns"] = m1[1]["motiond_cycle_overruns_total"] - m0[1]["motiond_cycle_overruns_total"]
-        ws["wakeup_latency"] = window_quantiles(m0, m1, "motiond_cycle_wakeup_latency_seconds")
-        ws["compute"] = window_quantiles(m0, m1, "motiond_cycle_compute_seconds")
-        ws["motiond_cpu_percent"] = round(100 * (c1[0] - c0[0]) / TICK / el, 1)
-        ws["motiond_cpu_percent_by_thread"] = {k: round(100 * (v - c0[1].get(k, 0)) / TICK / el, 1) for k, v in c1[1].items()}
-        ws["load_generator_cpu_percent"] = round(100 * ((ch1.children_user - ch0.children_user) + (ch1.children_system - ch0.children_system)) / el, 1)
-        results["ws"] = ws
-        print("ws", json.dumps(ws), flush=True)
-    finally:
-        proc.terminate()
-        proc.wait()
 
-    # 4. cyclictest, same CPU / priority / interval, after motiond has stopped
+        def add_moving(n):
+            for i in range(len(axes) - 3, len(axes) - 3 + n):
+                st, body = http("POST", "/api/v1/axes", dict(cfg, name=f"a{i}"))
+                assert st == 201, body
+                axes.append(f"a{i}")
+            for a in axes:
+                st, body = http("POST", f"/api/v1/axes/{a}/power?wait=true", {})
+                assert st == 202, body
+                st, body = http("POST", f"/api/v1/axes/{a}/move-velocity", {"velocity": 8.0 if a != "spindle" else 360.0})
+                assert st == 202, body
+            time.sleep(1)
+
+        add_moving(13)
+        results["ws"] = ws_load(proc, "ws", 100, axes)
+        add_moving(48)
+        results["ws64"] = ws_load(proc, "ws64", 100, axes)
+        results["ws1000x4"] = ws_load(proc, "ws1000x4", 1000, axes[:4])
+    finally:
+        stop(proc)
+
+    # 5. POST -> 202 at a 250 us cycle
+    proc, _ = start(["--db", ":memory:", "--cycle-us", "250"], log)
+    try:
+        time.sleep(1)
+        results["rtt_250us"] = rtt(2000 if QUICK else 10000)
+        print("rtt_250us", json.dumps(results["rtt_250us"]), flush=True)
+    finally:
+        stop(proc)
+
+    # 6. Footprint with the 64 axes stored
+    runs = []
+    for _ in range(3):
+        proc, ready = start(["--db", db], log)
+        time.sleep(2)
+        runs.append({"ready_ms": round(ready * 1000), "rss_mb": rss_mb(proc)})
+        stop(proc)
+    results["footprint_64_axes"] = runs
+    print("footprint_64_axes", json.dumps(runs), flush=True)
+
+    # 7. cyclictest, same CPU / priority / interval, after motiond has stopped
     cpu = results["realtime"].get("pinned_cpu")
     loops = WINDOW * 1000
     hist = os.path.join(OUT, "cyclictest.hist")
