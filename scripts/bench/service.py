@@ -19,7 +19,8 @@ WINDOW = 10 if QUICK else 30
 PORT = 18181
 BASE = f"http://127.0.0.1:{PORT}"
 # 1000 websocket clients: motiond and the load generator each hold ~1000 sockets.
-resource.setrlimit(resource.RLIMIT_NOFILE, (65536, 65536))
+_hard = resource.getrlimit(resource.RLIMIT_NOFILE)[1]
+resource.setrlimit(resource.RLIMIT_NOFILE, (_hard if _hard != resource.RLIM_INFINITY else 65536, _hard))
 TICK = os.sysconf("SC_CLK_TCK")
 
 

@@ -560,7 +560,7 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
             .install_axis(slot, axis, drive, false)
             .await
             .map_err(|e| format!("cannot install axis {}: {e}", a.name))?;
-        state.registry.write().unwrap().axes.insert(
+        state.registry_write().axes.insert(
             a.id,
             AxisEntry {
                 id: a.id,

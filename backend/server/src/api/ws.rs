@@ -197,7 +197,10 @@ pub async fn upgrade(
             .map(|s| s.chars().take(128).collect()),
         via: "websocket",
     };
+    // Clients send little (requests of at most 256 KiB): a small read chunk, because the read
+    // buffer is zeroed to its size on every read.
     ws.max_message_size(256 * 1024)
+        .read_buffer_size(4 * 1024)
         .on_upgrade(move |socket| session(s, socket, client, settings))
 }
 
@@ -281,6 +284,10 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     // is closed if nothing arrives within `ping_after` (a dead peer or a frozen client).
     let mut heard = Instant::now();
     let mut pinged: Option<Instant> = None;
+    // The registry as this socket last checked its subscriptions against it.
+    let mut seen_writes = u64::MAX;
+    // The size of the last tick's message (the next one is usually alike).
+    let mut last_len = 256;
     loop {
         let idle_deadline = match pinged {
             None => heard + settings.ping_after,
@@ -322,19 +329,11 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
             at = tick.tick() => {
                 // Socket jogs are not renewed here: only the client's keepalives renew them,
                 // so a client whose script hangs with the socket open still stops the axis.
-                let mut due = updates(&s, &mut subs, s.feed.tick_of(at));
-                if due.len() > 1 {
-                    // One message per tick: a JSON-RPC batch of the notifications.
-                    let len = due.iter().map(|m| m.len() + 1).sum::<usize>() + 1;
-                    let mut batch = String::with_capacity(len);
-                    for (i, m) in due.iter().enumerate() {
-                        batch.push(if i == 0 { '[' } else { ',' });
-                        batch.push_str(m);
-                    }
-                    batch.push(']');
-                    due = vec![batch];
-                }
-                due
+                let mut out = Batch::with_capacity(last_len);
+                updates(&s, &mut subs, &mut seen_writes, s.feed.tick_of(at), &mut out);
+                let m = out.finish();
+                last_len = m.as_ref().map_or(last_len, |m| m.len() + 64);
+                m.into_iter().collect()
             }
         };
         for m in outgoing {
@@ -353,7 +352,7 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
 }
 
 /// Follows axis subscriptions to the slot their axis is in now; ends those whose axis is gone.
-fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
+fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Batch) {
     let reg = s.registry.read().unwrap();
     subs.retain_mut(|sub| {
         let Topic::Axis { id, slot, name } = &mut sub.topic else {
@@ -361,7 +360,7 @@ fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
         };
         match reg.axes.get(id) {
             None => {
-                out.push(notify(
+                out.push(&notify(
                     "subscription_ended",
                     SubscriptionEnded {
                         topic: sub.key.clone(),
@@ -382,13 +381,57 @@ fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Vec<String>) {
     });
 }
 
-fn updates(s: &AppState, subs: &mut Vec<Sub>, tick: u64) -> Vec<String> {
-    let mut out = Vec::new();
-    if subs
-        .iter()
-        .any(|x| tick >= x.due && matches!(x.topic, Topic::Axis { .. }))
+/// The notifications of one tick, written into one message: one alone as itself, several as
+/// a JSON-RPC batch (an array).
+struct Batch {
+    buf: String,
+    n: usize,
+}
+
+impl Batch {
+    fn with_capacity(n: usize) -> Self {
+        Batch {
+            buf: String::with_capacity(n),
+            n: 0,
+        }
+    }
+
+    /// Starts the next notification (its text is written into `buf` after this).
+    fn next(&mut self) -> &mut String {
+        self.buf.push(if self.n == 0 { '[' } else { ',' });
+        self.n += 1;
+        &mut self.buf
+    }
+
+    fn push(&mut self, m: &str) {
+        self.next().push_str(m);
+    }
+
+    fn finish(mut self) -> Option<String> {
+        match self.n {
+            0 => None,
+            1 => {
+                self.buf.remove(0);
+                Some(self.buf)
+            }
+            _ => {
+                self.buf.push(']');
+                Some(self.buf)
+            }
+        }
+    }
+}
+
+fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, out: &mut Batch) {
+    let writes = s.registry_writes();
+    if writes != *seen_writes
+        && subs
+            .iter()
+            .any(|x| tick >= x.due && matches!(x.topic, Topic::Axis { .. }))
     {
-        follow_axes(s, subs, &mut out);
+        // Only after the registry changed: axes moved to other slots, were renamed or removed.
+        *seen_writes = writes;
+        follow_axes(s, subs, out);
     }
     for sub in subs.iter_mut().filter(|x| tick >= x.due) {
         // The rate's grid; a socket that fell behind skips what it missed.
@@ -401,7 +444,7 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, tick: u64) -> Vec<String> {
                 };
                 sub.last = Some(p.map);
                 if let Some(data) = p.data {
-                    out.push(update_message(&sub.key_json, p.cycle, p.full, &data));
+                    write_update(out.next(), &sub.key_json, p.cycle, p.full, &data);
                 }
             }
             Topic::System => {
@@ -416,7 +459,7 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, tick: u64) -> Vec<String> {
                 let full = sub.last.is_none();
                 sub.last = Some(Arc::new(map));
                 if full || !data.is_empty() {
-                    out.push(notify(
+                    out.push(&notify(
                         "update",
                         UpdateParams {
                             topic: sub.key.clone(),
@@ -429,14 +472,20 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, tick: u64) -> Vec<String> {
             }
         }
     }
-    out
 }
 
 /// An `update` notification (as `UpdateParams` serialises) from the feed's ready JSON.
+#[cfg(test)]
 fn update_message(topic_json: &str, cycle: u64, full: bool, data: &str) -> String {
+    let mut m = String::new();
+    write_update(&mut m, topic_json, cycle, full, data);
+    m
+}
+
+/// Writes an `update` notification into `m`.
+fn write_update(m: &mut String, topic_json: &str, cycle: u64, full: bool, data: &str) {
     use std::fmt::Write;
     const HEAD: &str = r#"{"jsonrpc":"2.0","method":"update","params":{"topic":"#;
-    let mut m = String::with_capacity(HEAD.len() + topic_json.len() + data.len() + 48);
     m.push_str(HEAD);
     m.push_str(topic_json);
     m.push_str(r#","cycle":"#);
@@ -448,7 +497,6 @@ fn update_message(topic_json: &str, cycle: u64, full: bool, data: &str) -> Strin
     });
     m.push_str(data);
     m.push_str("}}");
-    m
 }
 
 #[allow(clippy::too_many_arguments)]

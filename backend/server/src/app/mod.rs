@@ -50,6 +50,8 @@ pub struct AppState {
     pub feed: feed::Feed,
     /// Counters for `/metrics` (the rest is read at scrape time).
     pub metrics: crate::metrics::Metrics,
+    /// Bumped whenever the registry is written (sockets re-check their subscriptions then).
+    registry_writes: AtomicU64,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -61,7 +63,7 @@ pub struct AppState {
     ids_reserved: AtomicU64,
     reserve_lock: tokio::sync::Mutex<()>,
     pub db: SqlitePool,
-    audit_tx: mpsc::Sender<AuditEntry>,
+    audit_tx: mpsc::Sender<crate::store::AuditOp>,
     /// Audit rows lost (queue full, or not written after retries); shared with the writer.
     pub audit_dropped: Arc<AtomicU64>,
     pub info: SystemInfo,
@@ -76,7 +78,7 @@ impl AppState {
         db: SqlitePool,
         first_command_id: u64,
         info: SystemInfo,
-    ) -> (Arc<AppState>, mpsc::Receiver<AuditEntry>) {
+    ) -> (Arc<AppState>, mpsc::Receiver<crate::store::AuditOp>) {
         let (audit_tx, audit_rx) = mpsc::channel(8192);
         let scope = Mutex::new(Recordings::new(info.cycle_time_s, shared.period_ns));
         let state = AppState {
@@ -86,6 +88,7 @@ impl AppState {
             status_json: Mutex::new(vec![None; MAX_AXES]),
             feed: feed::Feed::new(MAX_AXES),
             metrics: Default::default(),
+            registry_writes: AtomicU64::new(0),
             registry: RwLock::new(Registry::default()),
             config_lock: tokio::sync::Mutex::new(()),
             commands: Mutex::new(CommandStore::default()),
@@ -150,6 +153,17 @@ impl AppState {
     }
 
     /// The latest status of a slot as JSON, serialised once per cycle whoever asks.
+    /// The registry to change (counted, see [`AppState::registry_writes`]).
+    pub fn registry_write(&self) -> std::sync::RwLockWriteGuard<'_, Registry> {
+        self.registry_writes.fetch_add(1, Relaxed);
+        self.registry.write().unwrap()
+    }
+
+    /// How often the registry has been written: unchanged, every axis is where it was.
+    pub fn registry_writes(&self) -> u64 {
+        self.registry_writes.load(Relaxed)
+    }
+
     pub fn status_json(&self, slot: AxisSlot) -> Option<(u64, StatusJson)> {
         let (cycle, status) = self.status(slot);
         let status = status?;
@@ -177,7 +191,16 @@ impl AppState {
     /// Queues an audit entry for the batching writer (motion commands are not delayed by the
     /// disk; configuration changes write their audit row in their own transaction instead).
     pub fn audit(&self, e: AuditEntry) {
-        if self.audit_tx.try_send(e).is_err() {
+        self.audit_op(crate::store::AuditOp::Row(e));
+    }
+
+    /// Queues the outcome of a command whose row was stored as `submitted`.
+    pub fn audit_outcome(&self, command_id: u64, outcome: String) {
+        self.audit_op(crate::store::AuditOp::Outcome(command_id, outcome));
+    }
+
+    fn audit_op(&self, op: crate::store::AuditOp) {
+        if self.audit_tx.try_send(op).is_err() {
             self.audit_dropped.fetch_add(1, Relaxed);
         }
     }

@@ -12,7 +12,7 @@ use tokio::sync::mpsc;
 use super::AppState;
 use super::commands::{apply_event, final_audit};
 use crate::cycle::Request;
-use crate::store::{self, AuditEntry};
+use crate::store::{self, AuditOp};
 
 impl AppState {
     /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
@@ -91,19 +91,18 @@ pub async fn pump(state: Arc<AppState>) {
 /// Writes queued audit entries in batches, one transaction per batch. A batch that cannot be
 /// written (database locked past its busy timeout, disk full) is tried again a few times; what
 /// is still not written is logged and counted in `lost` (`audit_dropped` in /system, /metrics).
-pub async fn audit_writer(
-    db: SqlitePool,
-    mut rx: mpsc::Receiver<AuditEntry>,
-    lost: Arc<AtomicU64>,
-) {
+pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost: Arc<AtomicU64>) {
     const TRIES: u32 = 3;
     let mut batch = Vec::with_capacity(256);
     while rx.recv_many(&mut batch, 256).await > 0 {
         for attempt in 1..=TRIES {
             let result = async {
                 let mut tx = db.begin().await?;
-                for e in &batch {
-                    store::audit(&mut *tx, e).await?;
+                for op in &batch {
+                    match op {
+                        AuditOp::Row(e) => store::audit(&mut *tx, e).await?,
+                        AuditOp::Outcome(id, o) => store::audit_outcome(&mut *tx, *id, o).await?,
+                    }
                 }
                 tx.commit().await
             }

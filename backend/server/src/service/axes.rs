@@ -146,7 +146,7 @@ pub async fn create(
         persistent: BTreeMap::new(),
     };
     let r = resource(s, &entry);
-    s.registry.write().unwrap().axes.insert(id, entry);
+    s.registry_write().axes.insert(id, entry);
     Ok(r)
 }
 
@@ -196,7 +196,7 @@ pub async fn replace(
         }
         return Err(e.into());
     }
-    let mut reg = s.registry.write().unwrap();
+    let mut reg = s.registry_write();
     let e = reg.axes.get_mut(&id).expect("locked by config_lock");
     e.name = config.name.clone();
     e.config = config;
@@ -237,7 +237,7 @@ pub async fn delete(s: &AppState, axis: &str, client: &ClientInfo) -> AppResult<
         }
         return Err(e.into());
     }
-    s.registry.write().unwrap().axes.remove(&id);
+    s.registry_write().axes.remove(&id);
     Ok(())
 }
 
@@ -429,7 +429,7 @@ pub async fn write_parameter(
         })?;
         s.audit(audit);
     }
-    let mut reg = s.registry.write().unwrap();
+    let mut reg = s.registry_write();
     let e = reg.axes.get_mut(&id).expect("locked by config_lock");
     e.params = p;
     if w.persistent {
@@ -688,7 +688,7 @@ pub async fn import(
         return Err(e);
     }
     {
-        let mut reg = s.registry.write().unwrap();
+        let mut reg = s.registry_write();
         reg.axes = entries.into_iter().map(|e| (e.id, e)).collect();
         if let Some(cams) = cams {
             reg.cams = cams.into_iter().map(|e| (e.id, e)).collect();

@@ -298,7 +298,7 @@ fn register(
         online,
     };
     let r = resource(&e, false);
-    s.registry.write().unwrap().cams.insert(id, e);
+    s.registry_write().cams.insert(id, e);
     r
 }
 
@@ -324,7 +324,7 @@ pub async fn set_online_change(
             s.drop_cam_data(e.id).await?;
         }
         _ => {
-            if let Some(c) = s.registry.write().unwrap().cams.get_mut(&e.id) {
+            if let Some(c) = s.registry_write().cams.get_mut(&e.id) {
                 c.online = change;
             }
         }
@@ -423,7 +423,7 @@ pub async fn delete(s: &AppState, key: &str, client: &ClientInfo) -> AppResult<(
         let _ = s.install_cam(e.id, e.cam.clone()).await;
         return Err(err.into());
     }
-    s.registry.write().unwrap().cams.remove(&e.id);
+    s.registry_write().cams.remove(&e.id);
     Ok(())
 }
 
@@ -441,7 +441,7 @@ pub async fn load(s: &AppState) -> Result<usize, String> {
                 s.install_cam(t.id, cam.clone())
                     .await
                     .map_err(|e| format!("cam table {}: {e}", t.id))?;
-                s.registry.write().unwrap().cams.insert(
+                s.registry_write().cams.insert(
                     t.id,
                     CamEntry {
                         id: t.id,

@@ -735,10 +735,41 @@ async fn submit(
         events: VecDeque::new(),
         final_audit: None,
     });
-    let reply = match s.command_request(id, slot, kind).await {
+    // The submission row is stored while the cycle thread decides (both take about a tenth
+    // of a millisecond; docs/decisions.md 71 and 79), so that no acknowledged command misses
+    // it after a crash; its outcome (`submitted` until then) follows through the batching
+    // writer, before the command's end row.
+    let row = AuditEntry {
+        outcome: Some("submitted".into()),
+        ..audit
+    };
+    let (stored, reply) =
+        tokio::join!(store::audit(&s.db, &row), s.command_request(id, slot, kind));
+    let stored = match stored {
+        Ok(()) => true,
+        Err(e) => {
+            tracing::error!("audit row of command {id} not stored: {e}");
+            s.audit_dropped
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            false
+        }
+    };
+    // The verdict as the audit log says it: as an update of the stored row, or a whole row.
+    let outcome = |outcome: String| {
+        if stored {
+            s.audit_outcome(id, outcome);
+        } else {
+            s.audit(AuditEntry {
+                outcome: Some(outcome),
+                ..row.clone()
+            });
+        }
+    };
+    let reply = match reply {
         Ok(r) => r,
         Err(e) => {
             s.commands.lock().unwrap().remove(id);
+            outcome(format!("failed:{}", e.problem().code));
             return Err(e);
         }
     };
@@ -752,21 +783,9 @@ async fn submit(
     );
     match reply.result {
         Ok(()) => {
-            // The submission row is stored before the command is acknowledged (about 0.1 ms:
-            // docs/decisions.md 71), so that no acknowledged command misses it after a crash;
-            // and before the command counts as accepted, so that an end row (written by the
-            // pump once it does) always comes after it. The command already acts: if the
-            // database refuses the row, that is counted and logged, and the acknowledgement
-            // still says what happened.
-            let row = AuditEntry {
-                outcome: Some("accepted".into()),
-                ..audit
-            };
-            if let Err(e) = store::audit(&s.db, &row).await {
-                tracing::error!("audit row of command {id} not stored: {e}");
-                s.audit_dropped
-                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            }
+            // Accepted only now, so that the end row (queued by the pump once the command
+            // counts as accepted and is final) comes after the outcome.
+            outcome("accepted".into());
             let final_audit = s.commands.lock().unwrap().map.get_mut(&id).and_then(|r| {
                 r.accepted = true;
                 r.accepted_cycle = reply.cycle;
@@ -782,10 +801,7 @@ async fn submit(
         }
         Err(e) => {
             s.commands.lock().unwrap().remove(id);
-            s.audit(AuditEntry {
-                outcome: Some(format!("rejected:{}", e.code())),
-                ..audit
-            });
+            outcome(format!("rejected:{}", e.code()));
             Err(AppError::rejected(e))
         }
     }

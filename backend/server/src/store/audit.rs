@@ -34,6 +34,27 @@ pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
         .map(|_| ())
 }
 
+/// The outcome of a command whose submission row was stored as `submitted` (the verdict came
+/// after the row was written).
+pub async fn audit_outcome<'e, E: sqlx::SqliteExecutor<'e>>(
+    e: E,
+    command_id: u64,
+    outcome: &str,
+) -> Result<(), sqlx::Error> {
+    sqlx::query("UPDATE audit_log SET outcome = ? WHERE command_id = ? AND outcome = 'submitted'")
+        .bind(outcome)
+        .bind(command_id as i64)
+        .execute(e)
+        .await
+        .map(|_| ())
+}
+
+/// What the batching audit writer does: store a row, or set a command's outcome.
+pub enum AuditOp {
+    Row(AuditEntry),
+    Outcome(u64, String),
+}
+
 /// One audit log row as stored.
 pub struct AuditRow {
     pub id: i64,
