@@ -278,8 +278,6 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
     let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
     let in_flight = Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT));
-    let mut tick = tokio::time::interval_at(s.feed.next_tick_at(Instant::now()), TICK);
-    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     // Idle watch: a Ping after `ping_after` without anything from the client, then the socket
     // is closed if nothing arrives within `ping_after` (a dead peer or a frozen client).
     let mut heard = Instant::now();
@@ -292,6 +290,18 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
         let idle_deadline = match pinged {
             None => heard + settings.ping_after,
             Some(at) => at + settings.ping_after,
+        };
+        // The socket sleeps until its next subscription is due (not every tick of the grid).
+        let next_due = subs
+            .iter()
+            .filter(|x| !matches!(x.topic, Topic::Commands))
+            .map(|x| x.due)
+            .min();
+        let due = async {
+            match next_due {
+                Some(t) => tokio::time::sleep_until(s.feed.at(t)).await,
+                None => std::future::pending().await,
+            }
         };
         let outgoing: Vec<String> = tokio::select! {
             msg = socket.recv() => {
@@ -326,11 +336,12 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                 Err(broadcast::error::RecvError::Lagged(k)) => vec![notify("commands_lagged", CommandsLagged { missed: k })],
                 Err(broadcast::error::RecvError::Closed) => vec![],
             },
-            at = tick.tick() => {
+            _ = due => {
                 // Socket jogs are not renewed here: only the client's keepalives renew them,
                 // so a client whose script hangs with the socket open still stops the axis.
                 let mut out = Batch::with_capacity(last_len);
-                updates(&s, &mut subs, &mut seen_writes, s.feed.tick_of(at), &mut out);
+                let tick = s.feed.tick_now().max(next_due.unwrap_or(0));
+                updates(&s, &mut subs, &mut seen_writes, tick, &mut out);
                 let m = out.finish();
                 last_len = m.as_ref().map_or(last_len, |m| m.len() + 64);
                 m.into_iter().collect()

@@ -2,13 +2,13 @@
 //! subscriber was sent before are made once per tick and shared by every socket that sends
 //! them, so that the cost of streaming grows with the axes, not with axes × subscribers.
 //!
-//! Ticks are a grid every [`TICK`] from the feed's epoch; every socket wakes on that grid and a
-//! subscription at a given rate is due on the same ticks in every socket, so subscribers of
-//! one axis at one rate share one delta. A delta is keyed by the object it starts from (the
+//! Ticks are a grid every [`TICK`] from the feed's epoch; a subscription at a given rate is due
+//! on the same ticks in every socket (and a socket sleeps until its next one is due), so
+//! subscribers of one axis at one rate share one delta. A delta is keyed by the object it starts from (the
 //! `Arc` a subscriber was sent), never by a tick number alone, so a socket that runs late can
 //! never be handed another socket's delta.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use serde_json::{Map, Value};
@@ -45,27 +45,28 @@ pub struct Piece {
 
 pub struct Feed {
     epoch: Instant,
-    frames: Vec<Mutex<Frame>>,
+    frames: Vec<RwLock<Frame>>,
 }
 
 impl Feed {
     pub fn new(slots: usize) -> Self {
         Feed {
             epoch: Instant::now(),
-            frames: (0..slots).map(|_| Mutex::default()).collect(),
+            frames: (0..slots).map(|_| RwLock::default()).collect(),
         }
     }
 
-    /// The first tick instant at or after `now`.
-    pub fn next_tick_at(&self, now: Instant) -> Instant {
-        let n = (now - self.epoch).as_nanos().div_ceil(TICK.as_nanos());
-        self.epoch + TICK * n as u32
+    /// When tick `tick` is.
+    pub fn at(&self, tick: u64) -> Instant {
+        self.epoch + Duration::from_nanos(tick.saturating_mul(TICK.as_nanos() as u64))
     }
 
-    /// The number of the tick scheduled at `at` (an instant of the grid).
-    pub fn tick_of(&self, at: Instant) -> u64 {
-        let d = at.saturating_duration_since(self.epoch).as_nanos();
-        ((d + TICK.as_nanos() / 2) / TICK.as_nanos()) as u64
+    /// The tick now (the last one that has begun).
+    pub fn tick_now(&self) -> u64 {
+        (Instant::now()
+            .saturating_duration_since(self.epoch)
+            .as_nanos()
+            / TICK.as_nanos()) as u64
     }
 
     /// The update of axis `slot` for a subscriber that was last sent `last` (`None`: nothing
@@ -77,7 +78,17 @@ impl Feed {
         tick: u64,
         last: Option<&StatusJson>,
     ) -> Option<Piece> {
-        let mut f = self.frames.get(slot as usize)?.lock().unwrap();
+        let frame = self.frames.get(slot as usize)?;
+        // Most subscribers find what they need made already: a shared read.
+        {
+            let f = frame.read().unwrap();
+            if f.map.is_some() && tick <= f.tick {
+                if let Some(p) = f.answer(last) {
+                    return Some(p);
+                }
+            }
+        }
+        let mut f = frame.write().unwrap();
         // A late socket uses the newer frame (newer data), never takes the feed back.
         if f.map.is_none() || tick > f.tick {
             let (cycle, map) = s.status_json(slot)?;
@@ -92,40 +103,46 @@ impl Feed {
             }
         }
         let map = f.map.clone()?;
-        let cycle = f.cycle;
-        let Some(last) = last else {
-            let data = f
-                .full
-                .get_or_insert_with(|| serde_json::to_string(&*map).unwrap_or_default().into())
-                .clone();
-            return Some(Piece {
-                cycle,
-                full: true,
-                data: Some(data),
-                map,
-            });
-        };
-        if Arc::ptr_eq(last, &map) {
-            return Some(Piece {
-                cycle,
-                full: false,
-                data: None,
-                map,
-            });
-        }
-        let data = match f.deltas.iter().find(|(from, _)| Arc::ptr_eq(from, last)) {
-            Some((_, d)) => d.clone(),
+        match last {
             None => {
-                let d = delta(last, &map);
-                let d = (!d.is_empty())
-                    .then(|| Arc::<str>::from(serde_json::to_string(&d).unwrap_or_default()));
-                f.deltas.push((last.clone(), d.clone()));
-                d
+                if f.full.is_none() {
+                    f.full = Some(serde_json::to_string(&*map).unwrap_or_default().into());
+                }
             }
+            Some(last) => {
+                if !Arc::ptr_eq(last, &map)
+                    && !f.deltas.iter().any(|(from, _)| Arc::ptr_eq(from, last))
+                {
+                    let d = delta(last, &map);
+                    let d = (!d.is_empty())
+                        .then(|| Arc::<str>::from(serde_json::to_string(&d).unwrap_or_default()));
+                    f.deltas.push((last.clone(), d));
+                }
+            }
+        }
+        f.answer(last)
+    }
+}
+
+impl Frame {
+    /// The update for a subscriber last sent `last`, if this frame has it made.
+    fn answer(&self, last: Option<&StatusJson>) -> Option<Piece> {
+        let map = self.map.clone()?;
+        let (data, full) = match last {
+            None => (Some(self.full.clone()?), true),
+            Some(last) if Arc::ptr_eq(last, &map) => (None, false),
+            Some(last) => (
+                self.deltas
+                    .iter()
+                    .find(|(from, _)| Arc::ptr_eq(from, last))?
+                    .1
+                    .clone(),
+                false,
+            ),
         };
         Some(Piece {
-            cycle,
-            full: false,
+            cycle: self.cycle,
+            full,
             data,
             map,
         })
