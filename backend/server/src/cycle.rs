@@ -147,9 +147,47 @@ pub struct Shared {
     pub cycle: AtomicU64,
     pub shutdown: AtomicBool,
     pub period_ns: u64,
-    /// Touched by the cycle thread when it produced verdicts or events: the pump drains at
+    /// Written by the cycle thread when it produced verdicts or events: the pump drains at
     /// once.
-    pub wake: tokio::sync::Notify,
+    pub wake: Wake,
+}
+
+/// The cycle thread's wake-up of the pump: an eventfd. Signalling is one `write(2)` — no lock,
+/// no allocation (a `tokio::sync::Notify` takes its waiters' mutex when the pump waits, and
+/// the cycle thread must never wait on a lock the async side holds).
+pub struct Wake {
+    fd: std::os::fd::OwnedFd,
+}
+
+impl Wake {
+    fn new() -> Self {
+        // SAFETY: eventfd returns a new descriptor or -1.
+        let fd = unsafe { libc::eventfd(0, libc::EFD_NONBLOCK | libc::EFD_CLOEXEC) };
+        assert!(fd >= 0, "eventfd: {}", std::io::Error::last_os_error());
+        // SAFETY: fd is a fresh descriptor that nothing else owns.
+        Wake {
+            fd: unsafe { std::os::fd::FromRawFd::from_raw_fd(fd) },
+        }
+    }
+
+    /// Wakes the pump (cycle thread): adds 1 to the counter; never blocks (a full counter,
+    /// 2^64 − 2 unread wake-ups, is already a wake-up).
+    pub fn signal(&self) {
+        let one: u64 = 1;
+        // SAFETY: writes 8 bytes from a valid u64 to our own descriptor.
+        unsafe {
+            libc::write(
+                std::os::fd::AsRawFd::as_raw_fd(&self.fd),
+                (&one as *const u64).cast(),
+                8,
+            )
+        };
+    }
+
+    /// The descriptor the pump waits on (a duplicate, for tokio's `AsyncFd`).
+    pub fn listener(&self) -> std::io::Result<std::os::fd::OwnedFd> {
+        self.fd.try_clone()
+    }
 }
 
 impl Shared {
@@ -161,7 +199,7 @@ impl Shared {
             garbage: ArrayQueue::new(4 * MAX_AXES + COMMAND_QUEUE),
             scope_frames: ArrayQueue::new(SCOPE_RING),
             stats: CycleStats::default(),
-            wake: tokio::sync::Notify::new(),
+            wake: Wake::new(),
             cycle: AtomicU64::new(0),
             shutdown: AtomicBool::new(false),
             period_ns,
@@ -675,7 +713,7 @@ impl CycleThread {
         // A verdict or an output change waits on the async side: wake the pump now rather
         // than at its next millisecond (one wake-up; nothing when the cycle produced nothing).
         if drained > 0 || sink.pushed > 0 {
-            shared.wake.notify_one();
+            shared.wake.signal();
         }
     }
 

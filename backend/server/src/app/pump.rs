@@ -79,10 +79,31 @@ impl AppState {
 pub async fn pump(state: Arc<AppState>) {
     let mut tick = tokio::time::interval(Duration::from_millis(1));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let fd = state.shared.wake.listener().expect("the pump's eventfd");
+    // SAFETY: `fd` is an open descriptor the AsyncFd owns until it is dropped.
+    let wake = unsafe {
+        tokio::io::unix::AsyncFd::register_with_interest(fd, tokio::io::Interest::READABLE)
+    }
+    .map_err(|e| e.to_string())
+    .expect("the pump's eventfd registered");
     loop {
         tokio::select! {
             _ = tick.tick() => {}
-            _ = state.shared.wake.notified() => {}
+            r = wake.readable() => {
+                if let Ok(mut ready) = r {
+                    // Read (and so reset) the counter; then wait for the next write.
+                    let mut n = [0u8; 8];
+                    // SAFETY: reads 8 bytes into a valid buffer from our own descriptor.
+                    unsafe {
+                        libc::read(
+                            std::os::fd::AsRawFd::as_raw_fd(wake.get_ref()),
+                            n.as_mut_ptr().cast(),
+                            8,
+                        )
+                    };
+                    ready.clear_ready();
+                }
+            }
         }
         state.drain();
     }
