@@ -722,3 +722,25 @@ async fn updates_due_together_come_as_one_batch() {
         send(ws, 99, "stop", json!({"axis": "x"})).await;
     }
 }
+
+/// A message over 256 KiB closes the socket with code 1009 (message too big), not silently.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_oversize_message_closes_the_socket_with_1009() {
+    let s = Server::start();
+    let mut ws = connect(&s).await;
+    let big = format!(
+        r#"{{"jsonrpc":"2.0","id":1,"method":"subscribe","params":{{"topic":"{}"}}}}"#,
+        "x".repeat(300 * 1024)
+    );
+    ws.send(Message::Text(big.into())).await.unwrap();
+    let close = loop {
+        match tokio::time::timeout(Duration::from_secs(20), ws.stream.next()).await {
+            Ok(Some(Ok(Message::Close(c)))) => break c,
+            Ok(Some(Ok(_))) => continue,
+            other => panic!("no close frame: {other:?}"),
+        }
+    };
+    let c = close.expect("a close frame with a code");
+    assert_eq!(u16::from(c.code), 1009, "{c:?}");
+    assert!(c.reason.contains("256 KiB"), "{c:?}");
+}

@@ -470,8 +470,11 @@ async fn accept_loop(
         tokio::spawn(async move {
             let _permit = permit;
             let mut http = hyper::server::conn::http1::Builder::new();
+            // Requests beyond the guard's limits (api/guard.rs) are refused there with a
+            // problem; hyper's buffer bounds what is read at all.
             http.timer(TokioTimer::new())
-                .header_read_timeout(read_timeout);
+                .header_read_timeout(read_timeout)
+                .max_buf_size(64 * 1024);
             let conn = http
                 .serve_connection(
                     TokioIo::new(stream),

@@ -311,7 +311,7 @@ pub fn document() -> Value {
             "version": env!("CARGO_PKG_VERSION"),
             "description": format!(
                 "JSON-RPC 2.0 over the websocket `/api/v1/ws`: subscriptions with deltas, and every command of the \
-    REST API. Text messages only (a binary one is an error), at most 256 KiB. At most {} requests per socket may \
+    REST API. Text messages only (a binary one is an error), at most 256 KiB (a longer one closes the socket with code 1009). At most {} requests per socket may \
     await their responses; more are refused (-32000, data.code `too_many_in_flight`). The server sends a websocket \
     Ping when it has received nothing from the client for {} s and closes the socket when nothing (no Pong, no \
     message) arrives within {} s after it (`--ws-ping-s`). Notifications due in the same tick of the server's 5 ms \

@@ -1,9 +1,12 @@
 //! What a request goes through before a handler, so that a web page in the engineer's browser
 //! cannot act on motiond for another site (docs/security.md):
 //!
-//! 1. [`check_host`], every request (a layer around the whole router): `Host` names this server
-//!    — a loopback name or address, or a `--public-name` — else 421 `misdirected_request`
-//!    (DNS rebinding: a foreign name that resolves to 127.0.0.1).
+//! 1. [`check_host`], every request (a layer around the whole router): a request line of at
+//!    most [`MAX_URI`] bytes (else 414 `uri_too_long`) and headers of at most [`MAX_HEADERS`]
+//!    bytes (else 431 `request_headers_too_large`) — beyond 64 KiB, or 100 headers, hyper
+//!    itself answers 414 / 431 without a body —; `Host` names this server — a loopback name or
+//!    address, or a `--public-name` — else 421 `misdirected_request` (DNS rebinding: a foreign
+//!    name that resolves to 127.0.0.1).
 //! 2. [`check_request`], every request to `/api/v1/…` (a layer of that router, so before its
 //!    routing): a state-changing one (any method but GET, HEAD, OPTIONS, TRACE) or a websocket
 //!    upgrade must not come from another origin — `Origin`, when sent, this server's own or one
@@ -89,8 +92,38 @@ impl Guard {
     }
 }
 
-/// 421 for a request to a host name this server does not serve (every request).
+/// The longest URI (path and query) motiond reads: 8 KiB.
+pub const MAX_URI: usize = 8 * 1024;
+/// The most header bytes (names and values) motiond reads: 16 KiB.
+pub const MAX_HEADERS: usize = 16 * 1024;
+
+/// 414 / 431 for a request too large to be one of motiond's, then 421 for a request to a host
+/// name this server does not serve (every request).
 pub async fn check_host(State(g): State<Arc<Guard>>, req: Request, next: Next) -> Response {
+    let uri = req.uri().path_and_query().map_or(0, |p| p.as_str().len());
+    if uri > MAX_URI {
+        return AppError::new(
+            axum::http::StatusCode::URI_TOO_LONG,
+            "uri_too_long",
+            "URI too long",
+            format!("the URI has {uri} bytes; at most {MAX_URI} are read"),
+        )
+        .into_response();
+    }
+    let headers: usize = req
+        .headers()
+        .iter()
+        .map(|(n, v)| n.as_str().len() + v.len())
+        .sum();
+    if headers > MAX_HEADERS {
+        return AppError::new(
+            axum::http::StatusCode::REQUEST_HEADER_FIELDS_TOO_LARGE,
+            "request_headers_too_large",
+            "Request headers too large",
+            format!("the headers have {headers} bytes; at most {MAX_HEADERS} are read"),
+        )
+        .into_response();
+    }
     match g.misdirected(&req) {
         Some(detail) => AppError::misdirected(detail).into_response(),
         None => next.run(req).await,

@@ -410,7 +410,8 @@ pub(crate) async fn not_found(uri: axum::http::Uri) -> Response {
 Errors are `application/problem+json` (RFC 9457) with a stable `code` and, for errors of the motion kernel, \
 the PLCopen `error_id`. Besides the errors listed for each operation, any route answers a method it does not take \
 with 405 `method_not_allowed` (the `Allow` header lists those it takes), a body over 2 MiB (64 MiB for cam tables and the configuration document) with 413 \
-`payload_too_large` and a path that is not UTF-8 with 400 `bad_request`.\n\n\
+`payload_too_large`, a URI over 8 KiB with 414 `uri_too_long`, headers over 16 KiB with 431 `request_headers_too_large` \
+(beyond 64 KiB or 100 headers the answer is a bare 414 or 431) and a path that is not UTF-8 with 400 `bad_request`.\n\n\
 Requests from web pages of other sites are refused: a `Host` that is not a loopback name or address or a name \
 given with `--public-name` is a 421 `misdirected_request` (any request); a request that changes something \
 (POST, PUT, PATCH, DELETE) or opens the websocket with an `Origin` other than the server's own or one given \

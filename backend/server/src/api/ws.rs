@@ -39,6 +39,10 @@ pub const DEFAULT_PING_S: f64 = 30.0;
 /// The close code for a client that did not answer a ping (private range: an HTTP 408 in
 /// websocket terms).
 pub const PING_TIMEOUT_CLOSE: u16 = 4408;
+/// The close code for a message over [`MAX_MESSAGE`] (RFC 6455: message too big).
+pub const MESSAGE_TOO_BIG_CLOSE: u16 = 1009;
+/// The longest message a client may send.
+pub const MAX_MESSAGE: usize = 256 * 1024;
 
 /// How the server watches idle sockets.
 #[derive(Clone, Copy, Debug)]
@@ -180,7 +184,8 @@ A request without an id is a notification: carried out, never answered. \
 The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of \
 several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. \
 Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has \
-heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again.",
+heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. \
+A message over 256 KiB closes the socket with code 1009 (message too big).",
     responses((status = 101, description = "Switching protocols"), super::errors::WebsocketErrors))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
@@ -199,7 +204,10 @@ pub async fn upgrade(
     };
     // Clients send little (requests of at most 256 KiB): a small read chunk, because the read
     // buffer is zeroed to its size on every read.
-    ws.max_message_size(256 * 1024)
+    // A frame of up to 1 MiB is read whole, so that one over the message limit is answered
+    // with the 1009 close frame after it (an unread rest would make the close a reset).
+    ws.max_message_size(MAX_MESSAGE)
+        .max_frame_size(1024 * 1024)
         .read_buffer_size(4 * 1024)
         .on_upgrade(move |socket| session(s, socket, client, settings))
 }
@@ -312,7 +320,23 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                     Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
                     Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
                     Some(Ok(_)) => vec![],
-                    _ => break,
+                    Some(Err(e)) => {
+                        // A message over the limit is answered with a close frame that says so
+                        // (1009), not a silently dropped connection.
+                        let too_big = e
+                            .into_inner()
+                            .downcast::<tungstenite::Error>()
+                            .is_ok_and(|e| matches!(*e, tungstenite::Error::Capacity(_)));
+                        if too_big {
+                            let close = axum::extract::ws::CloseFrame {
+                                code: MESSAGE_TOO_BIG_CLOSE,
+                                reason: format!("message too big: at most {} KiB", MAX_MESSAGE / 1024).into(),
+                            };
+                            let _ = socket.send(Message::Close(Some(close))).await;
+                        }
+                        break;
+                    }
+                    None => break,
                 }
             },
             _ = tokio::time::sleep_until(idle_deadline) => {
