@@ -380,6 +380,12 @@ impl Axis {
         }
     }
 
+    /// A ramp-in runs: the planner holds the slave's deviation from its cams, which moves
+    /// with neither a superposition nor a new coordinate origin (those shift the cams).
+    pub(super) fn ramping_in(&self) -> bool {
+        self.cam_set().is_some_and(|s| s.ramp)
+    }
+
     /// The base cam of a cam slave (the only one of an MC_CamIn coupling).
     fn cam_law(&self) -> Option<CamLaw> {
         self.cam_set().map(|s| s.base())

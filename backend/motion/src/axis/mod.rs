@@ -283,7 +283,7 @@ impl Axis {
         if let Some(t) = self.last_target.as_mut() {
             *t += shift;
         }
-        if self.planner.is_planned() {
+        if self.planner.is_planned() && !self.ramping_in() {
             self.planner.shift(shift);
         }
     }

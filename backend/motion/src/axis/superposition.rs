@@ -273,7 +273,7 @@ impl Axis {
             self.set.position += sp.added.0 * dt;
             self.set.velocity += sp.added.0;
             self.set.acceleration += sp.added.1;
-            if self.planner.is_planned() {
+            if self.planner.is_planned() && !self.ramping_in() {
                 self.planner.shift(sp.added.0 * dt);
             }
             if let Some(c) = self.coupling.as_mut() {
@@ -327,7 +327,7 @@ impl Axis {
         let delta = dir * v * dt;
         sp.applied += delta;
         if delta != 0.0 {
-            if self.planner.is_planned() {
+            if self.planner.is_planned() && !self.ramping_in() {
                 self.planner.shift(delta);
             }
             if let Some(j) = self.job.as_mut() {

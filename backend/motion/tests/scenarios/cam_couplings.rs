@@ -646,6 +646,44 @@ fn a_ramp_in_is_aborted_like_any_coupling() {
     assert!((r.st(1).set_position - (p + v * DT)).abs() < 1e-6);
 }
 
+/// A superposition during the ramp-in shifts the cam once: the deviation the ramp runs down is
+/// not moved with it (it would land the slave the distance twice off its cam).
+#[test]
+fn a_superposition_during_the_ramp_in_counts_once() {
+    let mut r = rig_at(0.0, 50.0);
+    r.cam(T_LINE, &line(true));
+    let ramp = CamIn {
+        start_mode: StartMode::RampIn,
+        ramp_in: RampIn {
+            velocity: 20.0,
+            ..RampIn::default()
+        },
+        ..cam_in(0, T_LINE)
+    };
+    let c = r.ok(1, CommandKind::CamIn(ramp));
+    r.run(0.3);
+    assert!(r.out(c).busy && r.st(1).set_velocity < -1.0);
+    let sp = r.ok(
+        1,
+        CommandKind::MoveSuperImposed(Superposition {
+            mode: SuperpositionMode::VeloReductionAdditiveMotion,
+            distance: 5.0,
+            velocity_diff: 10.0,
+            velocity_process: 20.0,
+            length: 20.0,
+            ..Default::default()
+        }),
+    );
+    r.until(10.0, |r| r.out(c).in_sync && r.out(sp).done);
+    r.run(0.1);
+    // The slave was moving negative: 5 more travel that way, once.
+    let (m, s) = (r.st(0).set_position, r.st(1).set_position);
+    assert!(
+        (s - (m - 5.0)).abs() < 1e-6,
+        "slave {s}, master {m}: not the cam − 5"
+    );
+}
+
 /// A cam slave is a coupled slave: one that crosses its soft limit is decoupled and stopped
 /// in ErrorStop (0x7003), a queued switch ends with the error; a pending coupling ends when a
 /// motion command takes the axis.
