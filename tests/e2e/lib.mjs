@@ -125,11 +125,15 @@ export async function startStack({ noDemo = true } = {}) {
     const killMotiond = async () => {
       await stopProcess(motiond);
     };
+    /** Sends a signal to motiond (SIGSTOP/SIGCONT: a server that is there but silent). */
+    const signalMotiond = (sig) => {
+      motiond.kill(sig);
+    };
     /** Starts motiond again on the same port and database. */
     const restartMotiond = async () => {
       motiond = await startMotiond();
     };
-    return { url, api, ownUi, stop, killMotiond, restartMotiond, logs: () => procs.map((p) => p.log()).join('\n') };
+    return { url, api, ownUi, stop, killMotiond, restartMotiond, signalMotiond, logs: () => procs.map((p) => p.log()).join('\n') };
   } catch (e) {
     const logs = procs.map((p) => p.log()).join('\n');
     await stop();

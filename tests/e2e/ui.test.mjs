@@ -36,8 +36,21 @@ after(async () => {
   await stack.stop();
 });
 
+/** Makes sure the test axis exists (a test run alone: created as the 'create an axis' test does). */
+async function ensureAxis() {
+  if ((await rest(stack.api, 'GET', `/axes/${AXIS}`)).status === 200) return;
+  const r = await rest(stack.api, 'POST', '/axes', {
+    name: AXIS,
+    unit: 'mm',
+    soft_limits: { min: -1000, max: 1000 },
+    dynamics: { max_velocity: 500, acceleration: 2500, deceleration: 2500, jerk: 25000, jog_velocity_slow: 10, jog_velocity_fast: 100 },
+  });
+  assert.equal(r.status, 201, JSON.stringify(r.body));
+}
+
 /** Makes sure the test axis is enabled and at rest (tests may run alone). */
 async function enabled() {
+  await ensureAxis();
   const s = await status(stack.api, AXIS);
   if (!s.power_status) {
     const r = await rest(stack.api, 'POST', `/axes/${AXIS}/power`, {});
@@ -631,6 +644,7 @@ describe('commissioning UI', () => {
   for (const [width, height] of [
     [1280, 800],
     [1024, 768],
+    [390, 844],
   ]) {
     test(`every page at ${width}×${height}: screenshots, nothing wider than the window`, async () => {
       await enabled();
@@ -794,14 +808,129 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
+  test('LIVE panel: the cycle advances while nothing moves; a silent socket shows as stale', async () => {
+    await enabled();
+    await atRest();
+    const page = await open(`/axes/${AXIS}`);
+    const ind = page.locator('.dro [data-live]');
+    await until(async () => (await ind.getAttribute('data-live')) === 'live', { what: 'the live indicator' });
+    const first = Number(await ind.getAttribute('data-cycle'));
+    const axisState = async () => (await status(stack.api, AXIS)).state;
+    // the axis stands still: only the system topic (1 Hz) speaks, and its cycle advances
+    await until(async () => Number(await ind.getAttribute('data-cycle')) > first, { what: 'the cycle to advance at standstill' });
+    assert.equal(await axisState(), 'standstill');
+    // a server that is there but silent (stopped): no message for 3 s is shown
+    stack.signalMotiond('SIGSTOP');
+    try {
+      await until(async () => (await ind.getAttribute('data-live')) === 'stale', { what: 'the stale indicator' });
+      assert.match(await ind.textContent(), /no message for \d+ s/);
+      await shot(page, 'online-live-silent');
+    } finally {
+      stack.signalMotiond('SIGCONT');
+    }
+    await until(async () => (await ind.getAttribute('data-live')) === 'live', { what: 'live again' });
+    await page.close();
+  });
+
+  for (const [width, height] of [
+    [1280, 800],
+    [390, 844],
+  ]) {
+    test(`the Plant select shows its whole option text at ${width}×${height}`, async () => {
+      await ensureAxis();
+      const page = await open(`/axes/${AXIS}/config`, { width, height });
+      const plant = page.locator('select[name="drive.plant.kind"]');
+      await plant.waitFor();
+      const m = await plant.evaluate((s) => {
+        // its natural width (the longest option and the arrow), measured on a free copy
+        const free = s.cloneNode(true);
+        free.style.cssText = 'position:absolute;left:0;top:0;width:auto;max-width:none';
+        document.body.appendChild(free);
+        const need = free.getBoundingClientRect().width;
+        free.remove();
+        const r = s.getBoundingClientRect();
+        return { need, has: r.width, left: r.left, right: r.right, vw: window.innerWidth, title: s.title, text: s.selectedOptions[0].textContent };
+      });
+      assert.ok(m.has >= m.need - 0.5, `the select is ${m.has} px wide, its text needs ${m.need} px`);
+      assert.ok(m.left >= 0 && m.right <= m.vw, `inside the window: ${JSON.stringify(m)}`);
+      assert.equal(m.title, m.text);
+      await page.close();
+    });
+  }
+
+  test('phone 390×844: the axis list is a menu in the header, the header is whole, every axis tab is reachable', async () => {
+    await ensureAxis();
+    // the desktop is as it was: the list beside the page, no menu button
+    const desk = await open(`/axes/${AXIS}`);
+    assert.equal(await desk.locator('#sidebar').isVisible(), true);
+    assert.equal(await desk.locator('button[name="menu"]').isVisible(), false);
+    await desk.close();
+
+    const page = await open(`/axes/${AXIS}`, { width: 390, height: 844 });
+    const sidebar = page.locator('#sidebar');
+    const menu = page.locator('button[name="menu"]');
+    assert.equal(await sidebar.isVisible(), false);
+    assert.equal(await menu.isVisible(), true);
+    // the header: every part inside the window, none over another
+    const parts = await page.evaluate(() =>
+      [...document.querySelectorAll('.topbar > *, .topbar .nav-link, .topbar-right > *')].map((e) => {
+        const r = e.getBoundingClientRect();
+        return { what: e.className || e.tagName, parent: e.parentElement.className, l: r.left, r: r.right, t: r.top, b: r.bottom };
+      }),
+    );
+    for (const p of parts) assert.ok(p.l >= 0 && p.r <= 390 && p.t >= 0, `${p.what} is cut: ${JSON.stringify(p)}`);
+    const siblings = parts.filter((p) => p.parent === 'topbar');
+    for (const a of siblings)
+      for (const b of siblings)
+        if (a !== b) assert.ok(a.r <= b.l || b.r <= a.l || a.b <= b.t || b.b <= a.t, `${a.what} overlaps ${b.what}`);
+    // every tab inside the window and clickable
+    for (const [tab, url] of [
+      ['parameters', /\/parameters$/],
+      ['config', /\/config$/],
+      ['online', new RegExp(`/axes/${AXIS}$`)],
+    ]) {
+      const t = page.locator(`.tabs [data-tab="${tab}"]`);
+      const box = await t.boundingBox();
+      assert.ok(box.x >= 0 && box.x + box.width <= 390, `tab ${tab} is cut: ${JSON.stringify(box)}`);
+      await t.click();
+      await page.waitForURL(url);
+      await page.waitForSelector(`.tabs [data-tab="${tab}"].active`);
+    }
+    await shot(page, 'phone-online');
+    // the menu opens over the page, an axis in it navigates and closes it
+    await menu.click();
+    await sidebar.waitFor({ state: 'visible' });
+    assert.equal(await menu.getAttribute('aria-expanded'), 'true');
+    await shot(page, 'phone-menu-open');
+    await page.keyboard.press('Escape');
+    await sidebar.waitFor({ state: 'hidden' });
+    await menu.click();
+    await page.click('#sidebar a[href="#/new-axis"]');
+    await page.waitForURL(/#\/new-axis$/);
+    await sidebar.waitFor({ state: 'hidden' });
+    await menu.click();
+    await page.click(`#sidebar .axis-item[data-axis="${AXIS}"]`);
+    await page.waitForURL(new RegExp(`#/axes/${AXIS}`));
+    await sidebar.waitFor({ state: 'hidden' });
+    await page.close();
+  });
+
   test('edit and delete the axis (it must be disabled first: the UI offers to do it)', async () => {
     await enabled();
     const page = await open(`/axes/${AXIS}/config`);
     await page.fill('input[name="dynamics.jog_velocity_fast"]', '150');
-    await page.click('button[name="save"]');
-    await page.waitForSelector('button[name="disable-axis"]', { timeout: 10000 });
+    // while the axis is enabled: Save and Delete are off, the reason and a way out beside them
+    const save = page.locator('button[name="save"]');
+    await page.waitForSelector('[data-testid="save-blocked"]');
+    assert.equal(await save.isDisabled(), true);
+    assert.equal(await page.locator('button[name="delete"]').isDisabled(), true);
+    assert.match(await page.locator('[data-testid="save-blocked"]').textContent(), /enabled: switch it off to save or delete/);
+    await shot(page, 'configuration-enabled');
     await page.click('button[name="disable-axis"]');
     await until(async () => !(await status(stack.api, AXIS)).power_status, { what: 'axis disabled' });
+    await page.waitForSelector('button[name="save"]:not([disabled])');
+    await page.waitForSelector('[data-testid="save-blocked"]', { state: 'detached' });
+    assert.equal(await page.inputValue('input[name="dynamics.jog_velocity_fast"]'), '150', 'the edit is kept');
     await page.click('button[name="save"]');
     await page.waitForSelector('.banner-ok', { timeout: 10000 });
     assert.equal((await rest(stack.api, 'GET', `/axes/${AXIS}`)).body.config.dynamics.jog_velocity_fast, 150);

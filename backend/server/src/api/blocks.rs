@@ -27,6 +27,7 @@ use crate::app::{AppState, Milestone};
 use crate::error::AppResult;
 use crate::model::*;
 use crate::service::commands::{self, Submission};
+use crate::service::idempotency;
 
 /// What a client must be allowed to do to send a block. Shown in the OpenAPI document
 /// (`x-motiond-block.role`); enforced once clients authenticate (the security issue).
@@ -89,7 +90,8 @@ macro_rules! catalogue {
 
         $(
             #[utoipa::path(post, path = concat!("/api/v1/axes/{axis}/", $name), tag = "commands", summary = $summary,
-                params(("axis" = String, Path, description = "axis id or name", example = "x"), WaitQuery),
+                params(("axis" = String, Path, description = "axis id or name", example = "x"), WaitQuery,
+                    ("Idempotency-Key" = Option<String>, Header, description = "1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.", example = "mes-order-4711-step-3")),
                 request_body = $body,
                 responses(
                     (status = 202, description = "Accepted: the command resource (final or at its milestone when waited for)",
@@ -100,6 +102,7 @@ macro_rules! catalogue {
                 State(s): State<Arc<AppState>>,
                 Path(axis): Path<String>,
                 client: Client,
+                headers: axum::http::HeaderMap,
                 Q(q): Q<WaitQuery>,
                 JsonBody(body, raw): JsonBody<$body>,
             ) -> AppResult<Response> {
@@ -113,8 +116,14 @@ macro_rules! catalogue {
                     body,
                     raw,
                     client: client.0,
+                    idempotency_key: idempotency::key(&headers)?,
                 };
-                Ok(accepted(commands::run(&s, sub, wait).await?))
+                let (view, replayed) = idempotency::run_once(&s, sub, wait).await?;
+                let mut r = accepted(view);
+                if replayed {
+                    r.headers_mut().insert("idempotent-replayed", HeaderValue::from_static("true"));
+                }
+                Ok(r)
             }
         )+
 
@@ -152,6 +161,7 @@ macro_rules! catalogue {
                                 body,
                                 raw,
                                 client,
+                                idempotency_key: None,
                             };
                             commands::run(s, sub, wait).await
                         }

@@ -122,6 +122,7 @@ pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry 
                 .and_then(|v| v.as_str().map(String::from))
                 .unwrap_or_default(),
         }),
+        idempotency_key: None,
     }
 }
 

@@ -52,6 +52,8 @@ pub struct AppState {
     pub metrics: crate::metrics::Metrics,
     /// Bumped whenever the registry is written (sockets re-check their subscriptions then).
     registry_writes: AtomicU64,
+    /// Recent `Idempotency-Key`s of motion commands and their answers.
+    pub idempotency: crate::service::idempotency::Keys,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -89,6 +91,7 @@ impl AppState {
             feed: feed::Feed::new(MAX_AXES),
             metrics: Default::default(),
             registry_writes: AtomicU64::new(0),
+            idempotency: Default::default(),
             registry: RwLock::new(Registry::default()),
             config_lock: tokio::sync::Mutex::new(()),
             commands: Mutex::new(CommandStore::default()),

@@ -283,6 +283,7 @@ pub async fn reset_following_error_peak(
         command_id: None,
         detail: String::new(),
         outcome: Some(outcome.into()),
+        idempotency_key: None,
     });
     match result {
         Ok(cycle) => Ok(PeakResetResource { axis: name, cycle }),

@@ -633,6 +633,8 @@ pub struct Submission<'a, B> {
     /// The body as sent, kept with the command and in the audit log.
     pub raw: serde_json::Value,
     pub client: ClientInfo,
+    /// The `Idempotency-Key` it was sent with (see `service::idempotency`).
+    pub idempotency_key: Option<String>,
 }
 
 /// Checks, submits and (with `wait`) waits for a command: what every command endpoint and
@@ -650,10 +652,16 @@ pub async fn run<B>(
         body,
         raw,
         client,
+        idempotency_key,
     } = sub;
-    let id = submit(s, axis, (name, milestone), raw, client, |reg, e| {
-        to_kind(&body, reg, e)
-    })
+    let id = submit(
+        s,
+        axis,
+        (name, milestone),
+        (raw, idempotency_key),
+        client,
+        |reg, e| to_kind(&body, reg, e),
+    )
     .await?;
     let view = match wait {
         Some(t) => wait_for(s, id, t).await,
@@ -684,7 +692,7 @@ async fn submit(
     s: &AppState,
     axis_key: &str,
     (name, milestone): (&'static str, Milestone),
-    parameters: serde_json::Value,
+    (parameters, key): (serde_json::Value, Option<String>),
     client: ClientInfo,
     build: impl FnOnce(&Registry, &AxisEntry) -> AppResult<CommandKind>,
 ) -> AppResult<CommandId> {
@@ -716,6 +724,7 @@ async fn submit(
         command_id: Some(id),
         detail: parameters.to_string(),
         outcome: None,
+        idempotency_key: key.clone(),
     };
     s.commands.lock().unwrap().insert(CommandRecord {
         id,
@@ -912,6 +921,7 @@ pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppRes
         command_id: Some(id),
         detail: serde_json::json!({"via": client.via}).to_string(),
         outcome: Some(outcome),
+        idempotency_key: None,
     });
     result
 }

@@ -5,5 +5,6 @@
 pub mod axes;
 pub mod cams;
 pub mod commands;
+pub mod idempotency;
 pub mod scope;
 pub mod simulation;

@@ -52,6 +52,7 @@ pub async fn inject_fault(
                 e.kernel_error().map_or("unknown", |id| id.code())
             ),
         }),
+        idempotency_key: None,
     });
     match result {
         Ok(_) => Ok(()),

@@ -14,13 +14,15 @@ pub struct AuditEntry {
     pub command_id: Option<u64>,
     pub detail: String,
     pub outcome: Option<String>,
+    /// The `Idempotency-Key` a motion command was sent with.
+    pub idempotency_key: Option<String>,
 }
 
 pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
     e: E,
     a: &AuditEntry,
 ) -> Result<(), sqlx::Error> {
-    sqlx::query("INSERT INTO audit_log (at, client_addr, client_id, action, target, command_id, detail, outcome) VALUES (?, ?, ?, ?, ?, ?, ?, ?)")
+    sqlx::query("INSERT INTO audit_log (at, client_addr, client_id, action, target, command_id, detail, outcome, idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)")
         .bind(&a.at)
         .bind(&a.client_addr)
         .bind(&a.client_id)
@@ -29,6 +31,7 @@ pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
         .bind(a.command_id.map(|c| c as i64))
         .bind(&a.detail)
         .bind(&a.outcome)
+        .bind(&a.idempotency_key)
         .execute(e)
         .await
         .map(|_| ())
@@ -53,6 +56,31 @@ pub async fn audit_outcome<'e, E: sqlx::SqliteExecutor<'e>>(
 pub enum AuditOp {
     Row(AuditEntry),
     Outcome(u64, String),
+}
+
+/// The newest submission of a motion command sent with `key`: (command id, action, target,
+/// body, outcome, when).
+pub async fn find_idempotency_key(
+    pool: &SqlitePool,
+    key: &str,
+) -> Result<Option<(u64, String, Option<String>, String, Option<String>, String)>, sqlx::Error> {
+    let row = sqlx::query(
+        "SELECT command_id, action, target, detail, outcome, at FROM audit_log \
+         WHERE idempotency_key = ? ORDER BY id DESC LIMIT 1",
+    )
+    .bind(key)
+    .fetch_optional(pool)
+    .await?;
+    Ok(row.map(|r| {
+        (
+            r.get::<Option<i64>, _>(0).unwrap_or_default() as u64,
+            r.get(1),
+            r.get(2),
+            r.get(3),
+            r.get(4),
+            r.get(5),
+        )
+    }))
 }
 
 /// One audit log row as stored.
@@ -90,6 +118,7 @@ pub async fn read_audit(
                 command_id: r.get::<Option<i64>, _>(6).map(|c| c as u64),
                 detail: r.get(7),
                 outcome: r.get(8),
+                idempotency_key: None,
             },
         })
         .collect())

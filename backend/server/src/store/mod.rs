@@ -9,7 +9,9 @@ pub mod audit;
 pub mod axes;
 pub mod cams;
 
-pub use audit::{AuditEntry, AuditOp, AuditRow, audit, audit_outcome, read_audit};
+pub use audit::{
+    AuditEntry, AuditOp, AuditRow, audit, audit_outcome, find_idempotency_key, read_audit,
+};
 pub use axes::{StoredAxis, load_axes, load_persistent};
 
 use std::str::FromStr;

@@ -1,0 +1,185 @@
+//! `Idempotency-Key` on motion commands (issue "Security and reliability"), against the real
+//! binary: a retry gets the first answer and does not act twice — also after a restart —; the key
+//! with another request, or while the first is still answered, is refused; a bad key is a 422.
+
+mod common;
+
+use common::*;
+use serde_json::{Value, json};
+
+/// POST with an `Idempotency-Key`; the response and whether it says it is a replay.
+async fn post_keyed(s: &Server, path: &str, key: &str, body: Value) -> (Resp, bool) {
+    let r = reqwest::Client::new()
+        .post(s.url(path))
+        .header("content-type", "application/json")
+        .header("idempotency-key", key)
+        .body(body.to_string())
+        .send()
+        .await
+        .expect("request sent");
+    let replayed = r
+        .headers()
+        .get("idempotent-replayed")
+        .is_some_and(|v| v == "true");
+    (resp_of(r).await, replayed)
+}
+
+fn position(v: &Value) -> f64 {
+    v["status"]["set_position"].as_f64().unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_retried_command_acts_once() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let mv = json!({"distance": 10.0, "velocity": 100.0});
+    let path = "/api/v1/axes/x/move-relative?wait=true";
+    let (first, replayed) = post_keyed(&s, path, "mes-order-1", mv.clone()).await;
+    assert_eq!(first.status, 202, "{}", first.text);
+    assert!(!replayed);
+    assert_eq!(first.json["state"], "done", "{}", first.text);
+    assert_eq!(position(&status(&s, "x").await), 10.0);
+    // The MES did not get the answer and sends it again: the same command, nothing moves.
+    let (again, replayed) = post_keyed(&s, path, "mes-order-1", mv.clone()).await;
+    assert_eq!(again.status, 202, "{}", again.text);
+    assert!(replayed);
+    assert_eq!(again.json["id"], first.json["id"]);
+    assert_eq!(again.json["state"], "done");
+    assert_eq!(position(&status(&s, "x").await), 10.0);
+    // The same key with another request.
+    let (other, _) = post_keyed(
+        &s,
+        path,
+        "mes-order-1",
+        json!({"distance": 20.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(
+        (other.status, other.json["code"].as_str()),
+        (409, Some("idempotency_key_reused")),
+        "{}",
+        other.text
+    );
+    // A refused command is refused again, not tried again.
+    let far = json!({"position": 5000.0, "velocity": 100.0});
+    let (no, _) = post_keyed(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        "mes-order-2",
+        far.clone(),
+    )
+    .await;
+    assert_eq!(no.status, 409, "{}", no.text);
+    let (no_again, _) = post_keyed(&s, "/api/v1/axes/x/move-absolute", "mes-order-2", far).await;
+    assert_eq!(
+        (no_again.status, &no_again.json["code"]),
+        (409, &no.json["code"]),
+        "{}",
+        no_again.text
+    );
+    // A key is 1–255 visible ASCII characters.
+    for bad in ["", "with space", &"k".repeat(256)] {
+        let (r, _) = post_keyed(&s, path, bad, mv.clone()).await;
+        assert_eq!(
+            r.field_error(),
+            (422, Some("Idempotency-Key")),
+            "{bad:?}: {}",
+            r.text
+        );
+    }
+    // A body that does not check does nothing and keeps no key: the corrected retry acts.
+    let (r, _) = post_keyed(
+        &s,
+        path,
+        "mes-order-3",
+        json!({"distance": 1.0, "velocity": -1.0}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    let (r, replayed) = post_keyed(
+        &s,
+        path,
+        "mes-order-3",
+        json!({"distance": 1.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_eq!((r.status, replayed), (202, false), "{}", r.text);
+    assert_eq!(position(&status(&s, "x").await), 11.0);
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_retry_while_the_first_is_answered_is_refused_and_after_a_restart_is_recognised() {
+    let dir = temp_dir();
+    let db = dir.join("idem.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    power_on(&s, "x").await;
+    // A long move waited for: its request is still being answered.
+    let url = s.url("/api/v1/axes/x/move-relative?wait=true&timeout_ms=60000");
+    let long = tokio::spawn(async move {
+        reqwest::Client::new()
+            .post(url)
+            .header("content-type", "application/json")
+            .header("idempotency-key", "mes-long")
+            .body(json!({"distance": 500.0, "velocity": 20.0}).to_string())
+            .send()
+            .await
+            .map(|r| r.status().as_u16())
+    });
+    // Wait until the move runs.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while status(&s, "x").await["status"]["state"] != "discrete_motion" {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the move did not start"
+        );
+        tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+    }
+    let (r, _) = post_keyed(
+        &s,
+        "/api/v1/axes/x/move-relative",
+        "mes-long",
+        json!({"distance": 500.0, "velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("idempotency_key_in_flight")),
+        "{}",
+        r.text
+    );
+    s.stop(); // SIGKILL while the move runs
+    let _ = long.await;
+    let s = Server::start_with(db, &[]);
+    power_on(&s, "x").await;
+    let before = position(&status(&s, "x").await);
+    let (r, _) = post_keyed(
+        &s,
+        "/api/v1/axes/x/move-relative",
+        "mes-long",
+        json!({"distance": 500.0, "velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("idempotency_key_replayed")),
+        "{}",
+        r.text
+    );
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("command "),
+        "{}",
+        r.text
+    );
+    assert_eq!(status(&s, "x").await["status"]["state"], "standstill");
+    assert_eq!(position(&status(&s, "x").await), before);
+    // Another request under that key is still another request.
+    let (r, _) = post_keyed(
+        &s,
+        "/api/v1/axes/x/move-relative",
+        "mes-long",
+        json!({"distance": 1.0, "velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(r.json["code"], "idempotency_key_reused", "{}", r.text);
+}
