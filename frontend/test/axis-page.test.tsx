@@ -5,6 +5,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
+import { mountPoint, unmount } from './dom';
 
 const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })) }));
 
@@ -14,7 +15,8 @@ vi.mock('../src/services', async () => {
     axes: new Store<unknown[]>([]),
     axesLoaded: new Store(true),
     statuses: new Store(new Map()),
-    live: { state: new Store({ kind: 'open', since: 0 }) },
+    system: new Store(null),
+    live: { state: new Store({ kind: 'open', since: 0 }), lastMessageAt: null },
     command: h.command,
     findHeldStop: vi.fn(),
     releaseCommand: vi.fn(),
@@ -57,12 +59,10 @@ beforeEach(() => {
         new Promise<Response>((resolve) => waiting.push({ url, answer: (b) => resolve(new Response(JSON.stringify(b), { status: 200 })) })),
     ),
   );
-  root = document.createElement('div');
-  document.body.appendChild(root);
+  root = mountPoint();
 });
 afterEach(() => {
-  act(() => render(null, root));
-  root.remove();
+  unmount(root);
   vi.unstubAllGlobals();
   statuses.get().clear();
 });

@@ -3,6 +3,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
+import { mountPoint, unmount } from './dom';
 
 const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), fetch: vi.fn() }));
 
@@ -24,12 +25,10 @@ beforeEach(() => {
   h.fetch.mockClear();
   // Nothing is asked of the server to show the override (no command history search).
   vi.stubGlobal('fetch', h.fetch);
-  root = document.createElement('div');
-  document.body.appendChild(root);
+  root = mountPoint();
 });
 afterEach(() => {
-  act(() => render(null, root));
-  root.remove();
+  unmount(root);
   vi.useRealTimers();
   expect(h.fetch).not.toHaveBeenCalled();
   vi.unstubAllGlobals();

@@ -2,17 +2,35 @@
 // errors (JSON paths such as `dynamics.jerk`, `drive.plant.damping`, `parameters.X`) are shown
 // at the field they name, anything else in the banner.
 import { useEffect, useState } from 'preact/hooks';
-import type { AxisConfig, AxisResource, ParamValue } from '../api/types';
+import type { AxisConfig, AxisLiveStatus, AxisResource, ParamValue } from '../api/types';
 import { ApiError, del, enc, post, put } from '../api/rest';
 import { command, refreshAxes, statuses } from '../services';
 import { navigate } from '../router';
 import { useStore } from '../store';
 import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
-import { inputNum } from '../format';
+import { STATE_LABEL, inputNum } from '../format';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
 
 type PlantKind = 'ideal' | 'pt1' | 'pt2';
+
+const PLANTS: [PlantKind, string][] = [
+  ['ideal', 'ideal (load = reference)'],
+  ['pt1', 'PT1 (first-order lag)'],
+  ['pt2', 'PT2 (tuned position loop)'],
+];
+
+/**
+ * Why the axis cannot be saved or deleted now, as its live status shows it (the server swaps
+ * only a disabled axis: state Disabled and power off), or null. Unknown status: null — the
+ * server judges, and its refusal is shown.
+ */
+export function reconfigureBlocked(s: Pick<AxisLiveStatus, 'state' | 'power_status'> | null | undefined): string | null {
+  if (!s) return null;
+  if (s.power_status) return 'The axis is enabled: switch it off to save or delete.';
+  if (s.state !== 'disabled') return `The axis is in ${STATE_LABEL[s.state]}: it must be Disabled to save or delete (reset it).`;
+  return null;
+}
 
 export interface ConfigForm {
   name: string;
@@ -227,7 +245,19 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     setFields({});
     setError(null);
   }, [axis?.id]);
-  const enabled = axis ? (st.get(axis.config.name)?.status?.power_status ?? false) : false;
+  const live = axis ? st.get(axis.config.name) : undefined;
+  // While the status is stale the buttons are off anyway (offline) or the server judges.
+  const blocked = axis && live && !live.stale ? reconfigureBlocked(live.status) : null;
+  const powered = !!(blocked && live?.status?.power_status);
+  const disableNow = async () => {
+    if (!axis) return;
+    try {
+      await command(axis.config.name, 'power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 });
+      setNotDisabled(false);
+    } catch (e) {
+      setError(errorText(e));
+    }
+  };
 
   const set = <K extends keyof ConfigForm>(k: K, v: ConfigForm[K]) => setForm({ ...form, [k]: v });
   const err = (path: string) => fields[path];
@@ -300,14 +330,15 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
       )}
       <ErrorBanner error={error} onClose={() => setError(null)} />
       {notDisabled && axis && (
-        <div class="banner banner-warn">
-          The axis must be disabled first.
-          <ActionButton kind="warn" name="disable-axis" disabled={!online} onClick={() => command(axis.config.name, 'power', { enable: false, enable_positive: false, enable_negative: false, override_percent: 100 }).then(() => setNotDisabled(false), (e) => setError(errorText(e)))}>
-            Disable {axis.config.name} now
-          </ActionButton>
+        <div class="banner banner-warn" data-testid="not-disabled">
+          The server refused: the axis must be disabled first.
+          {!powered && (
+            <ActionButton kind="warn" name="disable-axis" disabled={!online} onClick={disableNow}>
+              Disable {axis.config.name} now
+            </ActionButton>
+          )}
         </div>
       )}
-      {!creating && enabled && <div class="banner banner-info">The axis is enabled: saving or deleting needs it disabled.</div>}
       {message && <div class="banner banner-ok">{message}</div>}
       <form
         class="config-form"
@@ -355,11 +386,17 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
           </Panel>
           <Panel title="Simulated drive">
             <div class="form-grid">
-              <Field label="Plant" name="drive.plant">
-                <select name="drive.plant.kind" value={form.plant} onChange={(e) => set('plant', (e.target as HTMLSelectElement).value as PlantKind)}>
-                  <option value="ideal">ideal (load = reference)</option>
-                  <option value="pt1">PT1 (first-order lag)</option>
-                  <option value="pt2">PT2 (tuned position loop)</option>
+              <Field label="Plant" name="drive.plant" class="field-row">
+                <select
+                  name="drive.plant.kind"
+                  class="select-fit"
+                  value={form.plant}
+                  title={PLANTS.find(([k]) => k === form.plant)?.[1]}
+                  onChange={(e) => set('plant', (e.target as HTMLSelectElement).value as PlantKind)}
+                >
+                  {PLANTS.map(([k, label]) => (
+                    <option value={k}>{label}</option>
+                  ))}
                 </select>
               </Field>
               {form.plant === 'pt1' && num('drive.plant.time_constant', form.time_constant, (v) => set('time_constant', v), 'Time constant (s)', '> 0 and ≤ 10')}
@@ -423,7 +460,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
           </Panel>
         </div>
         <div class="form-actions sticky-actions">
-          <button type="submit" class="btn btn-primary" name="save" disabled={!online}>
+          <button type="submit" class="btn btn-primary" name="save" disabled={!online || !!blocked} aria-describedby={blocked ? 'save-blocked' : undefined}>
             {creating ? 'Create axis' : 'Save configuration'}
           </button>
           {!creating && (
@@ -435,7 +472,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
             (confirmDelete ? (
               <span class="confirm">
                 Delete axis <b>{axis.config.name}</b> and its persistent parameters?
-                <ActionButton kind="danger" name="delete-confirm" disabled={!online} onClick={remove}>
+                <ActionButton kind="danger" name="delete-confirm" disabled={!online || !!blocked} onClick={remove}>
                   Delete
                 </ActionButton>
                 <button type="button" class="btn" onClick={() => setConfirmDelete(false)}>
@@ -443,10 +480,20 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
                 </button>
               </span>
             ) : (
-              <button type="button" class="btn btn-danger-outline" name="delete" disabled={!online} onClick={() => setConfirmDelete(true)}>
+              <button type="button" class="btn btn-danger-outline" name="delete" disabled={!online || !!blocked} onClick={() => setConfirmDelete(true)}>
                 Delete axis…
               </button>
             ))}
+          {blocked && axis && (
+            <span class="save-blocked" id="save-blocked" data-testid="save-blocked">
+              {blocked}
+              {powered && (
+                <ActionButton kind="warn" name="disable-axis" disabled={!online} onClick={disableNow}>
+                  Disable {axis.config.name} now
+                </ActionButton>
+              )}
+            </span>
+          )}
         </div>
       </form>
     </div>
