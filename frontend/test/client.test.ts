@@ -66,6 +66,27 @@ describe('LiveClient', () => {
     expect(seen.length).toBe(2);
   });
 
+  it('stamps every message it receives, a batch or an answer alike; none from a replaced socket', () => {
+    let now = 1000;
+    const c = new LiveClient({ url: 'ws://test/api/v1/ws', createSocket: (u) => new FakeSocket(u) as any, random: () => 0.5, now: () => now });
+    c.subscribe<any>('system', 1, () => {});
+    c.start();
+    const ws = FakeSocket.all[0];
+    ws.open();
+    expect(c.lastMessageAt).toBeNull();
+    now = 2000;
+    ws.push([{ jsonrpc: '2.0', method: 'update', params: { topic: 'system', cycle: 5, full: true, data: { cycle: 5 } } }]);
+    expect(c.lastMessageAt).toBe(2000);
+    now = 3000;
+    ws.reply(ws.sent[0], { topic: 'system' });
+    expect(c.lastMessageAt).toBe(3000);
+    // the socket is lost; a late message of it is not the new socket speaking
+    ws.serverClose();
+    now = 4000;
+    ws.push({ jsonrpc: '2.0', method: 'update', params: { topic: 'system', cycle: 6, full: false, data: { cycle: 6 } } });
+    expect(c.lastMessageAt).toBe(3000);
+  });
+
   it('answers calls, and rejects with the problem+json of an error', async () => {
     const c = client();
     c.start();

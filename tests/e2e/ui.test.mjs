@@ -824,6 +824,8 @@ describe('commissioning UI', () => {
     try {
       await until(async () => (await ind.getAttribute('data-live')) === 'stale', { what: 'the stale indicator' });
       assert.match(await ind.textContent(), /no message for \d+ s/);
+      // the header says so too (its own 1 s tick)
+      await until(async () => (await page.locator('.topbar [data-conn="open"]').getAttribute('data-live')) === 'stale', { what: 'the silent header' });
       await shot(page, 'online-live-silent');
     } finally {
       stack.signalMotiond('SIGCONT');

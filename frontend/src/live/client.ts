@@ -57,6 +57,8 @@ export interface LiveClientOptions {
   createSocket?: (url: string) => WsLike;
   callTimeoutMs?: number;
   random?: () => number;
+  /** The wall clock (ms) that stamps each message received; `Date.now` by default. */
+  now?: () => number;
 }
 
 export class LiveClient {
@@ -71,6 +73,7 @@ export class LiveClient {
   private retryTimer: ReturnType<typeof setTimeout> | null = null;
   private attempt = 0;
   private stopped = false;
+  private lastMessage: number | null = null;
   private readonly createSocket: (url: string) => WsLike;
 
   constructor(private readonly opts: LiveClientOptions) {
@@ -79,6 +82,15 @@ export class LiveClient {
 
   get connected(): boolean {
     return this.state.get().kind === 'open';
+  }
+
+  /**
+   * When the last message of any kind (update, batch, answer) arrived, by `now`; null before
+   * the first. The server streams only changes, so an open socket can be silent: the age of
+   * this shows whether it still speaks (the `system` topic changes every update).
+   */
+  get lastMessageAt(): number | null {
+    return this.lastMessage;
   }
 
   start(): void {
@@ -123,6 +135,7 @@ export class LiveClient {
     };
     ws.onmessage = (ev) => {
       if (this.ws !== ws) return;
+      this.lastMessage = (this.opts.now ?? Date.now)();
       this.onMessage(String(ev.data));
     };
     ws.onerror = () => {

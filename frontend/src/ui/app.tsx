@@ -10,10 +10,13 @@ import { AxisConfigPage } from './axis-config';
 import { ScopePage } from './scope';
 import { CamListPage, CamPage } from './cams';
 import type { ConnState } from '../live/client';
+import { ageText } from '../live/liveness';
+import { useLiveness } from './liveness';
 
 function Connection() {
   const c = useStore(live.state);
   const sys = useStore(system);
+  const l = useLiveness();
   const [, tick] = useState(0);
   useEffect(() => {
     if (c.kind !== 'closed') return;
@@ -21,13 +24,15 @@ function Connection() {
     return () => clearInterval(t);
   }, [c.kind]);
   if (c.kind === 'open') {
+    // Open but silent (no message for a few seconds, though the system topic speaks every second).
+    const silent = l.kind === 'stale';
     return (
-      <div class="conn conn-open" data-conn="open" title="websocket connected">
+      <div class={`conn conn-open ${silent ? 'conn-silent' : ''}`} data-conn="open" data-live={l.kind} title={silent ? 'websocket open, but no message for a while' : 'websocket connected'}>
         <span class="conn-dot" />
-        <span>online</span>
+        <span>{silent ? `silent ${l.ageMs === null ? '' : ageText(l.ageMs)}` : 'online'}</span>
         {sys && (
           <span class="conn-info">
-            cycle {(sys.cycle_time * 1000).toFixed(sys.cycle_time < 0.001 ? 3 : 1)} ms · #{sys.cycle}
+            <span class="conn-cycle-time">cycle {(sys.cycle_time * 1000).toFixed(sys.cycle_time < 0.001 ? 3 : 1)} ms · </span>#{sys.cycle}
           </span>
         )}
       </div>

@@ -11,6 +11,7 @@ import { CommandLog } from './command-log';
 import { OverrideControl } from './override';
 import { Inching } from './inching';
 import { Trend } from './trend';
+import { LiveIndicator } from './liveness';
 import { href } from '../router';
 import { P_JOG_FAST, P_JOG_SLOW, numParam, useParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
@@ -233,7 +234,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="online-grid">
         <div class="online-col">
-          <Panel title="Live" class="dro" actions={<span class="muted small">{stale ? 'not live' : s ? `cycle ${liveStatus?.cycle}` : ''}</span>}>
+          <Panel title="Live" class="dro" actions={<LiveIndicator cycle={liveStatus?.cycle} stale={stale} />}>
             <Readout name="set_position" label="Set position" value={pos(s?.set_position)} unit={u} />
             <Readout name="actual_position" label="Actual position" value={pos(s?.actual_position)} unit={u} />
             <Readout name="set_velocity" label="Set velocity" value={vel(s?.set_velocity)} unit={`${u}/s`} />
