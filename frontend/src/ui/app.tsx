@@ -71,12 +71,13 @@ function ConnectionNotice({ c }: { c: ConnState }) {
   );
 }
 
-function Sidebar({ route }: { route: Route }) {
+/** The axis list: a column beside the page, on a narrow screen a menu opened from the header. */
+function Sidebar({ route, open }: { route: Route; open: boolean }) {
   const list = useStore(axes);
   const st = useStore(statuses);
   const current = route.page === 'axis' ? route.axis : null;
   return (
-    <nav class="sidebar">
+    <nav class={`sidebar ${open ? 'open' : ''}`} id="sidebar" aria-label="Axes">
       <div class="sidebar-head">Axes</div>
       <ul class="axis-list">
         {list.map((a) => {
@@ -110,9 +111,18 @@ export function App() {
   const route = useRoute();
   const conn = useStore(live.state);
   const loaded = useStore(axesLoaded);
+  // Narrow screens (style.css, ≤ 700 px): the axis list is a menu; any navigation closes it.
+  const [menuOpen, setMenuOpen] = useState(false);
   useEffect(() => {
     setFocus(route.page === 'axis' && route.tab === 'online' ? route.axis : null);
+    setMenuOpen(false);
   }, [route]);
+  useEffect(() => {
+    if (!menuOpen) return;
+    const onKey = (e: KeyboardEvent) => e.key === 'Escape' && setMenuOpen(false);
+    window.addEventListener('keydown', onKey);
+    return () => window.removeEventListener('keydown', onKey);
+  }, [menuOpen]);
   let page;
   switch (route.page) {
     case 'overview':
@@ -150,6 +160,18 @@ export function App() {
   return (
     <div class={`app app-${conn.kind === 'open' ? 'online' : 'offline'}`}>
       <header class="topbar">
+        <button
+          type="button"
+          class="menu-btn"
+          name="menu"
+          aria-controls="sidebar"
+          aria-expanded={menuOpen}
+          title="Axes"
+          onClick={() => setMenuOpen(!menuOpen)}
+        >
+          <span class="menu-icon" aria-hidden="true" />
+          Axes
+        </button>
         <a class="brand" href="#/">
           motiond
         </a>
@@ -168,7 +190,8 @@ export function App() {
       </header>
       <ConnectionNotice c={conn} />
       <div class="body">
-        <Sidebar route={route} />
+        <Sidebar route={route} open={menuOpen} />
+        {menuOpen && <div class="menu-backdrop" onClick={() => setMenuOpen(false)} />}
         <main class="main">{loaded || conn.kind === 'open' ? page : <div class="page muted">Waiting for motiond…</div>}</main>
       </div>
     </div>

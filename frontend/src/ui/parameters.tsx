@@ -240,81 +240,84 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
         </div>
       )}
 
-      <table class="grid param-table">
-        <colgroup>
-          <col class="c-no" />
-          <col class="c-name" />
-          <col class="c-value" />
-          <col class="c-unit" />
-          <col class="c-range" />
-          <col class="c-pers" />
-        </colgroup>
-        <thead>
-          <tr>
-            <th class="r">No.</th>
-            <th>Name</th>
-            <th class="r">Value</th>
-            <th>Unit</th>
-            <th>Range</th>
-            <th class="r" title="value of the persistent overlay (MC_WriteParameterPersistent)">Persistent</th>
-          </tr>
-        </thead>
-        {GROUPS.filter((g) => shown.some((p) => p.group === g.key)).map((g) => (
-          <tbody key={g.key}>
-            <tr class="group-row">
-              <th colSpan={6}>{g.label}</th>
+      {/* On a phone the table keeps readable columns and scrolls sideways in its box. */}
+      <div class="table-scroll">
+        <table class="grid param-table">
+          <colgroup>
+            <col class="c-no" />
+            <col class="c-name" />
+            <col class="c-value" />
+            <col class="c-unit" />
+            <col class="c-range" />
+            <col class="c-pers" />
+          </colgroup>
+          <thead>
+            <tr>
+              <th class="r">No.</th>
+              <th>Name</th>
+              <th class="r">Value</th>
+              <th>Unit</th>
+              <th>Range</th>
+              <th class="r" title="value of the persistent overlay (MC_WriteParameterPersistent)">Persistent</th>
             </tr>
-            {shown
-              .filter((p) => p.group === g.key)
-              .map((p) => {
-                const edited = edits[p.number] !== undefined && edits[p.number] !== valueText(p.value);
-                const err = rowErrors[p.number] ?? invalid[p.number];
-                const ro = p.read_only || p.group === 'status';
-                return (
-                    <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
-                      <td class="r mono">{p.number}</td>
-                      <td class="pname" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
-                        {p.name}
-                        {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
-                        <div class={`help ${openHelp === p.number ? 'help-open' : 'help-short'}`}>{p.help}</div>
-                      </td>
-                      <td class="r value-cell">
-                        {ro ? (
-                          <span class="mono">{valueText(p.value)}</span>
-                        ) : p.type === 'bool' ? (
-                          <select
-                            name={`param-${p.number}`}
-                            value={edits[p.number] ?? valueText(p.value)}
-                            onChange={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLSelectElement).value })}
-                          >
-                            <option value="true">true</option>
-                            <option value="false">false</option>
-                          </select>
-                        ) : (
-                          <input
-                            class="num"
-                            type="text"
-                            inputMode="decimal"
-                            name={`param-${p.number}`}
-                            value={edits[p.number] ?? valueText(p.value)}
-                            onInput={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLInputElement).value })}
-                          />
-                        )}
-                        {err && (
-                          <div class="field-error" role="alert">
-                            {err}
-                          </div>
-                        )}
-                      </td>
-                      <td>{p.unit_text}</td>
-                      <td class="mono small">{rangeText(p)}</td>
-                      <td class="r mono small">{p.persistent_value !== undefined && p.persistent_value !== null ? valueText(p.persistent_value) : ''}</td>
-                    </tr>
-                );
-              })}
-          </tbody>
-        ))}
-      </table>
+          </thead>
+          {GROUPS.filter((g) => shown.some((p) => p.group === g.key)).map((g) => (
+            <tbody key={g.key}>
+              <tr class="group-row">
+                <th colSpan={6}>{g.label}</th>
+              </tr>
+              {shown
+                .filter((p) => p.group === g.key)
+                .map((p) => {
+                  const edited = edits[p.number] !== undefined && edits[p.number] !== valueText(p.value);
+                  const err = rowErrors[p.number] ?? invalid[p.number];
+                  const ro = p.read_only || p.group === 'status';
+                  return (
+                      <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
+                        <td class="r mono">{p.number}</td>
+                        <td class="pname" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
+                          {p.name}
+                          {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
+                          <div class={`help ${openHelp === p.number ? 'help-open' : 'help-short'}`}>{p.help}</div>
+                        </td>
+                        <td class="r value-cell">
+                          {ro ? (
+                            <span class="mono">{valueText(p.value)}</span>
+                          ) : p.type === 'bool' ? (
+                            <select
+                              name={`param-${p.number}`}
+                              value={edits[p.number] ?? valueText(p.value)}
+                              onChange={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLSelectElement).value })}
+                            >
+                              <option value="true">true</option>
+                              <option value="false">false</option>
+                            </select>
+                          ) : (
+                            <input
+                              class="num"
+                              type="text"
+                              inputMode="decimal"
+                              name={`param-${p.number}`}
+                              value={edits[p.number] ?? valueText(p.value)}
+                              onInput={(e) => setEdits({ ...edits, [p.number]: (e.target as HTMLInputElement).value })}
+                            />
+                          )}
+                          {err && (
+                            <div class="field-error" role="alert">
+                              {err}
+                            </div>
+                          )}
+                        </td>
+                        <td>{p.unit_text}</td>
+                        <td class="mono small">{rangeText(p)}</td>
+                        <td class="r mono small">{p.persistent_value !== undefined && p.persistent_value !== null ? valueText(p.persistent_value) : ''}</td>
+                      </tr>
+                  );
+                })}
+            </tbody>
+          ))}
+        </table>
+      </div>
     </div>
   );
 }
