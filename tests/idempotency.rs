@@ -183,3 +183,55 @@ async fn a_retry_while_the_first_is_answered_is_refused_and_after_a_restart_is_r
     .await;
     assert_eq!(r.json["code"], "idempotency_key_reused", "{}", r.text);
 }
+
+/// An MES that gives up waiting (its connection closed mid-request) and retries later gets the
+/// first command's answer: the first request is carried on to its answer without its client.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_client_that_gave_up_waiting_gets_the_answer_on_retry() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let body = json!({"distance": 40.0, "velocity": 100.0});
+    let gave_up = reqwest::Client::builder()
+        .timeout(std::time::Duration::from_millis(50))
+        .build()
+        .unwrap()
+        .post(s.url("/api/v1/axes/x/move-relative?wait=true&timeout_ms=60000"))
+        .header("content-type", "application/json")
+        .header("idempotency-key", "mes-gave-up")
+        .body(body.to_string())
+        .send()
+        .await;
+    assert!(
+        gave_up.is_err(),
+        "the move should outlast the client's 50 ms"
+    );
+    // The move runs to its end all the same.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    loop {
+        let st = status(&s, "x").await;
+        if st["status"]["state"] == "standstill" && position(&st) == 40.0 {
+            break;
+        }
+        assert!(std::time::Instant::now() < deadline, "{st}");
+        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    }
+    // The retry: the first command, done; nothing moves again. (The first request's task may
+    // still be finishing its answer: then the key is in flight for a moment.)
+    let (r, replayed) = loop {
+        let (r, replayed) = post_keyed(
+            &s,
+            "/api/v1/axes/x/move-relative",
+            "mes-gave-up",
+            body.clone(),
+        )
+        .await;
+        if r.json["code"] != "idempotency_key_in_flight" {
+            break (r, replayed);
+        }
+        assert!(std::time::Instant::now() < deadline, "{}", r.text);
+        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    };
+    assert_eq!((r.status, replayed), (202, true), "{}", r.text);
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(position(&status(&s, "x").await), 40.0);
+}

@@ -24,6 +24,7 @@ use serde_json::Value;
 
 use super::{Client, JsonBody, Q, WaitQuery};
 use crate::app::{AppState, Milestone};
+use crate::error::AppError;
 use crate::error::AppResult;
 use crate::model::*;
 use crate::service::commands::{self, Submission};
@@ -108,17 +109,30 @@ macro_rules! catalogue {
             ) -> AppResult<Response> {
                 let wait = commands::wait_duration(q.wait, q.timeout_ms)?;
                 let block = &BLOCKS[Entry::$fn as usize];
-                let sub = Submission {
-                    name: block.name,
-                    milestone: block.milestone,
-                    to_kind: $to_kind,
-                    axis: &axis,
-                    body,
-                    raw,
-                    client: client.0,
-                    idempotency_key: idempotency::key(&headers)?,
+                let key = idempotency::key(&headers)?;
+                let keyed = key.is_some();
+                let run = async move {
+                    let sub = Submission {
+                        name: block.name,
+                        milestone: block.milestone,
+                        to_kind: $to_kind,
+                        axis: &axis,
+                        body,
+                        raw,
+                        client: client.0,
+                        idempotency_key: key,
+                    };
+                    idempotency::run_once(&s, sub, wait).await
                 };
-                let (view, replayed) = idempotency::run_once(&s, sub, wait).await?;
+                let (view, replayed) = if keyed {
+                    // Carried on to its answer even if the client goes away (an MES that
+                    // timed out), so that its retry finds the answer, not a key in flight.
+                    tokio::spawn(run).await.map_err(|e| {
+                        AppError::unavailable("command_task_failed", e.to_string())
+                    })??
+                } else {
+                    run.await?
+                };
                 let mut r = accepted(view);
                 if replayed {
                     r.headers_mut().insert("idempotent-replayed", HeaderValue::from_static("true"));
