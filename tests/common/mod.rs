@@ -57,16 +57,16 @@ impl Server {
         let l = log.clone();
         std::thread::spawn(move || {
             for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-                if let Some(i) = line.find("listening on http://") {
-                    let rest = &line[i + "listening on http://".len()..];
-                    let addr = rest
-                        .split_whitespace()
-                        .next()
-                        .unwrap_or_default()
-                        .to_string();
-                    let _ = tx.send(addr);
+                // Logged before the address is handed over: a test that reads the log once
+                // motiond listens finds everything up to that line.
+                l.lock().unwrap().push(line.clone());
+                if let Some(i) = line.find("listening on http") {
+                    // http://ADDR or https://ADDR
+                    let rest = &line[i + "listening on ".len()..];
+                    let url = rest.split_whitespace().next().unwrap_or_default();
+                    let (scheme, addr) = url.split_once("://").unwrap_or(("http", url));
+                    let _ = tx.send((scheme.to_string(), addr.to_string()));
                 }
-                l.lock().unwrap().push(line);
             }
         });
         let l = log.clone();
@@ -75,7 +75,7 @@ impl Server {
                 l.lock().unwrap().push(line);
             }
         });
-        let addr = match rx.recv_timeout(Duration::from_secs(60)) {
+        let (scheme, addr) = match rx.recv_timeout(Duration::from_secs(60)) {
             Ok(a) => a,
             Err(_) => {
                 let _ = child.kill();
@@ -84,7 +84,7 @@ impl Server {
         };
         Server {
             child,
-            base: format!("http://{addr}"),
+            base: format!("{scheme}://{addr}"),
             addr,
             log,
         }

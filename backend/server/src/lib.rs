@@ -25,6 +25,7 @@
 
 pub mod api;
 pub mod app;
+pub mod auth;
 pub mod cycle;
 pub mod error;
 pub mod metrics;
@@ -35,6 +36,7 @@ pub mod service;
 pub mod sim;
 pub mod stats;
 pub mod store;
+pub mod tls;
 pub mod ui;
 
 use std::collections::BTreeMap;
@@ -71,6 +73,60 @@ pub enum Cmd {
     Openapi,
     /// Print the websocket's AsyncAPI document (what `openapi/asyncapi.json` must contain).
     Asyncapi,
+    /// Manage users in the database given with `--db` (while no motiond runs on it; use the
+    /// API's `/api/v1/users` otherwise). The first user turns authentication on.
+    User {
+        #[command(subcommand)]
+        action: UserCmd,
+    },
+    /// Manage API tokens for machines in the database given with `--db`.
+    Token {
+        #[command(subcommand)]
+        action: TokenCmd,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+pub enum UserCmd {
+    /// Add a user; the password is read from standard input (one line; asked for without
+    /// echo on a terminal).
+    Add {
+        name: String,
+        /// Make the user an admin (the first user must be one).
+        #[arg(long, conflicts_with = "role")]
+        admin: bool,
+        /// viewer, operator, engineer or admin.
+        #[arg(long, value_parser = parse_role)]
+        role: Option<auth::Role>,
+    },
+    /// List the users and their roles.
+    List,
+    /// Set a user's password (read from standard input); ends its sessions.
+    Passwd { name: String },
+    /// Delete a user (never the last admin).
+    Delete { name: String },
+}
+
+#[derive(Subcommand, Debug)]
+pub enum TokenCmd {
+    /// Create an API token and print it (the only time it is shown).
+    Add {
+        name: String,
+        /// viewer, operator, engineer or admin.
+        #[arg(long, value_parser = parse_role)]
+        role: auth::Role,
+        /// Days until it expires; never when left out.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=3650))]
+        expires_in_days: Option<u32>,
+    },
+    /// List the tokens (never their secrets).
+    List,
+    /// Revoke a token by name.
+    Revoke { name: String },
+}
+
+fn parse_role(s: &str) -> Result<auth::Role, String> {
+    auth::Role::parse(s).ok_or_else(|| format!("{s:?} is not viewer, operator, engineer or admin"))
 }
 
 /// The options of `serve`. Global, so that `motiond --db m.db serve` and
@@ -78,7 +134,8 @@ pub enum Cmd {
 #[derive(clap::Args, Debug, Clone)]
 pub struct ServeArgs {
     /// Address to listen on: an IP address or `localhost` (bound to its loopback address), and a
-    /// port. Only loopback addresses are allowed until authentication exists.
+    /// port. A non-loopback address (`0.0.0.0:8443`) needs authentication (a user must exist)
+    /// and is served over TLS only.
     #[arg(long, global = true, default_value = "127.0.0.1:8080", value_parser = parse_listen)]
     pub listen: SocketAddr,
     /// A host name (or address) motiond answers to besides loopback names and addresses, e.g.
@@ -109,6 +166,24 @@ pub struct ServeArgs {
     /// closed (8–100000).
     #[arg(long = "max-connections", global = true, value_name = "N", default_value_t = 512, value_parser = clap::value_parser!(u32).range(8..=100_000))]
     pub max_connections: u32,
+    /// One holder commands motion at a time (`POST /api/v1/control`); `false` lets every
+    /// operator command at any time (single-client plants, tests).
+    #[arg(long, global = true, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    pub control_lease: bool,
+    /// Hours a browser session lasts from its login (1–720).
+    #[arg(long, global = true, value_name = "HOURS", default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=720))]
+    pub session_hours: u32,
+    /// Serve HTTPS with this certificate chain (PEM); with `--tls-key`.
+    #[arg(long, global = true, value_name = "PEM", requires = "tls_key")]
+    pub tls_cert: Option<std::path::PathBuf>,
+    /// The private key of `--tls-cert` (PEM).
+    #[arg(long, global = true, value_name = "PEM", requires = "tls_cert")]
+    pub tls_key: Option<std::path::PathBuf>,
+    /// Serve HTTPS also on a loopback address; without `--tls-cert`, with a self-signed
+    /// certificate made on first start and kept beside the database (its fingerprint is logged).
+    /// A non-loopback `--listen` implies it.
+    #[arg(long, global = true)]
+    pub tls: bool,
     /// Do not create the demo axes on a new database.
     #[arg(long, global = true)]
     pub no_demo: bool,
@@ -169,6 +244,12 @@ pub fn run() {
         Some(Cmd::Asyncapi) => {
             print!("{}", api::asyncapi::asyncapi_json());
             return;
+        }
+        Some(Cmd::User { action }) => {
+            return exit_with(admin_command(&cli.serve, Admin::User(action)));
+        }
+        Some(Cmd::Token { action }) => {
+            return exit_with(admin_command(&cli.serve, Admin::Token(action)));
         }
         Some(Cmd::Serve) | None => cli.serve,
     };
@@ -245,15 +326,130 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
     ]
 }
 
-fn serve(args: ServeArgs) -> Result<(), String> {
-    if !args.listen.ip().is_loopback() {
-        return Err(format!(
-            "refusing to listen on {}: binding a non-loopback address requires authentication, which motiond \
-             does not implement yet (DESIGN §6); use a loopback address such as 127.0.0.1:8080 \
-             (and a reverse proxy with authentication for remote access)",
-            args.listen
-        ));
+fn exit_with(r: Result<(), String>) {
+    if let Err(e) = r {
+        eprintln!("motiond: {e}");
+        std::process::exit(1);
     }
+}
+
+enum Admin {
+    User(UserCmd),
+    Token(TokenCmd),
+}
+
+/// Reads a password: a line of standard input, without echo when it is a terminal.
+fn read_password(prompt: &str) -> Result<String, String> {
+    use std::io::{BufRead, IsTerminal, Write};
+    let stdin = std::io::stdin();
+    let tty = stdin.is_terminal();
+    // SAFETY: termios of fd 0, restored below.
+    let mut old: libc::termios = unsafe { std::mem::zeroed() };
+    if tty {
+        eprint!("{prompt}: ");
+        let _ = std::io::stderr().flush();
+        unsafe {
+            if libc::tcgetattr(0, &mut old) == 0 {
+                let mut quiet = old;
+                quiet.c_lflag &= !libc::ECHO;
+                libc::tcsetattr(0, libc::TCSANOW, &quiet);
+            }
+        }
+    }
+    let mut line = String::new();
+    let r = stdin.lock().read_line(&mut line);
+    if tty {
+        unsafe { libc::tcsetattr(0, libc::TCSANOW, &old) };
+        eprintln!();
+    }
+    r.map_err(|e| format!("cannot read the password: {e}"))?;
+    let pw = line.trim_end_matches(['\n', '\r']).to_owned();
+    if pw.is_empty() {
+        return Err("no password given on standard input".into());
+    }
+    Ok(pw)
+}
+
+/// `motiond user …` / `motiond token …` on the database of `--db`.
+fn admin_command(args: &ServeArgs, cmd: Admin) -> Result<(), String> {
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| e.to_string())?;
+    rt.block_on(async {
+        let db = store::open(&args.db).await.map_err(|e| {
+            if e.contains("locked") {
+                format!("{e}\n(is motiond running on {}? stop it, or use the API: /api/v1/users, /api/v1/tokens)", args.db)
+            } else {
+                e
+            }
+        })?;
+        let auth = auth::Auth::load(db.clone(), std::time::Duration::from_secs(3600), false).await?;
+        let audit = |action: &str, target: &str| store::AuditEntry {
+            at: store::now_rfc3339(),
+            client_id: Some("cli".into()),
+            action: action.into(),
+            target: Some(target.into()),
+            outcome: Some("committed".into()),
+            ..Default::default()
+        };
+        let e = |e: error::AppError| e.problem().detail;
+        match cmd {
+            Admin::User(UserCmd::Add { name, admin, role }) => {
+                let role = if admin { auth::Role::Admin } else { role.unwrap_or(auth::Role::Viewer) };
+                let pw = read_password(&format!("password for {name}"))?;
+                auth.add_user(&name, role, &pw, audit("user.create", &name)).await.map_err(e)?;
+                println!("user {name} ({}) added; authentication is on", role.as_str());
+            }
+            Admin::User(UserCmd::List) => {
+                for u in auth.users() {
+                    println!("{}\t{}\t{}", u.name, u.role.as_str(), u.created_at);
+                }
+            }
+            Admin::User(UserCmd::Passwd { name }) => {
+                let pw = read_password(&format!("new password for {name}"))?;
+                auth.update_user(&name, None, Some(&pw), None, audit("user.password", &name)).await.map_err(e)?;
+                println!("password of {name} set; its sessions ended");
+            }
+            Admin::User(UserCmd::Delete { name }) => {
+                auth.delete_user(&name, audit("user.delete", &name)).await.map_err(e)?;
+                println!("user {name} deleted");
+            }
+            Admin::Token(TokenCmd::Add { name, role, expires_in_days }) => {
+                let t = auth
+                    .add_token(&name, role, expires_in_days, "cli", audit("token.create", &name))
+                    .await
+                    .map_err(e)?;
+                eprintln!("token {name} ({}) created; it is shown once:", role.as_str());
+                println!("{}", t.token);
+            }
+            Admin::Token(TokenCmd::List) => {
+                for t in auth.tokens() {
+                    println!(
+                        "{}\t{}\t{}\tcreated {}\tlast used {}\t{}",
+                        t.id,
+                        t.name,
+                        t.role.as_str(),
+                        t.created_at,
+                        t.last_used_at.as_deref().unwrap_or("never"),
+                        t.revoked_at.map_or("active".into(), |r| format!("revoked {r}"))
+                    );
+                }
+            }
+            Admin::Token(TokenCmd::Revoke { name }) => {
+                let Some(t) = auth.tokens().into_iter().find(|t| t.name == name) else {
+                    return Err(format!("no token {name}"));
+                };
+                auth.revoke_token(t.id, audit("token.revoke", &name)).await.map_err(e)?;
+                println!("token {name} revoked");
+            }
+        }
+        db.close().await;
+        Ok(())
+    })
+}
+
+fn serve(args: ServeArgs) -> Result<(), String> {
     // A file-size limit must fail the write (SQLite reports it, the request gets 503), not
     // kill the process.
     // SAFETY: setting a signal disposition to SIG_IGN before any thread is started.
@@ -347,7 +543,48 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
             ui::BUILD_COMMAND
         );
     }
-    let (state, audit_rx) = AppState::new(shared.clone(), output, db.clone(), first_id, info);
+    let remote = !args.listen.ip().is_loopback();
+    let tls_on = remote || args.tls || args.tls_cert.is_some();
+    let auth = Arc::new(
+        auth::Auth::load(
+            db.clone(),
+            std::time::Duration::from_secs(args.session_hours as u64 * 3600),
+            tls_on,
+        )
+        .await?,
+    );
+    first_admin_from_env(&auth).await?;
+    if remote && !auth.enabled() {
+        return Err(format!(
+            "refusing to listen on {}: a non-loopback address needs authentication, and no user exists; \
+             create an admin first (`motiond --db {} user add --admin NAME`, password on stdin, or \
+             MOTIOND_ADMIN_USER and MOTIOND_ADMIN_PASSWORD on first start)",
+            args.listen, args.db
+        ));
+    }
+    if auth.enabled() {
+        tracing::info!(
+            "authentication on: {} users; browser sessions last {} h",
+            auth.users().len(),
+            args.session_hours
+        );
+    } else {
+        tracing::info!("authentication off (no user exists): every local client may act");
+    }
+    let tls = if tls_on {
+        Some(tls::acceptor(&args)?)
+    } else {
+        None
+    };
+    let (state, audit_rx) = AppState::new(
+        shared.clone(),
+        output,
+        db.clone(),
+        first_id,
+        info,
+        auth,
+        args.control_lease,
+    );
     tokio::spawn(app::pump(state.clone()));
     let audit_task = tokio::spawn(app::audit_writer(
         db.clone(),
@@ -365,9 +602,24 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", args.listen))?;
     let local = listener.local_addr().map_err(|e| e.to_string())?;
-    tracing::info!("listening on http://{local} (UI /, API /api/v1, docs /docs)");
+    let scheme = if tls.is_some() { "https" } else { "http" };
+    tracing::info!("listening on {scheme}://{local} (UI /, API /api/v1, docs /docs)");
+    let mut public_names = args.public_names.clone();
+    if remote && !args.listen.ip().is_unspecified() {
+        // Clients that use the address itself are served; names must be given.
+        public_names.push(api::guard::parse_public_name(
+            &args.listen.ip().to_string(),
+        )?);
+    }
+    if remote && args.public_names.is_empty() {
+        tracing::warn!(
+            "listening on {} without --public-name: browsers and clients must use a name this server \
+             serves in Host (others get 421); give the machine's name with --public-name",
+            args.listen
+        );
+    }
     let guard = api::guard::Guard {
-        public_names: args.public_names.clone(),
+        public_names,
         allowed_origins: args.allowed_origins.clone(),
     };
     if !guard.public_names.is_empty() {
@@ -395,7 +647,7 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     });
     let max = args.max_connections as usize;
     let permits = Arc::new(tokio::sync::Semaphore::new(max));
-    accept_loop(listener, app, permits.clone(), read_timeout, stopping).await;
+    accept_loop(listener, app, permits.clone(), read_timeout, stopping, tls).await;
     // The connections end gracefully; open websockets would hold them forever: 2 s at most.
     if tokio::time::timeout(
         std::time::Duration::from_secs(2),
@@ -427,8 +679,9 @@ async fn accept_loop(
     permits: Arc<tokio::sync::Semaphore>,
     read_timeout: std::time::Duration,
     mut stopping: tokio::sync::watch::Receiver<bool>,
+    tls: Option<tokio_rustls::TlsAcceptor>,
 ) {
-    use hyper_util::rt::{TokioIo, TokioTimer};
+    use hyper_util::rt::TokioIo;
     use tokio::io::AsyncWriteExt;
     let max = permits.available_permits();
     loop {
@@ -466,31 +719,89 @@ async fn accept_loop(
                 r
             },
         );
-        let mut stop = stopping.clone();
+        let stop = stopping.clone();
+        let tls = tls.clone();
         tokio::spawn(async move {
             let _permit = permit;
-            let mut http = hyper::server::conn::http1::Builder::new();
-            // Requests beyond the guard's limits (api/guard.rs) are refused there with a
-            // problem; hyper's buffer bounds what is read at all.
-            http.timer(TokioTimer::new())
-                .header_read_timeout(read_timeout)
-                .max_buf_size(64 * 1024);
-            let conn = http
-                .serve_connection(
-                    TokioIo::new(stream),
-                    hyper_util::service::TowerToHyperService::new(svc),
-                )
-                .with_upgrades();
-            let mut conn = std::pin::pin!(conn);
-            tokio::select! {
-                _ = conn.as_mut() => {}
-                _ = async { let _ = stop.wait_for(|s| *s).await; } => {
-                    conn.as_mut().graceful_shutdown();
-                    let _ = conn.await;
+            match tls {
+                None => serve_connection(TokioIo::new(stream), svc, read_timeout, stop).await,
+                Some(acceptor) => {
+                    // The handshake is bounded like a request's headers.
+                    match tokio::time::timeout(read_timeout, acceptor.accept(stream)).await {
+                        Ok(Ok(s)) => {
+                            serve_connection(TokioIo::new(s), svc, read_timeout, stop).await
+                        }
+                        Ok(Err(e)) => tracing::debug!("TLS handshake with {addr} failed: {e}"),
+                        Err(_) => tracing::debug!("TLS handshake with {addr} timed out"),
+                    }
                 }
             }
         });
     }
+}
+
+/// One HTTP/1.1 connection (plain or TLS) until it ends or motiond stops.
+async fn serve_connection<I, S>(
+    io: I,
+    svc: S,
+    read_timeout: std::time::Duration,
+    mut stop: tokio::sync::watch::Receiver<bool>,
+) where
+    I: hyper::rt::Read + hyper::rt::Write + Unpin + Send + 'static,
+    S: tower::Service<
+            hyper::Request<hyper::body::Incoming>,
+            Response = axum::response::Response,
+            Error = std::convert::Infallible,
+        > + Clone
+        + Send
+        + 'static,
+    S::Future: Send + 'static,
+{
+    use hyper_util::rt::TokioTimer;
+    let mut http = hyper::server::conn::http1::Builder::new();
+    // Requests beyond the guard's limits (api/guard.rs) are refused there with a
+    // problem; hyper's buffer bounds what is read at all.
+    http.timer(TokioTimer::new())
+        .header_read_timeout(read_timeout)
+        .max_buf_size(64 * 1024);
+    let conn = http
+        .serve_connection(io, hyper_util::service::TowerToHyperService::new(svc))
+        .with_upgrades();
+    let mut conn = std::pin::pin!(conn);
+    tokio::select! {
+        _ = conn.as_mut() => {}
+        _ = async { let _ = stop.wait_for(|s| *s).await; } => {
+            conn.as_mut().graceful_shutdown();
+            let _ = conn.await;
+        }
+    }
+}
+
+/// The first admin, on a database without users, from `MOTIOND_ADMIN_USER` and
+/// `MOTIOND_ADMIN_PASSWORD` (for images and unattended installs; ignored once a user exists).
+async fn first_admin_from_env(auth: &auth::Auth) -> Result<(), String> {
+    let (Ok(name), Ok(password)) = (
+        std::env::var("MOTIOND_ADMIN_USER"),
+        std::env::var("MOTIOND_ADMIN_PASSWORD"),
+    ) else {
+        return Ok(());
+    };
+    if auth.enabled() {
+        return Ok(());
+    }
+    let audit = store::AuditEntry {
+        at: store::now_rfc3339(),
+        client_id: Some("environment".into()),
+        action: "user.create".into(),
+        target: Some(name.clone()),
+        outcome: Some("committed".into()),
+        ..Default::default()
+    };
+    auth.add_user(&name, auth::Role::Admin, &password, audit)
+        .await
+        .map_err(|e| format!("MOTIOND_ADMIN_USER: {}", e.problem().detail))?;
+    tracing::info!("created the admin {name} from MOTIOND_ADMIN_USER; authentication is on");
+    Ok(())
 }
 
 async fn shutdown_signal() {

@@ -344,6 +344,28 @@ pub struct ClientInfo {
     pub id: Option<String>,
     /// `rest` or `websocket`.
     pub via: &'static str,
+    /// `user:NAME` or `token:NAME`, when authentication is enabled.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub principal: Option<String>,
+    /// Who it is (role, credential), when authentication is enabled.
+    #[serde(skip)]
+    #[schema(ignore)]
+    pub identity: Option<crate::auth::Principal>,
+}
+
+impl ClientInfo {
+    /// The client as the holder of the machine's control knows it: its principal and its
+    /// `X-Client-Id` (`None` when it has neither).
+    pub fn control_key(&self) -> Option<String> {
+        match (&self.principal, &self.id) {
+            (None, None) => None,
+            (p, id) => Some(format!(
+                "{}/{}",
+                p.as_deref().unwrap_or(""),
+                id.as_deref().unwrap_or("")
+            )),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, ToSchema)]

@@ -1,5 +1,6 @@
 // REST client: JSON in and out, problem+json errors as ApiError with field errors by path.
 import type { Problem } from './types';
+import { clientId } from '../auth/client-id';
 
 export class ApiError extends Error {
   readonly status: number;
@@ -52,11 +53,28 @@ export function url(path: string): string {
 /**
  * Every request that changes something (POST, PUT, DELETE …) is declared JSON, also one without
  * a body: motiond refuses anything else with 415, because a page of another site may send
- * other types to it without asking the browser first (docs/security.md).
+ * other types to it without asking the browser first (docs/security.md). Every request names
+ * this tab (`X-Client-Id`, auth/client-id.ts): the control of the machine is held by a tab.
  */
 export function headers(method: string): Record<string, string> {
   const safe = ['GET', 'HEAD', 'OPTIONS'].includes(method.toUpperCase());
-  return safe ? { 'X-Client-Id': 'motiond-ui' } : { 'Content-Type': 'application/json', 'X-Client-Id': 'motiond-ui' };
+  return safe ? { 'X-Client-Id': clientId() } : { 'Content-Type': 'application/json', 'X-Client-Id': clientId() };
+}
+
+/**
+ * Requests whose 401 is the answer to what the user typed (a wrong password), not the end of
+ * the session.
+ */
+const CREDENTIAL_PATHS = new Set(['/auth/login', '/api/v1/auth/login']);
+
+let unauthorized: ((e: ApiError) => void) | null = null;
+
+/**
+ * Called with every 401 (no valid session while authentication is on) of a request other than
+ * the login itself: the session has ended, the login page comes back (main.tsx).
+ */
+export function onUnauthorized(handler: ((e: ApiError) => void) | null): void {
+  unauthorized = handler;
 }
 
 export async function api<T>(method: string, path: string, body?: unknown): Promise<T> {
@@ -80,7 +98,9 @@ export async function api<T>(method: string, path: string, body?: unknown): Prom
     }
   }
   if (!res.ok) {
-    throw new ApiError(res.status, isProblem(json) ? json : null, isProblem(json) ? undefined : `HTTP ${res.status} ${text.slice(0, 200)}`);
+    const e = new ApiError(res.status, isProblem(json) ? json : null, isProblem(json) ? undefined : `HTTP ${res.status} ${text.slice(0, 200)}`);
+    if (res.status === 401 && !CREDENTIAL_PATHS.has(path)) unauthorized?.(e);
+    throw e;
   }
   return json as T;
 }

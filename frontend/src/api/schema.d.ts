@@ -20,6 +20,80 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/auth/login": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Log in: a browser session (HttpOnly, SameSite=Strict cookie `motiond_session`; Secure over TLS)
+         * @description Five wrong passwords for a name lock it for 30 s (429). Machines use API tokens instead.
+         */
+        post: operations["login"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/auth/logout": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Log out: ends the session of the cookie sent and clears it (204 also without one) */
+        post: operations["logout"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/auth/password": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /** Change one's own password (a logged-in user); ends the user's other sessions */
+        put: operations["change_password"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/auth/session": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Who am I: whether authentication is enabled, and the client's user or token and role
+         * @description Public. A session cookie or token that is no longer valid is a 401.
+         */
+        get: operations["session"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes": {
         parameters: {
             query?: never;
@@ -882,6 +956,28 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/control": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Who holds control of the machine (one holder commands motion at a time) */
+        get: operations["get_control"];
+        put?: never;
+        /**
+         * Take or renew control of the machine for `lease_ms`
+         * @description While a client holds control, motion commands of every other client are refused with 409 `control_held` (stop, halt and power with `enable: false` are always accepted). The holder renews by sending this again before the lease ends; a lease not renewed ends by itself. A client is known by its user or token and its `X-Client-Id` header (which it must send while authentication is off). `take_over: true` takes control from another holder: admins only (anyone while authentication is off).
+         */
+        post: operations["take_control"];
+        /** Give control back (its holder, or an admin) */
+        delete: operations["release_control"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/scope/recordings": {
         parameters: {
             query?: never;
@@ -939,6 +1035,78 @@ export interface paths {
         put?: never;
         post?: never;
         delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/tokens": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The API tokens, revoked ones too (admin); never their secrets */
+        get: operations["list_tokens"];
+        put?: never;
+        /** Create an API token for a machine (admin): its secret is in this answer only */
+        post: operations["create_token"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/tokens/{id}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        post?: never;
+        /** Revoke an API token (admin): refused from now on; it stays listed */
+        delete: operations["revoke_token"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/users": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The users (admin) */
+        get: operations["list_users"];
+        put?: never;
+        /** Create a user (admin). The first user must be an admin: it turns authentication on */
+        post: operations["create_user"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/users/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** One user (admin) */
+        get: operations["get_user"];
+        /** Change a user's role or password (admin); a new password ends the user's sessions */
+        put: operations["update_user"];
+        post?: never;
+        /** Delete a user and end its sessions (admin); never the last admin */
+        delete: operations["delete_user"];
         options?: never;
         head?: never;
         patch?: never;
@@ -1002,6 +1170,7 @@ export interface components {
          *       },
          *       "id": 57,
          *       "outcome": "accepted",
+         *       "principal": "token:line-3-mes",
          *       "target": "x"
          *     }
          */
@@ -1017,6 +1186,11 @@ export interface components {
             client_addr?: string | null;
             /** @description The client's `X-Client-Id` header (`demo` for the demo machine). */
             client_id?: string | null;
+            /**
+             * @description Who: `user:NAME` (a browser session) or `token:NAME` (an API token); null while
+             *     authentication is not enabled.
+             */
+            principal?: string | null;
             /**
              * @description What: `axis.create`, `axis.replace`, `axis.delete`, `parameter.write`,
              *     `parameter.write_persistent`, `config.import`, `command.<name>` (submitted),
@@ -2274,6 +2448,8 @@ export interface components {
             id?: string | null;
             /** @description `rest` or `websocket`. */
             via: string;
+            /** @description `user:NAME` or `token:NAME`, when authentication is enabled. */
+            principal?: string | null;
         };
         /**
          * @description A change of a command's outputs.
@@ -2628,6 +2804,53 @@ export interface components {
              *     tables as they are; with it (also `[]`) they are replaced.
              */
             cam_tables?: components["schemas"]["CamTableBody"][] | null;
+        };
+        /**
+         * @description Who holds the control.
+         * @example {
+         *       "client_addr": "10.0.3.17:50312",
+         *       "client_id": "line-3-mes",
+         *       "expires_in_ms": 3170,
+         *       "lease_ms": 5000,
+         *       "principal": "token:line-3-mes",
+         *       "since": "2026-11-25T08:00:00.000Z"
+         *     }
+         */
+        ControlHolder: {
+            client_id?: string | null;
+            principal?: string | null;
+            client_addr: string;
+            /** @description When it took control. */
+            since: string;
+            /** Format: int64 */
+            lease_ms: number;
+            /**
+             * Format: int64
+             * @description Left of the lease when this was answered.
+             */
+            expires_in_ms: number;
+        };
+        /**
+         * @description The control of the machine as a client sees it.
+         * @example {
+         *       "holder": {
+         *         "client_addr": "10.0.3.17:50312",
+         *         "client_id": "line-3-mes",
+         *         "expires_in_ms": 3170,
+         *         "lease_ms": 5000,
+         *         "principal": null,
+         *         "since": "2026-11-25T08:00:00.000Z"
+         *       },
+         *       "lease_enabled": true,
+         *       "yours": false
+         *     }
+         */
+        ControlState: {
+            /** @description False when motiond runs with `--control-lease false`: nobody can hold control. */
+            lease_enabled: boolean;
+            holder?: null | components["schemas"]["ControlHolder"];
+            /** @description The asking client holds it. */
+            yours: boolean;
         };
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
@@ -3159,6 +3382,19 @@ export interface components {
             master?: string | null;
         };
         /**
+         * @description `POST /auth/login`.
+         * @example {
+         *       "name": "anna",
+         *       "password": "correct horse battery"
+         *     }
+         */
+        Login: {
+            /** @example anna */
+            name: string;
+            /** @example correct horse battery */
+            password: string;
+        };
+        /**
          * @description MC_ReadCamTableMasterPosition: the nearest solutions at or below and at or above the start.
          * @example {
          *       "master_high": {
@@ -3449,6 +3685,45 @@ export interface components {
             options?: components["schemas"]["MoveOptions"];
         };
         /**
+         * @description A new token: the only time its secret is shown.
+         * @example {
+         *       "created_at": "2026-11-25T08:00:00.000Z",
+         *       "created_by": "user:anna",
+         *       "expires_at": null,
+         *       "id": 3,
+         *       "last_used_at": null,
+         *       "name": "line-3-mes",
+         *       "revoked_at": null,
+         *       "role": "operator",
+         *       "token": "mtk_Yp3M0kq8rYdJ2tNwq6mC6Wb1dV8yO2uZ3nKXh5s0aQc"
+         *     }
+         */
+        NewToken: components["schemas"]["TokenView"] & {
+            /**
+             * @description Send as `Authorization: Bearer <token>`. Shown once; motiond keeps only its hash.
+             * @example mtk_Yp3M0kq8rYdJ2tNwq6mC6Wb1dV8yO2uZ3nKXh5s0aQc
+             */
+            token: string;
+        };
+        /**
+         * @description `POST /users`.
+         * @example {
+         *       "name": "bert",
+         *       "password": "bert-on-shift-2",
+         *       "role": "operator"
+         *     }
+         */
+        NewUser: {
+            /**
+             * @description 1–64 letters, digits and `.-_@`.
+             * @example anna
+             */
+            name: string;
+            role: components["schemas"]["Role"];
+            /** @description 8–1024 characters. */
+            password: string;
+        };
+        /**
          * @description MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes
          *     effect on its slaves, and how their offsets follow.
          * @example {
@@ -3581,6 +3856,18 @@ export interface components {
             value: components["schemas"]["ParamValue"];
             /** @description MC_WriteParameterPersistent: kept across restarts until the axis is replaced. */
             persistent?: boolean;
+        };
+        /**
+         * @description `PUT /auth/password`.
+         * @example {
+         *       "current_password": "correct horse battery",
+         *       "new_password": "staple battery horse"
+         *     }
+         */
+        PasswordChange: {
+            current_password: string;
+            /** @description 8–1024 characters. */
+            new_password: string;
         };
         /**
          * @description When the following-error peak hold counts from.
@@ -3781,6 +4068,11 @@ export interface components {
          */
         ReferenceMode: "default" | "plc_cam" | "hardware_sync" | "hardware_latch_pos" | "hardware_latch_neg" | "software_sync" | "soft_drive_latch_pos" | "soft_drive_latch_neg";
         /**
+         * @description What a client must be allowed to do. Ordered: each role may do what the ones before it may.
+         * @enum {string}
+         */
+        Role: "viewer" | "operator" | "engineer" | "admin";
+        /**
          * @description One channel of a recording, as resolved by the server.
          * @example {
          *       "axis": "x",
@@ -3941,6 +4233,29 @@ export interface components {
              * @description History kept before the trigger sample (s, 0 … duration_s; default 0).
              */
             pre_trigger_s?: number;
+        };
+        /**
+         * @description Who the client is.
+         * @example {
+         *       "auth_enabled": true,
+         *       "expires_at": "2026-11-25T20:00:00.000Z",
+         *       "kind": "user",
+         *       "name": "anna",
+         *       "principal": "user:anna",
+         *       "role": "engineer"
+         *     }
+         */
+        SessionState: {
+            /** @description False: no user exists yet, every client may do everything (loopback only). */
+            auth_enabled: boolean;
+            /** @description `user:NAME` or `token:NAME`; null when not authenticated. */
+            principal?: string | null;
+            name?: string | null;
+            /** @description `user` (browser session) or `token`. */
+            kind?: string | null;
+            role?: null | components["schemas"]["Role"];
+            /** @description When the session ends (null for tokens and when not authenticated). */
+            expires_at?: string | null;
         };
         /**
          * @description MC_SetOverride.
@@ -4338,6 +4653,23 @@ export interface components {
          */
         TableType: "equidistant" | "non_equidistant" | "motion_function";
         /**
+         * @description `POST /api/v1/control`.
+         * @example {
+         *       "lease_ms": 5000
+         *     }
+         */
+        TakeControl: {
+            /**
+             * Format: int64
+             * @description How long the control lasts unless renewed (by this request again), in ms (500–60000,
+             *     default 5000). Renew well before it runs out, e.g. every third of it.
+             * @example 5000
+             */
+            lease_ms?: number | null;
+            /** @description Take control from another holder (admin only; anyone while authentication is off). */
+            take_over?: boolean;
+        };
+        /**
          * @description Timing of the cycle thread, measured by itself.
          * @example {
          *       "audit_dropped": 0,
@@ -4413,6 +4745,53 @@ export interface components {
             scope_frames_dropped: number;
         };
         /**
+         * @description `POST /tokens`.
+         * @example {
+         *       "expires_in_days": 365,
+         *       "name": "line-3-mes",
+         *       "role": "operator"
+         *     }
+         */
+        TokenRequest: {
+            /**
+             * @description Names the token in the audit log (`token:NAME`): 1–64 letters, digits and `.-_@`.
+             * @example line-3-mes
+             */
+            name: string;
+            role: components["schemas"]["Role"];
+            /**
+             * Format: int32
+             * @description Days until it expires (1–3650); never when left out.
+             */
+            expires_in_days?: number | null;
+        };
+        /**
+         * @description An API token as the API shows it (never its secret, except once in [`NewToken`]).
+         * @example {
+         *       "created_at": "2026-11-25T08:00:00.000Z",
+         *       "created_by": "user:anna",
+         *       "expires_at": null,
+         *       "id": 3,
+         *       "last_used_at": "2026-11-25T09:12:40.000Z",
+         *       "name": "line-3-mes",
+         *       "revoked_at": null,
+         *       "role": "operator"
+         *     }
+         */
+        TokenView: {
+            /** Format: int64 */
+            id: number;
+            name: string;
+            role: components["schemas"]["Role"];
+            /** @description `user:NAME` of the admin who made it. */
+            created_by: string;
+            created_at: string;
+            expires_at?: string | null;
+            /** @description Written at most once a minute. */
+            last_used_at?: string | null;
+            revoked_at?: string | null;
+        };
+        /**
          * @description Direction of a trigger crossing.
          * @enum {string}
          */
@@ -4447,6 +4826,30 @@ export interface components {
          * @enum {string}
          */
         Unit: "none" | "position" | "velocity" | "acceleration" | "jerk" | "seconds" | "factor" | "percent" | "per_second" | "position_per_increment" | "increments" | "count" | "code";
+        /**
+         * @description `PUT /users/{name}`: what to change.
+         * @example {
+         *       "role": "engineer"
+         *     }
+         */
+        UserChange: {
+            role?: null | components["schemas"]["Role"];
+            /** @description A new password (8–1024 characters); ends the user's sessions. */
+            password?: string | null;
+        };
+        /**
+         * @description A user as the API shows it.
+         * @example {
+         *       "created_at": "2026-11-25T08:00:00.000Z",
+         *       "name": "anna",
+         *       "role": "engineer"
+         *     }
+         */
+        UserView: {
+            name: string;
+            role: components["schemas"]["Role"];
+            created_at: string;
+        };
         /**
          * @description MC_WriteMotionFunction: points to replace, by their `point_index`.
          * @example {
@@ -4505,6 +4908,15 @@ export interface components {
                  *       "type": "urn:motiond:problem:storage_unavailable"
                  *     }
                  */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Authentication is off (no user exists), or an API token asked to change its password. */
+        AuthNotApplicable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -4568,6 +4980,30 @@ export interface components {
                 [name: string]: unknown;
             };
             content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Invalid fields; `errors` names every one. */
+        BodyInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "name: must be 1-64 characters of letters, digits and . - _ @",
+                 *       "errors": [
+                 *         {
+                 *           "field": "name",
+                 *           "message": "must be 1-64 characters of letters, digits and . - _ @"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -4777,6 +5213,18 @@ export interface components {
             };
         };
         /**
+         * @description Another client holds control (`control_held`; `take_over` takes it, admins only), or
+         *     motiond runs with `--control-lease false` (`control_lease_disabled`).
+         */
+        ControlConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
          * @description A request that changes something (or a websocket upgrade) from another web origin:
          *     `Origin` is neither this server's own (the request's `Host`) nor allowed with
          *     `--allow-origin`, or `Sec-Fetch-Site` is neither `same-origin` nor `none`. Nothing was
@@ -4826,6 +5274,18 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
+        /**
+         * @description The role is too low (`role_insufficient`), or the request comes from another web origin
+         *     (`cross_origin_forbidden`). Nothing was done.
+         */
+        Forbidden: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
         /** @description The document is invalid; `errors` lists every invalid field (`axes[i].config.…`). */
         ImportInvalid: {
             headers: {
@@ -4845,6 +5305,24 @@ export interface components {
                  *       "status": 422,
                  *       "title": "Invalid request",
                  *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Wrong user name or password. */
+        LoginFailed: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "invalid_credentials",
+                 *       "detail": "wrong user name or password",
+                 *       "status": 401,
+                 *       "title": "Invalid credentials",
+                 *       "type": "urn:motiond:problem:invalid_credentials"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -5059,6 +5537,27 @@ export interface components {
             };
         };
         /**
+         * @description The user or token has a lower role than the request needs (`role_insufficient`).
+         *     Nothing was done.
+         */
+        RoleInsufficient: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "role_insufficient",
+                 *       "detail": "this needs the role operator or higher; token:dashboard has the role viewer",
+                 *       "status": 403,
+                 *       "title": "Forbidden",
+                 *       "type": "urn:motiond:problem:role_insufficient"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
          * @description The active recordings already use the scope's 8 signals (`scope_channels_busy`), or 8
          *     recordings are active or their memory is used up (`scope_busy`).
          */
@@ -5109,6 +5608,94 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
+        /** @description The database did not accept the write (`storage_unavailable`); nothing was changed. */
+        StorageUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "storage_unavailable",
+                 *       "detail": "the database did not accept the write: database is locked",
+                 *       "status": 503,
+                 *       "title": "Service unavailable",
+                 *       "type": "urn:motiond:problem:storage_unavailable"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description A token of that name exists (revoked tokens keep their names). */
+        TokenConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "token_exists",
+                 *       "detail": "a token line-3-mes exists (revoked tokens keep their names)",
+                 *       "status": 409,
+                 *       "title": "Conflict",
+                 *       "type": "urn:motiond:problem:token_exists"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such API token. */
+        TokenNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "token_not_found",
+                 *       "detail": "no token '17'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:token_not_found"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Five wrong passwords for this name within 30 s: try again later. */
+        TooManyLoginAttempts: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "too_many_login_attempts",
+                 *       "detail": "5 failed logins for anna: try again in 28 s",
+                 *       "status": 429,
+                 *       "title": "Too many login attempts",
+                 *       "type": "urn:motiond:problem:too_many_login_attempts"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Authentication is enabled and the request has no valid credentials: no session cookie
+         *     and no `Authorization: Bearer` token (`unauthenticated`), or a token or session that is
+         *     unknown, expired or revoked (`invalid_credentials`, `unauthenticated`). Comes with
+         *     `WWW-Authenticate: Bearer realm="motiond"`. Nothing was done.
+         */
+        Unauthenticated: {
+            headers: {
+                /** @description Bearer realm="motiond" */
+                "WWW-Authenticate"?: string;
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
         /**
          * @description The request is not declared `Content-Type: application/json`, which every POST, PUT,
          *     PATCH and DELETE must be, also one without a body. Nothing was done.
@@ -5125,6 +5712,33 @@ export interface components {
                  *       "status": 415,
                  *       "title": "Unsupported media type",
                  *       "type": "urn:motiond:problem:unsupported_media_type"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The name is taken, or the change would leave no admin. */
+        UserConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such user. */
+        UserNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "user_not_found",
+                 *       "detail": "no user 'bert'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:user_not_found"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -5224,9 +5838,124 @@ export interface operations {
                     "application/json": components["schemas"]["AuditRecord"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["AuditInvalid"];
             503: components["responses"]["AuditUnavailable"];
+        };
+    };
+    login: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["Login"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    /** @description motiond_session=…; Path=/; HttpOnly; SameSite=Strict; Max-Age=… */
+                    "Set-Cookie"?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SessionState"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["LoginFailed"];
+            403: components["responses"]["CrossOriginForbidden"];
+            409: components["responses"]["AuthNotApplicable"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+            429: components["responses"]["TooManyLoginAttempts"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    logout: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Logged out */
+            204: {
+                headers: {
+                    /** @description motiond_session=; Max-Age=0 … */
+                    "Set-Cookie"?: string;
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            403: components["responses"]["CrossOriginForbidden"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    change_password: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PasswordChange"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserView"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["AuthNotApplicable"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+            429: components["responses"]["TooManyLoginAttempts"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    session: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SessionState"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     list_axes: {
@@ -5247,6 +5976,8 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
         };
     };
@@ -5275,7 +6006,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             409: components["responses"]["AxisCreateConflict"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -5308,6 +6040,8 @@ export interface operations {
                     "application/json": components["schemas"]["AxisResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -5341,7 +6075,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["AxisReplaceConflict"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5378,7 +6113,8 @@ export interface operations {
                 };
                 content?: never;
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["AxisNotDisabled"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -5434,7 +6170,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5492,7 +6229,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5550,7 +6288,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5608,7 +6347,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5666,7 +6406,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5706,6 +6447,8 @@ export interface operations {
                     "application/json": components["schemas"]["CamInfo"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CamNotCoupled"];
             421: components["responses"]["MisdirectedRequest"];
@@ -5760,7 +6503,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5818,7 +6562,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5876,7 +6621,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5934,7 +6680,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -5992,7 +6739,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6050,7 +6798,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6108,7 +6857,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6166,7 +6916,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6224,7 +6975,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6282,7 +7034,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6340,7 +7093,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6398,7 +7152,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6456,7 +7211,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6514,7 +7270,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6572,7 +7329,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6630,7 +7388,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6688,7 +7447,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6746,7 +7506,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6780,6 +7541,8 @@ export interface operations {
                     "application/json": components["schemas"]["ParameterResource"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -6813,6 +7576,8 @@ export interface operations {
                     "application/json": components["schemas"]["ParameterResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisOrParameterNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -6851,7 +7616,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisOrParameterNotFound"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -6908,7 +7674,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -6966,7 +7733,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7024,7 +7792,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7082,7 +7851,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7119,7 +7889,8 @@ export interface operations {
                 content?: never;
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7152,6 +7923,8 @@ export interface operations {
                     "application/json": components["schemas"]["StatusResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7185,7 +7958,8 @@ export interface operations {
                     "application/json": components["schemas"]["PeakResetResource"];
                 };
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
@@ -7240,7 +8014,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7268,6 +8043,8 @@ export interface operations {
                     "application/json": components["schemas"]["CamTableResource"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
         };
     };
@@ -7296,7 +8073,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             409: components["responses"]["CamTableConflict"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7329,6 +8107,8 @@ export interface operations {
                     "application/json": components["schemas"]["CamTableResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7362,7 +8142,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             409: components["responses"]["CamTableConflict"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7399,7 +8180,8 @@ export interface operations {
                 };
                 content?: never;
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             409: components["responses"]["CamTableBusy"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7431,6 +8213,8 @@ export interface operations {
                     "application/json": components["schemas"]["Characteristics"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7474,6 +8258,8 @@ export interface operations {
                     "application/json": components["schemas"]["MasterPositionResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CamQueryInvalid"];
@@ -7503,6 +8289,8 @@ export interface operations {
                     "application/json": components["schemas"]["OnlineChange"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7536,7 +8324,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7574,7 +8363,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             409: components["responses"]["CamTableConflict"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7613,6 +8403,8 @@ export interface operations {
                     "application/json": components["schemas"]["MotionFunctionPoint"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableOrPointNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7651,7 +8443,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             409: components["responses"]["CamTableConflict"];
             413: components["responses"]["PayloadTooLarge"];
@@ -7688,6 +8481,8 @@ export interface operations {
                     "application/json": components["schemas"]["SlaveDynamicsResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CamQueryInvalid"];
@@ -7726,6 +8521,8 @@ export interface operations {
                     "application/json": components["schemas"]["CamValuesResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CamQueryInvalid"];
@@ -7756,6 +8553,8 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["AxisNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["QueryInvalid"];
@@ -7782,6 +8581,8 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["CommandNotFound"];
             421: components["responses"]["MisdirectedRequest"];
         };
@@ -7812,7 +8613,8 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7844,7 +8646,8 @@ export interface operations {
                 };
                 content?: never;
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7870,6 +8673,8 @@ export interface operations {
                     "application/json": components["schemas"]["ConfigDocument"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
         };
     };
@@ -7896,13 +8701,91 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             409: components["responses"]["AxisNotDisabled"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ImportInvalid"];
             503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    get_control: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ControlState"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    take_control: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TakeControl"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ControlState"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["ControlConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+        };
+    };
+    release_control: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ControlState"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["ControlConflict"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
         };
     };
     list_recordings: {
@@ -7923,6 +8806,8 @@ export interface operations {
                     "application/json": components["schemas"]["ScopeRecording"][];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
         };
     };
@@ -7951,7 +8836,8 @@ export interface operations {
                 };
             };
             400: components["responses"]["MalformedJson"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             409: components["responses"]["ScopeBusy"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
@@ -7990,6 +8876,8 @@ export interface operations {
                     "text/csv": string;
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             404: components["responses"]["RecordingNotFound"];
             409: components["responses"]["RecordingNotDone"];
             421: components["responses"]["MisdirectedRequest"];
@@ -8030,7 +8918,8 @@ export interface operations {
                 };
                 content?: never;
             };
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
             404: components["responses"]["RecordingNotFound"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
@@ -8054,12 +8943,248 @@ export interface operations {
                     "application/json": components["schemas"]["SystemResource"];
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    list_tokens: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["TokenView"][];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    create_token: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TokenRequest"];
+            };
+        };
+        responses: {
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["NewToken"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["TokenConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    revoke_token: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description token id */
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["TokenView"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["TokenNotFound"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    list_users: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserView"][];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    create_user: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["NewUser"];
+            };
+        };
+        responses: {
+            201: {
+                headers: {
+                    /** @description /api/v1/users/{name} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserView"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["UserConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    get_user: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description user name */
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserView"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["UserNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    update_user: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description user name */
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["UserChange"];
+            };
+        };
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["UserView"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["UserNotFound"];
+            409: components["responses"]["UserConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BodyInvalid"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    delete_user: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description user name */
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Deleted */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["UserNotFound"];
+            409: components["responses"]["UserConflict"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["StorageUnavailable"];
         };
     };
     upgrade: {
         parameters: {
-            query?: never;
+            query?: {
+                /**
+                 * @description Names the client as an `X-Client-Id` header would (a browser cannot set headers on a
+                 *     websocket): the audit log and the control of the machine know it by this.
+                 */
+                client_id?: string;
+            };
             header?: never;
             path?: never;
             cookie?: never;
@@ -8074,7 +9199,8 @@ export interface operations {
                 content?: never;
             };
             400: components["responses"]["WebsocketHandshakeInvalid"];
-            403: components["responses"]["CrossOriginForbidden"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
             426: components["responses"]["WebsocketUpgradeRequired"];
         };
@@ -8116,6 +9242,8 @@ export interface operations {
                     "text/plain": string;
                 };
             };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["MetricsQueryInvalid"];
         };

@@ -19,7 +19,7 @@ pub const MAX_LIMIT: u32 = 1000;
 /// One entry of the audit log: a change or a motion command, who made it and how it ended.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({
-    "id": 57, "at": "2025-01-01T12:00:00.000Z", "client_addr": "127.0.0.1:50312", "client_id": "line-3-mes",
+    "id": 57, "at": "2025-01-01T12:00:00.000Z", "client_addr": "127.0.0.1:50312", "client_id": "line-3-mes", "principal": "token:line-3-mes",
     "action": "command.move-absolute", "target": "x", "command_id": 42,
     "detail": {"position": 100.0, "velocity": 200.0}, "outcome": "accepted"
 }))]
@@ -32,6 +32,9 @@ pub struct AuditRecord {
     pub client_addr: Option<String>,
     /// The client's `X-Client-Id` header (`demo` for the demo machine).
     pub client_id: Option<String>,
+    /// Who: `user:NAME` (a browser session) or `token:NAME` (an API token); null while
+    /// authentication is not enabled.
+    pub principal: Option<String>,
     /// What: `axis.create`, `axis.replace`, `axis.delete`, `parameter.write`,
     /// `parameter.write_persistent`, `config.import`, `command.<name>` (submitted),
     /// `command.final` (ended), `command.release`, `simulation.fault`.
@@ -112,6 +115,7 @@ pub async fn audit_log(
                     at: e.at,
                     client_addr: e.client_addr,
                     client_id: e.client_id,
+                    principal: e.principal,
                     action: e.action,
                     target: e.target,
                     command_id: e.command_id,

@@ -48,6 +48,7 @@ pub async fn create_axis(
         at: store::now_rfc3339(),
         client_addr: Some(client.0.addr.clone()),
         client_id: client.0.id.clone(),
+        principal: client.0.principal.clone(),
         action: "axis.create".into(),
         target: Some(config.name.clone()),
         outcome: Some("committed".into()),

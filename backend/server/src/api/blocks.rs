@@ -30,20 +30,9 @@ use crate::model::*;
 use crate::service::commands::{self, Submission};
 use crate::service::idempotency;
 
-/// What a client must be allowed to do to send a block. Shown in the OpenAPI document
-/// (`x-motiond-block.role`); enforced once clients authenticate (the security issue).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Role {
-    /// Reads status, configuration and recordings.
-    Viewer,
-    /// Moves axes: every motion and coupling block, power, reset.
-    Operator,
-    /// Changes what the machine is: configuration, parameters, fault injection.
-    Engineer,
-    /// Users and tokens.
-    Admin,
-}
+/// What a client must be allowed to do to send a block (shown in the OpenAPI document as
+/// `x-motiond-block.role`, enforced by `crate::auth`).
+pub use crate::auth::Role;
 
 /// A catalogue entry as data.
 #[derive(Clone, Copy, Debug, Serialize)]

@@ -52,6 +52,38 @@ fn cycle_unavailable() -> Problem {
         "the cycle thread did not answer",
     ))
 }
+fn control_held() -> Problem {
+    p(AppError::conflict(
+        "control_held",
+        "control of the machine is held by token:line-3-mes (client line-3-mes) at 10.0.3.17:50312: motion \
+         commands from other clients are refused (stop, halt and disabling are always accepted); its lease \
+         ends in 3170 ms unless renewed",
+    ))
+}
+fn role_insufficient() -> Problem {
+    p(AppError::new(
+        axum::http::StatusCode::FORBIDDEN,
+        "role_insufficient",
+        "Forbidden",
+        "this needs the role operator or higher; token:dashboard has the role viewer",
+    ))
+}
+fn unauthenticated() -> Problem {
+    p(AppError::new(
+        axum::http::StatusCode::UNAUTHORIZED,
+        "unauthenticated",
+        "Authentication required",
+        "log in, or send `Authorization: Bearer <token>`; this needs the role operator",
+    ))
+}
+fn invalid_credentials(detail: &str) -> Problem {
+    p(AppError::new(
+        axum::http::StatusCode::UNAUTHORIZED,
+        "invalid_credentials",
+        "Invalid credentials",
+        detail,
+    ))
+}
 fn storage_unavailable() -> Problem {
     p(AppError::unavailable(
         "storage_unavailable",
@@ -122,7 +154,40 @@ problem_responses! {
         ("sec_fetch_site" = (summary = "A request the browser marks as from another site",
             value = json!(p(AppError::cross_origin(guard::foreign_site("cross-site"))))))));
 
+    // 401
+
+    /// Authentication is enabled and the request has no valid credentials: no session cookie
+    /// and no `Authorization: Bearer` token (`unauthenticated`), or a token or session that is
+    /// unknown, expired or revoked (`invalid_credentials`, `unauthenticated`). Comes with
+    /// `WWW-Authenticate: Bearer realm="motiond"`. Nothing was done.
+    Unauthenticated(examples(
+        ("unauthenticated" = (value = json!(unauthenticated()))),
+        ("invalid_credentials" = (value = json!(invalid_credentials("the API token line-3-mes was revoked"))))),
+        headers(("WWW-Authenticate" = String, description = "Bearer realm=\"motiond\"")));
+
+    /// Wrong user name or password.
+    LoginFailed(example = json!(invalid_credentials("wrong user name or password")));
+
+    /// The user or token has a lower role than the request needs (`role_insufficient`).
+    /// Nothing was done.
+    RoleInsufficient(example = json!(role_insufficient()));
+
+    /// The role is too low (`role_insufficient`), or the request comes from another web origin
+    /// (`cross_origin_forbidden`). Nothing was done.
+    Forbidden(examples(
+        ("role_insufficient" = (value = json!(role_insufficient()))),
+        ("origin" = (summary = "A page of another origin",
+            value = json!(p(AppError::cross_origin(guard::foreign_origin("http://evil.example", Some("127.0.0.1:8080"))))))),
+        ("sec_fetch_site" = (summary = "A request the browser marks as from another site",
+            value = json!(p(AppError::cross_origin(guard::foreign_site("cross-site"))))))));
+
     // 404
+
+    /// No such user.
+    UserNotFound(example = json!(p(AppError::not_found("user", "bert"))));
+
+    /// No such API token.
+    TokenNotFound(example = json!(p(AppError::not_found("token", "17"))));
 
     /// No such axis.
     AxisNotFound(example = json!(axis_not_found()));
@@ -154,7 +219,9 @@ problem_responses! {
         ("axis_cannot_be_started" = (summary = "A move on a disabled axis",
             value = json!(p(AppError::rejected(ErrorId::AXIS_CANNOT_BE_STARTED))))),
         ("feed_enable_missing" = (summary = "A jog without its direction's feed enable",
-            value = json!(p(AppError::rejected(ErrorId::FEED_ENABLE_MISSING)))))));
+            value = json!(p(AppError::rejected(ErrorId::FEED_ENABLE_MISSING))))),
+        ("control_held" = (summary = "Another client holds control of the machine (stop, halt and disabling always pass)",
+            value = json!(control_held())))));
 
     /// The axis is not (and was not) coupled through a cam.
     CamNotCoupled(example = json!(p(AppError::rejected(ErrorId::CAM_NOT_COUPLED))));
@@ -201,6 +268,28 @@ problem_responses! {
         ("no_free_cam_table_id" = (value = json!(p(AppError::conflict("no_free_cam_table_id", "all 255 cam table ids are used"))))),
         ("cam_change_pending" = (value = json!(p(AppError::conflict("cam_change_pending",
             "data written to this cam table earlier has not reached all its slaves yet")))))));
+
+    /// Authentication is off (no user exists), or an API token asked to change its password.
+    AuthNotApplicable(examples(
+        ("authentication_disabled" = (value = json!(p(AppError::conflict("authentication_disabled",
+            "no user exists: authentication is off (create an admin with `motiond user add --admin NAME`)"))))),
+        ("not_a_user" = (value = json!(p(AppError::conflict("not_a_user", "an API token has no password: log in as a user")))))));
+
+    /// The name is taken, or the change would leave no admin.
+    UserConflict(examples(
+        ("user_exists" = (value = json!(p(AppError::conflict("user_exists", "a user anna exists"))))),
+        ("last_admin" = (value = json!(p(AppError::conflict("last_admin", "anna is the last admin and cannot be deleted")))))));
+
+    /// A token of that name exists (revoked tokens keep their names).
+    TokenConflict(example = json!(p(AppError::conflict("token_exists",
+        "a token line-3-mes exists (revoked tokens keep their names)"))));
+
+    /// Another client holds control (`control_held`; `take_over` takes it, admins only), or
+    /// motiond runs with `--control-lease false` (`control_lease_disabled`).
+    ControlConflict(examples(
+        ("control_held" = (value = json!(control_held()))),
+        ("control_lease_disabled" = (value = json!(p(AppError::conflict("control_lease_disabled",
+            "motiond runs with --control-lease false: there is no control to take")))))));
 
     /// CSV of a recording that is not done.
     RecordingNotDone(example = json!(p(AppError::conflict(
@@ -297,7 +386,19 @@ problem_responses! {
         headers(("Upgrade" = String, description = "websocket"),
                 ("Sec-WebSocket-Version" = String, description = "13")));
 
+    /// Invalid fields; `errors` names every one.
+    BodyInvalid(example = json!(p(AppError::field("name", "must be 1-64 characters of letters, digits and . - _ @"))));
+
+    // 429
+
+    /// Five wrong passwords for this name within 30 s: try again later.
+    TooManyLoginAttempts(example = json!(p(AppError::new(axum::http::StatusCode::TOO_MANY_REQUESTS,
+        "too_many_login_attempts", "Too many login attempts", "5 failed logins for anna: try again in 28 s"))));
+
     // 503
+
+    /// The database did not accept the write (`storage_unavailable`); nothing was changed.
+    StorageUnavailable(example = json!(storage_unavailable()));
 
     /// The cycle thread did not take the request (`command_queue_full`: try again) or did not
     /// answer (`cycle_unavailable`).
@@ -428,6 +529,45 @@ error_sets! {
     WebsocketErrors {
         400: WebsocketHandshakeInvalid, 403: CrossOriginForbidden, 426: WebsocketUpgradeRequired,
     }
+    /// `GET /auth/session`.
+    SessionErrors { 401: Unauthenticated }
+    /// `POST /auth/login`.
+    LoginErrors {
+        400: MalformedJson, 401: LoginFailed, 409: AuthNotApplicable, 413: PayloadTooLarge,
+        422: BodyInvalid, 429: TooManyLoginAttempts, 503: StorageUnavailable,
+    }
+    /// `POST /auth/logout`.
+    LogoutErrors { 503: StorageUnavailable }
+    /// `PUT /auth/password`.
+    PasswordErrors {
+        400: MalformedJson, 409: AuthNotApplicable, 413: PayloadTooLarge, 422: BodyInvalid,
+        429: TooManyLoginAttempts, 503: StorageUnavailable,
+    }
+    /// `POST /users`.
+    UserCreateErrors {
+        400: MalformedJson, 409: UserConflict, 413: PayloadTooLarge, 422: BodyInvalid,
+        503: StorageUnavailable,
+    }
+    /// `GET /users/{name}`.
+    UserReadErrors { 404: UserNotFound }
+    /// `PUT /users/{name}`.
+    UserChangeErrors {
+        400: MalformedJson, 404: UserNotFound, 409: UserConflict, 413: PayloadTooLarge,
+        422: BodyInvalid, 503: StorageUnavailable,
+    }
+    /// `DELETE /users/{name}`.
+    UserDeleteErrors { 404: UserNotFound, 409: UserConflict, 503: StorageUnavailable }
+    /// `POST /tokens`.
+    TokenCreateErrors {
+        400: MalformedJson, 409: TokenConflict, 413: PayloadTooLarge, 422: BodyInvalid,
+        503: StorageUnavailable,
+    }
+    /// `DELETE /tokens/{id}`.
+    TokenRevokeErrors { 404: TokenNotFound, 503: StorageUnavailable }
+    /// `POST /control`.
+    ControlErrors { 400: MalformedJson, 409: ControlConflict, 413: PayloadTooLarge, 422: BodyInvalid }
+    /// `DELETE /control`.
+    ControlReleaseErrors { 409: ControlConflict }
     /// `POST /scope/recordings`.
     ScopeCreateErrors {
         400: MalformedJson, 409: ScopeBusy, 413: PayloadTooLarge, 422: ScopeInvalid,
@@ -443,37 +583,79 @@ error_sets! {
 }
 
 /// The answers of the request checks (`guard.rs`), added to every operation by the rule the
-/// checks follow: 421 to all, 403 and 415 to those that change something.
+/// checks follow: 421 to all, 403 and 415 to those that change something; and the role each
+/// needs ([`crate::auth::required`]): its `security`, `x-motiond-role`, 401 and 403.
 pub struct RequestChecks;
 
 impl utoipa::Modify for RequestChecks {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use axum::http::Method;
+        use utoipa::openapi::security::{
+            ApiKey, ApiKeyValue, Http, HttpAuthScheme, SecurityRequirement, SecurityScheme,
+        };
         use utoipa::openapi::{Ref, RefOr};
         let response = |name: &str| RefOr::Ref(Ref::from_response_name(name));
-        for item in doc.paths.paths.values_mut() {
-            let safe = [
-                &mut item.get,
-                &mut item.head,
-                &mut item.options,
-                &mut item.trace,
+        let components = doc.components.get_or_insert_with(Default::default);
+        components.security_schemes.insert(
+            "bearer".into(),
+            SecurityScheme::Http(
+                Http::builder()
+                    .scheme(HttpAuthScheme::Bearer)
+                    .description(Some("An API token (`POST /api/v1/tokens`), for machines"))
+                    .build(),
+            ),
+        );
+        components.security_schemes.insert(
+            "session".into(),
+            SecurityScheme::ApiKey(ApiKey::Cookie(ApiKeyValue::with_description(
+                crate::auth::COOKIE,
+                "The browser session of `POST /api/v1/auth/login`",
+            ))),
+        );
+        for (path, item) in doc.paths.paths.iter_mut() {
+            let ops = [
+                (Method::GET, &mut item.get, false),
+                (Method::HEAD, &mut item.head, false),
+                (Method::OPTIONS, &mut item.options, false),
+                (Method::TRACE, &mut item.trace, false),
+                (Method::POST, &mut item.post, true),
+                (Method::PUT, &mut item.put, true),
+                (Method::PATCH, &mut item.patch, true),
+                (Method::DELETE, &mut item.delete, true),
             ];
-            let changing = [
-                &mut item.post,
-                &mut item.put,
-                &mut item.patch,
-                &mut item.delete,
-            ];
-            for (op, changes) in safe
-                .into_iter()
-                .map(|o| (o, false))
-                .chain(changing.into_iter().map(|o| (o, true)))
-            {
+            for (method, op, changes) in ops {
                 let Some(op) = op.as_mut() else { continue };
+                let role = crate::auth::required(&method, path);
                 let responses = &mut op.responses.responses;
                 responses.insert("421".into(), response("MisdirectedRequest"));
                 if changes {
-                    responses.insert("403".into(), response("CrossOriginForbidden"));
+                    let forbidden = if role.is_some() {
+                        "Forbidden"
+                    } else {
+                        "CrossOriginForbidden"
+                    };
+                    responses.insert("403".into(), response(forbidden));
                     responses.insert("415".into(), response("UnsupportedMediaType"));
+                }
+                match role {
+                    Some(role) => {
+                        responses.insert("401".into(), response("Unauthenticated"));
+                        if !changes {
+                            responses.insert("403".into(), response("RoleInsufficient"));
+                        }
+                        op.security = Some(vec![
+                            SecurityRequirement::new("bearer", Vec::<String>::new()),
+                            SecurityRequirement::new("session", Vec::<String>::new()),
+                        ]);
+                        // A block names its role in `x-motiond-block` already (and utoipa
+                        // writes several extensions in no fixed order).
+                        let ext = op.extensions.get_or_insert_with(Default::default);
+                        if !ext.contains_key("x-motiond-block") {
+                            ext.insert("x-motiond-role".into(), serde_json::json!(role));
+                        }
+                    }
+                    // Public: no credentials needed.
+                    None => {}
                 }
             }
         }

@@ -2,6 +2,7 @@
 
 pub mod asyncapi;
 pub mod audit;
+pub mod auth;
 pub mod axes;
 pub mod blocks;
 pub mod cams;
@@ -141,10 +142,13 @@ impl<S: Send + Sync> FromRequestParts<S> for Client {
                 .take(128)
                 .collect()
         });
+        let identity = parts.extensions.get::<crate::auth::Principal>().cloned();
         Ok(Client(ClientInfo {
             addr,
             id,
             via: "rest",
+            principal: identity.as_ref().map(|p| p.label()),
+            identity,
         }))
     }
 }
@@ -254,6 +258,25 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             "/cam-tables/{table}/points/{point}",
             get(cams::get_point).put(cams::write_point),
         )
+        .route("/auth/session", get(auth::session))
+        .route("/auth/login", post(auth::login))
+        .route("/auth/logout", post(auth::logout))
+        .route("/auth/password", axum::routing::put(auth::change_password))
+        .route("/users", get(auth::list_users).post(auth::create_user))
+        .route(
+            "/users/{name}",
+            get(auth::get_user)
+                .put(auth::update_user)
+                .delete(auth::delete_user),
+        )
+        .route("/tokens", get(auth::list_tokens).post(auth::create_token))
+        .route("/tokens/{id}", axum::routing::delete(auth::revoke_token))
+        .route(
+            "/control",
+            get(auth::get_control)
+                .post(auth::take_control)
+                .delete(auth::release_control),
+        )
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
         .route(
@@ -276,6 +299,11 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
         .route("/metrics", get(system::metrics))
         .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::document()))
         .route("/asyncapi.json", get(asyncapi_document))
+        // Every route: the role it needs (crate::auth::required), once users exist.
+        .route_layer(axum::middleware::from_fn_with_state(
+            state.clone(),
+            auth::check_role,
+        ))
         // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
         .fallback(crate::ui::serve)
         .layer(axum::middleware::from_fn(problem_errors))
@@ -340,6 +368,16 @@ async fn problem_errors(req: Request, next: Next) -> Response {
     r
 }
 
+/// `GET /ws?client_id=…`.
+#[derive(Debug, Default, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct WsQuery {
+    /// Names the client as an `X-Client-Id` header would (a browser cannot set headers on a
+    /// websocket): the audit log and the control of the machine know it by this.
+    pub client_id: Option<String>,
+}
+
 /// 426 for a request to `/ws` that is not a websocket upgrade at all.
 pub(crate) fn upgrade_required(detail: &str) -> AppError {
     AppError::new(
@@ -367,10 +405,15 @@ async fn websocket(
     addr: ConnectInfo<SocketAddr>,
     headers: HeaderMap,
     settings: ws::Settings,
+    identity: Option<axum::Extension<crate::auth::Principal>>,
+    Q(q): Q<WsQuery>,
 ) -> Response {
     use WebSocketUpgradeRejection as R;
     let e = match ws {
-        Ok(ws) => return ws::upgrade(ws, state, addr, headers, settings).await,
+        Ok(ws) => {
+            let identity = identity.map(|e| e.0);
+            return ws::upgrade(ws, state, addr, headers, settings, identity, q.client_id).await;
+        }
         Err(e) => e,
     };
     match e {
@@ -432,6 +475,10 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
+        auth::session, auth::login, auth::logout, auth::change_password,
+        auth::list_users, auth::create_user, auth::get_user, auth::update_user, auth::delete_user,
+        auth::list_tokens, auth::create_token, auth::revoke_token,
+        auth::get_control, auth::take_control, auth::release_control,
     ),
     components(schemas(crate::error::Problem)),
     tags(
@@ -442,6 +489,8 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         (name = "simulation", description = "Fault injection into the simulated drives"),
         (name = "scope", description = "Recordings of axis signals at the cycle rate, optionally triggered"),
         (name = "system", description = "Version, cycle timing, metrics, configuration export/import, audit log"),
+        (name = "auth", description = "Login, users (passwords hashed with argon2id) and API tokens for machines; roles viewer < operator < engineer < admin"),
+        (name = "control", description = "Who commands motion: one holder at a time, with a renewed lease; stop, halt and disabling always pass"),
     )
 )]
 pub struct ApiDoc;

@@ -22,6 +22,7 @@ use utoipa::ToSchema;
 
 use super::blocks;
 use crate::app::AppState;
+use crate::auth::Role;
 use crate::error::AppError;
 use crate::model::*;
 use crate::service::commands;
@@ -186,6 +187,7 @@ several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the
 Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has \
 heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. \
 A message over 256 KiB closes the socket with code 1009 (message too big).",
+    params(super::WsQuery),
     responses((status = 101, description = "Switching protocols"), super::errors::WebsocketErrors))]
 pub async fn upgrade(
     ws: WebSocketUpgrade,
@@ -193,14 +195,21 @@ pub async fn upgrade(
     ConnectInfo(addr): ConnectInfo<SocketAddr>,
     headers: HeaderMap,
     settings: Settings,
+    identity: Option<crate::auth::Principal>,
+    client_id: Option<String>,
 ) -> Response {
     let client = ClientInfo {
         addr: addr.to_string(),
+        // A browser cannot set headers on a websocket: `?client_id=` names it instead.
         id: headers
             .get("x-client-id")
             .and_then(|v| v.to_str().ok())
+            .map(String::from)
+            .or(client_id)
             .map(|s| s.chars().take(128).collect()),
         via: "websocket",
+        principal: identity.as_ref().map(|p| p.label()),
+        identity,
     };
     // Clients send little (requests of at most 256 KiB): a small read chunk, because the read
     // buffer is zeroed to its size on every read.
@@ -579,6 +588,14 @@ fn handle(
     let notification = req.get("id").is_none();
     // (a closure, so that its early error returns are silenced for notifications too)
     #[allow(clippy::redundant_closure_call)]
+    let need = match method.as_str() {
+        "subscribe" | "unsubscribe" => Role::Viewer,
+        "keepalive" | "release" => Role::Operator,
+        name => blocks::find(name).map_or(Role::Viewer, |b| b.role),
+    };
+    if let Err(e) = may(s, client, need) {
+        return Some(api_error(&id, e)).filter(|_| !notification);
+    }
     let reply = (|| match method.as_str() {
         "subscribe" => {
             let Some(key) = params
@@ -770,6 +787,28 @@ fn handle(
         }
     })();
     reply.filter(|_| !notification)
+}
+
+/// Whether the socket's client may still do what needs `need`: its session or token is checked
+/// again at every request (it may have been logged out, revoked or given another role since
+/// the socket opened), and a socket opened before the first user existed gets nothing more.
+fn may(s: &AppState, client: &ClientInfo, need: Role) -> Result<(), AppError> {
+    match &client.identity {
+        Some(p) => {
+            let now = s.auth.recheck(p)?;
+            if now.role < need {
+                return Err(crate::auth::forbidden(&now, need));
+            }
+            Ok(())
+        }
+        None if s.auth.enabled() => Err(AppError::new(
+            axum::http::StatusCode::UNAUTHORIZED,
+            "unauthenticated",
+            "Authentication required",
+            "authentication was enabled after this socket opened: reconnect with a session or token",
+        )),
+        None => Ok(()),
+    }
 }
 
 fn too_many_in_flight(id: &Value) -> String {

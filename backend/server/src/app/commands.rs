@@ -111,6 +111,7 @@ pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry 
         at: store::now_rfc3339(),
         client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: "command.final".into(),
         target: Some(n.axis.clone()),
         command_id: Some(n.command),

@@ -71,6 +71,10 @@ pub struct AppState {
     pub info: SystemInfo,
     /// Scope recordings and the channel layout the cycle thread samples.
     pub scope: Mutex<Recordings>,
+    /// Users, sessions, tokens.
+    pub auth: Arc<crate::auth::Auth>,
+    /// Who holds control of the machine.
+    pub control: crate::service::control::Control,
 }
 
 impl AppState {
@@ -80,6 +84,8 @@ impl AppState {
         db: SqlitePool,
         first_command_id: u64,
         info: SystemInfo,
+        auth: Arc<crate::auth::Auth>,
+        control_lease: bool,
     ) -> (Arc<AppState>, mpsc::Receiver<crate::store::AuditOp>) {
         let (audit_tx, audit_rx) = mpsc::channel(8192);
         let scope = Mutex::new(Recordings::new(info.cycle_time_s, shared.period_ns));
@@ -104,6 +110,8 @@ impl AppState {
             audit_tx,
             audit_dropped: Arc::new(AtomicU64::new(0)),
             info,
+            auth,
+            control: crate::service::control::Control::new(control_lease),
         };
         (Arc::new(state), audit_rx)
     }

@@ -29,7 +29,7 @@ fn resource(s: &AppState, e: &AxisEntry) -> AxisResource {
 }
 
 /// An audit row of a configuration change by `client`, committed with the change.
-pub(super) fn audit_entry(
+pub(crate) fn audit_entry(
     client: &ClientInfo,
     action: &str,
     target: &str,
@@ -39,6 +39,7 @@ pub(super) fn audit_entry(
         at: store::now_rfc3339(),
         client_addr: Some(client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: action.into(),
         target: Some(target.into()),
         detail,
@@ -278,6 +279,7 @@ pub async fn reset_following_error_peak(
         at: store::now_rfc3339(),
         client_addr: Some(client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: "axis.following_error_peak.reset".into(),
         target: Some(name.clone()),
         command_id: None,

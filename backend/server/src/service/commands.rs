@@ -712,6 +712,10 @@ async fn submit(
             build(&reg, e).map_err(invalid)?,
         )
     };
+    // One holder commands motion at a time (stop, halt and disabling always pass).
+    s.control.admit(&client, &kind).inspect_err(|_| {
+        s.metrics.command(name, Verdict::rejected);
+    })?;
     let id = s.next_id();
     s.reserve_id(id).await?;
     let submitted_at = store::now_rfc3339();
@@ -719,6 +723,7 @@ async fn submit(
         at: submitted_at.clone(),
         client_addr: Some(client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: format!("command.{name}"),
         target: Some(axis_name.clone()),
         command_id: Some(id),
@@ -916,6 +921,7 @@ pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppRes
         at: store::now_rfc3339(),
         client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: "command.release".into(),
         target: Some(id.to_string()),
         command_id: Some(id),

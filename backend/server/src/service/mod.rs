@@ -5,6 +5,7 @@
 pub mod axes;
 pub mod cams;
 pub mod commands;
+pub mod control;
 pub mod idempotency;
 pub mod scope;
 pub mod simulation;

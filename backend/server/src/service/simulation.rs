@@ -41,6 +41,7 @@ pub async fn inject_fault(
         at: store::now_rfc3339(),
         client_addr: Some(client.addr.clone()),
         client_id: client.id.clone(),
+        principal: client.principal.clone(),
         action: "simulation.fault".into(),
         target: Some(name),
         command_id: None,

@@ -16,13 +16,15 @@ pub struct AuditEntry {
     pub outcome: Option<String>,
     /// The `Idempotency-Key` a motion command was sent with.
     pub idempotency_key: Option<String>,
+    /// `user:NAME` or `token:NAME` (authentication enabled).
+    pub principal: Option<String>,
 }
 
 pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
     e: E,
     a: &AuditEntry,
 ) -> Result<(), sqlx::Error> {
-    sqlx::query("INSERT INTO audit_log (at, client_addr, client_id, action, target, command_id, detail, outcome, idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)")
+    sqlx::query("INSERT INTO audit_log (at, client_addr, client_id, action, target, command_id, detail, outcome, idempotency_key, principal) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
         .bind(&a.at)
         .bind(&a.client_addr)
         .bind(&a.client_id)
@@ -32,6 +34,7 @@ pub async fn audit<'e, E: sqlx::SqliteExecutor<'e>>(
         .bind(&a.detail)
         .bind(&a.outcome)
         .bind(&a.idempotency_key)
+        .bind(&a.principal)
         .execute(e)
         .await
         .map(|_| ())
@@ -97,7 +100,7 @@ pub async fn read_audit(
     before_id: i64,
 ) -> Result<Vec<AuditRow>, sqlx::Error> {
     let rows = sqlx::query(
-        "SELECT id, at, client_addr, client_id, action, target, command_id, detail, outcome \
+        "SELECT id, at, client_addr, client_id, action, target, command_id, detail, outcome, principal \
          FROM audit_log WHERE id > ? AND id < ? ORDER BY id DESC LIMIT ?",
     )
     .bind(since_id)
@@ -119,6 +122,7 @@ pub async fn read_audit(
                 detail: r.get(7),
                 outcome: r.get(8),
                 idempotency_key: None,
+                principal: r.get(9),
             },
         })
         .collect())

@@ -6,6 +6,7 @@
 //! file fails at start-up with "database is locked" instead of two processes writing.
 
 pub mod audit;
+pub mod auth;
 pub mod axes;
 pub mod cams;
 
