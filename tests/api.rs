@@ -397,6 +397,47 @@ async fn stop_locks_the_axis_until_released() {
 /// keepalives the dead-man counts from the cycle the jog took effect in (its first event); the
 /// kernel reports the expiry in the cycle it fires (in_velocity falls, warning 0x7061) and ends
 /// the command with error 0x7061 once the axis is at rest.
+/// A client may not choose a long dead-man: each axis has the engineer's maximum
+/// (`dynamics.jog_deadman_max`, default 1 s), so a never-renewed jog runs at most that long.
+#[tokio::test]
+async fn a_jog_dead_man_is_bounded_by_the_axis_maximum() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let r = post(&s, "/api/v1/axes/y/jog", json!({"deadman_timeout": 10.0})).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.field_error(), (422, Some("deadman_timeout")));
+    assert!(r.text.contains("jog_deadman_max"), "{}", r.text);
+    let st = status(&s, "y").await;
+    assert_eq!(st["status"]["state"], "standstill", "nothing moved: {st}");
+    // The engineer raises it (on a disabled axis); then 5 s is taken, 6 s still refused.
+    let r = post(
+        &s,
+        "/api/v1/axes/y/power?wait=true",
+        json!({"enable": false}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let mut config = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+    assert_eq!(config["dynamics"]["jog_deadman_max"], 1.0);
+    config["dynamics"]["jog_deadman_max"] = json!(5.0);
+    let r = put(&s, "/api/v1/axes/y", config.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    config["dynamics"]["jog_deadman_max"] = json!(11.0);
+    let r = put(&s, "/api/v1/axes/y", config).await;
+    assert_eq!(r.field_error(), (422, Some("dynamics.jog_deadman_max")));
+    power_on(&s, "y").await;
+    let r = post(&s, "/api/v1/axes/y/jog", json!({"deadman_timeout": 6.0})).await;
+    assert_eq!(r.field_error(), (422, Some("deadman_timeout")));
+    let r = post(&s, "/api/v1/axes/y/jog", json!({"deadman_timeout": 5.0})).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let id = r.json["id"].as_u64().unwrap();
+    assert_eq!(
+        delete(&s, &format!("/api/v1/commands/{id}")).await.status,
+        200
+    );
+    s.stop();
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn a_jog_without_keepalive_is_stopped_by_its_deadman() {
     let s = Server::start();

@@ -281,6 +281,7 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             jerk: 25000.0,
             jog_velocity_slow: 10.0,
             jog_velocity_fast: 100.0,
+            jog_deadman_max: 1.0,
         },
         parameters: BTreeMap::from([(
             "AxisTargetPositionWindow".to_string(),
@@ -319,6 +320,7 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
                 jerk: 180000.0,
                 jog_velocity_slow: 90.0,
                 jog_velocity_fast: 720.0,
+                jog_deadman_max: 1.0,
             },
             parameters: BTreeMap::new(),
             drive: DriveConfig::default(),

@@ -63,6 +63,15 @@ pub struct AxisDynamics {
     /// #1002 AxisVeloManFast, units/s.
     #[schema(example = 100.0)]
     pub jog_velocity_fast: f64,
+    /// The longest dead-man a jog on this axis may ask for (`deadman_timeout`), in s
+    /// (0.05–10, default 1): what a client that vanishes mid-jog can cost, set by the engineer.
+    #[serde(default = "default_jog_deadman_max")]
+    #[schema(default = 1.0, example = 1.0, minimum = 0.05, maximum = 10.0)]
+    pub jog_deadman_max: f64,
+}
+
+fn default_jog_deadman_max() -> f64 {
+    1.0
 }
 
 /// The configuration of one axis (its base parameter set).
@@ -156,6 +165,9 @@ impl AxisConfigDto {
         }
         if d.jog_velocity_fast > d.max_velocity {
             err("dynamics.jog_velocity_fast", "must not exceed max_velocity");
+        }
+        if !(d.jog_deadman_max.is_finite() && (0.05..=10.0).contains(&d.jog_deadman_max)) {
+            err("dynamics.jog_deadman_max", "must be between 0.05 and 10 s");
         }
         if let Err(fe) = self.drive.validate() {
             for e in fe {
@@ -649,7 +661,8 @@ pub struct JogBody {
     #[serde(default)]
     #[schema(default = 0.0)]
     pub jerk: f64,
-    /// Seconds without keepalive after which the jog stops (0.05–10; default 0.5).
+    /// Seconds without keepalive after which the jog stops (0.05 s up to the axis's
+    /// `dynamics.jog_deadman_max`, at most 10; default 0.5).
     #[serde(default = "default_deadman_timeout")]
     #[schema(default = 0.5)]
     pub deadman_timeout: f64,

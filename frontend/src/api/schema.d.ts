@@ -1291,6 +1291,14 @@ export interface components {
              * @example 100
              */
             jog_velocity_fast: number;
+            /**
+             * Format: double
+             * @description The longest dead-man a jog on this axis may ask for (`deadman_timeout`), in s
+             *     (0.05–10, default 1): what a client that vanishes mid-jog can cost, set by the engineer.
+             * @default 1
+             * @example 1
+             */
+            jog_deadman_max: number;
         };
         /**
          * @description An axis as the API shows it.
@@ -1328,6 +1336,7 @@ export interface components {
          *           "acceleration": 2500,
          *           "deceleration": 2500,
          *           "jerk": 25000,
+         *           "jog_deadman_max": 1,
          *           "jog_velocity_fast": 100,
          *           "jog_velocity_slow": 10,
          *           "max_velocity": 500
@@ -2609,6 +2618,7 @@ export interface components {
          *           "acceleration": 2500,
          *           "deceleration": 2500,
          *           "jerk": 25000,
+         *           "jog_deadman_max": 1,
          *           "jog_velocity_fast": 100,
          *           "jog_velocity_slow": 10,
          *           "max_velocity": 500
@@ -2674,6 +2684,7 @@ export interface components {
          *               "acceleration": 2500,
          *               "deceleration": 2500,
          *               "jerk": 25000,
+         *               "jog_deadman_max": 1,
          *               "jog_velocity_fast": 100,
          *               "jog_velocity_slow": 10,
          *               "max_velocity": 500
@@ -2727,6 +2738,7 @@ export interface components {
          *               "acceleration": 2500,
          *               "deceleration": 2500,
          *               "jerk": 25000,
+         *               "jog_deadman_max": 1,
          *               "jog_velocity_fast": 100,
          *               "jog_velocity_slow": 10,
          *               "max_velocity": 500
@@ -2774,6 +2786,7 @@ export interface components {
          *               "acceleration": 18000,
          *               "deceleration": 18000,
          *               "jerk": 180000,
+         *               "jog_deadman_max": 1,
          *               "jog_velocity_fast": 720,
          *               "jog_velocity_slow": 90,
          *               "max_velocity": 3600
@@ -3200,7 +3213,8 @@ export interface components {
             jerk: number;
             /**
              * Format: double
-             * @description Seconds without keepalive after which the jog stops (0.05–10; default 0.5).
+             * @description Seconds without keepalive after which the jog stops (0.05 s up to the axis's
+             *     `dynamics.jog_deadman_max`, at most 10; default 0.5).
              * @default 0.5
              */
             deadman_timeout: number;

@@ -282,10 +282,16 @@ impl StopBody {
 }
 
 impl JogBody {
-    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+    pub fn to_kind(&self, _: &Registry, e: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
-        if !(self.deadman_timeout.is_finite() && (0.05..=10.0).contains(&self.deadman_timeout)) {
-            c.fail("deadman_timeout", "must be between 0.05 and 10 s");
+        // Bounded by the engineer's maximum for this axis: a client that vanishes mid-jog
+        // costs at most that long at jog speed.
+        let max = e.config.dynamics.jog_deadman_max;
+        if !(self.deadman_timeout.is_finite() && (0.05..=max).contains(&self.deadman_timeout)) {
+            c.fail(
+                "deadman_timeout",
+                &format!("must be between 0.05 and {max} s (the axis's dynamics.jog_deadman_max)"),
+            );
         }
         c.non_negative("velocity", self.velocity);
         c.non_negative("acceleration", self.acceleration);
