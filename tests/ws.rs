@@ -744,3 +744,42 @@ async fn an_oversize_message_closes_the_socket_with_1009() {
     assert_eq!(u16::from(c.code), 1009, "{c:?}");
     assert!(c.reason.contains("256 KiB"), "{c:?}");
 }
+
+/// A socket names its client by `X-Client-Id` (kept when not ASCII) or, from a browser that
+/// cannot set headers, by `?client_id=`; its commands carry the name.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_socket_names_its_client_by_header_or_query() {
+    use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+    let s = Server::start();
+    let mut req = format!("ws://{}/api/v1/ws", s.addr)
+        .into_client_request()
+        .unwrap();
+    req.headers_mut().insert(
+        "x-client-id",
+        tokio_tungstenite::tungstenite::http::HeaderValue::from_bytes("Presse-Süd".as_bytes())
+            .unwrap(),
+    );
+    let url = format!("ws://{}/api/v1/ws?client_id=panel-2", s.addr);
+    for (req, name) in [
+        (req, "Presse-Süd"),
+        (url.into_client_request().unwrap(), "panel-2"),
+    ] {
+        let (stream, _) = tokio_tungstenite::connect_async(req).await.unwrap();
+        let mut ws = Ws {
+            stream,
+            queue: Default::default(),
+            batches: 0,
+        };
+        send(
+            &mut ws,
+            1,
+            "set-override",
+            json!({"axis": "x", "velocity_factor": 1.0}),
+        )
+        .await;
+        let (r, _) = response(&mut ws, 1).await;
+        assert_eq!(r["result"]["client"]["id"], name, "{r}");
+        assert_eq!(r["result"]["client"]["via"], "websocket", "{r}");
+    }
+    s.stop();
+}

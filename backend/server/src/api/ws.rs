@@ -201,10 +201,10 @@ pub async fn upgrade(
     let client = ClientInfo {
         addr: addr.to_string(),
         // A browser cannot set headers on a websocket: `?client_id=` names it instead.
+        // Non-ASCII names arrive as UTF-8 bytes: decoded, never dropped (as for REST).
         id: headers
             .get("x-client-id")
-            .and_then(|v| v.to_str().ok())
-            .map(String::from)
+            .map(|v| String::from_utf8_lossy(v.as_bytes()).into_owned())
             .or(client_id)
             .map(|s| s.chars().take(128).collect()),
         via: "websocket",
