@@ -603,18 +603,40 @@ async fn persistent_parameters_survive_a_restart_and_others_do_not() {
         get(&s, "/api/v1/axes/y/parameters/AxisAcc").await.json["value"],
         2500.0
     );
-    // replacing the axis configuration drops the persistent overlay
-    let cfg = get(&s, "/api/v1/axes/x").await.json["config"].clone();
+    // A save that does not set AxisVeloMax anew keeps its persistent value (and the axis);
+    // one that does gives it up, and says so first.
+    let mut cfg = get(&s, "/api/v1/axes/x").await.json["config"].clone();
+    cfg["dynamics"]["jog_velocity_slow"] = json!(20.0);
+    let r = put(&s, "/api/v1/axes/x", cfg.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(
+        r.json["change"]["persistent_discarded"],
+        json!([]),
+        "{}",
+        r.text
+    );
+    let v = get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await;
+    assert_eq!(v.json["value"], 800.0, "{}", v.text);
+    assert_eq!(v.json["persistent_value"], 800.0, "{}", v.text);
+    assert_eq!(v.json["configured_value"], 500.0, "{}", v.text);
+    cfg["dynamics"]["max_velocity"] = json!(500.0 + 1.0);
+    let dry = put(&s, "/api/v1/axes/x?dry_run=true", cfg.clone()).await;
+    assert_eq!(
+        dry.json["change"]["persistent_discarded"][0]["name"], "AxisVeloMax",
+        "{}",
+        dry.text
+    );
+    assert_eq!(dry.json["change"]["persistent_discarded"][0]["new"], 800.0);
     let r = put(&s, "/api/v1/axes/x", cfg).await;
     assert_eq!(r.status, 200, "{}", r.text);
     let v = get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await;
-    assert_eq!(v.json["value"], 500.0, "{}", v.text);
+    assert_eq!(v.json["value"], 501.0, "{}", v.text);
     assert!(v.json.get("persistent_value").is_none());
     s.stop();
     let s = Server::start_with(db, &[]);
     assert_eq!(
         get(&s, "/api/v1/axes/x/parameters/AxisVeloMax").await.json["value"],
-        500.0
+        501.0
     );
     drop(s);
     let _ = std::fs::remove_dir_all(dir);
@@ -754,8 +776,23 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
     );
 
     power_on(&s, "z").await;
-    let mut changed = cfg.clone();
-    changed["dynamics"]["max_velocity"] = json!(150.0);
+    // What can be written online is, on the running axis (no rebuild); a new unit re-creates
+    // the axis, which must be disabled for it.
+    let mut faster = cfg.clone();
+    faster["dynamics"]["max_velocity"] = json!(150.0);
+    let r = put(&s, "/api/v1/axes/z", faster.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["change"]["rebuild"], false, "{}", r.text);
+    assert_eq!(r.json["change"]["parameters"][0]["name"], "AxisVeloMax");
+    assert_eq!(status(&s, "z").await["status"]["state"], "standstill");
+    let mut changed = faster.clone();
+    changed["unit"] = json!("m");
+    let r = put(&s, "/api/v1/axes/z?dry_run=true", changed.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["change"]["rebuild"], true, "{}", r.text);
+    assert_eq!(r.json["change"]["rebuild_reasons"][0], "unit changed");
+    assert_eq!(r.json["change"]["dry_run"], true);
+    assert_eq!(get(&s, "/api/v1/axes/z").await.json["config"]["unit"], "mm");
     assert_problem(
         &put(&s, "/api/v1/axes/z", changed.clone()).await,
         409,
@@ -780,6 +817,8 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
     }
     let r = put(&s, "/api/v1/axes/z", changed).await;
     assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["change"]["rebuild"], true, "{}", r.text);
+    assert_eq!(r.json["config"]["unit"], "m");
     assert_eq!(r.json["config"]["dynamics"]["max_velocity"], 150.0);
     assert_eq!(
         get(&s, "/api/v1/axes/z/parameters/1003").await.json["value"],

@@ -246,6 +246,56 @@ pub struct AxisResource {
     pub slot: u16,
     pub state: AxisState,
     pub config: AxisConfigDto,
+    /// What a `PUT` of the configuration changed (or, with `?dry_run=true`, would change).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub change: Option<ConfigChange>,
+}
+
+/// `PUT /axes/{axis}?dry_run=true`.
+#[derive(Debug, Default, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct ReplaceQuery {
+    /// Only say what the save would change (`change`), and change nothing.
+    #[serde(default)]
+    pub dry_run: bool,
+}
+
+/// What saving a new configuration of an axis does.
+#[derive(Clone, Debug, Default, Serialize, ToSchema)]
+#[schema(example = json!({"dry_run": true, "rebuild": false, "rebuild_reasons": [],
+    "parameters": [{"name": "AxisVeloManSlow", "number": 1001, "configured": 10.0, "online": 10.0, "new": 20.0}],
+    "persistent_discarded": []}))]
+pub struct ConfigChange {
+    /// Nothing was changed: this is what the save would do.
+    pub dry_run: bool,
+    /// The axis is (or would be) re-created from the configuration: it must be disabled, and
+    /// its position (0 afterwards), homed state and online values are lost; persistent values
+    /// of parameters the save does not change are kept. Without a rebuild the changed
+    /// parameters are written online (MC_WriteParameter) and nothing else is touched.
+    pub rebuild: bool,
+    /// Why a rebuild is needed (the fields that cannot change online).
+    pub rebuild_reasons: Vec<String>,
+    /// The parameters whose configured value changes.
+    pub parameters: Vec<ParameterChange>,
+    /// Persistent values given up because the save sets their parameter anew.
+    pub persistent_discarded: Vec<ParameterChange>,
+}
+
+/// One parameter a configuration save changes.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"name": "AxisVeloMax", "number": 1003, "configured": 500.0, "online": 650.0, "new": 700.0}))]
+pub struct ParameterChange {
+    #[schema(example = "AxisVeloMax")]
+    pub name: &'static str,
+    #[schema(example = 1003)]
+    pub number: u16,
+    /// The value of the configuration before the save.
+    pub configured: ParamValue,
+    /// The value in force before the save (an online or persistent write may differ).
+    pub online: ParamValue,
+    /// The value after the save (for a discarded persistent value: the persistent value).
+    pub new: ParamValue,
 }
 
 /// The whole configuration (`GET/PUT /config`).
@@ -282,7 +332,7 @@ pub struct ConfigAxis {
     "number": 1096, "name": "AxisCtrlVelocityPreCtrlWeight", "type": "lreal", "unit": "percent",
     "group": "controller", "read_only": false, "storage": 1096, "min": 0.0, "max": 100.0, "min_exclusive": false,
     "ads_index_offset": "0x0002000B", "help": "Weight of the velocity feed-forward in percent (100 = full feed-forward).",
-    "unit_text": "%", "value": 90.0, "persistent_value": 90.0
+    "unit_text": "%", "value": 90.0, "persistent_value": 90.0, "configured_value": 100.0
 }))]
 pub struct ParameterResource {
     #[serde(flatten)]
@@ -290,10 +340,15 @@ pub struct ParameterResource {
     /// The unit for this axis (e.g. `mm/s²`).
     #[schema(example = "mm/s")]
     pub unit_text: String,
+    /// The value in force (online).
     pub value: ParamValue,
     /// The value of the persistent overlay, when there is one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub persistent_value: Option<ParamValue>,
+    /// The value of the axis's configuration (the start-up value before the persistent
+    /// overlay); absent for status entries.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub configured_value: Option<ParamValue>,
 }
 
 /// `PUT /axes/{axis}/parameters/{parameter}`.

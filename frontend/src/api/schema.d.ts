@@ -121,7 +121,10 @@ export interface paths {
         };
         /** One axis */
         get: operations["get_axis"];
-        /** Replace an axis's configuration (the axis must be disabled; drops its persistent parameters) */
+        /**
+         * Replace an axis's configuration; `change` says what it did (`?dry_run=true`: what it would do)
+         * @description When only parameters that can be written online change (dynamics, software limits, `parameters`, the name), they are written online: the axis keeps running, homed, where it is. A change of unit, modulo or drive (or values that cannot be written online) re-creates the axis: it must be disabled (409 `axis_not_disabled`), and its position, homed state and online values are lost. Either way persistent values of the parameters the save sets anew are discarded (listed in `change.persistent_discarded`), the others kept.
+         */
         put: operations["replace_axis"];
         post?: never;
         /** Delete an axis (it must be disabled) */
@@ -1369,6 +1372,7 @@ export interface components {
             slot: number;
             state: components["schemas"]["AxisState"];
             config: components["schemas"]["AxisConfigDto"];
+            change?: null | components["schemas"]["ConfigChange"];
         };
         /**
          * @description `MC_AxisStates`.
@@ -2647,6 +2651,41 @@ export interface components {
             persistent_parameters?: Record<string, never>;
         };
         /**
+         * @description What saving a new configuration of an axis does.
+         * @example {
+         *       "dry_run": true,
+         *       "parameters": [
+         *         {
+         *           "configured": 10,
+         *           "name": "AxisVeloManSlow",
+         *           "new": 20,
+         *           "number": 1001,
+         *           "online": 10
+         *         }
+         *       ],
+         *       "persistent_discarded": [],
+         *       "rebuild": false,
+         *       "rebuild_reasons": []
+         *     }
+         */
+        ConfigChange: {
+            /** @description Nothing was changed: this is what the save would do. */
+            dry_run: boolean;
+            /**
+             * @description The axis is (or would be) re-created from the configuration: it must be disabled, and
+             *     its position (0 afterwards), homed state and online values are lost; persistent values
+             *     of parameters the save does not change are kept. Without a rebuild the changed
+             *     parameters are written online (MC_WriteParameter) and nothing else is touched.
+             */
+            rebuild: boolean;
+            /** @description Why a rebuild is needed (the fields that cannot change online). */
+            rebuild_reasons: string[];
+            /** @description The parameters whose configured value changes. */
+            parameters: components["schemas"]["ParameterChange"][];
+            /** @description Persistent values given up because the save sets their parameter anew. */
+            persistent_discarded: components["schemas"]["ParameterChange"][];
+        };
+        /**
          * @description The whole configuration (`GET/PUT /config`).
          * @example {
          *       "axes": [
@@ -3775,6 +3814,31 @@ export interface components {
          */
         ParamValue: boolean | number;
         /**
+         * @description One parameter a configuration save changes.
+         * @example {
+         *       "configured": 500,
+         *       "name": "AxisVeloMax",
+         *       "new": 700,
+         *       "number": 1003,
+         *       "online": 650
+         *     }
+         */
+        ParameterChange: {
+            /** @example AxisVeloMax */
+            name: string;
+            /**
+             * Format: int32
+             * @example 1003
+             */
+            number: number;
+            /** @description The value of the configuration before the save. */
+            configured: components["schemas"]["ParamValue"];
+            /** @description The value in force before the save (an online or persistent write may differ). */
+            online: components["schemas"]["ParamValue"];
+            /** @description The value after the save (for a discarded persistent value: the persistent value). */
+            new: components["schemas"]["ParamValue"];
+        };
+        /**
          * @description Descriptor of one `MC_AxisParameter` entry.
          * @example {
          *       "ads_index_offset": "0x0002000B",
@@ -3834,6 +3898,7 @@ export interface components {
          * @description One MC_AxisParameter entry with its value on an axis.
          * @example {
          *       "ads_index_offset": "0x0002000B",
+         *       "configured_value": 100,
          *       "group": "controller",
          *       "help": "Weight of the velocity feed-forward in percent (100 = full feed-forward).",
          *       "max": 100,
@@ -3856,8 +3921,10 @@ export interface components {
              * @example mm/s
              */
             unit_text: string;
+            /** @description The value in force (online). */
             value: components["schemas"]["ParamValue"];
             persistent_value?: null | components["schemas"]["ParamValue"];
+            configured_value?: null | components["schemas"]["ParamValue"];
         };
         /**
          * @description `PUT /axes/{axis}/parameters/{parameter}`.
@@ -6062,7 +6129,10 @@ export interface operations {
     };
     replace_axis: {
         parameters: {
-            query?: never;
+            query?: {
+                /** @description Only say what the save would change (`change`), and change nothing. */
+                dry_run?: boolean;
+            };
             header?: never;
             path: {
                 /**
@@ -6079,7 +6149,7 @@ export interface operations {
             };
         };
         responses: {
-            /** @description Replaced */
+            /** @description Replaced (or, with dry_run, the axis as it would be) */
             200: {
                 headers: {
                     [name: string]: unknown;

@@ -9,9 +9,10 @@ use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 
 use super::errors::{ConfigErrors, ReadErrors};
-use super::{Client, JsonBody};
+use super::{Client, JsonBody, Q};
 use crate::app::AppState;
 use crate::error::AppResult;
+use crate::model::ReplaceQuery;
 use crate::model::{
     AxisConfigDto, AxisResource, ConfigDocument, ParameterResource, ParameterWrite,
     PeakResetResource, StatusResource,
@@ -65,17 +66,25 @@ pub async fn create_axis(
 }
 
 #[utoipa::path(put, path = "/api/v1/axes/{axis}", tag = "axes",
-    summary = "Replace an axis's configuration (the axis must be disabled; drops its persistent parameters)",
-    params(("axis" = String, Path, description = "axis id or name", example = "x")),
+    summary = "Replace an axis's configuration; `change` says what it did (`?dry_run=true`: what it would do)",
+    description = "When only parameters that can be written online change (dynamics, software limits, \
+`parameters`, the name), they are written online: the axis keeps running, homed, where it is. A change of unit, \
+modulo or drive (or values that cannot be written online) re-creates the axis: it must be disabled (409 \
+`axis_not_disabled`), and its position, homed state and online values are lost. Either way persistent values of \
+the parameters the save sets anew are discarded (listed in `change.persistent_discarded`), the others kept.",
+    params(("axis" = String, Path, description = "axis id or name", example = "x"), ReplaceQuery),
     request_body = AxisConfigDto,
-    responses((status = 200, description = "Replaced", body = AxisResource), ConfigErrors))]
+    responses((status = 200, description = "Replaced (or, with dry_run, the axis as it would be)", body = AxisResource), ConfigErrors))]
 pub async fn replace_axis(
     State(s): State<Arc<AppState>>,
     Path(axis): Path<String>,
     client: Client,
+    Q(q): Q<ReplaceQuery>,
     JsonBody(config, _): JsonBody<AxisConfigDto>,
 ) -> AppResult<Json<AxisResource>> {
-    Ok(Json(axes::replace(&s, &axis, config, &client.0).await?))
+    Ok(Json(
+        axes::replace(&s, &axis, config, &client.0, q.dry_run).await?,
+    ))
 }
 
 #[utoipa::path(delete, path = "/api/v1/axes/{axis}", tag = "axes", summary = "Delete an axis (it must be disabled)",

@@ -11,8 +11,8 @@ use motion::{AxisState, AxisStatus, CommandKind};
 use crate::app::{AppState, AxisEntry};
 use crate::error::{AppError, AppResult};
 use crate::model::{
-    AxisConfigDto, AxisResource, ClientInfo, ConfigAxis, ConfigDocument, ParameterResource,
-    ParameterWrite, PeakResetResource, StatusResource,
+    AxisConfigDto, AxisResource, ClientInfo, ConfigAxis, ConfigChange, ConfigDocument,
+    ParameterChange, ParameterResource, ParameterWrite, PeakResetResource, StatusResource,
 };
 use crate::params::{self, ParamValue};
 use crate::sim::FieldError;
@@ -25,6 +25,7 @@ fn resource(s: &AppState, e: &AxisEntry) -> AxisResource {
         slot: e.slot,
         state,
         config: e.config.clone(),
+        change: None,
     }
 }
 
@@ -151,59 +152,222 @@ pub async fn create(
     Ok(r)
 }
 
-/// Replaces an axis's configuration (it must be disabled; its persistent parameters go).
+/// What a new configuration changes for an axis: the parameters whose configured value
+/// changes, the persistent values that give way to them, and whether the axis must be
+/// re-created (unit, modulo or drive changed, or the new values cannot be written online one
+/// by one, each leaving a consistent set) — decided here, shown by `?dry_run=true`.
+struct Plan {
+    change: ConfigChange,
+    /// Online writes (number, value), in an order that keeps the set consistent.
+    writes: Vec<(u16, f64)>,
+    /// The persistent values kept (storage number → value).
+    kept: BTreeMap<u16, ParamValue>,
+}
+
+fn plan(s: &AppState, e: &AxisEntry, new: &AxisConfigDto) -> AppResult<Plan> {
+    let ct = s.info.cycle_time_s;
+    let new_p = new.to_parameters(e.id, ct).map_err(AppError::invalid)?;
+    let old_p = e.config.to_parameters(e.id, ct).ok();
+    let mut change = ConfigChange::default();
+    let mut reasons = Vec::new();
+    if new.unit != e.config.unit {
+        reasons.push("unit changed".to_owned());
+    }
+    if new.modulo != e.config.modulo {
+        reasons.push("modulo changed".to_owned());
+    }
+    if new.drive != e.config.drive {
+        reasons.push("drive changed".to_owned());
+    }
+    let Some(old_p) = old_p else {
+        reasons.push("the stored configuration is not valid any more".to_owned());
+        change.rebuild_reasons = reasons;
+        change.rebuild = true;
+        return Ok(Plan {
+            change,
+            writes: Vec::new(),
+            kept: BTreeMap::new(),
+        });
+    };
+    let mut changed = Vec::new();
+    for ((info, old), (_, new_v)) in old_p.entries().zip(new_p.entries()) {
+        if old == new_v {
+            continue;
+        }
+        let online = e.params.get(info.number).unwrap_or(old);
+        change.parameters.push(ParameterChange {
+            name: info.name,
+            number: info.number,
+            configured: old,
+            online,
+            new: new_v,
+        });
+        if let Some(v) = e.persistent.get(&info.number) {
+            change.persistent_discarded.push(ParameterChange {
+                name: info.name,
+                number: info.number,
+                configured: old,
+                online,
+                new: *v,
+            });
+        }
+        if info.read_only {
+            reasons.push(format!("{} cannot be written online", info.name));
+        } else if online != new_v {
+            changed.push((info.number, new_v.as_f64()));
+        }
+    }
+    let kept: BTreeMap<u16, ParamValue> = e
+        .persistent
+        .iter()
+        .filter(|(n, _)| !change.parameters.iter().any(|c| c.number == **n))
+        .map(|(n, v)| (*n, *v))
+        .collect();
+    // The online writes in an order in which each leaves a consistent set (raising a maximum
+    // before what it bounds …), found by trying them against a copy as the kernel would.
+    let mut writes = Vec::new();
+    if reasons.is_empty() {
+        let mut p = e.params.clone();
+        let mut left = changed;
+        while !left.is_empty() {
+            let Some(i) = left
+                .iter()
+                .position(|(n, v)| p.clone().write(*n, *v).is_ok())
+            else {
+                reasons.push(format!(
+                    "the new values of {} cannot be written online one by one",
+                    left.iter()
+                        .filter_map(|(n, _)| params::by_number(*n).map(|i| i.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                break;
+            };
+            let (n, v) = left.remove(i);
+            p.write(n, v).expect("tried above");
+            writes.push((n, v));
+        }
+    }
+    change.rebuild = !reasons.is_empty();
+    change.rebuild_reasons = reasons;
+    Ok(Plan {
+        change,
+        writes,
+        kept,
+    })
+}
+
+/// Replaces an axis's configuration. Without a rebuild (see [`plan`]) the changed parameters
+/// are written online and the axis keeps running, homed, where it is; with one, the axis must
+/// be disabled and is re-created. Persistent values of parameters the save does not change
+/// are kept either way. `dry_run`: only the plan.
 pub async fn replace(
     s: &AppState,
     axis: &str,
     config: AxisConfigDto,
     client: &ClientInfo,
+    dry_run: bool,
 ) -> AppResult<AxisResource> {
     let _guard = s.config_lock.lock().await;
-    let (id, slot, old_name, old_config) = {
+    let (entry, plan) = {
         let reg = s.registry.read().unwrap();
         let e = reg
             .find(axis)
             .ok_or_else(|| AppError::not_found("axis", axis))?;
-        (e.id, e.slot, e.name.clone(), e.config.clone())
+        let planned = plan(s, e, &config)?;
+        let old = (e.config.clone(), e.params.clone(), e.persistent.clone());
+        ((e.id, e.slot, e.name.clone(), old), planned)
     };
-    let (p, new_axis, drive) = s
-        .build_axis(id, &config, &BTreeMap::new())
-        .map_err(AppError::invalid)?;
+    let (id, slot, old_name, (old_config, old_params, old_persistent)) = entry;
     check_name_free(s, &config.name, Some(id))?;
+    let Plan {
+        mut change,
+        writes,
+        kept,
+    } = plan;
+    if dry_run {
+        change.dry_run = true;
+        return Ok(AxisResource {
+            id,
+            slot,
+            state: s.status(slot).1.map(|st| st.state).unwrap_or_default(),
+            config,
+            change: Some(change),
+        });
+    }
     let json = serde_json::to_string(&config).expect("config serialises");
     let mut tx = s.db.begin().await?;
     store::axes::update_axis(&mut tx, id, &config.name, &json, &store::now_rfc3339()).await?;
-    store::axes::clear_persistent(&mut tx, id).await?;
+    for c in &change.persistent_discarded {
+        store::axes::delete_persistent(&mut tx, id, c.number).await?;
+    }
     store::audit(
         &mut *tx,
         &audit_entry(client, "axis.replace", &old_name, json),
     )
     .await?;
-    s.install_axis(slot, new_axis, drive, true)
-        .await
-        .map_err(|e| refused_unless_disabled(e, &old_name))?;
-    if let Err(e) = tx.commit().await {
-        // Put the old axis back (it is disabled: the new one was just installed).
-        let old_persistent = s
-            .registry
-            .read()
-            .unwrap()
-            .axes
-            .get(&id)
-            .map(|e| e.persistent.clone())
-            .unwrap_or_default();
-        if let Ok((_, a, d)) = s.build_axis(id, &old_config, &old_persistent) {
-            let _ = s.install_axis(slot, a, d, false).await;
+    let params = if change.rebuild {
+        let (p, new_axis, drive) = s
+            .build_axis(id, &config, &kept)
+            .map_err(AppError::invalid)?;
+        s.install_axis(slot, new_axis, drive, true)
+            .await
+            .map_err(|e| refused_unless_disabled(e, &old_name))?;
+        if let Err(e) = tx.commit().await {
+            // Put the old axis back (it is disabled: the new one was just installed).
+            if let Ok((_, a, d)) = s.build_axis(id, &old_config, &old_persistent) {
+                let _ = s.install_axis(slot, a, d, false).await;
+            }
+            return Err(e.into());
         }
-        return Err(e.into());
-    }
+        p
+    } else {
+        let mut p = old_params;
+        let mut done = Vec::new();
+        let mut failed = None;
+        for &(number, value) in &writes {
+            let before = p.get(number).map(|v| v.as_f64()).unwrap_or(value);
+            match s
+                .kernel_command(slot, CommandKind::WriteParameter { number, value })
+                .await
+            {
+                Ok(_) => {
+                    p.write(number, value).expect("planned");
+                    done.push((number, before));
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        let failed = match failed {
+            Some(e) => Some(e),
+            None => tx.commit().await.err().map(AppError::from),
+        };
+        if let Some(e) = failed {
+            // Nothing stored, so nothing left in force: the old values go back, last first.
+            for (number, value) in done.into_iter().rev() {
+                let _ = s
+                    .kernel_command(slot, CommandKind::WriteParameter { number, value })
+                    .await;
+            }
+            return Err(match e {
+                AppError::Rejected(id) => AppError::refused("parameters", id, id.text()),
+                e => e,
+            });
+        }
+        p
+    };
     let mut reg = s.registry_write();
     let e = reg.axes.get_mut(&id).expect("locked by config_lock");
     e.name = config.name.clone();
     e.config = config;
-    e.params = p;
-    e.persistent.clear();
-    Ok(resource(s, e))
+    e.params = params;
+    e.persistent = kept;
+    let mut r = resource(s, e);
+    r.change = Some(change);
+    Ok(r)
 }
 
 /// Deletes an axis (it must be disabled).
@@ -298,13 +462,20 @@ fn parameter_resource(
     e: &AxisEntry,
     info: &'static params::ParameterInfo,
     status: &AxisStatus,
+    configured: Option<&motion::AxisParameters>,
 ) -> ParameterResource {
     ParameterResource {
         info: *info,
         unit_text: info.unit.text(&e.config.unit),
         value: params::read(&e.params, info.number, status).unwrap_or(ParamValue::Number(f64::NAN)),
         persistent_value: e.persistent.get(&info.storage).copied(),
+        configured_value: configured.and_then(|c| c.get(info.number).ok()),
     }
+}
+
+/// The parameter set of an axis's configuration alone.
+fn configured(s: &AppState, e: &AxisEntry) -> Option<motion::AxisParameters> {
+    e.config.to_parameters(e.id, s.info.cycle_time_s).ok()
 }
 
 /// Every MC_AxisParameter of an axis with its values.
@@ -314,9 +485,10 @@ pub fn parameters(s: &AppState, axis: &str) -> AppResult<Vec<ParameterResource>>
         .find(axis)
         .ok_or_else(|| AppError::not_found("axis", axis))?;
     let status = s.status(e.slot).1.unwrap_or_default();
+    let c = configured(s, e);
     Ok(params::PARAMETERS
         .iter()
-        .map(|i| parameter_resource(e, i, &status))
+        .map(|i| parameter_resource(e, i, &status, c.as_ref()))
         .collect())
 }
 
@@ -329,7 +501,12 @@ pub fn parameter(s: &AppState, axis: &str, parameter: &str) -> AppResult<Paramet
     let info =
         params::lookup(parameter).ok_or_else(|| AppError::not_found("parameter", parameter))?;
     let status = s.status(e.slot).1.unwrap_or_default();
-    Ok(parameter_resource(e, info, &status))
+    Ok(parameter_resource(
+        e,
+        info,
+        &status,
+        configured(s, e).as_ref(),
+    ))
 }
 
 /// Writes a parameter: MC_WriteParameter, or MC_WriteParameterPersistent with `persistent`
@@ -439,7 +616,12 @@ pub async fn write_parameter(
         e.persistent.insert(info.storage, w.value);
     }
     let status = s.status(slot).1.unwrap_or_default();
-    Ok(parameter_resource(e, info, &status))
+    Ok(parameter_resource(
+        e,
+        info,
+        &status,
+        configured(s, e).as_ref(),
+    ))
 }
 
 /// The whole configuration: axes with their persistent parameters.

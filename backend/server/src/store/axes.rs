@@ -96,6 +96,20 @@ pub async fn clear_persistent(c: &mut SqliteConnection, axis_id: i64) -> Result<
         .map(|_| ())
 }
 
+/// Drops one persistent parameter value (by its storage number).
+pub async fn delete_persistent(
+    c: &mut SqliteConnection,
+    axis_id: i64,
+    number: u16,
+) -> Result<(), sqlx::Error> {
+    sqlx::query("DELETE FROM persistent_parameters WHERE axis_id = ? AND number = ?")
+        .bind(axis_id)
+        .bind(number as i64)
+        .execute(c)
+        .await
+        .map(|_| ())
+}
+
 /// Stores a persistent parameter value (JSON), replacing the one stored before.
 pub async fn upsert_persistent(
     c: &mut SqliteConnection,
