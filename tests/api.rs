@@ -118,10 +118,10 @@ async fn invalid_requests_are_problems_and_keep_no_command() {
     .await;
     assert_problem(&r, 422, "validation_failed");
     assert_eq!(r.json["errors"][0]["field"], "velocity");
-    // a timeout without wait=true: the client meant to wait
+    // a timeout beyond 10 minutes (a timeout alone means wait=true)
     let r = post(
         &s,
-        "/api/v1/axes/x/move-absolute?timeout_ms=100",
+        "/api/v1/axes/x/move-absolute?timeout_ms=600001",
         json!({"position": 10.0, "velocity": 5.0}),
     )
     .await;

@@ -267,10 +267,10 @@ async fn rpc_errors_and_unsubscribe() {
     };
     assert_eq!(first["params"]["topic"], "system");
     assert_eq!(first["params"]["full"], true);
-    // wait must be a boolean, and timeout_ms comes only with wait: true.
+    // wait must be a boolean, and timeout_ms at most 600000.
     for (k, extra) in [
         (40u64, json!({"wait": "yes"})),
-        (41, json!({"timeout_ms": 100})),
+        (41, json!({"timeout_ms": 600001})),
         (42, json!({"wait": true, "timeout_ms": -5})),
     ] {
         let mut p = json!({"axis": "x", "position": 1.0, "velocity": 1.0});
@@ -351,6 +351,10 @@ async fn a_socket_jog_runs_while_renewed_stops_when_its_client_falls_silent_and_
 
     // A jog whose socket closes is released: done, not a dead-man error (a dead-man of 5 s
     // leaves the server ample time to see the close on a busy machine).
+    let mut config = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+    config["dynamics"]["jog_deadman_max"] = json!(5.0);
+    let r = put(&s, "/api/v1/axes/y", config).await;
+    assert_eq!(r.json["change"]["rebuild"], false, "{}", r.text);
     let id = socket_jog(&mut ws, 2, 5.0).await;
     send(&mut ws, 50, "keepalive", json!({"command": id})).await;
     response(&mut ws, 50).await;

@@ -104,20 +104,26 @@ pub struct SimDriveConfig {
     /// Closed-loop response of the position-controlled load.
     pub plant: PlantModel,
     /// Delay between a setpoint and its effect on the load (s, 0…0.1).
+    #[cfg_attr(feature = "schema", schema(minimum = 0, maximum = 0.1))]
     pub dead_time: f64,
     /// Extrapolate the delayed setpoint over the dead time with its feed-forward velocity and
     /// acceleration, as a "lagless" CSP drive does.
     pub dead_time_compensation: bool,
     /// Weight of the setpoint's velocity feed-forward (0…2; 1 = full).
+    #[cfg_attr(feature = "schema", schema(minimum = 0, maximum = 2))]
     pub velocity_feed_forward: f64,
     /// Weight of the setpoint's acceleration feed-forward (0…2; PT2 only).
+    #[cfg_attr(feature = "schema", schema(minimum = 0, maximum = 2))]
     pub acceleration_feed_forward: f64,
     /// Time from the enable request to "operation enabled" (s, 0…10).
+    #[cfg_attr(feature = "schema", schema(minimum = 0, maximum = 10))]
     pub enable_delay: f64,
     /// Deceleration of the load while the power stage is off (units/s², > 0).
+    #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0))]
     pub coast_deceleration: f64,
     /// Static stiffness of the position loop against a load force (force units per position
     /// unit, > 0): a force F gives a following error F / load_stiffness.
+    #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0))]
     pub load_stiffness: f64,
     /// Reference cam (homing switch); `null` for none.
     pub reference_cam: Option<ReferenceCam>,
@@ -162,15 +168,18 @@ pub enum PlantModel {
     Pt1 {
         /// Time constant (s, > 0 and ≤ 10).
         #[serde(default = "default_time_constant")]
+        #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0, maximum = 10))]
         time_constant: f64,
     },
     /// Second-order lag (a tuned position loop).
     Pt2 {
         /// Natural frequency (Hz, > 0 and ≤ 1000).
         #[serde(default = "default_natural_frequency_hz")]
+        #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0, maximum = 1000))]
         natural_frequency_hz: f64,
         /// Damping ratio (> 0 and ≤ 10; 1 = critically damped).
         #[serde(default = "default_damping")]
+        #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0, maximum = 10))]
         damping: f64,
     },
 }
@@ -209,6 +218,7 @@ pub struct ReferenceCam {
 #[serde(deny_unknown_fields)]
 pub struct IndexPulse {
     /// Distance between pulses (> 0).
+    #[cfg_attr(feature = "schema", schema(exclusive_minimum = 0))]
     pub period: f64,
     /// Position of one pulse.
     #[serde(default)]
@@ -369,7 +379,10 @@ impl SimDriveConfig {
 pub enum SimFault {
     /// The drive faults at once with `code` (0 reads as 0x1000). The cause stays until
     /// `clear`, so a fault reset before that does not clear it.
-    DriveFault { code: u32 },
+    DriveFault {
+        #[cfg_attr(feature = "schema", schema(value_type = i64, minimum = 0, maximum = 4294967295_i64))]
+        code: u32,
+    },
     /// Constant load force; a positive force pushes towards negative positions and gives a
     /// following error of force / `load_stiffness`. 0 removes it.
     Load { force: f64 },

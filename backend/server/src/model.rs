@@ -25,6 +25,7 @@ fn is_false(b: &bool) -> bool {
 pub struct ModuloConfig {
     /// Modulo period in axis units (#1044), e.g. 360.
     #[schema(example = 360.0)]
+    #[schema(exclusive_minimum = 0)]
     pub period: f64,
 }
 
@@ -47,21 +48,27 @@ pub struct SoftLimits {
 pub struct AxisDynamics {
     /// #1003 AxisVeloMax, units/s.
     #[schema(example = 500.0)]
+    #[schema(exclusive_minimum = 0)]
     pub max_velocity: f64,
     /// #1004 AxisAcc, units/s².
     #[schema(example = 2500.0)]
+    #[schema(exclusive_minimum = 0)]
     pub acceleration: f64,
     /// #1005 AxisDec, units/s².
     #[schema(example = 2500.0)]
+    #[schema(exclusive_minimum = 0)]
     pub deceleration: f64,
     /// #1006 AxisJerk, units/s³.
     #[schema(example = 25000.0)]
+    #[schema(exclusive_minimum = 0)]
     pub jerk: f64,
     /// #1001 AxisVeloManSlow, units/s.
     #[schema(example = 10.0)]
+    #[schema(exclusive_minimum = 0)]
     pub jog_velocity_slow: f64,
     /// #1002 AxisVeloManFast, units/s.
     #[schema(example = 100.0)]
+    #[schema(exclusive_minimum = 0)]
     pub jog_velocity_fast: f64,
     /// The longest dead-man a jog on this axis may ask for (`deadman_timeout`), in s
     /// (0.05–10, default 1): what a client that vanishes mid-jog can cost, set by the engineer.
@@ -85,8 +92,10 @@ fn default_jog_deadman_max() -> f64 {
 }))]
 pub struct AxisConfigDto {
     /// Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64).
+    #[schema(pattern = "^[A-Za-z_][A-Za-z0-9_-]{0,63}$")]
     pub name: String,
     /// Engineering unit of positions (mm, m, um, deg, rad, rev, in, inc).
+    #[schema(pattern = "^(mm|m|um|deg|rad|rev|in|inc)$")]
     pub unit: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub modulo: Option<ModuloConfig>,
@@ -95,7 +104,7 @@ pub struct AxisConfigDto {
     pub dynamics: AxisDynamics,
     /// Further base values of MC_AxisParameter entries, by name (or number).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    #[schema(value_type = Object)]
+    #[schema(value_type = BTreeMap<String, ParamValue>)]
     pub parameters: BTreeMap<String, ParamValue>,
     /// The axis's drive: `kind` (default `simulated`) and that drive's fields.
     #[serde(default)]
@@ -305,6 +314,7 @@ pub struct ParameterChange {
 pub struct ConfigDocument {
     /// Format version (1).
     #[schema(example = 1)]
+    #[schema(minimum = 1, maximum = 1)]
     pub version: u32,
     pub axes: Vec<ConfigAxis>,
     /// The cam tables with their ids. An import without this field leaves the stored cam
@@ -318,11 +328,12 @@ pub struct ConfigDocument {
 #[serde(deny_unknown_fields)]
 #[schema(example = examples::config_axis)]
 pub struct ConfigAxis {
+    #[schema(minimum = 1)]
     pub id: i64,
     pub config: AxisConfigDto,
     /// The persistent parameter overlay, by parameter name.
     #[serde(default)]
-    #[schema(value_type = Object)]
+    #[schema(value_type = BTreeMap<String, ParamValue>)]
     pub persistent_parameters: BTreeMap<String, ParamValue>,
 }
 
@@ -490,6 +501,7 @@ pub struct PowerBody {
     pub enable_positive: bool,
     pub enable_negative: bool,
     /// Velocity override in percent (0–100).
+    #[schema(minimum = 0, maximum = 100)]
     pub override_percent: f64,
 }
 impl Default for PowerBody {
@@ -501,6 +513,17 @@ impl Default for PowerBody {
             override_percent: 100.0,
         }
     }
+}
+
+/// How a coupling interpolates a position table (`ST_CamInOptions.InterpolationType`): the
+/// document's view of `InterpolationType` without `4point`, which is no longer supported.
+#[derive(Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+#[allow(dead_code)]
+pub enum CouplingInterpolation {
+    Linear,
+    Spline,
+    SlidingSpline,
 }
 
 /// MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
@@ -527,29 +550,60 @@ pub struct SetPositionBody {
 #[schema(example = json!({"velocity_factor": 0.5}))]
 pub struct SetOverrideBody {
     /// 0.0–1.0.
+    #[schema(minimum = 0, maximum = 1)]
     pub velocity_factor: f64,
 }
 
-/// MC_MoveAbsolute / MC_MoveModulo: a target position.
+/// MC_MoveAbsolute: a target position.
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"position": 250.0, "velocity": 200.0}))]
 pub struct MoveBody {
-    /// Target position (a modulo target ≥ 0 for move-modulo).
+    /// Target position.
     pub position: f64,
     /// > 0, units/s.
+    #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     #[serde(default)]
     pub buffer_mode: BufferMode,
     #[serde(default)]
     pub options: MoveOptions,
-    /// MC_MoveModulo only.
+}
+
+/// MC_MoveModulo: a target within one turn, reached in a direction.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 90.0, "velocity": 360.0, "direction": "shortest_way"}))]
+pub struct MoveModuloBody {
+    /// Modulo target (≥ 0; a target of a full turn or more adds turns).
+    #[schema(minimum = 0)]
+    pub position: f64,
+    /// > 0, units/s.
+    #[schema(exclusive_minimum = 0)]
+    pub velocity: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub acceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub deceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub buffer_mode: BufferMode,
+    #[serde(default)]
+    pub options: MoveOptions,
+    /// Default `positive`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub direction: Option<Direction>,
 }
@@ -563,12 +617,16 @@ pub struct MoveRelativeBody {
     /// Signed distance, units.
     pub distance: f64,
     /// > 0, units/s.
+    #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     #[serde(default)]
     pub buffer_mode: BufferMode,
@@ -583,14 +641,18 @@ pub struct MoveRelativeBody {
 pub struct MoveContinuousRelativeBody {
     /// Signed distance, units.
     pub distance: f64,
+    #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     /// Velocity kept after the target (signed).
     pub end_velocity: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     #[serde(default)]
     pub buffer_mode: BufferMode,
@@ -604,14 +666,18 @@ pub struct MoveContinuousRelativeBody {
 #[schema(example = json!({"position": 500.0, "velocity": 200.0, "end_velocity": 50.0}))]
 pub struct MoveContinuousBody {
     pub position: f64,
+    #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     /// Velocity kept after the target (signed).
     pub end_velocity: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     #[serde(default)]
     pub buffer_mode: BufferMode,
@@ -624,12 +690,16 @@ pub struct MoveContinuousBody {
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"velocity": 100.0, "direction": "positive"}))]
 pub struct MoveVelocityBody {
+    #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     #[serde(default)]
     pub direction: Direction,
@@ -652,9 +722,11 @@ pub struct HaltBody {
     /// 0 = that of the running job.
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     /// Default `aborting`.
     #[serde(default)]
@@ -671,9 +743,11 @@ pub struct HaltBody {
 pub struct StopBody {
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     /// Default: none set.
     #[serde(default)]
@@ -702,24 +776,30 @@ pub struct JogBody {
     /// Inching distance (inching modes).
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub position: f64,
     /// Continuous mode velocity.
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub velocity: f64,
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     #[serde(default)]
     #[schema(default = 0.0)]
+    #[schema(minimum = 0)]
     pub jerk: f64,
     /// Seconds without keepalive after which the jog stops (0.05 s up to the axis's
     /// `dynamics.jog_deadman_max`, at most 10; default 0.5).
     #[serde(default = "default_deadman_timeout")]
     #[schema(default = 0.5)]
+    #[schema(minimum = 0.05, maximum = 10)]
     pub deadman_timeout: f64,
 }
 fn default_deadman_timeout() -> f64 {
@@ -763,7 +843,9 @@ pub struct HomeBody {
 pub struct GearInBody {
     /// Master axis id or name.
     pub master: String,
+    #[schema(schema_with = nonzero_number)]
     pub ratio_numerator: f64,
+    #[schema(minimum = 1, maximum = 65535)]
     pub ratio_denominator: u16,
 }
 
@@ -781,6 +863,7 @@ pub struct GearInDynBody {
     /// Slave acceleration that a ratio change may cause at the master's maximum velocity,
     /// units/s² (0 = the slave's AxisAcc #1004).
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
 }
 
@@ -805,10 +888,12 @@ pub struct CamInBody {
     /// Default 1 (not 0).
     #[serde(default = "one")]
     #[schema(default = 1.0)]
+    #[schema(schema_with = nonzero_number)]
     pub master_scaling: f64,
     /// Default 1 (not 0).
     #[serde(default = "one")]
     #[schema(default = 1.0)]
+    #[schema(schema_with = nonzero_number)]
     pub slave_scaling: f64,
     /// Default `absolute`.
     #[serde(default)]
@@ -829,6 +914,7 @@ pub struct CamInBody {
     /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
     /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<CouplingInterpolation>)]
     pub interpolation: Option<motion::cam::InterpolationType>,
     /// With a `ramp_in*` start mode: how the slave catches up with the cam (the limits of its
     /// deviation from the cam; `velocity` required, the others 0 = the axis defaults).
@@ -863,10 +949,12 @@ pub struct CamScalingBody {
     /// Default 1.
     #[serde(default = "one")]
     #[schema(default = 1.0)]
+    #[schema(schema_with = nonzero_number)]
     pub master_scaling: f64,
     /// Default 1.
     #[serde(default = "one")]
     #[schema(default = 1.0)]
+    #[schema(schema_with = nonzero_number)]
     pub slave_scaling: f64,
 }
 
@@ -898,6 +986,7 @@ pub struct CamInV2Body {
     /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
     /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<CouplingInterpolation>)]
     pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
@@ -922,6 +1011,7 @@ pub struct CamAddBody {
     /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
     /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<CouplingInterpolation>)]
     pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
@@ -949,6 +1039,7 @@ pub struct CamExchangeBody {
     /// `ST_CamInOptions.InterpolationType`: how this coupling interpolates a position table.
     /// Default: the table's own `interpolation`. Motion functions ignore it (their laws decide).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<CouplingInterpolation>)]
     pub interpolation: Option<motion::cam::InterpolationType>,
 }
 
@@ -1004,16 +1095,21 @@ pub struct MoveSuperImposedBody {
     /// Distance to make up (> 0: get ahead, < 0: fall back), units.
     pub distance: f64,
     /// Largest velocity difference to the main motion (> 0), units/s.
+    #[schema(exclusive_minimum = 0)]
     pub velocity_diff: f64,
     /// 0 = the axis default.
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub acceleration: f64,
     /// 0 = the axis default.
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub deceleration: f64,
     /// Mean velocity of the main motion while the superposition runs (> 0), units/s.
+    #[schema(exclusive_minimum = 0)]
     pub velocity_process: f64,
     /// Travel available for the superposition (> 0), units; see `mode`.
+    #[schema(exclusive_minimum = 0)]
     pub length: f64,
     #[serde(default)]
     pub abort_option: SuperpositionAbortOption,
@@ -1155,6 +1251,7 @@ pub struct TriggerRequest {
     pub edge: String,
     /// History before the trigger sample (s, 0 … duration_s, default 0).
     #[serde(default)]
+    #[schema(minimum = 0)]
     pub pre_trigger_s: f64,
 }
 
@@ -1172,8 +1269,10 @@ fn rising() -> String {
 }))]
 pub struct RecordingRequest {
     /// 1 to 8 signals.
+    #[schema(min_items = 1, max_items = 8)]
     pub channels: Vec<ChannelRequest>,
     /// Length of the recording (s): round(duration_s / cycle time) samples, at most 600 000.
+    #[schema(exclusive_minimum = 0)]
     pub duration_s: f64,
     /// `null` (or absent): record from the next cycle on.
     #[serde(default)]
@@ -1209,8 +1308,10 @@ pub fn valid_name(n: &str) -> bool {
 pub struct CamTableBody {
     /// MC_CAM_ID, 1..255 (`POST`: the lowest free one when left out; `PUT`: the table's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 255)]
     pub id: Option<u32>,
     /// Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64).
+    #[schema(pattern = "^[A-Za-z_][A-Za-z0-9_-]{0,63}$")]
     pub name: String,
     pub table_type: motion::cam::TableType,
     /// Repeats cyclically; the stroke (last minus first slave position) is added per cycle.
@@ -1225,7 +1326,7 @@ pub struct CamTableBody {
         skip_serializing_if = "Vec::is_empty",
         deserialize_with = "cam_rows"
     )]
-    #[schema(value_type = Vec<Vec<f64>>, example = json!([[0.0, 0.0], [180.0, 100.0], [360.0, 0.0]]))]
+    #[schema(schema_with = cam_rows_schema, example = json!([[0.0, 0.0], [180.0, 100.0], [360.0, 0.0]]))]
     pub rows: Vec<[f64; 2]>,
     /// Motion functions: `MC_MotionFunctionPoint`s, indices from 1 without gaps.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -1351,4 +1452,37 @@ fn cam_rows<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::
     }
     let rows: Vec<Row> = Deserialize::deserialize(d)?;
     Ok(rows.into_iter().map(|r| r.0).collect())
+}
+
+/// A number other than 0 (a gear ratio's numerator, a cam scaling): `anyOf` a positive and a
+/// negative number, as JSON Schema has no "not 0" for numbers that clients generate well.
+pub fn nonzero_number() -> utoipa::openapi::schema::Schema {
+    use utoipa::openapi::schema::{AnyOfBuilder, ObjectBuilder, Type};
+    AnyOfBuilder::new()
+        .item(
+            ObjectBuilder::new()
+                .schema_type(Type::Number)
+                .exclusive_minimum(Some(0.0)),
+        )
+        .item(
+            ObjectBuilder::new()
+                .schema_type(Type::Number)
+                .exclusive_maximum(Some(0.0)),
+        )
+        .description(Some("a number other than 0"))
+        .into()
+}
+
+/// A position table's rows: `[master, slave]` pairs.
+fn cam_rows_schema() -> utoipa::openapi::schema::Schema {
+    use utoipa::openapi::schema::{ArrayBuilder, ObjectBuilder, Type};
+    ArrayBuilder::new()
+        .items(
+            ArrayBuilder::new()
+                .items(ObjectBuilder::new().schema_type(Type::Number))
+                .min_items(Some(2))
+                .max_items(Some(2)),
+        )
+        .description(Some("[master, slave] pairs, masters rising strictly"))
+        .into()
 }

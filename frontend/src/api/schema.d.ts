@@ -1206,7 +1206,7 @@ export interface components {
             /** Format: int64 */
             command_id?: number | null;
             /** @description The request body or the final outputs (JSON; null when there is none). */
-            detail: Record<string, never>;
+            detail?: Record<string, never> | null;
             /** @description `committed`, `accepted`, `rejected:<code>`, `done`, `aborted`, `error:<code>`, `applied` … */
             outcome?: string | null;
         };
@@ -1242,7 +1242,9 @@ export interface components {
             soft_limits?: null | components["schemas"]["SoftLimits"];
             dynamics: components["schemas"]["AxisDynamics"];
             /** @description Further base values of MC_AxisParameter entries, by name (or number). */
-            parameters?: Record<string, never>;
+            parameters?: {
+                [key: string]: components["schemas"]["ParamValue"];
+            };
             /** @description The axis's drive: `kind` (default `simulated`) and that drive's fields. */
             drive?: components["schemas"]["DriveConfig"];
         };
@@ -1672,7 +1674,7 @@ export interface components {
             activation_position?: number;
             /** @description Default: absolute, no offset, scaling 1. */
             scaling?: components["schemas"]["CamScalingData"];
-            interpolation?: null | components["schemas"]["InterpolationType"];
+            interpolation?: null | components["schemas"]["CouplingInterpolation"];
         };
         /**
          * @description MC_CamExchange: replace one cam of a multi-cam slave.
@@ -1701,7 +1703,7 @@ export interface components {
             activation_position?: number;
             /** @description Default: absolute, no offset, scaling 1. */
             scaling?: components["schemas"]["CamScalingData"];
-            interpolation?: null | components["schemas"]["InterpolationType"];
+            interpolation?: null | components["schemas"]["CouplingInterpolation"];
         };
         /**
          * @description MC_CamIn: couple this axis (the slave) to `master` through a cam table, or — on a slave
@@ -1730,18 +1732,10 @@ export interface components {
              * @description Added to the scaled slave cam position. Default 0.
              */
             slave_offset?: number;
-            /**
-             * Format: double
-             * @description Default 1 (not 0).
-             * @default 1
-             */
-            master_scaling: number;
-            /**
-             * Format: double
-             * @description Default 1 (not 0).
-             * @default 1
-             */
-            slave_scaling: number;
+            /** @description a number other than 0 */
+            master_scaling?: number;
+            /** @description a number other than 0 */
+            slave_scaling?: number;
             /** @description Default `absolute`. */
             start_mode?: components["schemas"]["StartMode"];
             /** @description Default `instantaneous`. */
@@ -1756,7 +1750,7 @@ export interface components {
             master_scaling_mode?: components["schemas"]["CamScalingMode"];
             /** @description Default `user_defined`. */
             slave_scaling_mode?: components["schemas"]["CamScalingMode"];
-            interpolation?: null | components["schemas"]["InterpolationType"];
+            interpolation?: null | components["schemas"]["CouplingInterpolation"];
             ramp_in?: null | components["schemas"]["RampIn"];
         };
         /**
@@ -1786,7 +1780,7 @@ export interface components {
             operation?: components["schemas"]["CamOperationMode"];
             /** @description For `exchange`: the cam to replace (id or name; may be left out when the slave has one). */
             reference_cam_table?: string | null;
-            interpolation?: null | components["schemas"]["InterpolationType"];
+            interpolation?: null | components["schemas"]["CouplingInterpolation"];
         };
         /**
          * @description MC_CamInfoData of a cam slave (spec §3.5): the coupling as it is in this cycle. Cam
@@ -2029,18 +2023,10 @@ export interface components {
              * @description Default 0.
              */
             slave_offset?: number;
-            /**
-             * Format: double
-             * @description Default 1.
-             * @default 1
-             */
-            master_scaling: number;
-            /**
-             * Format: double
-             * @description Default 1.
-             * @default 1
-             */
-            slave_scaling: number;
+            /** @description a number other than 0 */
+            master_scaling?: number;
+            /** @description a number other than 0 */
+            slave_scaling?: number;
         };
         /**
          * @description `ST_CamScalingData` (spec §3.19): one cam's offsets and scalings in a multi-cam coupling.
@@ -2156,23 +2142,7 @@ export interface components {
             periodic?: boolean;
             /** @description How a position table is interpolated (ignored for motion functions). */
             interpolation?: components["schemas"]["InterpolationType"];
-            /**
-             * @description Position tables: `[master, slave]` rows, masters strictly rising.
-             * @example [
-             *       [
-             *         0,
-             *         0
-             *       ],
-             *       [
-             *         180,
-             *         100
-             *       ],
-             *       [
-             *         360,
-             *         0
-             *       ]
-             *     ]
-             */
+            /** @description [master, slave] pairs, masters rising strictly */
             rows?: number[][];
             /** @description Motion functions: `MC_MotionFunctionPoint`s, indices from 1 without gaps. */
             points?: components["schemas"]["MotionFunctionPoint"][];
@@ -2648,7 +2618,9 @@ export interface components {
             id: number;
             config: components["schemas"]["AxisConfigDto"];
             /** @description The persistent parameter overlay, by parameter name. */
-            persistent_parameters?: Record<string, never>;
+            persistent_parameters?: {
+                [key: string]: components["schemas"]["ParamValue"];
+            };
         };
         /**
          * @description What saving a new configuration of an axis does.
@@ -2904,6 +2876,12 @@ export interface components {
             /** @description The asking client holds it. */
             yours: boolean;
         };
+        /**
+         * @description How a coupling interpolates a position table (`ST_CamInOptions.InterpolationType`): the
+         *     document's view of `InterpolationType` without `4point`, which is no longer supported.
+         * @enum {string}
+         */
+        CouplingInterpolation: "linear" | "spline" | "sliding_spline";
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
         /**
@@ -3072,7 +3050,7 @@ export interface components {
         GearInBody: {
             /** @description Master axis id or name. */
             master: string;
-            /** Format: double */
+            /** @description a number other than 0 */
             ratio_numerator: number;
             /** Format: int32 */
             ratio_denominator: number;
@@ -3535,7 +3513,7 @@ export interface components {
          */
         MotionPointType: "ignore" | "rest" | "velocity" | "turn" | "motion" | "add" | "activation";
         /**
-         * @description MC_MoveAbsolute / MC_MoveModulo: a target position.
+         * @description MC_MoveAbsolute: a target position.
          * @example {
          *       "position": 250,
          *       "velocity": 200
@@ -3544,7 +3522,7 @@ export interface components {
         MoveBody: {
             /**
              * Format: double
-             * @description Target position (a modulo target ≥ 0 for move-modulo).
+             * @description Target position.
              */
             position: number;
             /**
@@ -3560,7 +3538,6 @@ export interface components {
             jerk?: number;
             buffer_mode?: components["schemas"]["BufferMode"];
             options?: components["schemas"]["MoveOptions"];
-            direction?: null | components["schemas"]["Direction"];
         };
         /**
          * @description MC_MoveContinuousAbsolute: a target position, then `end_velocity`.
@@ -3618,6 +3595,35 @@ export interface components {
             jerk?: number;
             buffer_mode?: components["schemas"]["BufferMode"];
             options?: components["schemas"]["MoveOptions"];
+        };
+        /**
+         * @description MC_MoveModulo: a target within one turn, reached in a direction.
+         * @example {
+         *       "direction": "shortest_way",
+         *       "position": 90,
+         *       "velocity": 360
+         *     }
+         */
+        MoveModuloBody: {
+            /**
+             * Format: double
+             * @description Modulo target (≥ 0; a target of a full turn or more adds turns).
+             */
+            position: number;
+            /**
+             * Format: double
+             * @description > 0, units/s.
+             */
+            velocity: number;
+            /** Format: double */
+            acceleration?: number;
+            /** Format: double */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
+            buffer_mode?: components["schemas"]["BufferMode"];
+            options?: components["schemas"]["MoveOptions"];
+            direction?: null | components["schemas"]["Direction"];
         };
         /**
          * @description `ST_MoveOptions`.
@@ -3777,6 +3783,12 @@ export interface components {
             password: string;
         };
         /**
+         * @description The activation modes an online change takes (the document's view of
+         *     [`CamActivationMode`]: `next_cycle_once` is refused, as TwinCAT does not implement it).
+         * @enum {string}
+         */
+        OnlineActivationMode: "instantaneous" | "at_master_cam_pos" | "at_master_axis_pos" | "next_cycle" | "as_soon_as_possible" | "off" | "delete_queued_data" | "at_master_axis_pos_positive_direction" | "at_master_axis_pos_negative_direction";
+        /**
          * @description MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes
          *     effect on its slaves, and how their offsets follow.
          * @example {
@@ -3792,7 +3804,7 @@ export interface components {
              *     move the slave; `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`: from there
              *     (and still only without a jump); `off`: coupled slaves keep the data they run with.
              */
-            activation_mode?: components["schemas"]["CamActivationMode"];
+            activation_mode?: components["schemas"]["OnlineActivationMode"];
             /** Format: double */
             activation_position?: number;
             master_scaling_mode?: components["schemas"]["CamScalingMode"];
@@ -3977,19 +3989,14 @@ export interface components {
             /** @enum {string} */
             kind: "ideal";
         } | {
+            /** @enum {string} */
+            kind: "pt1";
             /**
              * Format: double
              * @description Time constant (s, > 0 and ≤ 10).
              */
             time_constant?: number;
-            /** @enum {string} */
-            kind: "pt1";
         } | {
-            /**
-             * Format: double
-             * @description Natural frequency (Hz, > 0 and ≤ 1000).
-             */
-            natural_frequency_hz?: number;
             /**
              * Format: double
              * @description Damping ratio (> 0 and ≤ 10; 1 = critically damped).
@@ -3997,6 +4004,11 @@ export interface components {
             damping?: number;
             /** @enum {string} */
             kind: "pt2";
+            /**
+             * Format: double
+             * @description Natural frequency (Hz, > 0 and ≤ 1000).
+             */
+            natural_frequency_hz?: number;
         };
         /**
          * @description MC_Power.
@@ -4371,7 +4383,7 @@ export interface components {
          *     }
          */
         SimFault: {
-            /** Format: int32 */
+            /** Format: int64 */
             code: number;
             /** @enum {string} */
             kind: "drive_fault";
@@ -4381,10 +4393,10 @@ export interface components {
             /** @enum {string} */
             kind: "load";
         } | {
-            positive: boolean;
             active: boolean;
             /** @enum {string} */
             kind: "limit_switch";
+            positive: boolean;
         } | {
             /** @enum {string} */
             kind: "clear";
@@ -4932,6 +4944,11 @@ export interface components {
             created_at: string;
         };
         /**
+         * @description `MC_ValueSelectType`: which values MC_ReadMotionFunctionValues returns.
+         * @enum {string}
+         */
+        ValueSelect: "position" | "velocity" | "acceleration" | "jerk";
+        /**
          * @description MC_WriteMotionFunction: points to replace, by their `point_index`.
          * @example {
          *       "points": [
@@ -5328,6 +5345,30 @@ export interface components {
                 [name: string]: unknown;
             };
             content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The operation takes no parameters: the body must be `{}` (or empty). */
+        EmptyBodyInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "force: unknown field `force`, there are no fields",
+                 *       "errors": [
+                 *         {
+                 *           "field": "force",
+                 *           "message": "unknown field `force`, there are no fields"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -6183,8 +6224,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -6197,12 +6238,15 @@ export interface operations {
                 };
                 content?: never;
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
             409: components["responses"]["AxisNotDisabled"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
             503: components["responses"]["WriteUnavailable"];
         };
     };
@@ -6211,12 +6255,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6236,7 +6281,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -6270,12 +6315,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6329,12 +6375,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6388,12 +6435,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6447,12 +6495,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6544,12 +6593,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6569,7 +6619,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -6603,12 +6653,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6662,12 +6713,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6687,7 +6739,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["CamScalingBody"];
             };
@@ -6721,12 +6773,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6746,7 +6799,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["CamScalingV2Body"];
             };
@@ -6780,12 +6833,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6839,12 +6893,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6898,12 +6953,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6923,7 +6979,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -6957,12 +7013,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -6982,7 +7039,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["HaltBody"];
             };
@@ -7016,12 +7073,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7041,7 +7099,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["HomeBody"];
             };
@@ -7075,12 +7133,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7100,7 +7159,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["JogBody"];
             };
@@ -7134,12 +7193,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7193,12 +7253,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7252,12 +7313,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7311,12 +7373,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7370,12 +7433,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7397,7 +7461,7 @@ export interface operations {
         };
         requestBody: {
             content: {
-                "application/json": components["schemas"]["MoveBody"];
+                "application/json": components["schemas"]["MoveModuloBody"];
             };
         };
         responses: {
@@ -7429,12 +7493,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7488,12 +7553,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7547,12 +7613,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7715,12 +7782,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7740,7 +7808,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["PowerBody"];
             };
@@ -7774,12 +7842,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7799,7 +7868,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -7833,12 +7902,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -7892,12 +7962,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -8026,8 +8097,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -8042,11 +8113,14 @@ export interface operations {
                     "application/json": components["schemas"]["PeakResetResource"];
                 };
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["AxisNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -8055,12 +8129,13 @@ export interface operations {
             query?: {
                 /**
                  * @description Hold the response until the command is final or reaches its milestone
-                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
                  */
                 wait?: boolean;
                 /**
-                 * @description Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-                 *     is returned as it stands.
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
                  */
                 timeout_ms?: number;
             };
@@ -8080,7 +8155,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["StopBody"];
             };
@@ -8250,8 +8325,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -8264,12 +8339,15 @@ export interface operations {
                 };
                 content?: never;
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["CamTableNotFound"];
             409: components["responses"]["CamTableBusy"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
             503: components["responses"]["WriteUnavailable"];
         };
     };
@@ -8312,13 +8390,11 @@ export interface operations {
                 master_offset?: number;
                 /** @description Slave offset of the coupling (default 0). */
                 slave_offset?: number;
-                /** @description Master scaling of the coupling (default 1). */
                 master_scaling?: number;
-                /** @description Slave scaling of the coupling (default 1). */
                 slave_scaling?: number;
                 /** @description Master axis position the search starts from (default 0). */
                 master_start_position?: number;
-                /** @description Accuracy of the master positions found, axis units (default 1e-9 of the period). */
+                /** @description Accuracy of the master positions found, axis units (default (0): 1e-9 of the period). */
                 master_accuracy?: number;
             };
             header?: never;
@@ -8392,7 +8468,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["OnlineChange"];
             };
@@ -8577,12 +8653,12 @@ export interface operations {
             query: {
                 /** @description Raw master position of the first sample. */
                 start: number;
-                /** @description Raw master position of the last sample (at most). */
+                /** @description Raw master position of the last sample (at most; not before `start`). */
                 end: number;
                 /** @description Master step (> 0; at most 100 000 rows). */
                 increment: number;
                 /** @description Comma-separated: `position`, `velocity`, `acceleration`, `jerk` (default all four). */
-                values?: string;
+                values?: components["schemas"]["ValueSelect"][];
             };
             header?: never;
             path: {
@@ -8681,8 +8757,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -8697,12 +8773,15 @@ export interface operations {
                     "application/json": components["schemas"]["CommandResource"];
                 };
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -8716,8 +8795,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -8730,12 +8809,15 @@ export interface operations {
                 };
                 content?: never;
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["CommandNotFound"];
             409: components["responses"]["CommandUnknown"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
             503: components["responses"]["CycleUnavailable"];
         };
     };
@@ -8824,7 +8906,7 @@ export interface operations {
             path?: never;
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["TakeControl"];
             };
@@ -8979,8 +9061,8 @@ export interface operations {
             };
             cookie?: never;
         };
-        /** @description `{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`. */
-        requestBody: {
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
             };
@@ -9002,11 +9084,14 @@ export interface operations {
                 };
                 content?: never;
             };
+            400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["RecordingNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
         };
     };
     system: {
@@ -9206,7 +9291,7 @@ export interface operations {
             };
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["UserChange"];
             };

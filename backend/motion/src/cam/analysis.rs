@@ -307,10 +307,12 @@ fn search(cam: &Cam, start: f64, target: f64, accuracy: f64, dir: f64) -> Option
     let (k_start, xl) = cam.cycle_of(start);
     let mut cycles = SEARCH_CYCLES;
     if cam.periodic && cam.stroke() != 0.0 {
+        // Bounded before the cast: a far target must not overflow the count.
         let k_target = ((target - cam.eval(start).position) / cam.stroke())
             .abs()
-            .ceil() as i64;
-        cycles += k_target;
+            .ceil()
+            .min(MAX_SEARCH_CYCLES as f64) as i64;
+        cycles = cycles.saturating_add(k_target);
     }
     let cycles = cycles.min(MAX_SEARCH_CYCLES);
     let (mut k, mut i) = if cam.periodic {

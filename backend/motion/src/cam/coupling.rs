@@ -296,6 +296,24 @@ pub struct CamInfo {
     pub cams: [CamTerm; 4],
 }
 
+/// The activation modes an online change takes (the document's view of
+/// [`CamActivationMode`]: `next_cycle_once` is refused, as TwinCAT does not implement it).
+#[cfg(feature = "schema")]
+#[derive(Serialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+#[allow(dead_code)]
+pub enum OnlineActivationMode {
+    Instantaneous,
+    AtMasterCamPos,
+    AtMasterAxisPos,
+    NextCycle,
+    AsSoonAsPossible,
+    Off,
+    DeleteQueuedData,
+    AtMasterAxisPosPositiveDirection,
+    AtMasterAxisPosNegativeDirection,
+}
+
 /// MC_SetCamOnlineChangeMode (spec §1.10, §2.14): when data written to a coupled table takes
 /// effect on its slaves, and how their offsets follow.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -306,6 +324,7 @@ pub struct OnlineChange {
     /// move the slave; `at_master_cam_pos`, `at_master_axis_pos…`, `next_cycle`: from there
     /// (and still only without a jump); `off`: coupled slaves keep the data they run with.
     #[serde(default)]
+    #[cfg_attr(feature = "schema", schema(value_type = OnlineActivationMode))]
     pub activation_mode: CamActivationMode,
     #[serde(default)]
     pub activation_position: f64,

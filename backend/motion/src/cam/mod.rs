@@ -310,7 +310,7 @@ impl Cam {
         let xl = x - k * p;
         // Rounding can put xl a hair beyond the end: that is the next cycle's start.
         if xl >= self.xn {
-            (k as i64 + 1, xl - p)
+            ((k as i64).saturating_add(1), xl - p)
         } else {
             (k as i64, xl.max(self.x0))
         }

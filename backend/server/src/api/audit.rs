@@ -44,7 +44,7 @@ pub struct AuditRecord {
     pub target: Option<String>,
     pub command_id: Option<u64>,
     /// The request body or the final outputs (JSON; null when there is none).
-    #[schema(value_type = Object)]
+    #[schema(value_type = Option<Object>)]
     pub detail: serde_json::Value,
     /// `committed`, `accepted`, `rejected:<code>`, `done`, `aborted`, `error:<code>`, `applied` …
     pub outcome: Option<String>,
@@ -55,6 +55,7 @@ pub struct AuditRecord {
 #[serde(deny_unknown_fields)]
 pub struct AuditQuery {
     /// At most this many entries, newest first (1–1000, default 100).
+    #[param(minimum = 1, maximum = 1000)]
     pub limit: Option<u32>,
     /// Only entries with a larger id (newer than that entry). When more than `limit` are
     /// newer, the newest `limit` are returned.

@@ -89,12 +89,13 @@ pub async fn replace_axis(
 
 #[utoipa::path(delete, path = "/api/v1/axes/{axis}", tag = "axes", summary = "Delete an axis (it must be disabled)",
     params(("axis" = String, Path, description = "axis id or name", example = "x")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses((status = 204, description = "Deleted"), super::errors::AxisDeleteErrors))]
 pub async fn delete_axis(
     State(s): State<Arc<AppState>>,
     Path(axis): Path<String>,
     client: Client,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<StatusCode> {
     axes::delete(&s, &axis, &client.0).await?;
     Ok(StatusCode::NO_CONTENT)
@@ -116,12 +117,13 @@ pub async fn axis_status(
 following error of every cycle since the last reset (TwinCAT's online \"lag distance min/max\"). This restarts \
 them from the present following error; it changes no motion and creates no command.",
     params(("axis" = String, Path, description = "axis id or name", example = "x")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses((status = 200, description = "Reset; the peak hold counts from `cycle`", body = PeakResetResource), super::errors::PeakResetErrors))]
 pub async fn reset_following_error_peak(
     State(s): State<Arc<AppState>>,
     Path(axis): Path<String>,
     client: Client,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<Json<PeakResetResource>> {
     Ok(Json(
         axes::reset_following_error_peak(&s, &axis, &client.0).await?,

@@ -81,7 +81,7 @@ macro_rules! catalogue {
         $(
             #[utoipa::path(post, path = concat!("/api/v1/axes/{axis}/", $name), tag = "commands", summary = $summary,
                 params(("axis" = String, Path, description = "axis id or name", example = "x"), WaitQuery,
-                    ("Idempotency-Key" = Option<String>, Header, description = "1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.", example = "mes-order-4711-step-3")),
+                    ("Idempotency-Key" = Option<String>, Header, min_length = 1, max_length = 255, pattern = "^[!-~]+$", description = "1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.", example = "mes-order-4711-step-3")),
                 request_body = $body,
                 responses(
                     (status = 202, description = "Accepted: the command resource (final or at its milestone when waited for)",
@@ -153,9 +153,9 @@ macro_rules! catalogue {
             Some(match method {
                 $($name => {
                     let block = &BLOCKS[Entry::$fn as usize];
-                    match super::from_value::<$body>(&raw) {
+                    match super::from_value::<$body>(raw) {
                         Err(e) => Err(e),
-                        Ok(body) => {
+                        Ok((body, raw)) => {
                             let sub = Submission {
                                 name: block.name,
                                 milestone: block.milestone,
@@ -191,7 +191,7 @@ catalogue! {
         "MC_MoveRelative: move `distance` from the set position";
     move_additive: "move-additive", MoveRelativeBody, MoveRelativeBody::additive, Operator, Done,
         "MC_MoveAdditive: add `distance` to the running target";
-    move_modulo: "move-modulo", MoveBody, MoveBody::modulo, Operator, Done,
+    move_modulo: "move-modulo", MoveModuloBody, MoveModuloBody::modulo, Operator, Done,
         "MC_MoveModulo (modulo axes)";
     move_velocity: "move-velocity", MoveVelocityBody, MoveVelocityBody::to_kind, Operator, InVelocity,
         "MC_MoveVelocity (wait returns at in_velocity)";

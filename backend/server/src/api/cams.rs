@@ -27,7 +27,7 @@ pub const CAM_BODY_LIMIT: usize = 64 * 1024 * 1024;
 /// rows would cost hundreds of megabytes), with the same problem+json answers as `JsonBody`.
 pub struct LargeJsonBody<T>(pub T);
 
-impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for LargeJsonBody<T> {
+impl<T: DeserializeOwned + utoipa::ToSchema, S: Send + Sync> FromRequest<S> for LargeJsonBody<T> {
     type Rejection = AppError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
@@ -49,6 +49,14 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for LargeJsonBody<T> {
                     .map_err(|e| AppError::bad_json(e.to_string()))?;
                 return Err(super::not_an_object(&v));
             }
+        }
+        // A body of ordinary size is checked against its schema as `JsonBody`s are (no array
+        // for an object, `2.0` read as an integer); a large one (a table of many rows) is read
+        // straight from the bytes, without a value tree.
+        if bytes.len() <= super::BODY_LIMIT {
+            let value: serde_json::Value =
+                serde_json::from_slice(&bytes).map_err(|e| AppError::bad_json(e.to_string()))?;
+            return super::from_value(value).map(|(t, _)| LargeJsonBody(t));
         }
         let mut de = serde_json::Deserializer::from_slice(&bytes);
         let t = serde_path_to_error::deserialize(&mut de).map_err(|e| {
@@ -131,12 +139,13 @@ pub async fn replace_cam_table(
 
 #[utoipa::path(delete, path = "/api/v1/cam-tables/{table}", tag = "cams", summary = "Delete a cam table",
     params(("table" = String, Path, description = "cam table id (1..255) or name", example = "knife")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses((status = 204, description = "Deleted"), super::errors::CamTableDeleteErrors))]
 pub async fn delete_cam_table(
     State(s): State<Arc<AppState>>,
     Path(table): Path<String>,
     client: Client,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<StatusCode> {
     cams::delete(&s, &table, &client.0).await?;
     Ok(StatusCode::NO_CONTENT)
@@ -158,7 +167,24 @@ pub async fn characteristics(
 #[serde(deny_unknown_fields)]
 pub struct SlaveDynamicsQuery {
     /// Raw master position in the table's coordinates (no coupling offset or scaling).
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub master_position: f64,
+}
+
+/// The largest position magnitude the cam queries take: beyond it an f64 master position
+/// has less than 0.1 mm (or 0.0001°) resolution, and cycle counts would overflow.
+pub const MAX_POSITION: f64 = 1e12;
+
+/// A position query parameter within ±[`MAX_POSITION`].
+fn position(field: &str, x: f64) -> AppResult<f64> {
+    if x.is_finite() && x.abs() <= MAX_POSITION {
+        Ok(x)
+    } else {
+        Err(AppError::field(
+            field,
+            "must be a number from -1e12 to 1e12",
+        ))
+    }
 }
 
 #[utoipa::path(get, path = "/api/v1/cam-tables/{table}/slave-dynamics", tag = "cams",
@@ -170,7 +196,8 @@ pub async fn slave_dynamics(
     Path(table): Path<String>,
     Q(q): Q<SlaveDynamicsQuery>,
 ) -> AppResult<Json<SlaveDynamicsResource>> {
-    Ok(Json(cams::slave_dynamics(&s, &table, q.master_position)?))
+    let x = position("master_position", q.master_position)?;
+    Ok(Json(cams::slave_dynamics(&s, &table, x)?))
 }
 
 /// MC_ReadCamTableMasterPosition's inputs (axis coordinates and the coupling's offsets and
@@ -180,19 +207,31 @@ pub async fn slave_dynamics(
 #[serde(deny_unknown_fields)]
 pub struct MasterPositionQuery {
     /// The slave axis position to find master positions for.
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub slave_position: f64,
     /// Master offset of the coupling (default 0).
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub master_offset: Option<f64>,
     /// Slave offset of the coupling (default 0).
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub slave_offset: Option<f64>,
-    /// Master scaling of the coupling (default 1).
+    /// Master scaling of the coupling (default 1; not 0).
+    #[param(schema_with = nonzero_scaling)]
     pub master_scaling: Option<f64>,
-    /// Slave scaling of the coupling (default 1).
+    /// Slave scaling of the coupling (default 1; not 0).
+    #[param(schema_with = nonzero_scaling)]
     pub slave_scaling: Option<f64>,
     /// Master axis position the search starts from (default 0).
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub master_start_position: Option<f64>,
-    /// Accuracy of the master positions found, axis units (default 1e-9 of the period).
+    /// Accuracy of the master positions found, axis units (default (0): 1e-9 of the period).
+    #[param(minimum = 0)]
     pub master_accuracy: Option<f64>,
+}
+
+/// A scaling: a number other than 0, within ±1e12.
+pub(crate) fn nonzero_scaling() -> utoipa::openapi::schema::Schema {
+    crate::model::nonzero_number()
 }
 
 #[utoipa::path(get, path = "/api/v1/cam-tables/{table}/master-position", tag = "cams",
@@ -204,6 +243,14 @@ pub async fn master_position(
     Path(table): Path<String>,
     Q(q): Q<MasterPositionQuery>,
 ) -> AppResult<Json<MasterPositionResource>> {
+    position("slave_position", q.slave_position)?;
+    for (f, v) in [
+        ("master_offset", q.master_offset),
+        ("slave_offset", q.slave_offset),
+        ("master_start_position", q.master_start_position),
+    ] {
+        position(f, v.unwrap_or(0.0))?;
+    }
     let search = MasterSearch {
         slave_position: q.slave_position,
         master_offset: q.master_offset.unwrap_or(0.0),
@@ -221,12 +268,16 @@ pub async fn master_position(
 #[serde(deny_unknown_fields)]
 pub struct ValuesQuery {
     /// Raw master position of the first sample.
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub start: f64,
-    /// Raw master position of the last sample (at most).
+    /// Raw master position of the last sample (at most; not before `start`).
+    #[param(minimum = -1e12, maximum = 1e12)]
     pub end: f64,
     /// Master step (> 0; at most 100 000 rows).
+    #[param(exclusive_minimum = 0)]
     pub increment: f64,
     /// Comma-separated: `position`, `velocity`, `acceleration`, `jerk` (default all four).
+    #[param(value_type = Option<Vec<ValueSelect>>, style = Form, explode = false)]
     pub values: Option<String>,
 }
 
@@ -239,6 +290,8 @@ pub async fn values(
     Path(table): Path<String>,
     Q(q): Q<ValuesQuery>,
 ) -> AppResult<Json<CamValuesResource>> {
+    position("start", q.start)?;
+    position("end", q.end)?;
     let mut select = Vec::new();
     for v in q
         .values

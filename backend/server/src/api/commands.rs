@@ -40,7 +40,8 @@ pub struct ListQuery {
     /// Only commands in this state.
     pub state: Option<CommandState>,
     /// At most this many (default 100, at most 2000), newest first.
-    pub limit: Option<usize>,
+    #[param(minimum = 1, maximum = 2000)]
+    pub limit: Option<u32>,
 }
 
 #[utoipa::path(get, path = "/api/v1/commands", tag = "commands", summary = "Recent commands, newest first",
@@ -50,10 +51,16 @@ pub async fn list_commands(
     State(s): State<Arc<AppState>>,
     Q(q): Q<ListQuery>,
 ) -> AppResult<Json<Vec<CommandResource>>> {
+    if q.limit.is_some_and(|l| !(1..=2000).contains(&l)) {
+        return Err(crate::error::AppError::field(
+            "limit",
+            "must be between 1 and 2000",
+        ));
+    }
     let filter = ListFilter {
         axis: q.axis.as_deref(),
         state: q.state,
-        limit: q.limit,
+        limit: q.limit.map(|l| l as usize),
     };
     Ok(Json(commands::list(&s, filter)?))
 }
@@ -61,12 +68,13 @@ pub async fn list_commands(
 #[utoipa::path(delete, path = "/api/v1/commands/{id}", tag = "commands",
     summary = "Release a command (falling edge of Execute/Enable): unlocks a Stop, ends a jog, a power or a gear-in-dyn",
     params(("id" = u64, Path, description = "command id")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses((status = 200, description = "Released; the command as it stands", body = CommandResource), CommandControlErrors))]
 pub async fn release_command(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
     client: Client,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<Json<CommandResource>> {
     let id = parse_id(&id)?;
     commands::release(&s, id, &client.0).await?;
@@ -77,11 +85,12 @@ pub async fn release_command(
 
 #[utoipa::path(post, path = "/api/v1/commands/{id}/keepalive", tag = "commands", summary = "Renew a jog's dead-man",
     params(("id" = u64, Path, description = "command id")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses((status = 204, description = "Renewed"), CommandControlErrors))]
 pub async fn keepalive(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<StatusCode> {
     commands::keepalive(&s, parse_id(&id)?).await?;
     Ok(StatusCode::NO_CONTENT)

@@ -386,6 +386,9 @@ problem_responses! {
         headers(("Upgrade" = String, description = "websocket"),
                 ("Sec-WebSocket-Version" = String, description = "13")));
 
+    /// The operation takes no parameters: the body must be `{}` (or empty).
+    EmptyBodyInvalid(example = json!(p(AppError::field("force", "unknown field `force`, there are no fields"))));
+
     /// Invalid fields; `errors` names every one.
     BodyInvalid(example = json!(p(AppError::field("name", "must be 1-64 characters of letters, digits and . - _ @"))));
 
@@ -462,11 +465,17 @@ error_sets! {
     /// `GET /commands/{id}`.
     CommandReadErrors { 404: CommandNotFound }
     /// `DELETE /commands/{id}`, `POST /commands/{id}/keepalive`.
-    CommandControlErrors { 404: CommandNotFound, 409: CommandUnknown, 503: CycleUnavailable }
+    CommandControlErrors {
+        400: MalformedJson, 404: CommandNotFound, 409: CommandUnknown, 413: PayloadTooLarge,
+        422: EmptyBodyInvalid, 503: CycleUnavailable,
+    }
     /// `GET /axes/{axis}`, its status and its parameter list.
     ReadErrors { 404: AxisNotFound }
     /// `POST /axes/{axis}/status/following-error-peak/reset`.
-    PeakResetErrors { 404: AxisNotFound, 503: CycleUnavailable }
+    PeakResetErrors {
+        400: MalformedJson, 404: AxisNotFound, 413: PayloadTooLarge, 422: EmptyBodyInvalid,
+        503: CycleUnavailable,
+    }
     /// `GET /axes/{axis}/parameters/{parameter}`.
     ParameterReadErrors { 404: AxisOrParameterNotFound }
     /// `PUT /axes/{axis}/parameters/{parameter}`.
@@ -485,7 +494,10 @@ error_sets! {
         422: ConfigInvalid, 503: WriteUnavailable,
     }
     /// `DELETE /axes/{axis}`.
-    AxisDeleteErrors { 404: AxisNotFound, 409: AxisNotDisabled, 503: WriteUnavailable }
+    AxisDeleteErrors {
+        400: MalformedJson, 404: AxisNotFound, 409: AxisNotDisabled, 413: PayloadTooLarge,
+        422: EmptyBodyInvalid, 503: WriteUnavailable,
+    }
     /// `PUT /config` (on 503 the old configuration is still active).
     ImportErrors {
         400: MalformedJson, 409: AxisNotDisabled, 413: PayloadTooLarge, 422: ImportInvalid,
@@ -511,7 +523,10 @@ error_sets! {
         422: CamTableInvalid, 503: WriteUnavailable,
     }
     /// `DELETE /cam-tables/{table}`.
-    CamTableDeleteErrors { 404: CamTableNotFound, 409: CamTableBusy, 503: WriteUnavailable }
+    CamTableDeleteErrors {
+        400: MalformedJson, 404: CamTableNotFound, 409: CamTableBusy, 413: PayloadTooLarge,
+        422: EmptyBodyInvalid, 503: WriteUnavailable,
+    }
     /// `GET /axes/{axis}/cam-info`.
     CamInfoErrors { 404: AxisNotFound, 409: CamNotCoupled, 422: QueryInvalid }
     /// `GET /cam-tables/{table}/points/{point}`.
@@ -579,7 +594,9 @@ error_sets! {
         503: RecordingUnavailable,
     }
     /// `DELETE /scope/recordings/{id}`.
-    ScopeDeleteErrors { 404: RecordingNotFound }
+    ScopeDeleteErrors {
+        400: MalformedJson, 404: RecordingNotFound, 413: PayloadTooLarge, 422: EmptyBodyInvalid,
+    }
 }
 
 /// The answers of the request checks (`guard.rs`), added to every operation by the rule the

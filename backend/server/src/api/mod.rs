@@ -10,6 +10,7 @@ pub mod commands;
 pub mod errors;
 pub mod guard;
 pub mod scope;
+pub mod shape;
 pub mod simulation;
 pub mod system;
 pub mod ws;
@@ -45,7 +46,7 @@ pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
 /// field), wrong types, missing or unknown fields. An empty body is read as `{}`.
 pub struct JsonBody<T>(pub T, pub serde_json::Value);
 
-impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
+impl<T: DeserializeOwned + utoipa::ToSchema, S: Send + Sync> FromRequest<S> for JsonBody<T> {
     type Rejection = AppError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
@@ -68,7 +69,7 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
         if !value.is_object() {
             return Err(not_an_object(&value));
         }
-        let t = from_value(&value)?;
+        let (t, value) = from_value(value)?;
         Ok(JsonBody(t, value))
     }
 }
@@ -76,7 +77,17 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for JsonBody<T> {
 /// Reads a body (or websocket `params`) that is a JSON object; a 422 names the JSON path of the
 /// field at fault (`options.blending_position`, `channels[2].axis`), also of an unknown or a
 /// missing one.
-pub(crate) fn from_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, AppError> {
+pub(crate) fn from_value<T: DeserializeOwned + utoipa::ToSchema>(
+    mut value: serde_json::Value,
+) -> Result<(T, serde_json::Value), AppError> {
+    // Its shape against the document first: no array for an object, `2.0` is an integer.
+    shape::check(&T::name(), &mut value)?;
+    let t = read_value(&value)?;
+    Ok((t, value))
+}
+
+/// serde's reading of a checked value, with the JSON path of the field at fault.
+fn read_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, AppError> {
     serde_path_to_error::deserialize(value).map_err(|e| {
         let message = e.inner().to_string();
         let mut path = e.path().to_string();
@@ -172,11 +183,12 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for Q<T> {
 #[serde(deny_unknown_fields)]
 pub struct WaitQuery {
     /// Hold the response until the command is final or reaches its milestone
-    /// (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power).
-    #[serde(default)]
-    pub wait: bool,
-    /// Longest wait (default 10000, at most 600000; only with `wait=true`); then the command
-    /// is returned as it stands.
+    /// (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+    /// true when `timeout_ms` is given, else false.
+    pub wait: Option<bool>,
+    /// Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+    /// stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+    #[param(minimum = 0, maximum = 600000)]
     pub timeout_ms: Option<u64>,
 }
 
@@ -480,7 +492,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         auth::list_tokens, auth::create_token, auth::revoke_token,
         auth::get_control, auth::take_control, auth::release_control,
     ),
-    components(schemas(crate::error::Problem)),
+    components(schemas(crate::error::Problem, motion::cam::ValueSelect)),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
@@ -501,11 +513,13 @@ impl ApiDoc {
     pub fn document() -> utoipa::openapi::OpenApi {
         let mut doc = ApiDoc::openapi();
         doc.merge(blocks::BlockDoc::openapi());
-        let modifiers: [&dyn utoipa::Modify; 4] = [
+        let modifiers: [&dyn utoipa::Modify; 6] = [
             &ForeignExamples,
             &ErrorResponses,
             &RequestChecks,
             &PlainRefs,
+            &ClosedVariants,
+            &OptionalBodies,
         ];
         for m in modifiers {
             m.modify(&mut doc);
@@ -765,6 +779,74 @@ fn plain_ref(prop: &mut serde_json::Value) {
     }
     if !description.is_empty() {
         m.insert("description".into(), Value::String(description));
+    }
+}
+
+/// Tagged enums of the drive crate read with `deny_unknown_fields` (an unknown field is a
+/// 422): each variant's object says so (`additionalProperties: false`), which utoipa leaves out.
+struct ClosedVariants;
+
+impl utoipa::Modify for ClosedVariants {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::RefOr;
+        let Some(components) = doc.components.as_mut() else {
+            return;
+        };
+        for name in ["SimFault", "PlantModel"] {
+            let Some(schema) = components.schemas.get_mut(name) else {
+                continue;
+            };
+            let mut v = serde_json::to_value(&*schema).expect("schemas serialise");
+            if let Some(items) = v.get_mut("oneOf").and_then(|i| i.as_array_mut()) {
+                for item in items.iter_mut().filter_map(|i| i.as_object_mut()) {
+                    if item.get("type").and_then(|t| t.as_str()) == Some("object") {
+                        item.insert("additionalProperties".into(), false.into());
+                    }
+                }
+            }
+            *schema =
+                serde_json::from_value::<RefOr<_>>(v).expect("a rewritten schema is a schema");
+        }
+    }
+}
+
+/// An empty body is read as `{}` (`JsonBody`): where `{}` is a valid body — a body schema
+/// without required fields — the body itself is optional, and the document says so.
+struct OptionalBodies;
+
+impl utoipa::Modify for OptionalBodies {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::{RefOr, Required, schema::Schema};
+        let Some(components) = doc.components.as_ref() else {
+            return;
+        };
+        let optional: Vec<String> = components
+            .schemas
+            .iter()
+            .filter(|(_, s)| matches!(s, RefOr::T(Schema::Object(o)) if o.required.is_empty()))
+            .map(|(name, _)| format!("#/components/schemas/{name}"))
+            .collect();
+        for item in doc.paths.paths.values_mut() {
+            for op in [
+                &mut item.post,
+                &mut item.put,
+                &mut item.patch,
+                &mut item.delete,
+            ]
+            .into_iter()
+            .flatten()
+            {
+                let Some(body) = op.request_body.as_mut() else {
+                    continue;
+                };
+                let takes_empty = body.content.get("application/json").is_some_and(|c| {
+                    matches!(&c.schema, Some(RefOr::Ref(r)) if optional.contains(&r.ref_location))
+                });
+                if takes_empty {
+                    body.required = Some(Required::False);
+                }
+            }
+        }
     }
 }
 

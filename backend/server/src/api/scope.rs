@@ -182,7 +182,7 @@ fn to_csv(r: &ScopeRecording) -> String {
     description = "An `armed` or `recording` recording is cancelled (200 with the recording, state `cancelled`; \
 it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, `failed`) is deleted (204).",
     params(("id" = u64, Path, description = "recording id")),
-    request_body(content = crate::model::EmptyBody, description = "`{}`: the operation takes no parameters (a body is not read). Send it, or an empty body, as `application/json`."),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
     responses(
         (status = 200, description = "Cancelled", body = ScopeRecording),
         (status = 204, description = "Deleted"),
@@ -190,6 +190,7 @@ it stays listed until deleted or evicted). A finished one (`done`, `cancelled`, 
 pub async fn delete_recording(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,
+    _: super::JsonBody<crate::model::EmptyBody>,
 ) -> AppResult<Response> {
     let id = id_of(&id)?;
     match s.scope.lock().unwrap().delete(id) {

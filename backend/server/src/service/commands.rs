@@ -161,6 +161,7 @@ macro_rules! positioning_inputs {
 
 positioning_inputs! {
     MoveBody => position,
+    MoveModuloBody => position,
     MoveRelativeBody => distance,
     MoveContinuousBody => position,
     MoveContinuousRelativeBody => distance,
@@ -171,12 +172,11 @@ impl MoveBody {
     pub fn absolute(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
         let p = self.positioning(&mut c);
-        if self.direction.is_some() {
-            c.fail("direction", "only move-modulo takes a direction");
-        }
         c.done(CommandKind::MoveAbsolute(p))
     }
+}
 
+impl MoveModuloBody {
     /// MC_MoveModulo: only on a modulo axis, with a target within one turn's range.
     pub fn modulo(&self, _: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
@@ -681,14 +681,16 @@ pub async fn run<B>(
     })
 }
 
-/// `?wait=true&timeout_ms=N` as a duration to wait (`None`: answer at once).
-pub fn wait_duration(wait: bool, timeout_ms: Option<u64>) -> AppResult<Option<Duration>> {
+/// `?wait=true&timeout_ms=N` as a duration to wait (`None`: answer at once). A timeout alone
+/// is a client that means to wait.
+pub fn wait_duration(wait: Option<bool>, timeout_ms: Option<u64>) -> AppResult<Option<Duration>> {
     match (wait, timeout_ms) {
         (_, Some(t)) if t > 600_000 => Err(AppError::field("timeout_ms", "at most 600000")),
-        (true, t) => Ok(Some(Duration::from_millis(t.unwrap_or(10_000)))),
-        // A timeout without a wait is a client that meant to wait: say so instead of not waiting.
-        (false, Some(_)) => Err(AppError::field("timeout_ms", "only with wait=true")),
-        (false, None) => Ok(None),
+        (Some(false), _) => Ok(None),
+        (Some(true), t) | (None, t @ Some(_)) => {
+            Ok(Some(Duration::from_millis(t.unwrap_or(10_000))))
+        }
+        (None, None) => Ok(None),
     }
 }
 
