@@ -77,3 +77,12 @@ export function axisError(s: { state: AxisState; error_id: number; drive_fault: 
   }
   return { hex: null, code: null, text: s.drive_fault ? 'drive fault (no error number)' : 'error stop (no error number)' };
 }
+
+/** A moment as `YYYY-MM-DD HH:MM` in local time (users, tokens); '' for none. */
+export function dateTime(iso: string | undefined | null): string {
+  if (!iso) return '';
+  const d = new Date(iso);
+  if (Number.isNaN(d.getTime())) return iso;
+  const p = (n: number) => String(n).padStart(2, '0');
+  return `${d.getFullYear()}-${p(d.getMonth() + 1)}-${p(d.getDate())} ${p(d.getHours())}:${p(d.getMinutes())}`;
+}

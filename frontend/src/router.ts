@@ -7,6 +7,7 @@ export type Route =
   | { page: 'scope' }
   | { page: 'cams' }
   | { page: 'cam'; table: string }
+  | { page: 'users' }
   | { page: 'not-found'; path: string };
 
 export function parseRoute(hash: string): Route {
@@ -17,6 +18,7 @@ export function parseRoute(hash: string): Route {
   if (parts[0] === 'cams' && parts.length === 1) return { page: 'cams' };
   if (parts[0] === 'cams' && parts.length === 2) return { page: 'cam', table: parts[1] };
   if (parts[0] === 'new-axis' && parts.length === 1) return { page: 'new-axis' };
+  if (parts[0] === 'users' && parts.length === 1) return { page: 'users' };
   if (parts[0] === 'axes' && parts.length >= 2 && parts.length <= 3) {
     const tab = parts[2] ?? 'online';
     if (tab === 'online' || tab === 'parameters' || tab === 'config') return { page: 'axis', axis: parts[1], tab };
@@ -36,6 +38,8 @@ export function href(r: Route): string {
       return `#/cams/${encodeURIComponent(r.table)}`;
     case 'new-axis':
       return '#/new-axis';
+    case 'users':
+      return '#/users';
     case 'axis':
       return `#/axes/${encodeURIComponent(r.axis)}${r.tab === 'online' ? '' : '/' + r.tab}`;
     default:

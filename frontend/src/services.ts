@@ -9,6 +9,7 @@ import { RpcError } from './live/client';
 import { ScopeSession } from './scope/session';
 import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
 import { TrendBuffer } from './live/trend';
+import { clientId } from './auth/client-id';
 
 export interface LiveStatus {
   status: AxisLiveStatus | null;
@@ -34,9 +35,10 @@ export const STATUS_RATE_HZ = 25;
 export const FOCUS_RATE_HZ = 50;
 const LOG_MAX = 300;
 
-function wsUrl(): string {
+/** The websocket's URL; `client_id` names this tab as `X-Client-Id` does on REST (auth/client-id.ts). */
+export function wsUrl(id: string = clientId()): string {
   const l = typeof location !== 'undefined' ? location : ({ protocol: 'http:', host: '127.0.0.1:8080' } as Location);
-  return `${l.protocol === 'https:' ? 'wss:' : 'ws:'}//${l.host}/api/v1/ws`;
+  return `${l.protocol === 'https:' ? 'wss:' : 'ws:'}//${l.host}/api/v1/ws?client_id=${encodeURIComponent(id)}`;
 }
 
 export const live = new LiveClient({ url: wsUrl() });
@@ -286,11 +288,23 @@ export async function findHeldStop(axis: string): Promise<number | null> {
 // ---- wiring -----------------------------------------------------------------------------
 
 let started = false;
+let wired = false;
 let pollTimer: ReturnType<typeof setInterval> | null = null;
 
+/** Connects (again, after a stop: the handlers are installed once). */
 export function start(): void {
   if (started) return;
   started = true;
+  if (!wired) wire();
+  live.start();
+  // Axis configurations have no topic: look for other clients' changes now and then.
+  pollTimer = setInterval(() => {
+    if (live.connected) void refreshAxes();
+  }, 5000);
+}
+
+function wire(): void {
+  wired = true;
   live.on('command_event', onCommandEvent);
   live.on('commands_lagged', () => void refreshCommands());
   // Subscriptions are re-sent by the client on every (re)connection.
@@ -303,15 +317,12 @@ export function start(): void {
     void refreshCommands();
   });
   live.onClose(() => jog.connectionLost());
-  live.start();
-  // Axis configurations have no topic: look for other clients' changes now and then.
-  pollTimer = setInterval(() => {
-    if (live.connected) void refreshAxes();
-  }, 5000);
 }
 
+/** Disconnects (logged out: nothing may be read until the next login). */
 export function stop(): void {
   if (pollTimer) clearInterval(pollTimer);
-  live.stop();
+  pollTimer = null;
+  if (started) live.stop();
   started = false;
 }

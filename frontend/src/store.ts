@@ -50,6 +50,12 @@ export class Store<T> {
 
 export function useStore<T>(s: Store<T>): T {
   const [, tick] = useState(0);
-  useEffect(() => s.subscribe(() => tick((n) => n + 1)), [s]);
-  return s.get();
+  const value = s.get();
+  useEffect(() => {
+    const off = s.subscribe(() => tick((n) => n + 1));
+    // Set between the render and this effect (e.g. an answer that came first): not missed.
+    if (s.get() !== value) tick((n) => n + 1);
+    return off;
+  }, [s]);
+  return value;
 }

@@ -82,9 +82,11 @@ async function stopProcess(p) {
 
 /**
  * Starts motiond (fresh database, demo machine unless noDemo) and whatever serves the UI.
+ * `env` is added to motiond's environment (e.g. MOTIOND_ADMIN_USER/MOTIOND_ADMIN_PASSWORD: the
+ * first admin, so authentication is on), `args` to its command line.
  * Returns { url (the UI), api (motiond), stop() }.
  */
-export async function startStack({ noDemo = true } = {}) {
+export async function startStack({ noDemo = true, env = {}, args: extraArgs = [] } = {}) {
   if (!existsSync(MOTIOND)) throw new Error(`${MOTIOND} missing: cargo build -p motiond`);
   if (!existsSync(join(DIST, 'index.html'))) throw new Error(`${DIST} missing: cd frontend && npm run build`);
   const dir = mkdtempSync(join(tmpdir(), 'motiond-e2e-'));
@@ -94,11 +96,16 @@ export async function startStack({ noDemo = true } = {}) {
   const args = ['serve', '--listen', `127.0.0.1:${port}`, '--db', join(dir, 'm.db')];
   if (noDemo) args.push('--no-demo');
   if (ownUi) args.push('--ui-dir', DIST);
+  args.push(...extraArgs);
   const procs = [];
   const startMotiond = async () => {
-    const p = spawnLogged(MOTIOND, args, { cwd: dir, env: { ...process.env, RUST_LOG: process.env.RUST_LOG ?? 'warn' } }, 'motiond');
+    const p = spawnLogged(MOTIOND, args, { cwd: dir, env: { ...process.env, RUST_LOG: process.env.RUST_LOG ?? 'warn', ...env } }, 'motiond');
     procs.push(p);
-    await until(async () => (await fetch(`${api}/api/v1/system`)).ok, { what: 'motiond to answer', timeout: 30000 });
+    // With authentication on, an anonymous request is a 401: motiond answers all the same.
+    await until(async () => {
+      const r = await fetch(`${api}/api/v1/system`);
+      return r.ok || r.status === 401;
+    }, { what: 'motiond to answer', timeout: 30000 });
     return p;
   };
   let motiond = null;
@@ -167,11 +174,14 @@ export async function shot(page, name) {
   return path;
 }
 
-/** REST helper against motiond (anything but a GET is declared JSON, as motiond requires). */
-export async function rest(api, method, path, body) {
+/**
+ * REST helper against motiond (anything but a GET is declared JSON, as motiond requires);
+ * `headers` are added (a session `cookie`, `authorization`, `x-client-id` …).
+ */
+export async function rest(api, method, path, body, headers = {}) {
   const r = await fetch(`${api}/api/v1${path}`, {
     method,
-    headers: method === 'GET' ? {} : { 'content-type': 'application/json' },
+    headers: { ...(method === 'GET' ? {} : { 'content-type': 'application/json' }), ...headers },
     body: body === undefined ? undefined : JSON.stringify(body),
   });
   const text = await r.text();
@@ -182,6 +192,20 @@ export async function rest(api, method, path, body) {
     json = text;
   }
   return { status: r.status, body: json };
+}
+
+/** Logs in over the API; returns the session cookie (`motiond_session=…`) to send as `cookie`. */
+export async function loginCookie(api, name, password) {
+  const r = await fetch(`${api}/api/v1/auth/login`, {
+    method: 'POST',
+    headers: { 'content-type': 'application/json' },
+    body: JSON.stringify({ name, password }),
+  });
+  if (r.status !== 200) throw new Error(`login of ${name}: ${r.status} ${await r.text()}`);
+  const set = r.headers.getSetCookie?.() ?? [r.headers.get('set-cookie')];
+  const c = set.find((h) => h && h.startsWith('motiond_session='));
+  if (!c) throw new Error(`login of ${name}: no session cookie (${set})`);
+  return c.split(';')[0];
 }
 
 export const status = async (api, axis) => (await rest(api, 'GET', `/axes/${axis}/status`)).body.status;

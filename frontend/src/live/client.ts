@@ -70,6 +70,7 @@ export class LiveClient {
   private notificationHandlers = new Map<string, Set<(params: any) => void>>();
   private openHandlers = new Set<() => void>();
   private closeHandlers = new Set<() => void>();
+  private errorHandlers = new Set<(e: RpcError) => void>();
   private retryTimer: ReturnType<typeof setTimeout> | null = null;
   private attempt = 0;
   private stopped = false;
@@ -195,7 +196,9 @@ export class LiveClient {
       clearTimeout(p.timer);
       if ('error' in msg) {
         const e = msg.error ?? {};
-        p.reject(new RpcError(e.code ?? -32000, e.message ?? 'error', e.data ?? null));
+        const err = new RpcError(e.code ?? -32000, e.message ?? 'error', e.data ?? null);
+        this.errorHandlers.forEach((h) => h(err));
+        p.reject(err);
       } else {
         p.resolve(msg.result);
       }
@@ -289,6 +292,12 @@ export class LiveClient {
   onOpen(h: () => void): () => void {
     this.openHandlers.add(h);
     return () => this.openHandlers.delete(h);
+  }
+
+  /** Every error answer to a call (e.g. a 401 problem: the socket's session has ended). */
+  onCallError(h: (e: RpcError) => void): () => void {
+    this.errorHandlers.add(h);
+    return () => this.errorHandlers.delete(h);
   }
 
   onClose(h: () => void): () => void {

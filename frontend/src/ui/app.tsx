@@ -12,6 +12,9 @@ import { CamListPage, CamPage } from './cams';
 import type { ConnState } from '../live/client';
 import { ageText } from '../live/liveness';
 import { useLiveness } from './liveness';
+import { UsersPage } from './users';
+import { ControlBadge, UserBadge } from './header-auth';
+import { auth, may } from '../auth/session';
 
 function Connection() {
   const c = useStore(live.state);
@@ -111,6 +114,8 @@ export function App() {
   const route = useRoute();
   const conn = useStore(live.state);
   const loaded = useStore(axesLoaded);
+  // Users and tokens: for admins, and for anyone while authentication is off (to add the first user).
+  const admin = may(useStore(auth), 'admin');
   // Narrow screens (style.css, ≤ 700 px): the axis list is a menu; any navigation closes it.
   const [menuOpen, setMenuOpen] = useState(false);
   useEffect(() => {
@@ -142,6 +147,9 @@ export function App() {
       break;
     case 'cam':
       page = <CamPage key={route.table} table={route.table} />;
+      break;
+    case 'users':
+      page = <UsersPage />;
       break;
     default:
       page = (
@@ -180,7 +188,12 @@ export function App() {
           {nav({ page: 'scope' }, 'Scope', route.page === 'scope')}
           {nav({ page: 'cams' }, 'Cams', route.page === 'cams' || route.page === 'cam')}
           {nav({ page: 'new-axis' }, 'New axis', route.page === 'new-axis')}
+          {admin && nav({ page: 'users' }, 'Users', route.page === 'users')}
         </nav>
+        <div class="topbar-session">
+          <ControlBadge />
+          <UserBadge />
+        </div>
         <div class="topbar-right">
           <a class="nav-link small" href="/docs" target="_blank" rel="noreferrer">
             API

@@ -57,6 +57,8 @@ export interface ConfigForm {
   limitPos: string;
   faultOnHit: boolean;
   parameters: { key: string; value: string }[];
+  /** `dynamics.jog_deadman_max` as loaded (no field for it yet): sent back unchanged, else the server's default. */
+  jogDeadmanMax?: number;
 }
 
 export const DEFAULT_FORM: ConfigForm = {
@@ -106,6 +108,7 @@ export function formOf(c: AxisConfig): ConfigForm {
       jog_velocity_slow: n(c.dynamics.jog_velocity_slow),
       jog_velocity_fast: n(c.dynamics.jog_velocity_fast),
     },
+    jogDeadmanMax: (c.dynamics as Partial<AxisConfig['dynamics']>).jog_deadman_max,
     plant: plant.kind,
     time_constant: n(plant.time_constant, '0.005'),
     natural_frequency_hz: n(plant.natural_frequency_hz, '50'),
@@ -166,7 +169,8 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
       jerk: num('dynamics.jerk', f.dyn.jerk),
       jog_velocity_slow: num('dynamics.jog_velocity_slow', f.dyn.jog_velocity_slow),
       jog_velocity_fast: num('dynamics.jog_velocity_fast', f.dyn.jog_velocity_fast),
-    },
+      ...(f.jogDeadmanMax !== undefined ? { jog_deadman_max: f.jogDeadmanMax } : {}),
+    } as AxisConfig['dynamics'],
     // The schema says `object` without value types (utoipa value_type = Object).
     parameters: parameters as unknown as AxisConfig['parameters'],
     drive: {
