@@ -77,6 +77,22 @@ async fn power_and_move_absolute_with_wait_reaches_the_target() {
         "actual {actual} not within {window} of 120"
     );
     assert_eq!(st["status"]["state"], "standstill");
+    // A timeout alone means wait (decision 94); wait=false with it does not wait.
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?timeout_ms=20000",
+        json!({"position": 130.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=false&timeout_ms=20000",
+        json!({"position": 120.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(r.json["final"], false, "{}", r.text);
+    until_final(&s, r.json["id"].as_u64().unwrap(), 20).await;
     // the resource is kept and listed
     let c = get(&s, &loc).await;
     assert_eq!(c.json["state"], "done");
