@@ -54,6 +54,7 @@ pub enum Direction {
 #[serde(default, deny_unknown_fields)]
 pub struct MoveOptions {
     /// Blend at this position instead of the previous command's target.
+    #[cfg_attr(feature = "schema", schema(minimum = -1e12, maximum = 1e12))]
     pub blending_position: Option<f64>,
     /// Done at the logical end of positioning, without waiting for the target window.
     pub ignore_position_monitoring: bool,

@@ -537,6 +537,7 @@ pub struct EmptyBody {}
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"position": 0.0}))]
 pub struct SetPositionBody {
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub position: f64,
     #[serde(default, skip_serializing_if = "is_false")]
     pub relative: bool,
@@ -560,6 +561,7 @@ pub struct SetOverrideBody {
 #[schema(example = json!({"position": 250.0, "velocity": 200.0}))]
 pub struct MoveBody {
     /// Target position.
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub position: f64,
     /// > 0, units/s.
     #[schema(exclusive_minimum = 0)]
@@ -585,7 +587,7 @@ pub struct MoveBody {
 #[schema(example = json!({"position": 90.0, "velocity": 360.0, "direction": "shortest_way"}))]
 pub struct MoveModuloBody {
     /// Modulo target (≥ 0; a target of a full turn or more adds turns).
-    #[schema(minimum = 0)]
+    #[schema(minimum = 0, maximum = 1e12)]
     pub position: f64,
     /// > 0, units/s.
     #[schema(exclusive_minimum = 0)]
@@ -615,6 +617,7 @@ pub struct MoveModuloBody {
 #[schema(example = json!({"distance": 50.0, "velocity": 200.0}))]
 pub struct MoveRelativeBody {
     /// Signed distance, units.
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub distance: f64,
     /// > 0, units/s.
     #[schema(exclusive_minimum = 0)]
@@ -640,10 +643,12 @@ pub struct MoveRelativeBody {
 #[schema(example = json!({"distance": 100.0, "velocity": 200.0, "end_velocity": 50.0}))]
 pub struct MoveContinuousRelativeBody {
     /// Signed distance, units.
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub distance: f64,
     #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     /// Velocity kept after the target (signed).
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub end_velocity: f64,
     #[serde(default)]
     #[schema(minimum = 0)]
@@ -665,10 +670,12 @@ pub struct MoveContinuousRelativeBody {
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"position": 500.0, "velocity": 200.0, "end_velocity": 50.0}))]
 pub struct MoveContinuousBody {
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub position: f64,
     #[schema(exclusive_minimum = 0)]
     pub velocity: f64,
     /// Velocity kept after the target (signed).
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub end_velocity: f64,
     #[serde(default)]
     #[schema(minimum = 0)]
@@ -827,6 +834,7 @@ impl Default for JogBody {
 pub struct HomeBody {
     /// None = the calibration value (#1075).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub position: Option<f64>,
     /// Default `default` (the referencing sequence configured by #1076).
     #[serde(default)]
@@ -859,6 +867,7 @@ pub struct GearInDynBody {
     /// Master axis id or name.
     pub master: String,
     /// Slave travel per master travel (signed).
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub gear_ratio: f64,
     /// Slave acceleration that a ratio change may cause at the master's maximum velocity,
     /// units/s² (0 = the slave's AxisAcc #1004).
@@ -881,9 +890,11 @@ pub struct CamInBody {
     pub cam_table: String,
     /// Added to the master position before scaling (spec §1.5). Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub master_offset: f64,
     /// Added to the scaled slave cam position. Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub slave_offset: f64,
     /// Default 1 (not 0).
     #[serde(default = "one")]
@@ -904,6 +915,7 @@ pub struct CamInBody {
     /// For the position modes: master axis position, or raw cam position for
     /// `at_master_cam_pos`. Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// Default `user_defined`.
     #[serde(default)]
@@ -933,6 +945,7 @@ pub struct CamScalingBody {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// Default `user_defined`.
     #[serde(default)]
@@ -942,9 +955,11 @@ pub struct CamScalingBody {
     pub slave_scaling_mode: motion::cam::CamScalingMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub master_offset: f64,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub slave_offset: f64,
     /// Default 1.
     #[serde(default = "one")]
@@ -973,6 +988,7 @@ pub struct CamInV2Body {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// This cam's offsets and scalings (default: absolute, no offset, scaling 1).
     #[serde(default)]
@@ -1004,6 +1020,7 @@ pub struct CamAddBody {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// Default: absolute, no offset, scaling 1.
     #[serde(default)]
@@ -1032,6 +1049,7 @@ pub struct CamExchangeBody {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// Default: absolute, no offset, scaling 1.
     #[serde(default)]
@@ -1058,6 +1076,7 @@ pub struct CamRemoveBody {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
 }
 
@@ -1074,6 +1093,7 @@ pub struct CamScalingV2Body {
     pub activation_mode: motion::cam::CamActivationMode,
     /// Default 0.
     #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub activation_position: f64,
     /// Default: absolute, no offset, scaling 1.
     #[serde(default)]
@@ -1093,6 +1113,7 @@ pub struct MoveSuperImposedBody {
     #[serde(default)]
     pub mode: SuperpositionMode,
     /// Distance to make up (> 0: get ahead, < 0: fall back), units.
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub distance: f64,
     /// Largest velocity difference to the main motion (> 0), units/s.
     #[schema(exclusive_minimum = 0)]
@@ -1454,22 +1475,36 @@ fn cam_rows<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::
     Ok(rows.into_iter().map(|r| r.0).collect())
 }
 
-/// A number other than 0 (a gear ratio's numerator, a cam scaling): `anyOf` a positive and a
-/// negative number, as JSON Schema has no "not 0" for numbers that clients generate well.
+/// The largest magnitude of a position, distance, offset or end velocity a request may give.
+pub const MAX_MAGNITUDE: f64 = 1e12;
+/// The smallest magnitude of a scaling or gear ratio (dividing by less would overflow).
+pub const MIN_SCALING: f64 = 1e-9;
+
+/// A scaling or gear ratio: not 0, magnitude from [`MIN_SCALING`] to [`MAX_MAGNITUDE`].
+pub fn valid_scaling(v: f64) -> bool {
+    v.is_finite() && (MIN_SCALING..=MAX_MAGNITUDE).contains(&v.abs())
+}
+
+/// A number other than 0 (a gear ratio's numerator, a cam scaling) of a magnitude from 1e-9
+/// to 1e12: `anyOf` a positive and a negative range.
 pub fn nonzero_number() -> utoipa::openapi::schema::Schema {
     use utoipa::openapi::schema::{AnyOfBuilder, ObjectBuilder, Type};
     AnyOfBuilder::new()
         .item(
             ObjectBuilder::new()
                 .schema_type(Type::Number)
-                .exclusive_minimum(Some(0.0)),
+                .minimum(Some(MIN_SCALING))
+                .maximum(Some(MAX_MAGNITUDE)),
         )
         .item(
             ObjectBuilder::new()
                 .schema_type(Type::Number)
-                .exclusive_maximum(Some(0.0)),
+                .minimum(Some(-MAX_MAGNITUDE))
+                .maximum(Some(-MIN_SCALING)),
         )
-        .description(Some("a number other than 0"))
+        .description(Some(
+            "a number other than 0, from 1e-9 to 1e12 in magnitude",
+        ))
         .into()
 }
 

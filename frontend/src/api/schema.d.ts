@@ -1732,9 +1732,9 @@ export interface components {
              * @description Added to the scaled slave cam position. Default 0.
              */
             slave_offset?: number;
-            /** @description a number other than 0 */
+            /** @description a number other than 0, from 1e-9 to 1e12 in magnitude */
             master_scaling?: number;
-            /** @description a number other than 0 */
+            /** @description a number other than 0, from 1e-9 to 1e12 in magnitude */
             slave_scaling?: number;
             /** @description Default `absolute`. */
             start_mode?: components["schemas"]["StartMode"];
@@ -2023,9 +2023,9 @@ export interface components {
              * @description Default 0.
              */
             slave_offset?: number;
-            /** @description a number other than 0 */
+            /** @description a number other than 0, from 1e-9 to 1e12 in magnitude */
             master_scaling?: number;
-            /** @description a number other than 0 */
+            /** @description a number other than 0, from 1e-9 to 1e12 in magnitude */
             slave_scaling?: number;
         };
         /**
@@ -3050,7 +3050,7 @@ export interface components {
         GearInBody: {
             /** @description Master axis id or name. */
             master: string;
-            /** @description a number other than 0 */
+            /** @description a number other than 0, from 1e-9 to 1e12 in magnitude */
             ratio_numerator: number;
             /** Format: int32 */
             ratio_denominator: number;

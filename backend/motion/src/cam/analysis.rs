@@ -370,18 +370,18 @@ fn search(cam: &Cam, start: f64, target: f64, accuracy: f64, dir: f64) -> Option
         if dir > 0.0 {
             i += 1;
             if i == n {
-                if !cam.periodic || k - k_start >= cycles {
+                if !cam.periodic || k.saturating_sub(k_start) >= cycles {
                     return None;
                 }
                 i = 0;
-                k += 1;
+                k = k.saturating_add(1);
             }
         } else if i == 0 {
-            if !cam.periodic || k_start - k >= cycles {
+            if !cam.periodic || k_start.saturating_sub(k) >= cycles {
                 return None;
             }
             i = n - 1;
-            k -= 1;
+            k = k.saturating_sub(1);
         } else {
             i -= 1;
         }

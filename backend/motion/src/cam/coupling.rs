@@ -169,16 +169,20 @@ pub struct CamScalingData {
     #[serde(default)]
     pub master_relative: bool,
     #[serde(default)]
+    #[cfg_attr(feature = "schema", schema(minimum = -1e12, maximum = 1e12))]
     pub master_offset: f64,
     #[serde(default = "unit")]
+    #[cfg_attr(feature = "schema", schema(minimum = -1e12, maximum = 1e12))]
     pub master_scaling: f64,
     #[serde(default)]
     pub slave_scaling_mode: CamScalingMode,
     #[serde(default)]
     pub slave_relative: bool,
     #[serde(default)]
+    #[cfg_attr(feature = "schema", schema(minimum = -1e12, maximum = 1e12))]
     pub slave_offset: f64,
     #[serde(default = "unit")]
+    #[cfg_attr(feature = "schema", schema(minimum = -1e12, maximum = 1e12))]
     pub slave_scaling: f64,
 }
 

@@ -245,6 +245,17 @@ pub async fn master_position(
 ) -> AppResult<Json<MasterPositionResource>> {
     position("slave_position", q.slave_position)?;
     for (f, v) in [
+        ("master_scaling", q.master_scaling),
+        ("slave_scaling", q.slave_scaling),
+    ] {
+        if !crate::model::valid_scaling(v.unwrap_or(1.0)) {
+            return Err(AppError::field(
+                f,
+                "must be a number other than 0, from 1e-9 to 1e12 in magnitude",
+            ));
+        }
+    }
+    for (f, v) in [
         ("master_offset", q.master_offset),
         ("slave_offset", q.slave_offset),
         ("master_start_position", q.master_start_position),
@@ -293,13 +304,13 @@ pub async fn values(
     position("start", q.start)?;
     position("end", q.end)?;
     let mut select = Vec::new();
+    // Absent: all four; given, every item must name one (`values=` is an empty name).
     for v in q
         .values
         .as_deref()
-        .unwrap_or("")
-        .split(',')
+        .into_iter()
+        .flat_map(|v| v.split(','))
         .map(str::trim)
-        .filter(|v| !v.is_empty())
     {
         select.push(
             serde_json::from_value::<ValueSelect>(serde_json::Value::String(v.into())).map_err(

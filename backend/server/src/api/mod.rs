@@ -83,6 +83,7 @@ pub(crate) fn from_value<T: DeserializeOwned + utoipa::ToSchema>(
     // Its shape against the document first: no array for an object, `2.0` is an integer.
     shape::check(&T::name(), &mut value)?;
     let t = read_value(&value)?;
+    shape::check_closed(&T::name(), &value)?;
     Ok((t, value))
 }
 

@@ -30,7 +30,18 @@ pub fn check(name: &str, value: &mut Value) -> Result<(), AppError> {
     let Some(schema) = schemas().get(name) else {
         return Ok(());
     };
-    walk(schema, value, &mut String::new())
+    walk(schema, value, &mut String::new(), false)
+}
+
+/// After serde has read a body: a field the document does not know in a closed object
+/// (`additionalProperties: false`) that serde let pass — a tagged variant without fields
+/// ignores unknown ones. (Run after serde, whose refusals name the field and what was
+/// expected, as `renamed to distance`.)
+pub fn check_closed(name: &str, value: &Value) -> Result<(), AppError> {
+    let Some(schema) = schemas().get(name) else {
+        return Ok(());
+    };
+    walk(schema, &mut value.clone(), &mut String::new(), true)
 }
 
 fn resolve(schema: &Value) -> &Value {
@@ -60,16 +71,21 @@ fn at(path: &str) -> String {
     }
 }
 
-fn walk(schema: &Value, value: &mut Value, path: &mut String) -> Result<(), AppError> {
+fn walk(
+    schema: &Value,
+    value: &mut Value,
+    path: &mut String,
+    closed_too: bool,
+) -> Result<(), AppError> {
     let schema = resolve(schema);
     for key in ["oneOf", "anyOf"] {
         if let Some(branches) = schema.get(key).and_then(Value::as_array) {
-            return walk_branches(branches, value, path);
+            return walk_branches(branches, value, path, closed_too);
         }
     }
     if let Some(all) = schema.get("allOf").and_then(Value::as_array) {
         for s in all {
-            walk(s, value, path)?;
+            walk(s, value, path, closed_too)?;
         }
     }
     let ts = types(schema);
@@ -85,7 +101,7 @@ fn walk(schema: &Value, value: &mut Value, path: &mut String) -> Result<(), AppE
                 let len = path.len();
                 for (i, v) in items.iter_mut().enumerate() {
                     path.push_str(&format!("[{i}]"));
-                    walk(item, v, path)?;
+                    walk(item, v, path, closed_too)?;
                     path.truncate(len);
                 }
             }
@@ -93,8 +109,20 @@ fn walk(schema: &Value, value: &mut Value, path: &mut String) -> Result<(), AppE
         Value::Object(map) => {
             let props = schema.get("properties").and_then(Value::as_object);
             let extra = schema.get("additionalProperties").filter(|a| a.is_object());
+            let closed =
+                closed_too && schema.get("additionalProperties") == Some(&Value::Bool(false));
             for (k, v) in map.iter_mut() {
                 let Some(s) = props.and_then(|p| p.get(k)).or(extra) else {
+                    // serde ignores an unknown field where it has nothing to read (a
+                    // variant without fields): the document says the object is closed.
+                    if closed {
+                        let mut field = path.clone();
+                        if !field.is_empty() {
+                            field.push('.');
+                        }
+                        field.push_str(k);
+                        return Err(AppError::field(&field, "unknown field"));
+                    }
                     continue;
                 };
                 let len = path.len();
@@ -102,7 +130,7 @@ fn walk(schema: &Value, value: &mut Value, path: &mut String) -> Result<(), AppE
                     path.push('.');
                 }
                 path.push_str(k);
-                walk(s, v, path)?;
+                walk(s, v, path, closed_too)?;
                 path.truncate(len);
             }
         }
@@ -122,7 +150,12 @@ fn walk(schema: &Value, value: &mut Value, path: &mut String) -> Result<(), AppE
 /// `oneOf`/`anyOf`: an array is refused when no branch takes one; an object or number is
 /// walked by the branches that take its type (the first that passes wins, else the first
 /// error), so that a tagged variant's fields are checked by their own schema.
-fn walk_branches(branches: &[Value], value: &mut Value, path: &mut String) -> Result<(), AppError> {
+fn walk_branches(
+    branches: &[Value],
+    value: &mut Value,
+    path: &mut String,
+    closed_too: bool,
+) -> Result<(), AppError> {
     let kind = match value {
         Value::Array(_) => "array",
         Value::Object(_) => "object",
@@ -159,12 +192,12 @@ fn walk_branches(branches: &[Value], value: &mut Value, path: &mut String) -> Re
         })
     });
     if let Some(s) = tagged {
-        return walk(s, value, path);
+        return walk(s, value, path, closed_too);
     }
     let mut first_err = None;
     for s in candidates {
         let mut attempt = value.clone();
-        match walk(s, &mut attempt, path) {
+        match walk(s, &mut attempt, path, closed_too) {
             Ok(()) => {
                 *value = attempt;
                 return Ok(());
@@ -187,6 +220,9 @@ mod tests {
         let mut v = json!({"name": "a", "unit": "mm", "dynamics": {}, "drive": {"limit_switches": [-5, 5, true]}});
         let e = check("AxisConfigDto", &mut v).unwrap_err();
         assert_eq!(e.problem().errors[0].field, "drive.limit_switches");
+        let v = json!({"name": "a", "unit": "mm", "dynamics": {}, "drive": {"plant": {"kind": "ideal", "x": 1}}});
+        let e = check_closed("AxisConfigDto", &v).unwrap_err();
+        assert_eq!(e.problem().errors[0].field, "drive.plant.x");
         let mut v = json!({"name": "a", "unit": "mm", "dynamics": [1, 2, 3, 4, 5, 6]});
         let e = check("AxisConfigDto", &mut v).unwrap_err();
         assert_eq!(e.problem().errors[0].field, "dynamics");

@@ -27,9 +27,19 @@ impl Check {
             message: message.into(),
         });
     }
+    /// A position, distance, offset or end velocity: within ±1e12 (beyond it an f64 position
+    /// has no useful resolution, and sums of such inputs could overflow to infinity).
     fn finite(&mut self, field: &str, v: f64) {
-        if !v.is_finite() {
-            self.fail(field, "must be a finite number");
+        if !(v.is_finite() && v.abs() <= crate::model::MAX_MAGNITUDE) {
+            self.fail(field, "must be a number from -1e12 to 1e12");
+        }
+    }
+    fn scaling(&mut self, field: &str, v: f64) {
+        if !crate::model::valid_scaling(v) {
+            self.fail(
+                field,
+                "must be a number other than 0, from 1e-9 to 1e12 in magnitude",
+            );
         }
     }
     fn positive(&mut self, field: &str, v: f64) {
@@ -56,11 +66,8 @@ impl Check {
         self.finite("master_offset", mo);
         self.finite("slave_offset", so);
         self.finite("activation_position", position);
-        for (field, v) in [("master_scaling", ms), ("slave_scaling", ss)] {
-            if !(v.is_finite() && v != 0.0) {
-                self.fail(field, "must be a finite number other than 0");
-            }
-        }
+        self.scaling("master_scaling", ms);
+        self.scaling("slave_scaling", ss);
     }
     fn options(&mut self, o: &motion::MoveOptions) {
         if let Some(b) = o.blending_position {
@@ -359,9 +366,7 @@ impl GearInBody {
     pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
         let master = master_slot(&mut c, reg, axis, &self.master);
-        if !(self.ratio_numerator.is_finite() && self.ratio_numerator != 0.0) {
-            c.fail("ratio_numerator", "must be a finite number other than 0");
-        }
+        c.scaling("ratio_numerator", self.ratio_numerator);
         if self.ratio_denominator == 0 {
             c.fail("ratio_denominator", "must be ≥ 1");
         }
