@@ -9,6 +9,9 @@
 
 use super::*;
 
+/// The largest coordinate MC_SetPosition may make (1e15 units: an f64 still resolves 0.1 there).
+pub const MAX_COORDINATE: f64 = 1e15;
+
 impl Axis {
     /// Offers a command; the verdict is immediate and a rejected command changes nothing.
     pub fn submit(
@@ -127,6 +130,12 @@ impl Axis {
                 } else {
                     position - self.act_pos
                 };
+                // The new coordinates must stay where an f64 position still resolves the
+                // motion (and finite): relative shifts could otherwise add up to infinity.
+                let lands = |p: f64| (p + shift).abs() <= MAX_COORDINATE;
+                if !(shift.is_finite() && lands(self.act_pos) && lands(self.set.position)) {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
                 self.shift_coordinates(shift);
                 self.set_position_offset += shift;
                 if clear_position_lag {

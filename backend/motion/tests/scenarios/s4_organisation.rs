@@ -166,6 +166,34 @@ fn set_position_during_motion_shifts_coordinates_not_the_motion() {
     assert!((r.plants[0].pos - 100.0).abs() < 0.01);
 }
 
+/// Decision 95: MC_SetPosition never makes coordinates beyond ±1e15 (or infinite): relative
+/// shifts of 1e300, repeated, once made a spindle's positions infinite.
+#[test]
+fn set_position_refuses_coordinates_beyond_what_a_position_resolves() {
+    let mut r = Rig::new(1);
+    let set = |position: f64, relative: bool| CommandKind::SetPosition {
+        position,
+        relative,
+        clear_position_lag: false,
+    };
+    r.ok(0, set(9e14, true));
+    assert_eq!(
+        r.rejected(0, set(2e14, true)),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(
+        r.rejected(0, set(1e300, false)),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    r.run(0.01);
+    assert!(
+        (r.st(0).set_position - 9e14).abs() < 1.0,
+        "unchanged by the refusals"
+    );
+    assert!(r.st(0).actual_position.is_finite());
+    r.ok(0, set(-1e15, false));
+}
+
 #[test]
 fn set_position_with_clear_lag_during_motion_clears_it_for_good() {
     let mut p = params();
