@@ -1002,10 +1002,12 @@ async fn openapi_json_is_current() {
         "/api/v1/tokens",
         "/api/v1/tokens/{id}",
         "/api/v1/control",
+        "/api/v1/scope/setups",
+        "/api/v1/scope/setups/{name}",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 64, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 66, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

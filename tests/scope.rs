@@ -409,3 +409,71 @@ async fn the_actual_acceleration_is_the_recorded_actual_velocity_differentiated(
         "the move's acceleration was recorded"
     );
 }
+
+/// Saved scope setups: stored by name across restarts, checked as a recording request is,
+/// audited.
+#[tokio::test(flavor = "multi_thread")]
+async fn scope_setups_are_saved_by_name_and_survive_a_restart() {
+    let dir = temp_dir();
+    let db = dir.join("m.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    let setup = json!({
+        "recording": {"channels": [{"axis": "x", "signal": "set_velocity"}, {"axis": "x", "signal": "following_error"}],
+                      "duration_s": 2.0, "trigger": {"channel": 0, "level": 10.0, "edge": "rising", "pre_trigger_s": 0.2}},
+        "view": {"charts": [[0], [1]], "rolling": false}
+    });
+    let r = put(&s, "/api/v1/scope/setups/x-velocity-loop", setup.clone()).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.json["view"]["charts"], json!([[0], [1]]));
+    let mut changed = setup.clone();
+    changed["recording"]["duration_s"] = json!(3.0);
+    let r = put(&s, "/api/v1/scope/setups/x-velocity-loop", changed).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let mut bad = setup.clone();
+    bad["recording"]["channels"][0]["axis"] = json!("z");
+    let r = put(&s, "/api/v1/scope/setups/other", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "recording.channels[0].axis",
+        "{}",
+        r.text
+    );
+    let r = put(&s, "/api/v1/scope/setups/1bad", setup.clone()).await;
+    assert_problem(&r, 422, "validation_failed");
+    s.stop();
+
+    let s = Server::start_with(db, &[]);
+    let list = get(&s, "/api/v1/scope/setups").await;
+    assert_eq!(list.json.as_array().unwrap().len(), 1, "{}", list.text);
+    let r = get(&s, "/api/v1/scope/setups/x-velocity-loop").await;
+    assert_eq!(r.json["recording"]["duration_s"], 3.0, "{}", r.text);
+    // What it records can be started as it is.
+    let rec = post(&s, "/api/v1/scope/recordings", r.json["recording"].clone()).await;
+    assert_eq!(rec.status, 201, "{}", rec.text);
+    assert_eq!(
+        delete(&s, "/api/v1/scope/setups/x-velocity-loop")
+            .await
+            .status,
+        204
+    );
+    assert_problem(
+        &get(&s, "/api/v1/scope/setups/x-velocity-loop").await,
+        404,
+        "scope_setup_not_found",
+    );
+    let audit = get(&s, "/api/v1/audit?limit=10").await;
+    let actions: Vec<_> = audit
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["action"].clone())
+        .collect();
+    assert!(
+        actions.contains(&json!("scope_setup.put"))
+            && actions.contains(&json!("scope_setup.delete")),
+        "{actions:?}"
+    );
+    s.stop();
+}

@@ -1228,7 +1228,7 @@ pub struct PeakResetResource {
 // --- Scope recording requests -------------------------------------------------------------
 
 /// An axis by id (number or digits) or by name.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(untagged)]
 pub enum AxisKey {
     Id(i64),
@@ -1245,7 +1245,7 @@ impl AxisKey {
 }
 
 /// One signal of one axis.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"axis": "x", "signal": "set_position"}))]
 pub struct ChannelRequest {
@@ -1257,7 +1257,7 @@ pub struct ChannelRequest {
 }
 
 /// Start the recording when `channels[channel]` crosses `level` in the direction of `edge`.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"channel": 0, "level": 100.0, "edge": "rising", "pre_trigger_s": 0.002}))]
 pub struct TriggerRequest {
@@ -1281,7 +1281,7 @@ fn rising() -> String {
 }
 
 /// `POST /scope/recordings`.
-#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({
     "channels": [{"axis": "x", "signal": "set_position"}, {"axis": "x", "signal": "set_velocity"}],
@@ -1310,6 +1310,34 @@ pub fn valid_name(n: &str) -> bool {
             .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && n.chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// A saved scope setup (`PUT /scope/setups/{name}`): what to record and how the UI shows it.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "recording": {"channels": [{"axis": "x", "signal": "set_velocity"}, {"axis": "x", "signal": "following_error"}],
+                  "duration_s": 2.0, "trigger": {"channel": 0, "level": 10.0, "edge": "rising", "pre_trigger_s": 0.2}},
+    "view": {"charts": [[0], [1]], "rolling": false}
+}))]
+pub struct ScopeSetup {
+    /// What `POST /scope/recordings` is sent when the setup is started (checked like it).
+    pub recording: RecordingRequest,
+    /// How the client shows it (charts, colours, rolling mode …): kept as given, at most 64 KiB.
+    #[serde(default)]
+    #[schema(value_type = Object)]
+    pub view: serde_json::Map<String, serde_json::Value>,
+}
+
+/// A stored scope setup.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"name": "x-velocity-loop", "updated_at": "2026-11-25T15:00:00.000Z",
+    "recording": {"channels": [{"axis": "x", "signal": "set_velocity"}], "duration_s": 2.0}, "view": {}}))]
+pub struct ScopeSetupResource {
+    pub name: String,
+    pub updated_at: String,
+    #[serde(flatten)]
+    pub setup: ScopeSetup,
 }
 
 /// A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;

@@ -1026,6 +1026,45 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/scope/setups": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The saved scope setups, by name */
+        get: operations["list_setups"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/scope/setups/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** One saved scope setup */
+        get: operations["get_setup"];
+        /**
+         * Save a scope setup under a name (creates or replaces it)
+         * @description `recording` is checked as `POST /scope/recordings` checks it (axes must exist; errors at `recording.channels[i].axis` …); `view` is the client's, kept as given (at most 64 KiB). Stored in the database and audited.
+         */
+        put: operations["put_setup"];
+        post?: never;
+        /** Delete a saved scope setup */
+        delete: operations["delete_setup"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/system": {
         parameters: {
             query?: never;
@@ -4298,6 +4337,68 @@ export interface components {
             data?: number[][] | null;
         };
         /**
+         * @description A saved scope setup (`PUT /scope/setups/{name}`): what to record and how the UI shows it.
+         * @example {
+         *       "recording": {
+         *         "channels": [
+         *           {
+         *             "axis": "x",
+         *             "signal": "set_velocity"
+         *           },
+         *           {
+         *             "axis": "x",
+         *             "signal": "following_error"
+         *           }
+         *         ],
+         *         "duration_s": 2,
+         *         "trigger": {
+         *           "channel": 0,
+         *           "edge": "rising",
+         *           "level": 10,
+         *           "pre_trigger_s": 0.2
+         *         }
+         *       },
+         *       "view": {
+         *         "charts": [
+         *           [
+         *             0
+         *           ],
+         *           [
+         *             1
+         *           ]
+         *         ],
+         *         "rolling": false
+         *       }
+         *     }
+         */
+        ScopeSetup: {
+            /** @description What `POST /scope/recordings` is sent when the setup is started (checked like it). */
+            recording: components["schemas"]["RecordingRequest"];
+            /** @description How the client shows it (charts, colours, rolling mode …): kept as given, at most 64 KiB. */
+            view?: Record<string, never>;
+        };
+        /**
+         * @description A stored scope setup.
+         * @example {
+         *       "name": "x-velocity-loop",
+         *       "recording": {
+         *         "channels": [
+         *           {
+         *             "axis": "x",
+         *             "signal": "set_velocity"
+         *           }
+         *         ],
+         *         "duration_s": 2
+         *       },
+         *       "updated_at": "2026-11-25T15:00:00.000Z",
+         *       "view": {}
+         *     }
+         */
+        ScopeSetupResource: components["schemas"]["ScopeSetup"] & {
+            name: string;
+            updated_at: string;
+        };
+        /**
          * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step).
          * @enum {string}
          */
@@ -5713,6 +5814,24 @@ export interface components {
                  *       "status": 422,
                  *       "title": "Invalid request",
                  *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such saved scope setup. */
+        ScopeSetupNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "scope_setup_not_found",
+                 *       "detail": "no scope_setup 'x-velocity-loop'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:scope_setup_not_found"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -9092,6 +9211,138 @@ export interface operations {
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["EmptyBodyInvalid"];
+        };
+    };
+    list_setups: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description Setups */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeSetupResource"][];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["AuditInvalid"];
+            503: components["responses"]["AuditUnavailable"];
+        };
+    };
+    get_setup: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description setup name */
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The setup */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeSetupResource"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["ScopeSetupNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["AuditUnavailable"];
+        };
+    };
+    put_setup: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description setup name: a letter or `_`, then letters, digits, `_` or `-` (at most 64) */
+                name: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ScopeSetup"];
+            };
+        };
+        responses: {
+            /** @description Replaced */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeSetupResource"];
+                };
+            };
+            /** @description Created */
+            201: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ScopeSetupResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["ScopeInvalid"];
+            503: components["responses"]["StorageUnavailable"];
+        };
+    };
+    delete_setup: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description setup name */
+                name: string;
+            };
+            cookie?: never;
+        };
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Deleted */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["ScopeSetupNotFound"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
+            503: components["responses"]["StorageUnavailable"];
         };
     };
     system: {

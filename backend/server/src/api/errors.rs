@@ -208,6 +208,9 @@ problem_responses! {
         ("cam_table_not_found" = (value = json!(p(AppError::not_found("cam_table", "knife"))))),
         ("point_not_found" = (value = json!(p(AppError::not_found("point", "7")))))));
 
+    /// No such saved scope setup.
+    ScopeSetupNotFound(example = json!(p(AppError::not_found("scope_setup", "x-velocity-loop"))));
+
     /// No such recording (never made, deleted, or evicted).
     RecordingNotFound(example = json!(p(AppError::not_found("recording", "7"))));
 
@@ -592,6 +595,17 @@ error_sets! {
     ScopeGetErrors {
         404: RecordingNotFound, 409: RecordingNotDone, 422: RecordingQueryInvalid,
         503: RecordingUnavailable,
+    }
+    /// `GET /scope/setups/{name}`.
+    ScopeSetupReadErrors { 404: ScopeSetupNotFound, 503: AuditUnavailable }
+    /// `PUT /scope/setups/{name}`.
+    ScopeSetupWriteErrors {
+        400: MalformedJson, 413: PayloadTooLarge, 422: ScopeInvalid, 503: StorageUnavailable,
+    }
+    /// `DELETE /scope/setups/{name}`.
+    ScopeSetupDeleteErrors {
+        400: MalformedJson, 404: ScopeSetupNotFound, 413: PayloadTooLarge, 422: EmptyBodyInvalid,
+        503: StorageUnavailable,
     }
     /// `DELETE /scope/recordings/{id}`.
     ScopeDeleteErrors {

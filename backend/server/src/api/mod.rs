@@ -232,6 +232,13 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             "/scope/recordings/{id}",
             get(scope::get_recording).delete(scope::delete_recording),
         )
+        .route("/scope/setups", get(scope::list_setups))
+        .route(
+            "/scope/setups/{name}",
+            get(scope::get_setup)
+                .put(scope::put_setup)
+                .delete(scope::delete_setup),
+        )
         .route(
             "/cam-tables",
             get(cams::list_cam_tables)
@@ -484,6 +491,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
         simulation::inject_fault,
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
+        scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,

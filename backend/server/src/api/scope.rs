@@ -14,7 +14,7 @@ use super::errors::{ScopeCreateErrors, ScopeDeleteErrors, ScopeGetErrors};
 use super::{JsonBody, Q};
 use crate::app::AppState;
 use crate::error::{AppError, AppResult};
-use crate::model::RecordingRequest;
+use crate::model::{RecordingRequest, ScopeSetup, ScopeSetupResource};
 use crate::scope::{RecordingState, ScopeRecording};
 use crate::service::scope;
 
@@ -198,4 +198,63 @@ pub async fn delete_recording(
         Some(Some(cancelled)) => Ok(Json(cancelled).into_response()),
         Some(None) => Ok(StatusCode::NO_CONTENT.into_response()),
     }
+}
+
+#[utoipa::path(get, path = "/api/v1/scope/setups", tag = "scope",
+    summary = "The saved scope setups, by name",
+    responses((status = 200, description = "Setups", body = Vec<ScopeSetupResource>), super::errors::AuditErrors))]
+pub async fn list_setups(
+    State(s): State<Arc<AppState>>,
+) -> AppResult<Json<Vec<ScopeSetupResource>>> {
+    Ok(Json(scope::setups(&s).await?))
+}
+
+#[utoipa::path(get, path = "/api/v1/scope/setups/{name}", tag = "scope",
+    summary = "One saved scope setup",
+    params(("name" = String, Path, description = "setup name")),
+    responses((status = 200, description = "The setup", body = ScopeSetupResource), super::errors::ScopeSetupReadErrors))]
+pub async fn get_setup(
+    State(s): State<Arc<AppState>>,
+    Path(name): Path<String>,
+) -> AppResult<Json<ScopeSetupResource>> {
+    Ok(Json(scope::setup(&s, &name).await?))
+}
+
+#[utoipa::path(put, path = "/api/v1/scope/setups/{name}", tag = "scope",
+    summary = "Save a scope setup under a name (creates or replaces it)",
+    description = "`recording` is checked as `POST /scope/recordings` checks it (axes must exist; errors at \
+`recording.channels[i].axis` …); `view` is the client's, kept as given (at most 64 KiB). Stored in the database \
+and audited.",
+    params(("name" = String, Path, description = "setup name: a letter or `_`, then letters, digits, `_` or `-` (at most 64)")),
+    request_body = ScopeSetup,
+    responses((status = 200, description = "Replaced", body = ScopeSetupResource),
+        (status = 201, description = "Created", body = ScopeSetupResource), super::errors::ScopeSetupWriteErrors))]
+pub async fn put_setup(
+    State(s): State<Arc<AppState>>,
+    Path(name): Path<String>,
+    client: super::Client,
+    JsonBody(body, _): JsonBody<ScopeSetup>,
+) -> AppResult<Response> {
+    let (r, created) = scope::put_setup(&s, &name, body, &client.0).await?;
+    let status = if created {
+        StatusCode::CREATED
+    } else {
+        StatusCode::OK
+    };
+    Ok((status, Json(r)).into_response())
+}
+
+#[utoipa::path(delete, path = "/api/v1/scope/setups/{name}", tag = "scope",
+    summary = "Delete a saved scope setup",
+    params(("name" = String, Path, description = "setup name")),
+    request_body(content = crate::model::EmptyBody, description = "`{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422)."),
+    responses((status = 204, description = "Deleted"), super::errors::ScopeSetupDeleteErrors))]
+pub async fn delete_setup(
+    State(s): State<Arc<AppState>>,
+    Path(name): Path<String>,
+    client: super::Client,
+    _: JsonBody<crate::model::EmptyBody>,
+) -> AppResult<StatusCode> {
+    scope::delete_setup(&s, &name, &client.0).await?;
+    Ok(StatusCode::NO_CONTENT)
 }

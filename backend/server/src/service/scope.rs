@@ -3,7 +3,7 @@
 
 use crate::app::AppState;
 use crate::error::{AppError, AppResult};
-use crate::model::RecordingRequest;
+use crate::model::{ClientInfo, RecordingRequest, ScopeSetup, ScopeSetupResource};
 use crate::scope::{
     MAX_SAMPLES, NewRecording, SCOPE_CHANNELS, ScopeChannel, ScopeSignal, ScopeTrigger, TriggerEdge,
 };
@@ -125,4 +125,92 @@ pub fn recording(s: &AppState, body: RecordingRequest) -> AppResult<NewRecording
         trigger,
         pre_trigger_samples,
     })
+}
+
+/// The largest `view` of a scope setup, as JSON.
+const MAX_VIEW: usize = 64 * 1024;
+
+fn setup_resource(stored: crate::store::scope_setups::StoredSetup) -> Option<ScopeSetupResource> {
+    let setup = serde_json::from_str(&stored.body).ok()?;
+    Some(ScopeSetupResource {
+        name: stored.name,
+        updated_at: stored.updated_at,
+        setup,
+    })
+}
+
+/// The saved scope setups, by name.
+pub async fn setups(s: &AppState) -> AppResult<Vec<ScopeSetupResource>> {
+    let rows = crate::store::scope_setups::list(&s.db).await?;
+    Ok(rows.into_iter().filter_map(setup_resource).collect())
+}
+
+pub async fn setup(s: &AppState, name: &str) -> AppResult<ScopeSetupResource> {
+    setups(s)
+        .await?
+        .into_iter()
+        .find(|x| x.name == name)
+        .ok_or_else(|| AppError::not_found("scope_setup", name))
+}
+
+/// Stores a setup under `name` (checked as a recording request would be, against the axes
+/// there are now); `Ok((resource, created))`.
+pub async fn put_setup(
+    s: &AppState,
+    name: &str,
+    setup: ScopeSetup,
+    client: &ClientInfo,
+) -> AppResult<(ScopeSetupResource, bool)> {
+    if !crate::model::valid_name(name) {
+        return Err(AppError::field(
+            "name",
+            "must start with a letter or '_' and contain only letters, digits, '_' or '-' (at most 64)",
+        ));
+    }
+    recording(s, setup.recording.clone()).map_err(|e| match e {
+        AppError::Invalid(errs) => AppError::Invalid(
+            errs.into_iter()
+                .map(|f| FieldError {
+                    field: format!("recording.{}", f.field),
+                    message: f.message,
+                })
+                .collect(),
+        ),
+        e => e,
+    })?;
+    let body = serde_json::to_string(&setup).expect("a setup serialises");
+    if serde_json::to_string(&setup.view).map_or(0, |v| v.len()) > MAX_VIEW {
+        return Err(AppError::field("view", "at most 64 KiB of JSON"));
+    }
+    let at = crate::store::now_rfc3339();
+    let mut tx = s.db.begin().await?;
+    let replaced = crate::store::scope_setups::put(&mut tx, name, &body, &at).await?;
+    crate::store::audit(
+        &mut *tx,
+        &crate::service::axes::audit_entry(client, "scope_setup.put", name, body),
+    )
+    .await?;
+    tx.commit().await?;
+    Ok((
+        ScopeSetupResource {
+            name: name.to_owned(),
+            updated_at: at,
+            setup,
+        },
+        !replaced,
+    ))
+}
+
+pub async fn delete_setup(s: &AppState, name: &str, client: &ClientInfo) -> AppResult<()> {
+    let mut tx = s.db.begin().await?;
+    if !crate::store::scope_setups::delete(&mut tx, name).await? {
+        return Err(AppError::not_found("scope_setup", name));
+    }
+    crate::store::audit(
+        &mut *tx,
+        &crate::service::axes::audit_entry(client, "scope_setup.delete", name, String::new()),
+    )
+    .await?;
+    tx.commit().await?;
+    Ok(())
 }

@@ -9,6 +9,7 @@ pub mod audit;
 pub mod auth;
 pub mod axes;
 pub mod cams;
+pub mod scope_setups;
 
 pub use audit::{
     AuditEntry, AuditOp, AuditRow, audit, audit_outcome, find_idempotency_key, read_audit,
