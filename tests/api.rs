@@ -1007,7 +1007,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 66, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 68, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -1133,7 +1133,7 @@ async fn asyncapi_json_is_current() {
             "{method}"
         );
     }
-    assert_eq!(commands, 28);
+    assert_eq!(commands, 30);
     let s = Server::start();
     let served = get(&s, "/asyncapi.json").await;
     assert_eq!(served.status, 200);

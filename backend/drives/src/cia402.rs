@@ -315,8 +315,10 @@ impl Cia402Drive {
             TP_ENABLE
                 | match sp.latch_source {
                     LatchSource::IndexPulse => TP_SOURCE_INDEX | TP_POS_EDGE,
-                    LatchSource::CamRising => TP_POS_EDGE,
-                    LatchSource::CamFalling => TP_NEG_EDGE,
+                    // The drive's probe input 1 (0x60B8 bits 2-3 = 00) is where a reference
+                    // switch or a measuring probe is wired.
+                    LatchSource::CamRising | LatchSource::Input1Rising => TP_POS_EDGE,
+                    LatchSource::CamFalling | LatchSource::Input1Falling => TP_NEG_EDGE,
                 }
         } else {
             0

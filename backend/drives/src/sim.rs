@@ -388,8 +388,15 @@ pub enum SimFault {
     Load { force: f64 },
     /// Force a limit switch input on or off (in addition to the configured positions).
     LimitSwitch { positive: bool, active: bool },
-    /// Remove every injected cause (drive fault, load, forced switches). A latched fault
-    /// still needs a fault reset.
+    /// A mark on the load for the measuring probe at digital input 1: the input is on while
+    /// the actual position is at or beyond `position` (`null` removes the mark), so passing
+    /// the mark is an edge a touch probe latches exactly.
+    ProbeMark { position: Option<f64> },
+    /// Force digital input 1 on or off (besides the mark): the edge happens now, at the
+    /// position the load is at.
+    ProbeInput { active: bool },
+    /// Remove every injected cause (drive fault, load, forced switches and input, the probe
+    /// mark). A latched fault still needs a fault reset.
     Clear,
 }
 
@@ -464,6 +471,12 @@ pub struct SimDrive {
     load_force: f64,
     forced_limit_positive: bool,
     forced_limit_negative: bool,
+    /// Digital input 1 forced on (`SimFault::ProbeInput`).
+    forced_input1: bool,
+    /// The probe mark (`SimFault::ProbeMark`).
+    probe_mark: Option<f64>,
+    /// An edge of input 1 made by `ProbeInput` (true: rising), for the next cycle's latch.
+    input1_edge: Option<bool>,
     /// Switch levels at the end of the last cycle, for edges.
     last_limit_positive: bool,
     last_limit_negative: bool,
@@ -551,6 +564,9 @@ impl SimDrive {
             load_force: 0.0,
             forced_limit_positive: false,
             forced_limit_negative: false,
+            forced_input1: false,
+            probe_mark: None,
+            input1_edge: None,
             last_limit_positive: false,
             last_limit_negative: false,
             latch_valid: false,
@@ -603,11 +619,24 @@ impl SimDrive {
         if !setpoint.latch_enable {
             self.latch_valid = false;
         }
-        let latch = if setpoint.latch_enable && !self.latch_valid {
+        let mut latch = if setpoint.latch_enable && !self.latch_valid {
             Some(setpoint.latch_source)
         } else {
             None
         };
+        // An edge forced on input 1 since the last cycle happened where the load was.
+        if let Some(rising) = self.input1_edge.take() {
+            let wanted = match latch {
+                Some(LatchSource::Input1Rising) => rising,
+                Some(LatchSource::Input1Falling) => !rising,
+                _ => false,
+            };
+            if wanted {
+                self.latch_valid = true;
+                self.latch_position = self.position;
+                latch = None;
+            }
+        }
 
         // The power stage is on for this whole cycle only if it was on at its start.
         let powered = self.enabled;
@@ -659,11 +688,22 @@ impl SimDrive {
                 positive: false,
                 active,
             } => self.forced_limit_negative = active,
+            SimFault::ProbeMark { position } => self.probe_mark = position,
+            SimFault::ProbeInput { active } => {
+                let before = self.input1(self.position);
+                self.forced_input1 = active;
+                let after = self.input1(self.position);
+                if before != after {
+                    self.input1_edge = Some(after);
+                }
+            }
             SimFault::Clear => {
                 self.injected_fault = None;
                 self.load_force = 0.0;
                 self.forced_limit_positive = false;
                 self.forced_limit_negative = false;
+                self.forced_input1 = false;
+                self.probe_mark = None;
             }
         }
     }
@@ -694,6 +734,11 @@ impl SimDrive {
         self.config
             .reference_cam
             .is_some_and(|cam| cam.start <= x && x <= cam.end)
+    }
+
+    /// Digital input 1 at a position: forced on, or at or beyond the probe mark.
+    fn input1(&self, x: f64) -> bool {
+        self.forced_input1 || self.probe_mark.is_some_and(|m| x >= m)
     }
 
     fn limit_levels(&self) -> (bool, bool) {
@@ -835,6 +880,10 @@ impl SimDrive {
                 .config
                 .reference_cam
                 .and_then(|cam| cam_edge(a, b, cam, false)),
+            // The mark's edge, unless the input is forced on (then it has no edges).
+            LatchSource::Input1Rising | LatchSource::Input1Falling if self.forced_input1 => None,
+            LatchSource::Input1Rising => self.probe_mark.and_then(|m| mark_edge(a, b, m, true)),
+            LatchSource::Input1Falling => self.probe_mark.and_then(|m| mark_edge(a, b, m, false)),
         };
         if let Some(x) = event {
             self.latch_valid = true;
@@ -871,6 +920,14 @@ fn index_crossing(a: f64, b: f64, ip: IndexPulse) -> Option<f64> {
 /// Where the cam signal rises (`rising`) or falls on the way from `a` to `b`. The signal is
 /// true on `[start, end]`: moving positive it rises at `start` and falls after `end`, moving
 /// negative it rises at `end` and falls after `start`.
+/// The edge of an input that is on at and beyond `mark`, on the way from `a` to `b`: rising
+/// when reaching it from below, falling when leaving it downwards.
+fn mark_edge(a: f64, b: f64, mark: f64, rising: bool) -> Option<f64> {
+    let up = a < mark && mark <= b;
+    let down = b < mark && mark <= a;
+    ((rising && up) || (!rising && down)).then_some(mark)
+}
+
 fn cam_edge(a: f64, b: f64, cam: ReferenceCam, rising: bool) -> Option<f64> {
     let ReferenceCam { start, end } = cam;
     if b > a {
@@ -925,6 +982,14 @@ mod tests {
         assert!(a < 5.0 * 0.7);
         assert_eq!(index_crossing(a, 3.6, ip), Some(5.0 * 0.7));
         assert_eq!(index_crossing(5.0 * 0.7 + 1e-12, a, ip), Some(5.0 * 0.7));
+    }
+
+    #[test]
+    fn a_probe_mark_has_a_rising_edge_upwards_and_a_falling_one_downwards() {
+        assert_eq!(mark_edge(4.0, 6.0, 5.0, true), Some(5.0));
+        assert_eq!(mark_edge(4.0, 6.0, 5.0, false), None);
+        assert_eq!(mark_edge(6.0, 4.0, 5.0, false), Some(5.0));
+        assert_eq!(mark_edge(5.0, 6.0, 5.0, true), None, "already on");
     }
 
     #[test]

@@ -342,6 +342,10 @@ pub enum CommandKind {
         number: u16,
         value: f64,
     },
+    /// MC_TouchProbe: arm the drive's latch for one edge of `trigger`'s signal.
+    TouchProbe(TouchProbe),
+    /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
+    AbortTrigger,
     /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
     /// switch off a Power).
     Release {
@@ -388,10 +392,27 @@ impl CommandKind {
             CommandKind::MoveSuperImposed(_) => "move-superimposed",
             CommandKind::AbortSuperposition => "abort-superposition",
             CommandKind::WriteParameter { .. } => "write-parameter",
+            CommandKind::TouchProbe(_) => "touch-probe",
+            CommandKind::AbortTrigger => "abort-trigger",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
         }
     }
+}
+
+/// MC_TouchProbe's inputs (spec §4.3.1 and TRIGGER_REF, §6.15).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TouchProbe {
+    /// The signal and edge (`TRIGGER_REF.SignalSource`/`Edge`).
+    pub source: crate::LatchSource,
+    /// Only a position within [first_position, last_position] completes the cycle; one
+    /// outside is discarded and the latch re-armed.
+    pub window_only: bool,
+    pub first_position: f64,
+    pub last_position: f64,
+    /// `TRIGGER_REF.ModuloPositions`: positions (window and recorded) are modulo the axis's
+    /// AxisEncoderModuloValue; the window repeats every period and wraps when first > last.
+    pub modulo_positions: bool,
 }
 
 /// A command addressed to one axis.

@@ -31,6 +31,10 @@ pub enum LatchSource {
     CamRising,
     /// Falling edge of the reference cam input.
     CamFalling,
+    /// Rising edge of the drive's digital input 1 (a measuring probe).
+    Input1Rising,
+    /// Falling edge of the drive's digital input 1.
+    Input1Falling,
 }
 
 /// Feedback from one drive, read every cycle.

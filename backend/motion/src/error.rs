@@ -135,6 +135,9 @@ error_table! {
     CAM_NOT_COUPLED = 0x7087, "cam_not_coupled", "the axis is not coupled through a cam";
     /// MC_CamIn and MC_CamIn_V2 exclude each other on a slave (spec §1.9).
     CAM_FAMILY_MIXED = 0x7088, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave";
+    /// MC_TouchProbe while a probe cycle runs (end it first: MC_AbortTrigger) or while homing
+    /// uses the drive's latch.
+    TOUCH_PROBE_BUSY = 0x7090, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)";
 }
 
 impl fmt::Display for ErrorId {

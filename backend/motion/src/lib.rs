@@ -77,4 +77,4 @@ pub use drive::{DriveFeedback, DriveSetpoint, LatchSource};
 pub use error::ErrorId;
 pub use kernel::Kernel;
 pub use params::AxisParameters;
-pub use status::{AxisState, AxisStatus, HomingPhase};
+pub use status::{AxisState, AxisStatus, HomingPhase, ProbeStatus};

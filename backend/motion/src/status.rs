@@ -148,4 +148,26 @@ pub struct AxisStatus {
     pub cam_data_queued: bool,
     /// MC_CamInfo: the cam coupling (`cam_table_id` 0 when not coupled through a cam).
     pub cam: crate::cam::CamInfo,
+    /// MC_TouchProbe: armed, and what the last probe cycle recorded.
+    pub probe: ProbeStatus,
+}
+
+/// The touch probe of an axis (`MC_TouchProbeRecordedData` of its last probe cycle).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"armed": false, "command": 42, "counter": 1,
+    "recorded_position": 5.0, "absolute_position": 365.0, "modulo_position": 5.0})))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ProbeStatus {
+    /// A probe cycle (MC_TouchProbe) is running: the latch is armed.
+    pub armed: bool,
+    /// Command id of the probe cycle that recorded the values below (0: none yet).
+    pub command: u64,
+    /// Edges recorded since the axis was built (those outside a window-only window are not
+    /// counted).
+    pub counter: u32,
+    /// The latched position, absolute or modulo as the probe cycle asked.
+    pub recorded_position: f64,
+    pub absolute_position: f64,
+    /// Within [0, AxisEncoderModuloValue) (the absolute position when that is 0).
+    pub modulo_position: f64,
 }

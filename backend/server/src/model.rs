@@ -411,6 +411,18 @@ pub struct CommandEventDto {
     pub outputs: FbOutputs,
 }
 
+/// `MC_TouchProbeRecordedData` of a done probe cycle.
+#[derive(Clone, Copy, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"recorded_position": 5.0, "absolute_position": 365.0, "modulo_position": 5.0, "counter": 1}))]
+pub struct ProbeResult {
+    /// Absolute or modulo, as the probe cycle asked (`modulo_positions`).
+    pub recorded_position: f64,
+    pub absolute_position: f64,
+    pub modulo_position: f64,
+    /// Edges recorded on the axis so far (this one included).
+    pub counter: u32,
+}
+
 /// Where a command came from.
 #[derive(Clone, Debug, Default, Serialize, ToSchema)]
 #[schema(example = json!({"addr": "127.0.0.1:50312", "id": "line-3-mes", "via": "rest"}))]
@@ -487,6 +499,10 @@ pub struct CommandResource {
     pub client: ClientInfo,
     /// Output changes in order (the most recent 64).
     pub events: Vec<CommandEventDto>,
+    /// What a done `touch-probe` recorded (MC_TouchProbe's RecordedPosition and
+    /// RecordedData); absent for other blocks and before it is done.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub result: Option<ProbeResult>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -524,6 +540,57 @@ pub enum CouplingInterpolation {
     Linear,
     Spline,
     SlidingSpline,
+}
+
+/// The signal a touch probe latches on (`TRIGGER_REF.SignalSource`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ProbeSignal {
+    /// The drive's probe input 1 (a measuring probe; simulated: `probe_mark`/`probe_input`
+    /// faults).
+    #[default]
+    Input1,
+    /// The encoder's zero pulse (rising edge only).
+    IndexPulse,
+    /// The reference cam input.
+    ReferenceCam,
+}
+
+/// `E_SignalEdge`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SignalEdge {
+    #[default]
+    Rising,
+    Falling,
+}
+
+/// MC_TouchProbe (§4.3.1): the trigger (signal, edge, modulo positions) and the window.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"signal": "input1", "edge": "rising", "window_only": true,
+    "first_position": 100.0, "last_position": 120.0}))]
+pub struct TouchProbeBody {
+    /// Default `input1`.
+    #[serde(default)]
+    pub signal: ProbeSignal,
+    /// Default `rising`.
+    #[serde(default)]
+    pub edge: SignalEdge,
+    /// Only a position within [first_position, last_position] completes the cycle; an edge
+    /// outside is discarded and the latch re-armed.
+    #[serde(default)]
+    pub window_only: bool,
+    #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub first_position: f64,
+    #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub last_position: f64,
+    /// Positions (window and recorded) modulo the axis's period (AxisEncoderModuloValue);
+    /// the window repeats every period and wraps when first > last.
+    #[serde(default)]
+    pub modulo_positions: bool,
 }
 
 /// MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).

@@ -151,6 +151,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/abort-trigger": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture */
+        post: operations["abort_trigger"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/cam-add": {
         parameters: {
             query?: never;
@@ -716,6 +733,23 @@ export interface paths {
         put?: never;
         /** MC_Stop: stops and locks the axis until released with DELETE /commands/{id} */
         post: operations["stop"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/touch-probe": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result` */
+        post: operations["touch_probe"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1541,6 +1575,14 @@ export interface components {
          *       "override_percent": 100,
          *       "power_override_percent": 0,
          *       "power_status": true,
+         *       "probe": {
+         *         "absolute_position": 0,
+         *         "armed": false,
+         *         "command": 0,
+         *         "counter": 0,
+         *         "modulo_position": 0,
+         *         "recorded_position": 0
+         *       },
          *       "remaining_distance": 185.889,
          *       "remaining_time": 1.019,
          *       "set_acceleration": 0,
@@ -1681,6 +1723,8 @@ export interface components {
             cam_data_queued: boolean;
             /** @description MC_CamInfo: the cam coupling (`cam_table_id` 0 when not coupled through a cam). */
             cam: components["schemas"]["CamInfo"];
+            /** @description MC_TouchProbe: armed, and what the last probe cycle recorded. */
+            probe: components["schemas"]["ProbeStatus"];
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
@@ -2589,6 +2633,7 @@ export interface components {
             client: components["schemas"]["ClientInfo"];
             /** @description Output changes in order (the most recent 64). */
             events: components["schemas"]["CommandEventDto"][];
+            result?: null | components["schemas"]["ProbeResult"];
         };
         /**
          * @description A command's life as the API shows it.
@@ -3429,6 +3474,14 @@ export interface components {
          *       "override_percent": 100,
          *       "power_override_percent": 0,
          *       "power_status": true,
+         *       "probe": {
+         *         "absolute_position": 0,
+         *         "armed": false,
+         *         "command": 0,
+         *         "counter": 0,
+         *         "modulo_position": 0,
+         *         "recorded_position": 0
+         *       },
          *       "remaining_distance": 185.889,
          *       "remaining_time": 1.019,
          *       "set_acceleration": 0,
@@ -4070,6 +4123,74 @@ export interface components {
             override_percent: number;
         };
         /**
+         * @description `MC_TouchProbeRecordedData` of a done probe cycle.
+         * @example {
+         *       "absolute_position": 365,
+         *       "counter": 1,
+         *       "modulo_position": 5,
+         *       "recorded_position": 5
+         *     }
+         */
+        ProbeResult: {
+            /**
+             * Format: double
+             * @description Absolute or modulo, as the probe cycle asked (`modulo_positions`).
+             */
+            recorded_position: number;
+            /** Format: double */
+            absolute_position: number;
+            /** Format: double */
+            modulo_position: number;
+            /**
+             * Format: int32
+             * @description Edges recorded on the axis so far (this one included).
+             */
+            counter: number;
+        };
+        /**
+         * @description The signal a touch probe latches on (`TRIGGER_REF.SignalSource`).
+         * @enum {string}
+         */
+        ProbeSignal: "input1" | "index_pulse" | "reference_cam";
+        /**
+         * @description The touch probe of an axis (`MC_TouchProbeRecordedData` of its last probe cycle).
+         * @example {
+         *       "absolute_position": 365,
+         *       "armed": false,
+         *       "command": 42,
+         *       "counter": 1,
+         *       "modulo_position": 5,
+         *       "recorded_position": 5
+         *     }
+         */
+        ProbeStatus: {
+            /** @description A probe cycle (MC_TouchProbe) is running: the latch is armed. */
+            armed: boolean;
+            /**
+             * Format: int64
+             * @description Command id of the probe cycle that recorded the values below (0: none yet).
+             */
+            command: number;
+            /**
+             * Format: int32
+             * @description Edges recorded since the axis was built (those outside a window-only window are not
+             *     counted).
+             */
+            counter: number;
+            /**
+             * Format: double
+             * @description The latched position, absolute or modulo as the probe cycle asked.
+             */
+            recorded_position: number;
+            /** Format: double */
+            absolute_position: number;
+            /**
+             * Format: double
+             * @description Within [0, AxisEncoderModuloValue) (the absolute position when that is 0).
+             */
+            modulo_position: number;
+        };
+        /**
          * @description `application/problem+json` body.
          * @example {
          *       "code": "axis_cannot_be_started",
@@ -4477,6 +4598,11 @@ export interface components {
             clear_position_lag?: boolean;
         };
         /**
+         * @description `E_SignalEdge`.
+         * @enum {string}
+         */
+        SignalEdge: "rising" | "falling";
+        /**
          * @description A fault or disturbance injected into the simulation (tests, demos, commissioning).
          * @example {
          *       "force": 50,
@@ -4498,6 +4624,15 @@ export interface components {
             /** @enum {string} */
             kind: "limit_switch";
             positive: boolean;
+        } | {
+            /** @enum {string} */
+            kind: "probe_mark";
+            /** Format: double */
+            position?: number | null;
+        } | {
+            active: boolean;
+            /** @enum {string} */
+            kind: "probe_input";
         } | {
             /** @enum {string} */
             kind: "clear";
@@ -4674,6 +4809,14 @@ export interface components {
          *         "override_percent": 100,
          *         "power_override_percent": 0,
          *         "power_status": true,
+         *         "probe": {
+         *           "absolute_position": 0,
+         *           "armed": false,
+         *           "command": 0,
+         *           "counter": 0,
+         *           "modulo_position": 0,
+         *           "recorded_position": 0
+         *         },
          *         "remaining_distance": 185.889,
          *         "remaining_time": 1.019,
          *         "set_acceleration": 0,
@@ -4984,6 +5127,36 @@ export interface components {
             /** @description Written at most once a minute. */
             last_used_at?: string | null;
             revoked_at?: string | null;
+        };
+        /**
+         * @description MC_TouchProbe (§4.3.1): the trigger (signal, edge, modulo positions) and the window.
+         * @example {
+         *       "edge": "rising",
+         *       "first_position": 100,
+         *       "last_position": 120,
+         *       "signal": "input1",
+         *       "window_only": true
+         *     }
+         */
+        TouchProbeBody: {
+            /** @description Default `input1`. */
+            signal?: components["schemas"]["ProbeSignal"];
+            /** @description Default `rising`. */
+            edge?: components["schemas"]["SignalEdge"];
+            /**
+             * @description Only a position within [first_position, last_position] completes the cycle; an edge
+             *     outside is discarded and the latch re-armed.
+             */
+            window_only?: boolean;
+            /** Format: double */
+            first_position?: number;
+            /** Format: double */
+            last_position?: number;
+            /**
+             * @description Positions (window and recorded) modulo the axis's period (AxisEncoderModuloValue);
+             *     the window repeats every period and wraps when first > last.
+             */
+            modulo_positions?: boolean;
         };
         /**
          * @description Direction of a trigger crossing.
@@ -6370,6 +6543,66 @@ export interface operations {
         };
     };
     abort_superposition: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    abort_trigger: {
         parameters: {
             query?: {
                 /**
@@ -8277,6 +8510,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["StopBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    touch_probe: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["TouchProbeBody"];
             };
         };
         responses: {

@@ -244,6 +244,12 @@ impl Axis {
                 cx.report(cmd.id, DONE);
                 Ok(())
             }
+            CommandKind::TouchProbe(t) => self.submit_touch_probe(cx, cmd.id, t),
+            CommandKind::AbortTrigger => {
+                self.abort_trigger(cx);
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
             CommandKind::Home {
                 position,
                 mode,

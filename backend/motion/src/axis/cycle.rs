@@ -95,6 +95,7 @@ impl Axis {
         } else {
             self.in_window_timer = 0.0;
         }
+        let probe_armed = self.step_probe(cx, fb);
         self.update_status();
         // The peak hold counts cycles only: a submit's status update sees the setpoint the
         // drive has not answered yet. NaN feedback cannot stick (f64::min/max skip NaN).
@@ -110,8 +111,12 @@ impl Axis {
             position: self.set.position - self.offset,
             velocity: self.set.velocity,
             acceleration: self.set.acceleration,
-            latch_enable: self.latch.is_some(),
-            latch_source: self.latch.unwrap_or_default(),
+            latch_enable: self.latch.is_some() || probe_armed,
+            latch_source: match (self.latch, &self.probe) {
+                (Some(l), _) => l,
+                (None, Some(p)) if probe_armed => p.source(),
+                _ => LatchSource::default(),
+            },
         }
     }
 

@@ -35,6 +35,7 @@ mod job;
 mod monitoring;
 mod motion;
 mod planning;
+mod probe;
 mod status;
 mod superposition;
 
@@ -122,6 +123,8 @@ pub struct Axis {
     /// sample of the main motion).
     set_has_superposition: bool,
     latch: Option<LatchSource>,
+    /// MC_TouchProbe's running cycle.
+    probe: Option<probe::Probe>,
     prev_cam: bool,
     /// MC_CamIn waiting for its activation (the axis is not coupled yet).
     cam_in: Option<camming::PendingCamIn>,
@@ -195,6 +198,7 @@ impl Axis {
             superimposed: None,
             set_has_superposition: false,
             latch: None,
+            probe: None,
             prev_cam: false,
             cam_in: None,
             cam_switch: None,

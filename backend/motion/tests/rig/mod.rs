@@ -30,6 +30,8 @@ pub struct Plant {
     pub limit_negative: bool,
     /// Extra lag added to the actual position (a load that the drive cannot hold).
     pub load_lag: f64,
+    /// A measuring probe's mark: digital input 1 is on at and beyond it.
+    pub probe_mark: Option<f64>,
     latch_valid: bool,
     latch_pos: f64,
     prev_pos: f64,
@@ -52,6 +54,7 @@ impl Default for Plant {
             limit_positive: false,
             limit_negative: false,
             load_lag: 0.0,
+            probe_mark: None,
             latch_valid: false,
             latch_pos: 0.0,
             prev_pos: 0.0,
@@ -120,6 +123,14 @@ impl Plant {
                     let k = (lo / per).ceil() * per;
                     (k <= hi && a != b && k != a).then_some(k)
                 }),
+                LatchSource::Input1Rising | LatchSource::Input1Falling => {
+                    self.probe_mark.and_then(|m| {
+                        let up = a < m && m <= b;
+                        let down = b < m && m <= a;
+                        let rising = sp.latch_source == LatchSource::Input1Rising;
+                        ((rising && up) || (!rising && down)).then_some(m)
+                    })
+                }
                 LatchSource::CamRising | LatchSource::CamFalling => {
                     let (ca, cb) = (self.cam_at(a), self.cam_at(b));
                     let want = sp.latch_source == LatchSource::CamRising;

@@ -233,6 +233,10 @@ catalogue! {
         "MC_MoveSuperImposed: lay a relative distance over the running motion (409 axis_not_moving at standstill; warning 0x4243 when it can only be done in part)";
     abort_superposition: "abort-superposition", EmptyBody, |_, _, _| Ok(CommandKind::AbortSuperposition), Operator, Done,
         "MC_AbortSuperposition: end a running superposition (what it applied so far stays)";
+    touch_probe: "touch-probe", TouchProbeBody, TouchProbeBody::to_kind, Operator, Done,
+        "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
+    abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
+        "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
 }
 
 /// The catalogue entry of a block (websocket method) name.

@@ -32,6 +32,8 @@ pub struct CommandRecord {
     pub events: VecDeque<CommandEventDto>,
     /// The audit entry of its end, when it ended before its acceptance was recorded.
     pub final_audit: Option<AuditEntry>,
+    /// What a done MC_TouchProbe recorded (`MC_TouchProbeRecordedData`).
+    pub result: Option<motion::ProbeStatus>,
 }
 
 impl CommandRecord {
@@ -56,6 +58,12 @@ impl CommandRecord {
             finished_at: self.finished_at.clone(),
             client: self.client.clone(),
             events: self.events.iter().copied().collect(),
+            result: self.result.map(|p| crate::model::ProbeResult {
+                recorded_position: p.recorded_position,
+                absolute_position: p.absolute_position,
+                modulo_position: p.modulo_position,
+                counter: p.counter,
+            }),
         }
     }
 }

@@ -75,6 +75,8 @@ pub struct AppState {
     pub auth: Arc<crate::auth::Auth>,
     /// Who holds control of the machine.
     pub control: crate::service::control::Control,
+    /// Done MC_TouchProbe commands (id, slot) whose recorded data is still to be read.
+    pub probe_results: Mutex<Vec<(u64, u16)>>,
 }
 
 impl AppState {
@@ -112,6 +114,7 @@ impl AppState {
             info,
             auth,
             control: crate::service::control::Control::new(control_lease),
+            probe_results: Mutex::new(Vec::new()),
         };
         (Arc::new(state), audit_rx)
     }

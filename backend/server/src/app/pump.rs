@@ -31,6 +31,11 @@ impl AppState {
                 let Some(n) = apply_event(&mut store, &ev) else {
                     continue;
                 };
+                if n.is_final && n.outputs.done && n.name == "touch-probe" {
+                    if let Some(r) = store.map.get(&n.command) {
+                        self.probe_results.lock().unwrap().push((r.id, r.slot));
+                    }
+                }
                 if n.is_final {
                     if let Some(r) = store.map.get_mut(&n.command) {
                         let entry = final_audit(&n, &r.client);
@@ -48,6 +53,28 @@ impl AppState {
         }
         for e in audits {
             self.audit(e);
+        }
+        // A done probe cycle's recorded position, from the axis status that records it (the
+        // snapshot of its cycle may be published after its event: tried until it is).
+        {
+            let mut pending = self.probe_results.lock().unwrap();
+            if !pending.is_empty() {
+                let mut store = self.commands.lock().unwrap();
+                pending.retain(|&(id, slot)| {
+                    let Some(probe) = self.status(slot).1.map(|st| st.probe) else {
+                        return false;
+                    };
+                    if probe.command < id {
+                        return true;
+                    }
+                    if probe.command == id {
+                        if let Some(r) = store.map.get_mut(&id) {
+                            r.result = Some(probe);
+                        }
+                    }
+                    false
+                });
+            }
         }
         {
             let mut scope = self.scope.lock().unwrap();

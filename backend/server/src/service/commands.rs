@@ -607,6 +607,39 @@ impl CamScalingBody {
     }
 }
 
+impl TouchProbeBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        use motion::LatchSource as L;
+        let mut c = Check::default();
+        c.finite("first_position", self.first_position);
+        c.finite("last_position", self.last_position);
+        if self.window_only && !self.modulo_positions && self.first_position > self.last_position {
+            c.fail(
+                "last_position",
+                "an absolute window needs first_position <= last_position (only a modulo window wraps)",
+            );
+        }
+        let source = match (self.signal, self.edge) {
+            (ProbeSignal::Input1, SignalEdge::Rising) => L::Input1Rising,
+            (ProbeSignal::Input1, SignalEdge::Falling) => L::Input1Falling,
+            (ProbeSignal::ReferenceCam, SignalEdge::Rising) => L::CamRising,
+            (ProbeSignal::ReferenceCam, SignalEdge::Falling) => L::CamFalling,
+            (ProbeSignal::IndexPulse, SignalEdge::Rising) => L::IndexPulse,
+            (ProbeSignal::IndexPulse, SignalEdge::Falling) => {
+                c.fail("edge", "the index pulse is latched on its rising edge only");
+                L::IndexPulse
+            }
+        };
+        c.done(CommandKind::TouchProbe(motion::TouchProbe {
+            source,
+            window_only: self.window_only,
+            first_position: self.first_position,
+            last_position: self.last_position,
+            modulo_positions: self.modulo_positions,
+        }))
+    }
+}
+
 impl MoveSuperImposedBody {
     pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
@@ -761,6 +794,7 @@ async fn submit(
         finished_at: None,
         events: VecDeque::new(),
         final_audit: None,
+        result: None,
     });
     // The submission row is stored while the cycle thread decides (both take about a tenth
     // of a millisecond; docs/decisions.md 71 and 79), so that no acknowledged command misses

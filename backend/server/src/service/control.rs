@@ -251,6 +251,9 @@ impl Control {
             CommandKind::Stop { .. }
                 | CommandKind::Halt { .. }
                 | CommandKind::Power { enable: false, .. }
+                // A probe moves nothing.
+                | CommandKind::TouchProbe(_)
+                | CommandKind::AbortTrigger
         );
         if always {
             return Ok(());

@@ -1,0 +1,101 @@
+//! MC_TouchProbe / MC_AbortTrigger over HTTP with the simulated drive's probe input: a mark on
+//! the load (`probe_mark`) or the input forced (`probe_input`), the recorded position in the
+//! command's `result` and the axis status.
+
+mod common;
+
+use common::*;
+use serde_json::json;
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_touch_probe_records_where_the_load_passed_the_mark() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "probe_mark", "position": 123.456}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let p = post(
+        &s,
+        "/api/v1/axes/x/touch-probe",
+        json!({"signal": "input1", "edge": "rising", "window_only": true, "first_position": 100.0, "last_position": 150.0}),
+    )
+    .await;
+    assert_eq!(p.status, 202, "{}", p.text);
+    assert_eq!(p.json["state"], "busy", "{}", p.text);
+    let id = p.json["id"].as_u64().unwrap();
+    assert_eq!(status(&s, "x").await["status"]["probe"]["armed"], true);
+    // A second probe cycle while one runs is refused.
+    let r = post(&s, "/api/v1/axes/x/touch-probe", json!({})).await;
+    assert_problem(&r, 409, "touch_probe_busy");
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 200.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "done", "{fin}");
+    // The result is read from the status of the cycle that recorded it.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    let fin = loop {
+        let c = get(&s, &format!("/api/v1/commands/{id}")).await.json;
+        if c["result"].is_object() {
+            break c;
+        }
+        assert!(std::time::Instant::now() < deadline, "no result: {c}");
+        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    };
+    assert_eq!(fin["result"]["recorded_position"], 123.456, "{fin}");
+    assert_eq!(fin["result"]["counter"], 1);
+    let st = status(&s, "x").await;
+    assert_eq!(st["status"]["probe"]["recorded_position"], 123.456, "{st}");
+    assert_eq!(st["status"]["probe"]["command"], id);
+    assert_eq!(st["status"]["probe"]["armed"], false);
+    s.stop();
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_forced_input_edge_latches_where_the_axis_stands_and_abort_trigger_cancels() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let p = post(&s, "/api/v1/axes/y/touch-probe", json!({"edge": "falling"})).await;
+    let id = p.json["id"].as_u64().unwrap();
+    // Rising first (not the wanted edge), then falling: recorded at the standing position 0.
+    for active in [true, false] {
+        let r = post(
+            &s,
+            "/api/v1/axes/y/simulation/fault",
+            json!({"kind": "probe_input", "active": active}),
+        )
+        .await;
+        assert_eq!(r.status, 204, "{}", r.text);
+    }
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "done", "{fin}");
+    // Cancelled before the trigger: CommandAborted, and the abort itself is done.
+    let p = post(
+        &s,
+        "/api/v1/axes/y/touch-probe",
+        json!({"signal": "reference_cam"}),
+    )
+    .await;
+    let id = p.json["id"].as_u64().unwrap();
+    let a = post(&s, "/api/v1/axes/y/abort-trigger?wait=true", json!({})).await;
+    assert_eq!(a.json["state"], "done", "{}", a.text);
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "aborted", "{fin}");
+    // The index pulse has no falling edge to latch.
+    let r = post(
+        &s,
+        "/api/v1/axes/y/touch-probe",
+        json!({"signal": "index_pulse", "edge": "falling"}),
+    )
+    .await;
+    assert_eq!(r.field_error(), (422, Some("edge")));
+    s.stop();
+}
