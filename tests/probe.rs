@@ -99,3 +99,30 @@ async fn a_forced_input_edge_latches_where_the_axis_stands_and_abort_trigger_can
     assert_eq!(r.field_error(), (422, Some("edge")));
     s.stop();
 }
+
+/// MC_CalcDynamicsByRampTime (§4.5.3) as a function endpoint: the manual's 50 % example gives
+/// t1 = t2 = t/3; stiffness 1 is refused with 0x4B06.
+#[tokio::test(flavor = "multi_thread")]
+async fn calc_dynamics_by_ramp_time_gives_the_ramp_of_the_manual() {
+    let s = Server::start();
+    let r = get(
+        &s,
+        "/api/v1/functions/calc-dynamics-by-ramp-time?velocity=300&ramp_time=0.3&stiffness=0.5",
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let t1 = r.json["jerk_time"].as_f64().unwrap();
+    assert!((t1 - 0.1).abs() < 1e-12, "{}", r.text);
+    let a = r.json["acceleration"].as_f64().unwrap();
+    assert!((a - 1500.0).abs() < 1e-9, "{}", r.text);
+    assert_eq!(r.json["deceleration"], r.json["acceleration"]);
+    let r = get(
+        &s,
+        "/api/v1/functions/calc-dynamics-by-ramp-time?velocity=300&ramp_time=0.3&stiffness=1",
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["error_id"], 0x4B06);
+    assert_eq!(r.json["errors"][0]["field"], "stiffness");
+    s.stop();
+}

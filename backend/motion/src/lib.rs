@@ -65,6 +65,7 @@ pub mod cam;
 pub mod command;
 pub mod drive;
 pub mod error;
+pub mod functions;
 pub mod kernel;
 pub mod modulo;
 pub mod params;

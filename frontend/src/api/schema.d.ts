@@ -1015,6 +1015,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/functions/calc-dynamics-by-ramp-time": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_CalcDynamicsByRampTime: acceleration (= deceleration) and jerk that reach a velocity in a ramp time
+         * @description Ramp time t = 2·t1 + t2 (t1 each jerk phase, t2 constant acceleration) with t2/t1 = s/(1−s) for stiffness s: 0 gives a pure S-curve (t1 = t/2), 0.5 gives t1 = t2 = t/3, near 1 a trapezoid. Assumes the velocity is reached (on a short distance it is not). The results go into any move's `acceleration`, `deceleration` and `jerk`.
+         */
+        get: operations["calc_dynamics_by_ramp_time_fb"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/scope/recordings": {
         parameters: {
             query?: never;
@@ -4218,6 +4238,37 @@ export interface components {
             errors?: components["schemas"]["FieldError"][];
         };
         /**
+         * @description MC_CalcDynamicsByRampTime's outputs.
+         * @example {
+         *       "acceleration": 666.6666666666666,
+         *       "constant_acceleration_time": 0.1,
+         *       "deceleration": 666.6666666666666,
+         *       "jerk": 6666.666666666666,
+         *       "jerk_time": 0.1
+         *     }
+         */
+        RampDynamics: {
+            /** Format: double */
+            acceleration: number;
+            /**
+             * Format: double
+             * @description Equal to the acceleration (the manual: the ramp is computed once and used both ways).
+             */
+            deceleration: number;
+            /** Format: double */
+            jerk: number;
+            /**
+             * Format: double
+             * @description t1: each jerk phase of the ramp.
+             */
+            jerk_time: number;
+            /**
+             * Format: double
+             * @description t2: the constant-acceleration phase (ramp time = 2·t1 + t2).
+             */
+            constant_acceleration_time: number;
+        };
+        /**
          * @description How a ramp-in start mode catches the slave up with its cam: limits of the slave's deviation
          *     from the cam position (relative to the cam's own motion). `velocity` must be given for a
          *     ramp-in; acceleration, deceleration and jerk 0 mean the axis defaults (#1004–#1006).
@@ -5679,6 +5730,34 @@ export interface components {
                 [name: string]: unknown;
             };
             content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description An input out of range (`error_id` 0x4B06 `parameter_not_correct`), or an unknown or
+         *     missing query parameter.
+         */
+        FunctionInputInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "stiffness: must be from 0 to below 1 (1 would need an infinite jerk)",
+                 *       "error_id": 19206,
+                 *       "errors": [
+                 *         {
+                 *           "field": "stiffness",
+                 *           "message": "must be from 0 to below 1 (1 would need an infinite jerk)"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -9364,6 +9443,36 @@ export interface operations {
             409: components["responses"]["ControlConflict"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    calc_dynamics_by_ramp_time_fb: {
+        parameters: {
+            query: {
+                /** @description Velocity to reach (> 0), units/s. */
+                velocity: number;
+                /** @description Time to reach it from rest (> 0), s. */
+                ramp_time: number;
+                /** @description 0 (pure S-curve) to below 1 (nearly a trapezoid); default 0.5 (t1 = t2 = t/3). */
+                stiffness?: number;
+            };
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["RampDynamics"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["FunctionInputInvalid"];
         };
     };
     list_recordings: {

@@ -392,6 +392,11 @@ problem_responses! {
     /// The operation takes no parameters: the body must be `{}` (or empty).
     EmptyBodyInvalid(example = json!(p(AppError::field("force", "unknown field `force`, there are no fields"))));
 
+    /// An input out of range (`error_id` 0x4B06 `parameter_not_correct`), or an unknown or
+    /// missing query parameter.
+    FunctionInputInvalid(example = json!(p(AppError::refused("stiffness", ErrorId::PARAMETER_NOT_CORRECT,
+        "must be from 0 to below 1 (1 would need an infinite jerk)"))));
+
     /// Invalid fields; `errors` names every one.
     BodyInvalid(example = json!(p(AppError::field("name", "must be 1-64 characters of letters, digits and . - _ @"))));
 
@@ -596,6 +601,8 @@ error_sets! {
         404: RecordingNotFound, 409: RecordingNotDone, 422: RecordingQueryInvalid,
         503: RecordingUnavailable,
     }
+    /// `GET /functions/…`.
+    FunctionErrors { 422: FunctionInputInvalid }
     /// `GET /scope/setups/{name}`.
     ScopeSetupReadErrors { 404: ScopeSetupNotFound, 503: AuditUnavailable }
     /// `PUT /scope/setups/{name}`.

@@ -8,6 +8,7 @@ pub mod blocks;
 pub mod cams;
 pub mod commands;
 pub mod errors;
+pub mod functions;
 pub mod guard;
 pub mod scope;
 pub mod shape;
@@ -297,6 +298,10 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .post(auth::take_control)
                 .delete(auth::release_control),
         )
+        .route(
+            "/functions/calc-dynamics-by-ramp-time",
+            get(functions::calc_dynamics_by_ramp_time_fb),
+        )
         .route("/system", get(system::system))
         .route("/audit", get(audit::audit_log))
         .route(
@@ -492,6 +497,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         simulation::inject_fault,
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,
+        functions::calc_dynamics_by_ramp_time_fb,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,

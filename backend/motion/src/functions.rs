@@ -1,0 +1,83 @@
+//! Function FBs of Tc2_MC2 that compute values and touch no axis (spec §4.5).
+
+use serde::Serialize;
+
+use crate::ErrorId;
+
+/// MC_CalcDynamicsByRampTime's outputs.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"acceleration": 666.6666666666666,
+    "deceleration": 666.6666666666666, "jerk": 6666.666666666666, "jerk_time": 0.1, "constant_acceleration_time": 0.1})))]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RampDynamics {
+    pub acceleration: f64,
+    /// Equal to the acceleration (the manual: the ramp is computed once and used both ways).
+    pub deceleration: f64,
+    pub jerk: f64,
+    /// t1: each jerk phase of the ramp.
+    pub jerk_time: f64,
+    /// t2: the constant-acceleration phase (ramp time = 2·t1 + t2).
+    pub constant_acceleration_time: f64,
+}
+
+/// MC_CalcDynamicsByRampTime (§4.5.3): the acceleration (= deceleration) and jerk that reach
+/// `velocity` from rest in `ramp_time`, with `stiffness` in [0, 1) setting how much of the
+/// ramp is constant acceleration: t2/t1 = s/(1−s), so 0 is a pure S-curve (t1 = t/2, t2 = 0),
+/// 0.5 gives t1 = t2 = t/3 and near 1 a trapezoid (the manual's three examples). Stiffness 1
+/// would need an infinite jerk and is refused, as are a velocity or ramp time not > 0.
+pub fn calc_dynamics_by_ramp_time(
+    velocity: f64,
+    ramp_time: f64,
+    stiffness: f64,
+) -> Result<RampDynamics, ErrorId> {
+    let finite_positive = |x: f64| x.is_finite() && x > 0.0;
+    if !(finite_positive(velocity) && finite_positive(ramp_time) && (0.0..1.0).contains(&stiffness))
+    {
+        return Err(ErrorId::PARAMETER_NOT_CORRECT);
+    }
+    let t1 = ramp_time * (1.0 - stiffness) / (2.0 - stiffness);
+    let t2 = ramp_time * stiffness / (2.0 - stiffness);
+    let acceleration = velocity / (t1 + t2);
+    Ok(RampDynamics {
+        acceleration,
+        deceleration: acceleration,
+        jerk: acceleration / t1,
+        jerk_time: t1,
+        constant_acceleration_time: t2,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The manual's examples: stiffness 0 → t1 = t/2, t2 = 0; 0.5 → t1 = t2 = t/3; 0.99 →
+    /// t1 ≈ 0, t2 ≈ t. Integrating the profile reaches the velocity at the ramp time.
+    #[test]
+    fn the_manuals_three_stiffnesses() {
+        for (s, t1, t2) in [
+            (0.0, 0.5, 0.0),
+            (0.5, 1.0 / 3.0, 1.0 / 3.0),
+            (0.99, 0.0099, 0.9802),
+        ] {
+            let d = calc_dynamics_by_ramp_time(300.0, 1.0, s).unwrap();
+            assert!((d.jerk_time - t1).abs() < 1e-4, "{s}: {d:?}");
+            assert!(
+                (d.constant_acceleration_time - t2).abs() < 1e-4,
+                "{s}: {d:?}"
+            );
+            assert_eq!(d.deceleration, d.acceleration);
+            // v(t) = jerk·t1² (both jerk phases) + a·t2.
+            let v =
+                d.jerk * d.jerk_time * d.jerk_time + d.acceleration * d.constant_acceleration_time;
+            assert!((v - 300.0).abs() < 1e-9, "{s}: reaches {v}");
+            assert!((2.0 * d.jerk_time + d.constant_acceleration_time - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(
+            calc_dynamics_by_ramp_time(300.0, 1.0, 1.0),
+            Err(ErrorId::PARAMETER_NOT_CORRECT)
+        );
+        assert!(calc_dynamics_by_ramp_time(0.0, 1.0, 0.5).is_err());
+        assert!(calc_dynamics_by_ramp_time(10.0, 0.0, 0.5).is_err());
+    }
+}
