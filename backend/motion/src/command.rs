@@ -248,6 +248,10 @@ pub enum CommandKind {
         position: f64,
         relative: bool,
         clear_position_lag: bool,
+        /// `ST_SetPositionOptions.ClearPositionOffset`: undo the offset earlier
+        /// MC_SetPositions accumulated (#2003), back to the referenced coordinates;
+        /// `position` and `relative` are then not used.
+        clear_position_offset: bool,
     },
     /// MC_SetOverride (velocity factor 0..=1).
     SetOverride {

@@ -610,6 +610,10 @@ pub struct SetPositionBody {
     pub relative: bool,
     #[serde(default, skip_serializing_if = "is_false")]
     pub clear_position_lag: bool,
+    /// Undo the offset earlier set-positions accumulated (`status.set_position_offset`),
+    /// back to the referenced coordinates; `position` and `relative` are then not used.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub clear_position_offset: bool,
 }
 
 /// MC_SetOverride.

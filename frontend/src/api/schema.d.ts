@@ -4647,6 +4647,11 @@ export interface components {
             position: number;
             relative?: boolean;
             clear_position_lag?: boolean;
+            /**
+             * @description Undo the offset earlier set-positions accumulated (`status.set_position_offset`),
+             *     back to the referenced coordinates; `position` and `relative` are then not used.
+             */
+            clear_position_offset?: boolean;
         };
         /**
          * @description `E_SignalEdge`.

@@ -116,7 +116,14 @@ impl Axis {
                 position,
                 relative,
                 clear_position_lag,
+                clear_position_offset,
             } => {
+                // Undoing the accumulated offset is a relative shift by its opposite.
+                let (position, relative) = if clear_position_offset {
+                    (-self.set_position_offset, true)
+                } else {
+                    (position, relative)
+                };
                 if !position.is_finite() {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }

@@ -148,7 +148,8 @@ fn set_position_during_motion_shifts_coordinates_not_the_motion() {
             CommandKind::SetPosition {
                 position: 0.0,
                 relative: false,
-                clear_position_lag: false
+                clear_position_lag: false,
+                clear_position_offset: false,
             }
         ),
         ErrorId::AXIS_CANNOT_BE_STARTED
@@ -159,11 +160,45 @@ fn set_position_during_motion_shifts_coordinates_not_the_motion() {
             position: 1000.0,
             relative: true,
             clear_position_lag: false,
+            clear_position_offset: false,
         },
     );
     r.until(5.0, |r| r.out(m).done);
     assert!((r.st(0).set_position - 1100.0).abs() < 1e-9);
     assert!((r.plants[0].pos - 100.0).abs() < 0.01);
+}
+
+/// §4.1.3 Options.ClearPositionOffset: "deletes the accumulated offset created by
+/// MC_SetPosition calls and returns the axis to the originally referenced coordinate system
+/// (the Position input is then irrelevant)"; the following error is kept.
+#[test]
+fn s4_1_3_clear_position_offset_returns_to_the_referenced_coordinates() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let set = |position: f64, relative: bool, clear: bool| CommandKind::SetPosition {
+        position,
+        relative,
+        clear_position_lag: false,
+        clear_position_offset: clear,
+    };
+    r.ok(0, set(5.0, true, false));
+    r.ok(0, set(100.0, false, false));
+    r.run(0.01);
+    assert!((r.st(0).set_position_offset - 100.0).abs() < 1e-9);
+    assert!((r.st(0).actual_position - 100.0).abs() < 1e-9);
+    let lag = r.st(0).following_error;
+    r.ok(0, set(12345.0, false, true));
+    r.run(0.01);
+    assert_eq!(r.st(0).set_position_offset, 0.0);
+    assert!(
+        r.st(0).actual_position.abs() < 1e-9,
+        "{:?}",
+        r.st(0).actual_position
+    );
+    assert!(
+        (r.st(0).following_error - lag).abs() < 1e-9,
+        "the lag is kept"
+    );
 }
 
 /// Decision 95: MC_SetPosition never makes coordinates beyond ±1e15 (or infinite): relative
@@ -175,6 +210,7 @@ fn set_position_refuses_coordinates_beyond_what_a_position_resolves() {
         position,
         relative,
         clear_position_lag: false,
+        clear_position_offset: false,
     };
     r.ok(0, set(9e14, true));
     assert_eq!(
@@ -211,6 +247,7 @@ fn set_position_with_clear_lag_during_motion_clears_it_for_good() {
             position: 0.0,
             relative: true,
             clear_position_lag: true,
+            clear_position_offset: false,
         },
     );
     let after = r.st(0);

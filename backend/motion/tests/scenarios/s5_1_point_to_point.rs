@@ -184,6 +184,7 @@ fn s11a_22_move_modulo_from_standstill_uses_the_table_algorithm() {
             position: 90.9,
             relative: false,
             clear_position_lag: true,
+            clear_position_offset: false,
         },
     );
     let m = r.ok(

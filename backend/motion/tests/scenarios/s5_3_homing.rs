@@ -11,6 +11,7 @@ fn set_position_offset_5(r: &mut Rig) {
             position: 5.0,
             relative: true,
             clear_position_lag: false,
+            clear_position_offset: false,
         },
     );
     assert_eq!(r.st(0).set_position_offset, 5.0);

@@ -106,6 +106,7 @@ impl SetPositionBody {
             position: self.position,
             relative: self.relative,
             clear_position_lag: self.clear_position_lag,
+            clear_position_offset: self.clear_position_offset,
         })
     }
 }
