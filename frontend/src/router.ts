@@ -8,6 +8,7 @@ export type Route =
   | { page: 'cams' }
   | { page: 'cam'; table: string }
   | { page: 'users' }
+  | { page: 'system' }
   | { page: 'not-found'; path: string };
 
 export function parseRoute(hash: string): Route {
@@ -19,6 +20,7 @@ export function parseRoute(hash: string): Route {
   if (parts[0] === 'cams' && parts.length === 2) return { page: 'cam', table: parts[1] };
   if (parts[0] === 'new-axis' && parts.length === 1) return { page: 'new-axis' };
   if (parts[0] === 'users' && parts.length === 1) return { page: 'users' };
+  if (parts[0] === 'system' && parts.length === 1) return { page: 'system' };
   if (parts[0] === 'axes' && parts.length >= 2 && parts.length <= 3) {
     const tab = parts[2] ?? 'online';
     if (tab === 'online' || tab === 'parameters' || tab === 'config') return { page: 'axis', axis: parts[1], tab };
@@ -40,6 +42,8 @@ export function href(r: Route): string {
       return '#/new-axis';
     case 'users':
       return '#/users';
+    case 'system':
+      return '#/system';
     case 'axis':
       return `#/axes/${encodeURIComponent(r.axis)}${r.tab === 'online' ? '' : '/' + r.tab}`;
     default:

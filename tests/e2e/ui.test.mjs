@@ -917,26 +917,30 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
-  test('edit and delete the axis (it must be disabled first: the UI offers to do it)', async () => {
+  test('edit and delete the axis (a save that needs no rebuild keeps it enabled; Delete needs it disabled: the UI offers to do it)', async () => {
     await enabled();
     const page = await open(`/axes/${AXIS}/config`);
     await page.fill('input[name="dynamics.jog_velocity_fast"]', '150');
-    // while the axis is enabled: Save and Delete are off, the reason and a way out beside them
+    // while the axis is enabled: Save asks the server what it would do; Delete is off, the
+    // reason and a way out beside it
     const save = page.locator('button[name="save"]');
-    await page.waitForSelector('[data-testid="save-blocked"]');
-    assert.equal(await save.isDisabled(), true);
+    await page.waitForSelector('[data-testid="delete-blocked"]');
+    assert.equal(await save.isDisabled(), false);
     assert.equal(await page.locator('button[name="delete"]').isDisabled(), true);
-    assert.match(await page.locator('[data-testid="save-blocked"]').textContent(), /enabled: switch it off to save or delete/);
+    assert.match(await page.locator('[data-testid="delete-blocked"]').textContent(), /enabled: switch it off to re-create or delete it/);
     await shot(page, 'configuration-enabled');
+    await save.click();
+    await page.waitForSelector('[data-testid="save-panel"][data-rebuild="0"]');
+    assert.match(await page.locator('[data-testid="save-headline"]').textContent(), /nothing is reset/);
+    await page.click('button[name="confirm-save"]');
+    await page.waitForSelector('[data-testid="save-result"]', { timeout: 10000 });
+    assert.equal((await rest(stack.api, 'GET', `/axes/${AXIS}`)).body.config.dynamics.jog_velocity_fast, 150);
+    assert.ok((await status(stack.api, AXIS)).power_status, 'still enabled');
+    await shot(page, 'configuration-saved');
     await page.click('button[name="disable-axis"]');
     await until(async () => !(await status(stack.api, AXIS)).power_status, { what: 'axis disabled' });
-    await page.waitForSelector('button[name="save"]:not([disabled])');
-    await page.waitForSelector('[data-testid="save-blocked"]', { state: 'detached' });
-    assert.equal(await page.inputValue('input[name="dynamics.jog_velocity_fast"]'), '150', 'the edit is kept');
-    await page.click('button[name="save"]');
-    await page.waitForSelector('.banner-ok', { timeout: 10000 });
-    assert.equal((await rest(stack.api, 'GET', `/axes/${AXIS}`)).body.config.dynamics.jog_velocity_fast, 150);
-    await shot(page, 'configuration-saved');
+    await page.waitForSelector('button[name="delete"]:not([disabled])');
+    await page.waitForSelector('[data-testid="delete-blocked"]', { state: 'detached' });
     await page.click('button[name="delete"]');
     await page.click('button[name="delete-confirm"]');
     await page.waitForURL(/#\/$/, { timeout: 10000 });

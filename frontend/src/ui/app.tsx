@@ -13,6 +13,7 @@ import type { ConnState } from '../live/client';
 import { ageText } from '../live/liveness';
 import { useLiveness } from './liveness';
 import { UsersPage } from './users';
+import { SystemPage } from './system';
 import { ControlBadge, UserBadge } from './header-auth';
 import { auth, may } from '../auth/session';
 
@@ -151,6 +152,9 @@ export function App() {
     case 'users':
       page = <UsersPage />;
       break;
+    case 'system':
+      page = <SystemPage />;
+      break;
     default:
       page = (
         <div class="page">
@@ -188,6 +192,7 @@ export function App() {
           {nav({ page: 'scope' }, 'Scope', route.page === 'scope')}
           {nav({ page: 'cams' }, 'Cams', route.page === 'cams' || route.page === 'cam')}
           {nav({ page: 'new-axis' }, 'New axis', route.page === 'new-axis')}
+          {nav({ page: 'system' }, 'System', route.page === 'system')}
           {admin && nav({ page: 'users' }, 'Users', route.page === 'users')}
         </nav>
         <div class="topbar-session">

@@ -1,6 +1,11 @@
 // Create / edit / delete an axis. The form mirrors AxisConfigDto; the server's 422 field
 // errors (JSON paths such as `dynamics.jerk`, `drive.plant.damping`, `parameters.X`) are shown
 // at the field they name, anything else in the banner.
+//
+// Saving an existing axis first asks the server what the save would do (`?dry_run=true`) and
+// shows it (config/save-panel.tsx): parameters written online on the running axis, or the axis
+// re-created (then it must be disabled). The fields that are parameters show beside them the
+// online and persistent values where these differ from the configured (start-up) value.
 import { useEffect, useState } from 'preact/hooks';
 import type { AxisConfig, AxisLiveStatus, AxisResource, ParamValue } from '../api/types';
 import { ApiError, del, enc, post, put } from '../api/rest';
@@ -9,6 +14,9 @@ import { navigate } from '../router';
 import { useStore } from '../store';
 import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
 import { STATE_LABEL, inputNum } from '../format';
+import { useAxisParameters } from '../config/params';
+import { type ConfigChange, type SideValues, differingFields, rebuildBlockedText, sideText } from '../config/change';
+import { SavePanel, SaveResult } from '../config/save-panel';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
 
@@ -21,14 +29,15 @@ const PLANTS: [PlantKind, string][] = [
 ];
 
 /**
- * Why the axis cannot be saved or deleted now, as its live status shows it (the server swaps
- * only a disabled axis: state Disabled and power off), or null. Unknown status: null — the
- * server judges, and its refusal is shown.
+ * Why the axis cannot be re-created or deleted now, as its live status shows it (the server
+ * swaps only a disabled axis: state Disabled and power off), or null. Unknown status: null —
+ * the server judges, and its refusal is shown. A save that does not re-create the axis is
+ * never blocked by this (it writes the parameters online).
  */
 export function reconfigureBlocked(s: Pick<AxisLiveStatus, 'state' | 'power_status'> | null | undefined): string | null {
   if (!s) return null;
-  if (s.power_status) return 'The axis is enabled: switch it off to save or delete.';
-  if (s.state !== 'disabled') return `The axis is in ${STATE_LABEL[s.state]}: it must be Disabled to save or delete (reset it).`;
+  if (s.power_status) return 'The axis is enabled: switch it off to re-create or delete it.';
+  if (s.state !== 'disabled') return `The axis is in ${STATE_LABEL[s.state]}: it must be Disabled to be re-created or deleted (reset it).`;
   return null;
 }
 
@@ -57,8 +66,8 @@ export interface ConfigForm {
   limitPos: string;
   faultOnHit: boolean;
   parameters: { key: string; value: string }[];
-  /** `dynamics.jog_deadman_max` as loaded (no field for it yet): sent back unchanged, else the server's default. */
-  jogDeadmanMax?: number;
+  /** `dynamics.jog_deadman_max` (s); blank: not sent, the server's default (1 s). */
+  jogDeadmanMax: string;
 }
 
 export const DEFAULT_FORM: ConfigForm = {
@@ -70,6 +79,7 @@ export const DEFAULT_FORM: ConfigForm = {
   min: '0',
   max: '1000',
   dyn: { max_velocity: '500', acceleration: '2500', deceleration: '2500', jerk: '25000', jog_velocity_slow: '10', jog_velocity_fast: '100' },
+  jogDeadmanMax: '1',
   plant: 'pt2',
   time_constant: '0.005',
   natural_frequency_hz: '50',
@@ -108,7 +118,7 @@ export function formOf(c: AxisConfig): ConfigForm {
       jog_velocity_slow: n(c.dynamics.jog_velocity_slow),
       jog_velocity_fast: n(c.dynamics.jog_velocity_fast),
     },
-    jogDeadmanMax: (c.dynamics as Partial<AxisConfig['dynamics']>).jog_deadman_max,
+    jogDeadmanMax: n((c.dynamics as Partial<AxisConfig['dynamics']>).jog_deadman_max),
     plant: plant.kind,
     time_constant: n(plant.time_constant, '0.005'),
     natural_frequency_hz: n(plant.natural_frequency_hz, '50'),
@@ -169,7 +179,7 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
       jerk: num('dynamics.jerk', f.dyn.jerk),
       jog_velocity_slow: num('dynamics.jog_velocity_slow', f.dyn.jog_velocity_slow),
       jog_velocity_fast: num('dynamics.jog_velocity_fast', f.dyn.jog_velocity_fast),
-      ...(f.jogDeadmanMax !== undefined ? { jog_deadman_max: f.jogDeadmanMax } : {}),
+      ...(f.jogDeadmanMax.trim() !== '' ? { jog_deadman_max: num('dynamics.jog_deadman_max', f.jogDeadmanMax) } : {}),
     } as AxisConfig['dynamics'],
     // The schema says `object` without value types (utoipa value_type = Object).
     parameters: parameters as unknown as AxisConfig['parameters'],
@@ -201,6 +211,7 @@ function shownFields(f: ConfigForm): Set<string> {
     'soft_limits.min',
     'soft_limits.max',
     ...Object.keys(f.dyn).map((k) => `dynamics.${k}`),
+    'dynamics.jog_deadman_max',
     'drive.plant.time_constant',
     'drive.plant.natural_frequency_hz',
     'drive.plant.damping',
@@ -234,6 +245,12 @@ const DRIVE_LABELS: [keyof ConfigForm['drive'], string, string][] = [
   ['load_stiffness', 'Load stiffness', '> 0'],
 ];
 
+/** A dry run waiting for the user's word: its answer and the configuration it was asked for. */
+interface Pending {
+  change: ConfigChange;
+  config: AxisConfig;
+}
+
 export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
   const creating = axis === null;
   const [form, setForm] = useState<ConfigForm>(() => (axis ? formOf(axis.config) : DEFAULT_FORM));
@@ -241,18 +258,27 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
   const [error, setError] = useState<string | null>(null);
   const [notDisabled, setNotDisabled] = useState(false);
   const [message, setMessage] = useState<string | null>(null);
+  const [result, setResult] = useState<ConfigChange | null>(null);
+  const [pending, setPending] = useState<Pending | null>(null);
+  const [checking, setChecking] = useState(false);
+  const [saving, setSaving] = useState(false);
+  const [paramsVersion, setParamsVersion] = useState(0);
   const [confirmDelete, setConfirmDelete] = useState(false);
   const st = useStore(statuses);
   const online = useOnline();
+  const params = useAxisParameters(axis ? axis.config.name : null, axis?.id ?? 0, paramsVersion);
   useEffect(() => {
     setForm(axis ? formOf(axis.config) : DEFAULT_FORM);
     setFields({});
     setError(null);
+    setPending(null);
+    setResult(null);
   }, [axis?.id]);
   const live = axis ? st.get(axis.config.name) : undefined;
+  const fresh = live && !live.stale ? live.status : null;
   // While the status is stale the buttons are off anyway (offline) or the server judges.
-  const blocked = axis && live && !live.stale ? reconfigureBlocked(live.status) : null;
-  const powered = !!(blocked && live?.status?.power_status);
+  const blocked = axis ? reconfigureBlocked(fresh) : null;
+  const powered = !!(blocked && fresh?.power_status);
   const disableNow = async () => {
     if (!axis) return;
     try {
@@ -265,6 +291,23 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
 
   const set = <K extends keyof ConfigForm>(k: K, v: ConfigForm[K]) => setForm({ ...form, [k]: v });
   const err = (path: string) => fields[path];
+  // Online and persistent values that differ from the configured ones, by field path.
+  const sides: Record<string, SideValues> = creating ? {} : differingFields(params);
+  const side = (path: string) =>
+    sides[path] ? (
+      <span class="cfg-side" data-side={path} title="the parameter's value in force (online) and its persistent value, where they differ from the configured start-up value">
+        {sideText(sides[path])}
+      </span>
+    ) : null;
+  const limitSide = () => {
+    if (!form.softLimits || !(sides['soft_limits.min'] || sides['soft_limits.max'])) return null;
+    const part = (k: 'min' | 'max') => (sides[`soft_limits.${k}`] ? `${k}: ${sideText(sides[`soft_limits.${k}`])}` : null);
+    return (
+      <span class="cfg-side" data-side="soft_limits">
+        {[part('min'), part('max')].filter(Boolean).join('; ')}
+      </span>
+    );
+  };
 
   const fail = (e: unknown) => {
     const f = { ...fieldsOf(e) };
@@ -274,12 +317,13 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     const shown = shownFields(form);
     const other = Object.entries(f).filter(([k]) => !shown.has(k));
     if (Object.keys(f).length && other.length === 0) setError('The server refused the configuration: see the fields marked red.');
-    else if (other.length) setError(`${errorText(e)}`);
     else setError(errorText(e));
   };
 
+  /** Save pressed: a new axis is created; an existing one's save is first asked as a dry run. */
   const save = async () => {
     setMessage(null);
+    setResult(null);
     setError(null);
     setNotDisabled(false);
     const { config, errors } = configOf(form);
@@ -288,20 +332,49 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
       setError('Some fields are not numbers: see the fields marked red.');
       return;
     }
-    try {
-      if (creating) {
+    if (creating) {
+      try {
         const r = await post<AxisResource>('/axes', config);
         await refreshAxes();
         navigate({ page: 'axis', axis: r.config.name, tab: 'online' });
-      } else {
-        const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}`, config);
-        await refreshAxes();
-        setFields({});
-        setMessage('Saved. The axis runs with the new configuration (its persistent parameters were dropped).');
-        if (r.config.name !== axis.config.name) navigate({ page: 'axis', axis: r.config.name, tab: 'config' });
+      } catch (e) {
+        fail(e);
       }
+      return;
+    }
+    setChecking(true);
+    // the values beside the fields and those a rebuild would lose, read anew
+    setParamsVersion((v) => v + 1);
+    try {
+      const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}?dry_run=true`, config);
+      if (!r.change) throw new Error('The server did not say what the save would change.');
+      setPending({ change: r.change, config });
     } catch (e) {
       fail(e);
+    } finally {
+      setChecking(false);
+    }
+  };
+
+  /** The confirmed save: exactly the configuration the dry run was asked for. */
+  const confirmSave = async () => {
+    if (!axis || !pending) return;
+    setSaving(true);
+    try {
+      const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}`, pending.config);
+      setPending(null);
+      setFields({});
+      setForm(formOf(r.config));
+      setResult(r.change ?? null);
+      if (!r.change) setMessage('Saved.');
+      setParamsVersion((v) => v + 1);
+      await refreshAxes();
+      if (r.config.name !== axis.config.name) navigate({ page: 'axis', axis: r.config.name, tab: 'config' });
+    } catch (e) {
+      setPending(null);
+      fail(e);
+    } finally {
+      setSaving(false);
     }
   };
 
@@ -321,6 +394,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
   const num = (path: string, value: string, on: (v: string) => void, label: string, hint?: string) => (
     <Field label={label} error={err(path)} hint={hint} name={path}>
       <NumberInput name={path} value={value} onValue={on} />
+      {side(path)}
     </Field>
   );
 
@@ -329,7 +403,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
       {creating && (
         <div class="page-head">
           <h2>New axis</h2>
-          <span class="muted">a simulated axis; every field can be changed later (while the axis is disabled)</span>
+          <span class="muted">a simulated axis; every field can be changed later</span>
         </div>
       )}
       <ErrorBanner error={error} onClose={() => setError(null)} />
@@ -344,11 +418,29 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
         </div>
       )}
       {message && <div class="banner banner-ok">{message}</div>}
+      {result && <SaveResult change={result} onClose={() => setResult(null)} />}
+      {pending && axis && (
+        <SavePanel
+          change={pending.change}
+          axis={axis.config.name}
+          newName={pending.config.name}
+          unit={axis.config.unit}
+          position={fresh ? fresh.actual_position : null}
+          blocked={rebuildBlockedText(fresh, (s) => STATE_LABEL[s as AxisLiveStatus['state']] ?? s)}
+          params={params ? [...params.values()] : null}
+          powered={powered}
+          online={online}
+          saving={saving}
+          onSave={() => void confirmSave()}
+          onCancel={() => setPending(null)}
+          onDisable={disableNow}
+        />
+      )}
       <form
         class="config-form"
         onSubmit={(e) => {
           e.preventDefault();
-          if (online) void save();
+          if (online && !checking && !pending) void save();
         }}
       >
         <div class="config-grid">
@@ -377,6 +469,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
                   <NumberInput name="soft_limits.min" value={form.min} onValue={(v) => set('min', v)} disabled={!form.softLimits} placeholder="min" />
                   <NumberInput name="soft_limits.max" value={form.max} onValue={(v) => set('max', v)} disabled={!form.softLimits} placeholder="max" />
                 </span>
+                {limitSide()}
               </Field>
               {(err('soft_limits.min') || err('soft_limits.max')) && <div class="field-error">{err('soft_limits.min') ?? err('soft_limits.max')}</div>}
             </div>
@@ -386,6 +479,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
               {DYN_LABELS.map(([k, label, per, hint]) =>
                 num(`dynamics.${k}`, form.dyn[k], (v) => set('dyn', { ...form.dyn, [k]: v }), `${label} (${form.unit}${per})`, hint),
               )}
+              {num('dynamics.jog_deadman_max', form.jogDeadmanMax, (v) => set('jogDeadmanMax', v), 'Jog dead-man max (s)', '0.05 … 10 (default 1)')}
             </div>
           </Panel>
           <Panel title="Simulated drive">
@@ -464,11 +558,20 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
           </Panel>
         </div>
         <div class="form-actions sticky-actions">
-          <button type="submit" class="btn btn-primary" name="save" disabled={!online || !!blocked} aria-describedby={blocked ? 'save-blocked' : undefined}>
-            {creating ? 'Create axis' : 'Save configuration'}
+          <button type="submit" class="btn btn-primary" name="save" disabled={!online || checking || !!pending}>
+            {creating ? 'Create axis' : checking ? 'Checking…' : 'Save configuration…'}
           </button>
           {!creating && (
-            <button type="button" class="btn" name="revert" onClick={() => { setForm(formOf(axis.config)); setFields({}); setError(null); }}>
+            <button
+              type="button"
+              class="btn"
+              name="revert"
+              onClick={() => {
+                setForm(formOf(axis.config));
+                setFields({});
+                setError(null);
+              }}
+            >
               Revert
             </button>
           )}
@@ -484,15 +587,22 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
                 </button>
               </span>
             ) : (
-              <button type="button" class="btn btn-danger-outline" name="delete" disabled={!online || !!blocked} onClick={() => setConfirmDelete(true)}>
+              <button
+                type="button"
+                class="btn btn-danger-outline"
+                name="delete"
+                disabled={!online || !!blocked}
+                aria-describedby={blocked ? 'delete-blocked' : undefined}
+                onClick={() => setConfirmDelete(true)}
+              >
                 Delete axis…
               </button>
             ))}
           {blocked && axis && (
-            <span class="save-blocked" id="save-blocked" data-testid="save-blocked">
+            <span class="cfg-delete-blocked" id="delete-blocked" data-testid="delete-blocked">
               {blocked}
-              {powered && (
-                <ActionButton kind="warn" name="disable-axis" disabled={!online} onClick={disableNow}>
+              {powered && !pending && (
+                <ActionButton kind="warn" class="btn-small" name="disable-axis" disabled={!online} onClick={disableNow}>
                   Disable {axis.config.name} now
                 </ActionButton>
               )}

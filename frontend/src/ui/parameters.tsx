@@ -1,5 +1,7 @@
-// MC_AxisParameter pages: grouped, with units, ranges and help; edits are shown as a diff
-// (old → new) and applied one PUT at a time; the server's validation errors appear at the row.
+// MC_AxisParameter pages: grouped, with units, ranges and help; each value side by side as
+// configured (the axis configuration's start-up value), persistent and online (in force, the
+// one edited here); edits are shown as a diff (old → new) and applied one PUT at a time; the
+// server's validation errors appear at the row.
 import { useEffect, useMemo, useState } from 'preact/hooks';
 import { get, put, enc } from '../api/rest';
 import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
@@ -246,25 +248,27 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
           <colgroup>
             <col class="c-no" />
             <col class="c-name" />
+            <col class="c-conf" />
+            <col class="c-pers" />
             <col class="c-value" />
             <col class="c-unit" />
             <col class="c-range" />
-            <col class="c-pers" />
           </colgroup>
           <thead>
             <tr>
               <th class="r">No.</th>
               <th>Name</th>
-              <th class="r">Value</th>
+              <th class="r" title="the axis configuration's value: the start-up value when the configuration is (re)applied">Configured</th>
+              <th class="r" title="value of the persistent overlay (MC_WriteParameterPersistent)">Persistent</th>
+              <th class="r" title="the value in force (MC_ReadParameter); edit it here">Online</th>
               <th>Unit</th>
               <th>Range</th>
-              <th class="r" title="value of the persistent overlay (MC_WriteParameterPersistent)">Persistent</th>
             </tr>
           </thead>
           {GROUPS.filter((g) => shown.some((p) => p.group === g.key)).map((g) => (
             <tbody key={g.key}>
               <tr class="group-row">
-                <th colSpan={6}>{g.label}</th>
+                <th colSpan={7}>{g.label}</th>
               </tr>
               {shown
                 .filter((p) => p.group === g.key)
@@ -272,6 +276,10 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                   const edited = edits[p.number] !== undefined && edits[p.number] !== valueText(p.value);
                   const err = rowErrors[p.number] ?? invalid[p.number];
                   const ro = p.read_only || p.group === 'status';
+                  const configured = p.configured_value ?? null;
+                  const pers = p.persistent_value ?? null;
+                  // Highlighted where a value differs from the configured one.
+                  const differs = (v: ParamValue | null) => configured !== null && v !== null && valueText(v) !== valueText(configured);
                   return (
                       <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
                         <td class="r mono">{p.number}</td>
@@ -280,7 +288,11 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                           {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
                           <div class={`help ${openHelp === p.number ? 'help-open' : 'help-short'}`}>{p.help}</div>
                         </td>
-                        <td class="r value-cell">
+                        <td class="r mono small" data-col="configured">{valueText(configured)}</td>
+                        <td class={`r mono small ${differs(pers) ? 'pv-differs' : ''}`} data-col="persistent">
+                          {valueText(pers)}
+                        </td>
+                        <td class={`r value-cell ${differs(p.value) ? 'pv-differs' : ''}`} data-col="online">
                           {ro ? (
                             <span class="mono">{valueText(p.value)}</span>
                           ) : p.type === 'bool' ? (
@@ -310,7 +322,6 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                         </td>
                         <td>{p.unit_text}</td>
                         <td class="mono small">{rangeText(p)}</td>
-                        <td class="r mono small">{p.persistent_value !== undefined && p.persistent_value !== null ? valueText(p.persistent_value) : ''}</td>
                       </tr>
                   );
                 })}
