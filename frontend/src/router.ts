@@ -1,8 +1,12 @@
 import { useEffect, useState } from 'preact/hooks';
 
+/** The tabs of an axis page. */
+export type AxisTab = 'online' | 'coupling' | 'functions' | 'parameters' | 'config';
+const AXIS_TABS: readonly string[] = ['online', 'coupling', 'functions', 'parameters', 'config'];
+
 export type Route =
   | { page: 'overview' }
-  | { page: 'axis'; axis: string; tab: 'online' | 'parameters' | 'config' }
+  | { page: 'axis'; axis: string; tab: AxisTab }
   | { page: 'new-axis' }
   | { page: 'scope' }
   | { page: 'cams' }
@@ -23,7 +27,7 @@ export function parseRoute(hash: string): Route {
   if (parts[0] === 'system' && parts.length === 1) return { page: 'system' };
   if (parts[0] === 'axes' && parts.length >= 2 && parts.length <= 3) {
     const tab = parts[2] ?? 'online';
-    if (tab === 'online' || tab === 'parameters' || tab === 'config') return { page: 'axis', axis: parts[1], tab };
+    if (AXIS_TABS.includes(tab)) return { page: 'axis', axis: parts[1], tab: tab as AxisTab };
   }
   return { page: 'not-found', path };
 }

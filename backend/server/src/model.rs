@@ -1407,8 +1407,9 @@ pub struct ScopeSetup {
 pub struct ScopeSetupResource {
     pub name: String,
     pub updated_at: String,
-    #[serde(flatten)]
-    pub setup: ScopeSetup,
+    pub recording: RecordingRequest,
+    #[schema(value_type = Object)]
+    pub view: serde_json::Map<String, serde_json::Value>,
 }
 
 /// A cam table as sent: `POST /cam-tables` creates it, `PUT /cam-tables/{table}` replaces it;

@@ -4566,9 +4566,11 @@ export interface components {
          *       "view": {}
          *     }
          */
-        ScopeSetupResource: components["schemas"]["ScopeSetup"] & {
+        ScopeSetupResource: {
             name: string;
             updated_at: string;
+            recording: components["schemas"]["RecordingRequest"];
+            view: Record<string, never>;
         };
         /**
          * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step).

@@ -1,5 +1,5 @@
 // The scope recording endpoints (POST/GET/DELETE /api/v1/scope/recordings).
-import { del, get, post, enc } from '../api/rest';
+import { del, get, post, put, enc } from '../api/rest';
 import type { components } from '../api/schema';
 import type { RecordingRequest } from './data';
 
@@ -31,3 +31,12 @@ export const createRecording = (r: RecordingRequest) => post<Recording>(RECORDIN
 export const getRecording = (id: Recording['id']) => get<Recording>(`${RECORDINGS}/${enc(String(id))}`);
 export const cancelRecording = (id: Recording['id']) => del<unknown>(`${RECORDINGS}/${enc(String(id))}`);
 export const csvUrl = (id: Recording['id']) => `/api/v1${RECORDINGS}/${enc(String(id))}?format=csv`;
+
+// Saved scope setups (GET /scope/setups, GET/PUT/DELETE /scope/setups/{name}).
+type Setup = components['schemas']['ScopeSetup'];
+type SetupResource = components['schemas']['ScopeSetupResource'];
+export const SETUPS = '/scope/setups';
+export const listSetups = () => get<SetupResource[]>(SETUPS);
+export const getSetup = (name: string) => get<SetupResource>(`${SETUPS}/${enc(name)}`);
+export const putSetup = (name: string, s: Setup) => put<SetupResource>(`${SETUPS}/${enc(name)}`, s);
+export const deleteSetup = (name: string) => del<unknown>(`${SETUPS}/${enc(name)}`);

@@ -12,7 +12,30 @@ export interface ChartSeries {
   unit: string;
   scale: string;
   values: ArrayLike<number | null>;
+  /** Colour (default: by index). */
+  color?: string;
+  /** Dashed (the second recording of a comparison). */
+  dash?: boolean;
+  /** Join across nulls (a comparison's union of sample times); default: nulls are breaks (gaps). */
+  spanGaps?: boolean;
 }
+
+/** How one chart of a stack is drawn. */
+export interface PaneOptions {
+  /** uPlot cursor sync key: the hover cursor moves in every chart of the stack. */
+  syncKey?: string;
+  /** Draw the time axis' labels (only the bottom chart of a stack). */
+  showX?: boolean;
+  height?: number;
+  /** The x range (full view); default: the first and last t. */
+  limits?: { min: number; max: number };
+  /** Extra space (px) left and right so the plots of a stack line up. */
+  padLeft?: number;
+  padRight?: number;
+}
+
+/** Width of a y axis with its unit label (size + label). */
+export const Y_AXIS_WIDTH = 94;
 
 export interface ChartCallbacks {
   onCursors: (c1: number | null, c2: number | null) => void;
@@ -36,12 +59,18 @@ export class ScopeChart {
     private readonly cb: ChartCallbacks,
     /** Draw the trigger: a line at t = 0 and the level on the trigger channel's scale. */
     private readonly trigger: { scale: string; level: number } | null = null,
+    pane: PaneOptions = {},
   ) {
     const n = t.length;
-    this.limits = { min: n ? t[0] : 0, max: n ? t[n - 1] : 1 };
+    this.limits = pane.limits ? { ...pane.limits } : { min: n ? t[0] : 0, max: n ? t[n - 1] : 1 };
     if (this.limits.max <= this.limits.min) this.limits.max = this.limits.min + 1e-3;
     const scales: uPlot.Scales = { x: { time: false, min: this.limits.min, max: this.limits.max } };
-    const axes: uPlot.Axis[] = [{ label: 't (s)', stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }];
+    const showX = pane.showX ?? true;
+    const axes: uPlot.Axis[] = [
+      showX
+        ? { label: 't (s)', stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }
+        : { stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6', size: 4 }, size: 6, values: (_u, splits) => splits.map(() => '') },
+    ];
     const seen: string[] = [];
     series.forEach((s) => {
       if (seen.includes(s.scale)) return;
@@ -59,18 +88,25 @@ export class ScopeChart {
     });
     const opts: uPlot.Options = {
       width: Math.max(300, el.clientWidth),
-      height: Math.max(220, el.clientHeight || 420),
+      height: pane.height ?? Math.max(220, el.clientHeight || 420),
+      padding: [null, pane.padRight ? pane.padRight + 8 : null, null, pane.padLeft ? pane.padLeft + 8 : null],
       scales,
       axes,
       legend: { show: true, live: true },
-      cursor: { drag: { x: true, y: false, setScale: true }, points: { show: false } },
+      cursor: {
+        drag: { x: true, y: false, setScale: true },
+        points: { show: false },
+        ...(pane.syncKey ? { sync: { key: pane.syncKey, setSeries: false, scales: ['x', null] as [string, null] } } : {}),
+      },
       series: [
         { label: 't (s)', value: (_u, v) => (v === null || v === undefined ? '—' : v.toFixed(4)) },
         ...series.map((s, i) => ({
           label: `${s.label} (${s.unit})`,
           scale: s.scale,
-          stroke: COLORS[i % COLORS.length],
+          stroke: s.color ?? COLORS[i % COLORS.length],
           width: 1.5,
+          dash: s.dash ? [6, 4] : undefined,
+          spanGaps: s.spanGaps ?? false,
           value: (_u: uPlot, v: number | null) => (v === null || v === undefined ? '—' : String(Number(v.toPrecision(6)))),
         })),
       ],
@@ -125,6 +161,29 @@ export class ScopeChart {
     this.setRange({ ...this.limits });
   }
 
+  /** Cursors placed in another chart of the stack (no callback). */
+  syncCursors(c1: number | null, c2: number | null, next: 1 | 2): void {
+    this.c1 = c1;
+    this.c2 = c2;
+    this.next = next;
+    this.u.redraw(false, false);
+  }
+
+  get nextCursor(): 1 | 2 {
+    return this.next;
+  }
+
+  /** The x range from another chart of the stack. */
+  syncRange(r: { min: number; max: number }): void {
+    const cur = this.range();
+    if (Math.abs(cur.min - r.min) < 1e-12 && Math.abs(cur.max - r.max) < 1e-12) return;
+    this.u.setScale('x', r);
+  }
+
+  get cursors(): [number | null, number | null] {
+    return [this.c1, this.c2];
+  }
+
   setCursor(which: 1 | 2, x: number | null): void {
     if (which === 1) this.c1 = x;
     else this.c2 = x;
@@ -177,8 +236,9 @@ export class ScopeChart {
       if (Math.abs(e.clientX - d.x) < 4 && Math.abs(e.clientY - d.y) < 4) {
         const rect = over.getBoundingClientRect();
         const x = this.u.posToVal(e.clientX - rect.left, 'x');
-        this.setCursor(this.next, x);
+        const which = this.next;
         this.next = this.next === 1 ? 2 : 1;
+        this.setCursor(which, x);
       }
     };
     window.addEventListener('mousemove', this.onMove);
@@ -259,5 +319,116 @@ export class ScopeChart {
     window.removeEventListener('mousemove', this.onMove);
     window.removeEventListener('mouseup', this.onUp);
     this.u.destroy();
+  }
+}
+
+/** One pane of a stack: its series and (optionally) the trigger to draw. */
+export interface StackPane {
+  series: ChartSeries[];
+  trigger?: { scale: string; level: number } | null;
+}
+
+/**
+ * Charts stacked vertically with one shared time axis (labelled under the bottom one): the
+ * hover cursor (uPlot's cursor sync), zoom/pan and the two cursors C1/C2 are the same in all.
+ * The container carries `data-samples`, `data-series` (all panes), `data-charts` and
+ * `data-view` for the tests.
+ */
+let stackNo = 0;
+export class ScopeStack {
+  readonly charts: ScopeChart[] = [];
+  private syncing = false;
+
+  constructor(
+    private readonly el: HTMLElement,
+    t: ArrayLike<number>,
+    panes: StackPane[],
+    cb: ChartCallbacks,
+    opts: { limits?: { min: number; max: number }; height?: number } = {},
+  ) {
+    const key = `scope-stack-${++stackNo}`;
+    const sides = panes.map((p) => {
+      const scales = [...new Set(p.series.map((s) => s.scale))];
+      return { left: Math.ceil(scales.length / 2), right: Math.floor(scales.length / 2) };
+    });
+    const maxLeft = Math.max(0, ...sides.map((s) => s.left));
+    const maxRight = Math.max(0, ...sides.map((s) => s.right));
+    const total = opts.height ?? 420;
+    const each = panes.length <= 1 ? total : Math.max(150, Math.round(total / panes.length));
+    panes.forEach((p, i) => {
+      const div = document.createElement('div');
+      div.className = 'chart-pane';
+      div.dataset.chart = String(i);
+      el.appendChild(div);
+      const last = i === panes.length - 1;
+      const chart: ScopeChart = new ScopeChart(
+        div,
+        t,
+        p.series,
+        {
+          onCursors: (c1, c2) => {
+            if (!this.syncing) {
+              this.syncing = true;
+              for (const o of this.charts) if (o !== chart) o.syncCursors(c1, c2, chart.nextCursor);
+              this.syncing = false;
+            }
+            cb.onCursors(c1, c2);
+          },
+          onRange: (min, max) => {
+            this.el.dataset.view = `${min},${max}`;
+            if (!this.syncing) {
+              this.syncing = true;
+              for (const o of this.charts) if (o !== chart) o.syncRange({ min, max });
+              this.syncing = false;
+            }
+            cb.onRange(min, max);
+          },
+        },
+        p.trigger ?? null,
+        {
+          syncKey: key,
+          showX: last,
+          height: last && panes.length > 1 ? each + 40 : each,
+          limits: opts.limits,
+          padLeft: (maxLeft - sides[i].left) * Y_AXIS_WIDTH,
+          padRight: (maxRight - sides[i].right) * Y_AXIS_WIDTH,
+        },
+      );
+      this.charts.push(chart);
+    });
+    el.dataset.samples = String(t.length);
+    el.dataset.series = String(panes.reduce((a, p) => a + p.series.length, 0));
+    el.dataset.charts = String(panes.length);
+    const first = this.charts[0];
+    if (first) {
+      const r = opts.limits ?? { min: t.length ? t[0] : 0, max: t.length ? t[t.length - 1] : 1 };
+      el.dataset.view = `${r.min},${r.max}`;
+    }
+  }
+
+  zoom(factor: number): void {
+    this.charts[0]?.zoom(factor);
+  }
+  pan(fraction: number): void {
+    this.charts[0]?.pan(fraction);
+  }
+  reset(): void {
+    this.charts[0]?.reset();
+  }
+  clearCursors(): void {
+    this.syncing = true;
+    for (const c of this.charts.slice(1)) c.syncCursors(null, null, 1);
+    this.syncing = false;
+    this.charts[0]?.clearCursors();
+  }
+
+  destroy(): void {
+    for (const c of this.charts) c.destroy();
+    this.charts.length = 0;
+    this.el.replaceChildren();
+    delete this.el.dataset.samples;
+    delete this.el.dataset.series;
+    delete this.el.dataset.charts;
+    delete this.el.dataset.view;
   }
 }

@@ -1,14 +1,16 @@
 import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { axes, axesLoaded, command, statuses } from '../services';
-import { href } from '../router';
+import { href, type AxisTab } from '../router';
 import { ActionButton, Lamp, useOnline } from './common';
 import { STATE_LABEL, axisError } from '../format';
 import { OnlineTab } from './online';
 import { ParametersTab } from './parameters';
 import { AxisConfigPage } from './axis-config';
+import { CouplingTab } from './coupling';
+import { FunctionsTab } from './functions';
 
-export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'parameters' | 'config' }) {
+export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
   const list = useStore(axes);
   const loaded = useStore(axesLoaded);
   const st = useStore(statuses);
@@ -32,9 +34,17 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
   const live = st.get(axis);
   const s = live?.status;
   const err = axisError(s);
-  const tabLink = (t: typeof tab, label: string) => (
-    <a href={href({ page: 'axis', axis, tab: t })} class={`tab ${tab === t ? 'active' : ''}`} data-tab={t}>
-      {label}
+  // `short`: the label on a phone, where the five tabs share 390 px.
+  const tabLink = (t: typeof tab, label: string, short?: string) => (
+    <a href={href({ page: 'axis', axis, tab: t })} class={`tab ${tab === t ? 'active' : ''}`} data-tab={t} title={label}>
+      {short ? (
+        <>
+          <span class="tab-long">{label}</span>
+          <span class="tab-short">{short}</span>
+        </>
+      ) : (
+        label
+      )}
     </a>
   );
   return (
@@ -54,8 +64,10 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
         </span>
         <nav class="tabs">
           {tabLink('online', 'Online')}
-          {tabLink('parameters', 'Parameters')}
-          {tabLink('config', 'Configuration')}
+          {tabLink('coupling', 'Coupling')}
+          {tabLink('functions', 'Functions')}
+          {tabLink('parameters', 'Parameters', 'Params')}
+          {tabLink('config', 'Configuration', 'Config')}
         </nav>
       </div>
       {err && (
@@ -91,6 +103,8 @@ export function AxisPage({ axis, tab }: { axis: string; tab: 'online' | 'paramet
       {/* Keyed by the axis's id: another axis (or one replaced under the same name by an
           import) starts with fresh state, never the previous axis's inputs or parameters. */}
       {tab === 'online' && <OnlineTab key={a.id} axis={a} />}
+      {tab === 'coupling' && <CouplingTab key={a.id} axis={a} />}
+      {tab === 'functions' && <FunctionsTab key={a.id} axis={a} />}
       {tab === 'parameters' && <ParametersTab key={a.id} axis={a} />}
       {tab === 'config' && <AxisConfigPage key={a.id} axis={a} />}
     </div>

@@ -14,10 +14,10 @@ use motion::functions::{RampDynamics, calc_dynamics_by_ramp_time};
 #[serde(deny_unknown_fields)]
 pub struct RampQuery {
     /// Velocity to reach (> 0), units/s.
-    #[param(exclusive_minimum = 0, maximum = 1e12)]
+    #[param(minimum = 1e-9, maximum = 1e12)]
     pub velocity: f64,
     /// Time to reach it from rest (> 0), s.
-    #[param(exclusive_minimum = 0, maximum = 1e6)]
+    #[param(minimum = 1e-6, maximum = 1e6)]
     pub ramp_time: f64,
     /// 0 (pure S-curve) to below 1 (nearly a trapezoid); default 0.5 (t1 = t2 = t/3).
     #[param(minimum = 0, exclusive_maximum = 1)]
@@ -40,11 +40,11 @@ pub async fn calc_dynamics_by_ramp_time_fb(Q(q): Q<RampQuery>) -> AppResult<Json
             message.to_owned(),
         )
     };
-    if !(q.velocity.is_finite() && q.velocity > 0.0 && q.velocity <= 1e12) {
-        return Err(bad("velocity", "must be > 0 (at most 1e12)"));
+    if !(q.velocity.is_finite() && (1e-9..=1e12).contains(&q.velocity)) {
+        return Err(bad("velocity", "must be from 1e-9 to 1e12"));
     }
-    if !(q.ramp_time.is_finite() && q.ramp_time > 0.0 && q.ramp_time <= 1e6) {
-        return Err(bad("ramp_time", "must be > 0 (at most 1e6 s)"));
+    if !(q.ramp_time.is_finite() && (1e-6..=1e6).contains(&q.ramp_time)) {
+        return Err(bad("ramp_time", "must be from 1e-6 to 1e6 s"));
     }
     if !(0.0..1.0).contains(&stiffness) {
         return Err(bad(

@@ -225,7 +225,7 @@ pub async fn get_setup(
     description = "`recording` is checked as `POST /scope/recordings` checks it (axes must exist; errors at \
 `recording.channels[i].axis` …); `view` is the client's, kept as given (at most 64 KiB). Stored in the database \
 and audited.",
-    params(("name" = String, Path, description = "setup name: a letter or `_`, then letters, digits, `_` or `-` (at most 64)")),
+    params(("name" = String, Path, pattern = "^[A-Za-z_][A-Za-z0-9_-]{0,63}$", description = "setup name: a letter or `_`, then letters, digits, `_` or `-` (at most 64)")),
     request_body = ScopeSetup,
     responses((status = 200, description = "Replaced", body = ScopeSetupResource),
         (status = 201, description = "Created", body = ScopeSetupResource), super::errors::ScopeSetupWriteErrors))]

@@ -131,11 +131,12 @@ pub fn recording(s: &AppState, body: RecordingRequest) -> AppResult<NewRecording
 const MAX_VIEW: usize = 64 * 1024;
 
 fn setup_resource(stored: crate::store::scope_setups::StoredSetup) -> Option<ScopeSetupResource> {
-    let setup = serde_json::from_str(&stored.body).ok()?;
+    let setup: ScopeSetup = serde_json::from_str(&stored.body).ok()?;
     Some(ScopeSetupResource {
         name: stored.name,
         updated_at: stored.updated_at,
-        setup,
+        recording: setup.recording,
+        view: setup.view,
     })
 }
 
@@ -195,7 +196,8 @@ pub async fn put_setup(
         ScopeSetupResource {
             name: name.to_owned(),
             updated_at: at,
-            setup,
+            recording: setup.recording,
+            view: setup.view,
         },
         !replaced,
     ))
