@@ -292,6 +292,17 @@ pub fn check_password(field: &str, password: &str) -> AppResult<()> {
     }
 }
 
+/// The audit row of a change, then the commit of its transaction: both or neither.
+async fn audit_and_commit(
+    mut tx: sqlx::Transaction<'_, sqlx::Sqlite>,
+    audit: &store::AuditEntry,
+) -> AppResult<()> {
+    store::audit(&mut *tx, audit)
+        .await
+        .map_err(AppError::storage)?;
+    tx.commit().await.map_err(AppError::storage)
+}
+
 /// A storage error, or the 409 `code` when it is a UNIQUE violation (the name is taken).
 fn taken(e: sqlx::Error, code: &'static str, detail: String) -> AppError {
     match &e {
@@ -697,10 +708,7 @@ impl Auth {
         let id = store::auth::insert_user(&mut *tx, name, role.as_str(), &hash, &now)
             .await
             .map_err(|e| taken(e, "user_exists", format!("a user {name} exists")))?;
-        store::audit(&mut *tx, &audit)
-            .await
-            .map_err(AppError::storage)?;
-        tx.commit().await.map_err(AppError::storage)?;
+        audit_and_commit(tx, &audit).await?;
         let user = User {
             id,
             name: name.to_owned(),
@@ -770,10 +778,7 @@ impl Auth {
                 .map_err(AppError::storage)?;
             }
         }
-        store::audit(&mut *tx, &audit)
-            .await
-            .map_err(AppError::storage)?;
-        tx.commit().await.map_err(AppError::storage)?;
+        audit_and_commit(tx, &audit).await?;
         let mut books = self.books.write().unwrap();
         if password.is_some() {
             let keep = keep_session.map(|k| k.secret);
@@ -811,10 +816,7 @@ impl Auth {
         store::auth::delete_user(&mut *tx, id)
             .await
             .map_err(AppError::storage)?;
-        store::audit(&mut *tx, &audit)
-            .await
-            .map_err(AppError::storage)?;
-        tx.commit().await.map_err(AppError::storage)?;
+        audit_and_commit(tx, &audit).await?;
         let mut books = self.books.write().unwrap();
         books.users.remove(&id);
         books.sessions.retain(|_, s| s.user_id != id);
@@ -871,10 +873,7 @@ impl Auth {
         )
         .await
         .map_err(|e| taken(e, "token_exists", format!("a token {name} exists")))?;
-        store::audit(&mut *tx, &audit)
-            .await
-            .map_err(AppError::storage)?;
-        tx.commit().await.map_err(AppError::storage)?;
+        audit_and_commit(tx, &audit).await?;
         let t = Token {
             id,
             name: name.to_owned(),
@@ -902,10 +901,7 @@ impl Auth {
         store::auth::revoke_token(&mut *tx, id, &at)
             .await
             .map_err(AppError::storage)?;
-        store::audit(&mut *tx, &audit)
-            .await
-            .map_err(AppError::storage)?;
-        tx.commit().await.map_err(AppError::storage)?;
+        audit_and_commit(tx, &audit).await?;
         let mut books = self.books.write().unwrap();
         let t = books
             .tokens

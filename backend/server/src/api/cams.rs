@@ -171,13 +171,10 @@ pub struct SlaveDynamicsQuery {
     pub master_position: f64,
 }
 
-/// The largest position magnitude the cam queries take: beyond it an f64 master position
-/// has less than 0.1 mm (or 0.0001°) resolution, and cycle counts would overflow.
-pub const MAX_POSITION: f64 = 1e12;
-
-/// A position query parameter within ±[`MAX_POSITION`].
+/// A position query parameter within ±[`crate::model::MAX_MAGNITUDE`], the bound of every
+/// position a request gives (beyond it cycle counts of the cam search would overflow).
 fn position(field: &str, x: f64) -> AppResult<f64> {
-    if x.is_finite() && x.abs() <= MAX_POSITION {
+    if x.is_finite() && x.abs() <= crate::model::MAX_MAGNITUDE {
         Ok(x)
     } else {
         Err(AppError::field(

@@ -57,23 +57,26 @@ impl AppState {
         // A done probe cycle's recorded position, from the axis status that records it (the
         // snapshot of its cycle may be published after its event: tried until it is).
         {
+            // (the statuses read first: the snapshot's lock is not taken under the store's)
             let mut pending = self.probe_results.lock().unwrap();
-            if !pending.is_empty() {
-                let mut store = self.commands.lock().unwrap();
-                pending.retain(|&(id, slot)| {
-                    let Some(probe) = self.status(slot).1.map(|st| st.probe) else {
-                        return false;
-                    };
-                    if probe.command < id {
-                        return true;
-                    }
-                    if probe.command == id {
-                        if let Some(r) = store.map.get_mut(&id) {
-                            r.result = Some(probe);
-                        }
-                    }
+            let mut recorded = Vec::new();
+            pending.retain(|&(id, slot)| match self.status(slot).1.map(|st| st.probe) {
+                Some(probe) if probe.command < id => true,
+                Some(probe) if probe.command == id => {
+                    recorded.push((id, probe));
                     false
-                });
+                }
+                // Recorded over by a later cycle, or the axis is gone.
+                _ => false,
+            });
+            drop(pending);
+            if !recorded.is_empty() {
+                let mut store = self.commands.lock().unwrap();
+                for (id, probe) in recorded {
+                    if let Some(r) = store.map.get_mut(&id) {
+                        r.result = Some(probe);
+                    }
+                }
             }
         }
         {
