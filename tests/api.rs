@@ -1007,7 +1007,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 69, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 70, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -726,3 +726,80 @@ async fn a_ramp_in_couples_a_slave_away_from_its_cam() {
     assert!(close(&y["status"]["set_position"], 0.0), "{y}");
     assert_eq!(y["status"]["state"], "synchronized_motion");
 }
+
+/// `POST /cam-analysis` (issue 12, the cam editor's live plots): an unsaved table is analysed
+/// by the server's cam math — range, samples with both ends, characteristics equal to a stored
+/// table's, the jumps where a law meets a MOTION point — with the errors a store would give at
+/// the same fields, and nothing is stored.
+#[tokio::test(flavor = "multi_thread")]
+async fn an_unsaved_table_is_analysed_and_nothing_is_stored() {
+    let s = Server::start();
+    let a = post(&s, "/api/v1/cam-analysis?samples=5", polynom5()).await;
+    assert_eq!(a.status, 200, "{}", a.text);
+    assert_eq!(
+        (
+            a.json["master_start"].as_f64(),
+            a.json["master_end"].as_f64()
+        ),
+        (Some(0.0), Some(200.0))
+    );
+    let rows = a.json["values"]["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 5);
+    assert_eq!(
+        rows[1],
+        json!([50.0, 10.3515625, 0.52734375, 0.0140625, -0.00009375])
+    );
+    assert_eq!(rows[4][0], 200.0, "the last sample at the end");
+    assert!(
+        close(&a.json["characteristics"]["slave_velo_max"], 0.9375),
+        "{}",
+        a.text
+    );
+    assert_eq!(a.json["discontinuities"], json!([]));
+    assert_eq!(
+        get(&s, "/api/v1/cam-tables").await.json,
+        json!([]),
+        "nothing stored"
+    );
+
+    let jumpy = json!({"name": "jumpy", "table_type": "motion_function", "points": [
+        {"point_index": 1, "function_type": "polynom5", "point_type": "rest", "master_pos": 0.0, "slave_pos": 0.0},
+        {"point_index": 2, "function_type": "polynom1", "point_type": "motion", "master_pos": 100.0, "slave_pos": 50.0},
+        {"point_index": 3, "function_type": "polynom5", "point_type": "motion", "master_pos": 200.0, "slave_pos": 150.0},
+        {"point_index": 4, "function_type": "polynom5", "point_type": "rest", "master_pos": 360.0, "slave_pos": 0.0}]});
+    let a = post(&s, "/api/v1/cam-analysis", jumpy.clone()).await;
+    assert_eq!(a.status, 200, "{}", a.text);
+    assert_eq!(
+        a.json["values"]["rows"].as_array().unwrap().len(),
+        721,
+        "the default"
+    );
+    let d = a.json["discontinuities"].as_array().unwrap();
+    assert!(
+        d.iter()
+            .any(|j| j["index"] == 1 && j["quantity"] == "velocity" && close(&j["after"], 1.0)),
+        "{}",
+        a.text
+    );
+
+    // The errors of a store, at the same field; a bad sample count at `samples`.
+    let mut bad = jumpy.clone();
+    bad["points"][1]["point_type"] = json!("rest");
+    let r = post(&s, "/api/v1/cam-analysis", bad.clone()).await;
+    let put = post(&s, "/api/v1/cam-tables", bad).await;
+    assert_eq!((r.status, put.status), (422, 422), "{}", r.text);
+    assert_eq!(r.json["errors"], put.json["errors"], "{}", r.text);
+    assert_eq!(
+        r.json["errors"][0]["field"], "points[1].point_type",
+        "{}",
+        r.text
+    );
+    let r = post(&s, "/api/v1/cam-analysis?samples=1", jumpy).await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert_eq!(r.json["errors"][0]["field"], "samples", "{}", r.text);
+    assert_eq!(
+        get(&s, "/api/v1/cam-tables").await.json,
+        json!([]),
+        "nothing stored"
+    );
+}

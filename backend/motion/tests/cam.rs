@@ -879,3 +879,78 @@ fn every_rest_to_rest_law_matches_its_closed_form_at_start_middle_and_end() {
         );
     }
 }
+
+/// The cam editor's warnings (issue 12): where two laws meet with different velocities or
+/// accelerations, the boundary condition of one of them is not met. A rest-in-rest chain is
+/// continuous; a linear (POLYNOM1) segment after a rest point starts with a velocity the rest
+/// point denies; a periodic table whose end velocity differs from its start jumps at the wrap.
+#[test]
+fn discontinuities_name_the_point_and_the_quantity() {
+    use MotionFunctionType::*;
+    use MotionPointType::*;
+    let smooth = Cam::build(&CamTableData::motion_function(vec![
+        pt(1, Polynom5, Rest, 0.0, 0.0),
+        pt(2, Polynom5, Rest, 180.0, 100.0),
+        pt(3, Polynom5, Rest, 360.0, 0.0),
+    ]))
+    .unwrap();
+    assert_eq!(discontinuities(&smooth), vec![]);
+
+    // MOTION points constrain nothing, so the build accepts what the laws make of them.
+    let mut table = CamTableData::motion_function(vec![
+        pt(1, Polynom5, Rest, 0.0, 0.0),
+        pt(2, Polynom1, Motion, 100.0, 50.0),
+        pt(3, Polynom5, Motion, 200.0, 150.0),
+        pt(4, Polynom5, Rest, 360.0, 0.0),
+    ]);
+    table.periodic = true;
+    let jumpy = Cam::build(&table).unwrap();
+    let d = discontinuities(&jumpy);
+    let at = |d: &[Discontinuity], i: usize| {
+        d.iter()
+            .filter(|j| j.index == i)
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    // POLYNOM1 from (100, 50) to (200, 150) runs at 1 per master unit; POLYNOM5 before it
+    // ends at rest (its end values are point 2's v = 0), the one after starts at rest.
+    let one = at(&d, 1);
+    assert_eq!(one.len(), 1, "{d:?}");
+    assert_eq!(one[0].quantity, Quantity::Velocity);
+    assert!(!one[0].wrap);
+    assert_close(one[0].master, 100.0, 1e-12, "where");
+    assert_close(one[0].before, 0.0, 1e-9, "rest before");
+    assert_close(one[0].after, 1.0, 1e-9, "linear after");
+    let two = at(&d, 2);
+    assert_eq!(
+        two.iter()
+            .filter(|j| j.quantity == Quantity::Velocity)
+            .count(),
+        1,
+        "{d:?}"
+    );
+    // The wrap of a table that ends at rest where it starts at rest is continuous.
+    assert!(at(&d, 3).is_empty(), "{d:?}");
+
+    // A periodic table that ends moving and starts at rest: the velocity jumps at the wrap,
+    // reported at the last point; the position, which continues by the stroke, is not.
+    let mut ends_moving = CamTableData::motion_function(vec![
+        pt(1, Polynom5, Rest, 0.0, 0.0),
+        pt(2, Polynom1, Motion, 100.0, 50.0),
+        pt(3, Polynom1, Motion, 200.0, 150.0),
+    ]);
+    ends_moving.periodic = true;
+    let d = discontinuities(&Cam::build(&ends_moving).unwrap());
+    let wrap: Vec<_> = d.iter().filter(|j| j.wrap).collect();
+    assert_eq!(wrap.len(), 1, "{d:?}");
+    assert_eq!((wrap[0].index, wrap[0].quantity), (2, Quantity::Velocity));
+    assert_close(wrap[0].before, 1.0, 1e-9, "end velocity");
+    assert_close(wrap[0].after, 0.0, 1e-9, "start velocity");
+    // A linear position table: its velocity is a staircase by definition, nothing is reported.
+    let table = Cam::build(&CamTableData::positions(
+        vec![[0.0, 0.0], [10.0, 5.0], [20.0, 0.0]],
+        false,
+    ))
+    .unwrap();
+    assert_eq!(discontinuities(&table), vec![]);
+}

@@ -1527,6 +1527,45 @@ pub struct MasterPositionResource {
     pub master_high: motion::cam::CamMasterData,
 }
 
+/// What the cam editor plots while a table is edited (`POST /cam-analysis`): the table's
+/// range, its values over one cycle, its characteristic values and where boundary conditions
+/// are not met. Nothing is stored.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "master_start": 0.0, "master_end": 360.0, "slave_start": 0.0, "slave_end": 0.0,
+    "values": {"columns": ["master", "position", "velocity", "acceleration", "jerk"],
+               "rows": [[0.0, 0.0, 0.0, 0.0, 0.0], [360.0, 0.0, 0.0, 0.0, 0.0]]},
+    "characteristics": {"master_velo_nom": 1.0, "master_pos_start": 0.0, "slave_pos_start": 0.0,
+        "slave_velo_start": 0.0, "slave_acc_start": 0.0, "slave_jerk_start": 0.0,
+        "master_pos_end": 360.0, "slave_pos_end": 0.0, "slave_velo_end": 0.0, "slave_acc_end": 0.0,
+        "slave_jerk_end": 0.0, "m_pos_at_s_pos_min": 0.0, "slave_pos_min": 0.0,
+        "m_pos_at_s_velo_min": 270.0, "slave_velo_min": -1.04, "m_pos_at_s_acc_min": 90.0,
+        "slave_acc_min": -0.011, "s_velo_at_s_acc_min": 0.0, "m_pos_at_s_jerk_min": 45.0,
+        "slave_jerk_min": -0.0002, "slave_dyn_mom_min": -0.008, "m_pos_at_s_pos_max": 180.0,
+        "slave_pos_max": 100.0, "m_pos_at_s_velo_max": 90.0, "slave_velo_max": 1.04,
+        "m_pos_at_s_acc_max": 0.0, "slave_acc_max": 0.011, "s_velo_at_s_acc_max": 0.0,
+        "m_pos_at_s_jerk_max": 0.0, "slave_jerk_max": 0.0002, "slave_dyn_mom_max": 0.008,
+        "slave_velo_mean": 0.56, "slave_acc_eff": 0.007},
+    "discontinuities": [{"index": 1, "master": 180.0, "quantity": "velocity", "before": 0.0,
+        "after": 1.0, "wrap": false}]
+}))]
+pub struct CamAnalysisResource {
+    /// Raw master position of the first and the last row or point.
+    pub master_start: f64,
+    pub master_end: f64,
+    /// Raw slave position there.
+    pub slave_start: f64,
+    pub slave_end: f64,
+    /// `samples` rows from `master_start` to `master_end` (both included): master, position,
+    /// velocity, acceleration, jerk (per raw master unit).
+    pub values: CamValuesResource,
+    pub characteristics: motion::cam::Characteristics,
+    /// Where a law's boundary conditions are not met: the slave's position, velocity or
+    /// acceleration jumps where two laws meet or where a periodic table wraps. Warnings: the
+    /// table is valid and can be stored; a slave coupled through it will jump there.
+    pub discontinuities: Vec<motion::cam::Discontinuity>,
+}
+
 /// MC_ReadMotionFunctionValues: one row per sample, columns as named.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"columns": ["master", "position", "velocity"], "rows": [[0.0, 0.0, 0.0], [50.0, 10.3515625, 0.52734375]]}))]

@@ -756,6 +756,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/cam-analysis": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Analyse a cam table without storing it: values over one cycle, characteristic values, jumps where laws meet
+         * @description What the cam editor plots while a table is edited; the server is the one source of the cam math. The body is a cam table as for `POST /cam-tables`, validated the same way (the same errors at the same fields); nothing is stored and no coupled slave sees it.
+         */
+        post: operations["analyse"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/cam-tables": {
         parameters: {
             query?: never;
@@ -1778,6 +1798,115 @@ export interface components {
             /** @description Default: absolute, no offset, scaling 1. */
             scaling?: components["schemas"]["CamScalingData"];
             interpolation?: null | components["schemas"]["CouplingInterpolation"];
+        };
+        /**
+         * @description What the cam editor plots while a table is edited (`POST /cam-analysis`): the table's
+         *     range, its values over one cycle, its characteristic values and where boundary conditions
+         *     are not met. Nothing is stored.
+         * @example {
+         *       "characteristics": {
+         *         "m_pos_at_s_acc_max": 0,
+         *         "m_pos_at_s_acc_min": 90,
+         *         "m_pos_at_s_jerk_max": 0,
+         *         "m_pos_at_s_jerk_min": 45,
+         *         "m_pos_at_s_pos_max": 180,
+         *         "m_pos_at_s_pos_min": 0,
+         *         "m_pos_at_s_velo_max": 90,
+         *         "m_pos_at_s_velo_min": 270,
+         *         "master_pos_end": 360,
+         *         "master_pos_start": 0,
+         *         "master_velo_nom": 1,
+         *         "s_velo_at_s_acc_max": 0,
+         *         "s_velo_at_s_acc_min": 0,
+         *         "slave_acc_eff": 0.007,
+         *         "slave_acc_end": 0,
+         *         "slave_acc_max": 0.011,
+         *         "slave_acc_min": -0.011,
+         *         "slave_acc_start": 0,
+         *         "slave_dyn_mom_max": 0.008,
+         *         "slave_dyn_mom_min": -0.008,
+         *         "slave_jerk_end": 0,
+         *         "slave_jerk_max": 0.0002,
+         *         "slave_jerk_min": -0.0002,
+         *         "slave_jerk_start": 0,
+         *         "slave_pos_end": 0,
+         *         "slave_pos_max": 100,
+         *         "slave_pos_min": 0,
+         *         "slave_pos_start": 0,
+         *         "slave_velo_end": 0,
+         *         "slave_velo_max": 1.04,
+         *         "slave_velo_mean": 0.56,
+         *         "slave_velo_min": -1.04,
+         *         "slave_velo_start": 0
+         *       },
+         *       "discontinuities": [
+         *         {
+         *           "after": 1,
+         *           "before": 0,
+         *           "index": 1,
+         *           "master": 180,
+         *           "quantity": "velocity",
+         *           "wrap": false
+         *         }
+         *       ],
+         *       "master_end": 360,
+         *       "master_start": 0,
+         *       "slave_end": 0,
+         *       "slave_start": 0,
+         *       "values": {
+         *         "columns": [
+         *           "master",
+         *           "position",
+         *           "velocity",
+         *           "acceleration",
+         *           "jerk"
+         *         ],
+         *         "rows": [
+         *           [
+         *             0,
+         *             0,
+         *             0,
+         *             0,
+         *             0
+         *           ],
+         *           [
+         *             360,
+         *             0,
+         *             0,
+         *             0,
+         *             0
+         *           ]
+         *         ]
+         *       }
+         *     }
+         */
+        CamAnalysisResource: {
+            /**
+             * Format: double
+             * @description Raw master position of the first and the last row or point.
+             */
+            master_start: number;
+            /** Format: double */
+            master_end: number;
+            /**
+             * Format: double
+             * @description Raw slave position there.
+             */
+            slave_start: number;
+            /** Format: double */
+            slave_end: number;
+            /**
+             * @description `samples` rows from `master_start` to `master_end` (both included): master, position,
+             *     velocity, acceleration, jerk (per raw master unit).
+             */
+            values: components["schemas"]["CamValuesResource"];
+            characteristics: components["schemas"]["Characteristics"];
+            /**
+             * @description Where a law's boundary conditions are not met: the slave's position, velocity or
+             *     acceleration jumps where two laws meet or where a periodic table wraps. Warnings: the
+             *     table is valid and can be stored; a slave coupled through it will jump there.
+             */
+            discontinuities: components["schemas"]["Discontinuity"][];
         };
         /**
          * @description MC_CamExchange: replace one cam of a multi-cam slave.
@@ -2988,6 +3117,43 @@ export interface components {
         CouplingInterpolation: "linear" | "spline" | "sliding_spline";
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
+        /**
+         * @description A boundary condition that is not met: where two laws meet (or where a periodic table
+         *     wraps), the slave's value at the end of one differs from the start of the next.
+         * @example {
+         *       "after": 1,
+         *       "before": 0,
+         *       "index": 1,
+         *       "master": 180,
+         *       "quantity": "velocity",
+         *       "wrap": false
+         *     }
+         */
+        Discontinuity: {
+            /**
+             * @description Index (from 0) of the point or row where it happens; for the wrap of a periodic table
+             *     the last one.
+             */
+            index: number;
+            /**
+             * Format: double
+             * @description Raw master position of that point.
+             */
+            master: number;
+            quantity: components["schemas"]["Quantity"];
+            /**
+             * Format: double
+             * @description Value at the end of the piece before (per raw master unit).
+             */
+            before: number;
+            /**
+             * Format: double
+             * @description Value at the start of the piece after.
+             */
+            after: number;
+            /** @description True at the wrap of a periodic table (end of one cycle to the start of the next). */
+            wrap: boolean;
+        };
         /**
          * @description An axis's drive: `kind` and that drive's fields. A simulated drive: a model of a servo drive (times in seconds, positions in the axis's units).
          * @example {
@@ -4237,6 +4403,11 @@ export interface components {
             /** @description Invalid fields (422). */
             errors?: components["schemas"]["FieldError"][];
         };
+        /**
+         * @description Which value of the slave jumps where two pieces of a table meet.
+         * @enum {string}
+         */
+        Quantity: "position" | "velocity" | "acceleration";
         /**
          * @description MC_CalcDynamicsByRampTime's outputs.
          * @example {
@@ -8680,6 +8851,43 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    analyse: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Samples over the table's range, both ends included (default 721: every half unit of a
+                 *     360° cycle).
+                 */
+                samples?: number;
+            };
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["CamTableBody"];
+            };
+        };
+        responses: {
+            /** @description The table's range, values, characteristics and discontinuities */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CamAnalysisResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CamTableInvalid"];
         };
     };
     list_cam_tables: {

@@ -463,3 +463,102 @@ pub fn sample(
         })
         .collect())
 }
+
+/// Which value of the slave jumps where two pieces of a table meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    Position,
+    Velocity,
+    Acceleration,
+}
+
+/// A boundary condition that is not met: where two laws meet (or where a periodic table
+/// wraps), the slave's value at the end of one differs from the start of the next.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+pub struct Discontinuity {
+    /// Index (from 0) of the point or row where it happens; for the wrap of a periodic table
+    /// the last one.
+    pub index: usize,
+    /// Raw master position of that point.
+    pub master: f64,
+    pub quantity: Quantity,
+    /// Value at the end of the piece before (per raw master unit).
+    pub before: f64,
+    /// Value at the start of the piece after.
+    pub after: f64,
+    /// True at the wrap of a periodic table (end of one cycle to the start of the next).
+    pub wrap: bool,
+}
+
+/// Jumps of position, velocity or acceleration where the laws of a motion function meet, and
+/// at the wrap of a periodic table (motion functions and spline tables; a linear position
+/// table's velocity is a staircase by definition and is not reported). Jerk may jump at every
+/// point of the usual laws (polynomial 5 at rest) and is not a boundary condition.
+///
+/// The tolerance is relative to the largest magnitude of that quantity over the cycle, so
+/// rounding of the laws is not reported.
+pub fn discontinuities(cam: &Cam) -> Vec<Discontinuity> {
+    let motion_function = cam.motion_function();
+    let linear = motion_function.is_none() && cam.interpolation == super::InterpolationType::Linear;
+    if linear {
+        return Vec::new();
+    }
+    let c = characteristics(cam);
+    let scale = [
+        c.slave_pos_max.abs().max(c.slave_pos_min.abs()),
+        c.slave_velo_max.abs().max(c.slave_velo_min.abs()),
+        c.slave_acc_max.abs().max(c.slave_acc_min.abs()),
+    ];
+    let quantities = [
+        Quantity::Position,
+        Quantity::Velocity,
+        Quantity::Acceleration,
+    ];
+    let mut out = Vec::new();
+    let mut compare = |index: usize, master: f64, before: CamValues, after: CamValues, wrap| {
+        let b = [before.position, before.velocity, before.acceleration];
+        let a = [after.position, after.velocity, after.acceleration];
+        // A periodic table's position continues by its stroke: not a jump.
+        for q in usize::from(wrap)..3 {
+            let tol = 1e-9 + 1e-6 * scale[q];
+            if (b[q] - a[q]).abs() > tol {
+                out.push(Discontinuity {
+                    index,
+                    master,
+                    quantity: quantities[q],
+                    before: b[q],
+                    after: a[q],
+                    wrap,
+                });
+            }
+        }
+    };
+    let bp = cam.breakpoints();
+    let n = cam.pieces();
+    if let Some(f) = motion_function {
+        for i in 1..n {
+            let x = bp.get(i);
+            compare(
+                f.segments[i].point,
+                x,
+                cam.eval_piece(i - 1, x),
+                cam.eval_piece(i, x),
+                false,
+            );
+        }
+    }
+    if cam.periodic {
+        let (x0, xn) = cam.master_range();
+        compare(
+            cam.rows - 1,
+            xn,
+            cam.eval_piece(n - 1, xn),
+            cam.eval_piece(0, x0),
+            true,
+        );
+    }
+    out
+}

@@ -36,8 +36,8 @@ mod spline;
 mod table;
 
 pub use analysis::{
-    CamMasterData, Characteristics, MasterSearch, ValueSelect, characteristics, master_position,
-    sample,
+    CamMasterData, Characteristics, Discontinuity, MasterSearch, Quantity, ValueSelect,
+    characteristics, discontinuities, master_position, sample,
 };
 pub use coupling::{
     CamActivationMode, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling, CamScalingData,

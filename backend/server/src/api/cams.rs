@@ -15,7 +15,7 @@ use super::{Client, JsonBody, Q};
 use crate::app::AppState;
 use crate::error::{AppError, AppResult};
 use crate::model::{
-    CamTableBody, CamTableResource, CamValuesResource, MasterPositionResource,
+    CamAnalysisResource, CamTableBody, CamTableResource, CamValuesResource, MasterPositionResource,
     SlaveDynamicsResource,
 };
 use crate::service::cams;
@@ -330,6 +330,39 @@ pub async fn values(
         q.increment,
         &select,
     )?))
+}
+
+#[derive(Debug, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisQuery {
+    /// Samples over the table's range, both ends included (default 721: every half unit of a
+    /// 360° cycle).
+    #[param(minimum = 2, maximum = 100000)]
+    pub samples: Option<u32>,
+}
+
+#[utoipa::path(post, path = "/api/v1/cam-analysis", tag = "cams",
+    summary = "Analyse a cam table without storing it: values over one cycle, characteristic values, jumps where laws meet",
+    description = "What the cam editor plots while a table is edited; the server is the one source of the cam \
+math. The body is a cam table as for `POST /cam-tables`, validated the same way (the same errors at the same \
+fields); nothing is stored and no coupled slave sees it.",
+    params(AnalysisQuery),
+    request_body = CamTableBody,
+    responses((status = 200, description = "The table's range, values, characteristics and discontinuities", body = CamAnalysisResource),
+        super::errors::CamAnalysisErrors))]
+pub async fn analyse(
+    Q(q): Q<AnalysisQuery>,
+    LargeJsonBody(body): LargeJsonBody<CamTableBody>,
+) -> AppResult<Json<CamAnalysisResource>> {
+    let samples = q.samples.unwrap_or(721) as usize;
+    if !(2..=cams::MAX_VALUE_ROWS).contains(&samples) {
+        return Err(AppError::field(
+            "samples",
+            &format!("2..{} samples", cams::MAX_VALUE_ROWS),
+        ));
+    }
+    Ok(Json(cams::analyse(body, samples).await?))
 }
 
 #[utoipa::path(get, path = "/api/v1/cam-tables/{table}/online-change-mode", tag = "cams",

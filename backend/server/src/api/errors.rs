@@ -525,6 +525,8 @@ error_sets! {
         400: MalformedJson, 409: CamTableConflict, 413: PayloadTooLarge, 422: CamTableInvalid,
         503: WriteUnavailable,
     }
+    /// `POST /cam-analysis`.
+    CamAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: CamTableInvalid }
     /// `PUT /cam-tables/{table}`, its points.
     CamTableReplaceErrors {
         400: MalformedJson, 404: CamTableNotFound, 409: CamTableConflict, 413: PayloadTooLarge,

@@ -254,6 +254,10 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
         )
         .route(
+            "/cam-analysis",
+            post(cams::analyse).layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
+        )
+        .route(
             "/cam-tables/{table}/characteristics",
             get(cams::characteristics),
         )
@@ -499,7 +503,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,
         functions::calc_dynamics_by_ramp_time_fb,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
-        cams::delete_cam_table, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
+        cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
         axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
         auth::session, auth::login, auth::logout, auth::change_password,
@@ -640,6 +644,17 @@ impl utoipa::Modify for ForeignExamples {
             (
                 "Characteristics",
                 to_value(motion::cam::characteristics(&example_cam().0)),
+            ),
+            (
+                "Discontinuity",
+                to_value(motion::cam::Discontinuity {
+                    index: 1,
+                    master: 180.0,
+                    quantity: motion::cam::Quantity::Velocity,
+                    before: 0.0,
+                    after: 1.0,
+                    wrap: false,
+                }),
             ),
             (
                 "CamMasterData",

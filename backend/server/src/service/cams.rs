@@ -14,8 +14,8 @@ use super::axes::audit_entry;
 use crate::app::{AppState, CamEntry};
 use crate::error::{AppError, AppResult};
 use crate::model::{
-    CamTableBody, CamTableResource, CamValuesResource, ClientInfo, MasterPositionResource,
-    SlaveDynamicsResource, valid_name,
+    CamAnalysisResource, CamTableBody, CamTableResource, CamValuesResource, ClientInfo,
+    MasterPositionResource, SlaveDynamicsResource, valid_name,
 };
 use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
@@ -645,6 +645,48 @@ pub async fn master_position(
         master_low: low,
         master_high: high,
     })
+}
+
+/// The cam editor's view of a table that is not stored (or not yet): validated exactly as a
+/// `POST`/`PUT` would (the same errors at the same fields), then sampled over one cycle with
+/// its characteristics and its discontinuities. Off the async workers; nothing is stored.
+pub async fn analyse(body: CamTableBody, samples: usize) -> AppResult<CamAnalysisResource> {
+    let errs = check(&body, "");
+    if !errs.is_empty() {
+        return Err(AppError::Invalid(errs));
+    }
+    let (_, cam) = build(body.data()).await?;
+    tokio::task::spawn_blocking(move || {
+        let (x0, xn) = cam.master_range();
+        let (y0, yn) = cam.slave_range();
+        let step = (xn - x0) / (samples - 1) as f64;
+        let rows = (0..samples)
+            .map(|i| {
+                // The last sample exactly at the end (no rounding past the table).
+                let x = if i + 1 == samples {
+                    xn
+                } else {
+                    x0 + step * i as f64
+                };
+                let v = cam.eval_in_range(x);
+                vec![x, v.position, v.velocity, v.acceleration, v.jerk]
+            })
+            .collect();
+        CamAnalysisResource {
+            master_start: x0,
+            master_end: xn,
+            slave_start: y0,
+            slave_end: yn,
+            values: CamValuesResource {
+                columns: vec!["master", "position", "velocity", "acceleration", "jerk"],
+                rows,
+            },
+            characteristics: cam::characteristics(&cam),
+            discontinuities: cam::discontinuities(&cam),
+        }
+    })
+    .await
+    .map_err(|e| AppError::unavailable("internal", format!("the analysis failed: {e}")))
 }
 
 /// MC_ReadMotionFunctionValues (also for position tables: the cam editor plots both).
