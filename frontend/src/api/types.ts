@@ -58,3 +58,10 @@ export type MotionFunctionType = S['MotionFunctionType'];
 export type MotionPointType = S['MotionPointType'];
 export type CamCharacteristics = S['Characteristics'];
 export type CamValuesResource = S['CamValuesResource'];
+/** `POST /cam-analysis`: an unsaved table's values, characteristics and discontinuities. */
+export type CamAnalysisResource = S['CamAnalysisResource'];
+export type CamDiscontinuity = S['Discontinuity'];
+/** MC_SetCamOnlineChangeMode of a table (`/cam-tables/{table}/online-change-mode`). */
+export type OnlineChange = S['OnlineChange'];
+export type OnlineActivationMode = S['OnlineActivationMode'];
+export type TableType = S['TableType'];

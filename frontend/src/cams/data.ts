@@ -1,6 +1,7 @@
-// The cam editor's data: the points of a motion function as edited (texts as typed), their
-// conversion to the table the server takes, and the laws offered with what they need.
-import type { CamTableResource, MotionFunctionPoint, MotionFunctionType, MotionPointType } from '../api/types';
+// The cam editor's data: the table as edited (points of a motion function as typed, the rows
+// of a position table as CSV), its conversion to the body the server takes, the laws offered,
+// and what dragging a point on the plot does to it.
+import type { CamTableBody, CamTableResource, MotionFunctionPoint, MotionFunctionType, MotionPointType } from '../api/types';
 
 /** The laws in TwinCAT's order, with the names a TwinCAT engineer knows them by. */
 export const LAWS: { type: MotionFunctionType; label: string }[] = [
@@ -66,19 +67,26 @@ const num = (s: string) => {
   return t === '' ? 0 : Number(t);
 };
 
-/** The points as the server takes them: indices 1, 2, … in row order (no gaps). */
+/**
+ * The points as the server takes them: indices 1, 2, … in row order (no gaps), each linked to
+ * the next point that is not IGNORE (`rel_index_next_point`, 1 when none follows).
+ */
 export function pointsOf(rows: PointRow[]): MotionFunctionPoint[] {
-  return rows.map((r, i) => ({
-    point_index: i + 1,
-    function_type: r.function_type,
-    point_type: r.point_type,
-    rel_index_next_point: 1,
-    master_pos: num(r.master_pos),
-    slave_pos: num(r.slave_pos),
-    slave_velo: num(r.slave_velo),
-    slave_acc: num(r.slave_acc),
-    slave_jerk: num(r.slave_jerk),
-  }));
+  return rows.map((r, i) => {
+    let next = rows.findIndex((q, k) => k > i && q.point_type !== 'ignore');
+    if (next < 0) next = i + 1;
+    return {
+      point_index: i + 1,
+      function_type: r.function_type,
+      point_type: r.point_type,
+      rel_index_next_point: next - i,
+      master_pos: num(r.master_pos),
+      slave_pos: num(r.slave_pos),
+      slave_velo: num(r.slave_velo),
+      slave_acc: num(r.slave_acc),
+      slave_jerk: num(r.slave_jerk),
+    };
+  });
 }
 
 /** A new row after the last: one more segment of the same law, 10 % of the range further. */
@@ -105,8 +113,79 @@ export function csvToRows(csv: string): number[][] {
   return out;
 }
 
-/** The sampling increment for a plot of about `n` points over the table's range. */
-export function increment(t: CamTableResource, n = 720): number {
-  const span = Math.abs(t.master_end - t.master_start) || 1;
-  return span / n;
+/** The table as edited: what undo and redo go through. */
+export interface Draft {
+  periodic: boolean;
+  /** The points of a motion function (empty for a position table). */
+  points: PointRow[];
+  /** The rows of a position table as CSV text (empty for a motion function). */
+  csv: string;
+}
+
+/** What a table is, beside what is edited. */
+export type TableMeta = Pick<CamTableResource, 'id' | 'name' | 'table_type' | 'interpolation'>;
+
+export function draftOf(t: CamTableResource): Draft {
+  return { periodic: t.periodic, points: rowsOf(t.points ?? []), csv: t.rows ? rowsToCsv(t.rows) : '' };
+}
+
+/** The body of `PUT /cam-tables/{id}` and `POST /cam-analysis` for the table as edited. */
+export function bodyOf(t: TableMeta, d: Draft): CamTableBody {
+  return t.table_type === 'motion_function'
+    ? { id: t.id, name: t.name, table_type: t.table_type, periodic: d.periodic, points: pointsOf(d.points) }
+    : { id: t.id, name: t.name, table_type: t.table_type, periodic: d.periodic, interpolation: t.interpolation, rows: csvToRows(d.csv) };
+}
+
+/** A point of the plot that can be dragged: a motion function's point or a position table's row. */
+export interface Handle {
+  index: number;
+  master: number;
+  slave: number;
+}
+
+/** Position tables with more rows than this get no handles (they would hide the curve). */
+export const MAX_ROW_HANDLES = 100;
+
+export function handlesOf(t: TableMeta, d: Draft): Handle[] {
+  const pts: [number, number][] =
+    t.table_type === 'motion_function' ? d.points.map((r) => [num(r.master_pos), num(r.slave_pos)]) : (csvToRows(d.csv) as [number, number][]);
+  if (t.table_type !== 'motion_function' && pts.length > MAX_ROW_HANDLES) return [];
+  return pts.map(([master, slave], index) => ({ index, master, slave })).filter((h) => Number.isFinite(h.master) && Number.isFinite(h.slave));
+}
+
+/** The resolution a drag moves in over a range: about a thousandth of it, a power of ten. */
+export function stepOf(span: number): number {
+  const s = Math.abs(span);
+  return s > 0 && Number.isFinite(s) ? 10 ** (Math.floor(Math.log10(s)) - 3) : 0.001;
+}
+
+function snap(v: number, step: number): number {
+  const digits = Math.max(0, -Math.floor(Math.log10(step)));
+  return Number((Math.round(v / step) * step).toFixed(digits));
+}
+
+/**
+ * Where a dragged point goes: master and slave rounded to their steps, the master strictly
+ * between its neighbours' masters (at least one step from each); a point whose neighbours
+ * leave no room keeps its master. `masters` are the present masters of all points.
+ */
+export function dragTarget(masters: number[], i: number, master: number, slave: number, mStep: number, sStep: number): { master: number; slave: number } {
+  let m = snap(master, mStep);
+  const lo = i > 0 && Number.isFinite(masters[i - 1]) ? snap(masters[i - 1] + mStep, mStep) : -Infinity;
+  const hi = i < masters.length - 1 && Number.isFinite(masters[i + 1]) ? snap(masters[i + 1] - mStep, mStep) : Infinity;
+  if (lo > hi) m = masters[i];
+  else m = Math.min(hi, Math.max(lo, m));
+  return { master: m, slave: snap(slave, sStep) };
+}
+
+/** The draft with handle `i` dragged to (master, slave); an equidistant table keeps its masters. */
+export function dragDraft(t: TableMeta, d: Draft, i: number, master: number, slave: number, mStep: number, sStep: number): Draft {
+  if (t.table_type === 'motion_function') {
+    const to = dragTarget(d.points.map((r) => num(r.master_pos)), i, master, slave, mStep, sStep);
+    return { ...d, points: d.points.map((r, k) => (k === i ? { ...r, master_pos: String(to.master), slave_pos: String(to.slave) } : r)) };
+  }
+  const rows = csvToRows(d.csv);
+  if (!rows[i]) return d;
+  const to = dragTarget(rows.map((r) => r[0]), i, t.table_type === 'equidistant' ? rows[i][0] : master, slave, mStep, sStep);
+  return { ...d, csv: rowsToCsv(rows.map((r, k) => (k === i ? [t.table_type === 'equidistant' ? r[0] : to.master, to.slave] : r))) };
 }
