@@ -249,3 +249,85 @@ fn sdo_errors_are_cia301_aborts_and_a_mapping_must_be_valid() {
         assert_eq!(sd.sdo_read::<u8>(0x1018, 0).await.unwrap(), 4);
     });
 }
+
+/// Fault injection: a drive fault shows in the statusword (fault bit) with its 0x603F code,
+/// readable by SDO too, and a fault reset (controlword bit 7 edge) clears it; lost frames are
+/// a timeout of that exchange (no retries in OP) and the next exchange works again.
+#[test]
+fn an_injected_drive_fault_and_lost_frames_are_seen_by_the_maindevice() {
+    static STORAGE: PduStorage<16, MAX_PDU_DATA> = PduStorage::new();
+    let seg = segment(1);
+    let (tx, rx, pdu_loop) = STORAGE.try_split().expect("split once");
+    transport::spawn_in_process(tx, rx, seg.clone()).expect("thread");
+    let md = MainDevice::new(
+        pdu_loop,
+        Timeouts {
+            pdu: Duration::from_millis(500),
+            ..Timeouts::default()
+        },
+        MainDeviceConfig {
+            dc_static_sync_iterations: 10,
+            retry_behaviour: RetryBehaviour::None,
+        },
+    );
+    block_on(async {
+        let group = md
+            .init_single_group::<2, 32>(ethercrab::std::ethercat_now)
+            .await
+            .expect("init");
+        let group = group.into_op(&md).await.expect("OP");
+        let exchange = |cw: u16| {
+            let group = &group;
+            let md = &md;
+            async move {
+                group.tx_rx(md).await?;
+                let sd = group.subdevice(md, 0).unwrap();
+                let mut io = sd.io_raw_mut();
+                let sw = u16::from_le_bytes([io.inputs()[0], io.inputs()[1]]);
+                io.outputs()[0..2].copy_from_slice(&cw.to_le_bytes());
+                Ok::<u16, Error>(sw)
+            }
+        };
+        let mut sw = 0;
+        for _ in 0..50 {
+            sw = exchange(0x06).await.expect("cycle");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        assert_eq!(sw & 0x6F, 0x21, "ready to switch on: {sw:#06x}");
+        seg.lock()
+            .unwrap()
+            .app::<Cia402Emu>(0)
+            .unwrap()
+            .inject_fault(0x2310);
+        for _ in 0..20 {
+            sw = exchange(0x06).await.expect("cycle");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        assert_eq!(sw & 0x4F, 0x08, "fault: {sw:#06x}");
+        let sd = group.subdevice(&md, 0).unwrap();
+        assert_eq!(
+            sd.sdo_read::<u16>(0x603F, 0).await.unwrap(),
+            0x2310,
+            "the drive's error code"
+        );
+        for cw in [0x00, 0x80, 0x80, 0x06, 0x06, 0x06] {
+            sw = exchange(cw).await.expect("cycle");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        assert_eq!(
+            sw & 0x6F,
+            0x21,
+            "fault reset, then shutdown: ready to switch on: {sw:#06x}"
+        );
+        assert_eq!(sw & 0x08, 0, "no fault bit: {sw:#06x}");
+
+        let lost_before = seg.lock().unwrap().lost;
+        seg.lock().unwrap().faults.drop_frames = 1;
+        assert!(
+            matches!(exchange(0x06).await, Err(Error::Timeout(_))),
+            "a lost frame is a timeout"
+        );
+        assert_eq!(seg.lock().unwrap().lost, lost_before + 1);
+        exchange(0x06).await.expect("the next cycle answers");
+    });
+}

@@ -35,7 +35,7 @@ fn category(out: &mut Vec<u8>, kind: u16, mut data: Vec<u8>) {
 /// SM3 inputs (their lengths come from the CoE PDO assignment), FMMU 0 outputs, 1 inputs,
 /// 2 mailbox status.
 pub fn servo_drive(id: &Identity) -> Vec<u8> {
-    let mut words = vec![0u16; 0x40];
+    let mut words = [0u16; 0x40];
     words[0x08] = id.vendor_id as u16;
     words[0x09] = (id.vendor_id >> 16) as u16;
     words[0x0A] = id.product_code as u16;
