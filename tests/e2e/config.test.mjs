@@ -6,13 +6,10 @@
 // Screenshots go to target/ui-screenshots; with DOCS_SHOTS=1 also to docs/ui/config-*.png.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { copyFileSync, mkdirSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, launch, rest, shot, startStack, status, until } from './lib.mjs';
+import { launch, picture, rest, shot, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
 const AXIS = 'x';
-const DOCS = join(ROOT, 'docs', 'ui');
 
 let desk;
 let phone;
@@ -25,15 +22,6 @@ async function open(ctx, path) {
   await page.goto(`${stack.url}/#${path}`);
   await page.waitForSelector('[data-conn="open"]', { timeout: 20000 });
   return page;
-}
-
-/** A screenshot for the test's record, and for docs/ui when asked (DOCS_SHOTS=1). */
-async function picture(page, name) {
-  const path = await shot(page, name);
-  if (process.env.DOCS_SHOTS === '1') {
-    mkdirSync(DOCS, { recursive: true });
-    copyFileSync(path, join(DOCS, `${name}.png`));
-  }
 }
 
 const param = async (n) => (await rest(stack.api, 'GET', `/axes/${AXIS}/parameters/${n}`)).body;

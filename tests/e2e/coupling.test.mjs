@@ -6,12 +6,9 @@
 // and docs/ui/functions.png.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { copyFileSync, mkdirSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, launch, readout, rest, shot, startStack, status, until } from './lib.mjs';
+import { launch, picture, powerOn, readout, rest, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
-const DOCS = join(ROOT, 'docs', 'ui');
 
 let desk;
 let phone;
@@ -26,14 +23,6 @@ async function open(ctx, path) {
   return page;
 }
 
-async function picture(page, name) {
-  const path = await shot(page, name);
-  if (process.env.DOCS_SHOTS === '1') {
-    mkdirSync(DOCS, { recursive: true });
-    copyFileSync(path, join(DOCS, `${name}.png`));
-  }
-}
-
 const axis = (name) => ({
   name,
   unit: 'mm',
@@ -46,10 +35,8 @@ before(async () => {
   for (const n of ['x', 'y']) {
     const r = await rest(stack.api, 'POST', '/axes', axis(n));
     assert.equal(r.status, 201, JSON.stringify(r.body));
-    const p = await rest(stack.api, 'POST', `/axes/${n}/power`, {});
-    assert.equal(p.status, 202, JSON.stringify(p.body));
   }
-  for (const n of ['x', 'y']) await until(async () => (await status(stack.api, n)).power_status, { what: `${n} enabled` });
+  await powerOn(stack.api, ['x', 'y']);
 });
 
 after(async () => {

@@ -2,7 +2,7 @@
 // database, the built UI (served by motiond when it has --ui-dir, else by `vite preview`
 // with a proxy to motiond), and Debian's Chromium driven by playwright-core.
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, mkdirSync, rmSync, existsSync } from 'node:fs';
+import { copyFileSync, mkdtempSync, mkdirSync, rmSync, existsSync } from 'node:fs';
 import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join, resolve, dirname } from 'node:path';
@@ -12,7 +12,8 @@ import { chromium } from 'playwright-core';
 export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
 export const FRONTEND = join(ROOT, 'frontend');
 export const DIST = join(FRONTEND, 'dist');
-export const SHOTS = join(ROOT, 'target', 'ui-screenshots');
+/** Where screenshots go (E2E_SHOTS_DIR, else target/ui-screenshots). */
+export const SHOTS = process.env.E2E_SHOTS_DIR ? resolve(process.env.E2E_SHOTS_DIR) : join(ROOT, 'target', 'ui-screenshots');
 const CARGO_TARGET = process.env.CARGO_TARGET_DIR ? resolve(process.env.CARGO_TARGET_DIR) : join(ROOT, 'target');
 export const MOTIOND = process.env.MOTIOND_BIN ?? join(CARGO_TARGET, 'debug', 'motiond');
 export const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
@@ -174,6 +175,26 @@ export async function shot(page, name) {
   return path;
 }
 
+/** A screenshot for the test's record (`shot`), and for docs/ui/ when asked (DOCS_SHOTS=1). */
+export async function picture(page, name) {
+  const path = await shot(page, name);
+  if (process.env.DOCS_SHOTS === '1') {
+    const docs = join(ROOT, 'docs', 'ui');
+    mkdirSync(docs, { recursive: true });
+    copyFileSync(path, join(docs, `${name}.png`));
+  }
+  return path;
+}
+
+/** A new page of a launched browser at `url`, once its socket is open (script errors logged). */
+export async function openPage({ context }, url) {
+  const page = await context.newPage();
+  page.on('pageerror', (e) => console.error('pageerror:', e.message));
+  await page.goto(url);
+  await page.waitForSelector('[data-conn="open"]', { timeout: 20000 });
+  return page;
+}
+
 /**
  * REST helper against motiond (anything but a GET is declared JSON, as motiond requires);
  * `headers` are added (a session `cookie`, `authorization`, `x-client-id` …).
@@ -209,6 +230,45 @@ export async function loginCookie(api, name, password) {
 }
 
 export const status = async (api, axis) => (await rest(api, 'GET', `/axes/${axis}/status`)).body.status;
+
+/**
+ * What sticks out of the window on the right: the sideways scroll of the document and of `.main`,
+ * and every visible element of `.main` and of the header whose box ends beyond the window's
+ * right edge — except inside a container that scrolls or clips sideways itself (`.table-scroll`,
+ * the phone's header links), whose own box is checked instead.
+ */
+export async function overflowing(page) {
+  return page.evaluate(() => {
+    const W = document.documentElement.clientWidth;
+    const main = document.querySelector('.main');
+    const roots = [main, document.querySelector('.topbar')].filter(Boolean);
+    const clipped = (el, root) => {
+      for (let p = el.parentElement; p && p !== root; p = p.parentElement) {
+        if (getComputedStyle(p).overflowX !== 'visible') return true;
+      }
+      return false;
+    };
+    const name = (el) => `${el.tagName.toLowerCase()}${el.id ? '#' + el.id : ''}${[...el.classList].map((c) => '.' + c).join('')}${el.getAttribute('name') ? `[name=${el.getAttribute('name')}]` : ''}`;
+    const wide = [];
+    for (const root of roots)
+      for (const el of root.querySelectorAll('*')) {
+        const r = el.getBoundingClientRect();
+        if (!(r.width > 0 && r.height > 0) || r.right <= W + 0.5) continue;
+        if (getComputedStyle(el).visibility === 'hidden' || clipped(el, root)) continue;
+        wide.push(`${name(el)} ends at ${Math.round(r.right)} > ${W}`);
+      }
+    return { doc: document.documentElement.scrollWidth - window.innerWidth, main: main ? main.scrollWidth - main.clientWidth : 0, wide };
+  });
+}
+
+/** Enables the axes (MC_Power) and waits until each one is. */
+export async function powerOn(api, names) {
+  for (const n of names) {
+    const p = await rest(api, 'POST', `/axes/${n}/power`, {});
+    if (p.status !== 202) throw new Error(`power ${n}: ${p.status} ${JSON.stringify(p.body)}`);
+  }
+  for (const n of names) await until(async () => (await status(api, n)).power_status, { what: `${n} enabled` });
+}
 
 /** A readout of the online tab as a number. */
 export async function readout(page, name) {

@@ -4,14 +4,11 @@
 // Screenshots go to target/ui-screenshots; with DOCS_SHOTS=1 also to docs/ui/scope-*.png.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { copyFileSync, mkdirSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, launch, rest, shot, startStack, status, until } from './lib.mjs';
+import { launch, picture, rest, shot, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
 const AXIS = 'sc';
 const SETUP = 'e2e-stacked';
-const DOCS = join(ROOT, 'docs', 'ui');
 let desk;
 let phone;
 
@@ -21,14 +18,6 @@ async function open(browser, path) {
   await page.goto(`${stack.url}/#${path}`);
   await page.waitForSelector('[data-conn="open"]', { timeout: 20000 });
   return page;
-}
-
-async function picture(page, name) {
-  const path = await shot(page, name);
-  if (process.env.DOCS_SHOTS === '1') {
-    mkdirSync(DOCS, { recursive: true });
-    copyFileSync(path, join(DOCS, `${name}.png`));
-  }
 }
 
 const active = async () => (await rest(stack.api, 'GET', '/scope/recordings')).body.filter((r) => r.state === 'armed' || r.state === 'recording');

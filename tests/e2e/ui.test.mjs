@@ -2,7 +2,7 @@
 // motiond binary. Live values are polled with generous deadlines; nothing asserts timing.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launch, readout, rest, shot, startStack, status, until, sleep } from './lib.mjs';
+import { launch, overflowing, readout, rest, shot, startStack, status, until, sleep } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
 
@@ -641,34 +641,51 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
+  /** A cam table for the editor's page in the every-page test (a test run alone makes it). */
+  async function pagesCam() {
+    if ((await rest(stack.api, 'GET', '/cam-tables/pages')).status === 200) return;
+    const p = (i, x, y, law = 'polynom5', type = 'rest') => ({ point_index: i, function_type: law, point_type: type, master_pos: x, slave_pos: y });
+    const r = await rest(stack.api, 'POST', '/cam-tables', { name: 'pages', table_type: 'motion_function', periodic: true, points: [p(1, 0, 0), p(2, 100, 50, 'polynom1', 'motion'), p(3, 200, 100, 'polynom5', 'motion'), p(4, 360, 0)] });
+    assert.equal(r.status, 201, JSON.stringify(r.body));
+  }
+
   for (const [width, height] of [
+    [1600, 1000],
     [1280, 800],
     [1024, 768],
     [390, 844],
   ]) {
     test(`every page at ${width}×${height}: screenshots, nothing wider than the window`, async () => {
       await enabled();
+      await pagesCam();
       const page = await open('/', { width, height });
+      // [name, route, what shows that its content has loaded (one selector or several)]
       const pagesToSee = [
-        ['overview', '/'],
-        ['online', `/axes/${AXIS}`],
-        ['parameters', `/axes/${AXIS}/parameters`],
-        ['configuration', `/axes/${AXIS}/config`],
-        ['new-axis', '/new-axis'],
-        ['scope', '/scope'],
-        ['cams', '/cams'],
+        ['overview', '/', `.main [data-axis="${AXIS}"]`],
+        ['online', `/axes/${AXIS}`, '[data-readout="actual_position"]'],
+        ['coupling', `/axes/${AXIS}/coupling`, '[data-testid="coupling-kv"]'],
+        ['functions', `/axes/${AXIS}/functions`, '[data-testid="homing-phase"]'],
+        ['parameters', `/axes/${AXIS}/parameters`, '.params'],
+        ['configuration', `/axes/${AXIS}/config`, 'select[name="drive.plant.kind"]'],
+        ['new-axis', '/new-axis', 'input[name="name"]'],
+        ['scope', '/scope', '[data-channel="0"]'],
+        ['cams', '/cams', 'tr[data-cam="pages"]'],
+        // the editor with a jump warned (Polynom 1 from a MOTION point) and its handles
+        ['cam-editor', '/cams/pages', ['[data-analysis="current"]', 'tr.has-warning', '[data-handle="1"]']],
+        ['system', '/system', '[data-testid="timing"] tr[data-metric="period"]'],
+        // authentication is off in this stack: the users page is open to anyone
+        ['users', '/users', '[data-testid="users"]'],
       ];
-      for (const [name, path] of pagesToSee) {
+      for (const [name, path, ready] of pagesToSee) {
         await page.goto(`${stack.url}/#${path}`);
         await page.waitForSelector('[data-conn="open"]');
         await page.waitForSelector('.main .page');
+        for (const sel of [ready].flat()) await page.waitForSelector(sel);
         await sleep(400); // let live values arrive for the picture
         await shot(page, `${name}-${width}x${height}`);
-        const overflow = await page.evaluate(() => {
-          const main = document.querySelector('.main');
-          return { doc: document.documentElement.scrollWidth - window.innerWidth, main: main.scrollWidth - main.clientWidth };
-        });
-        assert.ok(overflow.doc <= 0 && overflow.main <= 0, `${name} at ${width}×${height} scrolls sideways: ${JSON.stringify(overflow)}`);
+        const o = await overflowing(page);
+        assert.ok(o.doc <= 0 && o.main <= 0, `${name} at ${width}×${height} scrolls sideways: ${JSON.stringify(o)}`);
+        assert.deepEqual(o.wide, [], `${name} at ${width}×${height}: elements beyond the window's right edge`);
       }
     });
   }

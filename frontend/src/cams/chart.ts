@@ -1,53 +1,242 @@
-// uPlot chart of a cam over its master: position, velocity, acceleration and jerk, each on its
-// own scale (the server's sampled values: it is the one source of the cam's math). The element
-// carries `data-samples` and `data-series` for the tests.
+// uPlot charts of a cam over its master, stacked on one master axis: position (with the points
+// as handles to drag), velocity, acceleration, jerk — the server's sampled values, the one source
+// of the cam's math. Discontinuities are marked by a dashed line at their master position.
+// The element carries `data-samples` and `data-series`; each handle is an element
+// `[data-handle=i]` placed with uPlot's valToPos, so tests can grab it.
 import uPlot from 'uplot';
+import type { Handle } from './data';
 
 export const CAM_COLORS = ['#1363c6', '#2b8a3e', '#d9480f', '#ae3ec9'];
+const NAMES = ['position', 'velocity', 'acceleration', 'jerk'];
+
+export type DragPhase = 'start' | 'move' | 'end';
+
+export interface CamChartCallbacks {
+  /**
+   * A handle is grabbed ('start'), dragged to (master, slave) in the values of the plot, not yet
+   * clamped ('move'), let go ('end': where the last move took it).
+   */
+  onDrag?: (index: number, master: number, slave: number, phase: DragPhase) => void;
+}
+
+let charts = 0;
 
 export class CamChart {
-  private u: uPlot;
+  private panes: uPlot[] = [];
+  private readout: HTMLElement;
+  private handleBox: HTMLElement | null = null;
+  private handles: Handle[] = [];
+  private warn = new Set<number>();
+  private marks: number[] = [];
+  private range: [number, number] = [0, 1];
+  /** While a handle is dragged, the scales stay where they were when it was grabbed. */
+  private frozen: { x: [number, number]; y: [number, number] } | null = null;
+  private dragging: number | null = null;
   private ro: ResizeObserver | null = null;
 
-  constructor(el: HTMLElement, columns: string[], rows: number[][]) {
-    const x = rows.map((r) => r[0]);
-    const names = columns.slice(1);
-    const scales: uPlot.Scales = { x: { time: false } };
-    const axes: uPlot.Axis[] = [{ label: 'master', stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }];
-    names.forEach((n, i) => {
-      scales[n] = { auto: true };
-      axes.push({
-        scale: n,
-        label: n,
-        side: i % 2 === 0 ? 3 : 1,
-        stroke: CAM_COLORS[i],
-        grid: { show: i === 0, stroke: '#eef0f3' },
-        ticks: { stroke: '#c9cfd6' },
-        size: 64,
-      });
+  constructor(
+    private readonly el: HTMLElement,
+    private readonly cb: CamChartCallbacks = {},
+  ) {
+    const key = `cam-${++charts}`;
+    el.replaceChildren();
+    this.readout = document.createElement('div');
+    this.readout.className = 'cam-readout mono';
+    el.appendChild(this.readout);
+    this.showReadout(null);
+    NAMES.forEach((name, i) => {
+      const box = document.createElement('div');
+      box.className = `cam-pane cam-pane-${name}`;
+      box.dataset.pane = name;
+      el.appendChild(box);
+      const last = i === NAMES.length - 1;
+      const opts: uPlot.Options = {
+        width: this.width(),
+        height: this.height(i),
+        legend: { show: false },
+        cursor: { sync: { key }, drag: { x: false, y: false } },
+        scales: {
+          x: { time: false, range: () => this.frozen?.x ?? this.range },
+          y: { range: (_u, min, max) => this.yRange(i, min, max) },
+        },
+        axes: [
+          last
+            ? { label: 'master', labelSize: 14, size: 30, stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }
+            : { stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6', size: 4 }, size: 6, values: (_u, splits) => splits.map(() => '') },
+          { label: name, labelSize: 16, stroke: CAM_COLORS[i], grid: { stroke: '#eef0f3' }, ticks: { stroke: '#c9cfd6' }, size: 56, space: i === 0 ? 30 : 18 },
+        ],
+        series: [{ label: 'master' }, { label: name, stroke: CAM_COLORS[i], width: 1.5 }],
+        hooks: {
+          draw: [(u) => this.drawMarks(u, i)],
+          setCursor: i === 0 ? [(u) => this.showReadout(u.cursor.idx ?? null)] : [],
+        },
+      };
+      this.panes.push(new uPlot(opts, [[], []], box));
     });
-    const width = () => Math.max(320, el.clientWidth || 640);
-    const opts: uPlot.Options = {
-      width: width(),
-      height: 320,
-      scales,
-      axes,
-      legend: { live: true },
-      cursor: { drag: { x: true, y: false } },
-      series: [{ label: 'master' }, ...names.map((n, i) => ({ label: n, scale: n, stroke: CAM_COLORS[i], width: 1.5 }))],
-    };
-    const data: uPlot.AlignedData = [x, ...names.map((_, i) => rows.map((r) => r[i + 1]))];
-    this.u = new uPlot(opts, data, el);
-    el.dataset.samples = String(x.length);
-    el.dataset.series = names.join(',');
+    el.dataset.series = NAMES.join(',');
+    el.dataset.samples = '0';
+    this.handleBox = this.panes[0].over;
     if (typeof ResizeObserver !== 'undefined') {
-      this.ro = new ResizeObserver(() => this.u.setSize({ width: width(), height: 320 }));
+      this.ro = new ResizeObserver(() => this.panes.forEach((u, i) => u.setSize({ width: this.width(), height: this.height(i) })));
       this.ro.observe(el);
     }
   }
 
+  private width(): number {
+    return Math.max(200, this.el.clientWidth || 600);
+  }
+
+  private height(i: number): number {
+    const small = (this.el.clientWidth || 600) < 560;
+    return i === 0 ? (small ? 200 : 250) : small ? 96 : 120;
+  }
+
+  /** Auto range of a pane; the position pane also holds the handles, and stays put while dragging. */
+  private yRange(i: number, min: number, max: number): [number, number] {
+    if (i === 0 && this.frozen) return this.frozen.y;
+    if (i === 0)
+      for (const h of this.handles) {
+        min = Math.min(min, h.slave);
+        max = Math.max(max, h.slave);
+      }
+    if (!Number.isFinite(min) || !Number.isFinite(max)) return [0, 1];
+    const r = uPlot.rangeNum(min, max, 0.1, true);
+    return [r[0] ?? min, r[1] ?? max];
+  }
+
+  /** New values (`columns`: master, position, velocity, acceleration, jerk) over [start, end]. */
+  setData(rows: number[][], start: number, end: number, discontinuities: number[] = []): void {
+    this.range = end > start ? [start, end] : [start, start + 1];
+    this.marks = discontinuities;
+    const x = rows.map((r) => r[0]);
+    this.panes.forEach((u, i) => u.setData([x, rows.map((r) => r[i + 1])], !this.frozen));
+    this.el.dataset.samples = String(x.length);
+    this.place();
+  }
+
+  /** The points to drag (and the ones with a warning). */
+  setHandles(handles: Handle[], warn: Set<number> = new Set()): void {
+    this.handles = handles;
+    this.warn = warn;
+    // the position scale holds the handles too: ranged again unless a drag holds it
+    if (!this.frozen) this.panes[0].setData(this.panes[0].data, true);
+    this.place();
+    if (this.panes[0].cursor.idx == null) this.showReadout(null);
+  }
+
+  /** Canvas position → values of the position pane (for a drag). */
+  private valuesAt(clientX: number, clientY: number): { master: number; slave: number } {
+    const u = this.panes[0];
+    const r = u.over.getBoundingClientRect();
+    const x = Math.min(r.width, Math.max(0, clientX - r.left));
+    const y = Math.min(r.height, Math.max(0, clientY - r.top));
+    return { master: u.posToVal(x, 'x'), slave: u.posToVal(y, 'y') };
+  }
+
+  /** Puts the handle elements where their points are. */
+  private place(): void {
+    const box = this.handleBox;
+    if (!box) return;
+    const u = this.panes[0];
+    const els = [...box.querySelectorAll<HTMLElement>('.cam-handle')];
+    while (els.length > this.handles.length) els.pop()!.remove();
+    while (els.length < this.handles.length) {
+      const h = document.createElement('div');
+      h.className = 'cam-handle';
+      h.tabIndex = -1;
+      this.grab(h);
+      box.appendChild(h);
+      els.push(h);
+    }
+    const w = box.clientWidth;
+    const hgt = box.clientHeight;
+    this.handles.forEach((p, k) => {
+      const h = els[k];
+      const left = u.valToPos(p.master, 'x');
+      const top = u.valToPos(p.slave, 'y');
+      const inside = Number.isFinite(left) && Number.isFinite(top) && left >= -0.5 && left <= w + 0.5 && top >= -0.5 && top <= hgt + 0.5;
+      h.dataset.handle = String(p.index);
+      h.dataset.master = String(p.master);
+      h.dataset.slave = String(p.slave);
+      h.style.left = `${left}px`;
+      h.style.top = `${top}px`;
+      h.style.display = inside ? '' : 'none';
+      h.title = `point ${p.index + 1}: master ${p.master}, slave ${p.slave} — drag to move it`;
+      h.classList.toggle('warn', this.warn.has(p.index));
+      h.classList.toggle('dragging', this.dragging === p.index);
+    });
+  }
+
+  /** Pointer handling of a handle: one drag from pointerdown to pointerup (captured). */
+  private grab(h: HTMLElement): void {
+    const index = () => Number(h.dataset.handle);
+    h.addEventListener('pointerdown', (e) => {
+      if (e.button !== 0) return;
+      e.preventDefault();
+      e.stopPropagation();
+      h.setPointerCapture?.(e.pointerId);
+      const u = this.panes[0];
+      this.frozen = { x: [u.scales.x.min!, u.scales.x.max!], y: [u.scales.y.min!, u.scales.y.max!] };
+      this.dragging = index();
+      const p = this.handles.find((q) => q.index === this.dragging);
+      if (p) this.cb.onDrag?.(this.dragging, p.master, p.slave, 'start');
+      this.place();
+    });
+    h.addEventListener('pointermove', (e) => {
+      if (this.dragging === null || this.dragging !== index()) return;
+      e.preventDefault();
+      const v = this.valuesAt(e.clientX, e.clientY);
+      this.cb.onDrag?.(this.dragging, v.master, v.slave, 'move');
+    });
+    const end = () => {
+      if (this.dragging === null) return;
+      const i = this.dragging;
+      this.dragging = null;
+      this.frozen = null;
+      // the drag ends where its last move took it (a click without a move changes nothing)
+      const p = this.handles.find((q) => q.index === i);
+      this.cb.onDrag?.(i, p?.master ?? NaN, p?.slave ?? NaN, 'end');
+      this.panes.forEach((u) => u.setData(u.data, true));
+      this.place();
+    };
+    h.addEventListener('pointerup', end);
+    h.addEventListener('pointercancel', end);
+  }
+
+  private drawMarks(u: uPlot, i: number): void {
+    if (i === 0) this.place();
+    if (!this.marks.length) return;
+    const ctx = u.ctx;
+    ctx.save();
+    ctx.strokeStyle = '#d32f2f';
+    ctx.lineWidth = uPlot.pxRatio;
+    ctx.setLineDash([4 * uPlot.pxRatio, 3 * uPlot.pxRatio]);
+    for (const m of this.marks) {
+      const x = Math.round(u.valToPos(m, 'x', true));
+      ctx.beginPath();
+      ctx.moveTo(x, u.bbox.top);
+      ctx.lineTo(x, u.bbox.top + u.bbox.height);
+      ctx.stroke();
+    }
+    ctx.restore();
+  }
+
+  private showReadout(idx: number | null): void {
+    const d = this.panes[0]?.data;
+    if (idx === null || !d || d[0][idx] === undefined) {
+      this.readout.textContent = this.handles.length ? 'Drag a point of the position plot to move it.' : '\u00a0';
+      return;
+    }
+    const parts = [`master ${fmt(d[0][idx])}`, ...this.panes.map((u, i) => `${NAMES[i]} ${fmt(u.data[1]?.[idx] as number)}`)];
+    this.readout.textContent = parts.join(' · ');
+  }
+
   destroy(): void {
     this.ro?.disconnect();
-    this.u.destroy();
+    this.panes.forEach((u) => u.destroy());
+    this.panes = [];
+    this.el.replaceChildren();
   }
 }
+
+const fmt = (v: number | null | undefined) => (v === null || v === undefined || !Number.isFinite(v) ? '—' : String(Number(v.toPrecision(5))));
