@@ -775,10 +775,25 @@ async fn axis_crud_with_validation_and_enabled_axes_protected() {
         );
     }
     let mut bad = cfg.clone();
-    bad["drive"] = json!({"kind": "cia402"});
+    bad["drive"] = json!({"kind": "servo"});
     let r = post(&s, "/api/v1/axes", bad).await;
     assert_problem(&r, 422, "validation_failed");
-    assert_eq!(r.json["errors"][0]["field"], "drive", "{}", r.json);
+    assert_eq!(r.json["errors"][0]["field"], "drive.kind", "{}", r.json);
+    // A CiA-402 drive names what it lacks; and needs an EtherCAT bus (this one is simulated).
+    let mut bad = cfg.clone();
+    bad["drive"] = json!({"kind": "cia402"});
+    let r = post(&s, "/api/v1/axes", bad.clone()).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "drive.subdevice",
+        "{}",
+        r.json
+    );
+    bad["drive"] = json!({"kind": "cia402", "subdevice": 0, "increments_per_unit": 1000.0});
+    bad["name"] = json!("servo");
+    let r = post(&s, "/api/v1/axes", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "drive.kind", "{}", r.json);
     let mut unknown = cfg.clone();
     unknown["colour"] = json!("red");
     assert_problem(
@@ -1007,7 +1022,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 70, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 73, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -1,8 +1,8 @@
 //! The drive bus: what the cycle thread exchanges the kernel's setpoints and the drives'
 //! feedback with, once per cycle, for every axis slot at once — the process image of a
-//! fieldbus. The simulated bus ([`SimBus`]) is the only implementation today; an EtherCAT bus
-//! of CiA-402 drives will implement the same trait in its own crate (this crate does no
-//! network I/O, so drive logic stays testable without a network card).
+//! fieldbus. The simulated bus ([`SimBus`]) is the default; the EtherCAT bus of CiA-402 drives
+//! implements the same trait in its own crate (`ethercat`: this crate does no network I/O, so
+//! drive logic stays testable without a network card).
 //!
 //! Drives are built off the cycle thread ([`DriveConfig::build`]) and attached to a slot
 //! there; whatever a slot held before comes back to be freed off the thread.
@@ -10,6 +10,7 @@
 use motion::{DriveFeedback, DriveSetpoint};
 use serde::{Deserialize, Serialize};
 
+use crate::cia402::{Cia402Config, Cia402Drive};
 use crate::sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
 
 /// How an axis's drive is configured: an object whose `kind` names the drive (`simulated`, the
@@ -21,6 +22,8 @@ use crate::sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
 pub enum DriveConfig {
     /// The simulated servo drive (plant model, cam, index pulse, limit switches, faults).
     Simulated(SimDriveConfig),
+    /// A CiA-402 servo drive on the EtherCAT bus (`--bus ethercat` or `--bus emulated`).
+    Cia402(Cia402Config),
 }
 
 impl Default for DriveConfig {
@@ -34,6 +37,7 @@ impl DriveConfig {
     pub fn validate(&self) -> Result<(), Vec<FieldError>> {
         match self {
             DriveConfig::Simulated(c) => c.validate(),
+            DriveConfig::Cia402(c) => c.validate(),
         }
     }
 
@@ -44,96 +48,123 @@ impl DriveConfig {
             DriveConfig::Simulated(c) => {
                 Drive::Simulated(Box::new(SimDrive::new(c.clone(), cycle_time_s)))
             }
+            DriveConfig::Cia402(c) => Drive::Cia402(Box::new(Cia402Drive::new(c.clone()))),
         }
     }
 }
 
-/// Reads the object's fields in place (no buffering), so that an error inside a drive's fields
-/// keeps its JSON path (`drive.plant.damping`) for whoever tracks it.
+/// A drive object is read whole, its `kind` (anywhere in it; `simulated` when absent) chooses
+/// the variant, and the variant is read from the object without `kind`. An error inside it
+/// names its path below the drive: the message is `PATH` + [`PATH_SEPARATOR`] + what is wrong,
+/// which the server splits to extend the field's JSON path (`drive.plant.damping`).
 impl<'de> Deserialize<'de> for DriveConfig {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Object;
-        impl<'de> serde::de::Visitor<'de> for Object {
-            type Value = DriveConfig;
-            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                f.write_str("a drive configuration object")
+        use serde::de::Error;
+        use serde_json::Value;
+        let mut map = match Value::deserialize(d)? {
+            Value::Object(map) => map,
+            other => {
+                return Err(D::Error::invalid_type(
+                    unexpected(&other),
+                    &"a drive configuration object",
+                ));
             }
-            fn visit_map<A: serde::de::MapAccess<'de>>(
-                self,
-                map: A,
-            ) -> Result<DriveConfig, A::Error> {
-                let fields = serde::de::value::MapAccessDeserializer::new(WithoutKind(map));
-                SimDriveConfig::deserialize(fields).map(DriveConfig::Simulated)
-            }
+        };
+        let at = |path: &str, message: &dyn core::fmt::Display| {
+            D::Error::custom(format_args!("{path}{PATH_SEPARATOR}{message}"))
+        };
+        let kind = match map.remove("kind") {
+            None => "simulated".to_string(),
+            Some(Value::String(k)) => k,
+            Some(_) => return Err(at("kind", &"must be a string")),
+        };
+        let fields = Value::Object(map);
+        let read = |e: serde_path_to_error::Error<serde_json::Error>| {
+            let path = e.path().to_string();
+            at(if path == "." { "" } else { &path }, e.inner())
+        };
+        match kind.as_str() {
+            "simulated" => serde_path_to_error::deserialize(&fields)
+                .map(DriveConfig::Simulated)
+                .map_err(read),
+            "cia402" => serde_path_to_error::deserialize(&fields)
+                .map(DriveConfig::Cia402)
+                .map_err(read),
+            other => Err(at(
+                "kind",
+                &format_args!(
+                    "unknown variant `{other}`, expected one of {}",
+                    KINDS.join(", ")
+                ),
+            )),
         }
-        d.deserialize_map(Object)
     }
 }
+
+fn unexpected(v: &serde_json::Value) -> serde::de::Unexpected<'_> {
+    use serde::de::Unexpected;
+    use serde_json::Value;
+    match v {
+        Value::Null => Unexpected::Unit,
+        Value::Bool(b) => Unexpected::Bool(*b),
+        Value::Number(_) => Unexpected::Other("a number"),
+        Value::String(s) => Unexpected::Str(s),
+        Value::Array(_) => Unexpected::Seq,
+        Value::Object(_) => Unexpected::Map,
+    }
+}
+
+/// Separates the path below a drive object from the message in a drive's read error.
+pub const PATH_SEPARATOR: char = '\u{1f}';
 
 /// The kinds of drive there are, as `kind` names them.
-const KINDS: &[&str] = &["simulated"];
+const KINDS: &[&str] = &["simulated", "cia402"];
 
-/// A drive object's fields without its `kind` (checked on the way: with a single kind, the
-/// fields that follow are that kind's wherever `kind` stands).
-struct WithoutKind<A>(A);
-
-impl<'de, A: serde::de::MapAccess<'de>> serde::de::MapAccess<'de> for WithoutKind<A> {
-    type Error = A::Error;
-
-    fn next_key_seed<K: serde::de::DeserializeSeed<'de>>(
-        &mut self,
-        seed: K,
-    ) -> Result<Option<K::Value>, A::Error> {
-        use serde::de::{Error, IntoDeserializer};
-        loop {
-            let Some(key) = self.0.next_key::<String>()? else {
-                return Ok(None);
-            };
-            if key != "kind" {
-                return seed.deserialize(key.into_deserializer()).map(Some);
-            }
-            let kind: String = self.0.next_value()?;
-            if !KINDS.contains(&kind.as_str()) {
-                return Err(A::Error::unknown_variant(&kind, KINDS));
-            }
-        }
-    }
-
-    fn next_value_seed<V: serde::de::DeserializeSeed<'de>>(
-        &mut self,
-        seed: V,
-    ) -> Result<V::Value, A::Error> {
-        self.0.next_value_seed(seed)
-    }
-}
-
-/// The schema: the simulated drive's object with `kind` in front (a `oneOf` over the kinds
-/// once there is more than one).
+/// The schema: one of the drive objects, each with its `kind` in front (optional for the
+/// simulated drive, which is the default).
 #[cfg(feature = "schema")]
 impl utoipa::PartialSchema for DriveConfig {
     fn schema() -> utoipa::openapi::RefOr<utoipa::openapi::schema::Schema> {
         use utoipa::openapi::RefOr;
-        use utoipa::openapi::schema::{Object, Schema, SchemaType, Type};
-        let mut schema = <SimDriveConfig as utoipa::PartialSchema>::schema();
-        if let RefOr::T(Schema::Object(o)) = &mut schema {
-            let kind = Object::builder()
-                .schema_type(SchemaType::Type(Type::String))
-                .enum_values(Some(KINDS.iter().copied()))
-                .default(Some("simulated".into()))
-                .description(Some(
-                    "The kind of drive; `simulated` (the default) is the only one yet.",
-                ))
-                .build();
-            let mut properties = std::mem::take(&mut o.properties);
-            o.properties.insert("kind".into(), kind.into());
-            o.properties.append(&mut properties);
-            o.description = Some(
-                "An axis's drive: `kind` and that drive's fields. A simulated drive: a model of \
-                 a servo drive (times in seconds, positions in the axis's units)."
-                    .into(),
-            );
-        }
-        schema
+        use utoipa::openapi::schema::{Object, OneOf, Schema, SchemaType, Type};
+        let with_kind = |mut schema: RefOr<Schema>, kind: &str, required: bool, about: &str| {
+            if let RefOr::T(Schema::Object(o)) = &mut schema {
+                let tag = Object::builder()
+                    .schema_type(SchemaType::Type(Type::String))
+                    .enum_values(Some([kind]))
+                    .default((!required).then(|| kind.into()))
+                    .description(Some(about))
+                    .build();
+                let mut properties = std::mem::take(&mut o.properties);
+                o.properties.insert("kind".into(), tag.into());
+                o.properties.append(&mut properties);
+                if required {
+                    o.required.insert(0, "kind".into());
+                }
+            }
+            schema
+        };
+        let sim = with_kind(
+            <SimDriveConfig as utoipa::PartialSchema>::schema(),
+            "simulated",
+            false,
+            "A simulated servo drive (the default): a model of a drive, times in seconds, \
+             positions in the axis's units.",
+        );
+        let cia402 = with_kind(
+            <Cia402Config as utoipa::PartialSchema>::schema(),
+            "cia402",
+            true,
+            "A CiA-402 servo drive on the EtherCAT bus (`--bus ethercat` or `--bus emulated`).",
+        );
+        OneOf::builder()
+            .item(sim)
+            .item(cia402)
+            .description(Some(
+                "An axis's drive: `kind` and that drive's fields — `simulated` (the default when \
+                 `kind` is left out) or `cia402`.",
+            ))
+            .into()
     }
 }
 
@@ -146,18 +177,21 @@ impl utoipa::ToSchema for DriveConfig {
         )>,
     ) {
         <SimDriveConfig as utoipa::ToSchema>::schemas(schemas);
+        <Cia402Config as utoipa::ToSchema>::schemas(schemas);
     }
 }
 
 /// A drive ready to be attached to a bus slot.
 pub enum Drive {
     Simulated(Box<SimDrive>),
+    Cia402(Box<Cia402Drive>),
 }
 
 impl core::fmt::Debug for Drive {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Drive::Simulated(_) => f.write_str("Drive::Simulated"),
+            Drive::Cia402(_) => f.write_str("Drive::Cia402"),
         }
     }
 }
@@ -238,7 +272,10 @@ impl DriveBus for SimBus {
         let Some(place) = self.drives.get_mut(slot) else {
             return Err(drive);
         };
-        let Drive::Simulated(d) = drive;
+        // A CiA-402 drive needs an EtherCAT bus.
+        let Drive::Simulated(d) = drive else {
+            return Err(drive);
+        };
         Ok(place.replace(d).map(Drive::Simulated))
     }
 
@@ -285,9 +322,34 @@ mod tests {
     }
 
     #[test]
+    fn a_cia402_drive_reads_with_its_kind_anywhere() {
+        let c: DriveConfig = serde_json::from_str(
+            r#"{"subdevice": 1, "increments_per_unit": 1000, "kind": "cia402"}"#,
+        )
+        .unwrap();
+        let DriveConfig::Cia402(c) = c else {
+            panic!("{c:?}")
+        };
+        assert_eq!((c.subdevice, c.increments_per_unit), (1, 1000.0));
+        let written = serde_json::to_value(DriveConfig::Cia402(c)).unwrap();
+        assert_eq!(written["kind"], "cia402");
+        // Errors inside name their path below the drive.
+        let e = serde_json::from_str::<DriveConfig>(r#"{"kind": "cia402", "subdevice": -1}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&format!("subdevice{PATH_SEPARATOR}")), "{e}");
+        let e = serde_json::from_str::<DriveConfig>(r#"{"plant": {"kind": "pt9"}}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&format!("plant.kind{PATH_SEPARATOR}")), "{e}");
+    }
+
+    #[test]
     fn an_unknown_kind_or_field_is_refused() {
+        let e = serde_json::from_str::<DriveConfig>(r#"{"kind": "servo"}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown variant `servo`"), "{e}");
         let e = serde_json::from_str::<DriveConfig>(r#"{"kind": "cia402"}"#).unwrap_err();
-        assert!(e.to_string().contains("unknown variant `cia402`"), "{e}");
+        assert!(e.to_string().contains("missing field"), "{e}");
         let e = serde_json::from_str::<DriveConfig>(r#"{"dead_tme": 0.1}"#).unwrap_err();
         assert!(e.to_string().contains("unknown field `dead_tme`"), "{e}");
         let e = serde_json::from_str::<DriveConfig>("[]").unwrap_err();

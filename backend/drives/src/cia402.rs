@@ -223,6 +223,7 @@ impl Cia402Drive {
             enabled: state == Cia402State::OperationEnabled
                 && tx.mode_display == self.config.mode.code(),
             fault,
+            bus_error: false,
             fault_code: if fault { tx.error_code as u32 } else { 0 },
             actual_position: self.position as f64 / self.config.increments_per_unit,
             actual_velocity: tx.velocity_actual as f64 / self.velocity_scale(),

@@ -592,6 +592,7 @@ impl SimDrive {
             ready: self.fault_code == 0,
             enabled: self.enabled,
             fault: self.fault_code != 0,
+            bus_error: false,
             fault_code: self.fault_code,
             actual_position: self.position,
             actual_velocity: self.velocity,

@@ -3,6 +3,7 @@
 //! hardware. This is the only crate of motiond's drives with network I/O; the CiA-402 logic
 //! itself (`drives::cia402`) stays free of it.
 
+pub mod bus;
 pub mod emu;
 
 pub use ethercrab;

@@ -47,6 +47,10 @@ pub struct DriveFeedback {
     pub fault: bool,
     /// Drive-specific fault code (0 when none).
     pub fault_code: u32,
+    /// The bus could not reach the drive (lost frames or wrong working counters in a row, or
+    /// its SubDevice left OP): the axis stops into ErrorStop with `bus_error` on its ramp, as
+    /// far as the drive still follows. The other fields are the drive's last answer.
+    pub bus_error: bool,
     pub actual_position: f64,
     pub actual_velocity: f64,
     /// Reference cam (homing switch) input.

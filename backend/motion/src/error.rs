@@ -137,6 +137,7 @@ error_table! {
     CAM_FAMILY_MIXED = 0x7088, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave";
     /// MC_TouchProbe while a probe cycle runs (end it first: MC_AbortTrigger) or while homing
     /// uses the drive's latch.
+    BUS_ERROR = 0x70A0, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)";
     TOUCH_PROBE_BUSY = 0x7090, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)";
 }
 

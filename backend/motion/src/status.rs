@@ -136,6 +136,9 @@ pub struct AxisStatus {
     /// 0 = no error.
     pub error_id: u32,
     pub drive_fault: bool,
+    /// The drive's own code of the fault that stopped the axis (CiA-402 0x603F, or the bus's
+    /// code when the drive could not be reached); 0 unless `drive_fault`.
+    pub drive_error_code: u32,
     /// Offset accumulated by MC_SetPosition since the last homing (#2003).
     pub set_position_offset: f64,
     /// Command that is executing (NcToPlc CmdNo), 0 when none.

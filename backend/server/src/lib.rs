@@ -26,6 +26,7 @@
 pub mod api;
 pub mod app;
 pub mod auth;
+pub mod bus;
 pub mod cycle;
 pub mod error;
 pub mod metrics;
@@ -187,6 +188,18 @@ pub struct ServeArgs {
     /// Do not create the demo axes on a new database.
     #[arg(long, global = true)]
     pub no_demo: bool,
+    /// The drive bus: `simulated` drives (the default), `ethercat` (CiA-402 drives on
+    /// `--interface`; needs `CAP_NET_RAW`), or `emulated` (an emulated EtherCAT segment of
+    /// CiA-402 drives in this process: EtherCAT without hardware).
+    #[arg(long, global = true, value_enum, default_value = "simulated")]
+    pub bus: bus::BusKind,
+    /// The network interface of the EtherCAT segment (`--bus ethercat`).
+    #[arg(long, global = true, value_name = "IFACE")]
+    pub interface: Option<String>,
+    /// Lost frames or wrong working counters in a row after which every axis of the EtherCAT
+    /// bus stops into ErrorStop (1–1000).
+    #[arg(long = "bus-max-errors", global = true, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub bus_max_errors: u32,
     /// The built commissioning UI, served at `/` [default: `frontend/dist` in the current
     /// directory, else the one of the source tree motiond was built from].
     #[arg(long, global = true, value_name = "PATH")]
@@ -326,6 +339,20 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             drive: DriveConfig::default(),
         },
     ]
+}
+
+/// The demo machine on the emulated EtherCAT segment: each axis's drive is the emulated
+/// CiA-402 servo at its position (1 µm per increment on the linear axes, 0.01° on the spindle).
+fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
+    for (i, a) in axes.iter_mut().enumerate() {
+        a.drive = DriveConfig::Cia402(drives::cia402::Cia402Config {
+            subdevice: i as u16,
+            increments_per_unit: if a.modulo.is_some() { 100.0 } else { 1000.0 },
+            velocity_increments_per_unit: None,
+            mode: drives::cia402::Cia402Mode::Csp,
+            position_gain: 50.0,
+        });
+    }
 }
 
 fn exit_with(r: Result<(), String>) {
@@ -474,6 +501,20 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     }
 
     let cycle_time = args.cycle_us as f64 * 1e-6;
+    // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
+    let (bus, bus_handle) = {
+        let (kind, iface) = (args.bus, args.interface.clone());
+        let (cycle, max) = (
+            std::time::Duration::from_micros(args.cycle_us as u64),
+            args.bus_max_errors,
+        );
+        tokio::task::spawn_blocking(move || {
+            bus::start(kind, iface.as_deref(), cycle, max, cycle::MAX_AXES)
+        })
+        .await
+        .map_err(|e| format!("the bus start-up failed: {e}"))?
+        .map_err(|e| format!("the {} bus did not come up: {e}", args.bus.name()))?
+    };
     let shared = Arc::new(cycle::Shared::new(args.cycle_us as u64 * 1000));
     let (input, output) = triple_buffer::triple_buffer(&cycle::Snapshot::default());
     let (grant_tx, grant_rx) = std::sync::mpsc::channel();
@@ -481,7 +522,6 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let cycle_thread = std::thread::Builder::new()
         .name("motiond-cycle".into())
         .spawn(move || {
-            let bus = Box::new(drives::SimBus::new(cycle::MAX_AXES));
             let ct = cycle::CycleThread::new(cycle_time, bus, thread_shared, input);
             let _ = grant_tx.send(cycle::request_realtime(80));
             ct.run();
@@ -530,6 +570,7 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         realtime,
         started: Instant::now(),
         ui_dir: ui::resolve_dir(args.ui_dir.as_deref()),
+        bus: bus_handle,
     };
     if ui::is_built(&info.ui_dir) {
         let dir = info.ui_dir.canonicalize();
@@ -831,7 +872,11 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
             .await
             .map_err(|e| format!("cannot write the database: {e}"))?;
         if stored.is_empty() && !no_demo {
-            for config in demo_axes() {
+            let mut demo = demo_axes();
+            if state.info.bus.kind == bus::BusKind::Emulated {
+                on_emulated_drives(&mut demo);
+            }
+            for config in demo {
                 let name = config.name.clone();
                 let audit = store::AuditEntry {
                     at: store::now_rfc3339(),

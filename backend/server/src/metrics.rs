@@ -327,6 +327,47 @@ pub fn render(s: &AppState, fine: bool) -> String {
         axes
     };
     let axes_configured = axes.len() as f64;
+    let mut bus_counters = Vec::new();
+    let mut bus_gauges = Vec::new();
+    if let Some((b, _)) = &s.info.bus.ethercat {
+        bus_counters = vec![
+            (
+                "motiond_bus_frames",
+                "EtherCAT cyclic frames sent",
+                b.frames.load(Relaxed),
+            ),
+            (
+                "motiond_bus_lost_frames",
+                "EtherCAT cyclic frames not answered in time",
+                b.lost_frames.load(Relaxed),
+            ),
+            (
+                "motiond_bus_working_counter_errors",
+                "EtherCAT cyclic frames with a wrong working counter",
+                b.working_counter_errors.load(Relaxed),
+            ),
+        ];
+        bus_gauges = vec![
+            (
+                "motiond_bus_faulted",
+                "The EtherCAT bus stopped its axes (lost frames or working counters in a row): 1, else 0",
+                None,
+                b.faulted.load(Relaxed) as u8 as f64,
+            ),
+            (
+                "motiond_bus_subdevices_not_op",
+                "EtherCAT SubDevices not in OP",
+                None,
+                b.al_states.iter().filter(|a| a.load(Relaxed) != 8).count() as f64,
+            ),
+            (
+                "motiond_bus_dc_cycle_offset",
+                "Where in its SYNC0 period the latest frame reached the DC reference clock",
+                Some(Unit::Seconds),
+                b.dc_cycle_offset.load(Relaxed) as f64 * 1e-9,
+            ),
+        ];
+    }
     let scrape = Scrape {
         histograms: vec![
             (
@@ -377,7 +418,10 @@ pub fn render(s: &AppState, fine: bool) -> String {
                 "Requests dropped undone after their requester had answered 503",
                 st.requests_expired.load(Relaxed),
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(bus_counters)
+        .collect(),
         gauges: vec![
             (
                 "motiond_cycle_time",
@@ -392,7 +436,10 @@ pub fn render(s: &AppState, fine: bool) -> String {
                 None,
                 s.info.realtime.sched_fifo as u8 as f64,
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(bus_gauges)
+        .collect(),
         axes,
         process: read_process(),
     };

@@ -47,5 +47,6 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28806, "cam_mode_invalid", "activation, start or scaling mode not allowed here"],
   [28807, "cam_not_coupled", "the axis is not coupled through a cam"],
   [28808, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave"],
+  [28832, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)"],
   [28816, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)"],
 ];

@@ -756,6 +756,64 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/bus": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The drive bus: kind, state, frame and working-counter figures, DC, the SubDevices with identity and AL state */
+        get: operations["bus"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/bus/faults": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Lose frames on the emulated EtherCAT segment (--bus emulated only) */
+        post: operations["inject_bus_fault"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/bus/subdevices/{position}/sdo/{index}/{sub}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * Read an object of a SubDevice by SDO upload (CoE), for diagnostics
+         * @description From the async side through the mailbox; the cycle is not touched. 409 `sdo_aborted` carries the CiA-301 abort code the SubDevice answered; 409 `bus_not_ethercat` on the simulated bus.
+         */
+        get: operations["sdo_read"];
+        /**
+         * Write an object of a SubDevice by SDO download (CoE); answers the value read back
+         * @description For commissioning and diagnostics; audited. A drive refuses what its state does not allow (e.g. the PDO mapping outside PRE-OP: 409 `sdo_aborted` with 0x08000022).
+         */
+        put: operations["sdo_write"];
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/cam-analysis": {
         parameters: {
             query?: never;
@@ -1273,6 +1331,11 @@ export type webhooks = Record<string, never>;
 export interface components {
     schemas: {
         /**
+         * @description An EtherCAT state machine state (AL status).
+         * @enum {string}
+         */
+        AlState: "init" | "pre_op" | "boot" | "safe_op" | "op" | "unknown";
+        /**
          * @description One entry of the audit log: a change or a motion command, who made it and how it ended.
          * @example {
          *       "action": "command.move-absolute",
@@ -1592,6 +1655,7 @@ export interface components {
          *       "constant_velocity": true,
          *       "coupled": false,
          *       "decelerating": false,
+         *       "drive_error_code": 0,
          *       "drive_fault": false,
          *       "enable_negative": true,
          *       "enable_positive": true,
@@ -1746,6 +1810,12 @@ export interface components {
             error_id: number;
             drive_fault: boolean;
             /**
+             * Format: int32
+             * @description The drive's own code of the fault that stopped the axis (CiA-402 0x603F, or the bus's
+             *     code when the drive could not be reached); 0 unless `drive_fault`.
+             */
+            drive_error_code: number;
+            /**
              * Format: double
              * @description Offset accumulated by MC_SetPosition since the last homing (#2003).
              */
@@ -1768,6 +1838,100 @@ export interface components {
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
+        /**
+         * @description Disturbances of the emulated segment.
+         * @example {
+         *       "lose_frames": 5
+         *     }
+         */
+        BusFault: {
+            /**
+             * Format: int32
+             * @description The next frames to lose (not answered): each is a lost frame for the bus; the bus
+             *     faults its axes after `max_errors_in_row` in a row.
+             */
+            lose_frames: number;
+        };
+        /** @enum {string} */
+        BusKind: "simulated" | "emulated" | "ethercat";
+        /**
+         * @description `GET /bus`.
+         * @example {
+         *       "cycle_time": 0.001,
+         *       "dc_cycle_offset_ns": 12000,
+         *       "dc_system_time_ns": 123456789000,
+         *       "errors_in_row": 0,
+         *       "expected_working_counter": 9,
+         *       "frames": 120345,
+         *       "interface": "emulated",
+         *       "kind": "emulated",
+         *       "last_working_counter": 9,
+         *       "lost_frames": 0,
+         *       "max_errors_in_row": 3,
+         *       "state": "op",
+         *       "subdevices": [
+         *         {
+         *           "al_state": "op",
+         *           "axis": "x",
+         *           "configured_address": 4096,
+         *           "dc": true,
+         *           "drive": {
+         *             "input_bytes": 29,
+         *             "mapping": "full",
+         *             "output_bytes": 15
+         *           },
+         *           "name": "motiond emulated servo 1",
+         *           "position": 0,
+         *           "product_code": 67239937,
+         *           "revision": 65536,
+         *           "serial": 537264128,
+         *           "vendor_id": 16714446
+         *         }
+         *       ],
+         *       "working_counter_errors": 0
+         *     }
+         */
+        BusResource: {
+            kind: components["schemas"]["BusKind"];
+            /** @description The network interface (`emulated` for the emulated segment); `null` when simulated. */
+            interface?: string | null;
+            /**
+             * Format: double
+             * @description Seconds between exchanges (= the SYNC0 period).
+             */
+            cycle_time: number;
+            /**
+             * @description `simulated`; `op` (every SubDevice in OP, frames flowing); `degraded` (a SubDevice is not
+             *     in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row:
+             *     every EtherCAT axis is stopped until MC_Reset once frames flow).
+             */
+            state: string;
+            /** Format: int64 */
+            frames: number;
+            /** Format: int64 */
+            lost_frames: number;
+            /** Format: int64 */
+            working_counter_errors: number;
+            /** Format: int64 */
+            errors_in_row: number;
+            /** Format: int32 */
+            max_errors_in_row: number;
+            /** Format: int32 */
+            expected_working_counter: number;
+            /** Format: int32 */
+            last_working_counter: number;
+            /**
+             * Format: int64
+             * @description The DC reference clock's system time at the latest exchange (ns since 2000-01-01).
+             */
+            dc_system_time_ns?: number | null;
+            /**
+             * Format: int64
+             * @description Where in its SYNC0 period the latest frame reached the reference clock (ns).
+             */
+            dc_cycle_offset_ns?: number | null;
+            subdevices: components["schemas"]["SubDeviceResource"][];
+        };
         /**
          * @description `MC_CamActivationMode` (spec §1.7): when a coupling, a cam switch or a scaling takes effect.
          * @enum {string}
@@ -2649,6 +2813,11 @@ export interface components {
             slave_acc_eff: number;
         };
         /**
+         * @description Cyclic synchronous mode of operation (0x6060).
+         * @enum {string}
+         */
+        Cia402Mode: "csp" | "csv";
+        /**
          * @description Where a command came from.
          * @example {
          *       "addr": "127.0.0.1:50312",
@@ -3155,7 +3324,7 @@ export interface components {
             wrap: boolean;
         };
         /**
-         * @description An axis's drive: `kind` and that drive's fields. A simulated drive: a model of a servo drive (times in seconds, positions in the axis's units).
+         * @description An axis's drive: `kind` and that drive's fields — `simulated` (the default when `kind` is left out) or `cia402`.
          * @example {
          *       "acceleration_feed_forward": 0,
          *       "coast_deceleration": 10000,
@@ -3187,7 +3356,7 @@ export interface components {
          */
         DriveConfig: {
             /**
-             * @description The kind of drive; `simulated` (the default) is the only one yet.
+             * @description A simulated servo drive (the default): a model of a drive, times in seconds, positions in the axis's units.
              * @default simulated
              * @enum {string}
              */
@@ -3243,6 +3412,53 @@ export interface components {
             index_pulse?: null | components["schemas"]["IndexPulse"];
             /** @description Hardware limit switches. Default: `{"fault_on_hit":false,"negative":null,"positive":null}`. */
             limit_switches?: components["schemas"]["LimitSwitches"];
+        } | {
+            /**
+             * @description A CiA-402 servo drive on the EtherCAT bus (`--bus ethercat` or `--bus emulated`).
+             * @enum {string}
+             */
+            kind: "cia402";
+            /**
+             * Format: int32
+             * @description Position of the drive on the bus (0 = first SubDevice).
+             */
+            subdevice: number;
+            /**
+             * Format: double
+             * @description Position increments (0x6064 / 0x607A) per engineering unit.
+             */
+            increments_per_unit: number;
+            /**
+             * Format: double
+             * @description Velocity increments (0x606C / 0x60FF) per engineering unit per second; the position
+             *     increments when not given.
+             */
+            velocity_increments_per_unit?: number | null;
+            mode?: components["schemas"]["Cia402Mode"];
+            /**
+             * Format: double
+             * @description CSV only: position loop gain (1/s) closed on our side.
+             */
+            position_gain?: number;
+        };
+        /**
+         * @description A CiA-402 drive's process data as motiond mapped it.
+         * @example {
+         *       "input_bytes": 29,
+         *       "mapping": "full",
+         *       "output_bytes": 15
+         *     }
+         */
+        DriveMapping: {
+            /**
+             * @description `full` (targets for CSP/CSV/CST, touch probe, digital inputs) or `minimal` (what a
+             *     drive refusing the full mapping takes: controlword, target, mode; statusword,
+             *     position, mode display, error code).
+             */
+            mapping: string;
+            /** @description RxPDO (outputs) and TxPDO (inputs) bytes. */
+            output_bytes: number;
+            input_bytes: number;
         };
         /**
          * @description MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
@@ -3636,6 +3852,7 @@ export interface components {
          *       "constant_velocity": true,
          *       "coupled": false,
          *       "decelerating": false,
+         *       "drive_error_code": 0,
          *       "drive_fault": false,
          *       "enable_negative": true,
          *       "enable_positive": true,
@@ -4774,6 +4991,63 @@ export interface components {
             pre_trigger_s?: number;
         };
         /**
+         * @description An object's value as read by SDO upload.
+         * @example {
+         *       "bytes": [
+         *         206,
+         *         10,
+         *         255,
+         *         0
+         *       ],
+         *       "hex": "ce0aff00",
+         *       "index": "0x1018",
+         *       "position": 0,
+         *       "signed": 16714446,
+         *       "sub": 1,
+         *       "text": null,
+         *       "unsigned": 16714446
+         *     }
+         */
+        SdoValue: {
+            /** Format: int32 */
+            position: number;
+            /** @description `0xIIII`. */
+            index: string;
+            /** Format: int32 */
+            sub: number;
+            /** @description As the SubDevice sent them (little endian). */
+            bytes: number[];
+            hex: string;
+            /**
+             * Format: int64
+             * @description The bytes as an unsigned and a signed little-endian integer (1 to 8 bytes).
+             */
+            unsigned?: number | null;
+            /** Format: int64 */
+            signed?: number | null;
+            /** @description The bytes as text, when they are printable ASCII (names, versions). */
+            text?: string | null;
+        };
+        /**
+         * @description `PUT …/sdo/{index}/{sub}`: an integer written with the object's size.
+         * @example {
+         *       "size": 1,
+         *       "value": 8
+         *     }
+         */
+        SdoWrite: {
+            /**
+             * Format: int64
+             * @description Written little endian in `size` bytes (negative values in two's complement).
+             */
+            value: number;
+            /**
+             * Format: int32
+             * @description 1, 2 or 4 bytes (SDO download expedited).
+             */
+            size: number;
+        };
+        /**
          * @description Who the client is.
          * @example {
          *       "auth_enabled": true,
@@ -5014,6 +5288,7 @@ export interface components {
          *         "constant_velocity": true,
          *         "coupled": false,
          *         "decelerating": false,
+         *         "drive_error_code": 0,
          *         "drive_fault": false,
          *         "enable_negative": true,
          *         "enable_positive": true,
@@ -5095,6 +5370,51 @@ export interface components {
             jerk: number;
             /** @description Default: none set. */
             options?: components["schemas"]["MoveOptions"];
+        };
+        /**
+         * @description One SubDevice of the segment.
+         * @example {
+         *       "al_state": "op",
+         *       "axis": "y",
+         *       "configured_address": 4097,
+         *       "dc": true,
+         *       "drive": {
+         *         "input_bytes": 29,
+         *         "mapping": "full",
+         *         "output_bytes": 15
+         *       },
+         *       "name": "motiond emulated servo 2",
+         *       "position": 1,
+         *       "product_code": 67239937,
+         *       "revision": 65536,
+         *       "serial": 537264129,
+         *       "vendor_id": 16714446
+         *     }
+         */
+        SubDeviceResource: {
+            /**
+             * Format: int32
+             * @description Position on the segment (0 = next to motiond); a CiA-402 drive's `subdevice`.
+             */
+            position: number;
+            /** Format: int32 */
+            configured_address: number;
+            name: string;
+            /** Format: int32 */
+            vendor_id: number;
+            /** Format: int32 */
+            product_code: number;
+            /** Format: int32 */
+            revision: number;
+            /** Format: int32 */
+            serial: number;
+            /** @description As read by the latest cycle. */
+            al_state: components["schemas"]["AlState"];
+            drive?: null | components["schemas"]["DriveMapping"];
+            /** @description Supports distributed clocks (runs SYNC0). */
+            dc: boolean;
+            /** @description The axis whose drive this is. */
+            axis?: string | null;
         };
         /**
          * @description A reader's copy of a histogram's figures, in microseconds.
@@ -5208,7 +5528,10 @@ export interface components {
             listen: string;
             database: string;
             axes: number;
-            /** @description `simulated` (EtherCAT later). */
+            /**
+             * @description `simulated`, `emulated` (an emulated EtherCAT segment) or `ethercat`; details in
+             *     `GET /api/v1/bus`.
+             */
             drive_bus: string;
             realtime: components["schemas"]["RealtimeGrant"];
             timing: components["schemas"]["Timing"];
@@ -5603,6 +5926,48 @@ export interface components {
                  *       "status": 422,
                  *       "title": "Invalid request",
                  *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description Not a number of frames to lose (1..100000). */
+        BusFaultInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "lose_frames: 1..100000",
+                 *       "errors": [
+                 *         {
+                 *           "field": "lose_frames",
+                 *           "message": "1..100000"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The bus is not the emulated segment. */
+        BusNotEmulated: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "bus_not_emulated",
+                 *       "detail": "only the emulated segment (--bus emulated) takes injected frame loss",
+                 *       "status": 409,
+                 *       "title": "Conflict",
+                 *       "type": "urn:motiond:problem:bus_not_emulated"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -6279,6 +6644,60 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
+        /**
+         * @description The SubDevice aborted the transfer (`sdo_aborted`, with the CiA-301 abort code), or
+         *     motiond runs the simulated bus (`bus_not_ethercat`).
+         */
+        SdoConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description An object index that is not one, or a value that does not fit its size. */
+        SdoInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "value: does not fit 1 bytes (-128..255)",
+                 *       "errors": [
+                 *         {
+                 *           "field": "value",
+                 *           "message": "does not fit 1 bytes (-128..255)"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The mailbox did not answer in time or the frame was lost. */
+        SdoUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "sdo_failed",
+                 *       "detail": "SDO transfer of 0x1018:1 with SubDevice 0 failed: timeout",
+                 *       "status": 503,
+                 *       "title": "Service unavailable",
+                 *       "type": "urn:motiond:problem:sdo_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
         /** @description The database did not accept the write (`storage_unavailable`); nothing was changed. */
         StorageUnavailable: {
             headers: {
@@ -6292,6 +6711,24 @@ export interface components {
                  *       "status": 503,
                  *       "title": "Service unavailable",
                  *       "type": "urn:motiond:problem:storage_unavailable"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No SubDevice at that position on the segment. */
+        SubDeviceNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "subdevice_not_found",
+                 *       "detail": "no subdevice '7'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:subdevice_not_found"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -8851,6 +9288,152 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    bus: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The bus */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["BusResource"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    inject_bus_fault: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["BusFault"];
+            };
+        };
+        responses: {
+            /** @description The segment will drop that many frames */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["BusNotEmulated"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["BusFaultInvalid"];
+        };
+    };
+    sdo_read: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description SubDevice position on the segment
+                 * @example 0
+                 */
+                position: number;
+                /**
+                 * @description object index, `0x1018` or decimal
+                 * @example 0x1018
+                 */
+                index: string;
+                /**
+                 * @description subindex
+                 * @example 1
+                 */
+                sub: number;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The value */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SdoValue"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["SubDeviceNotFound"];
+            409: components["responses"]["SdoConflict"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["SdoInvalid"];
+            503: components["responses"]["SdoUnavailable"];
+        };
+    };
+    sdo_write: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description SubDevice position on the segment
+                 * @example 0
+                 */
+                position: number;
+                /**
+                 * @description object index, `0x6065` or decimal
+                 * @example 0x6065
+                 */
+                index: string;
+                /**
+                 * @description subindex
+                 * @example 0
+                 */
+                sub: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SdoWrite"];
+            };
+        };
+        responses: {
+            /** @description Written; the value read back */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["SdoValue"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["SubDeviceNotFound"];
+            409: components["responses"]["SdoConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["SdoInvalid"];
+            503: components["responses"]["SdoUnavailable"];
         };
     };
     analyse: {

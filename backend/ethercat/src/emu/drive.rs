@@ -96,6 +96,9 @@ const MAPPABLE_TX: &[(u16, usize)] = &[
     (0x60FD, 4),
 ];
 
+/// Entries a PDO mapping object has (sub 1..=this).
+const MAX_ENTRIES: u8 = 16;
+
 /// CiA-402 modes of operation (0x6060).
 pub const MODE_CSP: i8 = 8;
 pub const MODE_CSV: i8 = 9;
@@ -123,7 +126,7 @@ impl Cia402Emu {
             (0x1A00, &[0x6041_0010, 0x6064_0020][..]),
         ] {
             od.add(index, 0, &[default.len() as u8], Access::RwPreOp, false);
-            for sub in 1..=8u8 {
+            for sub in 1..=MAX_ENTRIES {
                 let v = default.get(sub as usize - 1).copied().unwrap_or(0);
                 od.add(index, sub, &v.to_le_bytes(), Access::RwPreOp, false);
             }
@@ -435,7 +438,7 @@ impl WriteRules for Rules {
             return Err(abort::SUB0_NOT_ZERO);
         }
         if mapping && sub == 0 {
-            if v > 8 {
+            if v > u32::from(MAX_ENTRIES) {
                 return Err(abort::VALUE_RANGE);
             }
             let rx = index < 0x1800;

@@ -106,6 +106,8 @@ pub struct Axis {
     /// axis position = drive position + offset (MC_SetPosition, homing).
     offset: f64,
     error: ErrorId,
+    /// The drive's fault code when `error` is a drive fault.
+    drive_error_code: u32,
     fault_reset: bool,
     /// Cycles after MC_Reset during which a drive fault still shown by the (one cycle old)
     /// feedback is not taken as a new fault.
@@ -185,6 +187,7 @@ impl Axis {
             fed: false,
             offset: 0.0,
             error: ErrorId(0),
+            drive_error_code: 0,
             fault_reset: false,
             reset_grace: 0,
             homed: false,

@@ -107,7 +107,15 @@ impl Axis {
             && self.mode != Mode::ErrorStop
             && (self.enable || self.mode != Mode::Disabled)
         {
+            self.drive_error_code = fb.fault_code;
             self.enter_error(cx, ErrorId::DRIVE_FAULT);
+        }
+        if fb.bus_error
+            && self.reset_grace == 0
+            && self.mode != Mode::ErrorStop
+            && (self.enable || self.mode != Mode::Disabled)
+        {
+            self.enter_error(cx, ErrorId::BUS_ERROR);
         }
         let status = self.enable && fb.enabled && fb.ready && !fb.fault;
         if self.enable && !status && self.mode == Mode::Disabled {

@@ -87,6 +87,11 @@ impl Axis {
             0
         };
         s.drive_fault = self.error == ErrorId::DRIVE_FAULT && self.mode == Mode::ErrorStop;
+        s.drive_error_code = if s.drive_fault {
+            self.drive_error_code
+        } else {
+            0
+        };
         s.set_position_offset = self.set_position_offset;
         s.active_command = job.map(|j| j.id).unwrap_or(0);
         let (mut cam, queued, scaling) = self.cam_status();

@@ -24,6 +24,8 @@ pub struct Plant {
     pending: u32,
     pub fault: bool,
     pub fault_code: u32,
+    /// The bus cannot reach the drive (its feedback is flagged; the drive keeps following).
+    pub bus_error: bool,
     pub cam: Option<(f64, f64)>,
     pub index_period: Option<f64>,
     pub limit_positive: bool,
@@ -49,6 +51,7 @@ impl Default for Plant {
             pending: 0,
             fault: false,
             fault_code: 0,
+            bus_error: false,
             cam: None,
             index_period: None,
             limit_positive: false,
@@ -70,6 +73,7 @@ impl Plant {
 
     pub fn feedback(&self) -> DriveFeedback {
         DriveFeedback {
+            bus_error: self.bus_error,
             ready: !self.fault,
             enabled: self.enabled,
             fault: self.fault,

@@ -142,3 +142,44 @@ fn s11a_06_parameter_writes_do_not_change_the_state() {
     );
     assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
 }
+
+/// A bus that loses its drive (lost frames, working counters, a SubDevice out of OP) stops the
+/// axis into ErrorStop with 0x70A0 on the error ramp — the drive is still enabled and follows
+/// what reaches it, so the set velocity falls continuously instead of the power being cut — and
+/// a reset clears it only once the bus has the drive again (decision 104).
+#[test]
+fn a_bus_error_stops_on_the_ramp_into_errorstop_and_reset_needs_the_bus_back() {
+    let mut r = Rig::new(1);
+    let p = power(&mut r);
+    r.ok(0, velocity(100.0, Direction::Positive));
+    r.run(0.2);
+    let v0 = r.st(0).set_velocity;
+    assert!(v0 > 99.0, "{v0}");
+    r.plants[0].bus_error = true;
+    r.step();
+    assert_eq!(r.st(0).state, AxisState::ErrorStop);
+    assert_eq!(r.st(0).error_id, ErrorId::BUS_ERROR.0);
+    assert!(!r.st(0).drive_fault, "not a drive fault");
+    assert!(r.sp[0].enable, "the drive stays enabled for the ramp");
+    let mut last = r.st(0).set_velocity;
+    assert!(last > 0.0 && last < v0, "the ramp starts: {last}");
+    let mut cycles = 0;
+    while r.st(0).set_velocity > 0.0 {
+        r.step();
+        let v = r.st(0).set_velocity;
+        assert!(v <= last, "never faster again: {v} after {last}");
+        last = v;
+        cycles += 1;
+        assert!(cycles < 10_000, "stands");
+    }
+    assert!(cycles > 5, "a ramp, not a cut: {cycles} cycles");
+    // Reset while the bus still lacks the drive: ErrorStop again.
+    r.ok(0, CommandKind::Reset);
+    r.run(0.05);
+    assert_eq!(r.st(0).state, AxisState::ErrorStop);
+    assert_eq!(r.st(0).error_id, ErrorId::BUS_ERROR.0);
+    r.plants[0].bus_error = false;
+    r.ok(0, CommandKind::Reset);
+    r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
+    assert!(r.out(p).status);
+}

@@ -300,6 +300,22 @@ problem_responses! {
 
     // 413
 
+    /// No SubDevice at that position on the segment.
+    SubDeviceNotFound(example = json!(p(AppError::not_found("subdevice", "7"))));
+    /// The SubDevice aborted the transfer (`sdo_aborted`, with the CiA-301 abort code), or
+    /// motiond runs the simulated bus (`bus_not_ethercat`).
+    SdoConflict(examples(
+        ("sdo_aborted" = (value = json!(p(AppError::conflict("sdo_aborted",
+            "SubDevice 0 aborted the SDO transfer of 0x2000:0 with 0x06020000 (the object does not exist in the object dictionary)"))))),
+        ("bus_not_ethercat" = (value = json!(p(AppError::conflict("bus_not_ethercat",
+            "motiond runs the simulated bus: SDOs need --bus ethercat or --bus emulated")))))));
+    /// The bus is not the emulated segment.
+    BusNotEmulated(example = json!(p(AppError::conflict("bus_not_emulated",
+        "only the emulated segment (--bus emulated) takes injected frame loss"))));
+    /// The mailbox did not answer in time or the frame was lost.
+    SdoUnavailable(example = json!(p(AppError::unavailable("sdo_failed",
+        "SDO transfer of 0x1018:1 with SubDevice 0 failed: timeout"))));
+
     /// The body is larger than 2 MiB.
     PayloadTooLarge(example = json!(p(AppError::too_large(BODY_LIMIT))));
 
@@ -336,6 +352,12 @@ problem_responses! {
             value = json!(p(parameter_refused(ErrorId::PARAMETER_READ_ONLY))))),
         ("parameter_out_of_range" = (summary = "A value out of range (e.g. AxisVeloMax -1)",
             value = json!(p(parameter_refused(ErrorId::PARAMETER_OUT_OF_RANGE)))))));
+
+    /// An object index that is not one, or a value that does not fit its size.
+    SdoInvalid(example = json!(p(AppError::field("value", "does not fit 1 bytes (-128..255)"))));
+
+    /// Not a number of frames to lose (1..100000).
+    BusFaultInvalid(example = json!(p(AppError::field("lose_frames", "1..100000"))));
 
     /// The configuration is invalid; `errors` lists every invalid field. Nothing was changed.
     ConfigInvalid(example = json!(p(AppError::field("dynamics.jerk", "must be a finite number > 0"))));
@@ -525,6 +547,15 @@ error_sets! {
         400: MalformedJson, 409: CamTableConflict, 413: PayloadTooLarge, 422: CamTableInvalid,
         503: WriteUnavailable,
     }
+    /// `GET /bus/subdevices/{position}/sdo/{index}/{sub}`.
+    SdoErrors { 404: SubDeviceNotFound, 409: SdoConflict, 422: SdoInvalid, 503: SdoUnavailable }
+    /// `PUT /bus/subdevices/{position}/sdo/{index}/{sub}`.
+    SdoWriteErrors {
+        400: MalformedJson, 404: SubDeviceNotFound, 409: SdoConflict, 413: PayloadTooLarge,
+        422: SdoInvalid, 503: SdoUnavailable,
+    }
+    /// `POST /bus/faults`.
+    BusFaultErrors { 400: MalformedJson, 409: BusNotEmulated, 413: PayloadTooLarge, 422: BusFaultInvalid }
     /// `POST /cam-analysis`.
     CamAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: CamTableInvalid }
     /// `PUT /cam-tables/{table}`, its points.

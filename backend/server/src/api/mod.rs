@@ -5,6 +5,7 @@ pub mod audit;
 pub mod auth;
 pub mod axes;
 pub mod blocks;
+pub mod bus;
 pub mod cams;
 pub mod commands;
 pub mod errors;
@@ -91,10 +92,20 @@ pub(crate) fn from_value<T: DeserializeOwned + utoipa::ToSchema>(
 /// serde's reading of a checked value, with the JSON path of the field at fault.
 fn read_value<T: DeserializeOwned>(value: &serde_json::Value) -> Result<T, AppError> {
     serde_path_to_error::deserialize(value).map_err(|e| {
-        let message = e.inner().to_string();
+        let mut message = e.inner().to_string();
         let mut path = e.path().to_string();
         if path == "." {
             path.clear();
+        }
+        // A drive object reads its variant itself and says where inside it the error is.
+        if let Some((inner, rest)) = message.split_once(drives::bus::PATH_SEPARATOR) {
+            if !inner.is_empty() {
+                if !path.is_empty() {
+                    path.push('.');
+                }
+                path.push_str(inner);
+            }
+            message = rest.to_string();
         }
         // serde names a missing field in its message, and the path is the object lacking it.
         if let Some(name) = message
@@ -307,6 +318,12 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(functions::calc_dynamics_by_ramp_time_fb),
         )
         .route("/system", get(system::system))
+        .route("/bus", get(bus::bus))
+        .route(
+            "/bus/subdevices/{position}/sdo/{index}/{sub}",
+            get(bus::sdo_read).put(bus::sdo_write),
+        )
+        .route("/bus/faults", post(bus::inject_bus_fault))
         .route("/audit", get(audit::audit_log))
         .route(
             "/config",
@@ -505,7 +522,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
-        axes::export_config, axes::import_config, system::system, audit::audit_log, system::metrics, ws::upgrade,
+        axes::export_config, axes::import_config, system::system, bus::bus, bus::sdo_read, bus::sdo_write, bus::inject_bus_fault, audit::audit_log, system::metrics, ws::upgrade,
         auth::session, auth::login, auth::logout, auth::change_password,
         auth::list_users, auth::create_user, auth::get_user, auth::update_user, auth::delete_user,
         auth::list_tokens, auth::create_token, auth::revoke_token,
@@ -514,6 +531,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
     components(schemas(crate::error::Problem, motion::cam::ValueSelect)),
     tags(
         (name = "axes", description = "Axis configurations and live status"),
+        (name = "bus", description = "The drive bus: EtherCAT SubDevices, their state and SDOs (or the simulated bus)"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
         (name = "commands", description = "One endpoint per function block; command resources"),
         (name = "cams", description = "Cam tables (TwinCAT NC Camming): position tables and motion functions, and their analysis"),
@@ -574,7 +592,9 @@ impl utoipa::Modify for ForeignExamples {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
         use serde_json::{json, to_value};
         use utoipa::openapi::{RefOr, schema::Schema};
-        let drives::DriveConfig::Simulated(drive) = crate::demo_axes().remove(0).drive;
+        let drives::DriveConfig::Simulated(drive) = crate::demo_axes().remove(0).drive else {
+            unreachable!("the demo axes have simulated drives")
+        };
         let examples = [
             (
                 "FbOutputs",
@@ -686,6 +706,16 @@ impl utoipa::Modify for ForeignExamples {
                 "DriveConfig",
                 to_value(drives::DriveConfig::Simulated(drive.clone())),
             ),
+            (
+                "Cia402Config",
+                to_value(drives::cia402::Cia402Config {
+                    subdevice: 0,
+                    increments_per_unit: 10_000.0,
+                    velocity_increments_per_unit: None,
+                    mode: drives::cia402::Cia402Mode::Csp,
+                    position_gain: 50.0,
+                }),
+            ),
             ("PlantModel", to_value(drive.plant)),
             ("ReferenceCam", to_value(drive.reference_cam)),
             ("IndexPulse", to_value(drive.index_pulse)),
@@ -752,15 +782,26 @@ impl utoipa::Modify for PlainRefs {
         let Some(components) = doc.components.as_mut() else {
             return;
         };
-        for name in FOREIGN_WITH_DEFAULTS {
-            let Some(RefOr::T(Schema::Object(schema))) = components.schemas.get_mut(*name) else {
-                continue;
-            };
-            // Property by property, so that their order stays.
+        // Property by property, so that their order stays.
+        let rewrite = |schema: &mut utoipa::openapi::schema::Object| {
             for prop in schema.properties.values_mut() {
                 let mut v = serde_json::to_value(&*prop).expect("schemas serialise");
                 plain_ref(&mut v);
                 *prop = serde_json::from_value(v).expect("a rewritten schema is a schema");
+            }
+        };
+        for name in FOREIGN_WITH_DEFAULTS {
+            match components.schemas.get_mut(*name) {
+                Some(RefOr::T(Schema::Object(schema))) => rewrite(schema),
+                // A tagged union (the drive kinds): each branch's properties.
+                Some(RefOr::T(Schema::OneOf(one_of))) => {
+                    for item in &mut one_of.items {
+                        if let RefOr::T(Schema::Object(schema)) = item {
+                            rewrite(schema);
+                        }
+                    }
+                }
+                _ => {}
             }
         }
     }

@@ -59,7 +59,8 @@ pub struct SystemResource {
     pub listen: String,
     pub database: String,
     pub axes: usize,
-    /// `simulated` (EtherCAT later).
+    /// `simulated`, `emulated` (an emulated EtherCAT segment) or `ethercat`; details in
+    /// `GET /api/v1/bus`.
     pub drive_bus: &'static str,
     pub realtime: RealtimeGrant,
     pub timing: Timing,
@@ -88,7 +89,7 @@ pub fn system_resource(s: &AppState) -> SystemResource {
         listen: s.info.listen.clone(),
         database: s.info.db.clone(),
         axes: s.registry.read().unwrap().axes.len(),
-        drive_bus: "simulated",
+        drive_bus: s.info.bus.kind.name(),
         realtime: s.info.realtime.clone(),
         timing: Timing {
             wakeup_latency: st.wakeup_latency.summary(),

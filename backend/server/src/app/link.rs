@@ -248,6 +248,62 @@ impl AppState {
     }
 
     /// Builds the kernel's axis and drive for a configuration plus its persistent overlay.
+    /// A CiA-402 drive needs an EtherCAT bus with a CiA-402 drive at its position that no other
+    /// axis drives.
+    fn check_drive_on_bus(
+        &self,
+        id: i64,
+        drive: &drives::DriveConfig,
+    ) -> Result<(), Vec<FieldError>> {
+        let drives::DriveConfig::Cia402(c) = drive else {
+            return Ok(());
+        };
+        let err = |field: &str, message: String| {
+            Err(vec![FieldError {
+                field: field.into(),
+                message,
+            }])
+        };
+        let bus = &self.info.bus;
+        if bus.ethercat.is_none() {
+            return err(
+                "drive.kind",
+                "a cia402 drive needs an EtherCAT bus: motiond runs the simulated bus \
+                 (start it with --bus ethercat --interface IFACE, or --bus emulated)"
+                    .into(),
+            );
+        }
+        let drives = bus.drive_positions();
+        if !drives.contains(&c.subdevice) {
+            return err(
+                "drive.subdevice",
+                format!(
+                    "no CiA-402 drive at position {} of the segment (drives at {:?})",
+                    c.subdevice, drives
+                ),
+            );
+        }
+        let taken =
+            self.registry
+                .read()
+                .unwrap()
+                .axes
+                .values()
+                .find_map(|a| match &a.config.drive {
+                    drives::DriveConfig::Cia402(o) if o.subdevice == c.subdevice && a.id != id => {
+                        Some(a.name.clone())
+                    }
+                    _ => None,
+                });
+        if let Some(other) = taken {
+            return err(
+                "drive.subdevice",
+                format!("the drive at position {} is axis {other}'s", c.subdevice),
+            );
+        }
+        Ok(())
+    }
+
     pub fn build_axis(
         &self,
         id: i64,
@@ -256,6 +312,7 @@ impl AppState {
     ) -> Result<(AxisParameters, Box<Axis>, Drive), Vec<FieldError>> {
         let ct = self.info.cycle_time_s;
         let mut p = config.to_parameters(id, ct)?;
+        self.check_drive_on_bus(id, &config.drive)?;
         for (n, v) in persistent {
             if let Err(e) = params::set(&mut p, *n, *v) {
                 tracing::warn!(

@@ -36,6 +36,8 @@ pub struct SystemInfo {
     pub started: Instant,
     /// Where the commissioning UI's built files are (`--ui-dir`).
     pub ui_dir: std::path::PathBuf,
+    /// The drive bus (`--bus`).
+    pub bus: crate::bus::BusHandle,
 }
 
 /// A status as a JSON object, shared by every websocket subscriber of that cycle.

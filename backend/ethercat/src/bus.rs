@@ -1,0 +1,707 @@
+//! The EtherCAT drive bus: the cycle thread's [`DriveBus`] on a segment of CiA-402 servo
+//! drives through ethercrab. Bring-up ([`EthercatBus::start`], off the cycle thread): discovery
+//! and identity, the PRE-OP CoE script per drive (PDO mapping and assignment, interpolation
+//! period, SYNC0 mode), distributed clocks with SYNC0 at the cycle time, SAFE-OP → OP. Then one
+//! `tx_rx_dc` per cycle in [`DriveBus::exchange`]: the kernel's setpoints through
+//! `drives::cia402` into each drive's RxPDO, its TxPDO back into feedback. Lost frames and
+//! wrong working counters are counted; `max_errors_in_row` of them in a row, or a SubDevice
+//! that leaves OP, flag the axes' feedback with `bus_error` (the kernel stops them on their
+//! ramp into ErrorStop, 0x70A0) until the frames flow again and MC_Reset asks (which also
+//! requests OP again).
+
+use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU16, AtomicU64, Ordering::Relaxed};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use drives::cia402::{Cia402Drive, RxPdo, TxPdo};
+use drives::{BusError, Drive, DriveBus, SimBus, SimFault};
+use ethercrab::subdevice_group::{DcConfiguration, HasDc, Op};
+use ethercrab::{
+    DcSync, MainDevice, MainDeviceConfig, PduStorage, RegisterAddress, RetryBehaviour,
+    SubDeviceGroup, SubDeviceState, Timeouts,
+};
+use futures_lite::future::block_on;
+use motion::{DriveFeedback, DriveSetpoint};
+
+use crate::emu::{self, Segment};
+
+/// SubDevices on one segment (a power of two, as ethercrab wants).
+pub const MAX_SUBDEVICES: usize = 16;
+/// Bytes of process image of the whole group.
+pub const MAX_PDI: usize = 1024;
+const MAX_FRAMES: usize = 16;
+const MAX_PDU_DATA: usize = PduStorage::element_size(1100);
+
+type Group = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op, HasDc>;
+
+/// Where the frames go.
+pub enum Link {
+    /// A network interface (raw socket; `CAP_NET_RAW`).
+    Interface(String),
+    /// An emulated segment in this process.
+    Emulated(Arc<Mutex<Segment>>),
+}
+
+#[derive(Clone, Debug)]
+pub struct BusOptions {
+    pub cycle: Duration,
+    /// Lost frames or wrong working counters in a row before the bus faults its axes.
+    pub max_errors_in_row: u32,
+    /// How long one exchange may wait for its frame (the cycle thread never blocks longer).
+    pub pdu_timeout: Duration,
+}
+
+impl BusOptions {
+    pub fn new(cycle: Duration) -> BusOptions {
+        BusOptions {
+            cycle,
+            max_errors_in_row: 3,
+            pdu_timeout: (cycle * 3).max(Duration::from_millis(2)),
+        }
+    }
+}
+
+/// The objects of a drive's process data, by offset in its image (`None`: not mapped).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layout {
+    pub name: &'static str,
+    rx: [Option<usize>; 6],
+    tx: [Option<usize>; 10],
+    pub out_len: usize,
+    pub in_len: usize,
+}
+
+// RxPDO objects in `Layout::rx` order.
+const RX_OBJ: [u32; 6] = [
+    0x6040_0010,
+    0x607A_0020,
+    0x60FF_0020,
+    0x6071_0010,
+    0x6060_0008,
+    0x60B8_0010,
+];
+// TxPDO objects in `Layout::tx` order.
+const TX_OBJ: [u32; 10] = [
+    0x6041_0010,
+    0x6064_0020,
+    0x606C_0020,
+    0x6077_0010,
+    0x6061_0008,
+    0x603F_0010,
+    0x60FD_0020,
+    0x60B9_0010,
+    0x60BA_0020,
+    0x60BB_0020,
+];
+
+impl Layout {
+    fn of(name: &'static str, rx: &[usize], tx: &[usize]) -> Layout {
+        let mut l = Layout {
+            name,
+            ..Layout::default()
+        };
+        for &i in rx {
+            l.rx[i] = Some(l.out_len);
+            l.out_len += (RX_OBJ[i] & 0xFF) as usize / 8;
+        }
+        for &i in tx {
+            l.tx[i] = Some(l.in_len);
+            l.in_len += (TX_OBJ[i] & 0xFF) as usize / 8;
+        }
+        l
+    }
+    /// Everything motiond uses: CSP/CSV/CST targets, touch probe, digital inputs.
+    pub fn full() -> Layout {
+        Layout::of("full", &[0, 1, 2, 3, 4, 5], &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9])
+    }
+    /// What every CSP drive can map: controlword, target, mode; statusword, position, mode
+    /// display, error code.
+    pub fn minimal() -> Layout {
+        Layout::of("minimal", &[0, 1, 4], &[0, 1, 4, 5])
+    }
+    fn rx_objects(&self) -> Vec<u32> {
+        let mut v: Vec<(usize, u32)> = (0..6)
+            .filter_map(|i| self.rx[i].map(|o| (o, RX_OBJ[i])))
+            .collect();
+        v.sort();
+        v.into_iter().map(|(_, o)| o).collect()
+    }
+    fn tx_objects(&self) -> Vec<u32> {
+        let mut v: Vec<(usize, u32)> = (0..10)
+            .filter_map(|i| self.tx[i].map(|o| (o, TX_OBJ[i])))
+            .collect();
+        v.sort();
+        v.into_iter().map(|(_, o)| o).collect()
+    }
+
+    fn encode(&self, rx: &RxPdo, out: &mut [u8]) {
+        let put = |out: &mut [u8], at: Option<usize>, bytes: &[u8]| {
+            if let Some(at) = at {
+                out[at..at + bytes.len()].copy_from_slice(bytes);
+            }
+        };
+        put(out, self.rx[0], &rx.controlword.to_le_bytes());
+        put(out, self.rx[1], &rx.target_position.to_le_bytes());
+        put(out, self.rx[2], &rx.target_velocity.to_le_bytes());
+        put(out, self.rx[3], &0i16.to_le_bytes());
+        put(out, self.rx[4], &rx.mode.to_le_bytes());
+        put(out, self.rx[5], &rx.touch_probe_function.to_le_bytes());
+    }
+
+    fn decode(&self, inp: &[u8]) -> TxPdo {
+        let b = |at: Option<usize>, n: usize| -> [u8; 4] {
+            let mut v = [0u8; 4];
+            if let Some(at) = at {
+                v[..n].copy_from_slice(&inp[at..at + n]);
+            }
+            v
+        };
+        let u16_at = |i: usize| u16::from_le_bytes(b(self.tx[i], 2)[..2].try_into().expect("2"));
+        let i32_at = |i: usize| i32::from_le_bytes(b(self.tx[i], 4));
+        TxPdo {
+            statusword: u16_at(0),
+            position_actual: i32_at(1),
+            velocity_actual: i32_at(2),
+            mode_display: b(self.tx[4], 1)[0] as i8,
+            error_code: u16_at(5),
+            digital_inputs: i32_at(6) as u32,
+            touch_probe_status: u16_at(7),
+            touch_probe_pos_edge: i32_at(8),
+            touch_probe_neg_edge: i32_at(9),
+        }
+    }
+}
+
+/// One SubDevice as found at bring-up.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SubDeviceInfo {
+    pub position: u16,
+    pub configured_address: u16,
+    pub name: String,
+    pub vendor_id: u32,
+    pub product_code: u32,
+    pub revision: u32,
+    pub serial: u32,
+    /// A CiA-402 drive (0x1000 device type profile 402) with its process data layout.
+    pub drive: Option<Layout>,
+    pub dc: bool,
+}
+
+/// What the bus shares with the rest of motiond (the bus page, metrics): written by the
+/// cycle thread with atomics, read anywhere.
+pub struct BusStatus {
+    pub subdevices: Vec<SubDeviceInfo>,
+    /// AL state of each SubDevice as the last exchange read it (ethercrab's code: 1 INIT,
+    /// 2 PRE-OP, 4 SAFE-OP, 8 OP).
+    pub al_states: Vec<AtomicU8>,
+    pub frames: AtomicU64,
+    pub lost_frames: AtomicU64,
+    pub working_counter_errors: AtomicU64,
+    pub errors_in_row: AtomicU64,
+    pub expected_working_counter: u16,
+    pub last_working_counter: AtomicU16,
+    pub faulted: AtomicBool,
+    /// DC system time of the reference clock at the last exchange (ns since 2000).
+    pub dc_system_time: AtomicU64,
+    /// Where in its SYNC0 period the last frame reached the reference clock (ns).
+    pub dc_cycle_offset: AtomicU64,
+    pub interface: String,
+    pub cycle_ns: u64,
+    pub max_errors_in_row: u32,
+}
+
+/// SDO access to the bus's SubDevices from the async side (never the PDI).
+#[derive(Clone, Copy)]
+pub struct SdoAccess {
+    md: &'static MainDevice<'static>,
+    group: &'static Group,
+}
+
+#[derive(Debug, PartialEq, Eq)]
+pub enum SdoError {
+    NoSubDevice,
+    /// The CoE abort code the SubDevice answered.
+    Abort(u32),
+    /// No mailbox, a timeout or another transport error.
+    Failed(String),
+}
+
+impl SdoAccess {
+    fn map(e: ethercrab::error::Error) -> SdoError {
+        match e {
+            ethercrab::error::Error::Mailbox(ethercrab::error::MailboxError::Aborted {
+                code,
+                ..
+            }) => SdoError::Abort(u32::from(code)),
+            other => SdoError::Failed(other.to_string()),
+        }
+    }
+    /// Up to 4 bytes (expedited or normal upload; longer values are cut to what the
+    /// mailbox carries).
+    pub async fn read(&self, position: u16, index: u16, sub: u8) -> Result<Vec<u8>, SdoError> {
+        let sd = self
+            .group
+            .subdevice(self.md, position as usize)
+            .map_err(|_| SdoError::NoSubDevice)?;
+        let v: heapless::Vec<u8, 64> = sd.sdo_read(index, sub).await.map_err(Self::map)?;
+        Ok(v.to_vec())
+    }
+    pub async fn write(
+        &self,
+        position: u16,
+        index: u16,
+        sub: u8,
+        value: &[u8],
+    ) -> Result<(), SdoError> {
+        let sd = self
+            .group
+            .subdevice(self.md, position as usize)
+            .map_err(|_| SdoError::NoSubDevice)?;
+        let r = match value.len() {
+            1 => sd.sdo_write(index, sub, value[0]).await,
+            2 => {
+                sd.sdo_write(index, sub, u16::from_le_bytes([value[0], value[1]]))
+                    .await
+            }
+            4 => {
+                sd.sdo_write(index, sub, u32::from_le_bytes(value.try_into().expect("4")))
+                    .await
+            }
+            n => {
+                return Err(SdoError::Failed(format!(
+                    "{n} bytes: an SDO write is 1, 2 or 4 bytes"
+                )));
+            }
+        };
+        r.map_err(Self::map)
+    }
+}
+
+pub struct EthercatBus {
+    md: &'static MainDevice<'static>,
+    group: &'static Group,
+    status: Arc<BusStatus>,
+    /// Axes with simulated drives run beside the EtherCAT ones (a machine half commissioned).
+    sim: SimBus,
+    sim_feedback: Vec<DriveFeedback>,
+    /// The emulated segment, for fault injection into its drives.
+    segment: Option<Arc<Mutex<Segment>>>,
+    /// The drive of each axis slot.
+    slots: Vec<Option<Box<Cia402Drive>>>,
+    /// Slot → SubDevice position, for the slots with a drive.
+    layouts: Vec<Option<Layout>>,
+    faulted: bool,
+    errors_in_row: u32,
+    max_errors_in_row: u32,
+    reset_edge: bool,
+}
+
+fn leak<T>(t: T) -> &'static T {
+    Box::leak(Box::new(t))
+}
+
+/// The 0x60C2 interpolation period (value, index) of a cycle.
+fn interpolation_period(cycle: Duration) -> (u8, i8) {
+    let us = cycle.as_micros() as u64;
+    if us % 1000 == 0 && us / 1000 <= 255 {
+        ((us / 1000) as u8, -3)
+    } else if us <= 255 {
+        (us as u8, -6)
+    } else {
+        ((us / 100).min(255) as u8, -4)
+    }
+}
+
+impl EthercatBus {
+    /// Brings the segment up to OP (blocking; off the cycle thread). `slots`: the number of
+    /// axis slots.
+    pub fn start(link: Link, opts: &BusOptions, slots: usize) -> Result<EthercatBus, String> {
+        let storage: &'static PduStorage<MAX_FRAMES, MAX_PDU_DATA> = leak(PduStorage::new());
+        let (tx, rx, pdu_loop) = storage
+            .try_split()
+            .map_err(|_| "PDU storage split twice".to_string())?;
+        let segment = match &link {
+            Link::Emulated(s) => Some(s.clone()),
+            Link::Interface(_) => None,
+        };
+        let interface = match link {
+            Link::Interface(iface) => {
+                let task = ethercrab::std::tx_rx_task(&iface, tx, rx)
+                    .map_err(|e| format!("cannot open {iface} (CAP_NET_RAW needed): {e}"))?;
+                std::thread::Builder::new()
+                    .name("ecat-txrx".into())
+                    .spawn(move || {
+                        let _ = block_on(task);
+                    })
+                    .map_err(|e| e.to_string())?;
+                iface
+            }
+            Link::Emulated(segment) => {
+                emu::transport::spawn_in_process(tx, rx, segment).map_err(|e| e.to_string())?;
+                "emulated".to_string()
+            }
+        };
+        let md: &'static MainDevice<'static> = leak(MainDevice::new(
+            pdu_loop,
+            Timeouts {
+                pdu: opts.pdu_timeout.max(Duration::from_millis(20)),
+                ..Timeouts::default()
+            },
+            MainDeviceConfig {
+                dc_static_sync_iterations: 1000,
+                retry_behaviour: RetryBehaviour::None,
+            },
+        ));
+        let (group, infos) = block_on(bring_up(md, opts))?;
+        let group: &'static Group = leak(group);
+        let expected = infos
+            .iter()
+            .enumerate()
+            .map(|(i, _)| {
+                let sd = group.subdevice(md, i).expect("found at bring-up");
+                let io = sd.io_raw();
+                2 * u16::from(!io.outputs().is_empty()) + u16::from(!io.inputs().is_empty())
+            })
+            .sum();
+        let status = Arc::new(BusStatus {
+            al_states: infos.iter().map(|_| AtomicU8::new(8)).collect(),
+            subdevices: infos,
+            frames: AtomicU64::new(0),
+            lost_frames: AtomicU64::new(0),
+            working_counter_errors: AtomicU64::new(0),
+            errors_in_row: AtomicU64::new(0),
+            expected_working_counter: expected,
+            last_working_counter: AtomicU16::new(expected),
+            faulted: AtomicBool::new(false),
+            dc_system_time: AtomicU64::new(0),
+            dc_cycle_offset: AtomicU64::new(0),
+            interface,
+            cycle_ns: opts.cycle.as_nanos() as u64,
+            max_errors_in_row: opts.max_errors_in_row.max(1),
+        });
+        Ok(EthercatBus {
+            md,
+            group,
+            status,
+            sim: SimBus::new(slots),
+            sim_feedback: vec![DriveFeedback::default(); slots],
+            segment,
+            slots: (0..slots).map(|_| None).collect(),
+            layouts: vec![None; slots],
+            faulted: false,
+            errors_in_row: 0,
+            max_errors_in_row: opts.max_errors_in_row.max(1),
+            reset_edge: false,
+        })
+    }
+
+    pub fn status(&self) -> Arc<BusStatus> {
+        self.status.clone()
+    }
+
+    pub fn sdo(&self) -> SdoAccess {
+        SdoAccess {
+            md: self.md,
+            group: self.group,
+        }
+    }
+
+    /// Asks every SubDevice that is not in OP to go there (AL control), acknowledging its
+    /// error. One blocking round trip per such SubDevice; only on MC_Reset.
+    fn request_op(&self) {
+        for (i, st) in self.status.al_states.iter().enumerate() {
+            if st.load(Relaxed) != 8 {
+                if let Ok(sd) = self.group.subdevice(self.md, i) {
+                    let _ = block_on(sd.register_write(RegisterAddress::AlControl, 0x18u16));
+                }
+            }
+        }
+    }
+}
+
+async fn bring_up(
+    md: &'static MainDevice<'static>,
+    opts: &BusOptions,
+) -> Result<(Group, Vec<SubDeviceInfo>), String> {
+    let e = |what: &str| {
+        let what = what.to_string();
+        move |err: ethercrab::error::Error| format!("{what}: {err}")
+    };
+    let mut group = md
+        .init_single_group::<MAX_SUBDEVICES, MAX_PDI>(ethercrab::std::ethercat_now)
+        .await
+        .map_err(e("EtherCAT discovery"))?;
+    let mut infos = Vec::new();
+    for (position, mut sd) in group.iter_mut(md).enumerate() {
+        let id = sd.identity();
+        let mut info = SubDeviceInfo {
+            position: position as u16,
+            configured_address: sd.configured_address(),
+            name: sd.name().to_string(),
+            vendor_id: id.vendor_id,
+            product_code: id.product_id,
+            revision: id.revision,
+            serial: id.serial,
+            drive: None,
+            dc: sd.dc_support().any(),
+        };
+        let device_type = sd.sdo_read::<u32>(0x1000, 0).await.unwrap_or(0);
+        if device_type & 0xFFFF == 402 {
+            let mut chosen = None;
+            let mut last_err = String::new();
+            for layout in [Layout::full(), Layout::minimal()] {
+                let r = async {
+                    sd.sdo_write(0x1C12, 0, 0u8).await?;
+                    sd.sdo_write(0x1C13, 0, 0u8).await?;
+                    sd.sdo_write_array(0x1600, layout.rx_objects()).await?;
+                    sd.sdo_write_array(0x1A00, layout.tx_objects()).await?;
+                    sd.sdo_write_array(0x1C12, [0x1600u16]).await?;
+                    sd.sdo_write_array(0x1C13, [0x1A00u16]).await?;
+                    Ok::<(), ethercrab::error::Error>(())
+                }
+                .await;
+                match r {
+                    Ok(()) => {
+                        chosen = Some(layout);
+                        break;
+                    }
+                    Err(err) => last_err = err.to_string(),
+                }
+            }
+            let Some(layout) = chosen else {
+                return Err(format!(
+                    "SubDevice {position} ({}): the drive refused its PDO mapping: {last_err}",
+                    info.name
+                ));
+            };
+            // Optional objects: a drive without them keeps its own settings.
+            let (value, index) = interpolation_period(opts.cycle);
+            let _ = sd.sdo_write(0x60C2, 1, value).await;
+            let _ = sd.sdo_write(0x60C2, 2, index).await;
+            if info.dc {
+                let _ = sd.sdo_write(0x1C32, 1, 2u16).await;
+                let _ = sd.sdo_write(0x1C32, 2, opts.cycle.as_nanos() as u32).await;
+            }
+            info.drive = Some(layout);
+        }
+        if info.dc {
+            sd.set_dc_sync(DcSync::Sync0);
+        }
+        infos.push(info);
+    }
+    let group = group
+        .into_pre_op_pdi(md)
+        .await
+        .map_err(e("PRE-OP with process data"))?;
+    for (i, info) in infos.iter().enumerate() {
+        if let Some(l) = info.drive {
+            let sd = group.subdevice(md, i).map_err(e("SubDevice"))?;
+            let io = sd.io_raw();
+            if io.outputs().len() != l.out_len || io.inputs().len() != l.in_len {
+                return Err(format!(
+                    "SubDevice {i} ({}): process data of {}/{} bytes, its mapping says {}/{}",
+                    info.name,
+                    io.outputs().len(),
+                    io.inputs().len(),
+                    l.out_len,
+                    l.in_len
+                ));
+            }
+        }
+    }
+    // Distributed clocks: align the SubDevices' clocks, then SYNC0 at the cycle time.
+    let started = Instant::now();
+    for _ in 0..200 {
+        group
+            .tx_rx_sync_system_time(md)
+            .await
+            .map_err(e("DC alignment"))?;
+        if started.elapsed() > Duration::from_secs(2) {
+            break;
+        }
+    }
+    let group = group
+        .configure_dc_sync(
+            md,
+            DcConfiguration {
+                start_delay: Duration::from_millis(20),
+                sync0_period: opts.cycle,
+                sync0_shift: Duration::ZERO,
+            },
+        )
+        .await
+        .map_err(e("DC SYNC0"))?;
+    let group = group.into_safe_op(md).await.map_err(e("SAFE-OP"))?;
+    let group = group.request_into_op(md).await.map_err(e("OP request"))?;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let r = group.tx_rx_dc(md).await.map_err(e("cycle towards OP"))?;
+        if r.all_op() {
+            break;
+        }
+        if Instant::now() > deadline {
+            return Err("the SubDevices did not reach OP within 10 s".into());
+        }
+        std::thread::sleep(r.extra.next_cycle_wait.min(opts.cycle));
+    }
+    Ok((group, infos))
+}
+
+impl DriveBus for EthercatBus {
+    fn slots(&self) -> usize {
+        self.slots.len()
+    }
+
+    fn exchange(&mut self, setpoints: &[DriveSetpoint], feedback: &mut [DriveFeedback]) {
+        self.sim.exchange(setpoints, &mut self.sim_feedback);
+        let mut reset = false;
+        for ((drive, layout), sp) in self.slots.iter().zip(&self.layouts).zip(setpoints) {
+            let (Some(d), Some(l)) = (drive, layout) else {
+                continue;
+            };
+            reset |= sp.fault_reset;
+            if let Ok(sd) = self.group.subdevice(self.md, d.config().subdevice as usize) {
+                let mut io = sd.io_raw_mut();
+                l.encode(&d.outputs(sp), io.outputs());
+            }
+        }
+        let st = &*self.status;
+        st.frames.fetch_add(1, Relaxed);
+        match block_on(self.group.tx_rx_dc(self.md)) {
+            Ok(r) => {
+                st.last_working_counter.store(r.working_counter, Relaxed);
+                st.dc_system_time.store(r.extra.dc_system_time, Relaxed);
+                st.dc_cycle_offset
+                    .store(r.extra.cycle_start_offset.as_nanos() as u64, Relaxed);
+                for (a, s) in st.al_states.iter().zip(&r.subdevice_states) {
+                    a.store(
+                        match s {
+                            SubDeviceState::Other(v) => *v,
+                            s => u8::from(*s),
+                        },
+                        Relaxed,
+                    );
+                }
+                if r.working_counter == st.expected_working_counter {
+                    self.errors_in_row = 0;
+                } else {
+                    st.working_counter_errors.fetch_add(1, Relaxed);
+                    self.errors_in_row += 1;
+                }
+            }
+            Err(_) => {
+                st.lost_frames.fetch_add(1, Relaxed);
+                self.errors_in_row += 1;
+            }
+        }
+        st.errors_in_row.store(self.errors_in_row as u64, Relaxed);
+        if self.errors_in_row >= self.max_errors_in_row && !self.faulted {
+            self.faulted = true;
+            st.faulted.store(true, Relaxed);
+        }
+        // MC_Reset's edge: the bus is cleared once frames flow again, and SubDevices that
+        // left OP are asked back.
+        if reset && !self.reset_edge {
+            if self.errors_in_row == 0 && self.faulted {
+                self.faulted = false;
+                st.faulted.store(false, Relaxed);
+            }
+            if st.al_states.iter().any(|s| s.load(Relaxed) != 8) {
+                self.request_op();
+            }
+        }
+        self.reset_edge = reset;
+        for (slot, ((drive, layout), fb)) in self
+            .slots
+            .iter_mut()
+            .zip(&self.layouts)
+            .zip(feedback.iter_mut())
+            .enumerate()
+        {
+            let (Some(d), Some(l)) = (drive, layout) else {
+                // A simulated drive, or none (not ready).
+                *fb = self.sim_feedback[slot];
+                continue;
+            };
+            let position = d.config().subdevice as usize;
+            let tx = match self.group.subdevice(self.md, position) {
+                Ok(sd) => l.decode(sd.io_raw().inputs()),
+                Err(_) => TxPdo::default(),
+            };
+            *fb = d.feedback(&tx);
+            let al = st.al_states.get(position).map_or(0, |a| a.load(Relaxed));
+            // The drive's last answer, flagged: the kernel stops on its ramp into ErrorStop
+            // with bus_error, as far as the drive still takes setpoints.
+            fb.bus_error = self.faulted || al != 8;
+        }
+    }
+
+    fn attach(&mut self, slot: usize, drive: Drive) -> Result<Option<Drive>, Drive> {
+        let d = match drive {
+            Drive::Cia402(d) => d,
+            sim => {
+                // The slot's EtherCAT drive (if any) comes back with it.
+                let old = self.detach(slot);
+                return self.sim.attach(slot, sim).map(|o| o.or(old));
+            }
+        };
+        let Some(layout) = self
+            .status
+            .subdevices
+            .get(d.config().subdevice as usize)
+            .and_then(|s| s.drive)
+        else {
+            return Err(Drive::Cia402(d));
+        };
+        if slot >= self.slots.len() {
+            return Err(Drive::Cia402(d));
+        }
+        self.layouts[slot] = Some(layout);
+        let old_sim = self.sim.detach(slot);
+        Ok(self.slots[slot].replace(d).map(Drive::Cia402).or(old_sim))
+    }
+
+    fn detach(&mut self, slot: usize) -> Option<Drive> {
+        if let Some(l) = self.layouts.get_mut(slot) {
+            *l = None;
+        }
+        match self.slots.get_mut(slot).and_then(Option::take) {
+            Some(d) => Some(Drive::Cia402(d)),
+            None => self.sim.detach(slot),
+        }
+    }
+
+    /// Simulated drives as on the simulated bus; a drive of the emulated segment takes a
+    /// drive fault (its 0x603F code), its probe input and its limit switches (0x60FD); a
+    /// real drive takes nothing.
+    fn inject(&mut self, slot: usize, fault: SimFault) -> Result<(), BusError> {
+        let Some(Some(d)) = self.slots.get(slot) else {
+            return self.sim.inject(slot, fault);
+        };
+        let Some(segment) = &self.segment else {
+            return Err(BusError::Unsupported);
+        };
+        let position = d.config().subdevice as usize;
+        let mut seg = segment.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(drive) = seg.app::<emu::drive::Cia402Emu>(position) else {
+            return Err(BusError::Unsupported);
+        };
+        match fault {
+            SimFault::DriveFault { code } => drive.inject_fault(code.min(0xFFFF) as u16),
+            SimFault::ProbeInput { active } => drive.set_probe_input(active),
+            SimFault::LimitSwitch { positive, active } => {
+                let bit = if positive { 0b010 } else { 0b001 };
+                let now = drive.od.u32(0x60FD, 0);
+                drive.set_digital_inputs(if active { now | bit } else { now & !bit });
+            }
+            SimFault::Clear => {
+                drive.set_probe_input(false);
+                drive.set_digital_inputs(0);
+            }
+            SimFault::Load { .. } | SimFault::ProbeMark { .. } => {
+                return Err(BusError::Unsupported);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,186 @@
+//! The EtherCAT `DriveBus` against an emulated segment: bring-up to OP with the CoE script and
+//! SYNC0, a CiA-402 drive attached to an axis slot enables and follows CSP setpoints, a drive
+//! fault reaches the feedback with its 0x603F code, lost frames fault the bus's axes after N
+//! in a row and MC_Reset's edge clears it once frames flow.
+
+use std::time::{Duration, Instant};
+
+use drives::cia402::{Cia402Config, Cia402Mode};
+use drives::{DriveBus, DriveConfig};
+use ethercat::bus::{BusOptions, EthercatBus, Link};
+use ethercat::emu::Segment;
+use ethercat::emu::drive::{self, Cia402Emu, Plant};
+use ethercat::emu::sii::Identity;
+use motion::{DriveFeedback, DriveSetpoint};
+
+const CYCLE: Duration = Duration::from_millis(1);
+
+#[test]
+fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
+    let start = Instant::now();
+    let seg = Segment::new(
+        (0..2)
+            .map(|i| {
+                drive::servo(
+                    Identity {
+                        vendor_id: 0xACE,
+                        product_code: 0x402,
+                        revision: 1,
+                        serial: i,
+                        name: format!("servo {i}"),
+                    },
+                    Plant::default(),
+                )
+            })
+            .collect(),
+        Box::new(move || start.elapsed().as_nanos() as u64),
+    )
+    .shared();
+    let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 4)
+        .expect("bring-up");
+    let status = bus.status();
+    assert_eq!(status.subdevices.len(), 2);
+    assert_eq!(status.subdevices[1].name, "servo 1");
+    assert_eq!(status.subdevices[0].drive.map(|l| l.name), Some("full"));
+    assert_eq!(status.expected_working_counter, 6);
+
+    let cfg = DriveConfig::Cia402(Cia402Config {
+        subdevice: 1,
+        increments_per_unit: 1000.0,
+        velocity_increments_per_unit: None,
+        mode: Cia402Mode::Csp,
+        position_gain: 50.0,
+    });
+    assert!(bus.attach(2, cfg.build(0.001)).unwrap().is_none());
+    let mut sp = vec![DriveSetpoint::default(); 4];
+    let mut fb = vec![DriveFeedback::default(); 4];
+    let mut cycle = |bus: &mut EthercatBus, sp: &[DriveSetpoint], fb: &mut [DriveFeedback]| {
+        bus.exchange(sp, fb);
+        std::thread::sleep(CYCLE);
+    };
+    let until =
+        |what: &str,
+         bus: &mut EthercatBus,
+         sp: &mut Vec<DriveSetpoint>,
+         fb: &mut Vec<DriveFeedback>,
+         f: &dyn Fn(&DriveFeedback) -> bool,
+         cycle: &mut dyn FnMut(&mut EthercatBus, &[DriveSetpoint], &mut [DriveFeedback])| {
+            for _ in 0..5000 {
+                cycle(bus, sp, fb);
+                if f(&fb[2]) {
+                    return;
+                }
+            }
+            panic!("{what}: {:?}", fb[2]);
+        };
+    until(
+        "ready",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| f.ready && !f.fault,
+        &mut cycle,
+    );
+    assert!(!fb[0].ready, "an empty slot is never ready");
+    sp[2].enable = true;
+    until(
+        "enabled",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| f.enabled,
+        &mut cycle,
+    );
+    // A 5 mm move: the drive (subdevice 1) follows in increments.
+    for k in 1..=500 {
+        sp[2].position = 5.0 * k as f64 / 500.0;
+        sp[2].velocity = 5.0;
+        cycle(&mut bus, &sp, &mut fb);
+    }
+    sp[2].velocity = 0.0;
+    until(
+        "at 5 mm",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| (f.actual_position - 5.0).abs() < 0.002,
+        &mut cycle,
+    );
+    {
+        let mut s = seg.lock().unwrap();
+        assert!((s.app::<Cia402Emu>(1).unwrap().position - 5000.0).abs() < 2.0);
+        assert_eq!(
+            s.app::<Cia402Emu>(0).unwrap().state,
+            drive::State::SwitchOnDisabled,
+            "subdevice 0 untouched"
+        );
+    }
+
+    // A drive fault: its code in the feedback; a reset edge clears it.
+    seg.lock()
+        .unwrap()
+        .app::<Cia402Emu>(1)
+        .unwrap()
+        .inject_fault(0x2310);
+    until(
+        "drive fault",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| f.fault,
+        &mut cycle,
+    );
+    assert_eq!(fb[2].fault_code, 0x2310);
+    sp[2].enable = false;
+    sp[2].fault_reset = true;
+    until(
+        "fault reset",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| !f.fault,
+        &mut cycle,
+    );
+    sp[2].fault_reset = false;
+
+    // Lost frames: fewer than three in a row are counted only; three fault the bus.
+    let lost = status
+        .lost_frames
+        .load(std::sync::atomic::Ordering::Relaxed);
+    seg.lock().unwrap().faults.drop_frames = 2;
+    for _ in 0..5 {
+        cycle(&mut bus, &sp, &mut fb);
+    }
+    assert!(!fb[2].bus_error, "two lost frames do not fault the bus");
+    assert_eq!(
+        status
+            .lost_frames
+            .load(std::sync::atomic::Ordering::Relaxed),
+        lost + 2
+    );
+    seg.lock().unwrap().faults.drop_frames = 3;
+    for _ in 0..5 {
+        cycle(&mut bus, &sp, &mut fb);
+    }
+    assert!(fb[2].bus_error && !fb[2].fault, "{:?}", fb[2]);
+    assert!(status.faulted.load(std::sync::atomic::Ordering::Relaxed));
+    sp[2].fault_reset = true;
+    cycle(&mut bus, &sp, &mut fb);
+    sp[2].fault_reset = false;
+    until(
+        "bus fault cleared",
+        &mut bus,
+        &mut sp,
+        &mut fb,
+        &|f| !f.bus_error && f.ready,
+        &mut cycle,
+    );
+    assert!(!status.faulted.load(std::sync::atomic::Ordering::Relaxed));
+
+    // SDO from another thread while the cycle runs.
+    let sdo = bus.sdo();
+    let v = futures_lite::future::block_on(sdo.read(1, 0x1018, 4)).unwrap();
+    assert_eq!(v, 1u32.to_le_bytes());
+    let e = futures_lite::future::block_on(sdo.read(1, 0x2000, 0)).unwrap_err();
+    assert_eq!(e, ethercat::bus::SdoError::Abort(0x0602_0000));
+}

@@ -1,0 +1,435 @@
+//! The drive bus: what it is and how it is doing (`GET /bus`), SDO access to the EtherCAT
+//! SubDevices for diagnostics (never through the cycle: CoE mailbox traffic from the async
+//! side), and frame loss injected into the emulated segment.
+
+use std::sync::Arc;
+use std::sync::atomic::Ordering::Relaxed;
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::http::StatusCode;
+use ethercat::bus::SdoError;
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use super::{Client, JsonBody};
+use crate::app::AppState;
+use crate::bus::BusKind;
+use crate::error::{AppError, AppResult};
+use crate::service::axes::audit_entry;
+
+/// An EtherCAT state machine state (AL status).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum AlState {
+    Init,
+    PreOp,
+    Boot,
+    SafeOp,
+    Op,
+    Unknown,
+}
+
+impl AlState {
+    fn of(code: u8) -> AlState {
+        match code & 0x0F {
+            1 => AlState::Init,
+            2 => AlState::PreOp,
+            3 => AlState::Boot,
+            4 => AlState::SafeOp,
+            8 => AlState::Op,
+            _ => AlState::Unknown,
+        }
+    }
+}
+
+/// A CiA-402 drive's process data as motiond mapped it.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"mapping": "full", "output_bytes": 15, "input_bytes": 29}))]
+pub struct DriveMapping {
+    /// `full` (targets for CSP/CSV/CST, touch probe, digital inputs) or `minimal` (what a
+    /// drive refusing the full mapping takes: controlword, target, mode; statusword,
+    /// position, mode display, error code).
+    pub mapping: &'static str,
+    /// RxPDO (outputs) and TxPDO (inputs) bytes.
+    pub output_bytes: usize,
+    pub input_bytes: usize,
+}
+
+/// One SubDevice of the segment.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"position": 1, "configured_address": 4097, "name": "motiond emulated servo 2",
+    "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264129,
+    "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29},
+    "dc": true, "axis": "y"}))]
+pub struct SubDeviceResource {
+    /// Position on the segment (0 = next to motiond); a CiA-402 drive's `subdevice`.
+    pub position: u16,
+    pub configured_address: u16,
+    pub name: String,
+    pub vendor_id: u32,
+    pub product_code: u32,
+    pub revision: u32,
+    pub serial: u32,
+    /// As read by the latest cycle.
+    pub al_state: AlState,
+    /// A CiA-402 drive (device type 0x1000 profile 402), or `null`.
+    pub drive: Option<DriveMapping>,
+    /// Supports distributed clocks (runs SYNC0).
+    pub dc: bool,
+    /// The axis whose drive this is.
+    pub axis: Option<String>,
+}
+
+/// `GET /bus`.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({
+    "kind": "emulated", "interface": "emulated", "cycle_time": 0.001, "state": "op",
+    "frames": 120345, "lost_frames": 0, "working_counter_errors": 0, "errors_in_row": 0,
+    "max_errors_in_row": 3, "expected_working_counter": 9, "last_working_counter": 9,
+    "dc_system_time_ns": 123456789000u64, "dc_cycle_offset_ns": 12000,
+    "subdevices": [{"position": 0, "configured_address": 4096, "name": "motiond emulated servo 1",
+        "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264128,
+        "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29},
+        "dc": true, "axis": "x"}]
+}))]
+pub struct BusResource {
+    pub kind: BusKind,
+    /// The network interface (`emulated` for the emulated segment); `null` when simulated.
+    pub interface: Option<String>,
+    /// Seconds between exchanges (= the SYNC0 period).
+    pub cycle_time: f64,
+    /// `simulated`; `op` (every SubDevice in OP, frames flowing); `degraded` (a SubDevice is not
+    /// in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row:
+    /// every EtherCAT axis is stopped until MC_Reset once frames flow).
+    pub state: &'static str,
+    pub frames: u64,
+    pub lost_frames: u64,
+    pub working_counter_errors: u64,
+    pub errors_in_row: u64,
+    pub max_errors_in_row: u32,
+    pub expected_working_counter: u16,
+    pub last_working_counter: u16,
+    /// The DC reference clock's system time at the latest exchange (ns since 2000-01-01).
+    pub dc_system_time_ns: Option<u64>,
+    /// Where in its SYNC0 period the latest frame reached the reference clock (ns).
+    pub dc_cycle_offset_ns: Option<u64>,
+    pub subdevices: Vec<SubDeviceResource>,
+}
+
+pub fn bus_resource(s: &AppState) -> BusResource {
+    let h = &s.info.bus;
+    let Some((st, _)) = &h.ethercat else {
+        return BusResource {
+            kind: h.kind,
+            interface: None,
+            cycle_time: s.info.cycle_time_s,
+            state: "simulated",
+            frames: 0,
+            lost_frames: 0,
+            working_counter_errors: 0,
+            errors_in_row: 0,
+            max_errors_in_row: 0,
+            expected_working_counter: 0,
+            last_working_counter: 0,
+            dc_system_time_ns: None,
+            dc_cycle_offset_ns: None,
+            subdevices: Vec::new(),
+        };
+    };
+    let axes: Vec<(u16, String)> = s
+        .registry
+        .read()
+        .unwrap()
+        .axes
+        .values()
+        .filter_map(|a| match &a.config.drive {
+            drives::DriveConfig::Cia402(c) => Some((c.subdevice, a.name.clone())),
+            _ => None,
+        })
+        .collect();
+    let subdevices: Vec<SubDeviceResource> = st
+        .subdevices
+        .iter()
+        .zip(&st.al_states)
+        .map(|(d, al)| SubDeviceResource {
+            position: d.position,
+            configured_address: d.configured_address,
+            name: d.name.clone(),
+            vendor_id: d.vendor_id,
+            product_code: d.product_code,
+            revision: d.revision,
+            serial: d.serial,
+            al_state: AlState::of(al.load(Relaxed)),
+            drive: d.drive.map(|l| DriveMapping {
+                mapping: l.name,
+                output_bytes: l.out_len,
+                input_bytes: l.in_len,
+            }),
+            dc: d.dc,
+            axis: axes
+                .iter()
+                .find(|(p, _)| *p == d.position)
+                .map(|(_, n)| n.clone()),
+        })
+        .collect();
+    let state = if st.faulted.load(Relaxed) {
+        "faulted"
+    } else if subdevices.iter().any(|d| d.al_state != AlState::Op) {
+        "degraded"
+    } else {
+        "op"
+    };
+    BusResource {
+        kind: h.kind,
+        interface: Some(st.interface.clone()),
+        cycle_time: st.cycle_ns as f64 * 1e-9,
+        state,
+        frames: st.frames.load(Relaxed),
+        lost_frames: st.lost_frames.load(Relaxed),
+        working_counter_errors: st.working_counter_errors.load(Relaxed),
+        errors_in_row: st.errors_in_row.load(Relaxed),
+        max_errors_in_row: st.max_errors_in_row,
+        expected_working_counter: st.expected_working_counter,
+        last_working_counter: st.last_working_counter.load(Relaxed),
+        dc_system_time_ns: Some(st.dc_system_time.load(Relaxed)),
+        dc_cycle_offset_ns: Some(st.dc_cycle_offset.load(Relaxed)),
+        subdevices,
+    }
+}
+
+#[utoipa::path(get, path = "/api/v1/bus", tag = "bus",
+    summary = "The drive bus: kind, state, frame and working-counter figures, DC, the SubDevices with identity and AL state",
+    responses((status = 200, description = "The bus", body = BusResource)))]
+pub async fn bus(State(s): State<Arc<AppState>>) -> Json<BusResource> {
+    Json(bus_resource(&s))
+}
+
+/// An object's value as read by SDO upload.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"position": 0, "index": "0x1018", "sub": 1, "bytes": [206, 10, 255, 0],
+    "hex": "ce0aff00", "unsigned": 16714446, "signed": 16714446, "text": null}))]
+pub struct SdoValue {
+    pub position: u16,
+    /// `0xIIII`.
+    pub index: String,
+    pub sub: u8,
+    /// As the SubDevice sent them (little endian).
+    pub bytes: Vec<u8>,
+    pub hex: String,
+    /// The bytes as an unsigned and a signed little-endian integer (1 to 8 bytes).
+    pub unsigned: Option<u64>,
+    pub signed: Option<i64>,
+    /// The bytes as text, when they are printable ASCII (names, versions).
+    pub text: Option<String>,
+}
+
+/// `PUT …/sdo/{index}/{sub}`: an integer written with the object's size.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"value": 8, "size": 1}))]
+pub struct SdoWrite {
+    /// Written little endian in `size` bytes (negative values in two's complement).
+    #[schema(minimum = -2147483648_i64, maximum = 4294967295_i64)]
+    pub value: i64,
+    /// 1, 2 or 4 bytes (SDO download expedited).
+    #[schema(minimum = 1, maximum = 4)]
+    pub size: u8,
+}
+
+fn index_of(s: &str) -> AppResult<u16> {
+    let v = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
+        Some(h) => u16::from_str_radix(h, 16).ok(),
+        None => s.parse::<u16>().ok(),
+    };
+    v.ok_or_else(|| {
+        AppError::field(
+            "index",
+            "an object index: 0x0000–0xFFFF (hex with 0x, or decimal)",
+        )
+    })
+}
+
+fn sdo_access(s: &AppState) -> AppResult<ethercat::bus::SdoAccess> {
+    s.info
+        .bus
+        .ethercat
+        .as_ref()
+        .map(|(_, a)| *a)
+        .ok_or_else(|| {
+            AppError::conflict(
+                "bus_not_ethercat",
+                "motiond runs the simulated bus: SDOs need --bus ethercat or --bus emulated",
+            )
+        })
+}
+
+fn sdo_failed(e: SdoError, position: u16, index: u16, sub: u8) -> AppError {
+    match e {
+        SdoError::NoSubDevice => AppError::not_found("subdevice", &position.to_string()),
+        SdoError::Abort(code) => AppError::conflict(
+            "sdo_aborted",
+            format!(
+                "SubDevice {position} aborted the SDO transfer of {index:#06x}:{sub} with {code:#010x} ({})",
+                abort_text(code)
+            ),
+        ),
+        SdoError::Failed(why) => AppError::unavailable(
+            "sdo_failed",
+            format!("SDO transfer of {index:#06x}:{sub} with SubDevice {position} failed: {why}"),
+        ),
+    }
+}
+
+/// CiA-301's words for the abort codes a drive answers most.
+fn abort_text(code: u32) -> &'static str {
+    match code {
+        0x0503_0000 => "toggle bit not changed",
+        0x0504_0001 => "command specifier not valid or unknown",
+        0x0601_0000 => "unsupported access to an object",
+        0x0601_0001 => "attempt to read a write-only object",
+        0x0601_0002 => "attempt to write a read-only object",
+        0x0601_0003 => "subindex cannot be written, subindex 0 must be 0 for write access",
+        0x0602_0000 => "the object does not exist in the object dictionary",
+        0x0604_0041 => "the object cannot be mapped into the PDO",
+        0x0604_0042 => "the number and length of the objects would exceed the PDO length",
+        0x0607_0010 => "data type does not match, length of service parameter does not match",
+        0x0609_0011 => "subindex does not exist",
+        0x0609_0030 => "value range of parameter exceeded",
+        0x0800_0022 => "data cannot be transferred or stored because of the present device state",
+        _ => "see the drive's manual",
+    }
+}
+
+fn value_of(position: u16, index: u16, sub: u8, bytes: Vec<u8>) -> SdoValue {
+    let (unsigned, signed) = if (1..=8).contains(&bytes.len()) {
+        let mut b = [0u8; 8];
+        b[..bytes.len()].copy_from_slice(&bytes);
+        let u = u64::from_le_bytes(b);
+        let bits = 8 * bytes.len() as u32;
+        let s = if bits == 64 {
+            u as i64
+        } else {
+            ((u << (64 - bits)) as i64) >> (64 - bits)
+        };
+        (Some(u), Some(s))
+    } else {
+        (None, None)
+    };
+    let text = (!bytes.is_empty() && bytes.iter().all(|b| b.is_ascii_graphic() || *b == b' '))
+        .then(|| String::from_utf8_lossy(&bytes).into_owned());
+    SdoValue {
+        position,
+        index: format!("{index:#06x}"),
+        sub,
+        hex: bytes.iter().map(|b| format!("{b:02x}")).collect(),
+        bytes,
+        unsigned,
+        signed,
+        text,
+    }
+}
+
+#[utoipa::path(get, path = "/api/v1/bus/subdevices/{position}/sdo/{index}/{sub}", tag = "bus",
+    summary = "Read an object of a SubDevice by SDO upload (CoE), for diagnostics",
+    description = "From the async side through the mailbox; the cycle is not touched. 409 `sdo_aborted` carries the \
+CiA-301 abort code the SubDevice answered; 409 `bus_not_ethercat` on the simulated bus.",
+    params(("position" = u16, Path, description = "SubDevice position on the segment", example = 0),
+        ("index" = String, Path, description = "object index, `0x1018` or decimal", example = "0x1018"),
+        ("sub" = u8, Path, description = "subindex", example = 1)),
+    responses((status = 200, description = "The value", body = SdoValue), super::errors::SdoErrors))]
+pub async fn sdo_read(
+    State(s): State<Arc<AppState>>,
+    Path((position, index, sub)): Path<(u16, String, u8)>,
+) -> AppResult<Json<SdoValue>> {
+    let index = index_of(&index)?;
+    let sdo = sdo_access(&s)?;
+    let bytes = sdo
+        .read(position, index, sub)
+        .await
+        .map_err(|e| sdo_failed(e, position, index, sub))?;
+    Ok(Json(value_of(position, index, sub, bytes)))
+}
+
+#[utoipa::path(put, path = "/api/v1/bus/subdevices/{position}/sdo/{index}/{sub}", tag = "bus",
+    summary = "Write an object of a SubDevice by SDO download (CoE); answers the value read back",
+    description = "For commissioning and diagnostics; audited. A drive refuses what its state does not allow (e.g. the \
+PDO mapping outside PRE-OP: 409 `sdo_aborted` with 0x08000022).",
+    params(("position" = u16, Path, description = "SubDevice position on the segment", example = 0),
+        ("index" = String, Path, description = "object index, `0x6065` or decimal", example = "0x6065"),
+        ("sub" = u8, Path, description = "subindex", example = 0)),
+    request_body = SdoWrite,
+    responses((status = 200, description = "Written; the value read back", body = SdoValue), super::errors::SdoWriteErrors))]
+pub async fn sdo_write(
+    State(s): State<Arc<AppState>>,
+    Path((position, index, sub)): Path<(u16, String, u8)>,
+    client: Client,
+    JsonBody(w, _): JsonBody<SdoWrite>,
+) -> AppResult<Json<SdoValue>> {
+    let index = index_of(&index)?;
+    if !matches!(w.size, 1 | 2 | 4) {
+        return Err(AppError::field("size", "1, 2 or 4 bytes"));
+    }
+    let bits = 8 * u32::from(w.size);
+    let (min, max) = (-(1i64 << (bits - 1)), (1i64 << bits) - 1);
+    if !(min..=max).contains(&w.value) {
+        return Err(AppError::field(
+            "value",
+            &format!("does not fit {} bytes ({min}..{max})", w.size),
+        ));
+    }
+    let sdo = sdo_access(&s)?;
+    let bytes = (w.value as u64).to_le_bytes()[..w.size as usize].to_vec();
+    let r = sdo.write(position, index, sub, &bytes).await;
+    s.audit(audit_entry(
+        &client.0,
+        "bus.sdo_write",
+        &format!("subdevice {position}"),
+        serde_json::json!({"index": format!("{index:#06x}"), "sub": sub, "value": w.value, "size": w.size,
+            "result": match &r { Ok(()) => "written".to_string(), Err(e) => format!("{e:?}") }})
+        .to_string(),
+    ));
+    r.map_err(|e| sdo_failed(e, position, index, sub))?;
+    let back = sdo
+        .read(position, index, sub)
+        .await
+        .map_err(|e| sdo_failed(e, position, index, sub))?;
+    Ok(Json(value_of(position, index, sub, back)))
+}
+
+/// Disturbances of the emulated segment.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"lose_frames": 5}))]
+pub struct BusFault {
+    /// The next frames to lose (not answered): each is a lost frame for the bus; the bus
+    /// faults its axes after `max_errors_in_row` in a row.
+    #[schema(minimum = 1, maximum = 100000)]
+    pub lose_frames: u32,
+}
+
+#[utoipa::path(post, path = "/api/v1/bus/faults", tag = "bus",
+    summary = "Lose frames on the emulated EtherCAT segment (--bus emulated only)",
+    request_body = BusFault,
+    responses((status = 204, description = "The segment will drop that many frames"), super::errors::BusFaultErrors))]
+pub async fn inject_bus_fault(
+    State(s): State<Arc<AppState>>,
+    client: Client,
+    JsonBody(f, raw): JsonBody<BusFault>,
+) -> AppResult<StatusCode> {
+    if !(1..=100_000).contains(&f.lose_frames) {
+        return Err(AppError::field("lose_frames", "1..100000"));
+    }
+    let Some(seg) = &s.info.bus.segment else {
+        return Err(AppError::conflict(
+            "bus_not_emulated",
+            "only the emulated segment (--bus emulated) takes injected frame loss",
+        ));
+    };
+    seg.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .faults
+        .drop_frames += f.lose_frames;
+    s.audit(audit_entry(&client.0, "bus.fault", "bus", raw.to_string()));
+    Ok(StatusCode::NO_CONTENT)
+}

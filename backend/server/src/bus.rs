@@ -1,0 +1,148 @@
+//! Which drive bus motiond runs (`--bus`): the simulated bus (the default), an EtherCAT segment
+//! on a network interface, or an emulated EtherCAT segment of CiA-402 drives in this process
+//! (`--bus emulated`: the same EtherCAT code path as real hardware, without hardware). Built
+//! before the cycle thread starts; what the API may see of it lives in [`BusHandle`].
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use drives::DriveBus;
+use ethercat::bus::{BusOptions, BusStatus, EthercatBus, Link, SdoAccess};
+use ethercat::emu::Segment;
+use ethercat::emu::drive::{self, Plant};
+use ethercat::emu::sii::Identity;
+use serde::Serialize;
+use utoipa::ToSchema;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum BusKind {
+    /// Simulated drives only (no EtherCAT).
+    Simulated,
+    /// An emulated EtherCAT segment of CiA-402 servo drives in this process.
+    Emulated,
+    /// EtherCAT on `--interface` (needs `CAP_NET_RAW`).
+    Ethercat,
+}
+
+impl BusKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            BusKind::Simulated => "simulated",
+            BusKind::Emulated => "emulated",
+            BusKind::Ethercat => "ethercat",
+        }
+    }
+}
+
+/// The drives of the emulated segment: one per demo axis.
+pub const EMULATED_DRIVES: u32 = 3;
+
+/// What the API sees of the bus.
+#[derive(Clone)]
+pub struct BusHandle {
+    pub kind: BusKind,
+    /// EtherCAT (real or emulated): the bus's shared status and SDO access.
+    pub ethercat: Option<(Arc<BusStatus>, SdoAccess)>,
+    /// The emulated segment (fault injection: lost frames).
+    pub segment: Option<Arc<Mutex<Segment>>>,
+}
+
+impl BusHandle {
+    pub fn simulated() -> BusHandle {
+        BusHandle {
+            kind: BusKind::Simulated,
+            ethercat: None,
+            segment: None,
+        }
+    }
+
+    /// Positions of the SubDevices that are CiA-402 drives.
+    pub fn drive_positions(&self) -> Vec<u16> {
+        self.ethercat.as_ref().map_or_else(Vec::new, |(st, _)| {
+            st.subdevices
+                .iter()
+                .filter(|s| s.drive.is_some())
+                .map(|s| s.position)
+                .collect()
+        })
+    }
+}
+
+/// The identity of emulated drive `i` (a vendor id from the range no EtherCAT vendor has).
+pub fn emulated_identity(i: u32) -> Identity {
+    Identity {
+        vendor_id: 0x00FF_0ACE,
+        product_code: 0x0402_0001,
+        revision: 0x0001_0000,
+        serial: 0x2026_0000 + i,
+        name: format!("motiond emulated servo {}", i + 1),
+    }
+}
+
+/// Builds the bus (blocking: an EtherCAT segment is brought up to OP here).
+pub fn start(
+    kind: BusKind,
+    interface: Option<&str>,
+    cycle: Duration,
+    max_errors_in_row: u32,
+    slots: usize,
+) -> Result<(Box<dyn DriveBus>, BusHandle), String> {
+    let link = match kind {
+        BusKind::Simulated => {
+            return Ok((Box::new(drives::SimBus::new(slots)), BusHandle::simulated()));
+        }
+        BusKind::Ethercat => Link::Interface(
+            interface
+                .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
+                .to_string(),
+        ),
+        BusKind::Emulated => {
+            let start = Instant::now();
+            let segment = Segment::new(
+                (0..EMULATED_DRIVES)
+                    .map(|i| drive::servo(emulated_identity(i), Plant::default()))
+                    .collect(),
+                Box::new(move || start.elapsed().as_nanos() as u64),
+            )
+            .shared();
+            Link::Emulated(segment)
+        }
+    };
+    let segment = match &link {
+        Link::Emulated(s) => Some(s.clone()),
+        Link::Interface(_) => None,
+    };
+    let mut opts = BusOptions::new(cycle);
+    opts.max_errors_in_row = max_errors_in_row;
+    let bus = EthercatBus::start(link, &opts, slots)?;
+    let status = bus.status();
+    for s in &status.subdevices {
+        tracing::info!(
+            "EtherCAT SubDevice {} {:#06x} '{}' vendor {:#010x} product {:#010x} rev {:#010x} serial {}{}",
+            s.position,
+            s.configured_address,
+            s.name,
+            s.vendor_id,
+            s.product_code,
+            s.revision,
+            s.serial,
+            s.drive.map_or(String::new(), |l| format!(
+                ", CiA-402 drive ({} mapping)",
+                l.name
+            ))
+        );
+    }
+    tracing::info!(
+        "EtherCAT on {}: {} SubDevices in OP, DC SYNC0 every {} µs",
+        status.interface,
+        status.subdevices.len(),
+        cycle.as_micros()
+    );
+    let handle = BusHandle {
+        kind,
+        ethercat: Some((status, bus.sdo())),
+        segment,
+    };
+    Ok((Box::new(bus), handle))
+}

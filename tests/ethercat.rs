@@ -1,0 +1,207 @@
+//! The real binary on the emulated EtherCAT segment (`--bus emulated`): the demo machine's axes
+//! are CiA-402 drives brought to OP through ethercrab; the bus resource with identities and AL
+//! states; power + move-absolute with wait reaches the target on the emulated drive; SDO reads
+//! of the identity; a drive fault is ErrorStop with the drive's code and a reset clears it;
+//! lost frames stop the axes (bus_error) and are counted; on the simulated bus a cia402 drive
+//! and SDOs are refused with clear problems.
+
+mod common;
+
+use common::*;
+use serde_json::{Value, json};
+use std::time::{Duration, Instant};
+
+async fn until_status(s: &Server, axis: &str, what: &str, f: impl Fn(&Value) -> bool) -> Value {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        let st = status(s, axis).await;
+        if f(&st["status"]) {
+            return st["status"].clone();
+        }
+        assert!(
+            Instant::now() < deadline,
+            "{axis}: {what}: {}",
+            st["status"]
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
+    let s = Server::start_with(":memory:", &["--bus", "emulated"]);
+    let bus = get(&s, "/api/v1/bus").await;
+    assert_eq!(bus.status, 200, "{}", bus.text);
+    assert_eq!(bus.json["kind"], "emulated");
+    assert_eq!(bus.json["state"], "op", "{}", bus.text);
+    let subs = bus.json["subdevices"].as_array().unwrap();
+    assert_eq!(subs.len(), 3);
+    for (i, (sd, axis)) in subs.iter().zip(["x", "y", "spindle"]).enumerate() {
+        assert_eq!(sd["position"], i);
+        assert_eq!(sd["al_state"], "op");
+        assert_eq!(sd["vendor_id"], 0x00FF_0ACE);
+        assert_eq!(sd["name"], format!("motiond emulated servo {}", i + 1));
+        assert_eq!(sd["drive"]["mapping"], "full");
+        assert_eq!(sd["axis"], axis);
+    }
+    assert_eq!(bus.json["expected_working_counter"], 9);
+    let sys = get(&s, "/api/v1/system").await;
+    assert_eq!(sys.json["drive_bus"], "emulated");
+    let x = get(&s, "/api/v1/axes/x").await;
+    assert_eq!(x.json["config"]["drive"]["kind"], "cia402", "{}", x.text);
+
+    // SDO upload of the identity object, and an abort with its CiA-301 code.
+    let v = get(&s, "/api/v1/bus/subdevices/0/sdo/0x1018/1").await;
+    assert_eq!(v.status, 200, "{}", v.text);
+    assert_eq!(v.json["unsigned"], 0x00FF_0ACE);
+    let name = get(&s, "/api/v1/bus/subdevices/2/sdo/0x1008/0").await;
+    assert_eq!(name.json["text"], "motiond emulated servo 3");
+    let abort = get(&s, "/api/v1/bus/subdevices/0/sdo/0x2000/0").await;
+    assert_problem(&abort, 409, "sdo_aborted");
+    assert!(
+        abort.json["detail"]
+            .as_str()
+            .unwrap()
+            .contains("0x06020000"),
+        "{}",
+        abort.text
+    );
+    assert_problem(
+        &get(&s, "/api/v1/bus/subdevices/9/sdo/0x1018/1").await,
+        404,
+        "subdevice_not_found",
+    );
+    // A write the drive refuses in OP (the PDO mapping), and one it takes.
+    let w = put(
+        &s,
+        "/api/v1/bus/subdevices/0/sdo/0x1600/0",
+        json!({"value": 0, "size": 1}),
+    )
+    .await;
+    assert_problem(&w, 409, "sdo_aborted");
+    assert!(
+        w.json["detail"].as_str().unwrap().contains("0x08000022"),
+        "{}",
+        w.text
+    );
+    let w = put(
+        &s,
+        "/api/v1/bus/subdevices/0/sdo/0x6065/0",
+        json!({"value": 20000, "size": 4}),
+    )
+    .await;
+    assert_eq!(w.status, 200, "{}", w.text);
+    assert_eq!(w.json["unsigned"], 20000);
+
+    // Power and a move with wait: the emulated drive stands at the target, in increments.
+    power_on(&s, "x").await;
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 120.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let st = until_status(&s, "x", "at 120", |st| {
+        (st["actual_position"].as_f64().unwrap() - 120.0).abs() < 0.002
+    })
+    .await;
+    assert_eq!(st["state"], "standstill");
+    let pos = get(&s, "/api/v1/bus/subdevices/0/sdo/0x6064/0").await;
+    assert!(
+        (pos.json["signed"].as_i64().unwrap() - 120_000).abs() <= 2,
+        "{}",
+        pos.text
+    );
+
+    // A drive fault: ErrorStop with the drive's 0x603F code; a reset clears it.
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "drive_fault", "code": 0x2310}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let st = until_status(&s, "x", "drive fault", |st| st["state"] == "error_stop").await;
+    assert_eq!(st["error_id"], 0x7010);
+    assert_eq!(st["drive_error_code"], 0x2310);
+    reset_to_standstill(&s, "x").await;
+
+    // Lost frames: counted; three in a row stop the axes with bus_error; reset once they flow.
+    let lost = bus_field(&s, "lost_frames").await;
+    let r = post(&s, "/api/v1/bus/faults", json!({"lose_frames": 5})).await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let st = until_status(&s, "x", "bus error", |st| st["state"] == "error_stop").await;
+    assert_eq!(st["error_id"], 0x70A0);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while bus_field(&s, "lost_frames").await < lost + 5 {
+        assert!(Instant::now() < deadline, "the lost frames are counted");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    assert_eq!(get(&s, "/api/v1/bus").await.json["state"], "faulted");
+    let metrics = reqwest::get(s.url("/metrics"))
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert!(metrics.contains("motiond_bus_faulted 1"), "{metrics}");
+    reset_to_standstill(&s, "x").await;
+    assert_eq!(get(&s, "/api/v1/bus").await.json["state"], "op");
+
+    // A second axis on a drive already taken is refused.
+    let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+    cfg["name"] = json!("y2");
+    let r = post(&s, "/api/v1/axes", cfg).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "drive.subdevice",
+        "{}",
+        r.text
+    );
+}
+
+/// MC_Reset with wait, then the axis back in Standstill (its power stayed on).
+async fn reset_to_standstill(s: &Server, axis: &str) {
+    let r = post(
+        s,
+        &format!("/api/v1/axes/{axis}/reset?wait=true&timeout_ms=5000"),
+        json!({}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    until_status(s, axis, "standstill after reset", |st| {
+        st["state"] == "standstill"
+    })
+    .await;
+}
+
+async fn bus_field(s: &Server, f: &str) -> u64 {
+    get(s, "/api/v1/bus").await.json[f].as_u64().unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn the_simulated_bus_refuses_cia402_drives_and_sdos_clearly() {
+    let s = Server::start();
+    let bus = get(&s, "/api/v1/bus").await;
+    assert_eq!(
+        (bus.json["kind"].as_str(), bus.json["state"].as_str()),
+        (Some("simulated"), Some("simulated"))
+    );
+    assert_problem(
+        &get(&s, "/api/v1/bus/subdevices/0/sdo/0x1018/1").await,
+        409,
+        "bus_not_ethercat",
+    );
+    assert_problem(
+        &post(&s, "/api/v1/bus/faults", json!({"lose_frames": 1})).await,
+        409,
+        "bus_not_emulated",
+    );
+    let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+    cfg["name"] = json!("servo");
+    cfg["drive"] = json!({"kind": "cia402", "subdevice": 0, "increments_per_unit": 1000.0});
+    let r = post(&s, "/api/v1/axes", cfg).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "drive.kind", "{}", r.text);
+}
