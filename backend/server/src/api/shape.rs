@@ -194,6 +194,25 @@ fn walk_branches(
     if let Some(s) = tagged {
         return walk(s, value, path, closed_too);
     }
+    // No tag given: the branch whose tag may be left out (it has a default, e.g. a simulated
+    // drive without `kind`) is the one meant, so that its errors are reported.
+    let untagged_default = candidates.iter().find(|s| {
+        let r = resolve(s);
+        let props = r.get("properties").and_then(Value::as_object);
+        let required = r.get("required").and_then(Value::as_array);
+        props.is_some_and(|p| {
+            p.iter().any(|(k, v)| {
+                v.get("enum")
+                    .and_then(Value::as_array)
+                    .is_some_and(|e| e.len() == 1)
+                    && value.get(k).is_none()
+                    && !required.is_some_and(|req| req.iter().any(|x| x == k))
+            })
+        })
+    });
+    if let Some(s) = untagged_default {
+        return walk(s, value, path, closed_too);
+    }
     let mut first_err = None;
     for s in candidates {
         let mut attempt = value.clone();
