@@ -191,7 +191,12 @@ impl Kernel {
                 Err(cam) => Err(cam),
             };
         }
-        let generation = self.cams.stage(id, cam)?;
+        if self.cam_change_pending(id) {
+            return Err(cam);
+        }
+        let current = self.cams.generation(id);
+        let cur_in_use = self.axes.iter().flatten().any(|a| a.runs_cam(id, current));
+        let generation = self.cams.stage(id, cam, cur_in_use)?;
         for a in self.axes.iter_mut().flatten() {
             a.queue_cam_data(id, generation, change);
         }
@@ -206,9 +211,19 @@ impl Kernel {
         }
     }
 
-    /// An earlier online change of table `id` has not reached all its slaves yet.
+    /// An earlier online change of table `id` has not reached all its slaves yet (a slave has
+    /// it queued), or slaves run both generations held so that a third cannot be staged. A
+    /// slave that keeps older data by choice (DELETEQUEUEDDATA, OFF) does not block a write.
     pub fn cam_change_pending(&self, id: u32) -> bool {
-        self.cams.change_pending(id)
+        let queued = self
+            .axes
+            .iter()
+            .flatten()
+            .any(|a| a.cam_data_queued_for(id));
+        let current = self.cams.generation(id);
+        queued
+            || (self.cams.has_old(id)
+                && self.axes.iter().flatten().any(|a| a.runs_cam(id, current)))
     }
 
     /// A cam the kernel no longer uses (replaced, or left by its last slave after an online

@@ -321,6 +321,15 @@ impl Axis {
         })
     }
 
+    /// Data written to table `id` waits to take effect on this slave.
+    pub fn cam_data_queued_for(&self, id: u32) -> bool {
+        self.cam_data.is_some_and(|d| {
+            self.cam_set()
+                .and_then(|set| set.terms[d.term])
+                .is_some_and(|l| l.table == id)
+        })
+    }
+
     /// An online change of table `id` (new data in generation `generation`) is to reach this slave
     /// as `change` says (OFF: it keeps the data it runs).
     pub fn queue_cam_data(&mut self, id: u32, generation: u32, change: crate::cam::OnlineChange) {
@@ -335,15 +344,16 @@ impl Axis {
         }
         let law = set.terms[term].expect("found");
         let m = law.master_pos;
+        // Decision 63: ASSOONASPOSSIBLE, like INSTANTANEOUS, is the first cycle where the new
+        // data does not move the slave.
+        let mode = match change.activation_mode {
+            Act::AsSoonAsPossible => Act::Instantaneous,
+            other => other,
+        };
         self.cam_data = Some(PendingData {
             term,
             generation,
-            act: Activation::new(
-                change.activation_mode,
-                change.activation_position,
-                m,
-                law.raw(m),
-            ),
+            act: Activation::new(mode, change.activation_position, m, law.raw(m)),
             master_scaling_mode: change.master_scaling_mode,
             slave_scaling_mode: change.slave_scaling_mode,
             due: false,

@@ -412,9 +412,12 @@ impl CamStore {
     }
 
     /// Makes `cam` the one in force while the slaves of the present one keep it until the
-    /// change reaches them; `Err` while an earlier change is still on its way. Returns the
+    /// change reaches them. When slaves still run an older generation by choice (the change
+    /// was dropped with DELETEQUEUEDDATA, or the mode was OFF) and nobody runs the present one
+    /// (`cur_in_use` false), the present one is retired and the older stays for its slaves.
+    /// `Err` when both generations held are in use (a third cannot be held). Returns the
     /// generation of the new cam.
-    pub fn stage(&mut self, id: u32, cam: Arc<Cam>) -> Result<u32, Arc<Cam>> {
+    pub fn stage(&mut self, id: u32, cam: Arc<Cam>, cur_in_use: bool) -> Result<u32, Arc<Cam>> {
         match self.slots.get_mut(id as usize) {
             Some(s) if id >= 1 && s.old.is_none() && s.cur.is_some() => {
                 s.next_gen += 1;
@@ -422,12 +425,21 @@ impl CamStore {
                 self.has_old = true;
                 Ok(s.next_gen)
             }
+            Some(s) if id >= 1 && s.old.is_some() && !cur_in_use => {
+                s.next_gen += 1;
+                let unused = s.cur.replace((s.next_gen, cam));
+                let generation = s.next_gen;
+                if let Some((_, c)) = unused {
+                    self.retire(c);
+                }
+                Ok(generation)
+            }
             _ => Err(cam),
         }
     }
 
-    /// An earlier online change of `id` still runs on some slave.
-    pub fn change_pending(&self, id: u32) -> bool {
+    /// Slaves run an older generation of `id` than the one in force.
+    pub fn has_old(&self, id: u32) -> bool {
         self.slots.get(id as usize).is_some_and(|s| s.old.is_some())
     }
 

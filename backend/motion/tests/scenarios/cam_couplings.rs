@@ -830,6 +830,43 @@ fn written_data_reaches_a_coupled_slave_by_the_online_change_rules() {
     );
     r.k.drop_cam_data(T_HALF);
     assert!(!r.st(1).cam_data_queued);
+    // The slave keeps its data by choice: that blocks no further write. The next one, with
+    // ASSOONASPOSSIBLE, reaches it in the first cycle where it does not move the slave.
+    assert!(!r.k.cam_change_pending(T_HALF));
+    let asap = OnlineChange {
+        activation_mode: CamActivationMode::AsSoonAsPossible,
+        ..OnlineChange::default()
+    };
+    let again = Arc::new(Cam::build(&table(110.0)).unwrap());
+    assert!(r.k.change_cam(T_HALF, again.clone(), asap).is_ok());
+    assert!(r.st(1).cam_data_queued);
+    assert!(r.k.cam_change_pending(T_HALF), "on its way");
+    r.until(5.0, |r| !r.st(1).cam_data_queued);
+    r.run(0.01);
+    let xl = r.st(1).cam.actual_master_cam_pos;
+    let k = ((r.st(0).set_position - xl) / 360.0).round();
+    let want = k * 240.0 + again.eval(xl).position;
+    assert!(
+        (r.st(1).set_position - want).abs() < 1e-6,
+        "runs the newest data: {} ≠ {want}",
+        r.st(1).set_position
+    );
+    // OFF: the slave keeps its data, and a later write is taken again.
+    let off = OnlineChange {
+        activation_mode: CamActivationMode::Off,
+        ..OnlineChange::default()
+    };
+    assert!(
+        r.k.change_cam(T_HALF, Arc::new(Cam::build(&table(130.0)).unwrap()), off)
+            .is_ok()
+    );
+    assert!(!r.st(1).cam_data_queued);
+    assert!(!r.k.cam_change_pending(T_HALF));
+    assert!(
+        r.k.change_cam(T_HALF, Arc::new(Cam::build(&table(140.0)).unwrap()), asap)
+            .is_ok()
+    );
+    r.until(5.0, |r| !r.st(1).cam_data_queued);
 }
 
 fn v2(master: u16, table: u32, operation: CamOperationMode) -> CamInV2 {
