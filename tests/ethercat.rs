@@ -205,3 +205,100 @@ async fn the_simulated_bus_refuses_cia402_drives_and_sdos_clearly() {
     assert_problem(&r, 422, "validation_failed");
     assert_eq!(r.json["errors"][0]["field"], "drive.kind", "{}", r.text);
 }
+
+/// Moves the calling thread into a new network namespace with loopback up and a veth pair
+/// `ecA`–`ecB`; `Err` says why not (then the raw-socket tier is skipped).
+fn private_veth() -> Result<(), String> {
+    // SAFETY: unshare affects only this thread (network namespaces are per task); children
+    // spawned from it inherit the namespace.
+    if unsafe { libc::unshare(libc::CLONE_NEWNET) } != 0 {
+        return Err(format!(
+            "unshare(CLONE_NEWNET): {}",
+            std::io::Error::last_os_error()
+        ));
+    }
+    for args in [
+        &["link", "set", "lo", "up"][..],
+        &["link", "add", "ecA", "type", "veth", "peer", "name", "ecB"],
+        &["link", "set", "ecA", "up"],
+        &["link", "set", "ecB", "up"],
+    ] {
+        let out = std::process::Command::new("ip")
+            .args(args)
+            .output()
+            .map_err(|e| format!("ip: {e}"))?;
+        if !out.status.success() {
+            return Err(format!(
+                "ip {}: {}",
+                args.join(" "),
+                String::from_utf8_lossy(&out.stderr)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The raw-socket tier: `motiond emulate-segment` answers on one end of a veth pair in a
+/// network namespace this test makes, `motiond --bus ethercat --interface` runs ethercrab's
+/// own raw-socket path on the other: bring-up to OP, an axis created on drive 1 moves there.
+#[test]
+fn the_binary_drives_an_emulated_segment_over_a_veth_pair() {
+    let t = std::thread::spawn(|| {
+        if let Err(why) = private_veth() {
+            eprintln!("SKIPPED: the veth tier needs a network namespace: {why}");
+            return;
+        }
+        let mut emulator = bin()
+            .args(["emulate-segment", "--on", "ecB", "--drives", "2"])
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .expect("emulator");
+        let s = Server::start_with(":memory:", &["--bus", "ethercat", "--interface", "ecA"]);
+        // Sockets of this runtime are made on this thread: inside the namespace.
+        let rt = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        rt.block_on(async {
+            let bus = get(&s, "/api/v1/bus").await;
+            assert_eq!(bus.json["kind"], "ethercat", "{}", bus.text);
+            assert_eq!(bus.json["interface"], "ecA");
+            assert_eq!(bus.json["state"], "op", "{}", bus.text);
+            assert_eq!(bus.json["subdevices"].as_array().unwrap().len(), 2);
+            let v = get(&s, "/api/v1/bus/subdevices/1/sdo/0x1018/4").await;
+            assert_eq!(v.json["unsigned"], 0x2026_0001u32, "{}", v.text);
+            // The demo axes stay simulated on real EtherCAT (their scaling would be a guess);
+            // an axis is created on drive 1.
+            let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+            assert_eq!(cfg["drive"]["kind"], "simulated");
+            cfg["name"] = json!("z");
+            cfg["soft_limits"] = Value::Null;
+            cfg["drive"] = json!({"kind": "cia402", "subdevice": 1, "increments_per_unit": 1000.0});
+            let r = post(&s, "/api/v1/axes", cfg).await;
+            assert_eq!(r.status, 201, "{}", r.text);
+            power_on(&s, "z").await;
+            let m = post(
+                &s,
+                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=20000",
+                json!({"position": -40.0, "velocity": 200.0}),
+            )
+            .await;
+            assert_eq!(m.json["state"], "done", "{}", m.text);
+            until_status(&s, "z", "at -40", |st| {
+                (st["actual_position"].as_f64().unwrap() + 40.0).abs() < 0.002
+            })
+            .await;
+            let pos = get(&s, "/api/v1/bus/subdevices/1/sdo/0x6064/0").await;
+            assert!(
+                (pos.json["signed"].as_i64().unwrap() + 40_000).abs() <= 2,
+                "{}",
+                pos.text
+            );
+            assert_eq!(get(&s, "/api/v1/bus").await.json["lost_frames"], 0);
+        });
+        s.stop();
+        let _ = emulator.kill();
+        let _ = emulator.wait();
+    });
+    t.join().expect("the test thread");
+}

@@ -80,6 +80,30 @@ pub fn emulated_identity(i: u32) -> Identity {
     }
 }
 
+/// The emulated segment of `drives` CiA-402 servos, on the segment's own clock.
+fn emulated_segment(drives: u32) -> Arc<Mutex<Segment>> {
+    let start = Instant::now();
+    Segment::new(
+        (0..drives)
+            .map(|i| drive::servo(emulated_identity(i), Plant::default()))
+            .collect(),
+        Box::new(move || start.elapsed().as_nanos() as u64),
+    )
+    .shared()
+}
+
+/// `motiond emulate-segment`: the emulated segment on a raw socket until the process ends.
+pub fn serve_emulated_segment(interface: &str, drives: u32) -> Result<(), String> {
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let server =
+        ethercat::emu::transport::serve_raw_socket(interface, emulated_segment(drives), stop)
+            .map_err(|e| format!("cannot serve on {interface} (CAP_NET_RAW needed): {e}"))?;
+    println!("emulated EtherCAT segment of {drives} CiA-402 drives on {interface}");
+    server
+        .join()
+        .map_err(|_| "the emulated segment stopped".to_string())
+}
+
 /// Builds the bus (blocking: an EtherCAT segment is brought up to OP here).
 pub fn start(
     kind: BusKind,
@@ -97,17 +121,7 @@ pub fn start(
                 .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
                 .to_string(),
         ),
-        BusKind::Emulated => {
-            let start = Instant::now();
-            let segment = Segment::new(
-                (0..EMULATED_DRIVES)
-                    .map(|i| drive::servo(emulated_identity(i), Plant::default()))
-                    .collect(),
-                Box::new(move || start.elapsed().as_nanos() as u64),
-            )
-            .shared();
-            Link::Emulated(segment)
-        }
+        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES)),
     };
     let segment = match &link {
         Link::Emulated(s) => Some(s.clone()),

@@ -85,6 +85,17 @@ pub enum Cmd {
         #[command(subcommand)]
         action: TokenCmd,
     },
+    /// Serve an emulated EtherCAT segment of CiA-402 servo drives on a network interface (a
+    /// raw socket; `CAP_NET_RAW`), for trying `--bus ethercat` without hardware: one end of a
+    /// veth pair here, `motiond --bus ethercat --interface` on the other. Runs until stopped.
+    EmulateSegment {
+        /// The interface to answer frames on.
+        #[arg(long = "on", value_name = "IFACE")]
+        on: String,
+        /// Drives on the segment (1–16).
+        #[arg(long, default_value_t = bus::EMULATED_DRIVES, value_parser = clap::value_parser!(u32).range(1..=16))]
+        drives: u32,
+    },
 }
 
 #[derive(Subcommand, Debug)]
@@ -263,6 +274,9 @@ pub fn run() {
         }
         Some(Cmd::Token { action }) => {
             return exit_with(admin_command(&cli.serve, Admin::Token(action)));
+        }
+        Some(Cmd::EmulateSegment { on, drives }) => {
+            return exit_with(bus::serve_emulated_segment(&on, drives));
         }
         Some(Cmd::Serve) | None => cli.serve,
     };
