@@ -230,6 +230,22 @@ pub trait DriveBus: Send {
         let _ = (slot, fault);
         Err(BusError::Unsupported)
     }
+
+    /// A bus with a clock of its own (EtherCAT distributed clocks): how far (ns) the last
+    /// exchange was from the phase of the bus's cycle it should have in (positive: late). The
+    /// cycle thread moves its next deadline by a share of it, so that exactly one exchange
+    /// falls in each SYNC0 period; `None` for a bus that follows the cycle thread.
+    fn sync_error_ns(&self) -> Option<i64> {
+        None
+    }
+}
+
+/// How much (ns) the cycle thread moves its next deadline for a bus's sync error: an eighth
+/// of the error, at most a twentieth of the period per cycle (a slow, jitter-damping follow of
+/// the reference clock; a big error is taken over many cycles, never by skipping one).
+pub fn sync_correction_ns(error_ns: i64, period_ns: u64) -> i64 {
+    let max = (period_ns / 20) as i64;
+    (-error_ns / 8).clamp(-max, max)
 }
 
 /// The simulated bus: one [`SimDrive`] per occupied slot, stepped by the exchange.
@@ -319,6 +335,26 @@ mod tests {
         assert_eq!(last, sim);
         let empty: DriveConfig = serde_json::from_str("{}").unwrap();
         assert_eq!(empty, DriveConfig::default());
+    }
+
+    /// The cycle follows a bus clock slowly: an eighth of the error, never more than a
+    /// twentieth of the period in one cycle; a steady error is worked off over cycles.
+    #[test]
+    fn the_sync_correction_is_a_damped_share_of_the_error() {
+        assert_eq!(sync_correction_ns(0, 1_000_000), 0);
+        assert_eq!(
+            sync_correction_ns(80_000, 1_000_000),
+            -10_000,
+            "late: wake earlier"
+        );
+        assert_eq!(sync_correction_ns(-80_000, 1_000_000), 10_000);
+        assert_eq!(sync_correction_ns(499_999, 1_000_000), -50_000, "clamped");
+        // A constant phase error of 400 µs is down to a tenth of it within 25 cycles.
+        let mut e: i64 = 400_000;
+        for _ in 0..25 {
+            e += sync_correction_ns(e, 1_000_000);
+        }
+        assert!(e.abs() < 40_000, "{e}");
     }
 
     #[test]

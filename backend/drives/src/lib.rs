@@ -23,5 +23,5 @@ pub mod bus;
 pub mod cia402;
 pub mod sim;
 
-pub use bus::{BusError, Drive, DriveBus, DriveConfig, SimBus};
+pub use bus::{BusError, Drive, DriveBus, DriveConfig, SimBus, sync_correction_ns};
 pub use sim::{FieldError, SimDrive, SimDriveConfig, SimFault};

@@ -552,6 +552,18 @@ impl DriveBus for EthercatBus {
         self.slots.len()
     }
 
+    /// The frame should reach the reference clock half a SYNC0 period after the pulse: the
+    /// drives latch their outputs at SYNC0, so half a period of margin either side.
+    fn sync_error_ns(&self) -> Option<i64> {
+        let period = self.status.cycle_ns as i64;
+        let offset = self.status.dc_cycle_offset.load(Relaxed) as i64;
+        (period > 0 && self.errors_in_row == 0).then(|| {
+            let e = offset - period / 2;
+            // Wrapped into (−period/2, period/2].
+            if e > period / 2 { e - period } else { e }
+        })
+    }
+
     fn exchange(&mut self, setpoints: &[DriveSetpoint], feedback: &mut [DriveFeedback]) {
         self.sim.exchange(setpoints, &mut self.sim_feedback);
         let mut reset = false;

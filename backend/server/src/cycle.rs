@@ -440,6 +440,10 @@ impl CycleThread {
             stats.compute.record(end - woke);
             stats.cycles.fetch_add(1, Relaxed);
             deadline += period;
+            // Follow a bus clock (EtherCAT DC): one exchange per SYNC0 period.
+            if let Some(e) = self.bus.sync_error_ns() {
+                deadline = deadline.saturating_add_signed(drives::sync_correction_ns(e, period));
+            }
             if end >= deadline {
                 // Late: skip the deadlines already passed (keeping the grid) and count them.
                 let missed = (end - deadline) / period + 1;
