@@ -149,6 +149,59 @@ async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
     reset_to_standstill(&s, "x").await;
     assert_eq!(get(&s, "/api/v1/bus").await.json["state"], "op");
 
+    // A SubDevice that drops to SAFE-OP (its watchdog): its axis stops with bus_error, the bus
+    // is degraded; MC_Reset asks it back to OP.
+    power_on(&s, "y").await;
+    let r = post(&s, "/api/v1/bus/faults", json!({"safe_op": 1})).await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let st = until_status(&s, "y", "bus error", |st| st["state"] == "error_stop").await;
+    assert_eq!(st["error_id"], 0x70A0);
+    let bus = get(&s, "/api/v1/bus").await;
+    assert_eq!(bus.json["state"], "degraded", "{}", bus.text);
+    assert_eq!(bus.json["subdevices"][1]["al_state"], "safe_op");
+    assert_eq!(
+        status(&s, "x").await["status"]["state"],
+        "standstill",
+        "x is not on it"
+    );
+    reset_to_standstill(&s, "y").await;
+    assert_eq!(
+        get(&s, "/api/v1/bus").await.json["subdevices"][1]["al_state"],
+        "op"
+    );
+
+    // The touch probe through 0x60B8–0x60BB: a mark passing the drive's probe input 1.
+    let probe = post(
+        &s,
+        "/api/v1/axes/x/touch-probe",
+        json!({"signal": "input1", "edge": "rising"}),
+    )
+    .await;
+    assert_eq!(probe.status, 202, "{}", probe.text);
+    let id = probe.json["id"].as_u64().unwrap();
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "probe_input", "active": true}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let done = until_final(&s, id, 10).await;
+    assert_eq!(done["state"], "done", "{done}");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let done = loop {
+        let c = get(&s, &format!("/api/v1/commands/{id}")).await.json;
+        if c["result"].is_object() {
+            break c;
+        }
+        assert!(Instant::now() < deadline, "no result: {c}");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    assert!(
+        (done["result"]["recorded_position"].as_f64().unwrap() - 120.0).abs() < 0.01,
+        "{done}"
+    );
+
     // A second axis on a drive already taken is refused.
     let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
     cfg["name"] = json!("y2");

@@ -782,7 +782,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** Lose frames on the emulated EtherCAT segment (--bus emulated only) */
+        /** Lose frames on the emulated EtherCAT segment, or drop a SubDevice to SAFE-OP (--bus emulated only) */
         post: operations["inject_bus_fault"];
         delete?: never;
         options?: never;
@@ -1839,7 +1839,7 @@ export interface components {
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
         /**
-         * @description Disturbances of the emulated segment.
+         * @description Disturbances of the emulated segment (at least one).
          * @example {
          *       "lose_frames": 5
          *     }
@@ -1850,7 +1850,13 @@ export interface components {
              * @description The next frames to lose (not answered): each is a lost frame for the bus; the bus
              *     faults its axes after `max_errors_in_row` in a row.
              */
-            lose_frames: number;
+            lose_frames?: number | null;
+            /**
+             * Format: int32
+             * @description A SubDevice (by position) drops to SAFE-OP with an error (AL status code 0x001B,
+             *     SyncManager watchdog), as a drive whose frames came late does: its axis stops.
+             */
+            safe_op?: number | null;
         };
         /** @enum {string} */
         BusKind: "simulated" | "emulated" | "ethercat";
@@ -5931,7 +5937,7 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
-        /** @description Not a number of frames to lose (1..100000). */
+        /** @description Not a number of frames to lose (1..100000), or no disturbance given. */
         BusFaultInvalid: {
             headers: {
                 [name: string]: unknown;
@@ -5964,7 +5970,7 @@ export interface components {
                 /**
                  * @example {
                  *       "code": "bus_not_emulated",
-                 *       "detail": "only the emulated segment (--bus emulated) takes injected frame loss",
+                 *       "detail": "only the emulated segment (--bus emulated) takes injected faults",
                  *       "status": 409,
                  *       "title": "Conflict",
                  *       "type": "urn:motiond:problem:bus_not_emulated"
@@ -9320,7 +9326,7 @@ export interface operations {
             path?: never;
             cookie?: never;
         };
-        requestBody: {
+        requestBody?: {
             content: {
                 "application/json": components["schemas"]["BusFault"];
             };
@@ -9336,6 +9342,7 @@ export interface operations {
             400: components["responses"]["MalformedJson"];
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
+            404: components["responses"]["SubDeviceNotFound"];
             409: components["responses"]["BusNotEmulated"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];

@@ -53,6 +53,9 @@ pub trait Application: Send {
 pub struct SegmentFaults {
     /// Frames to lose (no answer) from now on.
     pub drop_frames: u32,
+    /// A SubDevice (by position) that drops to SAFE-OP with an error (AL status code 0x001B,
+    /// SyncManager watchdog), at the next frame.
+    pub safe_op: Option<usize>,
 }
 
 /// A line of emulated SubDevices, in bus order.
@@ -124,6 +127,11 @@ impl Segment {
             return None;
         }
         let now = (self.clock)();
+        if let Some(n) = self.faults.safe_op.take() {
+            if let Some(esc) = self.escs.get_mut(n) {
+                esc.fall_to(esc::AL_SAFE_OP, esc::al_code::SM_WATCHDOG);
+            }
+        }
         if self.faults.drop_frames > 0 {
             self.faults.drop_frames -= 1;
             self.lost += 1;

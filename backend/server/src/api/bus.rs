@@ -397,19 +397,25 @@ pub async fn sdo_write(
     Ok(Json(value_of(position, index, sub, back)))
 }
 
-/// Disturbances of the emulated segment.
+/// Disturbances of the emulated segment (at least one).
 #[derive(Clone, Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"lose_frames": 5}))]
 pub struct BusFault {
     /// The next frames to lose (not answered): each is a lost frame for the bus; the bus
     /// faults its axes after `max_errors_in_row` in a row.
+    #[serde(default)]
     #[schema(minimum = 1, maximum = 100000)]
-    pub lose_frames: u32,
+    pub lose_frames: Option<u32>,
+    /// A SubDevice (by position) drops to SAFE-OP with an error (AL status code 0x001B,
+    /// SyncManager watchdog), as a drive whose frames came late does: its axis stops.
+    #[serde(default)]
+    #[schema(minimum = 0, maximum = 65535)]
+    pub safe_op: Option<u16>,
 }
 
 #[utoipa::path(post, path = "/api/v1/bus/faults", tag = "bus",
-    summary = "Lose frames on the emulated EtherCAT segment (--bus emulated only)",
+    summary = "Lose frames on the emulated EtherCAT segment, or drop a SubDevice to SAFE-OP (--bus emulated only)",
     request_body = BusFault,
     responses((status = 204, description = "The segment will drop that many frames"), super::errors::BusFaultErrors))]
 pub async fn inject_bus_fault(
@@ -417,19 +423,28 @@ pub async fn inject_bus_fault(
     client: Client,
     JsonBody(f, raw): JsonBody<BusFault>,
 ) -> AppResult<StatusCode> {
-    if !(1..=100_000).contains(&f.lose_frames) {
+    if f.lose_frames.is_some_and(|n| !(1..=100_000).contains(&n)) {
         return Err(AppError::field("lose_frames", "1..100000"));
+    }
+    if f.lose_frames.is_none() && f.safe_op.is_none() {
+        return Err(AppError::field("body", "give lose_frames or safe_op"));
     }
     let Some(seg) = &s.info.bus.segment else {
         return Err(AppError::conflict(
             "bus_not_emulated",
-            "only the emulated segment (--bus emulated) takes injected frame loss",
+            "only the emulated segment (--bus emulated) takes injected faults",
         ));
     };
-    seg.lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .faults
-        .drop_frames += f.lose_frames;
+    {
+        let mut seg = seg.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(n) = f.safe_op {
+            if n as usize >= seg.escs.len() {
+                return Err(AppError::not_found("subdevice", &n.to_string()));
+            }
+            seg.faults.safe_op = Some(n as usize);
+        }
+        seg.faults.drop_frames += f.lose_frames.unwrap_or(0);
+    }
     s.audit(audit_entry(&client.0, "bus.fault", "bus", raw.to_string()));
     Ok(StatusCode::NO_CONTENT)
 }

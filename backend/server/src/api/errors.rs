@@ -311,7 +311,7 @@ problem_responses! {
             "motiond runs the simulated bus: SDOs need --bus ethercat or --bus emulated")))))));
     /// The bus is not the emulated segment.
     BusNotEmulated(example = json!(p(AppError::conflict("bus_not_emulated",
-        "only the emulated segment (--bus emulated) takes injected frame loss"))));
+        "only the emulated segment (--bus emulated) takes injected faults"))));
     /// The mailbox did not answer in time or the frame was lost.
     SdoUnavailable(example = json!(p(AppError::unavailable("sdo_failed",
         "SDO transfer of 0x1018:1 with SubDevice 0 failed: timeout"))));
@@ -356,7 +356,7 @@ problem_responses! {
     /// An object index that is not one, or a value that does not fit its size.
     SdoInvalid(example = json!(p(AppError::field("value", "does not fit 1 bytes (-128..255)"))));
 
-    /// Not a number of frames to lose (1..100000).
+    /// Not a number of frames to lose (1..100000), or no disturbance given.
     BusFaultInvalid(example = json!(p(AppError::field("lose_frames", "1..100000"))));
 
     /// The configuration is invalid; `errors` lists every invalid field. Nothing was changed.
@@ -555,7 +555,10 @@ error_sets! {
         422: SdoInvalid, 503: SdoUnavailable,
     }
     /// `POST /bus/faults`.
-    BusFaultErrors { 400: MalformedJson, 409: BusNotEmulated, 413: PayloadTooLarge, 422: BusFaultInvalid }
+    BusFaultErrors {
+        400: MalformedJson, 404: SubDeviceNotFound, 409: BusNotEmulated, 413: PayloadTooLarge,
+        422: BusFaultInvalid,
+    }
     /// `POST /cam-analysis`.
     CamAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: CamTableInvalid }
     /// `PUT /cam-tables/{table}`, its points.
