@@ -22,6 +22,9 @@ pub enum Cia402Mode {
     /// Cyclic synchronous velocity (9): we close the position loop (`position_gain`) and send
     /// the velocity with the feed-forward.
     Csv,
+    /// Cyclic synchronous torque (10): we close position and velocity loops (`position_gain`,
+    /// `velocity_gain`) and send the torque with the acceleration feed-forward.
+    Cst,
 }
 
 impl Cia402Mode {
@@ -30,6 +33,7 @@ impl Cia402Mode {
         match self {
             Cia402Mode::Csp => 8,
             Cia402Mode::Csv => 9,
+            Cia402Mode::Cst => 10,
         }
     }
 }
@@ -49,9 +53,24 @@ pub struct Cia402Config {
     pub velocity_increments_per_unit: Option<f64>,
     #[serde(default)]
     pub mode: Cia402Mode,
-    /// CSV only: position loop gain (1/s) closed on our side.
+    /// CSV and CST: position loop gain (1/s) closed on our side.
     #[serde(default = "default_gain")]
     pub position_gain: f64,
+    /// CST: velocity loop gain, per mille of rated torque (0x6071) per engineering unit/s of
+    /// velocity error; must be > 0 in CST.
+    #[serde(default)]
+    pub velocity_gain: f64,
+    /// CST: torque feed-forward, per mille of rated torque per engineering unit/s² of set
+    /// acceleration (the load's inertia).
+    #[serde(default)]
+    pub acceleration_feed_forward: f64,
+    /// CST: the torque sent is limited to ± this, per mille of rated torque (1–32767).
+    #[serde(default = "default_max_torque")]
+    pub max_torque: f64,
+}
+
+fn default_max_torque() -> f64 {
+    1000.0
 }
 
 fn default_gain() -> f64 {
@@ -75,6 +94,21 @@ impl Cia402Config {
             positive("velocity_increments_per_unit", v);
         }
         positive("position_gain", self.position_gain);
+        if self.mode == Cia402Mode::Cst {
+            positive("velocity_gain", self.velocity_gain);
+        }
+        if !(self.max_torque.is_finite() && (1.0..=32767.0).contains(&self.max_torque)) {
+            errors.push(FieldError {
+                field: "max_torque".into(),
+                message: "1..32767 per mille of rated torque".into(),
+            });
+        }
+        if !(self.acceleration_feed_forward.is_finite() && self.acceleration_feed_forward >= 0.0) {
+            errors.push(FieldError {
+                field: "acceleration_feed_forward".into(),
+                message: "must be a finite number >= 0".into(),
+            });
+        }
         if errors.is_empty() {
             Ok(())
         } else {
@@ -115,6 +149,8 @@ pub struct RxPdo {
     pub target_position: i32,
     /// 0x60FF, velocity increments per second.
     pub target_velocity: i32,
+    /// 0x6071, per mille of the rated torque.
+    pub target_torque: i16,
     /// 0x6060.
     pub mode: i8,
     /// 0x60B8: bit 0 enable probe 1, bit 2 source (0 probe input, 1 index pulse), bit 4
@@ -299,18 +335,27 @@ impl Cia402Drive {
         };
         let following = state == OperationEnabled && tx.mode_display == self.config.mode.code();
         // Until the drive follows, it is told to stay where it is: no jump when it enables.
-        let (target, velocity) = if following {
+        let (target, velocity, torque) = if following {
             let target = (sp.position * self.config.increments_per_unit).round() as i64;
-            let velocity = match self.config.mode {
-                Cia402Mode::Csp => sp.velocity,
-                Cia402Mode::Csv => {
-                    let actual = self.position as f64 / self.config.increments_per_unit;
-                    sp.velocity + self.config.position_gain * (sp.position - actual)
+            let actual = self.position as f64 / self.config.increments_per_unit;
+            let c = &self.config;
+            match c.mode {
+                Cia402Mode::Csp => (target, sp.velocity, 0.0),
+                Cia402Mode::Csv => (
+                    target,
+                    sp.velocity + c.position_gain * (sp.position - actual),
+                    0.0,
+                ),
+                Cia402Mode::Cst => {
+                    let v_cmd = sp.velocity + c.position_gain * (sp.position - actual);
+                    let v_act = tx.velocity_actual as f64 / self.velocity_scale();
+                    let t = c.velocity_gain * (v_cmd - v_act)
+                        + c.acceleration_feed_forward * sp.acceleration;
+                    (target, sp.velocity, t.clamp(-c.max_torque, c.max_torque))
                 }
-            };
-            (target, velocity)
+            }
         } else {
-            (self.position, 0.0)
+            (self.position, 0.0, 0.0)
         };
         let touch_probe_function = if sp.latch_enable {
             TP_ENABLE
@@ -331,6 +376,7 @@ impl Cia402Drive {
             target_velocity: (velocity * self.velocity_scale())
                 .round()
                 .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            target_torque: torque.round() as i16,
             mode: self.config.mode.code(),
             touch_probe_function,
         }

@@ -171,6 +171,9 @@ fn config() -> Cia402Config {
         velocity_increments_per_unit: None,
         mode: Cia402Mode::Csp,
         position_gain: 50.0,
+        velocity_gain: 0.0,
+        acceleration_feed_forward: 0.0,
+        max_torque: 1000.0,
     }
 }
 

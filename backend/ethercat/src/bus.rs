@@ -143,7 +143,7 @@ impl Layout {
         put(out, self.rx[0], &rx.controlword.to_le_bytes());
         put(out, self.rx[1], &rx.target_position.to_le_bytes());
         put(out, self.rx[2], &rx.target_velocity.to_le_bytes());
-        put(out, self.rx[3], &0i16.to_le_bytes());
+        put(out, self.rx[3], &rx.target_torque.to_le_bytes());
         put(out, self.rx[4], &rx.mode.to_le_bytes());
         put(out, self.rx[5], &rx.touch_probe_function.to_le_bytes());
     }

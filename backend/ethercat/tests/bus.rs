@@ -50,6 +50,9 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
         velocity_increments_per_unit: None,
         mode: Cia402Mode::Csp,
         position_gain: 50.0,
+        velocity_gain: 0.0,
+        acceleration_feed_forward: 0.0,
+        max_torque: 1000.0,
     });
     assert!(bus.attach(2, cfg.build(0.001)).unwrap().is_none());
     let mut sp = vec![DriveSetpoint::default(); 4];
@@ -183,4 +186,83 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
     assert_eq!(v, 1u32.to_le_bytes());
     let e = futures_lite::future::block_on(sdo.read(1, 0x2000, 0)).unwrap_err();
     assert_eq!(e, ethercat::bus::SdoError::Abort(0x0602_0000));
+}
+
+/// CST (0x6060 = 10): motiond closes position and velocity loops and sends the torque; the
+/// emulated drive's plant (inertia and friction) follows a slow move to the target.
+#[test]
+fn a_cst_axis_closes_its_loops_on_our_side_and_reaches_the_target() {
+    let start = Instant::now();
+    let seg = Segment::new(
+        vec![drive::servo(
+            Identity {
+                vendor_id: 0xACE,
+                product_code: 0x402,
+                revision: 1,
+                serial: 9,
+                name: "cst".into(),
+            },
+            Plant::default(),
+        )],
+        Box::new(move || start.elapsed().as_nanos() as u64),
+    )
+    .shared();
+    let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 2)
+        .expect("bring-up");
+    let cfg = DriveConfig::Cia402(Cia402Config {
+        subdevice: 0,
+        increments_per_unit: 1000.0,
+        velocity_increments_per_unit: None,
+        mode: Cia402Mode::Cst,
+        position_gain: 20.0,
+        velocity_gain: 40.0,
+        acceleration_feed_forward: 0.5,
+        max_torque: 1000.0,
+    });
+    assert!(cfg.validate().is_ok());
+    assert!(bus.attach(0, cfg.build(0.001)).unwrap().is_none());
+    let mut sp = vec![
+        DriveSetpoint {
+            enable: true,
+            ..DriveSetpoint::default()
+        },
+        DriveSetpoint::default(),
+    ];
+    let mut fb = vec![DriveFeedback::default(); 2];
+    let mut enabled = false;
+    for _ in 0..3000 {
+        bus.exchange(&sp, &mut fb);
+        std::thread::sleep(CYCLE);
+        if fb[0].enabled {
+            enabled = true;
+            break;
+        }
+    }
+    assert!(enabled, "{:?}", fb[0]);
+    {
+        let mut s = seg.lock().unwrap();
+        assert_eq!(
+            s.app::<Cia402Emu>(0).unwrap().od.i8(0x6061, 0),
+            10,
+            "CST displayed"
+        );
+    }
+    // 2 units in 1 s at constant velocity, then hold.
+    for k in 1..=1000 {
+        sp[0].position = 2.0 * k as f64 / 1000.0;
+        sp[0].velocity = 2.0;
+        bus.exchange(&sp, &mut fb);
+        std::thread::sleep(CYCLE);
+    }
+    sp[0].velocity = 0.0;
+    let mut settled = false;
+    for _ in 0..5000 {
+        bus.exchange(&sp, &mut fb);
+        std::thread::sleep(CYCLE);
+        if (fb[0].actual_position - 2.0).abs() < 0.01 && fb[0].actual_velocity.abs() < 0.05 {
+            settled = true;
+            break;
+        }
+    }
+    assert!(settled, "CST settles at the target: {:?}", fb[0]);
 }

@@ -365,6 +365,9 @@ fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
             velocity_increments_per_unit: None,
             mode: drives::cia402::Cia402Mode::Csp,
             position_gain: 50.0,
+            velocity_gain: 0.0,
+            acceleration_feed_forward: 0.0,
+            max_torque: 1000.0,
         });
     }
 }

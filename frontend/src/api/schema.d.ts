@@ -2822,7 +2822,7 @@ export interface components {
          * @description Cyclic synchronous mode of operation (0x6060).
          * @enum {string}
          */
-        Cia402Mode: "csp" | "csv";
+        Cia402Mode: "csp" | "csv" | "cst";
         /**
          * @description Where a command came from.
          * @example {
@@ -3443,9 +3443,26 @@ export interface components {
             mode?: components["schemas"]["Cia402Mode"];
             /**
              * Format: double
-             * @description CSV only: position loop gain (1/s) closed on our side.
+             * @description CSV and CST: position loop gain (1/s) closed on our side.
              */
             position_gain?: number;
+            /**
+             * Format: double
+             * @description CST: velocity loop gain, per mille of rated torque (0x6071) per engineering unit/s of
+             *     velocity error; must be > 0 in CST.
+             */
+            velocity_gain?: number;
+            /**
+             * Format: double
+             * @description CST: torque feed-forward, per mille of rated torque per engineering unit/s² of set
+             *     acceleration (the load's inertia).
+             */
+            acceleration_feed_forward?: number;
+            /**
+             * Format: double
+             * @description CST: the torque sent is limited to ± this, per mille of rated torque (1–32767).
+             */
+            max_torque?: number;
         };
         /**
          * @description A CiA-402 drive's process data as motiond mapped it.
