@@ -214,7 +214,13 @@ pub struct Cia402Drive {
     last_raw: i32,
     seen: bool,
     last: TxPdo,
+    /// Cycles the fault reset (controlword bit 7) is still held: a drive samples the
+    /// controlword at its SYNC0, so a one-cycle pulse could fall between two samples.
+    reset_hold: core::cell::Cell<u32>,
 }
+
+/// Cycles a fault reset is held while the drive still reports the fault.
+const RESET_HOLD_CYCLES: u32 = 16;
 
 impl Cia402Drive {
     pub fn new(config: Cia402Config) -> Cia402Drive {
@@ -224,6 +230,7 @@ impl Cia402Drive {
             last_raw: 0,
             seen: false,
             last: TxPdo::default(),
+            reset_hold: core::cell::Cell::new(0),
         }
     }
 
@@ -299,9 +306,19 @@ impl Cia402Drive {
         use controlword::*;
         let tx = &self.last;
         let state = Cia402State::from_statusword(tx.statusword);
+        if !matches!(state, Fault | FaultReactionActive) {
+            self.reset_hold.set(0);
+        }
         let controlword = match state {
             Fault | FaultReactionActive => {
+                // MC_Reset's edge starts a fault reset that is held for some cycles (or until
+                // the drive leaves the fault): the drive must see the rising edge of bit 7.
                 if sp.fault_reset {
+                    self.reset_hold.set(RESET_HOLD_CYCLES);
+                }
+                let hold = self.reset_hold.get();
+                if hold > 0 {
+                    self.reset_hold.set(hold - 1);
                     FAULT_RESET
                 } else {
                     DISABLE_VOLTAGE

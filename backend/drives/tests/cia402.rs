@@ -489,3 +489,55 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
     assert_eq!(device.position, 10_000);
     assert_eq!(k.status(0).unwrap().actual_position, 10.0);
 }
+
+/// A drive samples the controlword at its SYNC0: MC_Reset's one-cycle edge is held as a fault
+/// reset (bit 7) for some cycles while the drive still reports the fault, then released (a
+/// later reset makes a new rising edge); it ends as soon as the drive leaves the fault.
+#[test]
+fn a_fault_reset_is_held_until_the_drive_leaves_the_fault() {
+    let mut drive = Cia402Drive::new(config());
+    // The drive reports a fault (statusword 0x0008).
+    drive.feedback(&TxPdo {
+        statusword: 0x0008,
+        error_code: 0x2310,
+        mode_display: 8,
+        ..TxPdo::default()
+    });
+    let reset = DriveSetpoint {
+        fault_reset: true,
+        ..DriveSetpoint::default()
+    };
+    assert_eq!(drive.outputs(&reset).controlword, controlword::FAULT_RESET);
+    let held = (0..40)
+        .take_while(|_| {
+            drive.outputs(&DriveSetpoint::default()).controlword == controlword::FAULT_RESET
+        })
+        .count();
+    assert!((8..=20).contains(&held), "held {held} more cycles");
+    assert_eq!(
+        drive.outputs(&DriveSetpoint::default()).controlword,
+        controlword::DISABLE_VOLTAGE,
+        "then released"
+    );
+    // A new reset; the drive leaves the fault at once: the hold ends with it.
+    assert_eq!(drive.outputs(&reset).controlword, controlword::FAULT_RESET);
+    drive.feedback(&TxPdo {
+        statusword: 0x0040,
+        mode_display: 8,
+        ..TxPdo::default()
+    });
+    assert_eq!(
+        drive.outputs(&DriveSetpoint::default()).controlword,
+        controlword::DISABLE_VOLTAGE
+    );
+    drive.feedback(&TxPdo {
+        statusword: 0x0008,
+        mode_display: 8,
+        ..TxPdo::default()
+    });
+    assert_eq!(
+        drive.outputs(&DriveSetpoint::default()).controlword,
+        controlword::DISABLE_VOLTAGE,
+        "a new fault needs a new reset"
+    );
+}

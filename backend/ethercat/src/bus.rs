@@ -6,8 +6,8 @@
 //! `drives::cia402` into each drive's RxPDO, its TxPDO back into feedback. Lost frames and
 //! wrong working counters are counted; `max_errors_in_row` of them in a row, or a SubDevice
 //! that leaves OP, flag the axes' feedback with `bus_error` (the kernel stops them on their
-//! ramp into ErrorStop, 0x70A0) until the frames flow again and MC_Reset asks (which also
-//! requests OP again).
+//! ramp into ErrorStop, 0x70A0, latched there until MC_Reset); as many good frames in a row
+//! clear the bus, and a power-on or reset edge of an axis asks its SubDevice back to OP.
 
 use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU16, AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex};
@@ -47,8 +47,13 @@ pub struct BusOptions {
     pub cycle: Duration,
     /// Lost frames or wrong working counters in a row before the bus faults its axes.
     pub max_errors_in_row: u32,
-    /// How long one exchange may wait for its frame (the cycle thread never blocks longer).
+    /// How long one frame may take to come back (ethercrab has one timeout for the mailbox
+    /// traffic of the bring-up and for the cyclic frames).
     pub pdu_timeout: Duration,
+    /// Times a frame is sent again after a timeout before it counts as lost: the cycle thread
+    /// never waits longer than (1 + retries) × `pdu_timeout` for the bus. Bring-up needs them
+    /// (the first frames on a link that has just come up are lost now and then).
+    pub retries: usize,
 }
 
 impl BusOptions {
@@ -56,7 +61,8 @@ impl BusOptions {
         BusOptions {
             cycle,
             max_errors_in_row: 3,
-            pdu_timeout: (cycle * 3).max(Duration::from_millis(2)),
+            pdu_timeout: (cycle * 4).max(Duration::from_millis(10)),
+            retries: 2,
         }
     }
 }
@@ -201,6 +207,8 @@ pub struct BusStatus {
     pub expected_working_counter: u16,
     pub last_working_counter: AtomicU16,
     pub faulted: AtomicBool,
+    /// Times the bus faulted (N bad frames in a row) since start.
+    pub faults: AtomicU64,
     /// DC system time of the reference clock at the last exchange (ns since 2000).
     pub dc_system_time: AtomicU64,
     /// Where in its SYNC0 period the last frame reached the reference clock (ns).
@@ -292,8 +300,10 @@ pub struct EthercatBus {
     layouts: Vec<Option<Layout>>,
     faulted: bool,
     errors_in_row: u32,
+    good_in_row: u32,
     max_errors_in_row: u32,
-    reset_edge: bool,
+    /// Per slot: enable and fault_reset of the last setpoint (their edges ask for OP).
+    last_requests: Vec<(bool, bool)>,
 }
 
 fn leak<T>(t: T) -> &'static T {
@@ -344,12 +354,12 @@ impl EthercatBus {
         let md: &'static MainDevice<'static> = leak(MainDevice::new(
             pdu_loop,
             Timeouts {
-                pdu: opts.pdu_timeout.max(Duration::from_millis(20)),
+                pdu: opts.pdu_timeout,
                 ..Timeouts::default()
             },
             MainDeviceConfig {
                 dc_static_sync_iterations: 1000,
-                retry_behaviour: RetryBehaviour::None,
+                retry_behaviour: RetryBehaviour::Count(opts.retries),
             },
         ));
         let (group, infos) = block_on(bring_up(md, opts))?;
@@ -373,6 +383,7 @@ impl EthercatBus {
             expected_working_counter: expected,
             last_working_counter: AtomicU16::new(expected),
             faulted: AtomicBool::new(false),
+            faults: AtomicU64::new(0),
             dc_system_time: AtomicU64::new(0),
             dc_cycle_offset: AtomicU64::new(0),
             interface,
@@ -390,8 +401,9 @@ impl EthercatBus {
             layouts: vec![None; slots],
             faulted: false,
             errors_in_row: 0,
+            good_in_row: 0,
             max_errors_in_row: opts.max_errors_in_row.max(1),
-            reset_edge: false,
+            last_requests: vec![(false, false); slots],
         })
     }
 
@@ -566,12 +578,29 @@ impl DriveBus for EthercatBus {
 
     fn exchange(&mut self, setpoints: &[DriveSetpoint], feedback: &mut [DriveFeedback]) {
         self.sim.exchange(setpoints, &mut self.sim_feedback);
-        let mut reset = false;
-        for ((drive, layout), sp) in self.slots.iter().zip(&self.layouts).zip(setpoints) {
+        // A SubDevice out of OP is asked back when one of its axes powers on or resets (an
+        // edge of enable or fault_reset): the engineer's "try again".
+        let mut want_op = false;
+        for (((drive, layout), sp), last) in self
+            .slots
+            .iter_mut()
+            .zip(&self.layouts)
+            .zip(setpoints)
+            .zip(self.last_requests.iter_mut())
+        {
             let (Some(d), Some(l)) = (drive, layout) else {
                 continue;
             };
-            reset |= sp.fault_reset;
+            let request = (sp.enable, sp.fault_reset);
+            if (request.0 && !last.0) || (request.1 && !last.1) {
+                let position = d.config().subdevice as usize;
+                want_op |= self
+                    .status
+                    .al_states
+                    .get(position)
+                    .is_some_and(|a| a.load(Relaxed) != 8);
+            }
+            *last = request;
             if let Ok(sd) = self.group.subdevice(self.md, d.config().subdevice as usize) {
                 let mut io = sd.io_raw_mut();
                 l.encode(&d.outputs(sp), io.outputs());
@@ -579,7 +608,7 @@ impl DriveBus for EthercatBus {
         }
         let st = &*self.status;
         st.frames.fetch_add(1, Relaxed);
-        match block_on(self.group.tx_rx_dc(self.md)) {
+        let good = match block_on(self.group.tx_rx_dc(self.md)) {
             Ok(r) => {
                 st.last_working_counter.store(r.working_counter, Relaxed);
                 st.dc_system_time.store(r.extra.dc_system_time, Relaxed);
@@ -594,35 +623,40 @@ impl DriveBus for EthercatBus {
                         Relaxed,
                     );
                 }
-                if r.working_counter == st.expected_working_counter {
-                    self.errors_in_row = 0;
-                } else {
+                let ok = r.working_counter == st.expected_working_counter;
+                if !ok {
                     st.working_counter_errors.fetch_add(1, Relaxed);
-                    self.errors_in_row += 1;
                 }
+                ok
             }
             Err(_) => {
                 st.lost_frames.fetch_add(1, Relaxed);
-                self.errors_in_row += 1;
+                false
             }
-        }
-        st.errors_in_row.store(self.errors_in_row as u64, Relaxed);
-        if self.errors_in_row >= self.max_errors_in_row && !self.faulted {
-            self.faulted = true;
-            st.faulted.store(true, Relaxed);
-        }
-        // MC_Reset's edge: the bus is cleared once frames flow again, and SubDevices that
-        // left OP are asked back.
-        if reset && !self.reset_edge {
-            if self.errors_in_row == 0 && self.faulted {
+        };
+        // Hysteresis: N bad frames in a row fault the bus, N good ones in a row clear it. The
+        // axes that were enabled are latched in ErrorStop by the kernel until MC_Reset; a bus
+        // fault with no axis enabled leaves nothing to latch.
+        if good {
+            self.errors_in_row = 0;
+            self.good_in_row = self.good_in_row.saturating_add(1);
+            if self.faulted && self.good_in_row >= self.max_errors_in_row {
                 self.faulted = false;
                 st.faulted.store(false, Relaxed);
             }
-            if st.al_states.iter().any(|s| s.load(Relaxed) != 8) {
-                self.request_op();
+        } else {
+            self.good_in_row = 0;
+            self.errors_in_row += 1;
+            if self.errors_in_row >= self.max_errors_in_row && !self.faulted {
+                self.faulted = true;
+                st.faulted.store(true, Relaxed);
+                st.faults.fetch_add(1, Relaxed);
             }
         }
-        self.reset_edge = reset;
+        st.errors_in_row.store(self.errors_in_row as u64, Relaxed);
+        if want_op {
+            self.request_op();
+        }
         for (slot, ((drive, layout), fb)) in self
             .slots
             .iter_mut()

@@ -129,6 +129,7 @@ pub fn start(
     };
     let mut opts = BusOptions::new(cycle);
     opts.max_errors_in_row = max_errors_in_row;
+
     let bus = EthercatBus::start(link, &opts, slots)?;
     let status = bus.status();
     for s in &status.subdevices {

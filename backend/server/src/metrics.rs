@@ -346,6 +346,11 @@ pub fn render(s: &AppState, fine: bool) -> String {
                 "EtherCAT cyclic frames with a wrong working counter",
                 b.working_counter_errors.load(Relaxed),
             ),
+            (
+                "motiond_bus_faults",
+                "Times the EtherCAT bus stopped its axes (lost frames or working counters in a row)",
+                b.faults.load(Relaxed),
+            ),
         ];
         bus_gauges = vec![
             (

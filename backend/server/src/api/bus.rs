@@ -85,7 +85,7 @@ pub struct SubDeviceResource {
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({
     "kind": "emulated", "interface": "emulated", "cycle_time": 0.001, "state": "op",
-    "frames": 120345, "lost_frames": 0, "working_counter_errors": 0, "errors_in_row": 0,
+    "frames": 120345, "lost_frames": 0, "working_counter_errors": 0, "faults": 0, "errors_in_row": 0,
     "max_errors_in_row": 3, "expected_working_counter": 9, "last_working_counter": 9,
     "dc_system_time_ns": 123456789000u64, "dc_cycle_offset_ns": 12000,
     "subdevices": [{"position": 0, "configured_address": 4096, "name": "motiond emulated servo 1",
@@ -100,12 +100,15 @@ pub struct BusResource {
     /// Seconds between exchanges (= the SYNC0 period).
     pub cycle_time: f64,
     /// `simulated`; `op` (every SubDevice in OP, frames flowing); `degraded` (a SubDevice is not
-    /// in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row:
-    /// every EtherCAT axis is stopped until MC_Reset once frames flow).
+    /// in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row,
+    /// until as many good ones in a row: every enabled EtherCAT axis was stopped and stays in
+    /// ErrorStop until MC_Reset).
     pub state: &'static str,
     pub frames: u64,
     pub lost_frames: u64,
     pub working_counter_errors: u64,
+    /// Times the bus faulted (`max_errors_in_row` bad frames in a row) since start.
+    pub faults: u64,
     pub errors_in_row: u64,
     pub max_errors_in_row: u32,
     pub expected_working_counter: u16,
@@ -128,6 +131,7 @@ pub fn bus_resource(s: &AppState) -> BusResource {
             frames: 0,
             lost_frames: 0,
             working_counter_errors: 0,
+            faults: 0,
             errors_in_row: 0,
             max_errors_in_row: 0,
             expected_working_counter: 0,
@@ -188,6 +192,7 @@ pub fn bus_resource(s: &AppState) -> BusResource {
         frames: st.frames.load(Relaxed),
         lost_frames: st.lost_frames.load(Relaxed),
         working_counter_errors: st.working_counter_errors.load(Relaxed),
+        faults: st.faults.load(Relaxed),
         errors_in_row: st.errors_in_row.load(Relaxed),
         max_errors_in_row: st.max_errors_in_row,
         expected_working_counter: st.expected_working_counter,
@@ -402,8 +407,8 @@ pub async fn sdo_write(
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"lose_frames": 5}))]
 pub struct BusFault {
-    /// The next frames to lose (not answered): each is a lost frame for the bus; the bus
-    /// faults its axes after `max_errors_in_row` in a row.
+    /// The next frames to lose (not answered). The bus sends a frame up to three times
+    /// before it counts as lost; `max_errors_in_row` lost ones in a row fault the bus.
     #[serde(default)]
     #[schema(minimum = 1, maximum = 100000)]
     pub lose_frames: Option<u32>,

@@ -250,7 +250,7 @@ impl AppState {
     /// Builds the kernel's axis and drive for a configuration plus its persistent overlay.
     /// A CiA-402 drive needs an EtherCAT bus with a CiA-402 drive at its position that no other
     /// axis drives.
-    fn check_drive_on_bus(
+    pub fn check_drive_on_bus(
         &self,
         id: i64,
         drive: &drives::DriveConfig,

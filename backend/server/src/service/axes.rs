@@ -280,6 +280,9 @@ pub async fn replace(
     };
     let (id, slot, old_name, (old_config, old_params, old_persistent)) = entry;
     check_name_free(s, &config.name, Some(id))?;
+    // The dry run answers what the save would: a drive the bus does not have is a 422 here too.
+    s.check_drive_on_bus(id, &config.drive)
+        .map_err(AppError::Invalid)?;
     let Plan {
         mut change,
         writes,
