@@ -146,11 +146,21 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
     );
     sp[2].fault_reset = false;
 
-    // Lost frames: fewer than three in a row are counted only; three fault the bus.
+    // Lost frames (each sent three times before it counts as lost): fewer than three in a row
+    // are counted only; three fault the bus.
     let lost = status
         .lost_frames
         .load(std::sync::atomic::Ordering::Relaxed);
-    seg.lock().unwrap().faults.drop_frames = 2;
+    seg.lock().unwrap().faults.drop_frames = 1;
+    cycle(&mut bus, &sp, &mut fb);
+    assert_eq!(
+        status
+            .lost_frames
+            .load(std::sync::atomic::Ordering::Relaxed),
+        lost,
+        "a frame answered on its retry is not lost"
+    );
+    seg.lock().unwrap().faults.drop_frames = 6;
     for _ in 0..5 {
         cycle(&mut bus, &sp, &mut fb);
     }
@@ -161,8 +171,8 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
             .load(std::sync::atomic::Ordering::Relaxed),
         lost + 2
     );
-    seg.lock().unwrap().faults.drop_frames = 3;
-    for _ in 0..5 {
+    seg.lock().unwrap().faults.drop_frames = 9;
+    for _ in 0..3 {
         cycle(&mut bus, &sp, &mut fb);
     }
     assert!(fb[2].bus_error && !fb[2].fault, "{:?}", fb[2]);

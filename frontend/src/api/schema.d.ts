@@ -1847,8 +1847,8 @@ export interface components {
         BusFault: {
             /**
              * Format: int32
-             * @description The next frames to lose (not answered): each is a lost frame for the bus; the bus
-             *     faults its axes after `max_errors_in_row` in a row.
+             * @description The next frames to lose (not answered). The bus sends a frame up to three times
+             *     before it counts as lost; `max_errors_in_row` lost ones in a row fault the bus.
              */
             lose_frames?: number | null;
             /**
@@ -1868,6 +1868,7 @@ export interface components {
          *       "dc_system_time_ns": 123456789000,
          *       "errors_in_row": 0,
          *       "expected_working_counter": 9,
+         *       "faults": 0,
          *       "frames": 120345,
          *       "interface": "emulated",
          *       "kind": "emulated",
@@ -1908,8 +1909,9 @@ export interface components {
             cycle_time: number;
             /**
              * @description `simulated`; `op` (every SubDevice in OP, frames flowing); `degraded` (a SubDevice is not
-             *     in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row:
-             *     every EtherCAT axis is stopped until MC_Reset once frames flow).
+             *     in OP: its axes are stopped); `faulted` (lost frames or wrong working counters in a row,
+             *     until as many good ones in a row: every enabled EtherCAT axis was stopped and stays in
+             *     ErrorStop until MC_Reset).
              */
             state: string;
             /** Format: int64 */
@@ -1918,6 +1920,11 @@ export interface components {
             lost_frames: number;
             /** Format: int64 */
             working_counter_errors: number;
+            /**
+             * Format: int64
+             * @description Times the bus faulted (`max_errors_in_row` bad frames in a row) since start.
+             */
+            faults: number;
             /** Format: int64 */
             errors_in_row: number;
             /** Format: int32 */
