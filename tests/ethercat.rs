@@ -215,6 +215,26 @@ async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
         "{done}"
     );
 
+    // The configuration document names the bus; a document for another bus is refused whole.
+    let mut doc = get(&s, "/api/v1/config").await.json;
+    assert_eq!(
+        doc["bus"],
+        json!({"kind": "emulated", "max_errors_in_row": 5}),
+        "{doc}"
+    );
+    doc["bus"] = json!({"kind": "ethercat", "interface": "enp2s0"});
+    let r = put(&s, "/api/v1/config", doc).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "bus.kind", "{}", r.text);
+    assert!(
+        r.json["errors"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("--bus ethercat --interface enp2s0"),
+        "{}",
+        r.text
+    );
+
     // A second axis on a drive already taken is refused.
     let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
     cfg["name"] = json!("y2");
@@ -253,6 +273,10 @@ async fn the_simulated_bus_refuses_cia402_drives_and_sdos_clearly() {
     assert_eq!(
         (bus.json["kind"].as_str(), bus.json["state"].as_str()),
         (Some("simulated"), Some("simulated"))
+    );
+    assert_eq!(
+        get(&s, "/api/v1/config").await.json["bus"],
+        json!({"kind": "simulated"})
     );
     assert_problem(
         &get(&s, "/api/v1/bus/subdevices/0/sdo/0x1018/1").await,

@@ -321,6 +321,26 @@ pub struct ConfigDocument {
     /// tables as they are; with it (also `[]`) they are replaced.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cam_tables: Option<Vec<CamTableBody>>,
+    /// The drive bus the machine runs on (`--bus`, `--interface`, `--bus-max-errors` at start).
+    /// Exported as it runs; an import that names another bus kind is refused (start motiond
+    /// with that bus first), the interface and error limit are information only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bus: Option<BusSettings>,
+}
+
+/// The drive bus of a configuration document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"kind": "ethercat", "interface": "enp2s0", "max_errors_in_row": 3}))]
+pub struct BusSettings {
+    pub kind: crate::bus::BusKind,
+    /// The network interface (`ethercat`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 64)]
+    pub interface: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 1000)]
+    pub max_errors_in_row: Option<u32>,
 }
 
 /// One axis of the configuration document.
@@ -1263,7 +1283,7 @@ pub(crate) mod examples {
                 _ => json!({"id": i + 1, "config": config, "persistent_parameters": {}}),
             })
             .collect();
-        json!({"version": 1, "axes": axes})
+        json!({"version": 1, "axes": axes, "bus": {"kind": "simulated"}})
     }
 
     /// `x` moving (the kernel's status example), not coupled.

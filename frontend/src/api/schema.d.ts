@@ -1946,6 +1946,21 @@ export interface components {
             subdevices: components["schemas"]["SubDeviceResource"][];
         };
         /**
+         * @description The drive bus of a configuration document.
+         * @example {
+         *       "interface": "enp2s0",
+         *       "kind": "ethercat",
+         *       "max_errors_in_row": 3
+         *     }
+         */
+        BusSettings: {
+            kind: components["schemas"]["BusKind"];
+            /** @description The network interface (`ethercat`). */
+            interface?: string | null;
+            /** Format: int32 */
+            max_errors_in_row?: number | null;
+        };
+        /**
          * @description `MC_CamActivationMode` (spec §1.7): when a coupling, a cam switch or a scaling takes effect.
          * @enum {string}
          */
@@ -3227,6 +3242,9 @@ export interface components {
          *           "persistent_parameters": {}
          *         }
          *       ],
+         *       "bus": {
+         *         "kind": "simulated"
+         *       },
          *       "version": 1
          *     }
          */
@@ -3243,6 +3261,7 @@ export interface components {
              *     tables as they are; with it (also `[]`) they are replaced.
              */
             cam_tables?: components["schemas"]["CamTableBody"][] | null;
+            bus?: null | components["schemas"]["BusSettings"];
         };
         /**
          * @description Who holds the control.

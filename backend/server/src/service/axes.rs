@@ -630,10 +630,21 @@ pub async fn write_parameter(
 /// The whole configuration: axes with their persistent parameters.
 pub fn export(s: &AppState) -> ConfigDocument {
     let cam_tables = Some(super::cams::export(s));
+    let bus = &s.info.bus;
+    let bus = Some(crate::model::BusSettings {
+        kind: bus.kind,
+        interface: bus
+            .ethercat
+            .as_ref()
+            .filter(|_| bus.kind == crate::bus::BusKind::Ethercat)
+            .map(|(st, _)| st.interface.clone()),
+        max_errors_in_row: bus.ethercat.as_ref().map(|(st, _)| st.max_errors_in_row),
+    });
     let reg = s.registry.read().unwrap();
     ConfigDocument {
         version: 1,
         cam_tables,
+        bus,
         axes: reg
             .axes
             .values()
@@ -675,6 +686,23 @@ pub async fn import(
             field: "version".into(),
             message: "must be 1".into(),
         });
+    }
+    if let Some(b) = &doc.bus {
+        let running = s.info.bus.kind;
+        if b.kind != running {
+            errs.push(FieldError {
+                field: "bus.kind".into(),
+                message: format!(
+                    "this machine runs on the {} bus; motiond runs the {} bus: start it with --bus {}{} first",
+                    b.kind.name(),
+                    running.name(),
+                    b.kind.name(),
+                    b.interface
+                        .as_deref()
+                        .map_or(String::new(), |i| format!(" --interface {i}"))
+                ),
+            });
+        }
     }
     if doc.axes.len() > crate::cycle::MAX_AXES {
         errs.push(FieldError {
