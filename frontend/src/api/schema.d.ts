@@ -6765,7 +6765,10 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
-        /** @description No SubDevice at that position on the segment. */
+        /**
+         * @description No SubDevice at that position on the segment (`subdevice_not_found`), or a subindex
+         *     beyond 255 (`subindex_not_found`).
+         */
         SubDeviceNotFound: {
             headers: {
                 [name: string]: unknown;
@@ -9404,7 +9407,7 @@ export interface operations {
                  */
                 position: number;
                 /**
-                 * @description object index, `0x1018` or decimal
+                 * @description object index in hex, `0x1018`
                  * @example 0x1018
                  */
                 index: string;
@@ -9447,7 +9450,7 @@ export interface operations {
                  */
                 position: number;
                 /**
-                 * @description object index, `0x6065` or decimal
+                 * @description object index in hex, `0x6065`
                  * @example 0x6065
                  */
                 index: string;

@@ -243,16 +243,23 @@ pub struct SdoWrite {
 }
 
 fn index_of(s: &str) -> AppResult<u16> {
-    let v = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
-        Some(h) => u16::from_str_radix(h, 16).ok(),
-        None => s.parse::<u16>().ok(),
-    };
-    v.ok_or_else(|| {
-        AppError::field(
-            "index",
-            "an object index: 0x0000–0xFFFF (hex with 0x, or decimal)",
-        )
-    })
+    s.strip_prefix("0x")
+        .or_else(|| s.strip_prefix("0X"))
+        .filter(|h| (1..=4).contains(&h.len()))
+        .and_then(|h| u16::from_str_radix(h, 16).ok())
+        .ok_or_else(|| AppError::field("index", "an object index in hex: 0x0000–0xFFFF"))
+}
+
+/// The path's SubDevice position and subindex: beyond their range there is no such one (404).
+fn sdo_path(position: &str, index: &str, sub: &str) -> AppResult<(u16, u16, u8)> {
+    let position = position
+        .parse::<u16>()
+        .map_err(|_| AppError::not_found("subdevice", position))?;
+    let index = index_of(index)?;
+    let sub = sub
+        .parse::<u8>()
+        .map_err(|_| AppError::not_found("subindex", sub))?;
+    Ok((position, index, sub))
 }
 
 fn sdo_access(s: &AppState) -> AppResult<ethercat::bus::SdoAccess> {
@@ -340,14 +347,14 @@ fn value_of(position: u16, index: u16, sub: u8, bytes: Vec<u8>) -> SdoValue {
     description = "From the async side through the mailbox; the cycle is not touched. 409 `sdo_aborted` carries the \
 CiA-301 abort code the SubDevice answered; 409 `bus_not_ethercat` on the simulated bus.",
     params(("position" = u16, Path, description = "SubDevice position on the segment", example = 0),
-        ("index" = String, Path, description = "object index, `0x1018` or decimal", example = "0x1018"),
+        ("index" = String, Path, description = "object index in hex, `0x1018`", example = "0x1018", pattern = "^0[xX][0-9a-fA-F]{1,4}$"),
         ("sub" = u8, Path, description = "subindex", example = 1)),
     responses((status = 200, description = "The value", body = SdoValue), super::errors::SdoErrors))]
 pub async fn sdo_read(
     State(s): State<Arc<AppState>>,
-    Path((position, index, sub)): Path<(u16, String, u8)>,
+    Path((position, index, sub)): Path<(String, String, String)>,
 ) -> AppResult<Json<SdoValue>> {
-    let index = index_of(&index)?;
+    let (position, index, sub) = sdo_path(&position, &index, &sub)?;
     let sdo = sdo_access(&s)?;
     let bytes = sdo
         .read(position, index, sub)
@@ -361,17 +368,17 @@ pub async fn sdo_read(
     description = "For commissioning and diagnostics; audited. A drive refuses what its state does not allow (e.g. the \
 PDO mapping outside PRE-OP: 409 `sdo_aborted` with 0x08000022).",
     params(("position" = u16, Path, description = "SubDevice position on the segment", example = 0),
-        ("index" = String, Path, description = "object index, `0x6065` or decimal", example = "0x6065"),
+        ("index" = String, Path, description = "object index in hex, `0x6065`", example = "0x6065", pattern = "^0[xX][0-9a-fA-F]{1,4}$"),
         ("sub" = u8, Path, description = "subindex", example = 0)),
     request_body = SdoWrite,
     responses((status = 200, description = "Written; the value read back", body = SdoValue), super::errors::SdoWriteErrors))]
 pub async fn sdo_write(
     State(s): State<Arc<AppState>>,
-    Path((position, index, sub)): Path<(u16, String, u8)>,
+    Path((position, index, sub)): Path<(String, String, String)>,
     client: Client,
     JsonBody(w, _): JsonBody<SdoWrite>,
 ) -> AppResult<Json<SdoValue>> {
-    let index = index_of(&index)?;
+    let (position, index, sub) = sdo_path(&position, &index, &sub)?;
     if !matches!(w.size, 1 | 2 | 4) {
         return Err(AppError::field("size", "1, 2 or 4 bytes"));
     }

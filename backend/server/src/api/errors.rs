@@ -300,7 +300,8 @@ problem_responses! {
 
     // 413
 
-    /// No SubDevice at that position on the segment.
+    /// No SubDevice at that position on the segment (`subdevice_not_found`), or a subindex
+    /// beyond 255 (`subindex_not_found`).
     SubDeviceNotFound(example = json!(p(AppError::not_found("subdevice", "7"))));
     /// The SubDevice aborted the transfer (`sdo_aborted`, with the CiA-301 abort code), or
     /// motiond runs the simulated bus (`bus_not_ethercat`).
