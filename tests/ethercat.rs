@@ -30,7 +30,17 @@ async fn until_status(s: &Server, axis: &str, what: &str, f: impl Fn(&Value) -> 
 #[tokio::test(flavor = "multi_thread")]
 async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
     // Five in a row: a loaded machine loses a frame of the in-process segment now and then.
-    let s = Server::start_with(":memory:", &["--bus", "emulated", "--bus-max-errors", "5"]);
+    let s = Server::start_with(
+        ":memory:",
+        &[
+            "--bus",
+            "emulated",
+            "--bus-max-errors",
+            "5",
+            "--bus-timeout-ms",
+            "50",
+        ],
+    );
     let bus = get(&s, "/api/v1/bus").await;
     assert_eq!(bus.status, 200, "{}", bus.text);
     assert_eq!(bus.json["kind"], "emulated");

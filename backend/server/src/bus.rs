@@ -112,6 +112,7 @@ pub fn start(
     interface: Option<&str>,
     cycle: Duration,
     max_errors_in_row: u32,
+    timeout: Option<Duration>,
     slots: usize,
 ) -> Result<(Box<dyn DriveBus>, BusHandle), String> {
     let link = match kind {
@@ -131,6 +132,9 @@ pub fn start(
     };
     let mut opts = BusOptions::new(cycle);
     opts.max_errors_in_row = max_errors_in_row;
+    if let Some(t) = timeout {
+        opts.pdu_timeout = t;
+    }
 
     let bus = EthercatBus::start(link, &opts, slots)?;
     let status = bus.status();

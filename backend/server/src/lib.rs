@@ -211,6 +211,10 @@ pub struct ServeArgs {
     /// bus stops into ErrorStop (1–1000).
     #[arg(long = "bus-max-errors", global = true, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub bus_max_errors: u32,
+    /// How long an EtherCAT frame may take to come back before it is sent again (twice) and
+    /// then counted as lost, in ms (1–1000) [default: four cycles, at least 10 ms].
+    #[arg(long = "bus-timeout-ms", global = true, value_name = "MS", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub bus_timeout_ms: Option<u32>,
     /// The built commissioning UI, served at `/` [default: `frontend/dist` in the current
     /// directory, else the one of the source tree motiond was built from].
     #[arg(long, global = true, value_name = "PATH")]
@@ -521,12 +525,14 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
     let (bus, bus_handle) = {
         let (kind, iface) = (args.bus, args.interface.clone());
-        let (cycle, max) = (
+        let (cycle, max, timeout) = (
             std::time::Duration::from_micros(args.cycle_us as u64),
             args.bus_max_errors,
+            args.bus_timeout_ms
+                .map(|ms| std::time::Duration::from_millis(ms as u64)),
         );
         tokio::task::spawn_blocking(move || {
-            bus::start(kind, iface.as_deref(), cycle, max, cycle::MAX_AXES)
+            bus::start(kind, iface.as_deref(), cycle, max, timeout, cycle::MAX_AXES)
         })
         .await
         .map_err(|e| format!("the bus start-up failed: {e}"))?
