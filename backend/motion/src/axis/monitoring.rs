@@ -110,14 +110,15 @@ impl Axis {
             self.drive_error_code = fb.fault_code;
             self.enter_error(cx, ErrorId::DRIVE_FAULT);
         }
+        // A powered axis that loses its drive stops; one still waiting for its power-on waits
+        // for the bus too (the drive-not-ready timeout bounds the wait).
         if fb.bus_error
             && self.reset_grace == 0
-            && self.mode != Mode::ErrorStop
-            && (self.enable || self.mode != Mode::Disabled)
+            && !matches!(self.mode, Mode::ErrorStop | Mode::Disabled)
         {
             self.enter_error(cx, ErrorId::BUS_ERROR);
         }
-        let status = self.enable && fb.enabled && fb.ready && !fb.fault;
+        let status = self.enable && fb.enabled && fb.ready && !fb.fault && !fb.bus_error;
         if self.enable && !status && self.mode == Mode::Disabled {
             self.power_on_timer += dt;
             if self.power_on_timer > POWER_ON_TIMEOUT {

@@ -173,13 +173,24 @@ fn a_bus_error_stops_on_the_ramp_into_errorstop_and_reset_needs_the_bus_back() {
         assert!(cycles < 10_000, "stands");
     }
     assert!(cycles > 5, "a ramp, not a cut: {cycles} cycles");
-    // Reset while the bus still lacks the drive: ErrorStop again.
+    // Reset while the bus still lacks the drive: the power status is false, so the axis is
+    // Disabled (PLCopen's reset without power), and MC_Power, still enabled, waits for the drive.
     r.ok(0, CommandKind::Reset);
     r.run(0.05);
-    assert_eq!(r.st(0).state, AxisState::ErrorStop);
-    assert_eq!(r.st(0).error_id, ErrorId::BUS_ERROR.0);
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+    assert!(!r.st(0).power_status);
+    assert!(r.out(p).busy && !r.out(p).status && !r.out(p).error);
+    // The bus has the drive again: MC_Power's enable brings the axis up where it stands.
     r.plants[0].bus_error = false;
-    r.ok(0, CommandKind::Reset);
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
     assert!(r.out(p).status);
+    // A power-on while the bus lacks the drive waits for it instead of failing at once.
+    let mut r = Rig::new(1);
+    r.plants[0].bus_error = true;
+    let p = r.ok(0, power_with_override(100.0));
+    r.run(0.1);
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+    assert!(r.out(p).busy && !r.out(p).error);
+    r.plants[0].bus_error = false;
+    r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
 }
