@@ -1,5 +1,5 @@
 import type { AxisState } from './api/types';
-import { errorInfo } from './api/errors';
+import { errorInfo, hexId } from './api/errors';
 
 export const STATE_LABEL: Record<AxisState, string> = {
   disabled: 'Disabled',
@@ -67,15 +67,18 @@ export interface AxisErrorText {
   hex: string | null;
   code: string | null;
   text: string;
+  /** The drive's own code (CiA-402 0x603F, or the bus's) in hex, when it sent one. */
+  driveCode: string | null;
 }
 
-export function axisError(s: { state: AxisState; error_id: number; drive_fault: boolean } | null | undefined): AxisErrorText | null {
+export function axisError(s: { state: AxisState; error_id: number; drive_fault: boolean; drive_error_code?: number } | null | undefined): AxisErrorText | null {
   if (!s || (!s.error_id && s.state !== 'error_stop')) return null;
+  const driveCode = s.drive_error_code ? hexId(s.drive_error_code) : null;
   if (s.error_id) {
     const e = errorInfo(s.error_id);
-    return { hex: e.hex, code: e.code, text: e.text + (s.drive_fault && e.code !== 'drive_fault' ? ' · drive fault' : '') };
+    return { hex: e.hex, code: e.code, text: e.text + (s.drive_fault && e.code !== 'drive_fault' ? ' · drive fault' : ''), driveCode };
   }
-  return { hex: null, code: null, text: s.drive_fault ? 'drive fault (no error number)' : 'error stop (no error number)' };
+  return { hex: null, code: null, text: s.drive_fault ? 'drive fault (no error number)' : 'error stop (no error number)', driveCode };
 }
 
 /** A moment as `YYYY-MM-DD HH:MM` in local time (users, tokens); '' for none. */

@@ -2,7 +2,7 @@ import { describe, expect, it } from 'vitest';
 import { fieldErrors } from '../src/api/rest';
 import { errorInfo } from '../src/api/errors';
 import { diff, parseValue, rangeText } from '../src/ui/parameters';
-import { configOf, DEFAULT_FORM, formOf } from '../src/ui/axis-config';
+import { configOf, DEFAULT_FORM, formOf, shownFields } from '../src/ui/axis-config';
 import type { ParameterResource } from '../src/api/types';
 
 describe('problem+json field errors', () => {
@@ -78,6 +78,7 @@ describe('axis configuration form', () => {
       dynamics: { max_velocity: 500, acceleration: 2500, deceleration: 2500, jerk: 25000, jog_velocity_slow: 10, jog_velocity_fast: 100 },
       parameters: { AxisTargetPositionWindow: 0.01 },
       drive: {
+        kind: 'simulated',
         plant: { kind: 'pt2', natural_frequency_hz: 50, damping: 0.8 },
         dead_time: 0.001,
         dead_time_compensation: true,
@@ -106,5 +107,79 @@ describe('axis configuration form', () => {
   it('leaves range checks to the server (a negative jerk is sent)', () => {
     const { config } = configOf({ ...DEFAULT_FORM, name: 'z', dyn: { ...DEFAULT_FORM.dyn, jerk: '-1' } });
     expect(config!.dynamics.jerk).toBe(-1);
+  });
+
+  const dynamics = { max_velocity: 500, acceleration: 2500, deceleration: 2500, jerk: 25000, jog_velocity_slow: 10, jog_velocity_fast: 100, jog_deadman_max: 1 };
+
+  it('round-trips a CiA-402 drive as the server sends it (blank velocity increments: null)', () => {
+    const cfg = {
+      name: 'x',
+      unit: 'mm',
+      dynamics,
+      parameters: { AxisTargetPositionWindow: 0.01 },
+      drive: { kind: 'cia402', subdevice: 0, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 },
+    };
+    const f = formOf(cfg as never);
+    expect(f.driveKind).toBe('cia402');
+    expect(f.cia).toEqual({ subdevice: '0', increments_per_unit: '1000', velocity_increments_per_unit: '', position_gain: '50', velocity_gain: '0', acceleration_feed_forward: '0', max_torque: '1000' });
+    expect(f.ciaMode).toBe('csp');
+    const { config, errors } = configOf(f);
+    expect(errors).toEqual({});
+    expect(config).toEqual(cfg);
+    // CSV with its own velocity scaling and gain
+    const csv = configOf({ ...f, ciaMode: 'csv', cia: { ...f.cia, subdevice: '2', increments_per_unit: '131072', velocity_increments_per_unit: '10', position_gain: '80' } });
+    expect(csv.config!.drive).toEqual({ kind: 'cia402', subdevice: 2, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'csv', position_gain: 80, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 });
+  });
+
+  it('round-trips a CST drive with its torque loop; a drive read without the CST fields gets the server defaults; a save keeps the gains of the other modes', () => {
+    const cst = { kind: 'cia402', subdevice: 1, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'cst', position_gain: 40, velocity_gain: 2.5, acceleration_feed_forward: 0.1, max_torque: 1500 };
+    const cfg = { name: 'y', unit: 'mm', dynamics, parameters: {}, drive: cst };
+    const f = formOf(cfg as never);
+    expect(f.ciaMode).toBe('cst');
+    expect(f.cia).toEqual({ subdevice: '1', increments_per_unit: '131072', velocity_increments_per_unit: '10', position_gain: '40', velocity_gain: '2.5', acceleration_feed_forward: '0.1', max_torque: '1500' });
+    expect(configOf(f)).toEqual({ config: cfg, errors: {} });
+    // switched to CSP: the CST gains (hidden) go along unchanged
+    expect(configOf({ ...f, ciaMode: 'csp' }).config!.drive).toEqual({ ...cst, mode: 'csp' });
+    // an older configuration without them
+    const old = formOf({ ...cfg, drive: { kind: 'cia402', subdevice: 1, increments_per_unit: 1000, mode: 'csv' } } as never);
+    expect(old.cia).toMatchObject({ position_gain: '50', velocity_gain: '0', acceleration_feed_forward: '0', max_torque: '1000' });
+    // typed text that is no number: named by its JSON path
+    expect(configOf({ ...f, cia: { ...f.cia, velocity_gain: 'fast', max_torque: '' } }).errors).toEqual({ 'drive.velocity_gain': 'not a number', 'drive.max_torque': 'required' });
+  });
+
+  it('a CiA-402 drive: no simulated field is sent; the simulated one keeps what was typed while the kind is switched', () => {
+    const typed = { ...DEFAULT_FORM, name: 'z', plant: 'pt1' as const, time_constant: '0.02', cia: { ...DEFAULT_FORM.cia, subdevice: '1' } };
+    const cia = configOf({ ...typed, driveKind: 'cia402' }).config!;
+    expect(cia.drive).toEqual({ kind: 'cia402', subdevice: 1, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 });
+    const sim = configOf({ ...typed, driveKind: 'simulated' }).config!;
+    expect(sim.drive).toMatchObject({ kind: 'simulated', plant: { kind: 'pt1', time_constant: 0.02 }, dead_time: 0.001 });
+    // a simulated drive read from a configuration starts the CiA-402 fields at their defaults
+    expect(formOf(sim).cia).toEqual(DEFAULT_FORM.cia);
+    expect(formOf(sim).driveKind).toBe('simulated');
+    // a configuration without a kind is a simulated drive
+    expect(formOf({ ...sim, drive: undefined }).driveKind).toBe('simulated');
+  });
+
+  it('CiA-402 fields that are not numbers are named by their JSON path; the position must be whole', () => {
+    const f = { ...DEFAULT_FORM, name: 'z', driveKind: 'cia402' as const, damping: 'not checked', cia: { ...DEFAULT_FORM.cia, subdevice: '1.5', increments_per_unit: '', velocity_increments_per_unit: 'x' } };
+    const { config, errors } = configOf(f);
+    expect(config).toBeNull();
+    expect(errors).toEqual({ 'drive.subdevice': 'a whole number', 'drive.increments_per_unit': 'required', 'drive.velocity_increments_per_unit': 'not a number' });
+    expect(configOf({ ...f, cia: { ...f.cia, subdevice: '' , increments_per_unit: '1', velocity_increments_per_unit: '' } }).errors).toEqual({ 'drive.subdevice': 'required' });
+  });
+
+  it("the fields shown depend on the drive's kind (other paths go to the banner)", () => {
+    const cia = shownFields({ ...DEFAULT_FORM, driveKind: 'cia402' });
+    for (const p of ['drive.kind', 'drive.subdevice', 'drive.increments_per_unit', 'drive.velocity_increments_per_unit', 'drive.mode']) expect(cia.has(p)).toBe(true);
+    // the gains by mode: none in CSP, the position gain in CSV, all in CST
+    const gains = ['drive.position_gain', 'drive.velocity_gain', 'drive.acceleration_feed_forward', 'drive.max_torque'];
+    expect(gains.filter((p) => cia.has(p))).toEqual([]);
+    expect(gains.filter((p) => shownFields({ ...DEFAULT_FORM, driveKind: 'cia402', ciaMode: 'csv' }).has(p))).toEqual(['drive.position_gain']);
+    expect(gains.filter((p) => shownFields({ ...DEFAULT_FORM, driveKind: 'cia402', ciaMode: 'cst' }).has(p))).toEqual(gains);
+    expect(cia.has('drive.plant.damping')).toBe(false);
+    const sim = shownFields(DEFAULT_FORM);
+    expect(sim.has('drive.kind')).toBe(true);
+    expect(sim.has('drive.plant.damping')).toBe(true);
+    expect(sim.has('drive.subdevice')).toBe(false);
   });
 });

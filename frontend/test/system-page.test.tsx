@@ -4,7 +4,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, unmount } from './dom';
+import { mountPoint, problem, unmount } from './dom';
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
@@ -17,20 +17,11 @@ vi.mock('../src/services', async () => {
 
 import { AuditPanel, ConfigPanel } from '../src/ui/system';
 import { parseRoute, href } from '../src/router';
-import { buses, ms, plantText } from '../src/system/bus';
+import { ms, plantText, simulatedAxes } from '../src/system/bus';
 
 type Answer = [number, unknown];
 let asked: { method: string; url: string; body: unknown }[];
 let answer: (method: string, url: string, body: unknown) => Answer;
-
-const problem = (status: number, code: string, title: string, detail: string, errors?: { field: string; message: string }[]) => ({
-  type: `urn:motiond:problem:${code}`,
-  title,
-  status,
-  detail,
-  code,
-  ...(errors ? { errors } : {}),
-});
 
 let root: HTMLElement;
 beforeEach(() => {
@@ -238,14 +229,10 @@ describe('the route and the bus', () => {
     expect(href({ page: 'system' })).toBe('#/system');
   });
 
-  it('axes by bus: the simulated drives on the simulated bus; an unknown kind apart', () => {
+  it('the simulated bus: the axes with simulated drives, by id', () => {
     const a = (id: number, name: string, kind?: string) => ({ id, slot: id, state: 'disabled', config: { name, unit: 'mm', dynamics: {}, drive: kind ? { kind } : undefined } }) as never;
-    expect(buses([])).toEqual([{ kind: 'simulated', driveKinds: [], axes: [] }]);
-    const b = buses([a(2, 'y', 'simulated'), a(1, 'x'), a(3, 'z', 'ethercat')]);
-    expect(b.map((x) => [x.kind, x.driveKinds, x.axes.map((y: { config: { name: string } }) => y.config.name)])).toEqual([
-      ['simulated', ['simulated'], ['x', 'y']],
-      ['unknown', ['ethercat'], ['z']],
-    ]);
+    expect(simulatedAxes([])).toEqual([]);
+    expect(simulatedAxes([a(2, 'y', 'simulated'), a(1, 'x'), a(3, 'z', 'cia402')]).map((x: { config: { name: string } }) => x.config.name)).toEqual(['x', 'y']);
     expect(plantText({ kind: 'pt2', natural_frequency_hz: 50, damping: 0.8 })).toBe('PT2 50 Hz, ζ 0.8');
     expect(plantText({ kind: 'pt1', time_constant: 0.01 })).toBe('PT1 T 0.01 s');
     expect(ms(0.001)).toBe('1 ms');

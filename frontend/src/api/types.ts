@@ -27,8 +27,18 @@ export type MoveVelocityBody = S['MoveVelocityBody'];
 export type HomeBody = S['HomeBody'];
 export type Direction = S['Direction'];
 export type DriveConfig = S['DriveConfig'];
-/** The simulated drive's configuration: the only kind of drive yet. */
-export type SimDriveConfig = DriveConfig;
+/** The simulated drive's configuration (`kind: "simulated"`, the default). */
+export type SimDriveConfig = Extract<DriveConfig, { kind: 'simulated' }>;
+/** A CiA-402 servo drive on the EtherCAT bus (`kind: "cia402"`). */
+export type Cia402DriveConfig = Extract<DriveConfig, { kind: 'cia402' }>;
+export type Cia402Mode = S['Cia402Mode'];
+/** `GET /bus`: the drive bus (simulated, emulated or real EtherCAT) and its SubDevices. */
+export type BusResource = S['BusResource'];
+export type SubDeviceResource = S['SubDeviceResource'];
+export type AlState = S['AlState'];
+/** An object read from (or written to and read back from) a SubDevice by SDO. */
+export type SdoValue = S['SdoValue'];
+export type SdoWrite = S['SdoWrite'];
 export type PlantModel = S['PlantModel'];
 
 /** A `command_event` notification of the `commands` websocket topic. */

@@ -1,7 +1,18 @@
 // `GET /metrics?buckets=fine`: Prometheus text (not under /api/v1), read with the tab's
-// client id; a refusal is an ApiError as for the JSON API.
-import { ApiError, headers, isProblem } from '../api/rest';
+// client id; a refusal is an ApiError as for the JSON API. The drive bus (`GET /bus`) and SDO
+// access to its SubDevices.
+import { ApiError, get, headers, isProblem, put } from '../api/rest';
+import type { BusResource, SdoValue, SdoWrite } from '../api/types';
 import { cycleHistograms, type CycleHistograms } from './prometheus';
+import { sdoPath } from './bus';
+
+export const getBus = () => get<BusResource>('/bus');
+
+/** SDO upload of `index:sub` from the SubDevice at `position`. */
+export const sdoRead = (position: number, index: string, sub: number) => get<SdoValue>(sdoPath(position, index, sub));
+
+/** SDO download; the answer is the value read back. */
+export const sdoWrite = (position: number, index: string, sub: number, body: SdoWrite) => put<SdoValue>(sdoPath(position, index, sub), body);
 
 export async function getMetricsText(): Promise<string> {
   let res: Response;

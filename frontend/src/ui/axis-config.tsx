@@ -1,13 +1,18 @@
 // Create / edit / delete an axis. The form mirrors AxisConfigDto; the server's 422 field
-// errors (JSON paths such as `dynamics.jerk`, `drive.plant.damping`, `parameters.X`) are shown
-// at the field they name, anything else in the banner.
+// errors (JSON paths such as `dynamics.jerk`, `drive.plant.damping`, `drive.subdevice`,
+// `parameters.X`) are shown at the field they name, anything else in the banner.
+//
+// The drive is a simulated one (plant model, homing cam, switches) or a CiA-402 servo drive on
+// the EtherCAT bus (its SubDevice chosen from `GET /bus`); on the simulated bus CiA-402 is
+// offered disabled, with how to start motiond for it.
 //
 // Saving an existing axis first asks the server what the save would do (`?dry_run=true`) and
 // shows it (config/save-panel.tsx): parameters written online on the running axis, or the axis
 // re-created (then it must be disabled). The fields that are parameters show beside them the
 // online and persistent values where these differ from the configured (start-up) value.
 import { useEffect, useState } from 'preact/hooks';
-import type { AxisConfig, AxisLiveStatus, AxisResource, ParamValue } from '../api/types';
+import type { JSX } from 'preact';
+import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../api/types';
 import { ApiError, del, enc, post, put } from '../api/rest';
 import { command, refreshAxes, statuses } from '../services';
 import { navigate } from '../router';
@@ -17,10 +22,24 @@ import { STATE_LABEL, inputNum } from '../format';
 import { useAxisParameters } from '../config/params';
 import { type ConfigChange, type SideValues, differingFields, rebuildBlockedText, sideText } from '../config/change';
 import { SavePanel, SaveResult } from '../config/save-panel';
+import { cia402Unavailable, driveOptions, firstFreeDrive } from '../system/bus';
+import { useBus } from './bus';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
 
 type PlantKind = 'ideal' | 'pt1' | 'pt2';
+export type DriveKind = 'simulated' | 'cia402';
+
+const DRIVE_KINDS: [DriveKind, string][] = [
+  ['simulated', 'Simulated'],
+  ['cia402', 'CiA-402 on EtherCAT'],
+];
+
+const CIA_MODES: [Cia402Mode, string, string][] = [
+  ['csp', 'CSP (position)', 'cyclic synchronous position: the drive closes the position loop'],
+  ['csv', 'CSV (velocity)', 'cyclic synchronous velocity: motiond closes the position loop'],
+  ['cst', 'CST (torque)', 'cyclic synchronous torque: motiond closes the position and velocity loops'],
+];
 
 const PLANTS: [PlantKind, string][] = [
   ['ideal', 'ideal (load = reference)'],
@@ -50,6 +69,8 @@ export interface ConfigForm {
   min: string;
   max: string;
   dyn: Record<'max_velocity' | 'acceleration' | 'deceleration' | 'jerk' | 'jog_velocity_slow' | 'jog_velocity_fast', string>;
+  /** `drive.kind`; the other kind's fields are kept while the kind is switched. */
+  driveKind: DriveKind;
   plant: PlantKind;
   time_constant: string;
   natural_frequency_hz: string;
@@ -65,10 +86,19 @@ export interface ConfigForm {
   limitNeg: string;
   limitPos: string;
   faultOnHit: boolean;
+  /**
+   * The CiA-402 drive: `drive.subdevice` etc.; `velocity_increments_per_unit` blank: null (the
+   * position increments). Every field is sent whatever the mode (the hidden ones as read), so
+   * a save keeps the gains of the other modes.
+   */
+  cia: Record<CiaField, string>;
+  ciaMode: Cia402Mode;
   parameters: { key: string; value: string }[];
   /** `dynamics.jog_deadman_max` (s); blank: not sent, the server's default (1 s). */
   jogDeadmanMax: string;
 }
+
+type CiaField = 'subdevice' | 'increments_per_unit' | 'velocity_increments_per_unit' | 'position_gain' | 'velocity_gain' | 'acceleration_feed_forward' | 'max_torque';
 
 export const DEFAULT_FORM: ConfigForm = {
   name: '',
@@ -80,6 +110,7 @@ export const DEFAULT_FORM: ConfigForm = {
   max: '1000',
   dyn: { max_velocity: '500', acceleration: '2500', deceleration: '2500', jerk: '25000', jog_velocity_slow: '10', jog_velocity_fast: '100' },
   jogDeadmanMax: '1',
+  driveKind: 'simulated',
   plant: 'pt2',
   time_constant: '0.005',
   natural_frequency_hz: '50',
@@ -95,11 +126,15 @@ export const DEFAULT_FORM: ConfigForm = {
   limitNeg: '',
   limitPos: '',
   faultOnHit: false,
+  // the server's defaults (a CST drive needs a velocity gain > 0: the server says so at the field)
+  cia: { subdevice: '', increments_per_unit: '1000', velocity_increments_per_unit: '', position_gain: '50', velocity_gain: '0', acceleration_feed_forward: '0', max_torque: '1000' },
+  ciaMode: 'csp',
   parameters: [],
 };
 
 export function formOf(c: AxisConfig): ConfigForm {
-  const d = (c.drive ?? {}) as NonNullable<AxisConfig['drive']>;
+  const cia = c.drive?.kind === 'cia402' ? c.drive : null;
+  const d: Partial<SimDriveConfig> = c.drive && c.drive.kind !== 'cia402' ? c.drive : {};
   const plant = (d.plant ?? { kind: 'pt2', natural_frequency_hz: 50, damping: 0.8 }) as { kind: PlantKind; time_constant?: number; natural_frequency_hz?: number; damping?: number };
   const n = (v: number | null | undefined, dflt = '') => (v === null || v === undefined ? dflt : inputNum(v));
   return {
@@ -141,6 +176,19 @@ export function formOf(c: AxisConfig): ConfigForm {
     limitNeg: n(d.limit_switches?.negative),
     limitPos: n(d.limit_switches?.positive),
     faultOnHit: d.limit_switches?.fault_on_hit ?? false,
+    driveKind: cia ? 'cia402' : 'simulated',
+    cia: cia
+      ? {
+          subdevice: String(cia.subdevice),
+          increments_per_unit: n(cia.increments_per_unit),
+          velocity_increments_per_unit: n(cia.velocity_increments_per_unit),
+          position_gain: n(cia.position_gain, DEFAULT_FORM.cia.position_gain),
+          velocity_gain: n(cia.velocity_gain, DEFAULT_FORM.cia.velocity_gain),
+          acceleration_feed_forward: n(cia.acceleration_feed_forward, DEFAULT_FORM.cia.acceleration_feed_forward),
+          max_torque: n(cia.max_torque, DEFAULT_FORM.cia.max_torque),
+        }
+      : { ...DEFAULT_FORM.cia },
+    ciaMode: cia?.mode ?? 'csp',
     parameters: Object.entries(c.parameters ?? {}).map(([key, value]) => ({ key, value: String(value) })),
   };
 }
@@ -155,7 +203,12 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
     return v;
   };
   const opt = (path: string, s: string): number | null => (s.trim() === '' ? null : num(path, s));
-  const plant =
+  const whole = (path: string, s: string): number => {
+    const v = num(path, s);
+    if (Number.isFinite(v) && !Number.isInteger(v)) errors[path] = 'a whole number';
+    return v;
+  };
+  const plant = () =>
     f.plant === 'ideal'
       ? { kind: 'ideal' as const }
       : f.plant === 'pt1'
@@ -183,8 +236,19 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
     } as AxisConfig['dynamics'],
     // The schema says `object` without value types (utoipa value_type = Object).
     parameters: parameters as unknown as AxisConfig['parameters'],
-    drive: {
-      plant,
+    drive: f.driveKind === 'cia402' ? {
+      kind: 'cia402',
+      subdevice: whole('drive.subdevice', f.cia.subdevice),
+      increments_per_unit: num('drive.increments_per_unit', f.cia.increments_per_unit),
+      velocity_increments_per_unit: opt('drive.velocity_increments_per_unit', f.cia.velocity_increments_per_unit),
+      mode: f.ciaMode,
+      position_gain: num('drive.position_gain', f.cia.position_gain),
+      velocity_gain: num('drive.velocity_gain', f.cia.velocity_gain),
+      acceleration_feed_forward: num('drive.acceleration_feed_forward', f.cia.acceleration_feed_forward),
+      max_torque: num('drive.max_torque', f.cia.max_torque),
+    } : {
+      kind: 'simulated',
+      plant: plant(),
       dead_time: num('drive.dead_time', f.drive.dead_time),
       dead_time_compensation: f.dead_time_compensation,
       velocity_feed_forward: num('drive.velocity_feed_forward', f.drive.velocity_feed_forward),
@@ -195,14 +259,26 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
       reference_cam: f.refCam ? { start: num('drive.reference_cam.start', f.camStart), end: num('drive.reference_cam.end', f.camEnd) } : null,
       index_pulse: f.index ? { period: num('drive.index_pulse.period', f.indexPeriod), offset: num('drive.index_pulse.offset', f.indexOffset) } : null,
       limit_switches: { negative: opt('drive.limit_switches.negative', f.limitNeg), positive: opt('drive.limit_switches.positive', f.limitPos), fault_on_hit: f.faultOnHit },
-    } as AxisConfig['drive'],
+    },
   };
   return { config: Object.keys(errors).length ? null : config, errors };
 }
 
+/** The field paths of the CiA-402 drive's inputs in a mode (position gain: CSV and CST; the torque loop's: CST). */
+function ciaFields(mode: Cia402Mode): string[] {
+  return [
+    'drive.subdevice',
+    'drive.increments_per_unit',
+    'drive.velocity_increments_per_unit',
+    'drive.mode',
+    ...(mode !== 'csp' ? ['drive.position_gain'] : []),
+    ...(mode === 'cst' ? ['drive.velocity_gain', 'drive.acceleration_feed_forward', 'drive.max_torque'] : []),
+  ];
+}
+
 /** Every field path the form shows (errors for other paths go to the banner). */
-function shownFields(f: ConfigForm): Set<string> {
-  const s = new Set([
+export function shownFields(f: ConfigForm): Set<string> {
+  const common = [
     'name',
     'unit',
     'modulo',
@@ -212,6 +288,11 @@ function shownFields(f: ConfigForm): Set<string> {
     'soft_limits.max',
     ...Object.keys(f.dyn).map((k) => `dynamics.${k}`),
     'dynamics.jog_deadman_max',
+    'drive.kind',
+  ];
+  if (f.driveKind === 'cia402') return new Set([...common, ...ciaFields(f.ciaMode), ...f.parameters.map((p) => `parameters.${p.key.trim()}`)]);
+  const s = new Set([
+    ...common,
     'drive.plant.time_constant',
     'drive.plant.natural_frequency_hz',
     'drive.plant.damping',
@@ -267,6 +348,8 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
   const st = useStore(statuses);
   const online = useOnline();
   const params = useAxisParameters(axis ? axis.config.name : null, axis?.id ?? 0, paramsVersion);
+  // The bus, read once: whether CiA-402 drives exist, and which ones (and whose) to offer.
+  const { bus } = useBus(null);
   useEffect(() => {
     setForm(axis ? formOf(axis.config) : DEFAULT_FORM);
     setFields({});
@@ -403,7 +486,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
       {creating && (
         <div class="page-head">
           <h2>New axis</h2>
-          <span class="muted">a simulated axis; every field can be changed later</span>
+          <span class="muted">a simulated drive or a CiA-402 drive on EtherCAT; every field can be changed later</span>
         </div>
       )}
       <ErrorBanner error={error} onClose={() => setError(null)} />
@@ -482,55 +565,35 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
               {num('dynamics.jog_deadman_max', form.jogDeadmanMax, (v) => set('jogDeadmanMax', v), 'Jog dead-man max (s)', '0.05 … 10 (default 1)')}
             </div>
           </Panel>
-          <Panel title="Simulated drive">
-            <div class="form-grid">
-              <Field label="Plant" name="drive.plant" class="field-row">
-                <select
-                  name="drive.plant.kind"
-                  class="select-fit"
-                  value={form.plant}
-                  title={PLANTS.find(([k]) => k === form.plant)?.[1]}
-                  onChange={(e) => set('plant', (e.target as HTMLSelectElement).value as PlantKind)}
-                >
-                  {PLANTS.map(([k, label]) => (
-                    <option value={k}>{label}</option>
-                  ))}
-                </select>
-              </Field>
-              {form.plant === 'pt1' && num('drive.plant.time_constant', form.time_constant, (v) => set('time_constant', v), 'Time constant (s)', '> 0 and ≤ 10')}
-              {form.plant === 'pt2' && num('drive.plant.natural_frequency_hz', form.natural_frequency_hz, (v) => set('natural_frequency_hz', v), 'Natural frequency (Hz)', '> 0 and ≤ 1000')}
-              {form.plant === 'pt2' && num('drive.plant.damping', form.damping, (v) => set('damping', v), 'Damping', '1 = critically damped')}
-              {DRIVE_LABELS.map(([k, label, hint]) => num(`drive.${k}`, form.drive[k], (v) => set('drive', { ...form.drive, [k]: v }), label, hint))}
-              <label class="check">
-                <input type="checkbox" name="drive.dead_time_compensation" checked={form.dead_time_compensation} onChange={(e) => set('dead_time_compensation', (e.target as HTMLInputElement).checked)} /> dead-time
-                compensation
-              </label>
-            </div>
+          <Panel title="Drive">
+            <DriveFields form={form} setForm={setForm} bus={bus} axis={axis?.config.name ?? null} err={err} num={num} />
           </Panel>
-          <Panel title="Homing and switches (simulated)">
-            <div class="form-grid">
-              <Field label={`Reference cam (${form.unit})`} name="drive.reference_cam" error={err('drive.reference_cam.start') ?? err('drive.reference_cam.end')}>
-                <span class="inline">
-                  <input type="checkbox" name="ref-cam-on" checked={form.refCam} onChange={(e) => set('refCam', (e.target as HTMLInputElement).checked)} />
-                  <NumberInput name="drive.reference_cam.start" value={form.camStart} onValue={(v) => set('camStart', v)} disabled={!form.refCam} placeholder="start" />
-                  <NumberInput name="drive.reference_cam.end" value={form.camEnd} onValue={(v) => set('camEnd', v)} disabled={!form.refCam} placeholder="end" />
-                </span>
-              </Field>
-              <Field label={`Index pulse (${form.unit})`} name="drive.index_pulse" error={err('drive.index_pulse.period') ?? err('drive.index_pulse.offset')}>
-                <span class="inline">
-                  <input type="checkbox" name="index-on" checked={form.index} onChange={(e) => set('index', (e.target as HTMLInputElement).checked)} />
-                  <NumberInput name="drive.index_pulse.period" value={form.indexPeriod} onValue={(v) => set('indexPeriod', v)} disabled={!form.index} placeholder="period" />
-                  <NumberInput name="drive.index_pulse.offset" value={form.indexOffset} onValue={(v) => set('indexOffset', v)} disabled={!form.index} placeholder="offset" />
-                </span>
-              </Field>
-              {num('drive.limit_switches.negative', form.limitNeg, (v) => set('limitNeg', v), `Limit switch − (${form.unit})`, 'blank = none')}
-              {num('drive.limit_switches.positive', form.limitPos, (v) => set('limitPos', v), `Limit switch + (${form.unit})`, 'blank = none')}
-              <label class="check">
-                <input type="checkbox" name="drive.limit_switches.fault_on_hit" checked={form.faultOnHit} onChange={(e) => set('faultOnHit', (e.target as HTMLInputElement).checked)} /> a switch
-                faults the drive
-              </label>
-            </div>
-          </Panel>
+          {form.driveKind === 'simulated' && (
+            <Panel title="Homing and switches (simulated)">
+              <div class="form-grid">
+                <Field label={`Reference cam (${form.unit})`} name="drive.reference_cam" error={err('drive.reference_cam.start') ?? err('drive.reference_cam.end')}>
+                  <span class="inline">
+                    <input type="checkbox" name="ref-cam-on" checked={form.refCam} onChange={(e) => set('refCam', (e.target as HTMLInputElement).checked)} />
+                    <NumberInput name="drive.reference_cam.start" value={form.camStart} onValue={(v) => set('camStart', v)} disabled={!form.refCam} placeholder="start" />
+                    <NumberInput name="drive.reference_cam.end" value={form.camEnd} onValue={(v) => set('camEnd', v)} disabled={!form.refCam} placeholder="end" />
+                  </span>
+                </Field>
+                <Field label={`Index pulse (${form.unit})`} name="drive.index_pulse" error={err('drive.index_pulse.period') ?? err('drive.index_pulse.offset')}>
+                  <span class="inline">
+                    <input type="checkbox" name="index-on" checked={form.index} onChange={(e) => set('index', (e.target as HTMLInputElement).checked)} />
+                    <NumberInput name="drive.index_pulse.period" value={form.indexPeriod} onValue={(v) => set('indexPeriod', v)} disabled={!form.index} placeholder="period" />
+                    <NumberInput name="drive.index_pulse.offset" value={form.indexOffset} onValue={(v) => set('indexOffset', v)} disabled={!form.index} placeholder="offset" />
+                  </span>
+                </Field>
+                {num('drive.limit_switches.negative', form.limitNeg, (v) => set('limitNeg', v), `Limit switch − (${form.unit})`, 'blank = none')}
+                {num('drive.limit_switches.positive', form.limitPos, (v) => set('limitPos', v), `Limit switch + (${form.unit})`, 'blank = none')}
+                <label class="check">
+                  <input type="checkbox" name="drive.limit_switches.fault_on_hit" checked={form.faultOnHit} onChange={(e) => set('faultOnHit', (e.target as HTMLInputElement).checked)} /> a switch
+                  faults the drive
+                </label>
+              </div>
+            </Panel>
+          )}
           <Panel title="Further base parameters (MC_AxisParameter by name)" class="wide">
             <table class="grid kv">
               <tbody>
@@ -610,6 +673,108 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
           )}
         </div>
       </form>
+    </div>
+  );
+}
+
+type NumField = (path: string, value: string, on: (v: string) => void, label: string, hint?: string) => JSX.Element;
+
+/** The drive's kind and the fields of that kind: the simulated drive's model, or the CiA-402 drive on the bus. */
+function DriveFields({ form, setForm, bus, axis, err, num }: {
+  form: ConfigForm;
+  setForm: (f: ConfigForm) => void;
+  bus: BusResource | null;
+  axis: string | null;
+  err: (path: string) => string | undefined;
+  num: NumField;
+}) {
+  const set = <K extends keyof ConfigForm>(k: K, v: ConfigForm[K]) => setForm({ ...form, [k]: v });
+  const setCia = (k: keyof ConfigForm['cia'], v: string) => set('cia', { ...form.cia, [k]: v });
+  const noCia = cia402Unavailable(bus);
+  const sub = form.cia.subdevice.trim() === '' ? null : Number(form.cia.subdevice);
+  const options = driveOptions(bus, axis, sub);
+  const chooseKind = (k: DriveKind) => {
+    // A new CiA-402 drive starts on the first drive no axis uses.
+    const free = k === 'cia402' && form.cia.subdevice.trim() === '' ? firstFreeDrive(options) : null;
+    setForm({ ...form, driveKind: k, ...(free !== null ? { cia: { ...form.cia, subdevice: String(free) } } : {}) });
+  };
+  const u = form.unit;
+  return (
+    <div class="form-grid">
+      <Field
+        label="Drive"
+        name="drive.kind"
+        class="field-row"
+        error={err('drive.kind')}
+        hint={noCia && form.driveKind !== 'cia402' ? <span data-testid="cia402-unavailable">CiA-402 is not offered: {noCia}</span> : undefined}
+      >
+        <select name="drive.kind" class="select-fit" value={form.driveKind} onChange={(e) => chooseKind((e.target as HTMLSelectElement).value as DriveKind)}>
+          {DRIVE_KINDS.map(([k, label]) => (
+            <option value={k} disabled={k === 'cia402' && !!noCia && form.driveKind !== 'cia402'}>
+              {label}
+            </option>
+          ))}
+        </select>
+      </Field>
+      {form.driveKind === 'cia402' ? (
+        <>
+          <Field label="SubDevice (position on the bus)" name="drive.subdevice" class="field-row" error={err('drive.subdevice')} hint={options.length ? undefined : bus ? 'no CiA-402 drive on the bus' : 'the bus could not be read'}>
+            {options.length ? (
+              <select name="drive.subdevice" class="select-fit" value={form.cia.subdevice} onChange={(e) => setCia('subdevice', (e.target as HTMLSelectElement).value)}>
+                {sub === null && <option value="">choose a drive…</option>}
+                {options.map((o) => (
+                  <option value={String(o.position)}>{o.label}</option>
+                ))}
+              </select>
+            ) : (
+              <NumberInput name="drive.subdevice" value={form.cia.subdevice} onValue={(v) => setCia('subdevice', v)} placeholder="0" />
+            )}
+          </Field>
+          {num('drive.increments_per_unit', form.cia.increments_per_unit, (v) => setCia('increments_per_unit', v), `Increments per ${u}`, 'position 0x6064 / 0x607A, > 0')}
+          {num('drive.velocity_increments_per_unit', form.cia.velocity_increments_per_unit, (v) => setCia('velocity_increments_per_unit', v), 'Velocity increments', `per ${u}/s (0x606C / 0x60FF); blank = as position`)}
+          <Field label="Mode" name="drive.mode" error={err('drive.mode')}>
+            <select name="drive.mode" value={form.ciaMode} title={CIA_MODES.find(([k]) => k === form.ciaMode)?.[2]} onChange={(e) => set('ciaMode', (e.target as HTMLSelectElement).value as Cia402Mode)}>
+              {CIA_MODES.map(([k, label, title]) => (
+                <option value={k} title={title}>
+                  {label}
+                </option>
+              ))}
+            </select>
+          </Field>
+          {form.ciaMode !== 'csp' && num('drive.position_gain', form.cia.position_gain, (v) => setCia('position_gain', v), 'Position gain (1/s)', 'the position loop motiond closes, > 0')}
+          {form.ciaMode === 'cst' && (
+            <>
+              {num('drive.velocity_gain', form.cia.velocity_gain, (v) => setCia('velocity_gain', v), `Velocity gain (‰ per ${u}/s)`, 'of rated torque (0x6071) per velocity error, > 0')}
+              {num('drive.acceleration_feed_forward', form.cia.acceleration_feed_forward, (v) => setCia('acceleration_feed_forward', v), `Acceleration feed-forward (‰ per ${u}/s²)`, 'of rated torque per set acceleration (the inertia), ≥ 0')}
+              {num('drive.max_torque', form.cia.max_torque, (v) => setCia('max_torque', v), 'Max torque (‰)', 'of rated torque, 1–32767')}
+            </>
+          )}
+        </>
+      ) : (
+        <>
+          <Field label="Plant" name="drive.plant" class="field-row">
+            <select
+              name="drive.plant.kind"
+              class="select-fit"
+              value={form.plant}
+              title={PLANTS.find(([k]) => k === form.plant)?.[1]}
+              onChange={(e) => set('plant', (e.target as HTMLSelectElement).value as PlantKind)}
+            >
+              {PLANTS.map(([k, label]) => (
+                <option value={k}>{label}</option>
+              ))}
+            </select>
+          </Field>
+          {form.plant === 'pt1' && num('drive.plant.time_constant', form.time_constant, (v) => set('time_constant', v), 'Time constant (s)', '> 0 and ≤ 10')}
+          {form.plant === 'pt2' && num('drive.plant.natural_frequency_hz', form.natural_frequency_hz, (v) => set('natural_frequency_hz', v), 'Natural frequency (Hz)', '> 0 and ≤ 1000')}
+          {form.plant === 'pt2' && num('drive.plant.damping', form.damping, (v) => set('damping', v), 'Damping', '1 = critically damped')}
+          {DRIVE_LABELS.map(([k, label, hint]) => num(`drive.${k}`, form.drive[k], (v) => set('drive', { ...form.drive, [k]: v }), label, hint))}
+          <label class="check">
+            <input type="checkbox" name="drive.dead_time_compensation" checked={form.dead_time_compensation} onChange={(e) => set('dead_time_compensation', (e.target as HTMLInputElement).checked)} /> dead-time
+            compensation
+          </label>
+        </>
+      )}
     </div>
   );
 }

@@ -61,6 +61,7 @@ export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
           id {a.id} · {a.config.unit}
           {a.config.modulo ? ` · modulo ${a.config.modulo.period}` : ''}
           {a.config.soft_limits ? ` · soft limits ${a.config.soft_limits.min} … ${a.config.soft_limits.max}` : ''}
+          {a.config.drive?.kind === 'cia402' ? ` · CiA-402 drive, SubDevice ${a.config.drive.subdevice}` : ''}
         </span>
         <nav class="tabs">
           {tabLink('online', 'Online')}
@@ -80,6 +81,12 @@ export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
               </>
             )}
             <span data-testid="axis-error-text">{err.text}</span>
+            {err.driveCode && (
+              <>
+                {' '}
+                — <span data-testid="axis-drive-code" title="the drive's own error code (CiA-402 0x603F)">drive code <b>{err.driveCode}</b></span>
+              </>
+            )}
           </span>
           <ActionButton
             kind="danger"

@@ -33,6 +33,16 @@ export function Led({ on, label, tone = 'green', title }: { on: boolean | undefi
   );
 }
 
+/** A key figure: its label above its value; `tone` colours it (ok green, warn amber, bad red). */
+export function Kpi({ label, value, name, tone, title }: { label: string; value: string; name: string; tone?: 'ok' | 'warn' | 'bad'; title?: string }) {
+  return (
+    <div class={`kpi ${tone ? `kpi-${tone}` : ''}`} data-kpi={name} title={title}>
+      <span class="kpi-label">{label}</span>
+      <span class="kpi-value mono">{value}</span>
+    </div>
+  );
+}
+
 export function Panel({ title, children, class: cls, actions, id }: { title: ComponentChildren; children: ComponentChildren; class?: string; actions?: ComponentChildren; id?: string }) {
   return (
     <section class={`panel ${cls ?? ''}`} id={id}>

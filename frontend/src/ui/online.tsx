@@ -13,6 +13,7 @@ import { Inching } from './inching';
 import { Trend } from './trend';
 import { LiveIndicator } from './liveness';
 import { href } from '../router';
+import { hexId } from '../api/errors';
 import { P_JOG_FAST, P_JOG_SLOW, numParam, useParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
 
@@ -284,6 +285,11 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               </div>
             )}
             {s && s.homing_phase !== 'idle' && <div class="small muted">homing phase: {s.homing_phase}</div>}
+            {!!s?.drive_error_code && (
+              <div class="small text-error" data-testid="drive-error-code" title="the drive's own error code (CiA-402 0x603F)">
+                drive error code {hexId(s.drive_error_code)}
+              </div>
+            )}
           </Panel>
           <Trend axis={axis} unit={u} online={online} />
         </div>

@@ -68,6 +68,7 @@ export function Overview() {
                     {err ? (
                       <span class="err-text" title={err.code ?? undefined}>
                         {err.hex && <b>{err.hex}</b>} {err.text}
+                        {err.driveCode && <> — drive code {err.driveCode}</>}
                       </span>
                     ) : s?.drive_fault ? (
                       <span class="err-text">drive fault</span>

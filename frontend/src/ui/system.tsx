@@ -1,16 +1,15 @@
 // System: what a commissioning engineer checks before trusting the machine. The cycle's timing
 // (`GET /system` every 2 s: wake-up latency, compute time and period in µs, overruns), its
 // distributions (`GET /metrics?buckets=fine`), overruns over the last minutes (kept here), the
-// real-time grants, the drive bus, the audit log, and the configuration as one document:
+// real-time grants, the drive bus (ui/bus.tsx), the audit log, and the configuration as one document:
 // download it, or import a file after seeing what it would change.
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { ApiError, get, put } from '../api/rest';
-import type { AxisResource, Problem } from '../api/types';
+import type { Problem } from '../api/types';
 import { useStore } from '../store';
-import { axes, refreshAxes, statuses } from '../services';
+import { refreshAxes, statuses } from '../services';
 import { auth, may } from '../auth/session';
-import type { JSX } from 'preact';
-import { Lamp, Led, Panel, errorText } from './common';
+import { Kpi, Led, Panel, errorText } from './common';
 import { getCycleHistograms } from '../system/api';
 import type { CycleHistograms } from '../system/prometheus';
 import { HistogramChart, OverrunChart } from '../system/charts';
@@ -37,7 +36,7 @@ import {
   type AuditRecord,
 } from '../system/audit';
 import { diffConfig, diffCounts, exportName, importErrors, notADocument, valueText, type ConfigDiff, type ConfigDocument, type ItemDiff } from '../system/config-diff';
-import { buses, driveKind, ms, plantText, type Bus } from '../system/bus';
+import { BusPanel } from './bus';
 
 /** Polls of this page, kept while the page is away (the gap is drawn as one). */
 const history = new TimingHistory(HISTORY_S);
@@ -109,7 +108,7 @@ export function SystemPage() {
       <Panel title="Overruns over time" class="sys-overruns" actions={<span class="muted small">last {HISTORY_S / 60} min, kept by this page</span>}>
         <OverrunChart points={history.points} windowS={HISTORY_S} version={version} />
       </Panel>
-      <BusPanel sys={sys} />
+      <BusPanel />
       <ConfigPanel />
       <AuditPanel />
     </div>
@@ -170,15 +169,6 @@ function TimingPanel({ sys }: { sys: SystemResource | null }) {
         </>
       )}
     </Panel>
-  );
-}
-
-function Kpi({ label, value, name, tone }: { label: string; value: string; name: string; tone?: 'ok' | 'bad' }) {
-  return (
-    <div class={`kpi ${tone ? `kpi-${tone}` : ''}`} data-kpi={name}>
-      <span class="kpi-label">{label}</span>
-      <span class="kpi-value mono">{value}</span>
-    </div>
   );
 }
 
@@ -274,87 +264,6 @@ function HistogramPanel({ hist, error, version }: { hist: CycleHistograms | null
       </div>
       <p class="muted small sys-note">Cycles per bucket (≈6 % wide, log scale), from GET /metrics?buckets=fine.</p>
     </Panel>
-  );
-}
-
-/** How each bus is shown; an EtherCAT bus gets its own view here (SubDevices, states, …). */
-const BUS_VIEWS: Record<Bus['kind'], (p: { bus: Bus }) => JSX.Element> = {
-  simulated: SimulatedBus,
-  unknown: UnknownBus,
-};
-
-function BusPanel({ sys }: { sys: SystemResource | null }) {
-  const list = useStore(axes);
-  const all = buses(list);
-  return (
-    <Panel title="Bus" class="sys-bus" actions={sys && <span class="muted small">drive bus: {sys.drive_bus}</span>}>
-      {all.map((b) => {
-        const View = BUS_VIEWS[b.kind];
-        return <View key={b.kind} bus={b} />;
-      })}
-    </Panel>
-  );
-}
-
-function SimulatedBus({ bus }: { bus: Bus }) {
-  const st = useStore(statuses);
-  return (
-    <div class="bus" data-bus="simulated">
-      <h4 data-testid="bus-title">
-        Simulated bus: {bus.axes.length} {bus.axes.length === 1 ? 'axis' : 'axes'}
-      </h4>
-      {bus.axes.length > 0 && (
-        <div class="table-fit">
-          <table class="grid bus-table">
-            <thead>
-              <tr>
-                <th>Axis</th>
-                <th class="r hide-phone">Id</th>
-                <th>Drive</th>
-                <th>Plant</th>
-                <th class="r">Dead time</th>
-                <th class="r hide-phone">Enable delay</th>
-              </tr>
-            </thead>
-            <tbody>
-              {bus.axes.map((a) => (
-                <BusAxisRow key={a.id} a={a} state={st.get(a.config.name)?.status?.state ?? a.state} />
-              ))}
-            </tbody>
-          </table>
-        </div>
-      )}
-    </div>
-  );
-}
-
-function BusAxisRow({ a, state }: { a: AxisResource; state: AxisResource['state'] }) {
-  const d = a.config.drive;
-  return (
-    <tr data-axis={a.config.name}>
-      <td class="nowrap">
-        <Lamp state={state} />
-        <a href={`#/axes/${encodeURIComponent(a.config.name)}/config`}>
-          <b>{a.config.name}</b>
-        </a>
-      </td>
-      <td class="r mono hide-phone">{a.id}</td>
-      <td data-drive-kind={driveKind(a)}>{driveKind(a)}</td>
-      <td>{plantText(d?.plant).replace(/ /g, '\u00a0').replace(/,\u00a0/g, ', ')}</td>
-      <td class="r mono nowrap">{ms(d?.dead_time)}</td>
-      <td class="r mono nowrap hide-phone">{ms(d?.enable_delay)}</td>
-    </tr>
-  );
-}
-
-function UnknownBus({ bus }: { bus: Bus }) {
-  return (
-    <div class="bus" data-bus="unknown">
-      <h4>Other drives: {bus.axes.length}</h4>
-      <p class="muted small">
-        {bus.axes.map((a) => `${a.config.name} (${driveKind(a)})`).join(', ')}: drive kinds this page does not know yet.
-      </p>
-    </div>
   );
 }
 
