@@ -32,7 +32,70 @@ pub const MAX_PDI: usize = 1024;
 const MAX_FRAMES: usize = 16;
 const MAX_PDU_DATA: usize = PduStorage::element_size(1100);
 
-type Group = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op, HasDc>;
+type DcGroup = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op, HasDc>;
+type FreeGroup = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op>;
+
+/// The group in OP: with distributed clocks (SYNC0, the usual case for servo drives), or
+/// free-running when no SubDevice has a DC unit (then each exchange is a plain `tx_rx` and
+/// the drives take their setpoints when the frame passes).
+enum Group {
+    Dc(DcGroup),
+    Free(FreeGroup),
+}
+
+/// What one exchange read: working counter, AL states, and with DC the reference's time and
+/// the frame's offset in the SYNC0 period.
+struct Exchanged {
+    working_counter: u16,
+    states: heapless::Vec<SubDeviceState, MAX_SUBDEVICES>,
+    dc: Option<(u64, u64)>,
+}
+
+impl Group {
+    fn subdevice<'g>(
+        &'g self,
+        md: &'static MainDevice<'static>,
+        i: usize,
+    ) -> Result<
+        ethercrab::SubDeviceRef<
+            'static,
+            ethercrab::SubDevicePdi<'g, MAX_PDI, ethercrab::DefaultLock>,
+        >,
+        ethercrab::error::Error,
+    > {
+        match self {
+            Group::Dc(g) => g.subdevice(md, i),
+            Group::Free(g) => g.subdevice(md, i),
+        }
+    }
+
+    async fn exchange(
+        &self,
+        md: &'static MainDevice<'static>,
+    ) -> Result<Exchanged, ethercrab::error::Error> {
+        Ok(match self {
+            Group::Dc(g) => {
+                let r = g.tx_rx_dc(md).await?;
+                Exchanged {
+                    working_counter: r.working_counter,
+                    states: r.subdevice_states,
+                    dc: Some((
+                        r.extra.dc_system_time,
+                        r.extra.cycle_start_offset.as_nanos() as u64,
+                    )),
+                }
+            }
+            Group::Free(g) => {
+                let r = g.tx_rx(md).await?;
+                Exchanged {
+                    working_counter: r.working_counter,
+                    states: r.subdevice_states,
+                    dc: None,
+                }
+            }
+        })
+    }
+}
 
 /// Where the frames go.
 pub enum Link {
@@ -521,6 +584,23 @@ async fn bring_up(
             }
         }
     }
+    let deadline = Instant::now() + Duration::from_secs(10);
+    if !infos.iter().any(|i| i.dc) {
+        // No DC unit on the segment: free-running process data.
+        let group = group.into_safe_op(md).await.map_err(e("SAFE-OP"))?;
+        let group = group.request_into_op(md).await.map_err(e("OP request"))?;
+        loop {
+            let r = group.tx_rx(md).await.map_err(e("cycle towards OP"))?;
+            if r.all_op() {
+                break;
+            }
+            if Instant::now() > deadline {
+                return Err("the SubDevices did not reach OP within 10 s".into());
+            }
+            std::thread::sleep(opts.cycle);
+        }
+        return Ok((Group::Free(group), infos));
+    }
     // Distributed clocks: align the SubDevices' clocks, then SYNC0 at the cycle time.
     let started = Instant::now();
     for _ in 0..200 {
@@ -545,7 +625,6 @@ async fn bring_up(
         .map_err(e("DC SYNC0"))?;
     let group = group.into_safe_op(md).await.map_err(e("SAFE-OP"))?;
     let group = group.request_into_op(md).await.map_err(e("OP request"))?;
-    let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         let r = group.tx_rx_dc(md).await.map_err(e("cycle towards OP"))?;
         if r.all_op() {
@@ -556,7 +635,7 @@ async fn bring_up(
         }
         std::thread::sleep(r.extra.next_cycle_wait.min(opts.cycle));
     }
-    Ok((group, infos))
+    Ok((Group::Dc(group), infos))
 }
 
 impl DriveBus for EthercatBus {
@@ -569,7 +648,8 @@ impl DriveBus for EthercatBus {
     fn sync_error_ns(&self) -> Option<i64> {
         let period = self.status.cycle_ns as i64;
         let offset = self.status.dc_cycle_offset.load(Relaxed) as i64;
-        (period > 0 && self.errors_in_row == 0).then(|| {
+        let dc = matches!(self.group, Group::Dc(_));
+        (dc && period > 0 && self.errors_in_row == 0).then(|| {
             let e = offset - period / 2;
             // Wrapped into (−period/2, period/2].
             if e > period / 2 { e - period } else { e }
@@ -608,13 +688,14 @@ impl DriveBus for EthercatBus {
         }
         let st = &*self.status;
         st.frames.fetch_add(1, Relaxed);
-        let good = match block_on(self.group.tx_rx_dc(self.md)) {
+        let good = match block_on(self.group.exchange(self.md)) {
             Ok(r) => {
                 st.last_working_counter.store(r.working_counter, Relaxed);
-                st.dc_system_time.store(r.extra.dc_system_time, Relaxed);
-                st.dc_cycle_offset
-                    .store(r.extra.cycle_start_offset.as_nanos() as u64, Relaxed);
-                for (a, s) in st.al_states.iter().zip(&r.subdevice_states) {
+                if let Some((time, offset)) = r.dc {
+                    st.dc_system_time.store(time, Relaxed);
+                    st.dc_cycle_offset.store(offset, Relaxed);
+                }
+                for (a, s) in st.al_states.iter().zip(&r.states) {
                     a.store(
                         match s {
                             SubDeviceState::Other(v) => *v,

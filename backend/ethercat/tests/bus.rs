@@ -276,3 +276,68 @@ fn a_cst_axis_closes_its_loops_on_our_side_and_reaches_the_target() {
     }
     assert!(settled, "CST settles at the target: {:?}", fb[0]);
 }
+
+/// A segment without distributed clocks (ESCs without a DC unit) runs free: bring-up skips
+/// SYNC0, each exchange is a plain `tx_rx`, the cycle has no clock to follow, and a CSP drive
+/// still enables and follows.
+#[test]
+fn a_segment_without_dc_runs_free() {
+    let start = Instant::now();
+    let seg = Segment::with_dc(
+        vec![drive::servo(
+            Identity {
+                vendor_id: 0xACE,
+                product_code: 0x402,
+                revision: 1,
+                serial: 5,
+                name: "free".into(),
+            },
+            Plant::default(),
+        )],
+        Box::new(move || start.elapsed().as_nanos() as u64),
+        false,
+    )
+    .shared();
+    let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 2)
+        .expect("bring-up");
+    assert!(!bus.status().subdevices[0].dc);
+    let cfg = DriveConfig::Cia402(Cia402Config {
+        subdevice: 0,
+        increments_per_unit: 1000.0,
+        velocity_increments_per_unit: None,
+        mode: Cia402Mode::Csp,
+        position_gain: 50.0,
+        velocity_gain: 0.0,
+        acceleration_feed_forward: 0.0,
+        max_torque: 1000.0,
+    });
+    assert!(bus.attach(0, cfg.build(0.001)).unwrap().is_none());
+    let mut sp = vec![
+        DriveSetpoint {
+            enable: true,
+            ..DriveSetpoint::default()
+        },
+        DriveSetpoint::default(),
+    ];
+    let mut fb = vec![DriveFeedback::default(); 2];
+    let mut reached = false;
+    for k in 0..5000 {
+        bus.exchange(&sp, &mut fb);
+        assert_eq!(bus.sync_error_ns(), None, "no bus clock to follow");
+        std::thread::sleep(CYCLE);
+        if fb[0].enabled {
+            sp[0].position = (sp[0].position + 0.01).min(1.0);
+        }
+        if k > 10 && (fb[0].actual_position - 1.0).abs() < 0.002 {
+            reached = true;
+            break;
+        }
+    }
+    assert!(reached, "{:?}", fb[0]);
+    assert_eq!(
+        bus.status()
+            .lost_frames
+            .load(std::sync::atomic::Ordering::Relaxed),
+        0
+    );
+}

@@ -110,12 +110,14 @@ fn get_u64(mem: &[u8], addr: u16) -> u64 {
 }
 
 impl Esc {
-    /// `downstream`: another SubDevice follows on port 1 (its link is up).
+    /// `downstream`: another SubDevice follows on port 1 (its link is up); `dc`: it has a
+    /// distributed clock unit.
     pub fn new(
         sii: Vec<u8>,
         app: Box<dyn Application>,
         local_offset: u64,
         downstream: bool,
+        dc: bool,
     ) -> Esc {
         let mut mem = Box::new([0u8; 0x10000]);
         mem[0x0000] = 0x11; // ET1100-like
@@ -124,8 +126,13 @@ impl Esc {
         mem[0x0005] = 8; // SyncManagers
         mem[0x0006] = 8; // KiB of process RAM
         mem[0x0007] = 0x0F; // ports 0 and 1 EBUS/MII
-        // Support flags: DC supported, 64-bit DC, enhanced DC sync.
-        put_u16(&mut mem[..], 0x0008, (1 << 2) | (1 << 3) | (1 << 8));
+        // Support flags: DC supported, 64-bit DC, enhanced DC sync (or none of them).
+        let flags = if dc {
+            (1 << 2) | (1 << 3) | (1 << 8)
+        } else {
+            0
+        };
+        put_u16(&mut mem[..], 0x0008, flags);
         // DL status: port 0 linked and communicating; port 1 too when a device follows,
         // otherwise its loop is closed.
         let mut dl: u16 = (1 << 4) | (1 << 9);
@@ -148,6 +155,11 @@ impl Esc {
             downstream_round_trip: 0,
             app,
         }
+    }
+
+    /// Has a distributed clock unit (its registers 0x0900–0x09FF answer).
+    pub fn has_dc(&self) -> bool {
+        get_u16(&self.mem[..], 0x0008) & (1 << 2) != 0
     }
 
     pub fn station_address(&self) -> u16 {

@@ -80,6 +80,15 @@ impl Segment {
         apps: Vec<(Vec<u8>, Box<dyn Application>)>,
         clock: Box<dyn FnMut() -> u64 + Send>,
     ) -> Segment {
+        Segment::with_dc(apps, clock, true)
+    }
+
+    /// As [`Segment::new`]; `dc` false: ESCs without a distributed clock unit (free-run).
+    pub fn with_dc(
+        apps: Vec<(Vec<u8>, Box<dyn Application>)>,
+        clock: Box<dyn FnMut() -> u64 + Send>,
+        dc: bool,
+    ) -> Segment {
         let n = apps.len();
         let escs = apps
             .into_iter()
@@ -91,6 +100,7 @@ impl Segment {
                     app,
                     1_000_000 * (i as u64 + 1) + 777 * i as u64,
                     i + 1 < n,
+                    dc,
                 );
                 esc.downstream_round_trip = 2 * HOP_NS * (n - i - 1) as u64;
                 esc
@@ -171,9 +181,14 @@ impl Segment {
         let logical = u32::from_le_bytes([head[2], head[3], head[4], head[5]]);
         let mut position = adp;
         let mut scratch = vec![0u8; data.len()];
+        // Registers of a DC unit do not exist (and count nothing) in an ESC without one.
+        let dc_register = (0x0900..0x0A00).contains(&ado) && cmd < 10 || cmd == 14;
         for esc in &mut self.escs {
             let by_position = position == 0;
             position = position.wrapping_add(1);
+            if dc_register && !esc.has_dc() {
+                continue;
+            }
             let by_station = esc.station_address() == adp;
             match cmd {
                 // APRD, FPRD
