@@ -78,6 +78,21 @@ fn default_gain() -> f64 {
 }
 
 impl Cia402Config {
+    /// A CSP drive at `subdevice` with `increments_per_unit`, the other fields at the defaults
+    /// a configuration without them reads as.
+    pub fn csp(subdevice: u16, increments_per_unit: f64) -> Cia402Config {
+        Cia402Config {
+            subdevice,
+            increments_per_unit,
+            velocity_increments_per_unit: None,
+            mode: Cia402Mode::Csp,
+            position_gain: default_gain(),
+            velocity_gain: 0.0,
+            acceleration_feed_forward: 0.0,
+            max_torque: default_max_torque(),
+        }
+    }
+
     /// Checks every field; errors name the field by its JSON path below the drive object.
     pub fn validate(&self) -> Result<(), Vec<FieldError>> {
         let mut errors = Vec::new();

@@ -165,16 +165,7 @@ impl Device {
 }
 
 fn config() -> Cia402Config {
-    Cia402Config {
-        subdevice: 0,
-        increments_per_unit: 1000.0,
-        velocity_increments_per_unit: None,
-        mode: Cia402Mode::Csp,
-        position_gain: 50.0,
-        velocity_gain: 0.0,
-        acceleration_feed_forward: 0.0,
-        max_torque: 1000.0,
-    }
+    Cia402Config::csp(0, 1000.0)
 }
 
 fn enable() -> DriveSetpoint {

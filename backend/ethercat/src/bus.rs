@@ -163,6 +163,17 @@ const TX_OBJ: [u32; 10] = [
     0x60BB_0020,
 ];
 
+/// The mapped objects (`offsets[i]` of `objects[i]`), in the order of their offsets.
+fn in_image_order(offsets: &[Option<usize>], objects: &[u32]) -> Vec<u32> {
+    let mut v: Vec<(usize, u32)> = offsets
+        .iter()
+        .zip(objects)
+        .filter_map(|(o, &obj)| o.map(|o| (o, obj)))
+        .collect();
+    v.sort();
+    v.into_iter().map(|(_, o)| o).collect()
+}
+
 impl Layout {
     fn of(name: &'static str, rx: &[usize], tx: &[usize]) -> Layout {
         let mut l = Layout {
@@ -189,18 +200,10 @@ impl Layout {
         Layout::of("minimal", &[0, 1, 4], &[0, 1, 4, 5])
     }
     fn rx_objects(&self) -> Vec<u32> {
-        let mut v: Vec<(usize, u32)> = (0..6)
-            .filter_map(|i| self.rx[i].map(|o| (o, RX_OBJ[i])))
-            .collect();
-        v.sort();
-        v.into_iter().map(|(_, o)| o).collect()
+        in_image_order(&self.rx, &RX_OBJ)
     }
     fn tx_objects(&self) -> Vec<u32> {
-        let mut v: Vec<(usize, u32)> = (0..10)
-            .filter_map(|i| self.tx[i].map(|o| (o, TX_OBJ[i])))
-            .collect();
-        v.sort();
-        v.into_iter().map(|(_, o)| o).collect()
+        in_image_order(&self.tx, &TX_OBJ)
     }
 
     fn encode(&self, rx: &RxPdo, out: &mut [u8]) {

@@ -3,57 +3,31 @@
 //! fault reaches the feedback with its 0x603F code, lost frames fault the bus's axes after N
 //! in a row and MC_Reset's edge clears it once frames flow.
 
-use std::time::{Duration, Instant};
+mod common;
 
+use std::time::Duration;
+
+use common::servos;
 use drives::cia402::{Cia402Config, Cia402Mode};
 use drives::{DriveBus, DriveConfig};
 use ethercat::bus::{BusOptions, EthercatBus, Link};
-use ethercat::emu::Segment;
-use ethercat::emu::drive::{self, Cia402Emu, Plant};
-use ethercat::emu::sii::Identity;
+use ethercat::emu::drive::{self, Cia402Emu};
 use motion::{DriveFeedback, DriveSetpoint};
 
 const CYCLE: Duration = Duration::from_millis(1);
 
 #[test]
 fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
-    let start = Instant::now();
-    let seg = Segment::new(
-        (0..2)
-            .map(|i| {
-                drive::servo(
-                    Identity {
-                        vendor_id: 0xACE,
-                        product_code: 0x402,
-                        revision: 1,
-                        serial: i,
-                        name: format!("servo {i}"),
-                    },
-                    Plant::default(),
-                )
-            })
-            .collect(),
-        Box::new(move || start.elapsed().as_nanos() as u64),
-    )
-    .shared();
+    let seg = servos(2, true);
     let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 4)
         .expect("bring-up");
     let status = bus.status();
     assert_eq!(status.subdevices.len(), 2);
-    assert_eq!(status.subdevices[1].name, "servo 1");
+    assert_eq!(status.subdevices[1].name, "motiond servo 1");
     assert_eq!(status.subdevices[0].drive.map(|l| l.name), Some("full"));
     assert_eq!(status.expected_working_counter, 6);
 
-    let cfg = DriveConfig::Cia402(Cia402Config {
-        subdevice: 1,
-        increments_per_unit: 1000.0,
-        velocity_increments_per_unit: None,
-        mode: Cia402Mode::Csp,
-        position_gain: 50.0,
-        velocity_gain: 0.0,
-        acceleration_feed_forward: 0.0,
-        max_torque: 1000.0,
-    });
+    let cfg = DriveConfig::Cia402(Cia402Config::csp(1, 1000.0));
     assert!(bus.attach(2, cfg.build(0.001)).unwrap().is_none());
     let mut sp = vec![DriveSetpoint::default(); 4];
     let mut fb = vec![DriveFeedback::default(); 4];
@@ -193,7 +167,7 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
     // SDO from another thread while the cycle runs.
     let sdo = bus.sdo();
     let v = futures_lite::future::block_on(sdo.read(1, 0x1018, 4)).unwrap();
-    assert_eq!(v, 1u32.to_le_bytes());
+    assert_eq!(v, common::identity(1).serial.to_le_bytes());
     let e = futures_lite::future::block_on(sdo.read(1, 0x2000, 0)).unwrap_err();
     assert_eq!(e, ethercat::bus::SdoError::Abort(0x0602_0000));
 }
@@ -202,32 +176,15 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
 /// emulated drive's plant (inertia and friction) follows a slow move to the target.
 #[test]
 fn a_cst_axis_closes_its_loops_on_our_side_and_reaches_the_target() {
-    let start = Instant::now();
-    let seg = Segment::new(
-        vec![drive::servo(
-            Identity {
-                vendor_id: 0xACE,
-                product_code: 0x402,
-                revision: 1,
-                serial: 9,
-                name: "cst".into(),
-            },
-            Plant::default(),
-        )],
-        Box::new(move || start.elapsed().as_nanos() as u64),
-    )
-    .shared();
+    let seg = servos(1, true);
     let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 2)
         .expect("bring-up");
     let cfg = DriveConfig::Cia402(Cia402Config {
-        subdevice: 0,
-        increments_per_unit: 1000.0,
-        velocity_increments_per_unit: None,
         mode: Cia402Mode::Cst,
         position_gain: 20.0,
         velocity_gain: 40.0,
         acceleration_feed_forward: 0.5,
-        max_torque: 1000.0,
+        ..Cia402Config::csp(0, 1000.0)
     });
     assert!(cfg.validate().is_ok());
     assert!(bus.attach(0, cfg.build(0.001)).unwrap().is_none());
@@ -282,35 +239,11 @@ fn a_cst_axis_closes_its_loops_on_our_side_and_reaches_the_target() {
 /// still enables and follows.
 #[test]
 fn a_segment_without_dc_runs_free() {
-    let start = Instant::now();
-    let seg = Segment::with_dc(
-        vec![drive::servo(
-            Identity {
-                vendor_id: 0xACE,
-                product_code: 0x402,
-                revision: 1,
-                serial: 5,
-                name: "free".into(),
-            },
-            Plant::default(),
-        )],
-        Box::new(move || start.elapsed().as_nanos() as u64),
-        false,
-    )
-    .shared();
+    let seg = servos(1, false);
     let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 2)
         .expect("bring-up");
     assert!(!bus.status().subdevices[0].dc);
-    let cfg = DriveConfig::Cia402(Cia402Config {
-        subdevice: 0,
-        increments_per_unit: 1000.0,
-        velocity_increments_per_unit: None,
-        mode: Cia402Mode::Csp,
-        position_gain: 50.0,
-        velocity_gain: 0.0,
-        acceleration_feed_forward: 0.0,
-        max_torque: 1000.0,
-    });
+    let cfg = DriveConfig::Cia402(Cia402Config::csp(0, 1000.0));
     assert!(bus.attach(0, cfg.build(0.001)).unwrap().is_none());
     let mut sp = vec![
         DriveSetpoint {

@@ -3,11 +3,12 @@
 //! distributed clocks with SYNC0, SAFE-OP → OP, the CiA-402 enable sequence and a CSP move,
 //! one setpoint per SYNC0 pulse; SDO aborts with their CiA-301 codes; a drive fault.
 
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+mod common;
 
-use ethercat::emu::drive::{self, Cia402Emu, Plant};
-use ethercat::emu::sii::Identity;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use ethercat::emu::drive::{self, Cia402Emu};
 use ethercat::emu::{Segment, transport};
 use ethercrab::error::{Error, MailboxError};
 use ethercrab::subdevice_group::DcConfiguration;
@@ -17,25 +18,8 @@ use futures_lite::future::block_on;
 const MAX_PDU_DATA: usize = PduStorage::element_size(1100);
 const CYCLE: Duration = Duration::from_millis(1);
 
-fn identity(i: u32) -> Identity {
-    Identity {
-        vendor_id: 0x0000_0ACE,
-        product_code: 0x0402_0001,
-        revision: 0x0001_0000 + i,
-        serial: 1000 + i,
-        name: format!("motiond servo {i}"),
-    }
-}
-
 fn segment(n: u32) -> Arc<Mutex<Segment>> {
-    let start = Instant::now();
-    Segment::new(
-        (0..n)
-            .map(|i| drive::servo(identity(i), Plant::default()))
-            .collect(),
-        Box::new(move || start.elapsed().as_nanos() as u64),
-    )
-    .shared()
+    common::servos(n, true)
 }
 
 fn maindevice(

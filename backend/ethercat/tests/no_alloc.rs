@@ -3,16 +3,15 @@
 //! emulator's own thread allocates; it is not counted). One test in this file, so no other
 //! test thread can be counted by mistake.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use drives::cia402::{Cia402Config, Cia402Mode};
+use drives::cia402::Cia402Config;
 use drives::{DriveBus, DriveConfig};
 use ethercat::bus::{BusOptions, EthercatBus, Link};
-use ethercat::emu::Segment;
-use ethercat::emu::drive::{self, Plant};
-use ethercat::emu::sii::Identity;
 use motion::{DriveFeedback, DriveSetpoint};
 
 struct Counting;
@@ -53,34 +52,11 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn the_exchange_does_not_allocate() {
-    let start = Instant::now();
-    let seg = Segment::new(
-        vec![drive::servo(
-            Identity {
-                vendor_id: 0xACE,
-                product_code: 0x402,
-                revision: 1,
-                serial: 3,
-                name: "na".into(),
-            },
-            Plant::default(),
-        )],
-        Box::new(move || start.elapsed().as_nanos() as u64),
-    )
-    .shared();
+    let seg = common::servos(1, true);
     let cycle = Duration::from_millis(1);
     let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(cycle), 2)
         .expect("bring-up");
-    let cfg = DriveConfig::Cia402(Cia402Config {
-        subdevice: 0,
-        increments_per_unit: 1000.0,
-        velocity_increments_per_unit: None,
-        mode: Cia402Mode::Csp,
-        position_gain: 50.0,
-        velocity_gain: 0.0,
-        acceleration_feed_forward: 0.0,
-        max_torque: 1000.0,
-    });
+    let cfg = DriveConfig::Cia402(Cia402Config::csp(0, 1000.0));
     assert!(bus.attach(0, cfg.build(0.001)).unwrap().is_none());
     let mut sp = vec![
         DriveSetpoint {

@@ -363,16 +363,10 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
 /// CiA-402 servo at its position (1 µm per increment on the linear axes, 0.01° on the spindle).
 fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
     for (i, a) in axes.iter_mut().enumerate() {
-        a.drive = DriveConfig::Cia402(drives::cia402::Cia402Config {
-            subdevice: i as u16,
-            increments_per_unit: if a.modulo.is_some() { 100.0 } else { 1000.0 },
-            velocity_increments_per_unit: None,
-            mode: drives::cia402::Cia402Mode::Csp,
-            position_gain: 50.0,
-            velocity_gain: 0.0,
-            acceleration_feed_forward: 0.0,
-            max_torque: 1000.0,
-        });
+        a.drive = DriveConfig::Cia402(drives::cia402::Cia402Config::csp(
+            i as u16,
+            if a.modulo.is_some() { 100.0 } else { 1000.0 },
+        ));
     }
 }
 

@@ -583,6 +583,3 @@ pub fn servo(id: Identity, plant: Plant) -> (Vec<u8>, Box<dyn Application>) {
     let sii = super::sii::servo_drive(&id);
     (sii, Box::new(Cia402Emu::new(&id, plant)))
 }
-
-#[allow(dead_code)]
-const _: () = assert!(AL_OP == 8);

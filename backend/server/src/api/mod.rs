@@ -708,16 +708,7 @@ impl utoipa::Modify for ForeignExamples {
             ),
             (
                 "Cia402Config",
-                to_value(drives::cia402::Cia402Config {
-                    subdevice: 0,
-                    increments_per_unit: 10_000.0,
-                    velocity_increments_per_unit: None,
-                    mode: drives::cia402::Cia402Mode::Csp,
-                    position_gain: 50.0,
-                    velocity_gain: 0.0,
-                    acceleration_feed_forward: 0.0,
-                    max_torque: 1000.0,
-                }),
+                to_value(drives::cia402::Cia402Config::csp(0, 10_000.0)),
             ),
             ("PlantModel", to_value(drive.plant)),
             ("ReferenceCam", to_value(drive.reference_cam)),

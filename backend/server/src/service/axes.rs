@@ -280,15 +280,16 @@ pub async fn replace(
     };
     let (id, slot, old_name, (old_config, old_params, old_persistent)) = entry;
     check_name_free(s, &config.name, Some(id))?;
-    // The dry run answers what the save would: a drive the bus does not have is a 422 here too.
-    s.check_drive_on_bus(id, &config.drive)
-        .map_err(AppError::Invalid)?;
     let Plan {
         mut change,
         writes,
         kept,
     } = plan;
     if dry_run {
+        // What the save would answer: a drive the bus does not have is a 422 here too (the
+        // save itself checks it where the axis is built).
+        s.check_drive_on_bus(id, &config.drive)
+            .map_err(AppError::Invalid)?;
         change.dry_run = true;
         return Ok(AxisResource {
             id,
