@@ -447,6 +447,7 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
             enable_positive: true,
             enable_negative: true,
             override_percent: 100.0,
+            buffer_mode: motion::BufferMode::Aborting,
         },
     };
     assert_eq!(k.submit(power, &mut events), Verdict::Accepted);

@@ -93,6 +93,7 @@ impl Machine {
             enable_positive: true,
             enable_negative: true,
             override_percent: 100.0,
+            buffer_mode: motion::BufferMode::Aborting,
         });
         self.until(0.5, |m| m.st().state == AxisState::Standstill);
     }

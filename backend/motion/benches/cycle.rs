@@ -60,6 +60,7 @@ impl Machine {
                     enable_positive: true,
                     enable_negative: true,
                     override_percent: 100.0,
+                    buffer_mode: BufferMode::Aborting,
                 },
             );
         }
@@ -131,6 +132,7 @@ impl Machine {
                             enable_positive: true,
                             enable_negative: true,
                             override_percent: o,
+                            buffer_mode: BufferMode::Aborting,
                         },
                     );
                 }
@@ -251,6 +253,7 @@ fn cam_machine() -> Machine {
                 enable_positive: true,
                 enable_negative: true,
                 override_percent: 100.0,
+                buffer_mode: BufferMode::Aborting,
             },
         );
     }

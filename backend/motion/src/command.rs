@@ -240,6 +240,9 @@ pub enum CommandKind {
         enable_positive: bool,
         enable_negative: bool,
         override_percent: f64,
+        /// Evaluated when the enable is removed (§4.1.1): `Aborting` disables at once, any
+        /// other mode waits until the axis no longer executes a job.
+        buffer_mode: BufferMode,
     },
     /// MC_Reset.
     Reset,

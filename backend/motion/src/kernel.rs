@@ -429,6 +429,7 @@ mod tests {
                 enable_positive: true,
                 enable_negative: true,
                 override_percent: 100.0,
+                buffer_mode: BufferMode::Aborting,
             };
             accept(&mut k, 1 + a as u64, a, power, &mut e);
         }

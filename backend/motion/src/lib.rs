@@ -36,7 +36,7 @@
 //!     enable: true,
 //!     enable_positive: true,
 //!     enable_negative: true,
-//!     override_percent: 100.0,
+//!     override_percent: 100.0, buffer_mode: BufferMode::Aborting,
 //! };
 //! let verdict = kernel.submit(Command { id: 1, axis: 0, kind: power }, &mut events);
 //! assert_eq!(verdict, Verdict::Accepted);
@@ -78,4 +78,4 @@ pub use drive::{DriveFeedback, DriveSetpoint, LatchSource};
 pub use error::ErrorId;
 pub use kernel::Kernel;
 pub use params::AxisParameters;
-pub use status::{AxisState, AxisStatus, HomingPhase, ProbeStatus};
+pub use status::{AxisOpModes, AxisState, AxisStatus, HomingPhase, ProbeStatus};

@@ -153,6 +153,65 @@ pub struct AxisStatus {
     pub cam: crate::cam::CamInfo,
     /// MC_TouchProbe: armed, and what the last probe cycle recorded.
     pub probe: ProbeStatus,
+    // ST_AxisStatus (MC_ReadStatus, spec §6.11.13): the StateDWord flags the fields above do
+    // not give already.
+    /// StateDWord bit 0: ready for operation (enabled, drive ready, no error).
+    pub operational: bool,
+    /// Bit 20: operational and the position loop closed (false while MC_TorqueControl has
+    /// the drive in torque mode).
+    pub control_loop_closed: bool,
+    /// Bit 2: the set velocity is zero.
+    pub not_moving: bool,
+    /// Bit 7: the last motion was ended by a stop (MC_Stop, an error or a monitoring stop:
+    /// feed enable, software limit) rather than reaching its end; cleared by the next motion
+    /// command.
+    pub has_been_stopped: bool,
+    /// Bit 11: a homing run is busy.
+    pub homing_busy: bool,
+    /// Bit 16: the touch probe holds a latched position from its last completed probe cycle
+    /// (cleared when a new probe cycle is armed or one is aborted).
+    pub external_latch_valid: bool,
+    /// Bit 17: the running positioning job got a new target while the axis moved (an
+    /// Aborting command replacing a move, a blended successor, MC_MoveAdditive).
+    pub new_target_position: bool,
+    /// Bit 25: point-to-point mode — the axis is not a coupled slave.
+    pub ptp_mode: bool,
+    /// Bit 30: the drive's process data are not valid (a lost or refused bus exchange).
+    pub io_data_invalid: bool,
+    /// The kernel's cycle counter when this status was made (`NcCycleCounter`).
+    pub nc_cycle_counter: u64,
+    /// `ST_AxisOpModes`: the operating modes the parameters switch on (OpModeDWord).
+    pub op_modes: AxisOpModes,
+}
+
+/// `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AxisOpModes {
+    /// Bit 0: #1023 AxisEnPositionRangeMonitoring.
+    pub position_area_monitoring: bool,
+    /// Bit 1: #1025 AxisEnTargetPositionMonitoring.
+    pub target_position_monitoring: bool,
+    /// Bit 2: #1034 AxisEnLoopingDistance.
+    pub loop_mode: bool,
+    /// Bit 3: #1030 AxisEnMotionMonitoring.
+    pub motion_monitoring: bool,
+    /// Bit 4: #1028 AxisEnInTargetTimeout.
+    pub peh_time_monitoring: bool,
+    /// Bit 7: the axis is a modulo axis.
+    pub modulo: bool,
+    /// Bit 16: #1020 AxisEnPositionLagMonitoring.
+    pub position_lag_monitoring: bool,
+    /// Bit 18: #1016 AxisEnMinSoftPosLimit.
+    pub soft_limit_min_monitoring: bool,
+    /// Bit 19: #1018 AxisEnMaxSoftPosLimit.
+    pub soft_limit_max_monitoring: bool,
+    /// Bit 20: #1046 AxisEnablePosCorrection.
+    pub position_correction: bool,
+    /// Bit 21: #1065 AxisAllowMotionCmdToSlaveAxis.
+    pub allow_slave_commands: bool,
+    /// Bit 22: #1066 AxisAllowMotionCmdToExtSetAxis.
+    pub allow_ext_set_axis_commands: bool,
 }
 
 /// The touch probe of an axis (`MC_TouchProbeRecordedData` of its last probe cycle).

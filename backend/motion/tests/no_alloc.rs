@@ -85,6 +85,7 @@ fn step_and_replanning_allocate_nothing() {
                 enable_positive: true,
                 enable_negative: true,
                 override_percent: 100.0,
+                buffer_mode: BufferMode::Aborting,
             },
         );
     }
@@ -184,6 +185,7 @@ fn step_and_replanning_allocate_nothing() {
                 enable_positive: true,
                 enable_negative: true,
                 override_percent: o,
+                buffer_mode: BufferMode::Aborting,
             },
         );
         if c == 0 {

@@ -59,7 +59,7 @@ fn positioning() -> impl Strategy<Value = Positioning> {
 
 fn command() -> impl Strategy<Value = CommandKind> {
     prop_oneof![
-        3 => (any::<bool>(), 0.0..=100.0f64).prop_map(|(enable, o)| CommandKind::Power { enable, enable_positive: true, enable_negative: true, override_percent: o }),
+        3 => (any::<bool>(), 0.0..=100.0f64, buffer_mode()).prop_map(|(enable, o, buffer_mode)| CommandKind::Power { enable, enable_positive: true, enable_negative: true, override_percent: o, buffer_mode }),
         1 => Just(CommandKind::Reset),
         4 => positioning().prop_map(CommandKind::MoveAbsolute),
         2 => positioning().prop_map(CommandKind::MoveRelative),
@@ -312,7 +312,7 @@ proptest! {
         }
         // Switching both axes off ends every command: nothing stays busy for ever.
         for axis in 0..2u16 {
-            r.cmd(axis, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 });
+            r.cmd(axis, CommandKind::Power { enable: false, enable_positive: false, enable_negative: false, override_percent: 100.0 , buffer_mode: BufferMode::Aborting});
         }
         r.run(0.5);
         let busy = r.busy_commands();

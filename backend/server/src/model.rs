@@ -539,6 +539,10 @@ pub struct PowerBody {
     /// Velocity override in percent (0–100).
     #[schema(minimum = 0, maximum = 100)]
     pub override_percent: f64,
+    /// How removing the enable (enable=false, or DELETE of the enabling command) acts:
+    /// `aborting` (default) disables at once; any other mode waits until the axis no longer
+    /// executes a job (§4.1.1), the command staying busy until then.
+    pub buffer_mode: BufferMode,
 }
 impl Default for PowerBody {
     fn default() -> Self {
@@ -547,6 +551,7 @@ impl Default for PowerBody {
             enable_positive: true,
             enable_negative: true,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         }
     }
 }

@@ -110,6 +110,7 @@ fn a_cycle_allocates_nothing() {
                         enable_positive: true,
                         enable_negative: true,
                         override_percent: 100.0,
+                        buffer_mode: motion::BufferMode::Aborting,
                     };
                     assert!(
                         shared

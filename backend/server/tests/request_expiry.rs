@@ -41,6 +41,7 @@ fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
                 enable_positive: true,
                 enable_negative: true,
                 override_percent: 100.0,
+                buffer_mode: motion::BufferMode::Aborting,
             },
         })
     };

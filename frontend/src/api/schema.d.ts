@@ -1481,6 +1481,33 @@ export interface components {
              */
             jog_deadman_max: number;
         };
+        /** @description `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters. */
+        AxisOpModes: {
+            /** @description Bit 0: #1023 AxisEnPositionRangeMonitoring. */
+            position_area_monitoring: boolean;
+            /** @description Bit 1: #1025 AxisEnTargetPositionMonitoring. */
+            target_position_monitoring: boolean;
+            /** @description Bit 2: #1034 AxisEnLoopingDistance. */
+            loop_mode: boolean;
+            /** @description Bit 3: #1030 AxisEnMotionMonitoring. */
+            motion_monitoring: boolean;
+            /** @description Bit 4: #1028 AxisEnInTargetTimeout. */
+            peh_time_monitoring: boolean;
+            /** @description Bit 7: the axis is a modulo axis. */
+            modulo: boolean;
+            /** @description Bit 16: #1020 AxisEnPositionLagMonitoring. */
+            position_lag_monitoring: boolean;
+            /** @description Bit 18: #1016 AxisEnMinSoftPosLimit. */
+            soft_limit_min_monitoring: boolean;
+            /** @description Bit 19: #1018 AxisEnMaxSoftPosLimit. */
+            soft_limit_max_monitoring: boolean;
+            /** @description Bit 20: #1046 AxisEnablePosCorrection. */
+            position_correction: boolean;
+            /** @description Bit 21: #1065 AxisAllowMotionCmdToSlaveAxis. */
+            allow_slave_commands: boolean;
+            /** @description Bit 22: #1066 AxisAllowMotionCmdToExtSetAxis. */
+            allow_ext_set_axis_commands: boolean;
+        };
         /**
          * @description An axis as the API shows it.
          * @example {
@@ -1653,6 +1680,7 @@ export interface components {
          *       "command_buffered": false,
          *       "compensating": false,
          *       "constant_velocity": true,
+         *       "control_loop_closed": false,
          *       "coupled": false,
          *       "decelerating": false,
          *       "drive_error_code": 0,
@@ -1660,15 +1688,19 @@ export interface components {
          *       "enable_negative": true,
          *       "enable_positive": true,
          *       "error_id": 0,
+         *       "external_latch_valid": false,
          *       "following_error": 0.002,
          *       "following_error_max": 0.0219,
          *       "following_error_min": -0.0001,
          *       "gear_ratio": 0,
+         *       "has_been_stopped": false,
          *       "has_job": true,
          *       "homed": true,
+         *       "homing_busy": false,
          *       "homing_phase": "idle",
          *       "in_position_area": false,
          *       "in_target_position": false,
+         *       "io_data_invalid": false,
          *       "modulo_actual_position": 64.109,
          *       "modulo_set_position": 64.111,
          *       "modulo_set_turns": 0,
@@ -1676,6 +1708,24 @@ export interface components {
          *       "moving": true,
          *       "moving_backward": false,
          *       "moving_forward": true,
+         *       "nc_cycle_counter": 0,
+         *       "new_target_position": false,
+         *       "not_moving": false,
+         *       "op_modes": {
+         *         "allow_ext_set_axis_commands": false,
+         *         "allow_slave_commands": false,
+         *         "loop_mode": false,
+         *         "modulo": false,
+         *         "motion_monitoring": false,
+         *         "peh_time_monitoring": false,
+         *         "position_area_monitoring": false,
+         *         "position_correction": false,
+         *         "position_lag_monitoring": false,
+         *         "soft_limit_max_monitoring": false,
+         *         "soft_limit_min_monitoring": false,
+         *         "target_position_monitoring": false
+         *       },
+         *       "operational": false,
          *       "override_percent": 100,
          *       "power_override_percent": 0,
          *       "power_status": true,
@@ -1687,6 +1737,7 @@ export interface components {
          *         "modulo_position": 0,
          *         "recorded_position": 0
          *       },
+         *       "ptp_mode": false,
          *       "remaining_distance": 185.889,
          *       "remaining_time": 1.019,
          *       "set_acceleration": 0,
@@ -1835,6 +1886,44 @@ export interface components {
             cam: components["schemas"]["CamInfo"];
             /** @description MC_TouchProbe: armed, and what the last probe cycle recorded. */
             probe: components["schemas"]["ProbeStatus"];
+            /** @description StateDWord bit 0: ready for operation (enabled, drive ready, no error). */
+            operational: boolean;
+            /**
+             * @description Bit 20: operational and the position loop closed (false while MC_TorqueControl has
+             *     the drive in torque mode).
+             */
+            control_loop_closed: boolean;
+            /** @description Bit 2: the set velocity is zero. */
+            not_moving: boolean;
+            /**
+             * @description Bit 7: the last motion was ended by a stop (MC_Stop, an error or a monitoring stop:
+             *     feed enable, software limit) rather than reaching its end; cleared by the next motion
+             *     command.
+             */
+            has_been_stopped: boolean;
+            /** @description Bit 11: a homing run is busy. */
+            homing_busy: boolean;
+            /**
+             * @description Bit 16: the touch probe holds a latched position from its last completed probe cycle
+             *     (cleared when a new probe cycle is armed or one is aborted).
+             */
+            external_latch_valid: boolean;
+            /**
+             * @description Bit 17: the running positioning job got a new target while the axis moved (an
+             *     Aborting command replacing a move, a blended successor, MC_MoveAdditive).
+             */
+            new_target_position: boolean;
+            /** @description Bit 25: point-to-point mode — the axis is not a coupled slave. */
+            ptp_mode: boolean;
+            /** @description Bit 30: the drive's process data are not valid (a lost or refused bus exchange). */
+            io_data_invalid: boolean;
+            /**
+             * Format: int64
+             * @description The kernel's cycle counter when this status was made (`NcCycleCounter`).
+             */
+            nc_cycle_counter: number;
+            /** @description `ST_AxisOpModes`: the operating modes the parameters switch on (OpModeDWord). */
+            op_modes: components["schemas"]["AxisOpModes"];
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
@@ -3899,6 +3988,7 @@ export interface components {
          *       "command_buffered": false,
          *       "compensating": false,
          *       "constant_velocity": true,
+         *       "control_loop_closed": false,
          *       "coupled": false,
          *       "decelerating": false,
          *       "drive_error_code": 0,
@@ -3906,15 +3996,19 @@ export interface components {
          *       "enable_negative": true,
          *       "enable_positive": true,
          *       "error_id": 0,
+         *       "external_latch_valid": false,
          *       "following_error": 0.002,
          *       "following_error_max": 0.0219,
          *       "following_error_min": -0.0001,
          *       "gear_ratio": 0,
+         *       "has_been_stopped": false,
          *       "has_job": true,
          *       "homed": true,
+         *       "homing_busy": false,
          *       "homing_phase": "idle",
          *       "in_position_area": false,
          *       "in_target_position": false,
+         *       "io_data_invalid": false,
          *       "master": null,
          *       "modulo_actual_position": 64.109,
          *       "modulo_set_position": 64.111,
@@ -3923,6 +4017,24 @@ export interface components {
          *       "moving": true,
          *       "moving_backward": false,
          *       "moving_forward": true,
+         *       "nc_cycle_counter": 0,
+         *       "new_target_position": false,
+         *       "not_moving": false,
+         *       "op_modes": {
+         *         "allow_ext_set_axis_commands": false,
+         *         "allow_slave_commands": false,
+         *         "loop_mode": false,
+         *         "modulo": false,
+         *         "motion_monitoring": false,
+         *         "peh_time_monitoring": false,
+         *         "position_area_monitoring": false,
+         *         "position_correction": false,
+         *         "position_lag_monitoring": false,
+         *         "soft_limit_max_monitoring": false,
+         *         "soft_limit_min_monitoring": false,
+         *         "target_position_monitoring": false
+         *       },
+         *       "operational": false,
          *       "override_percent": 100,
          *       "power_override_percent": 0,
          *       "power_status": true,
@@ -3934,6 +4046,7 @@ export interface components {
          *         "modulo_position": 0,
          *         "recorded_position": 0
          *       },
+         *       "ptp_mode": false,
          *       "remaining_distance": 185.889,
          *       "remaining_time": 1.019,
          *       "set_acceleration": 0,
@@ -4573,6 +4686,8 @@ export interface components {
              * @default 100
              */
             override_percent: number;
+            /** @default aborting */
+            buffer_mode: components["schemas"]["BufferMode"];
         };
         /**
          * @description `MC_TouchProbeRecordedData` of a done probe cycle.
@@ -5335,6 +5450,7 @@ export interface components {
          *         "command_buffered": false,
          *         "compensating": false,
          *         "constant_velocity": true,
+         *         "control_loop_closed": false,
          *         "coupled": false,
          *         "decelerating": false,
          *         "drive_error_code": 0,
@@ -5342,15 +5458,19 @@ export interface components {
          *         "enable_negative": true,
          *         "enable_positive": true,
          *         "error_id": 0,
+         *         "external_latch_valid": false,
          *         "following_error": 0.002,
          *         "following_error_max": 0.0219,
          *         "following_error_min": -0.0001,
          *         "gear_ratio": 0,
+         *         "has_been_stopped": false,
          *         "has_job": true,
          *         "homed": true,
+         *         "homing_busy": false,
          *         "homing_phase": "idle",
          *         "in_position_area": false,
          *         "in_target_position": false,
+         *         "io_data_invalid": false,
          *         "master": null,
          *         "modulo_actual_position": 64.109,
          *         "modulo_set_position": 64.111,
@@ -5359,6 +5479,24 @@ export interface components {
          *         "moving": true,
          *         "moving_backward": false,
          *         "moving_forward": true,
+         *         "nc_cycle_counter": 0,
+         *         "new_target_position": false,
+         *         "not_moving": false,
+         *         "op_modes": {
+         *           "allow_ext_set_axis_commands": false,
+         *           "allow_slave_commands": false,
+         *           "loop_mode": false,
+         *           "modulo": false,
+         *           "motion_monitoring": false,
+         *           "peh_time_monitoring": false,
+         *           "position_area_monitoring": false,
+         *           "position_correction": false,
+         *           "position_lag_monitoring": false,
+         *           "soft_limit_max_monitoring": false,
+         *           "soft_limit_min_monitoring": false,
+         *           "target_position_monitoring": false
+         *         },
+         *         "operational": false,
          *         "override_percent": 100,
          *         "power_override_percent": 0,
          *         "power_status": true,
@@ -5370,6 +5508,7 @@ export interface components {
          *           "modulo_position": 0,
          *           "recorded_position": 0
          *         },
+         *         "ptp_mode": false,
          *         "remaining_distance": 185.889,
          *         "remaining_time": 1.019,
          *         "set_acceleration": 0,

@@ -50,6 +50,7 @@ impl Axis {
                 enable_positive,
                 enable_negative,
                 override_percent,
+                buffer_mode,
             } => {
                 if !(0.0..=100.0).contains(&override_percent) {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
@@ -60,25 +61,33 @@ impl Axis {
                 if let Some(mut old) = self.power.take() {
                     old.end(cx, End::Aborted);
                 }
+                let holds = Held::start(
+                    cx,
+                    cmd.id,
+                    FbOutputs {
+                        busy: true,
+                        active: true,
+                        status: self.status.power_status,
+                        ..FbOutputs::default()
+                    },
+                );
+                self.disable_when_idle = false;
                 if enable {
                     if !self.enable {
                         self.power_on_timer = 0.0;
                     }
                     self.enable = true;
-                    let held = Held::start(
-                        cx,
-                        cmd.id,
-                        FbOutputs {
-                            busy: true,
-                            active: true,
-                            status: self.status.power_status,
-                            ..FbOutputs::default()
-                        },
-                    );
-                    self.power = Some(held);
+                    self.power_buffer_mode = buffer_mode;
+                    self.power = Some(holds);
+                } else if buffer_mode != BufferMode::Aborting && self.enable && self.executes_job()
+                {
+                    // §4.1.1: the enable is removed once the axis no longer executes a job;
+                    // until then this command reports the enabled axis.
+                    self.power = Some(holds);
+                    self.disable_when_idle = true;
                 } else {
+                    self.power = Some(holds);
                     self.disable(cx);
-                    cx.report(cmd.id, DONE);
                 }
                 Ok(())
             }
@@ -198,6 +207,7 @@ impl Axis {
                 }
                 let (dec, jk) = self.stop_dynamics(deceleration, jerk);
                 self.abort_all(cx);
+                self.has_been_stopped = true;
                 if let Some(mut old) = self.stop.take() {
                     old.end(cx, End::Aborted);
                 }
@@ -278,7 +288,11 @@ impl Axis {
             return Ok(());
         }
         if self.power.as_ref().is_some_and(|p| p.id == target) {
-            self.disable(cx);
+            if self.power_buffer_mode != BufferMode::Aborting && self.executes_job() {
+                self.disable_when_idle = true;
+            } else {
+                self.disable(cx);
+            }
             return Ok(());
         }
         if let Some(c) = self

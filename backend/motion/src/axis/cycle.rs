@@ -34,6 +34,8 @@ impl Axis {
             events,
             cams,
         };
+        self.cycle = cycle;
+        self.io_data_invalid = fb.bus_error;
         self.act_pos = fb.actual_position + self.offset;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
@@ -88,6 +90,7 @@ impl Axis {
         }
         self.try_unlock(cx);
         self.settle_cam(cx);
+        self.step_buffered_disable(cx);
         // InTargetPosition's dwell counts cycles (not status updates: submits update too).
         let lag = (self.act_pos - self.set.position).abs();
         if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {

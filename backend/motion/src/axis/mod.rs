@@ -81,6 +81,11 @@ pub struct Axis {
     job: Option<Job>,
     next: Option<Job>,
     power: Option<Held>,
+    /// MC_Power's BufferMode of the enabling command: how its release removes the enable.
+    power_buffer_mode: BufferMode,
+    /// A buffered disable (MC_Power BufferMode ≠ Aborting) waits for the axis to finish its
+    /// jobs; `power` is the command that reports it.
+    disable_when_idle: bool,
     stop: Option<Held>,
     /// MC_Reset waiting for the error-stop ramp to end.
     pending_reset: Option<Held>,
@@ -144,6 +149,14 @@ pub struct Axis {
     cam_scaling_term: usize,
     /// MC_CamInfo of the last cam coupling, kept after an error ended it (until MC_CamOut).
     cam_last: crate::cam::CamInfo,
+    /// The cycle of the latest step (the status's NcCycleCounter).
+    cycle: u64,
+    /// The drive's process data were invalid in the latest cycle (bus error).
+    io_data_invalid: bool,
+    /// The last motion was ended by a stop (HasBeenStopped).
+    has_been_stopped: bool,
+    /// The running job got its target while the axis moved (NewTargetPosition).
+    new_target: bool,
 }
 
 impl Axis {
@@ -152,7 +165,7 @@ impl Axis {
         parameters.axis_cycle_time = cycle_time;
         let p = &parameters;
         let (last_dec, last_jerk) = (p.axis_dec, p.axis_jerk);
-        Box::new(Axis {
+        let mut axis = Box::new(Axis {
             config: AxisConfig {
                 modulo: config.modulo,
                 parameters,
@@ -169,6 +182,8 @@ impl Axis {
             job: None,
             next: None,
             power: None,
+            power_buffer_mode: BufferMode::Aborting,
+            disable_when_idle: false,
             stop: None,
             pending_reset: None,
             enable: false,
@@ -211,7 +226,14 @@ impl Axis {
             cam_v2_op: None,
             cam_scaling_term: 0,
             cam_last: crate::cam::CamInfo::default(),
-        })
+            cycle: 0,
+            io_data_invalid: false,
+            has_been_stopped: false,
+            new_target: false,
+        });
+        // The status is whole from the start (flags such as NotMoving, OpModes).
+        axis.update_status();
+        axis
     }
 
     /// The slot the kernel keeps this axis in: the `axis` of every event it reports.

@@ -9,6 +9,7 @@ impl Axis {
     /// Note 2: Enable FALSE → Disabled (ErrorStop stays ErrorStop).
     pub(super) fn disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         self.enable = false;
+        self.disable_when_idle = false;
         self.last_target = None;
         self.abort_superposition(cx);
         self.abort_all(cx);
@@ -26,6 +27,23 @@ impl Axis {
             position: self.act_pos,
             ..Kinematics::default()
         };
+    }
+
+    /// The axis executes a job (§4.1.1's test for a buffered disable): a motion, a coupling,
+    /// a superposition or a coupling waiting for its activation, running or buffered.
+    pub(super) fn executes_job(&self) -> bool {
+        self.job.is_some()
+            || self.next.is_some()
+            || self.coupling.is_some()
+            || self.superimposed.is_some()
+            || self.cam_in.is_some()
+    }
+
+    /// A buffered disable takes effect once the axis no longer executes a job.
+    pub(super) fn step_buffered_disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        if self.disable_when_idle && !self.executes_job() {
+            self.disable(cx);
+        }
     }
 
     /// MC_Reset: clears ErrorStop (notes 3/4) and the MC_Stop lock; takes actual as set.
@@ -66,6 +84,7 @@ impl Axis {
             return;
         }
         self.error = e;
+        self.has_been_stopped = true;
         if let Some(mut sp) = self.superimposed.take() {
             sp.cmd.end(cx, End::Error(e));
         }
@@ -203,6 +222,7 @@ impl Axis {
         } else {
             (p.axis_dec, p.axis_jerk)
         };
+        self.has_been_stopped = true;
         if let Some(mut n) = self.next.take() {
             n.finish_error(cx, e);
         }

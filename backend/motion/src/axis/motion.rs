@@ -363,6 +363,10 @@ impl Axis {
 
     pub(super) fn start_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, mut job: Job) {
         job.activate(cx);
+        if job.kind != JobKind::Halt {
+            self.has_been_stopped = false;
+        }
+        self.new_target = job.is_positioning() && self.set.velocity.abs() > EPS_V;
         job.since_keepalive = 0;
         if job.kind == (JobKind::Positioning { continuous: true }) && !job.past_target {
             // The end velocity keeps the direction from where the move really starts (a

@@ -55,6 +55,7 @@ impl Axis {
             rearm: false,
         });
         self.status.probe.armed = true;
+        self.status.external_latch_valid = false;
         Ok(())
     }
 
@@ -63,6 +64,7 @@ impl Axis {
     pub(super) fn abort_trigger(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         if let Some(mut p) = self.probe.take() {
             p.held.end(cx, End::Aborted);
+            self.status.external_latch_valid = false;
         }
         self.status.probe.armed = false;
     }
@@ -115,6 +117,7 @@ impl Axis {
             s.recorded_position = x;
             s.absolute_position = absolute;
             s.modulo_position = modulo;
+            self.status.external_latch_valid = true;
             p.held.end(cx, End::Done);
             return false;
         }

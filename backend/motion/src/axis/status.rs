@@ -108,7 +108,31 @@ impl Axis {
                 ..self.cam_last
             };
         }
+        let op_modes = crate::status::AxisOpModes {
+            position_area_monitoring: p.axis_en_position_range_monitoring,
+            target_position_monitoring: p.axis_en_target_position_monitoring,
+            loop_mode: p.axis_en_looping_distance,
+            motion_monitoring: p.axis_en_motion_monitoring,
+            peh_time_monitoring: p.axis_en_in_target_timeout,
+            modulo: self.config.modulo,
+            position_lag_monitoring: p.axis_en_position_lag_monitoring,
+            soft_limit_min_monitoring: p.axis_en_min_soft_pos_limit,
+            soft_limit_max_monitoring: p.axis_en_max_soft_pos_limit,
+            position_correction: p.axis_enable_pos_correction,
+            allow_slave_commands: p.axis_allow_motion_cmd_to_slave_axis,
+            allow_ext_set_axis_commands: p.axis_allow_motion_cmd_to_ext_set_axis,
+        };
         let s = &mut self.status;
+        s.op_modes = op_modes;
+        s.operational = s.power_status && matches!(self.mode, Mode::Enabled | Mode::Stopping);
+        s.control_loop_closed = s.operational;
+        s.not_moving = !s.moving;
+        s.has_been_stopped = self.has_been_stopped;
+        s.homing_busy = state == AxisState::Homing;
+        s.new_target_position = self.new_target && self.job.is_some_and(|j| j.is_positioning());
+        s.ptp_mode = !s.coupled;
+        s.io_data_invalid = self.io_data_invalid;
+        s.nc_cycle_counter = self.cycle;
         s.cam = cam;
         s.cam_table_queued = queued;
         s.cam_scaling_pending = scaling;

@@ -873,6 +873,7 @@ pub fn power_with_override(override_percent: f64) -> CommandKind {
         enable_positive: true,
         enable_negative: true,
         override_percent,
+        buffer_mode: BufferMode::Aborting,
     }
 }
 
@@ -883,6 +884,7 @@ pub fn power_off() -> CommandKind {
         enable_positive: false,
         enable_negative: false,
         override_percent: 100.0,
+        buffer_mode: BufferMode::Aborting,
     }
 }
 

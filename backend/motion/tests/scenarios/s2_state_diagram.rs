@@ -48,6 +48,7 @@ fn s11a_03_power_off_from_motion_disables_and_aborts() {
             enable_positive: false,
             enable_negative: false,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         },
     );
     assert_eq!(r.st(0).state, AxisState::Disabled);
@@ -94,6 +95,7 @@ fn s11a_04_errorstop_rejects_everything_until_reset() {
             enable_positive: false,
             enable_negative: false,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         },
     );
     assert_eq!(r.st(0).state, AxisState::ErrorStop);

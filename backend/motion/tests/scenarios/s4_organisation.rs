@@ -297,3 +297,167 @@ fn repeated_fault_and_reset_rounds_can_always_be_re_enabled() {
         r.ok(0, CommandKind::Reset);
     }
 }
+
+/// MC_Power with both feed enables (a buffered disable keeps them: the move it waits for
+/// may go on).
+fn power_buffered(enable: bool, buffer_mode: BufferMode) -> CommandKind {
+    CommandKind::Power {
+        enable,
+        enable_positive: true,
+        enable_negative: true,
+        override_percent: 100.0,
+        buffer_mode,
+    }
+}
+
+/// §4.1.1 MC_Power BufferMode, evaluated when the enable is removed: a buffered disable waits
+/// until the axis no longer executes a job — the move runs to its target and ends Done, the
+/// disabling command stays busy with the axis enabled every cycle until then, and the axis
+/// is Disabled in the cycle the move ended. Aborting disables at once (the move aborted).
+#[test]
+fn s4_1_1_power_buffer_mode_disables_once_the_job_has_ended() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(50.0, 100.0)));
+    r.run(0.1);
+    let off = r.ok(0, power_buffered(false, BufferMode::Buffered));
+    let mut cycles = 0;
+    while r.out(m).busy {
+        assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
+        assert!(r.st(0).power_status);
+        assert!(r.out(off).busy && r.out(off).status && !r.out(off).done);
+        r.step();
+        cycles += 1;
+        assert!(cycles < 5000, "the move never ended");
+    }
+    assert!(r.out(m).done && !r.out(m).command_aborted);
+    assert!((r.st(0).set_position - 50.0).abs() < 1e-9);
+    // The disable takes effect in the cycle the move ended.
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+    assert!(r.out(off).done && !r.out(off).busy);
+
+    // Aborting (the default): at once, the running move aborted.
+    power(&mut r);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 100.0)));
+    r.run(0.1);
+    r.ok(0, power_buffered(false, BufferMode::Aborting));
+    assert!(r.out(m).command_aborted);
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+}
+
+/// §4.1.1: the BufferMode of the enabling MC_Power applies when its Enable falls (the release
+/// of the command). At standstill a buffered disable acts at once; a newer enabling power
+/// cancels a disable still waiting.
+#[test]
+fn s4_1_1_power_release_with_buffer_mode_waits_and_a_new_enable_cancels_it() {
+    let mut r = Rig::new(1);
+    let on = r.ok(0, power_buffered(true, BufferMode::Buffered));
+    r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(20.0, 100.0)));
+    r.run(0.05);
+    r.ok(0, CommandKind::Release { target: on });
+    r.step();
+    assert_eq!(r.st(0).state, AxisState::DiscreteMotion);
+    assert!(r.out(on).busy);
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(m).done);
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+    assert!(!r.out(on).busy);
+
+    // At standstill the buffered release disables in the same submit.
+    let on = r.ok(0, power_buffered(true, BufferMode::Buffered));
+    r.until(1.0, |r| r.st(0).state == AxisState::Standstill);
+    r.ok(0, CommandKind::Release { target: on });
+    assert_eq!(r.st(0).state, AxisState::Disabled);
+
+    // A disable waiting for the move is cancelled by a new enable: the move ends, the axis
+    // stays enabled.
+    power(&mut r);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 100.0)));
+    r.run(0.05);
+    let off = r.ok(0, power_buffered(false, BufferMode::Buffered));
+    let on = r.ok(0, power_buffered(true, BufferMode::Aborting));
+    assert!(r.out(off).command_aborted);
+    r.until(5.0, |r| !r.out(m).busy);
+    assert!(r.out(m).done);
+    r.run(0.1);
+    assert_eq!(r.st(0).state, AxisState::Standstill);
+    assert!(r.out(on).busy && r.out(on).status);
+}
+
+/// §4.2.8 MC_ReadStatus / §6.11.13 ST_AxisStatus: the StateDWord flags cycle by cycle —
+/// Operational and ControlLoopClosed with the enable, NotMoving against Moving, NewTarget-
+/// Position while an Aborting move replaced a running one, HasBeenStopped after MC_Stop until
+/// the next motion command, PTPmode off while coupled, the cycle counter of every step, and
+/// the OpModes from the parameters.
+#[test]
+fn s4_2_8_extended_status_flags_follow_the_axis_in_every_cycle() {
+    let mut r = Rig::new(2);
+    let st = r.st(0);
+    assert!(!st.operational && !st.control_loop_closed && st.not_moving && st.ptp_mode);
+    assert!(st.op_modes.position_lag_monitoring && !st.op_modes.position_correction);
+    power(&mut r);
+    assert!(r.st(0).operational && r.st(0).control_loop_closed);
+    let c0 = r.st(0).nc_cycle_counter;
+    r.step();
+    assert_eq!(r.st(0).nc_cycle_counter, c0 + 1);
+
+    let a = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    r.run(0.2);
+    assert!(
+        !r.st(0).new_target_position,
+        "the first move started from rest"
+    );
+    r.ok(0, CommandKind::MoveAbsolute(mv(50.0, 100.0)));
+    assert!(r.out(a).command_aborted);
+    let mut was_new = false;
+    r.until(5.0, |r| {
+        let s = r.st(0);
+        assert_eq!(s.not_moving, !s.moving);
+        assert_eq!(s.homing_busy, s.state == AxisState::Homing);
+        was_new |= s.new_target_position;
+        s.state == AxisState::Standstill
+    });
+    assert!(was_new, "NewTargetPosition while the replacing move ran");
+    assert!(!r.st(0).new_target_position && !r.st(0).has_been_stopped);
+
+    r.ok(0, velocity(50.0, Direction::Positive));
+    r.run(0.2);
+    let stop = r.ok(
+        0,
+        CommandKind::Stop {
+            deceleration: 0.0,
+            jerk: 0.0,
+            options: MoveOptions::default(),
+        },
+    );
+    assert!(r.st(0).has_been_stopped);
+    r.until(2.0, |r| r.out(stop).done);
+    r.ok(0, CommandKind::Release { target: stop });
+    r.step();
+    assert!(
+        r.st(0).has_been_stopped,
+        "stays until the next motion command"
+    );
+    r.ok(0, CommandKind::MoveRelative(mv(1.0, 10.0)));
+    assert!(!r.st(0).has_been_stopped);
+
+    // A coupled slave is not in PTP mode.
+    r.power_on(1);
+    r.until(2.0, |r| {
+        r.st(1).state == AxisState::Standstill && r.st(0).state == AxisState::Standstill
+    });
+    r.ok(1, gear_in(0, 1.0, 1));
+    r.step();
+    assert!(r.st(1).coupled && !r.st(1).ptp_mode);
+
+    // OpModes follow the parameters written online.
+    r.ok(
+        0,
+        CommandKind::WriteParameter {
+            number: 1046,
+            value: 1.0,
+        },
+    );
+    assert!(r.st(0).op_modes.position_correction);
+}

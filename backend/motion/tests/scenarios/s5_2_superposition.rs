@@ -312,6 +312,7 @@ fn s11a_31_superposition_abort_options() {
             enable_positive: false,
             enable_negative: false,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         },
     );
     assert!(r.out(s).command_aborted);

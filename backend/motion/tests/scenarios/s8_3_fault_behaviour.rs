@@ -132,6 +132,7 @@ fn feed_enable_missing_rejects_and_stops() {
             enable_positive: true,
             enable_negative: false,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         },
     );
     r.until(0.1, |r| r.st(0).state == AxisState::Standstill);
@@ -148,6 +149,7 @@ fn feed_enable_missing_rejects_and_stops() {
             enable_positive: false,
             enable_negative: false,
             override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
         },
     );
     r.step();

@@ -94,6 +94,7 @@ impl PowerBody {
             enable_positive: self.enable_positive,
             enable_negative: self.enable_negative,
             override_percent: self.override_percent,
+            buffer_mode: self.buffer_mode,
         })
     }
 }
