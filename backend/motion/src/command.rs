@@ -353,6 +353,12 @@ pub enum CommandKind {
     TouchProbe(TouchProbe),
     /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
     AbortTrigger,
+    /// MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing (§5.6): a phase shift of
+    /// this slave against `master`, the slave's coupling.
+    Phasing {
+        master: AxisSlot,
+        motion: PhasingMotion,
+    },
     /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
     /// switch off a Power).
     Release {
@@ -401,6 +407,11 @@ impl CommandKind {
             CommandKind::WriteParameter { .. } => "write-parameter",
             CommandKind::TouchProbe(_) => "touch-probe",
             CommandKind::AbortTrigger => "abort-trigger",
+            CommandKind::Phasing { motion, .. } => match motion.kind {
+                PhasingKind::Absolute => "phasing-absolute",
+                PhasingKind::Relative => "phasing-relative",
+                PhasingKind::Halt => "halt-phasing",
+            },
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
         }
@@ -420,6 +431,29 @@ pub struct TouchProbe {
     /// `TRIGGER_REF.ModuloPositions`: positions (window and recorded) are modulo the axis's
     /// AxisEncoderModuloValue; the window repeats every period and wraps when first > last.
     pub modulo_positions: bool,
+}
+
+/// Which phasing block (`E_PhasingType`, §6.8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PhasingKind {
+    /// MC_PhasingAbsolute: establish `phase_shift`.
+    Absolute,
+    /// MC_PhasingRelative: change the phase shift by `phase_shift`.
+    Relative,
+    /// MC_HaltPhasing: bring the phase motion to rest (`phase_shift`, `velocity` unused).
+    Halt,
+}
+
+/// The inputs of a phasing block (§5.6.1–5.6.3); dynamics 0 = the axis's defaults.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhasingMotion {
+    pub kind: PhasingKind,
+    pub phase_shift: f64,
+    /// Maximum velocity of the phase motion, ≥ 0.01.
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    pub jerk: f64,
 }
 
 /// A command addressed to one axis.

@@ -139,6 +139,8 @@ error_table! {
     /// uses the drive's latch.
     BUS_ERROR = 0x70A0, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)";
     TOUCH_PROBE_BUSY = 0x7090, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)";
+    /// MC_PhasingAbsolute/Relative and MC_HaltPhasing need the axis enabled and coupled to the given master by MC_GearIn or a cam (not MC_GearInDyn, §5.6).
+    PHASING_NOT_COUPLED = 0x70B0, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam";
 }
 
 impl fmt::Display for ErrorId {

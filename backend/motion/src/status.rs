@@ -182,6 +182,14 @@ pub struct AxisStatus {
     pub nc_cycle_counter: u64,
     /// `ST_AxisOpModes`: the operating modes the parameters switch on (OpModeDWord).
     pub op_modes: AxisOpModes,
+    /// Bit 15: a phasing command (MC_PhasingAbsolute/Relative, MC_HaltPhasing) runs.
+    pub phasing_active: bool,
+    /// The phase shift of this slave against its master (`AbsPhasingPos`, MC_PhasingAbsolute's
+    /// AbsolutePhaseShift); 0 when not coupled.
+    pub absolute_phase_shift: f64,
+    /// What the running phasing command has covered so far (MC_PhasingRelative's
+    /// CoveredPhaseShift); 0 when none runs.
+    pub covered_phase_shift: f64,
 }
 
 /// `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters.

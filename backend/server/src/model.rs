@@ -618,6 +618,50 @@ pub struct TouchProbeBody {
     pub modulo_positions: bool,
 }
 
+/// MC_PhasingAbsolute / MC_PhasingRelative (§5.6.2, §5.6.3): a phase shift of this slave
+/// against its master made by a jerk-limited superimposed motion (the slave coupled by
+/// gear-in or a cam, not gear-in-dyn). BufferMode is Aborting only: a new phasing command
+/// takes over from the running one's velocity, which is also how ContinuousUpdate is
+/// served. The shift reached is the status's `absolute_phase_shift` / `covered_phase_shift`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "phase_shift": 10.0, "velocity": 20.0}))]
+pub struct PhasingBody {
+    /// Master axis id or name: the master the slave is coupled to.
+    pub master: String,
+    /// Absolute: the shift to establish; relative: the change of the shift (slave units).
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub phase_shift: f64,
+    /// Maximum velocity of the phase motion, ≥ 0.01 units/s.
+    #[schema(minimum = 0.01)]
+    pub velocity: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub acceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub deceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub jerk: f64,
+}
+
+/// MC_HaltPhasing (§5.6.1): bring the phase motion to rest (0 = the axis's default
+/// deceleration and jerk); the shift stays where the phase stops.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"master": "x", "deceleration": 500.0}))]
+pub struct HaltPhasingBody {
+    /// Master axis id or name: the master the slave is coupled to.
+    pub master: String,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub deceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub jerk: f64,
+}
+
 /// MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]

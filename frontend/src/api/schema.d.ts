@@ -392,6 +392,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/halt-phasing": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_HaltPhasing: bring the phase motion to rest (aborts the running phasing; the shift stays where it stops) */
+        post: operations["halt_phasing"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/home": {
         parameters: {
             query?: never;
@@ -591,6 +608,40 @@ export interface paths {
         /** Write a parameter (MC_WriteParameter, or MC_WriteParameterPersistent with persistent=true) */
         put: operations["write_parameter"];
         post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/phasing-absolute": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in or a cam) */
+        post: operations["phasing_absolute"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/phasing-relative": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_PhasingRelative: change the phase shift of this coupled slave by phase_shift (covered so far: status covered_phase_shift) */
+        post: operations["phasing_relative"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1587,6 +1638,7 @@ export interface components {
         /**
          * @description Copyable status of one axis, published every cycle.
          * @example {
+         *       "absolute_phase_shift": 0,
          *       "accelerating": false,
          *       "active_command": 42,
          *       "actual_acceleration": 0,
@@ -1682,6 +1734,7 @@ export interface components {
          *       "constant_velocity": true,
          *       "control_loop_closed": false,
          *       "coupled": false,
+         *       "covered_phase_shift": 0,
          *       "decelerating": false,
          *       "drive_error_code": 0,
          *       "drive_fault": false,
@@ -1727,6 +1780,7 @@ export interface components {
          *       },
          *       "operational": false,
          *       "override_percent": 100,
+         *       "phasing_active": false,
          *       "power_override_percent": 0,
          *       "power_status": true,
          *       "probe": {
@@ -1924,6 +1978,20 @@ export interface components {
             nc_cycle_counter: number;
             /** @description `ST_AxisOpModes`: the operating modes the parameters switch on (OpModeDWord). */
             op_modes: components["schemas"]["AxisOpModes"];
+            /** @description Bit 15: a phasing command (MC_PhasingAbsolute/Relative, MC_HaltPhasing) runs. */
+            phasing_active: boolean;
+            /**
+             * Format: double
+             * @description The phase shift of this slave against its master (`AbsPhasingPos`, MC_PhasingAbsolute's
+             *     AbsolutePhaseShift); 0 when not coupled.
+             */
+            absolute_phase_shift: number;
+            /**
+             * Format: double
+             * @description What the running phasing command has covered so far (MC_PhasingRelative's
+             *     CoveredPhaseShift); 0 when none runs.
+             */
+            covered_phase_shift: number;
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
@@ -3728,6 +3796,22 @@ export interface components {
             options?: components["schemas"]["MoveOptions"];
         };
         /**
+         * @description MC_HaltPhasing (§5.6.1): bring the phase motion to rest (0 = the axis's default
+         *     deceleration and jerk); the shift stays where the phase stops.
+         * @example {
+         *       "deceleration": 500,
+         *       "master": "x"
+         *     }
+         */
+        HaltPhasingBody: {
+            /** @description Master axis id or name: the master the slave is coupled to. */
+            master: string;
+            /** Format: double */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
+        };
+        /**
          * @description MC_Home.
          * @example {
          *       "mode": "direct",
@@ -3895,6 +3979,7 @@ export interface components {
         /**
          * @description The live status of an axis: the kernel's status plus what only the server can name.
          * @example {
+         *       "absolute_phase_shift": 0,
          *       "accelerating": false,
          *       "active_command": 42,
          *       "actual_acceleration": 0,
@@ -3990,6 +4075,7 @@ export interface components {
          *       "constant_velocity": true,
          *       "control_loop_closed": false,
          *       "coupled": false,
+         *       "covered_phase_shift": 0,
          *       "decelerating": false,
          *       "drive_error_code": 0,
          *       "drive_fault": false,
@@ -4036,6 +4122,7 @@ export interface components {
          *       },
          *       "operational": false,
          *       "override_percent": 100,
+         *       "phasing_active": false,
          *       "power_override_percent": 0,
          *       "power_status": true,
          *       "probe": {
@@ -4633,6 +4720,38 @@ export interface components {
              * @description The first cycle of the new peak hold.
              */
             cycle: number;
+        };
+        /**
+         * @description MC_PhasingAbsolute / MC_PhasingRelative (§5.6.2, §5.6.3): a phase shift of this slave
+         *     against its master made by a jerk-limited superimposed motion (the slave coupled by
+         *     gear-in or a cam, not gear-in-dyn). BufferMode is Aborting only: a new phasing command
+         *     takes over from the running one's velocity, which is also how ContinuousUpdate is
+         *     served. The shift reached is the status's `absolute_phase_shift` / `covered_phase_shift`.
+         * @example {
+         *       "master": "x",
+         *       "phase_shift": 10,
+         *       "velocity": 20
+         *     }
+         */
+        PhasingBody: {
+            /** @description Master axis id or name: the master the slave is coupled to. */
+            master: string;
+            /**
+             * Format: double
+             * @description Absolute: the shift to establish; relative: the change of the shift (slave units).
+             */
+            phase_shift: number;
+            /**
+             * Format: double
+             * @description Maximum velocity of the phase motion, ≥ 0.01 units/s.
+             */
+            velocity: number;
+            /** Format: double */
+            acceleration?: number;
+            /** Format: double */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
         };
         /**
          * @description Closed-loop response of the load to the position reference.
@@ -5357,6 +5476,7 @@ export interface components {
          *       "axis_id": 1,
          *       "cycle": 2009,
          *       "status": {
+         *         "absolute_phase_shift": 0,
          *         "accelerating": false,
          *         "active_command": 42,
          *         "actual_acceleration": 0,
@@ -5452,6 +5572,7 @@ export interface components {
          *         "constant_velocity": true,
          *         "control_loop_closed": false,
          *         "coupled": false,
+         *         "covered_phase_shift": 0,
          *         "decelerating": false,
          *         "drive_error_code": 0,
          *         "drive_fault": false,
@@ -5498,6 +5619,7 @@ export interface components {
          *         },
          *         "operational": false,
          *         "override_percent": 100,
+         *         "phasing_active": false,
          *         "power_override_percent": 0,
          *         "power_status": true,
          *         "probe": {
@@ -8305,6 +8427,66 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    halt_phasing: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["HaltPhasingBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
     home: {
         parameters: {
             query?: {
@@ -9012,6 +9194,126 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["ParameterInvalid"];
             503: components["responses"]["ParameterWriteUnavailable"];
+        };
+    };
+    phasing_absolute: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PhasingBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    phasing_relative: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PhasingBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     power: {

@@ -262,6 +262,9 @@ impl Axis {
                 Ok(())
             }
             CommandKind::TouchProbe(t) => self.submit_touch_probe(cx, cmd.id, t),
+            CommandKind::Phasing { master, motion } => {
+                self.submit_phasing(cx, cmd.id, master, motion)
+            }
             CommandKind::AbortTrigger => {
                 self.abort_trigger(cx);
                 cx.report(cmd.id, DONE);
@@ -363,6 +366,9 @@ impl Axis {
             j.finish_aborted(cx);
         }
         self.coupling = None;
+        // The phase belongs to the coupling: a new one starts without a shift.
+        self.end_phasing(cx, End::Aborted);
+        self.phase = Kinematics::default();
         self.cancel_cam_in(cx, End::Aborted);
         self.settle_cam(cx);
     }

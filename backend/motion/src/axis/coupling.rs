@@ -267,6 +267,7 @@ impl Axis {
             return Ok(());
         }
         self.abort_superposition(cx);
+        self.end_phasing(cx, End::Aborted);
         self.coupling = None;
         if let Some(mut j) = self.job.take() {
             j.finish_aborted(cx);

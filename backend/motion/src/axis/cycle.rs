@@ -78,6 +78,7 @@ impl Axis {
             self.step_cam_activations(cx, master);
             self.step_feed_enables(cx);
             self.step_job(cx, dt, fb, master);
+            self.step_phasing(cx, dt);
             self.step_superposition(cx, dt);
             self.step_soft_limits(cx, dt);
             self.step_following_error(cx, dt);

@@ -34,6 +34,7 @@ mod homing;
 mod job;
 mod monitoring;
 mod motion;
+mod phasing;
 mod planning;
 mod probe;
 mod status;
@@ -157,6 +158,10 @@ pub struct Axis {
     has_been_stopped: bool,
     /// The running job got its target while the axis moved (NewTargetPosition).
     new_target: bool,
+    /// The phase shift against the master (AbsPhasingPos) and its motion (§5.6).
+    phase: Kinematics,
+    phase_planner: Planner,
+    phasing: Option<phasing::PhasingJob>,
 }
 
 impl Axis {
@@ -230,6 +235,9 @@ impl Axis {
             io_data_invalid: false,
             has_been_stopped: false,
             new_target: false,
+            phase: Kinematics::default(),
+            phase_planner: Planner::new(cycle_time),
+            phasing: None,
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();

@@ -85,6 +85,7 @@ impl Axis {
         }
         self.error = e;
         self.has_been_stopped = true;
+        self.end_phasing(cx, End::Error(e));
         if let Some(mut sp) = self.superimposed.take() {
             sp.cmd.end(cx, End::Error(e));
         }

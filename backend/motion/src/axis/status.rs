@@ -122,7 +122,11 @@ impl Axis {
             allow_slave_commands: p.axis_allow_motion_cmd_to_slave_axis,
             allow_ext_set_axis_commands: p.axis_allow_motion_cmd_to_ext_set_axis,
         };
+        let (phasing_active, absolute_phase_shift, covered_phase_shift) = self.phasing_status();
         let s = &mut self.status;
+        s.phasing_active = phasing_active;
+        s.absolute_phase_shift = absolute_phase_shift;
+        s.covered_phase_shift = covered_phase_shift;
         s.op_modes = op_modes;
         s.operational = s.power_status && matches!(self.mode, Mode::Enabled | Mode::Stopping);
         s.control_loop_closed = s.operational;

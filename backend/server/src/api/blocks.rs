@@ -237,6 +237,12 @@ catalogue! {
         "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
     abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
         "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
+    phasing_absolute: "phasing-absolute", PhasingBody, PhasingBody::absolute, Operator, Done,
+        "MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in or a cam)";
+    phasing_relative: "phasing-relative", PhasingBody, PhasingBody::relative, Operator, Done,
+        "MC_PhasingRelative: change the phase shift of this coupled slave by phase_shift (covered so far: status covered_phase_shift)";
+    halt_phasing: "halt-phasing", HaltPhasingBody, HaltPhasingBody::to_kind, Operator, Done,
+        "MC_HaltPhasing: bring the phase motion to rest (aborts the running phasing; the shift stays where it stops)";
 }
 
 /// The catalogue entry of a block (websocket method) name.

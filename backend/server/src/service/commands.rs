@@ -380,6 +380,62 @@ impl GearInBody {
     }
 }
 
+impl PhasingBody {
+    fn to_phasing(
+        &self,
+        reg: &Registry,
+        axis: &AxisEntry,
+        kind: motion::PhasingKind,
+    ) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        c.finite("phase_shift", self.phase_shift);
+        if !(self.velocity.is_finite() && self.velocity >= 0.01) {
+            c.fail("velocity", "must be ≥ 0.01");
+        }
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.done(CommandKind::Phasing {
+            master,
+            motion: motion::PhasingMotion {
+                kind,
+                phase_shift: self.phase_shift,
+                velocity: self.velocity,
+                acceleration: self.acceleration,
+                deceleration: self.deceleration,
+                jerk: self.jerk,
+            },
+        })
+    }
+    pub fn absolute(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        self.to_phasing(reg, axis, motion::PhasingKind::Absolute)
+    }
+    pub fn relative(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        self.to_phasing(reg, axis, motion::PhasingKind::Relative)
+    }
+}
+
+impl HaltPhasingBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let master = master_slot(&mut c, reg, axis, &self.master);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.done(CommandKind::Phasing {
+            master,
+            motion: motion::PhasingMotion {
+                kind: motion::PhasingKind::Halt,
+                phase_shift: 0.0,
+                velocity: 0.0,
+                acceleration: 0.0,
+                deceleration: self.deceleration,
+                jerk: self.jerk,
+            },
+        })
+    }
+}
+
 impl GearInDynBody {
     pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();

@@ -254,6 +254,14 @@ impl Control {
                 // A probe moves nothing.
                 | CommandKind::TouchProbe(_)
                 | CommandKind::AbortTrigger
+                // Halting a phase motion is a stop.
+                | CommandKind::Phasing {
+                    motion: motion::PhasingMotion {
+                        kind: motion::PhasingKind::Halt,
+                        ..
+                    },
+                    ..
+                }
         );
         if always {
             return Ok(());

@@ -1,0 +1,192 @@
+//! Phasing (spec §5.6): MC_PhasingAbsolute, MC_PhasingRelative and MC_HaltPhasing — a phase
+//! shift between a coupled slave and its master, made by a jerk-limited motion of the phase
+//! itself laid over what the coupling gives. Apart from the coupling because it is a motion
+//! with its own profile (planned like a job, on its own planner) while the coupling law only
+//! moves by what the phase adds.
+
+use super::coupling::CouplingLaw;
+use super::*;
+use crate::planner::Limits;
+
+/// The running phasing command.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PhasingJob {
+    pub(super) cmd: Held,
+    /// The absolute phase shift it brings the slave to (MC_HaltPhasing: where it stops).
+    target: f64,
+    /// The phase shift when it started (CoveredPhaseShift counts from here).
+    start: f64,
+    halting: bool,
+}
+
+impl Axis {
+    /// MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing: admission (a slave coupled
+    /// to `master` by a gear or a cam — not MC_GearInDyn, §5.6), the plan from where the
+    /// phase is now (an earlier phasing is aborted, its velocity carried on).
+    pub(super) fn submit_phasing(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        master: AxisSlot,
+        ph: PhasingMotion,
+    ) -> Result<(), ErrorId> {
+        let p = self.p();
+        let dynamics = [ph.acceleration, ph.deceleration, ph.jerk];
+        if !(ph.phase_shift.is_finite()
+            && ph.velocity.is_finite()
+            && dynamics.iter().all(|x| x.is_finite() && *x >= 0.0))
+        {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        // §5.6.2: Velocity ≥ 0.01 (not used by MC_HaltPhasing).
+        if ph.kind != PhasingKind::Halt && ph.velocity < 0.01 {
+            return Err(ErrorId::PARAMETER_NOT_CORRECT);
+        }
+        let coupled = match self.coupling {
+            Some(c) if c.master == master => !matches!(c.law, CouplingLaw::GearDyn { .. }),
+            _ => false,
+        };
+        if !coupled || self.mode != Mode::Enabled {
+            return Err(ErrorId::PHASING_NOT_COUPLED);
+        }
+        let or = |x: f64, d: f64| if x > 0.0 { x } else { d };
+        let acc = or(ph.acceleration, p.axis_acc);
+        let dec = or(ph.deceleration, p.axis_dec);
+        let jerk = or(ph.jerk, p.axis_jerk);
+        let from = self.phase;
+        let limits = Limits {
+            velocity: ph.velocity.max(from.velocity.abs()).max(EPS_V),
+            acceleration: acc,
+            deceleration: dec,
+            jerk,
+        };
+        let (planned, target) = match ph.kind {
+            PhasingKind::Halt => {
+                let r = self.phase_planner.plan_velocity(from, 0.0, &limits);
+                (r, self.phase_planner.end_state().position)
+            }
+            kind => {
+                let target = if kind == PhasingKind::Absolute {
+                    ph.phase_shift
+                } else {
+                    from.position + ph.phase_shift
+                };
+                let limits = Limits {
+                    velocity: ph.velocity,
+                    ..limits
+                };
+                (
+                    self.phase_planner.plan_position(from, target, 0.0, &limits),
+                    target,
+                )
+            }
+        };
+        if planned.is_err() {
+            // The checks above leave the solver nothing it cannot solve; should it fail all
+            // the same, the running phase (whose plan the attempt overwrote) stops on the
+            // closed-form ramp and its command ends with the error.
+            if let Some(mut old) = self.phasing.take() {
+                old.cmd.end(cx, End::Error(ErrorId::PLANNING_FAILED));
+            }
+            if from.velocity != 0.0 || from.acceleration != 0.0 {
+                self.phase_planner.plan_fallback_stop(from, dec, jerk);
+            } else {
+                self.phase_planner.clear();
+            }
+            return Err(ErrorId::PLANNING_FAILED);
+        }
+        if let Some(mut old) = self.phasing.take() {
+            old.cmd.end(cx, End::Aborted);
+        }
+        let cmd = Held::start(
+            cx,
+            id,
+            FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            },
+        );
+        self.phasing = Some(PhasingJob {
+            cmd,
+            target: if ph.kind == PhasingKind::Halt {
+                self.phase_planner.end_state().position
+            } else {
+                target
+            },
+            start: from.position,
+            halting: ph.kind == PhasingKind::Halt,
+        });
+        Ok(())
+    }
+
+    /// One cycle of the phase: its profile's increment moves the slave (and the coupling
+    /// with it); Done once the phase stands at its target (§5.6.2) or, halting, at rest
+    /// (§5.6.1). Ends aborted when the coupling it shifts is gone.
+    pub(super) fn step_phasing(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
+        if self.coupling.is_none() || self.mode != Mode::Enabled {
+            if self.phasing.is_some() || self.phase_planner.is_planned() {
+                self.end_phasing(cx, End::Aborted);
+            }
+            if self.coupling.is_none() {
+                self.phase = Kinematics::default();
+            }
+            return;
+        }
+        let Some(k) = self.phase_planner.step(dt) else {
+            return;
+        };
+        let d = k.position - self.phase.position;
+        if let Some(c) = self.coupling.as_mut() {
+            c.law.shift_slave(d);
+        }
+        self.set.position += d;
+        self.set.velocity += k.velocity;
+        self.set.acceleration += k.acceleration;
+        self.set.jerk += k.jerk;
+        self.phase = k;
+        if self.phase_planner.finished() {
+            let ph = self.phasing.take();
+            let at = match ph {
+                Some(p) if !p.halting => p.target,
+                _ => k.position,
+            };
+            // Exactly at the target: the last sample's residue goes into the slave too.
+            let rest = at - k.position;
+            if let Some(c) = self.coupling.as_mut() {
+                c.law.shift_slave(rest);
+            }
+            self.set.position += rest;
+            self.phase = Kinematics {
+                position: at,
+                ..Kinematics::default()
+            };
+            if let Some(mut p) = ph {
+                p.cmd.end(cx, End::Done);
+            }
+            self.phase_planner.clear();
+        }
+    }
+
+    /// Ends the running phasing command (`end`); the phase stays where it is.
+    pub(super) fn end_phasing(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
+        if let Some(mut ph) = self.phasing.take() {
+            ph.cmd.end(cx, end);
+        }
+        self.phase_planner.clear();
+        self.phase.velocity = 0.0;
+        self.phase.acceleration = 0.0;
+        self.phase.jerk = 0.0;
+    }
+
+    /// The phasing part of the status (PhasingActive, AbsPhasingPos, CoveredPhaseShift).
+    pub(super) fn phasing_status(&self) -> (bool, f64, f64) {
+        (
+            self.phasing.is_some(),
+            self.phase.position,
+            self.phasing
+                .map(|p| self.phase.position - p.start)
+                .unwrap_or(0.0),
+        )
+    }
+}
