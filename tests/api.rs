@@ -1022,7 +1022,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 76, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 79, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -423,6 +423,7 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
             AxisConfig {
                 modulo: false,
                 parameters: AxisParameters::default(),
+                compensation_table: None,
             },
             DT,
         ),

@@ -28,6 +28,7 @@ impl Machine {
                 AxisConfig {
                     modulo: false,
                     parameters: p,
+                    compensation_table: None,
                 },
                 DT,
             ),

@@ -37,6 +37,7 @@ impl Machine {
                     AxisConfig {
                         modulo: false,
                         parameters: p,
+                        compensation_table: None,
                     },
                     0.001,
                 ),
@@ -200,6 +201,7 @@ fn cam_machine() -> Machine {
                 AxisConfig {
                     modulo: false,
                     parameters: p,
+                    compensation_table: None,
                 },
                 0.001,
             ),

@@ -353,6 +353,32 @@ pub enum CommandKind {
     TouchProbe(TouchProbe),
     /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
     AbortTrigger,
+    /// MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
+    /// position (and taken off the drive's setpoint), reached as `mode` says. A further one
+    /// takes over from the correction reached; `Release` freezes it where it is.
+    PositionCorrectionLimiter {
+        value: f64,
+        mode: PositionCorrectionMode,
+        /// FAST: the acceleration bound (0 = no limitation).
+        acceleration: f64,
+        /// FULLLENGTH: the travel a change is spread over (> 0).
+        correction_length: f64,
+    },
+    /// MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): `backlash` (None = the
+    /// axis's #1036 AxisBacklash) applied when travelling in the compensating direction,
+    /// changed at most at `ramp` units/s.
+    BacklashCompensation {
+        backlash: Option<f64>,
+        compensate_in_positive_direction: bool,
+        ramp: f64,
+        disable_mode: DisableMode,
+    },
+    /// MC_TableBasedPositionCompensation (§4.5.12, Enable-type): the axis's compensation
+    /// table at the set position, changed at most at `ramp` units/s.
+    TableBasedPositionCompensation {
+        ramp: f64,
+        disable_mode: DisableMode,
+    },
     /// MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing (§5.6): a phase shift of
     /// this slave against `master`, the slave's coupling.
     Phasing {
@@ -407,6 +433,11 @@ impl CommandKind {
             CommandKind::WriteParameter { .. } => "write-parameter",
             CommandKind::TouchProbe(_) => "touch-probe",
             CommandKind::AbortTrigger => "abort-trigger",
+            CommandKind::PositionCorrectionLimiter { .. } => "position-correction-limiter",
+            CommandKind::BacklashCompensation { .. } => "backlash-compensation",
+            CommandKind::TableBasedPositionCompensation { .. } => {
+                "table-based-position-compensation"
+            }
             CommandKind::Phasing { motion, .. } => match motion.kind {
                 PhasingKind::Absolute => "phasing-absolute",
                 PhasingKind::Relative => "phasing-relative",
@@ -431,6 +462,33 @@ pub struct TouchProbe {
     /// `TRIGGER_REF.ModuloPositions`: positions (window and recorded) are modulo the axis's
     /// AxisEncoderModuloValue; the window repeats every period and wraps when first > last.
     pub modulo_positions: bool,
+}
+
+/// `E_AxisPositionCorrectionMode` (§6.9): how MC_PositionCorrectionLimiter reaches a new
+/// correction value.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionCorrectionMode {
+    /// At once (a jump of the drive's setpoint by the change).
+    #[default]
+    Unlimited,
+    /// As fast as `acceleration` allows: at most acceleration × cycle time² per cycle.
+    Fast,
+    /// Spread over `correction_length` of the axis's travel.
+    FullLength,
+}
+
+/// `E_DisableMode` (§6.9): what a compensation leaves when its Enable falls.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DisableMode {
+    /// The last correction stays.
+    #[default]
+    Hold,
+    /// The correction returns to 0 at once (a jump of the drive's setpoint).
+    Reset,
 }
 
 /// Which phasing block (`E_PhasingType`, §6.8).

@@ -141,6 +141,8 @@ error_table! {
     TOUCH_PROBE_BUSY = 0x7090, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)";
     /// MC_PhasingAbsolute/Relative and MC_HaltPhasing need the axis enabled and coupled to the given master by MC_GearIn or a cam (not MC_GearInDyn, §5.6).
     PHASING_NOT_COUPLED = 0x70B0, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam";
+    /// MC_TableBasedPositionCompensation on an axis whose configuration has no compensation table.
+    COMPENSATION_TABLE_MISSING = 0x70B1, "compensation_table_missing", "the axis has no position compensation table";
 }
 
 impl fmt::Display for ErrorId {

@@ -380,6 +380,7 @@ mod tests {
             let config = AxisConfig {
                 modulo: false,
                 parameters: AxisParameters::default(),
+                compensation_table: None,
             };
             k.insert_axis(i as AxisSlot, Axis::new(config, DT)).unwrap();
         }

@@ -16,7 +16,7 @@
 //!
 //! let dt = 0.001;
 //! let mut kernel = Kernel::new(dt, 1);
-//! let config = AxisConfig { modulo: false, parameters: AxisParameters::default() };
+//! let config = AxisConfig { modulo: false, parameters: AxisParameters::default(), compensation_table: None };
 //! kernel.insert_axis(0, Axis::new(config, dt)).unwrap();
 //!
 //! let mut events: Vec<CommandEvent> = Vec::new();
@@ -63,6 +63,7 @@
 pub mod axis;
 pub mod cam;
 pub mod command;
+pub mod compensation;
 pub mod drive;
 pub mod error;
 pub mod functions;
@@ -74,8 +75,11 @@ pub mod status;
 
 pub use axis::{Axis, AxisConfig};
 pub use command::*;
+pub use compensation::{CompensationTable, WorkDirection};
 pub use drive::{DriveFeedback, DriveSetpoint, LatchSource};
 pub use error::ErrorId;
 pub use kernel::Kernel;
 pub use params::AxisParameters;
-pub use status::{AxisOpModes, AxisState, AxisStatus, HomingPhase, ProbeStatus};
+pub use status::{
+    AxisOpModes, AxisState, AxisStatus, HomingPhase, PositionCorrectionStatus, ProbeStatus,
+};

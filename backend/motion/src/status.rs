@@ -190,6 +190,29 @@ pub struct AxisStatus {
     /// What the running phasing command has covered so far (MC_PhasingRelative's
     /// CoveredPhaseShift); 0 when none runs.
     pub covered_phase_shift: f64,
+    /// Position correction (§7.2): what the compensations add to the actual position and
+    /// take off the drive's setpoint.
+    pub position_correction: PositionCorrectionStatus,
+}
+
+/// The position correction of an axis and its sources (MC_PositionCorrectionLimiter,
+/// MC_BacklashCompensation's CurrentBacklash, MC_TableBasedPositionCompensation's
+/// CurrentCorrection); `*_limiting`: the source has not reached what it was asked for yet
+/// (the blocks' Limiting output).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PositionCorrectionStatus {
+    /// The sum, as sent with the latest setpoint.
+    pub total: f64,
+    pub limiter: f64,
+    pub limiter_enabled: bool,
+    pub limiter_limiting: bool,
+    pub backlash: f64,
+    pub backlash_enabled: bool,
+    pub backlash_limiting: bool,
+    pub table: f64,
+    pub table_enabled: bool,
+    pub table_limiting: bool,
 }
 
 /// `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters.

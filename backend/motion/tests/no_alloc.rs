@@ -56,6 +56,7 @@ fn step_and_replanning_allocate_nothing() {
                 AxisConfig {
                     modulo: i % 2 == 1,
                     parameters: p,
+                    compensation_table: None,
                 },
                 0.001,
             ),

@@ -326,6 +326,7 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             },
             ..SimDriveConfig::default()
         }),
+        position_compensation_table: None,
     };
     vec![
         // Travel 0–1000 mm (software limits), switches 5 mm beyond.
@@ -355,6 +356,7 @@ pub fn demo_axes() -> Vec<AxisConfigDto> {
             },
             parameters: BTreeMap::new(),
             drive: DriveConfig::default(),
+            position_compensation_table: None,
         },
     ]
 }

@@ -109,6 +109,10 @@ pub struct AxisConfigDto {
     /// The axis's drive: `kind` (default `simulated`) and that drive's fields.
     #[serde(default)]
     pub drive: DriveConfig,
+    /// The table MC_TableBasedPositionCompensation applies (§4.5.12): equidistant
+    /// compensation values from min_position to max_position. Changing it re-creates the axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_compensation_table: Option<motion::CompensationTable>,
 }
 
 pub const UNITS: &[&str] = &["mm", "m", "um", "deg", "rad", "rev", "in", "inc"];
@@ -177,6 +181,11 @@ impl AxisConfigDto {
         }
         if !(d.jog_deadman_max.is_finite() && (0.05..=10.0).contains(&d.jog_deadman_max)) {
             err("dynamics.jog_deadman_max", "must be between 0.05 and 10 s");
+        }
+        if let Some(t) = &self.position_compensation_table {
+            if let Err((field, message)) = t.validate() {
+                err(&format!("position_compensation_table.{field}"), message);
+            }
         }
         if let Err(fe) = self.drive.validate() {
             for e in fe {
@@ -616,6 +625,73 @@ pub struct TouchProbeBody {
     /// the window repeats every period and wraps when first > last.
     #[serde(default)]
     pub modulo_positions: bool,
+}
+
+/// MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
+/// position and taken off the drive's setpoint, reached as `mode` says; active until released
+/// with DELETE /commands/{id} (the correction then stays where it is). A further one takes
+/// over from the correction reached. Needs AxisEnablePosCorrection (#1046), else 409
+/// invalid_mode. The status's `position_correction` shows it and `limiter_limiting`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"value": 0.05, "mode": "fast", "acceleration": 1000.0}))]
+pub struct PositionCorrectionLimiterBody {
+    /// The correction (axis units).
+    #[schema(minimum = -1e9, maximum = 1e9)]
+    pub value: f64,
+    /// `unlimited` (default: at once), `fast` (at most acceleration × cycle time² per cycle),
+    /// `full_length` (spread over correction_length of travel).
+    #[serde(default)]
+    pub mode: motion::PositionCorrectionMode,
+    /// fast: units/s² (0 = no limitation).
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub acceleration: f64,
+    /// full_length: the travel a change is spread over (> 0).
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub correction_length: f64,
+}
+
+/// MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): the backlash is applied while
+/// the axis travels in the compensating direction — negative (reference on the left flank,
+/// default) or positive — changing at most `ramp` units/s; active until released with DELETE
+/// /commands/{id} (`disable_mode` hold keeps the correction, reset returns it to 0 at once).
+/// Needs AxisEnablePosCorrection (#1046). CurrentBacklash is the status's
+/// `position_correction.backlash`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"backlash": 0.02, "ramp": 1.0}))]
+pub struct BacklashCompensationBody {
+    /// Signed backlash (positive: encoder on the motor; negative: encoder with play); absent
+    /// = the axis's AxisBacklash (#1036).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = -1e6, maximum = 1e6)]
+    pub backlash: Option<f64>,
+    /// false: compensated while travelling negative (left flank); true: while positive.
+    #[serde(default)]
+    pub compensate_in_positive_direction: bool,
+    /// The velocity (units/s, > 0) with which the compensation is applied.
+    #[schema(exclusive_minimum = 0)]
+    pub ramp: f64,
+    #[serde(default)]
+    pub disable_mode: motion::DisableMode,
+}
+
+/// MC_TableBasedPositionCompensation (§4.5.12, Enable-type): the compensation of the axis's
+/// `position_compensation_table` at the set position, changing at most `ramp` units/s; active
+/// until released with DELETE /commands/{id}. Needs AxisEnablePosCorrection (#1046) and a
+/// table (409 compensation_table_missing). CurrentCorrection is the status's
+/// `position_correction.table`.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"ramp": 1.0}))]
+pub struct TableCompensationBody {
+    /// The velocity (units/s, > 0) with which the compensation is applied.
+    #[schema(exclusive_minimum = 0)]
+    pub ramp: f64,
+    #[serde(default)]
+    pub disable_mode: motion::DisableMode,
 }
 
 /// MC_PhasingAbsolute / MC_PhasingRelative (§5.6.2, §5.6.3): a phase shift of this slave

@@ -65,6 +65,7 @@ fn a_cycle_allocates_nothing() {
             AxisConfig {
                 modulo: false,
                 parameters: AxisParameters::default(),
+                compensation_table: None,
             },
             ct,
         )

@@ -26,6 +26,7 @@ fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
             AxisConfig {
                 modulo: false,
                 parameters: AxisParameters::default(),
+                compensation_table: None,
             },
             ct,
         ),

@@ -50,4 +50,5 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28832, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)"],
   [28816, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)"],
   [28848, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam"],
+  [28849, "compensation_table_missing", "the axis has no position compensation table"],
 ];

@@ -168,6 +168,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/backlash-compensation": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_BacklashCompensation: apply the backlash while travelling in the compensating direction, at most at `ramp`; active until DELETE /commands/{id} (disable_mode hold or reset) */
+        post: operations["backlash_compensation"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/cam-add": {
         parameters: {
             query?: never;
@@ -648,6 +665,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/position-correction-limiter": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_PositionCorrectionLimiter: a correction added to the actual position and taken off the drive's setpoint, reached at once, as fast as an acceleration allows, or over a travel; active until DELETE /commands/{id} */
+        post: operations["position_correction_limiter"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/power": {
         parameters: {
             query?: never;
@@ -784,6 +818,23 @@ export interface paths {
         put?: never;
         /** MC_Stop: stops and locks the axis until released with DELETE /commands/{id} */
         post: operations["stop"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/table-based-position-compensation": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_TableBasedPositionCompensation: apply the axis's position compensation table at the set position, at most at `ramp`; active until DELETE /commands/{id} */
+        post: operations["table_based_position_compensation"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1474,6 +1525,7 @@ export interface components {
             };
             /** @description The axis's drive: `kind` (default `simulated`) and that drive's fields. */
             drive?: components["schemas"]["DriveConfig"];
+            position_compensation_table?: null | components["schemas"]["CompensationTable"];
         };
         /**
          * @description Default dynamics of the axis (used when a command passes 0).
@@ -1781,6 +1833,18 @@ export interface components {
          *       "operational": false,
          *       "override_percent": 100,
          *       "phasing_active": false,
+         *       "position_correction": {
+         *         "backlash": 0,
+         *         "backlash_enabled": false,
+         *         "backlash_limiting": false,
+         *         "limiter": 0,
+         *         "limiter_enabled": false,
+         *         "limiter_limiting": false,
+         *         "table": 0,
+         *         "table_enabled": false,
+         *         "table_limiting": false,
+         *         "total": 0
+         *       },
          *       "power_override_percent": 0,
          *       "power_status": true,
          *       "probe": {
@@ -1992,6 +2056,39 @@ export interface components {
              *     CoveredPhaseShift); 0 when none runs.
              */
             covered_phase_shift: number;
+            /**
+             * @description Position correction (§7.2): what the compensations add to the actual position and
+             *     take off the drive's setpoint.
+             */
+            position_correction: components["schemas"]["PositionCorrectionStatus"];
+        };
+        /**
+         * @description MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): the backlash is applied while
+         *     the axis travels in the compensating direction — negative (reference on the left flank,
+         *     default) or positive — changing at most `ramp` units/s; active until released with DELETE
+         *     /commands/{id} (`disable_mode` hold keeps the correction, reset returns it to 0 at once).
+         *     Needs AxisEnablePosCorrection (#1046). CurrentBacklash is the status's
+         *     `position_correction.backlash`.
+         * @example {
+         *       "backlash": 0.02,
+         *       "ramp": 1
+         *     }
+         */
+        BacklashCompensationBody: {
+            /**
+             * Format: double
+             * @description Signed backlash (positive: encoder on the motor; negative: encoder with play); absent
+             *     = the axis's AxisBacklash (#1036).
+             */
+            backlash?: number | null;
+            /** @description false: compensated while travelling negative (left flank); true: while positive. */
+            compensate_in_positive_direction?: boolean;
+            /**
+             * Format: double
+             * @description The velocity (units/s, > 0) with which the compensation is applied.
+             */
+            ramp: number;
+            disable_mode?: components["schemas"]["DisableMode"];
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
@@ -3144,6 +3241,57 @@ export interface components {
          */
         CommandState: "busy" | "active" | "done" | "aborted" | "error";
         /**
+         * @description The table: `compensation[i]` at `min_position + i · (max − min) / (n − 1)`.
+         * @example {
+         *       "compensation": [
+         *         1,
+         *         0.9,
+         *         0.8,
+         *         0.7,
+         *         0.6,
+         *         0.5,
+         *         0.4,
+         *         0.3,
+         *         0.2,
+         *         0.1,
+         *         0,
+         *         0.1,
+         *         0.2,
+         *         0.3,
+         *         0.4,
+         *         0.5,
+         *         0.4,
+         *         0.3,
+         *         0.2,
+         *         0.1,
+         *         0
+         *       ],
+         *       "max_position": 10,
+         *       "min_position": -10
+         *     }
+         */
+        CompensationTable: {
+            /**
+             * Format: double
+             * @description Where the table starts (uncorrected set position).
+             */
+            min_position: number;
+            /**
+             * Format: double
+             * @description Where it ends (> min_position).
+             */
+            max_position: number;
+            /** @description The compensation values (axis units), equidistant from min to max; 2 to 100 000. */
+            compensation: number[];
+            /** @description The travel direction the compensation applies in (the other: none). */
+            direction?: components["schemas"]["WorkDirection"];
+            /**
+             * @description The table repeats every max − min (a modulo axis's period); otherwise positions
+             *     outside [min, max] take the nearer end's value.
+             */
+            modulo?: boolean;
+        };
+        /**
          * @description One axis of the configuration document.
          * @example {
          *       "config": {
@@ -3475,6 +3623,11 @@ export interface components {
         CouplingInterpolation: "linear" | "spline" | "sliding_spline";
         /** @enum {string} */
         Direction: "positive" | "negative" | "shortest_way" | "current_direction";
+        /**
+         * @description `E_DisableMode` (§6.9): what a compensation leaves when its Enable falls.
+         * @enum {string}
+         */
+        DisableMode: "hold" | "reset";
         /**
          * @description A boundary condition that is not met: where two laws meet (or where a periodic table
          *     wraps), the slave's value at the end of one differs from the start of the next.
@@ -4123,6 +4276,18 @@ export interface components {
          *       "operational": false,
          *       "override_percent": 100,
          *       "phasing_active": false,
+         *       "position_correction": {
+         *         "backlash": 0,
+         *         "backlash_enabled": false,
+         *         "backlash_limiting": false,
+         *         "limiter": 0,
+         *         "limiter_enabled": false,
+         *         "limiter_limiting": false,
+         *         "table": 0,
+         *         "table_enabled": false,
+         *         "table_limiting": false,
+         *         "total": 0
+         *       },
          *       "power_override_percent": 0,
          *       "power_status": true,
          *       "probe": {
@@ -4785,6 +4950,71 @@ export interface components {
              * @description Natural frequency (Hz, > 0 and ≤ 1000).
              */
             natural_frequency_hz?: number;
+        };
+        /**
+         * @description MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
+         *     position and taken off the drive's setpoint, reached as `mode` says; active until released
+         *     with DELETE /commands/{id} (the correction then stays where it is). A further one takes
+         *     over from the correction reached. Needs AxisEnablePosCorrection (#1046), else 409
+         *     invalid_mode. The status's `position_correction` shows it and `limiter_limiting`.
+         * @example {
+         *       "acceleration": 1000,
+         *       "mode": "fast",
+         *       "value": 0.05
+         *     }
+         */
+        PositionCorrectionLimiterBody: {
+            /**
+             * Format: double
+             * @description The correction (axis units).
+             */
+            value: number;
+            /**
+             * @description `unlimited` (default: at once), `fast` (at most acceleration × cycle time² per cycle),
+             *     `full_length` (spread over correction_length of travel).
+             */
+            mode?: components["schemas"]["PositionCorrectionMode"];
+            /**
+             * Format: double
+             * @description fast: units/s² (0 = no limitation).
+             */
+            acceleration?: number;
+            /**
+             * Format: double
+             * @description full_length: the travel a change is spread over (> 0).
+             */
+            correction_length?: number;
+        };
+        /**
+         * @description `E_AxisPositionCorrectionMode` (§6.9): how MC_PositionCorrectionLimiter reaches a new
+         *     correction value.
+         * @enum {string}
+         */
+        PositionCorrectionMode: "unlimited" | "fast" | "full_length";
+        /**
+         * @description The position correction of an axis and its sources (MC_PositionCorrectionLimiter,
+         *     MC_BacklashCompensation's CurrentBacklash, MC_TableBasedPositionCompensation's
+         *     CurrentCorrection); `*_limiting`: the source has not reached what it was asked for yet
+         *     (the blocks' Limiting output).
+         */
+        PositionCorrectionStatus: {
+            /**
+             * Format: double
+             * @description The sum, as sent with the latest setpoint.
+             */
+            total: number;
+            /** Format: double */
+            limiter: number;
+            limiter_enabled: boolean;
+            limiter_limiting: boolean;
+            /** Format: double */
+            backlash: number;
+            backlash_enabled: boolean;
+            backlash_limiting: boolean;
+            /** Format: double */
+            table: number;
+            table_enabled: boolean;
+            table_limiting: boolean;
         };
         /**
          * @description MC_Power.
@@ -5620,6 +5850,18 @@ export interface components {
          *         "operational": false,
          *         "override_percent": 100,
          *         "phasing_active": false,
+         *         "position_correction": {
+         *           "backlash": 0,
+         *           "backlash_enabled": false,
+         *           "backlash_limiting": false,
+         *           "limiter": 0,
+         *           "limiter_enabled": false,
+         *           "limiter_limiting": false,
+         *           "table": 0,
+         *           "table_enabled": false,
+         *           "table_limiting": false,
+         *           "total": 0
+         *         },
          *         "power_override_percent": 0,
          *         "power_status": true,
          *         "probe": {
@@ -5845,6 +6087,24 @@ export interface components {
             drive_bus: string;
             realtime: components["schemas"]["RealtimeGrant"];
             timing: components["schemas"]["Timing"];
+        };
+        /**
+         * @description MC_TableBasedPositionCompensation (§4.5.12, Enable-type): the compensation of the axis's
+         *     `position_compensation_table` at the set position, changing at most `ramp` units/s; active
+         *     until released with DELETE /commands/{id}. Needs AxisEnablePosCorrection (#1046) and a
+         *     table (409 compensation_table_missing). CurrentCorrection is the status's
+         *     `position_correction.table`.
+         * @example {
+         *       "ramp": 1
+         *     }
+         */
+        TableCompensationBody: {
+            /**
+             * Format: double
+             * @description The velocity (units/s, > 0) with which the compensation is applied.
+             */
+            ramp: number;
+            disable_mode?: components["schemas"]["DisableMode"];
         };
         /**
          * @description `MC_TableType`.
@@ -6084,6 +6344,11 @@ export interface components {
          * @enum {string}
          */
         ValueSelect: "position" | "velocity" | "acceleration" | "jerk";
+        /**
+         * @description `E_WorkDirection` (§6.11.7): in which travel direction a compensation applies.
+         * @enum {string}
+         */
+        WorkDirection: "both" | "positive" | "negative";
         /**
          * @description MC_WriteMotionFunction: points to replace, by their `point_index`.
          * @example {
@@ -7643,6 +7908,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    backlash_compensation: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["BacklashCompensationBody"];
             };
         };
         responses: {
@@ -9316,6 +9641,66 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    position_correction_limiter: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PositionCorrectionLimiterBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
     power: {
         parameters: {
             query?: {
@@ -9697,6 +10082,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["StopBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    table_based_position_compensation: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TableCompensationBody"];
             };
         };
         responses: {

@@ -262,6 +262,11 @@ impl Axis {
                 Ok(())
             }
             CommandKind::TouchProbe(t) => self.submit_touch_probe(cx, cmd.id, t),
+            kind @ (CommandKind::PositionCorrectionLimiter { .. }
+            | CommandKind::BacklashCompensation { .. }
+            | CommandKind::TableBasedPositionCompensation { .. }) => {
+                self.submit_correction(cx, cmd.id, kind)
+            }
             CommandKind::Phasing { master, motion } => {
                 self.submit_phasing(cx, cmd.id, master, motion)
             }
@@ -288,6 +293,9 @@ impl Axis {
         if let Some(s) = self.stop.as_mut().filter(|s| s.id == target) {
             s.released = true;
             self.try_unlock(cx);
+            return Ok(());
+        }
+        if self.release_correction(cx, target) {
             return Ok(());
         }
         if self.power.as_ref().is_some_and(|p| p.id == target) {

@@ -22,7 +22,7 @@ impl Axis {
             // A drive that reports no number is a faulty drive; keep the last good values.
             let fb = DriveFeedback {
                 fault: true,
-                actual_position: self.act_pos - self.offset,
+                actual_position: self.act_pos - self.offset - self.corrections.sent,
                 actual_velocity: 0.0,
                 ..*fb
             };
@@ -36,7 +36,8 @@ impl Axis {
         };
         self.cycle = cycle;
         self.io_data_invalid = fb.bus_error;
-        self.act_pos = fb.actual_position + self.offset;
+        // The drive answers the setpoint sent last cycle, which carried that cycle's correction.
+        self.act_pos = fb.actual_position + self.offset + self.corrections.sent;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
         if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {
@@ -100,6 +101,9 @@ impl Axis {
             self.in_window_timer = 0.0;
         }
         let probe_armed = self.step_probe(cx, fb);
+        let correction = self.step_corrections();
+        let correction_rate = (correction - self.corrections.sent) / dt;
+        self.corrections.sent = correction;
         self.update_status();
         // The peak hold counts cycles only: a submit's status update sees the setpoint the
         // drive has not answered yet. NaN feedback cannot stick (f64::min/max skip NaN).
@@ -112,8 +116,8 @@ impl Axis {
             enable: self.enable
                 && !(self.mode == Mode::ErrorStop && self.error == ErrorId::DRIVE_FAULT),
             fault_reset,
-            position: self.set.position - self.offset,
-            velocity: self.set.velocity,
+            position: self.set.position - self.offset - correction,
+            velocity: self.set.velocity - correction_rate,
             acceleration: self.set.acceleration,
             latch_enable: self.latch.is_some() || probe_armed,
             latch_source: match (self.latch, &self.probe) {

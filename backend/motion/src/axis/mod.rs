@@ -28,6 +28,7 @@ use crate::status::{AxisState, AxisStatus, HomingPhase};
 mod blending;
 mod camming;
 mod commands;
+mod correction;
 mod coupling;
 mod cycle;
 mod homing;
@@ -52,6 +53,8 @@ pub struct AxisConfig {
     /// Rotary modulo axis: the modulo period is #1044 (AxisEncoderModuloValue).
     pub modulo: bool,
     pub parameters: AxisParameters,
+    /// The table MC_TableBasedPositionCompensation uses (validated by the builder).
+    pub compensation_table: Option<crate::CompensationTable>,
 }
 
 /// Velocities below this are "at rest" (units/s); far below any real resolution.
@@ -162,6 +165,8 @@ pub struct Axis {
     phase: Kinematics,
     phase_planner: Planner,
     phasing: Option<phasing::PhasingJob>,
+    /// Position correction (§7.2): limiter, backlash and table compensation.
+    corrections: correction::Corrections,
 }
 
 impl Axis {
@@ -174,6 +179,7 @@ impl Axis {
             config: AxisConfig {
                 modulo: config.modulo,
                 parameters,
+                compensation_table: config.compensation_table,
             },
             slot: 0,
             cycle_time,
@@ -238,6 +244,7 @@ impl Axis {
             phase: Kinematics::default(),
             phase_planner: Planner::new(cycle_time),
             phasing: None,
+            corrections: correction::Corrections::default(),
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();

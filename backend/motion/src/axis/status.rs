@@ -123,8 +123,10 @@ impl Axis {
             allow_ext_set_axis_commands: p.axis_allow_motion_cmd_to_ext_set_axis,
         };
         let (phasing_active, absolute_phase_shift, covered_phase_shift) = self.phasing_status();
+        let position_correction = self.correction_status();
         let s = &mut self.status;
         s.phasing_active = phasing_active;
+        s.position_correction = position_correction;
         s.absolute_phase_shift = absolute_phase_shift;
         s.covered_phase_shift = covered_phase_shift;
         s.op_modes = op_modes;

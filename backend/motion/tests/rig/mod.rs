@@ -249,10 +249,24 @@ impl Rig {
     }
 
     pub fn with(configs: Vec<(bool, AxisParameters)>) -> Rig {
+        Rig::with_configs(
+            configs
+                .into_iter()
+                .map(|(modulo, parameters)| AxisConfig {
+                    modulo,
+                    parameters,
+                    compensation_table: None,
+                })
+                .collect(),
+        )
+    }
+
+    pub fn with_configs(configs: Vec<AxisConfig>) -> Rig {
         let n = configs.len();
         let mut k = Kernel::new(DT, n);
         let mut bounds = Vec::new();
-        for (i, (modulo, p)) in configs.into_iter().enumerate() {
+        for (i, config) in configs.into_iter().enumerate() {
+            let p = &config.parameters;
             bounds.push(Bounds {
                 velocity: p.axis_velo_max,
                 acceleration: p
@@ -261,17 +275,7 @@ impl Rig {
                     .max(p.axis_fast_dec),
                 jerk: p.axis_jerk.max(p.axis_fast_jerk),
             });
-            k.insert_axis(
-                i as u16,
-                Axis::new(
-                    AxisConfig {
-                        modulo,
-                        parameters: p,
-                    },
-                    DT,
-                ),
-            )
-            .unwrap();
+            k.insert_axis(i as u16, Axis::new(config, DT)).unwrap();
         }
         Rig {
             k,

@@ -237,6 +237,12 @@ catalogue! {
         "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
     abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
         "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
+    position_correction_limiter: "position-correction-limiter", PositionCorrectionLimiterBody, PositionCorrectionLimiterBody::to_kind, Operator, Active,
+        "MC_PositionCorrectionLimiter: a correction added to the actual position and taken off the drive's setpoint, reached at once, as fast as an acceleration allows, or over a travel; active until DELETE /commands/{id}";
+    backlash_compensation: "backlash-compensation", BacklashCompensationBody, BacklashCompensationBody::to_kind, Operator, Active,
+        "MC_BacklashCompensation: apply the backlash while travelling in the compensating direction, at most at `ramp`; active until DELETE /commands/{id} (disable_mode hold or reset)";
+    table_based_position_compensation: "table-based-position-compensation", TableCompensationBody, TableCompensationBody::to_kind, Operator, Active,
+        "MC_TableBasedPositionCompensation: apply the axis's position compensation table at the set position, at most at `ramp`; active until DELETE /commands/{id}";
     phasing_absolute: "phasing-absolute", PhasingBody, PhasingBody::absolute, Operator, Done,
         "MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in or a cam)";
     phasing_relative: "phasing-relative", PhasingBody, PhasingBody::relative, Operator, Done,

@@ -150,6 +150,8 @@ pub enum Milestone {
     InEndVelocity,
     /// MC_Power's Status: the axis is enabled.
     Status,
+    /// An Enable-type block is active (a compensation applied from now on).
+    Active,
 }
 
 impl Milestone {
@@ -162,6 +164,7 @@ impl Milestone {
             Milestone::InSync => o.in_sync,
             Milestone::InEndVelocity => o.in_end_velocity,
             Milestone::Status => o.status,
+            Milestone::Active => o.active,
         };
         o.done || o.error || o.command_aborted || arrived
     }

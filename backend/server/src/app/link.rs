@@ -326,6 +326,7 @@ impl AppState {
             AxisConfig {
                 modulo: config.modulo.is_some(),
                 parameters: p.clone(),
+                compensation_table: config.position_compensation_table.clone(),
             },
             ct,
         );

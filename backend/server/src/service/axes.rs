@@ -179,6 +179,9 @@ fn plan(s: &AppState, e: &AxisEntry, new: &AxisConfigDto) -> AppResult<Plan> {
     if new.drive != e.config.drive {
         reasons.push("drive changed".to_owned());
     }
+    if new.position_compensation_table != e.config.position_compensation_table {
+        reasons.push("position compensation table changed".to_owned());
+    }
     let Some(old_p) = old_p else {
         reasons.push("the stored configuration is not valid any more".to_owned());
         change.rebuild_reasons = reasons;

@@ -380,6 +380,56 @@ impl GearInBody {
     }
 }
 
+impl PositionCorrectionLimiterBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.value.is_finite() && self.value.abs() <= 1e9) {
+            c.fail("value", "must be a number from -1e9 to 1e9");
+        }
+        c.non_negative("acceleration", self.acceleration);
+        if self.mode == motion::PositionCorrectionMode::FullLength {
+            c.positive("correction_length", self.correction_length);
+        } else {
+            c.non_negative("correction_length", self.correction_length);
+        }
+        c.done(CommandKind::PositionCorrectionLimiter {
+            value: self.value,
+            mode: self.mode,
+            acceleration: self.acceleration,
+            correction_length: self.correction_length,
+        })
+    }
+}
+
+impl BacklashCompensationBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if let Some(b) = self.backlash {
+            if !(b.is_finite() && b.abs() <= 1e6) {
+                c.fail("backlash", "must be a number from -1e6 to 1e6");
+            }
+        }
+        c.positive("ramp", self.ramp);
+        c.done(CommandKind::BacklashCompensation {
+            backlash: self.backlash,
+            compensate_in_positive_direction: self.compensate_in_positive_direction,
+            ramp: self.ramp,
+            disable_mode: self.disable_mode,
+        })
+    }
+}
+
+impl TableCompensationBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.positive("ramp", self.ramp);
+        c.done(CommandKind::TableBasedPositionCompensation {
+            ramp: self.ramp,
+            disable_mode: self.disable_mode,
+        })
+    }
+}
+
 impl PhasingBody {
     fn to_phasing(
         &self,

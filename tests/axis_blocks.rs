@@ -1,0 +1,275 @@
+//! Issue 9's single-axis blocks over HTTP and the websocket on the demo machine: phasing of a
+//! gear slave, the position-correction blocks (limiter, backlash, the axis's compensation
+//! table), MC_Power's BufferMode and the extended status.
+
+mod common;
+
+use common::*;
+use serde_json::{Value, json};
+
+async fn write_parameter(s: &Server, axis: &str, name: &str, value: Value) {
+    let r = put(
+        s,
+        &format!("/api/v1/axes/{axis}/parameters/{name}"),
+        json!({ "value": value }),
+    )
+    .await;
+    assert!(r.status < 300, "{name}: {}", r.text);
+}
+
+async fn until_status(s: &Server, axis: &str, what: &str, f: impl Fn(&Value) -> bool) -> Value {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    loop {
+        let st = status(s, axis).await;
+        if f(&st["status"]) {
+            return st;
+        }
+        assert!(std::time::Instant::now() < deadline, "{what}: {st}");
+        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    }
+}
+
+/// §5.6: y coupled 1:1 to x is shifted by 5 mm while x runs; the shift stays; a relative
+/// phasing sent over the websocket adds 2; phasing on an uncoupled axis is a 409 with its
+/// code; a bad velocity a 422 at its field.
+#[tokio::test(flavor = "multi_thread")]
+async fn phasing_shifts_a_gear_slave_against_its_master() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/phasing-absolute",
+        json!({"master": "x", "phase_shift": 1.0, "velocity": 5.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "phasing_not_coupled");
+    let r = post(
+        &s,
+        "/api/v1/axes/y/phasing-absolute",
+        json!({"master": "x", "phase_shift": 1.0, "velocity": 0.001}),
+    )
+    .await;
+    assert_eq!(r.field_error(), (422, Some("velocity")), "{}", r.text);
+    let g = post(
+        &s,
+        "/api/v1/axes/y/gear-in?wait=true",
+        json!({"master": "x", "ratio_numerator": 1.0, "ratio_denominator": 1}),
+    )
+    .await;
+    assert_eq!(g.json["state"], "done", "{}", g.text);
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-velocity?wait=true",
+        json!({"velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(m.json["outputs"]["in_velocity"], true, "{}", m.text);
+    let p = post(
+        &s,
+        "/api/v1/axes/y/phasing-absolute?wait=true&timeout_ms=20000",
+        json!({"master": "x", "phase_shift": 5.0, "velocity": 10.0, "acceleration": 100.0, "deceleration": 100.0, "jerk": 1000.0}),
+    )
+    .await;
+    assert_eq!(p.json["state"], "done", "{}", p.text);
+    let st = status(&s, "y").await;
+    assert_eq!(st["status"]["absolute_phase_shift"], 5.0, "{st}");
+    assert_eq!(st["status"]["phasing_active"], false);
+
+    // The websocket method of the same block family.
+    let (mut ws, _) = tokio_tungstenite::connect_async(s.url("/api/v1/ws").replace("http", "ws"))
+        .await
+        .expect("websocket");
+    use futures_util::{SinkExt, StreamExt};
+    let call = json!({"jsonrpc": "2.0", "id": 7, "method": "phasing-relative",
+        "params": {"axis": "y", "master": "x", "phase_shift": 2.0, "velocity": 10.0, "wait": true, "timeout_ms": 20000}});
+    ws.send(tokio_tungstenite::tungstenite::Message::Text(
+        call.to_string().into(),
+    ))
+    .await
+    .unwrap();
+    let answer = loop {
+        let m = ws.next().await.expect("answer").expect("frame");
+        let v: Value = serde_json::from_str(m.to_text().unwrap()).unwrap();
+        if v["id"] == 7 {
+            break v;
+        }
+    };
+    assert_eq!(answer["result"]["state"], "done", "{answer}");
+    let st = status(&s, "y").await;
+    let shift = st["status"]["absolute_phase_shift"].as_f64().unwrap();
+    assert!((shift - 7.0).abs() < 1e-9, "{st}");
+    // Slave − master = the shift (both coupled at 0, ratio 1).
+    let x = status(&s, "x").await["status"]["set_position"]
+        .as_f64()
+        .unwrap();
+    let y = st["status"]["set_position"].as_f64().unwrap();
+    assert!((y - x - 7.0).abs() < 0.5, "x {x} y {y}");
+    s.stop();
+}
+
+/// §4.5.2/§4.5.5/§4.5.12 on the simulated drive: refused (409 invalid_mode) until
+/// AxisEnablePosCorrection is on; the limiter's correction shows in the status and the
+/// drive's position moves by it while the axis's set position stays; the backlash follows
+/// the travel direction; the compensation table is part of the axis configuration (422 at
+/// its field when invalid) and applies along the travel; DELETE ends each block.
+#[tokio::test(flavor = "multi_thread")]
+async fn position_corrections_move_the_drive_not_the_axis() {
+    let s = Server::start();
+    // The table with the axis (it rebuilds y, which is off).
+    let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+    cfg["position_compensation_table"] =
+        json!({"min_position": 0.0, "max_position": 10.0, "compensation": [0.0, 0.1]});
+    let bad = put(&s, "/api/v1/axes/y", {
+        let mut c = cfg.clone();
+        c["position_compensation_table"]["max_position"] = json!(-1.0);
+        c
+    })
+    .await;
+    assert_eq!(
+        bad.field_error(),
+        (422, Some("position_compensation_table.max_position")),
+        "{}",
+        bad.text
+    );
+    let r = put(&s, "/api/v1/axes/y", cfg.clone()).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(
+        get(&s, "/api/v1/axes/y").await.json["config"]["position_compensation_table"]["compensation"],
+        json!([0.0, 0.1])
+    );
+    power_on(&s, "y").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/position-correction-limiter",
+        json!({"value": 0.5}),
+    )
+    .await;
+    assert_problem(&r, 409, "invalid_mode");
+    write_parameter(&s, "y", "AxisEnablePosCorrection", json!(true)).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/position-correction-limiter",
+        json!({"value": 0.5, "mode": "full_length"}),
+    )
+    .await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("correction_length")),
+        "{}",
+        r.text
+    );
+    let l = post(
+        &s,
+        "/api/v1/axes/y/position-correction-limiter?wait=true",
+        json!({"value": 0.5, "mode": "fast", "acceleration": 100000.0}),
+    )
+    .await;
+    assert_eq!(l.json["state"], "active", "{}", l.text);
+    let lid = l.json["id"].as_u64().unwrap();
+    let st = until_status(&s, "y", "limiter applied", |st| {
+        st["position_correction"]["limiter"] == 0.5
+    })
+    .await;
+    assert_eq!(st["status"]["position_correction"]["limiter_enabled"], true);
+    // The axis stays where it was; its actual position (drive + correction) too.
+    assert!(
+        st["status"]["set_position"].as_f64().unwrap().abs() < 1e-9,
+        "{st}"
+    );
+    until_status(&s, "y", "actual ideal", |st| {
+        st["actual_position"].as_f64().unwrap().abs() < 1e-3
+    })
+    .await;
+    let d = delete(&s, &format!("/api/v1/commands/{lid}")).await;
+    assert!(d.status < 300, "{}", d.text);
+    let fin = until_final(&s, lid, 10).await;
+    assert_eq!(fin["state"], "done", "{fin}");
+    assert_eq!(
+        status(&s, "y").await["status"]["position_correction"]["limiter"],
+        0.5
+    );
+
+    let b = post(
+        &s,
+        "/api/v1/axes/y/backlash-compensation?wait=true",
+        json!({"backlash": 0.2, "ramp": 2.0, "disable_mode": "reset"}),
+    )
+    .await;
+    assert_eq!(b.json["state"], "active", "{}", b.text);
+    let bid = b.json["id"].as_u64().unwrap();
+    let m = post(
+        &s,
+        "/api/v1/axes/y/move-relative?wait=true&timeout_ms=20000",
+        json!({"distance": -5.0, "velocity": 50.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    until_status(&s, "y", "backlash reached", |st| {
+        (st["position_correction"]["backlash"].as_f64().unwrap() - 0.2).abs() < 1e-9
+    })
+    .await;
+    delete(&s, &format!("/api/v1/commands/{bid}")).await;
+    until_status(&s, "y", "backlash reset", |st| {
+        st["position_correction"]["backlash"] == 0.0
+    })
+    .await;
+
+    let t = post(
+        &s,
+        "/api/v1/axes/y/table-based-position-compensation?wait=true",
+        json!({"ramp": 1.0}),
+    )
+    .await;
+    assert_eq!(t.json["state"], "active", "{}", t.text);
+    let m = post(
+        &s,
+        "/api/v1/axes/y/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 5.0, "velocity": 50.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    until_status(&s, "y", "table at 5", |st| {
+        (st["position_correction"]["table"].as_f64().unwrap() - 0.05).abs() < 1e-9
+    })
+    .await;
+    s.stop();
+}
+
+/// §4.1.1: a disable with BufferMode buffered waits for the running move; §6.11.13: the
+/// extended status is in the status resource.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_buffered_disable_waits_for_the_move_and_the_status_is_extended() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let st = status(&s, "x").await;
+    assert_eq!(st["status"]["operational"], true, "{st}");
+    assert_eq!(st["status"]["ptp_mode"], true);
+    assert_eq!(st["status"]["op_modes"]["soft_limit_max_monitoring"], true);
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 50.0, "velocity": 100.0}),
+    )
+    .await;
+    let mid = m.json["id"].as_u64().unwrap();
+    let off = post(
+        &s,
+        "/api/v1/axes/x/power",
+        json!({"enable": false, "buffer_mode": "buffered"}),
+    )
+    .await;
+    assert_eq!(off.status, 202, "{}", off.text);
+    let oid = off.json["id"].as_u64().unwrap();
+    let fin = until_final(&s, mid, 20).await;
+    assert_eq!(fin["state"], "done", "the move ran to its end: {fin}");
+    let fin = until_final(&s, oid, 20).await;
+    assert_eq!(fin["state"], "done", "{fin}");
+    let st = status(&s, "x").await;
+    assert_eq!(st["status"]["state"], "disabled", "{st}");
+    assert!(
+        (st["status"]["set_position"].as_f64().unwrap() - 50.0).abs() < 0.05,
+        "{st}"
+    );
+    s.stop();
+}
