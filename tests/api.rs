@@ -1148,7 +1148,7 @@ async fn asyncapi_json_is_current() {
             "{method}"
         );
     }
-    assert_eq!(commands, 30);
+    assert_eq!(commands, 36);
     let s = Server::start();
     let served = get(&s, "/asyncapi.json").await;
     assert_eq!(served.status, 200);

@@ -200,6 +200,10 @@ pub struct AxisStatus {
 /// CurrentCorrection); `*_limiting`: the source has not reached what it was asked for yet
 /// (the blocks' Limiting output).
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"total": 0.25, "limiter": 0.05,
+    "limiter_enabled": true, "limiter_limiting": false, "backlash": 0.2,
+    "backlash_enabled": true, "backlash_limiting": false, "table": 0.0,
+    "table_enabled": false, "table_limiting": false})))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PositionCorrectionStatus {
     /// The sum, as sent with the latest setpoint.
@@ -217,6 +221,12 @@ pub struct PositionCorrectionStatus {
 
 /// `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"position_area_monitoring": true,
+    "target_position_monitoring": true, "loop_mode": false, "motion_monitoring": false,
+    "peh_time_monitoring": true, "modulo": false, "position_lag_monitoring": true,
+    "soft_limit_min_monitoring": true, "soft_limit_max_monitoring": true,
+    "position_correction": false, "allow_slave_commands": false,
+    "allow_ext_set_axis_commands": false})))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct AxisOpModes {
     /// Bit 0: #1023 AxisEnPositionRangeMonitoring.

@@ -551,7 +551,8 @@ pub struct PowerBody {
     /// How removing the enable (enable=false, or DELETE of the enabling command) acts:
     /// `aborting` (default) disables at once; any other mode waits until the axis no longer
     /// executes a job (§4.1.1), the command staying busy until then.
-    pub buffer_mode: BufferMode,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub buffer_mode: Option<BufferMode>,
 }
 impl Default for PowerBody {
     fn default() -> Self {
@@ -560,7 +561,7 @@ impl Default for PowerBody {
             enable_positive: true,
             enable_negative: true,
             override_percent: 100.0,
-            buffer_mode: BufferMode::Aborting,
+            buffer_mode: None,
         }
     }
 }

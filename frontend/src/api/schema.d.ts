@@ -1584,7 +1584,23 @@ export interface components {
              */
             jog_deadman_max: number;
         };
-        /** @description `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters. */
+        /**
+         * @description `ST_AxisOpModes` (spec §6.11.11): the decoded OpModeDWord, from the axis's parameters.
+         * @example {
+         *       "allow_ext_set_axis_commands": false,
+         *       "allow_slave_commands": false,
+         *       "loop_mode": false,
+         *       "modulo": false,
+         *       "motion_monitoring": false,
+         *       "peh_time_monitoring": true,
+         *       "position_area_monitoring": true,
+         *       "position_correction": false,
+         *       "position_lag_monitoring": true,
+         *       "soft_limit_max_monitoring": true,
+         *       "soft_limit_min_monitoring": true,
+         *       "target_position_monitoring": true
+         *     }
+         */
         AxisOpModes: {
             /** @description Bit 0: #1023 AxisEnPositionRangeMonitoring. */
             position_area_monitoring: boolean;
@@ -4996,6 +5012,18 @@ export interface components {
          *     MC_BacklashCompensation's CurrentBacklash, MC_TableBasedPositionCompensation's
          *     CurrentCorrection); `*_limiting`: the source has not reached what it was asked for yet
          *     (the blocks' Limiting output).
+         * @example {
+         *       "backlash": 0.2,
+         *       "backlash_enabled": true,
+         *       "backlash_limiting": false,
+         *       "limiter": 0.05,
+         *       "limiter_enabled": true,
+         *       "limiter_limiting": false,
+         *       "table": 0,
+         *       "table_enabled": false,
+         *       "table_limiting": false,
+         *       "total": 0.25
+         *     }
          */
         PositionCorrectionStatus: {
             /**
@@ -5035,8 +5063,8 @@ export interface components {
              * @default 100
              */
             override_percent: number;
-            /** @default aborting */
-            buffer_mode: components["schemas"]["BufferMode"];
+            /** @default null */
+            buffer_mode: null | components["schemas"]["BufferMode"];
         };
         /**
          * @description `MC_TouchProbeRecordedData` of a done probe cycle.

@@ -94,7 +94,7 @@ impl PowerBody {
             enable_positive: self.enable_positive,
             enable_negative: self.enable_negative,
             override_percent: self.override_percent,
-            buffer_mode: self.buffer_mode,
+            buffer_mode: self.buffer_mode.unwrap_or_default(),
         })
     }
 }
