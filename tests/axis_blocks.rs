@@ -273,3 +273,55 @@ async fn a_buffered_disable_waits_for_the_move_and_the_status_is_extended() {
     );
     s.stop();
 }
+
+/// §4.5.4 / §4.5.10 over HTTP: the override filter sets the power override; the set-override
+/// factors are checked at their fields.
+#[tokio::test(flavor = "multi_thread")]
+async fn override_filter_and_set_override_factors() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/override-filter?wait=true",
+        json!({"raw": 16383.5}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(
+        status(&s, "x").await["status"]["power_override_percent"],
+        50.0
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/x/override-filter",
+        json!({"raw": 1.0, "lower_threshold": 10.0, "upper_threshold": 5.0}),
+    )
+    .await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("upper_threshold")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/x/set-override",
+        json!({"velocity_factor": 1.0, "acceleration_factor": 0.0}),
+    )
+    .await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("acceleration_factor")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/x/set-override?wait=true",
+        json!({"velocity_factor": 0.5, "acceleration_factor": 0.5, "jerk_factor": 0.25}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(status(&s, "x").await["status"]["set_override_factor"], 0.5);
+    s.stop();
+}

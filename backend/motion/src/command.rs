@@ -256,9 +256,23 @@ pub enum CommandKind {
         /// `position` and `relative` are then not used.
         clear_position_offset: bool,
     },
-    /// MC_SetOverride (velocity factor 0..=1).
+    /// MC_SetOverride (§4.5.10): the velocity factor 0..=1 scales every motion at once (as
+    /// MC_Power's override); the acceleration and jerk factors (0 < f ≤ 1; TwinCAT has them
+    /// but does not support them) scale the dynamics of the motion commands started after.
     SetOverride {
         velocity_factor: f64,
+        acceleration_factor: f64,
+        jerk_factor: f64,
+    },
+    /// MC_OverrideFilter (§4.5.4): a raw override value (e.g. an analog input in digits)
+    /// clamped to the thresholds and quantised into `steps`, applied as MC_Power's override;
+    /// after each change a new value waits `recovery_time` seconds — except 0 % and 100 %.
+    OverrideFilter {
+        raw: f64,
+        lower_threshold: f64,
+        upper_threshold: f64,
+        steps: u32,
+        recovery_time: f64,
     },
     MoveAbsolute(Positioning),
     MoveRelative(Positioning),
@@ -404,6 +418,7 @@ impl CommandKind {
             CommandKind::Reset => "reset",
             CommandKind::SetPosition { .. } => "set-position",
             CommandKind::SetOverride { .. } => "set-override",
+            CommandKind::OverrideFilter { .. } => "override-filter",
             CommandKind::MoveAbsolute(_) => "move-absolute",
             CommandKind::MoveRelative(_) => "move-relative",
             CommandKind::MoveAdditive(_) => "move-additive",

@@ -47,6 +47,22 @@ pub fn calc_dynamics_by_ramp_time(
     })
 }
 
+/// MC_OverrideFilter's filtering (§4.5.4) without its quiet time: `raw` clamped to
+/// [lower, upper] and quantised down into `steps` equal steps of 100 % (200 steps = 0.5 %),
+/// so that the upper threshold gives 100 % and anything below the first step 0 %. Refused
+/// (0x4B06) when steps ≤ 1 or lower ≥ upper, as the manual says, or for numbers that are not
+/// finite. Returns the override in percent.
+pub fn override_filter(raw: f64, lower: f64, upper: f64, steps: u32) -> Result<f64, ErrorId> {
+    if steps <= 1 || !(raw.is_finite() && lower.is_finite() && upper.is_finite()) || lower >= upper
+    {
+        return Err(ErrorId::PARAMETER_NOT_CORRECT);
+    }
+    let share = (raw.clamp(lower, upper) - lower) / (upper - lower);
+    // The tiny allowance keeps a raw value that is exactly on a step on it despite rounding.
+    let step = (share * steps as f64 + 1e-9).floor().min(steps as f64);
+    Ok(step * 100.0 / steps as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -79,5 +95,31 @@ mod tests {
         );
         assert!(calc_dynamics_by_ramp_time(0.0, 1.0, 0.5).is_err());
         assert!(calc_dynamics_by_ramp_time(10.0, 0.0, 0.5).is_err());
+    }
+
+    /// §4.5.4: the defaults (0…32767 digits, 200 steps) give 0.5 % steps; the raw value is
+    /// clamped to the thresholds; steps ≤ 1 and lower ≥ upper are refused.
+    #[test]
+    fn override_filter_clamps_and_quantises() {
+        assert_eq!(override_filter(32767.0, 0.0, 32767.0, 200), Ok(100.0));
+        assert_eq!(override_filter(40000.0, 0.0, 32767.0, 200), Ok(100.0));
+        assert_eq!(override_filter(-5.0, 0.0, 32767.0, 200), Ok(0.0));
+        // One step is 163.835 digits: just below it is 0 %, on it 0.5 %.
+        assert_eq!(override_filter(163.0, 0.0, 32767.0, 200), Ok(0.0));
+        assert_eq!(override_filter(163.835, 0.0, 32767.0, 200), Ok(0.5));
+        assert_eq!(override_filter(16383.5, 0.0, 32767.0, 200), Ok(50.0));
+        assert_eq!(override_filter(7.5, 5.0, 10.0, 4), Ok(50.0));
+        for (steps, lower, upper) in [
+            (1, 0.0, 10.0),
+            (0, 0.0, 10.0),
+            (200, 10.0, 10.0),
+            (200, 11.0, 10.0),
+        ] {
+            assert_eq!(
+                override_filter(5.0, lower, upper, steps),
+                Err(ErrorId::PARAMETER_NOT_CORRECT)
+            );
+        }
+        assert!(override_filter(f64::NAN, 0.0, 10.0, 200).is_err());
     }
 }

@@ -256,6 +256,8 @@ fn a_low_override_brakes_without_running_backwards() {
         0,
         CommandKind::SetOverride {
             velocity_factor: 0.05,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
         },
     );
     r.run(0.5);
@@ -319,7 +321,11 @@ fn kind(s: &Successor) -> CommandKind {
             buffer_mode,
             options: MoveOptions::default(),
         },
-        Successor::Override(velocity_factor) => CommandKind::SetOverride { velocity_factor },
+        Successor::Override(velocity_factor) => CommandKind::SetOverride {
+            velocity_factor,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
+        },
     }
 }
 

@@ -71,7 +71,7 @@ fn command() -> impl Strategy<Value = CommandKind> {
         1 => Just(CommandKind::Stop { deceleration: 0.0, jerk: 0.0, options: MoveOptions::default() }),
         2 => (0usize..5, any::<bool>(), 0.1..20.0f64).prop_map(|(m, forward, position)| CommandKind::Jog { mode: [JogMode::StandardSlow, JogMode::StandardFast, JogMode::Continuous, JogMode::Inching, JogMode::InchingModulo][m], forward, position, velocity: 100.0, dynamics: Dynamics::default(), deadman: 0.3 }),
         1 => (-100.0..100.0f64, any::<bool>(), any::<bool>()).prop_map(|(position, relative, clear_position_lag)| CommandKind::SetPosition { position, relative, clear_position_lag, clear_position_offset: false }),
-        1 => (0.0..=1.0f64).prop_map(|velocity_factor| CommandKind::SetOverride { velocity_factor }),
+        1 => (0.0..=1.0f64).prop_map(|velocity_factor| CommandKind::SetOverride { velocity_factor, acceleration_factor: 1.0, jerk_factor: 1.0 }),
         1 => prop_oneof![Just(HomingMode::Direct), Just(HomingMode::ForceCalibration), Just(HomingMode::ResetCalibration), Just(HomingMode::Default)].prop_map(|mode| CommandKind::Home { position: Some(0.0), mode, options: HomingOptions::default() }),
         1 => (-3.0..3.0f64, 1u16..4).prop_map(|(n, d)| gear_in(0, n, d)),
         1 => Just(CommandKind::GearOut),

@@ -54,6 +54,8 @@ fn the_status_shows_the_power_override_and_the_set_override_factor() {
         0,
         CommandKind::SetOverride {
             velocity_factor: 0.4,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
         },
     );
     r.step();

@@ -767,9 +767,58 @@ pub struct SetPositionBody {
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"velocity_factor": 0.5}))]
 pub struct SetOverrideBody {
-    /// 0.0–1.0.
+    /// 0.0–1.0: scales the velocity of every motion at once (with MC_Power's override).
     #[schema(minimum = 0, maximum = 1)]
     pub velocity_factor: f64,
+    /// (0, 1], default 1: scales acceleration and deceleration of motion commands started
+    /// after it (not MC_Halt or MC_Stop).
+    #[serde(default = "one")]
+    #[schema(exclusive_minimum = 0, maximum = 1, default = 1.0)]
+    pub acceleration_factor: f64,
+    /// (0, 1], default 1: scales the jerk of motion commands started after it.
+    #[serde(default = "one")]
+    #[schema(exclusive_minimum = 0, maximum = 1, default = 1.0)]
+    pub jerk_factor: f64,
+}
+
+/// MC_OverrideFilter (§4.5.4): a raw override (e.g. an analog potentiometer in digits) clamped
+/// to the thresholds and quantised into `steps`, applied as the axis's MC_Power override
+/// (`power_override_percent`). After each change of the filtered value a new one waits until
+/// `recovery_time` has passed — and is then applied without being sent again — except 0 % and
+/// 100 %, which act at once.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"raw": 16384}))]
+pub struct OverrideFilterBody {
+    /// OverrideValueRaw, digits.
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub raw: f64,
+    /// LowerOverrideThreshold (default 0).
+    #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12, default = 0.0)]
+    pub lower_threshold: f64,
+    /// UpperOverrideThreshold (default 32767), above lower_threshold.
+    #[serde(default = "default_upper_threshold")]
+    #[schema(minimum = -1e12, maximum = 1e12, default = 32767.0)]
+    pub upper_threshold: f64,
+    /// OverrideSteps (default 200 = 0.5 %), at least 2.
+    #[serde(default = "default_override_steps")]
+    #[schema(minimum = 2, default = 200)]
+    pub steps: u32,
+    /// OverrideRecoveryTime in seconds (default 0.15).
+    #[serde(default = "default_recovery_time")]
+    #[schema(minimum = 0, maximum = 3600, default = 0.15)]
+    pub recovery_time: f64,
+}
+
+fn default_upper_threshold() -> f64 {
+    32767.0
+}
+fn default_override_steps() -> u32 {
+    200
+}
+fn default_recovery_time() -> f64 {
+    0.15
 }
 
 /// MC_MoveAbsolute: a target position.

@@ -596,6 +596,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/override-filter": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_OverrideFilter: a raw override value (digits) clamped, quantised and applied as the power override after its recovery time (0 % and 100 % at once) */
+        post: operations["override_filter"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/parameters": {
         parameters: {
             query?: never;
@@ -725,7 +742,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_SetOverride */
+        /** MC_SetOverride: velocity factor at once; acceleration and jerk factors for the motion commands that follow */
         post: operations["set_override"];
         delete?: never;
         options?: never;
@@ -4736,6 +4753,47 @@ export interface components {
             slave_scaling_mode?: components["schemas"]["CamScalingMode"];
         };
         /**
+         * @description MC_OverrideFilter (§4.5.4): a raw override (e.g. an analog potentiometer in digits) clamped
+         *     to the thresholds and quantised into `steps`, applied as the axis's MC_Power override
+         *     (`power_override_percent`). After each change of the filtered value a new one waits until
+         *     `recovery_time` has passed — and is then applied without being sent again — except 0 % and
+         *     100 %, which act at once.
+         * @example {
+         *       "raw": 16384
+         *     }
+         */
+        OverrideFilterBody: {
+            /**
+             * Format: double
+             * @description OverrideValueRaw, digits.
+             */
+            raw: number;
+            /**
+             * Format: double
+             * @description LowerOverrideThreshold (default 0).
+             * @default 0
+             */
+            lower_threshold: number;
+            /**
+             * Format: double
+             * @description UpperOverrideThreshold (default 32767), above lower_threshold.
+             * @default 32767
+             */
+            upper_threshold: number;
+            /**
+             * Format: int32
+             * @description OverrideSteps (default 200 = 0.5 %), at least 2.
+             * @default 200
+             */
+            steps: number;
+            /**
+             * Format: double
+             * @description OverrideRecoveryTime in seconds (default 0.15).
+             * @default 0.15
+             */
+            recovery_time: number;
+        };
+        /**
          * @description UI group of a parameter (no meaning for the kernel).
          * @enum {string}
          */
@@ -5620,9 +5678,22 @@ export interface components {
         SetOverrideBody: {
             /**
              * Format: double
-             * @description 0.0–1.0.
+             * @description 0.0–1.0: scales the velocity of every motion at once (with MC_Power's override).
              */
             velocity_factor: number;
+            /**
+             * Format: double
+             * @description (0, 1], default 1: scales acceleration and deceleration of motion commands started
+             *     after it (not MC_Halt or MC_Stop).
+             * @default 1
+             */
+            acceleration_factor: number;
+            /**
+             * Format: double
+             * @description (0, 1], default 1: scales the jerk of motion commands started after it.
+             * @default 1
+             */
+            jerk_factor: number;
         };
         /**
          * @description MC_SetPosition.
@@ -9414,6 +9485,66 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["MoveVelocityBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    override_filter: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["OverrideFilterBody"];
             };
         };
         responses: {

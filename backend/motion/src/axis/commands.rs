@@ -113,11 +113,43 @@ impl Axis {
                 cx.report(cmd.id, DONE);
                 Ok(())
             }
-            CommandKind::SetOverride { velocity_factor } => {
-                if !(0.0..=1.0).contains(&velocity_factor) {
+            CommandKind::SetOverride {
+                velocity_factor,
+                acceleration_factor,
+                jerk_factor,
+            } => {
+                let dyn_factor = |f: f64| f > 0.0 && f <= 1.0;
+                if !(0.0..=1.0).contains(&velocity_factor)
+                    || !dyn_factor(acceleration_factor)
+                    || !dyn_factor(jerk_factor)
+                {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
                 self.override_factor = velocity_factor;
+                self.acc_factor = acceleration_factor;
+                self.jerk_factor = jerk_factor;
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::OverrideFilter {
+                raw,
+                lower_threshold,
+                upper_threshold,
+                steps,
+                recovery_time,
+            } => {
+                let percent = crate::functions::override_filter(
+                    raw,
+                    lower_threshold,
+                    upper_threshold,
+                    steps,
+                )?;
+                if !(recovery_time.is_finite() && recovery_time >= 0.0) {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                self.override_filter.recovery_time = recovery_time;
+                self.override_filter.pending = Some(percent);
+                self.step_override_filter(0.0);
                 cx.report(cmd.id, DONE);
                 Ok(())
             }

@@ -53,6 +53,7 @@ impl Axis {
         self.act_vel = fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
+        self.step_override_filter(dt);
         // Power and drive readiness (notes 1, 2, 5).
         self.step_power(cx, dt, fb);
 

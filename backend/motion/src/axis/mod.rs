@@ -62,6 +62,19 @@ const EPS_V: f64 = 1e-9;
 /// How long a drive may take to report "operation enabled" after MC_Power.
 const POWER_ON_TIMEOUT: f64 = 1.0;
 
+/// MC_OverrideFilter between calls (§4.5.4): after every change of the filtered override a
+/// new value waits until `recovery_time` has passed since it (0 % and 100 % never wait).
+#[derive(Clone, Copy, Debug, Default)]
+struct OverrideFilterState {
+    recovery_time: f64,
+    /// Seconds since the filtered override last changed.
+    since_change: f64,
+    /// The latest filtered value (percent) not yet applied.
+    pending: Option<f64>,
+    /// The last value applied (percent).
+    applied: Option<f64>,
+}
+
 /// The axis's own mode; the PLCopen state is derived from it and the active job.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Mode {
@@ -101,6 +114,11 @@ pub struct Axis {
     limit_negative: bool,
     power_override: f64,
     override_factor: f64,
+    /// MC_SetOverride's AccFactor and JerkFactor: scale the dynamics of motion commands.
+    acc_factor: f64,
+    jerk_factor: f64,
+    /// MC_OverrideFilter's quiet time and the value waiting for its end.
+    override_filter: OverrideFilterState,
     power_on_timer: f64,
     set: Kinematics,
     /// The setpoint position sent last cycle: the actual position read now answers it, so
@@ -204,6 +222,9 @@ impl Axis {
             limit_negative: false,
             power_override: 100.0,
             override_factor: 1.0,
+            acc_factor: 1.0,
+            jerk_factor: 1.0,
+            override_filter: OverrideFilterState::default(),
             power_on_timer: 0.0,
             set: Kinematics::default(),
             sent_position: 0.0,

@@ -29,6 +29,28 @@ impl Axis {
         };
     }
 
+    /// MC_OverrideFilter (§4.5.4): a filtered value waiting for the quiet time after the last
+    /// change is applied as MC_Power's override once it has passed; 0 % and 100 % at once.
+    pub(super) fn step_override_filter(&mut self, dt: f64) {
+        let f = &mut self.override_filter;
+        f.since_change += dt;
+        let Some(v) = f.pending else {
+            return;
+        };
+        if f.applied == Some(v) {
+            f.pending = None;
+        } else if v == 0.0
+            || v == 100.0
+            || f.applied.is_none()
+            || f.since_change >= f.recovery_time - 1e-9
+        {
+            f.pending = None;
+            f.applied = Some(v);
+            f.since_change = 0.0;
+            self.power_override = v;
+        }
+    }
+
     /// The axis executes a job (§4.1.1's test for a buffered disable): a motion, a coupling,
     /// a superposition or a coupling waiting for its activation, running or buffered.
     pub(super) fn executes_job(&self) -> bool {

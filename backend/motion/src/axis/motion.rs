@@ -46,7 +46,17 @@ impl Axis {
         {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
-        Ok((acc, dec, jerk))
+        Ok(self.scaled_dynamics(acc, dec, jerk))
+    }
+
+    /// MC_SetOverride's AccFactor and JerkFactor on the dynamics of a motion command (not on
+    /// MC_Halt, MC_Stop or an error stop: a stop keeps its full deceleration).
+    pub(super) fn scaled_dynamics(&self, acc: f64, dec: f64, jerk: f64) -> (f64, f64, f64) {
+        (
+            acc * self.acc_factor,
+            dec * self.acc_factor,
+            jerk * self.jerk_factor,
+        )
     }
 
     pub(super) fn check_velocity(&self, v: f64) -> Result<f64, ErrorId> {
@@ -259,13 +269,13 @@ impl Axis {
                 }
                 let dir = if forward { 1.0 } else { -1.0 };
                 let p = self.p();
+                let scaled = |v: f64| {
+                    let (a, d, j) = self.scaled_dynamics(p.axis_acc, p.axis_dec, p.axis_jerk);
+                    (v, a, d, j)
+                };
                 let (v, acc, dec, jerk) = match mode {
-                    JogMode::StandardSlow => {
-                        (p.axis_velo_man_slow, p.axis_acc, p.axis_dec, p.axis_jerk)
-                    }
-                    JogMode::StandardFast => {
-                        (p.axis_velo_man_fast, p.axis_acc, p.axis_dec, p.axis_jerk)
-                    }
+                    JogMode::StandardSlow => scaled(p.axis_velo_man_slow),
+                    JogMode::StandardFast => scaled(p.axis_velo_man_fast),
                     _ => {
                         let v = self.check_velocity(velocity)?;
                         let (a, d, j) = self.dynamics(dynamics)?;

@@ -37,6 +37,8 @@ fn the_rig_holds_a_move_from_rest_to_its_own_dynamics() {
         0,
         CommandKind::SetOverride {
             velocity_factor: 0.5,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
         },
     );
     assert!(r.from_rest[0].is_none());

@@ -354,6 +354,8 @@ fn run(case: &Case) {
                     0,
                     CommandKind::SetOverride {
                         velocity_factor: factor,
+                        acceleration_factor: 1.0,
+                        jerk_factor: 1.0,
                     },
                 );
                 r.run(run);

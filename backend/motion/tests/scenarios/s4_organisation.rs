@@ -47,6 +47,8 @@ fn velocity_never_exceeds_commanded_velocity_times_override_in_any_cycle() {
         0,
         CommandKind::SetOverride {
             velocity_factor: 0.4,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
         },
     );
     let v_before = r.st(0).set_velocity.abs();
@@ -460,4 +462,123 @@ fn s4_2_8_extended_status_flags_follow_the_axis_in_every_cycle() {
         },
     );
     assert!(r.st(0).op_modes.position_correction);
+}
+
+fn set_override(velocity_factor: f64, acceleration_factor: f64, jerk_factor: f64) -> CommandKind {
+    CommandKind::SetOverride {
+        velocity_factor,
+        acceleration_factor,
+        jerk_factor,
+    }
+}
+
+/// §4.5.10 MC_SetOverride: AccFactor and JerkFactor (0 < f ≤ 1) scale the acceleration,
+/// deceleration and jerk of the motion commands started after them — a move's |a| reaches
+/// half the axis's acceleration and no more in any cycle; MC_Halt keeps its full
+/// deceleration; factors outside (0, 1] are refused.
+#[test]
+fn s4_5_10_set_override_factors_scale_the_dynamics_of_new_moves() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    for (v, a, j) in [
+        (1.1, 1.0, 1.0),
+        (1.0, 0.0, 1.0),
+        (1.0, 1.0, 1.5),
+        (1.0, f64::NAN, 1.0),
+    ] {
+        assert_eq!(
+            r.rejected(0, set_override(v, a, j)),
+            ErrorId::PARAMETER_NOT_CORRECT
+        );
+    }
+    r.ok(0, set_override(1.0, 0.5, 0.5));
+    let acc = r.k.parameters(0).unwrap().axis_acc;
+    let jerk = r.k.parameters(0).unwrap().axis_jerk;
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(200.0, 400.0)));
+    let mut peak: f64 = 0.0;
+    let mut last_a = 0.0;
+    r.until(5.0, |r| {
+        let a = r.st(0).set_acceleration;
+        assert!(a.abs() <= 0.5 * acc + 1e-6, "|a| {a} above half of {acc}");
+        assert!(
+            ((a - last_a) / DT).abs() <= 0.5 * jerk + 1e-3,
+            "jerk above half"
+        );
+        last_a = a;
+        peak = peak.max(a.abs());
+        r.out(m).done
+    });
+    assert!(peak > 0.49 * acc, "the halved acceleration is used: {peak}");
+    // A halt brakes with its own deceleration, unscaled.
+    r.ok(0, velocity(300.0, Direction::Negative));
+    r.run(1.0);
+    r.ok(
+        0,
+        CommandKind::Halt {
+            deceleration: 1000.0,
+            jerk: 0.0,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        },
+    );
+    let mut peak: f64 = 0.0;
+    r.until(2.0, |r| {
+        peak = peak.max(r.st(0).set_acceleration.abs());
+        r.st(0).state == AxisState::Standstill
+    });
+    assert!(peak > 900.0, "halt braked with {peak}, not its 1000");
+}
+
+fn filter(raw: f64, recovery_time: f64) -> CommandKind {
+    CommandKind::OverrideFilter {
+        raw,
+        lower_threshold: 0.0,
+        upper_threshold: 32767.0,
+        steps: 200,
+        recovery_time,
+    }
+}
+
+/// §4.5.4 MC_OverrideFilter: the raw value becomes a quantised override (MC_Power's, the
+/// PlcToNc.Override it is made for); after each change a new value waits for the recovery
+/// time — then it is applied without being sent again — except 0 % and 100 %, which act at
+/// once; steps ≤ 1 or lower ≥ upper are refused (0x4B06).
+#[test]
+fn s4_5_4_override_filter_quantises_and_waits_for_its_recovery_time() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::OverrideFilter {
+                raw: 1.0,
+                lower_threshold: 5.0,
+                upper_threshold: 5.0,
+                steps: 200,
+                recovery_time: 0.15
+            }
+        ),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    r.ok(0, filter(16383.5, 0.15));
+    assert_eq!(r.st(0).power_override_percent, 50.0);
+    r.run(0.05);
+    r.ok(0, filter(8191.75, 0.15));
+    assert_eq!(
+        r.st(0).power_override_percent,
+        50.0,
+        "waits for the quiet time"
+    );
+    let mut cycles = 0;
+    r.until(1.0, |r| {
+        cycles += 1;
+        r.st(0).power_override_percent == 25.0
+    });
+    // 150 ms after the change to 50 %, of which 50 ms had passed.
+    assert!((99..=101).contains(&cycles), "{cycles}");
+    // 0 % acts at once, and so does 100 % right after it.
+    r.ok(0, filter(10.0, 0.15));
+    assert_eq!(r.st(0).power_override_percent, 0.0);
+    r.ok(0, filter(40000.0, 0.15));
+    assert_eq!(r.st(0).power_override_percent, 100.0);
 }

@@ -91,6 +91,8 @@ fn s11a_20_move_velocity_in_velocity_and_stays_busy() {
         0,
         CommandKind::SetOverride {
             velocity_factor: 0.5,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
         },
     );
     r.step();

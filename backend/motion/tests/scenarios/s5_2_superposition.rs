@@ -169,6 +169,8 @@ fn s11a_31_superposition_abort_table_every_row_and_column() {
                         1,
                         CommandKind::SetOverride {
                             velocity_factor: 0.0,
+                            acceleration_factor: 1.0,
+                            jerk_factor: 1.0,
                         },
                     );
                 }
@@ -207,6 +209,8 @@ fn s11a_31_superposition_abort_table_every_row_and_column() {
                         1,
                         CommandKind::SetOverride {
                             velocity_factor: 1.0,
+                            acceleration_factor: 1.0,
+                            jerk_factor: 1.0,
                         },
                     );
                 }
@@ -251,6 +255,8 @@ fn s11a_31_superposition_abort_options() {
             0,
             CommandKind::SetOverride {
                 velocity_factor: 0.0,
+                acceleration_factor: 1.0,
+                jerk_factor: 1.0,
             },
         );
         r.run(2.0);
@@ -259,6 +265,8 @@ fn s11a_31_superposition_abort_options() {
             0,
             CommandKind::SetOverride {
                 velocity_factor: 1.0,
+                acceleration_factor: 1.0,
+                jerk_factor: 1.0,
             },
         );
         r.until(5.0, |r| !r.out(s).busy);

@@ -184,7 +184,9 @@ catalogue! {
     set_position: "set-position", SetPositionBody, SetPositionBody::to_kind, Operator, Done,
         "MC_SetPosition";
     set_override: "set-override", SetOverrideBody, SetOverrideBody::to_kind, Operator, Done,
-        "MC_SetOverride";
+        "MC_SetOverride: velocity factor at once; acceleration and jerk factors for the motion commands that follow";
+    override_filter: "override-filter", OverrideFilterBody, OverrideFilterBody::to_kind, Operator, Done,
+        "MC_OverrideFilter: a raw override value (digits) clamped, quantised and applied as the power override after its recovery time (0 % and 100 % at once)";
     move_absolute: "move-absolute", MoveBody, MoveBody::absolute, Operator, Done,
         "MC_MoveAbsolute";
     move_relative: "move-relative", MoveRelativeBody, MoveRelativeBody::relative, Operator, Done,

@@ -118,8 +118,43 @@ impl SetOverrideBody {
         if !(self.velocity_factor.is_finite() && (0.0..=1.0).contains(&self.velocity_factor)) {
             c.fail("velocity_factor", "must be between 0 and 1");
         }
+        for (field, f) in [
+            ("acceleration_factor", self.acceleration_factor),
+            ("jerk_factor", self.jerk_factor),
+        ] {
+            if !(f.is_finite() && f > 0.0 && f <= 1.0) {
+                c.fail(field, "must be above 0 and at most 1");
+            }
+        }
         c.done(CommandKind::SetOverride {
             velocity_factor: self.velocity_factor,
+            acceleration_factor: self.acceleration_factor,
+            jerk_factor: self.jerk_factor,
+        })
+    }
+}
+
+impl OverrideFilterBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        c.finite("raw", self.raw);
+        c.finite("lower_threshold", self.lower_threshold);
+        c.finite("upper_threshold", self.upper_threshold);
+        if self.upper_threshold <= self.lower_threshold {
+            c.fail("upper_threshold", "must be above lower_threshold");
+        }
+        if self.steps <= 1 {
+            c.fail("steps", "must be at least 2");
+        }
+        if !(self.recovery_time.is_finite() && (0.0..=3600.0).contains(&self.recovery_time)) {
+            c.fail("recovery_time", "must be between 0 and 3600 s");
+        }
+        c.done(CommandKind::OverrideFilter {
+            raw: self.raw,
+            lower_threshold: self.lower_threshold,
+            upper_threshold: self.upper_threshold,
+            steps: self.steps,
+            recovery_time: self.recovery_time,
         })
     }
 }
