@@ -325,3 +325,100 @@ async fn override_filter_and_set_override_factors() {
     assert_eq!(status(&s, "x").await["status"]["set_override_factor"], 0.5);
     s.stop();
 }
+
+/// §4.5.9, §4.5.13/14, §4.2.3 over HTTP and the websocket: an absolute encoder scaling at
+/// standstill moves the reading (and #1040 reads it back), in motion it is a 409; positions
+/// and encoder counts convert both ways, a position too far for the counter is a 422 at
+/// `position`; the axis's components name its drive.
+#[tokio::test(flavor = "multi_thread")]
+async fn encoder_scaling_conversions_and_components() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let m = post(
+        &s,
+        "/api/v1/axes/y/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 10.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/set-encoder-scaling-factor?wait=true",
+        json!({"scaling_factor": 0.5}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let st = until_status(&s, "y", "scaled", |st| st["encoder_scaling_factor"] == 0.5).await;
+    assert!(
+        (st["status"]["actual_position"].as_f64().unwrap() - 5.0).abs() < 1e-3,
+        "{st}"
+    );
+    assert!(
+        (st["status"]["set_position"].as_f64().unwrap() - 5.0).abs() < 1e-3,
+        "{st}"
+    );
+    let p = get(&s, "/api/v1/axes/y/parameters/AxisEncoderScalingFactor").await;
+    assert_eq!(p.json["value"], 0.5, "{}", p.text);
+    let count = st["status"]["encoder_count"].as_u64().unwrap();
+    assert_eq!(count, 10, "{st}");
+    let c = get(
+        &s,
+        &format!(
+            "/api/v1/axes/y/convert-inc-pos-to-pos?inc_pos={}",
+            count + 4
+        ),
+    )
+    .await;
+    assert_eq!(c.status, 200, "{}", c.text);
+    assert!(
+        (c.json["position"].as_f64().unwrap() - 7.0).abs() < 1e-3,
+        "{}",
+        c.text
+    );
+    let c = get(&s, "/api/v1/axes/y/convert-pos-to-inc-pos?position=4").await;
+    assert_eq!(c.json["inc_pos"], 8, "{}", c.text);
+    let c = get(&s, "/api/v1/axes/y/convert-pos-to-inc-pos?position=1e12").await;
+    assert_eq!(c.field_error(), (422, Some("position")), "{}", c.text);
+    assert_eq!(c.json["error_id"], 0x70B3, "{}", c.text);
+
+    let (mut ws, _) = tokio_tungstenite::connect_async(s.url("/api/v1/ws").replace("http", "ws"))
+        .await
+        .expect("websocket");
+    use futures_util::{SinkExt, StreamExt};
+    let call = json!({"jsonrpc": "2.0", "id": 3, "method": "read-axis-components", "params": {"axis": "y"}});
+    ws.send(tokio_tungstenite::tungstenite::Message::Text(
+        call.to_string().into(),
+    ))
+    .await
+    .unwrap();
+    let answer = loop {
+        let m = ws.next().await.expect("answer").expect("frame");
+        let v: Value = serde_json::from_str(m.to_text().unwrap()).unwrap();
+        if v["id"] == 3 {
+            break v;
+        }
+    };
+    assert_eq!(answer["result"]["drive"]["kind"], "simulated", "{answer}");
+    assert_eq!(
+        answer["result"]["encoder"]["scaling_factor"], 0.5,
+        "{answer}"
+    );
+    let rest = get(&s, "/api/v1/axes/y/read-axis-components").await;
+    assert_eq!(rest.json, answer["result"]);
+
+    post(
+        &s,
+        "/api/v1/axes/y/move-velocity",
+        json!({"velocity": 10.0}),
+    )
+    .await;
+    until_status(&s, "y", "moving", |st| st["moving"] == true).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/set-encoder-scaling-factor",
+        json!({"scaling_factor": 0.25}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    s.stop();
+}

@@ -367,6 +367,12 @@ pub enum CommandKind {
     TouchProbe(TouchProbe),
     /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
     AbortTrigger,
+    /// MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment; absolute
+    /// (the position jumps with it, at rest only) or relative (no jump; in motion too).
+    SetEncoderScalingFactor {
+        factor: f64,
+        relative: bool,
+    },
     /// MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
     /// position (and taken off the drive's setpoint), reached as `mode` says. A further one
     /// takes over from the correction reached; `Release` freezes it where it is.
@@ -448,6 +454,7 @@ impl CommandKind {
             CommandKind::WriteParameter { .. } => "write-parameter",
             CommandKind::TouchProbe(_) => "touch-probe",
             CommandKind::AbortTrigger => "abort-trigger",
+            CommandKind::SetEncoderScalingFactor { .. } => "set-encoder-scaling-factor",
             CommandKind::PositionCorrectionLimiter { .. } => "position-correction-limiter",
             CommandKind::BacklashCompensation { .. } => "backlash-compensation",
             CommandKind::TableBasedPositionCompensation { .. } => {

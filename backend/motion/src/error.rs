@@ -143,6 +143,10 @@ error_table! {
     PHASING_NOT_COUPLED = 0x70B0, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam";
     /// MC_TableBasedPositionCompensation on an axis whose configuration has no compensation table.
     COMPENSATION_TABLE_MISSING = 0x70B1, "compensation_table_missing", "the axis has no position compensation table";
+    /// MC_SetEncoderScalingFactor in relative mode while moving: the drive's velocity would step by more than the axis's acceleration allows in one cycle.
+    ENCODER_SCALING_STEP_TOO_LARGE = 0x70B2, "encoder_scaling_step_too_large", "this encoder scaling change in motion would step the drive's velocity; change it at standstill or in smaller steps";
+    /// MC_ConvertPosToIncPos: the position is so far from the actual one that the encoder counter would overflow on the way.
+    POSITION_OUT_OF_COUNTER_RANGE = 0x70B3, "position_out_of_counter_range", "the position is too far from the actual position for the encoder counter";
 }
 
 impl fmt::Display for ErrorId {

@@ -63,6 +63,40 @@ pub fn override_filter(raw: f64, lower: f64, upper: f64, steps: u32) -> Result<f
     Ok(step * 100.0 / steps as f64)
 }
 
+/// MC_ConvertIncPosToPos (§4.5.13): the axis position of encoder count `inc_pos`, from the
+/// axis's latest status — its raw count and actual position — counting the difference on the
+/// counter of `mask` (#1043) the short way round (past and future overflows are not
+/// considered, as the manual says) and scaling it with the encoder scaling now.
+pub fn convert_inc_pos_to_pos(status: &crate::AxisStatus, inc_pos: u32, mask: u32) -> f64 {
+    status.actual_position
+        + count_difference(inc_pos, status.encoder_count, mask) as f64
+            * status.encoder_scaling_factor
+}
+
+/// MC_ConvertPosToIncPos (§4.5.14): the encoder count of axis position `position`; refused
+/// (0x70B3) when the position is so far from the actual one that the counter of `mask` would
+/// overflow on the way (half its range or more), or is not a number.
+pub fn convert_pos_to_inc_pos(
+    status: &crate::AxisStatus,
+    position: f64,
+    mask: u32,
+) -> Result<u32, ErrorId> {
+    let period = mask as f64 + 1.0;
+    let delta = ((position - status.actual_position) / status.encoder_scaling_factor).round();
+    if !delta.is_finite() || delta.abs() >= period / 2.0 {
+        return Err(ErrorId::POSITION_OUT_OF_COUNTER_RANGE);
+    }
+    let count = (status.encoder_count as f64 + delta).rem_euclid(period);
+    Ok(count as u32 & mask)
+}
+
+/// `to − from` on a counter of `mask + 1` values, in [−range/2, range/2).
+fn count_difference(to: u32, from: u32, mask: u32) -> i64 {
+    let period = mask as i64 + 1;
+    let d = ((to & mask) as i64 - (from & mask) as i64).rem_euclid(period);
+    if d >= period / 2 { d - period } else { d }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,5 +155,43 @@ mod tests {
             );
         }
         assert!(override_filter(f64::NAN, 0.0, 10.0, 200).is_err());
+    }
+
+    /// §4.5.13/14: positions from counts and back, relative to the present count, across the
+    /// counter's wrap; a position half the counter away or more is refused.
+    #[test]
+    fn inc_pos_conversions_count_from_the_present_count_the_short_way() {
+        let st = crate::AxisStatus {
+            actual_position: 100.0,
+            encoder_count: 4_294_967_290,
+            encoder_scaling_factor: 0.001,
+            ..Default::default()
+        };
+        let mask = u32::MAX;
+        assert_eq!(convert_inc_pos_to_pos(&st, 4_294_967_290, mask), 100.0);
+        // 10 counts further, across the wrap: +0.01.
+        assert!((convert_inc_pos_to_pos(&st, 4, mask) - 100.01).abs() < 1e-9);
+        assert!((convert_inc_pos_to_pos(&st, 4_294_967_280, mask) - 99.99).abs() < 1e-9);
+        assert_eq!(convert_pos_to_inc_pos(&st, 100.01, mask), Ok(4));
+        assert_eq!(convert_pos_to_inc_pos(&st, 99.99, mask), Ok(4_294_967_280));
+        for inc in [0u32, 17, 4_294_967_295, 2_000_000_000] {
+            let p = convert_inc_pos_to_pos(&st, inc, mask);
+            assert_eq!(convert_pos_to_inc_pos(&st, p, mask), Ok(inc), "{inc}");
+        }
+        // 16-bit counter: 40000 counts away is more than half of it.
+        let st16 = crate::AxisStatus {
+            encoder_count: 100,
+            ..st
+        };
+        assert_eq!(
+            convert_pos_to_inc_pos(&st16, 100.0 + 40.0, 0xFFFF),
+            Err(ErrorId::POSITION_OUT_OF_COUNTER_RANGE)
+        );
+        assert_eq!(
+            convert_pos_to_inc_pos(&st16, 100.0 + 30.0, 0xFFFF),
+            Ok(30_100)
+        );
+        assert!((convert_inc_pos_to_pos(&st16, 65_535, 0xFFFF) - 99.899).abs() < 1e-9);
+        assert!(convert_pos_to_inc_pos(&st, f64::NAN, mask).is_err());
     }
 }

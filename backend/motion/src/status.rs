@@ -193,6 +193,11 @@ pub struct AxisStatus {
     /// Position correction (§7.2): what the compensations add to the actual position and
     /// take off the drive's setpoint.
     pub position_correction: PositionCorrectionStatus,
+    /// The raw encoder count (drive position ÷ the scaling the axis was built with, masked
+    /// by #1043): what MC_ConvertIncPosToPos / MC_ConvertPosToIncPos count from.
+    pub encoder_count: u32,
+    /// The encoder scaling now (#1040, units per increment; MC_SetEncoderScalingFactor).
+    pub encoder_scaling_factor: f64,
 }
 
 /// The position correction of an axis and its sources (MC_PositionCorrectionLimiter,

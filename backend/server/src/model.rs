@@ -628,6 +628,125 @@ pub struct TouchProbeBody {
     pub modulo_positions: bool,
 }
 
+/// `E_SetScalingFactorMode` (§6.11.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum EncoderScalingMode {
+    /// The position is the count × the new factor: it jumps (at standstill only; the set
+    /// position goes along, nothing moves).
+    #[default]
+    Absolute,
+    /// The offset takes up the change: no jump, also in motion (as long as the drive's
+    /// velocity steps by no more than the axis's acceleration in one cycle).
+    Relative,
+}
+
+/// MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment (#1040). The axis's
+/// drive is its encoder, so its setpoints are scaled alike and the position loop stays closed.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"scaling_factor": 0.001, "mode": "relative"}))]
+pub struct SetEncoderScalingFactorBody {
+    /// Units per encoder increment (> 0).
+    #[schema(minimum = 1e-12, maximum = 1e12)]
+    pub scaling_factor: f64,
+    #[serde(default)]
+    pub mode: EncoderScalingMode,
+}
+
+/// An encoder count for MC_ConvertIncPosToPos.
+#[derive(Debug, Deserialize, utoipa::IntoParams, ToSchema)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct IncPosQuery {
+    /// The encoder count (UDINT, masked by AxisEncoderMask #1043).
+    #[param(minimum = 0, maximum = 4294967295_u64)]
+    #[schema(minimum = 0, maximum = 4294967295_u64)]
+    pub inc_pos: u32,
+}
+
+/// A position for MC_ConvertPosToIncPos.
+#[derive(Debug, Deserialize, utoipa::IntoParams, ToSchema)]
+#[into_params(parameter_in = Query)]
+#[serde(deny_unknown_fields)]
+pub struct PositionQuery {
+    /// Axis position (in the actual position's coordinates).
+    #[param(minimum = -1e12, maximum = 1e12)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub position: f64,
+}
+
+/// MC_ConvertIncPosToPos / MC_ConvertPosToIncPos: a position and its encoder count, from the
+/// status of `cycle` (the encoder count and actual position of that cycle).
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"position": 100.01, "inc_pos": 100010, "cycle": 52000,
+    "encoder_count": 100000, "actual_position": 100.0, "encoder_scaling_factor": 0.001}))]
+pub struct PositionConversion {
+    pub position: f64,
+    pub inc_pos: u32,
+    pub cycle: u64,
+    /// The count and actual position the conversion counted from.
+    pub encoder_count: u32,
+    pub actual_position: f64,
+    pub encoder_scaling_factor: f64,
+}
+
+/// MC_ReadAxisComponents (§4.2.3, ST_AxisComponents): the encoder, controller and drive of
+/// an axis. motiond gives each axis one of each, numbered with the axis id.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"encoder_ids": [1], "controller_ids": [1], "drive_ids": [1],
+    "encoder": {"id": 1, "kind": "drive_feedback", "scaling_factor": 1.0, "mask": 4294967295_u64},
+    "controller": {"id": 1, "kind": "in_drive"},
+    "drive": {"id": 1, "kind": "simulated", "subdevice": null, "operation_mode": "csp"},
+    "active_control_loop": 0}))]
+pub struct AxisComponents {
+    /// `EncoderIDs`, `ControllerIDs`, `DriveIDs` (one each).
+    pub encoder_ids: Vec<i64>,
+    pub controller_ids: Vec<i64>,
+    pub drive_ids: Vec<i64>,
+    pub encoder: EncoderComponent,
+    pub controller: ControllerComponent,
+    pub drive: DriveComponent,
+    /// The control loop in use (MC_SelectControlLoop's EncoderIndex; an axis has one, 0).
+    pub active_control_loop: u16,
+}
+
+/// The encoder of an axis: the drive's position feedback.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"id": 1, "kind": "drive_feedback", "scaling_factor": 1.0, "mask": 4294967295_u64}))]
+pub struct EncoderComponent {
+    pub id: i64,
+    /// `drive_feedback`: the drive's own position is the encoder.
+    pub kind: String,
+    /// AxisEncoderScalingFactor (#1040), units per increment.
+    pub scaling_factor: f64,
+    /// AxisEncoderMask (#1043).
+    pub mask: u32,
+}
+
+/// The position controller of an axis.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"id": 1, "kind": "in_drive"}))]
+pub struct ControllerComponent {
+    pub id: i64,
+    /// `in_drive` (CSP, the simulated drive: the drive closes the position loop) or `motiond`
+    /// (CSV, CST: motiond closes it).
+    pub kind: String,
+}
+
+/// The drive of an axis.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"id": 1, "kind": "cia402", "subdevice": 0, "operation_mode": "csp"}))]
+pub struct DriveComponent {
+    pub id: i64,
+    /// `simulated` or `cia402`.
+    pub kind: String,
+    /// The EtherCAT SubDevice position of a CiA-402 drive.
+    pub subdevice: Option<u16>,
+    /// The configured operation mode (`csp`, `csv`, `cst`).
+    pub operation_mode: String,
+}
+
 /// MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
 /// position and taken off the drive's setpoint, reached as `mode` says; active until released
 /// with DELETE /commands/{id} (the correction then stays where it is). A further one takes

@@ -51,4 +51,6 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28816, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)"],
   [28848, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam"],
   [28849, "compensation_table_missing", "the axis has no position compensation table"],
+  [28850, "encoder_scaling_step_too_large", "this encoder scaling change in motion would step the drive's velocity; change it at standstill or in smaller steps"],
+  [28851, "position_out_of_counter_range", "the position is too far from the actual position for the encoder counter"],
 ];

@@ -341,6 +341,46 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/convert-inc-pos-to-pos": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_ConvertIncPosToPos: the axis position of an encoder count
+         * @description Scaled with the encoder scaling now and counted from the encoder count of the latest cycle (the status's `encoder_count`, `actual_position`) the short way round the counter (AxisEncoderMask #1043): past and future overflows are not considered. Also the websocket method `convert-inc-pos-to-pos` {axis, inc_pos}.
+         */
+        get: operations["convert_inc_pos_to_pos"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/convert-pos-to-inc-pos": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_ConvertPosToIncPos: the encoder count of an axis position
+         * @description Counted from the encoder count of the latest cycle; a position half the counter's range or more away from the actual one is a 422 `position_out_of_counter_range` (the counter would overflow on the way). Also the websocket method `convert-pos-to-inc-pos` {axis, position}.
+         */
+        get: operations["convert_pos_to_inc_pos"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/gear-in": {
         parameters: {
             query?: never;
@@ -716,6 +756,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/read-axis-components": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_ReadAxisComponents: the encoder, controller and drive of the axis
+         * @description Also the websocket method `read-axis-components` {axis}.
+         */
+        get: operations["read_axis_components"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/reset": {
         parameters: {
             query?: never;
@@ -727,6 +787,23 @@ export interface paths {
         put?: never;
         /** MC_Reset: clear an axis error */
         post: operations["reset"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/set-encoder-scaling-factor": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_SetEncoderScalingFactor: the encoder's units per increment; absolute (the position jumps, at standstill only) or relative (no jump, also in motion) */
+        post: operations["set_encoder_scaling_factor"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1506,6 +1583,52 @@ export interface components {
             outcome?: string | null;
         };
         /**
+         * @description MC_ReadAxisComponents (§4.2.3, ST_AxisComponents): the encoder, controller and drive of
+         *     an axis. motiond gives each axis one of each, numbered with the axis id.
+         * @example {
+         *       "active_control_loop": 0,
+         *       "controller": {
+         *         "id": 1,
+         *         "kind": "in_drive"
+         *       },
+         *       "controller_ids": [
+         *         1
+         *       ],
+         *       "drive": {
+         *         "id": 1,
+         *         "kind": "simulated",
+         *         "operation_mode": "csp",
+         *         "subdevice": null
+         *       },
+         *       "drive_ids": [
+         *         1
+         *       ],
+         *       "encoder": {
+         *         "id": 1,
+         *         "kind": "drive_feedback",
+         *         "mask": 4294967295,
+         *         "scaling_factor": 1
+         *       },
+         *       "encoder_ids": [
+         *         1
+         *       ]
+         *     }
+         */
+        AxisComponents: {
+            /** @description `EncoderIDs`, `ControllerIDs`, `DriveIDs` (one each). */
+            encoder_ids: number[];
+            controller_ids: number[];
+            drive_ids: number[];
+            encoder: components["schemas"]["EncoderComponent"];
+            controller: components["schemas"]["ControllerComponent"];
+            drive: components["schemas"]["DriveComponent"];
+            /**
+             * Format: int32
+             * @description The control loop in use (MC_SelectControlLoop's EncoderIndex; an axis has one, 0).
+             */
+            active_control_loop: number;
+        };
+        /**
          * @description The configuration of one axis (its base parameter set).
          * @example {
          *       "drive": {},
@@ -1825,6 +1948,8 @@ export interface components {
          *       "drive_fault": false,
          *       "enable_negative": true,
          *       "enable_positive": true,
+         *       "encoder_count": 0,
+         *       "encoder_scaling_factor": 0,
          *       "error_id": 0,
          *       "external_latch_valid": false,
          *       "following_error": 0.002,
@@ -2094,6 +2219,17 @@ export interface components {
              *     take off the drive's setpoint.
              */
             position_correction: components["schemas"]["PositionCorrectionStatus"];
+            /**
+             * Format: int32
+             * @description The raw encoder count (drive position ÷ the scaling the axis was built with, masked
+             *     by #1043): what MC_ConvertIncPosToPos / MC_ConvertPosToIncPos count from.
+             */
+            encoder_count: number;
+            /**
+             * Format: double
+             * @description The encoder scaling now (#1040, units per increment; MC_SetEncoderScalingFactor).
+             */
+            encoder_scaling_factor: number;
         };
         /**
          * @description MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): the backlash is applied while
@@ -3649,6 +3785,22 @@ export interface components {
             yours: boolean;
         };
         /**
+         * @description The position controller of an axis.
+         * @example {
+         *       "id": 1,
+         *       "kind": "in_drive"
+         *     }
+         */
+        ControllerComponent: {
+            /** Format: int64 */
+            id: number;
+            /**
+             * @description `in_drive` (CSP, the simulated drive: the drive closes the position loop) or `motiond`
+             *     (CSV, CST: motiond closes it).
+             */
+            kind: string;
+        };
+        /**
          * @description How a coupling interpolates a position table (`ST_CamInOptions.InterpolationType`): the
          *     document's view of `InterpolationType` without `4point`, which is no longer supported.
          * @enum {string}
@@ -3697,6 +3849,28 @@ export interface components {
             after: number;
             /** @description True at the wrap of a periodic table (end of one cycle to the start of the next). */
             wrap: boolean;
+        };
+        /**
+         * @description The drive of an axis.
+         * @example {
+         *       "id": 1,
+         *       "kind": "cia402",
+         *       "operation_mode": "csp",
+         *       "subdevice": 0
+         *     }
+         */
+        DriveComponent: {
+            /** Format: int64 */
+            id: number;
+            /** @description `simulated` or `cia402`. */
+            kind: string;
+            /**
+             * Format: int32
+             * @description The EtherCAT SubDevice position of a CiA-402 drive.
+             */
+            subdevice?: number | null;
+            /** @description The configured operation mode (`csp`, `csv`, `cst`). */
+            operation_mode: string;
         };
         /**
          * @description An axis's drive: `kind` and that drive's fields — `simulated` (the default when `kind` is left out) or `cia402`.
@@ -3857,6 +4031,36 @@ export interface components {
          * @example {}
          */
         EmptyBody: Record<string, never>;
+        /**
+         * @description The encoder of an axis: the drive's position feedback.
+         * @example {
+         *       "id": 1,
+         *       "kind": "drive_feedback",
+         *       "mask": 4294967295,
+         *       "scaling_factor": 1
+         *     }
+         */
+        EncoderComponent: {
+            /** Format: int64 */
+            id: number;
+            /** @description `drive_feedback`: the drive's own position is the encoder. */
+            kind: string;
+            /**
+             * Format: double
+             * @description AxisEncoderScalingFactor (#1040), units per increment.
+             */
+            scaling_factor: number;
+            /**
+             * Format: int32
+             * @description AxisEncoderMask (#1043).
+             */
+            mask: number;
+        };
+        /**
+         * @description `E_SetScalingFactorMode` (§6.11.6).
+         * @enum {string}
+         */
+        EncoderScalingMode: "absolute" | "relative";
         /**
          * @description The outputs of a function block (`ST_McOutputs` plus the milestone flags).
          * @example {
@@ -4267,6 +4471,8 @@ export interface components {
          *       "drive_fault": false,
          *       "enable_negative": true,
          *       "enable_positive": true,
+         *       "encoder_count": 0,
+         *       "encoder_scaling_factor": 0,
          *       "error_id": 0,
          *       "external_latch_valid": false,
          *       "following_error": 0.002,
@@ -5026,6 +5232,35 @@ export interface components {
             natural_frequency_hz?: number;
         };
         /**
+         * @description MC_ConvertIncPosToPos / MC_ConvertPosToIncPos: a position and its encoder count, from the
+         *     status of `cycle` (the encoder count and actual position of that cycle).
+         * @example {
+         *       "actual_position": 100,
+         *       "cycle": 52000,
+         *       "encoder_count": 100000,
+         *       "encoder_scaling_factor": 0.001,
+         *       "inc_pos": 100010,
+         *       "position": 100.01
+         *     }
+         */
+        PositionConversion: {
+            /** Format: double */
+            position: number;
+            /** Format: int32 */
+            inc_pos: number;
+            /** Format: int64 */
+            cycle: number;
+            /**
+             * Format: int32
+             * @description The count and actual position the conversion counted from.
+             */
+            encoder_count: number;
+            /** Format: double */
+            actual_position: number;
+            /** Format: double */
+            encoder_scaling_factor: number;
+        };
+        /**
          * @description MC_PositionCorrectionLimiter (§4.5.5, Enable-type): a correction added to the actual
          *     position and taken off the drive's setpoint, reached as `mode` says; active until released
          *     with DELETE /commands/{id} (the correction then stays where it is). A further one takes
@@ -5670,6 +5905,22 @@ export interface components {
             expires_at?: string | null;
         };
         /**
+         * @description MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment (#1040). The axis's
+         *     drive is its encoder, so its setpoints are scaled alike and the position loop stays closed.
+         * @example {
+         *       "mode": "relative",
+         *       "scaling_factor": 0.001
+         *     }
+         */
+        SetEncoderScalingFactorBody: {
+            /**
+             * Format: double
+             * @description Units per encoder increment (> 0).
+             */
+            scaling_factor: number;
+            mode?: components["schemas"]["EncoderScalingMode"];
+        };
+        /**
          * @description MC_SetOverride.
          * @example {
          *       "velocity_factor": 0.5
@@ -5907,6 +6158,8 @@ export interface components {
          *         "drive_fault": false,
          *         "enable_negative": true,
          *         "enable_positive": true,
+         *         "encoder_count": 0,
+         *         "encoder_scaling_factor": 0,
          *         "error_id": 0,
          *         "external_latch_valid": false,
          *         "following_error": 0.002,
@@ -8611,6 +8864,72 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    convert_inc_pos_to_pos: {
+        parameters: {
+            query: {
+                /** @description The encoder count (UDINT, masked by AxisEncoderMask #1043). */
+                inc_pos: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["PositionConversion"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["FunctionInputInvalid"];
+        };
+    };
+    convert_pos_to_inc_pos: {
+        parameters: {
+            query: {
+                /** @description Axis position (in the actual position's coordinates). */
+                position: number;
+            };
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["PositionConversion"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["FunctionInputInvalid"];
+        };
+    };
     gear_in: {
         parameters: {
             query?: {
@@ -9920,6 +10239,35 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    read_axis_components: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["AxisComponents"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
     reset: {
         parameters: {
             query?: {
@@ -9954,6 +10302,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    set_encoder_scaling_factor: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SetEncoderScalingFactorBody"];
             };
         };
         responses: {

@@ -206,7 +206,17 @@ impl Axis {
                 // it. #3000 AxisGearRatio is read-only like in the table: a ratio written
                 // directly would step the slave's velocity; MC_GearInDyn changes it with a
                 // limited acceleration.
-                self.config.parameters.write(number, value)?;
+                if let Some(factor) = self.encoder_scaling_written(number, value) {
+                    // A new encoder scaling changes the reading (§4.5.9, absolute mode).
+                    self.set_encoder_scaling(factor, false, (number, value))?;
+                } else {
+                    self.config.parameters.write(number, value)?;
+                }
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::SetEncoderScalingFactor { factor, relative } => {
+                self.set_encoder_scaling(factor, relative, (1040, factor))?;
                 cx.report(cmd.id, DONE);
                 Ok(())
             }

@@ -22,7 +22,7 @@ impl Axis {
             // A drive that reports no number is a faulty drive; keep the last good values.
             let fb = DriveFeedback {
                 fault: true,
-                actual_position: self.act_pos - self.offset - self.corrections.sent,
+                actual_position: (self.act_pos - self.offset - self.corrections.sent) / self.enc_k,
                 actual_velocity: 0.0,
                 ..*fb
             };
@@ -37,7 +37,8 @@ impl Axis {
         self.cycle = cycle;
         self.io_data_invalid = fb.bus_error;
         // The drive answers the setpoint sent last cycle, which carried that cycle's correction.
-        self.act_pos = fb.actual_position + self.offset + self.corrections.sent;
+        // Read through the encoder scaling (1 unless MC_SetEncoderScalingFactor changed it).
+        self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.sent;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
         if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {
@@ -45,12 +46,12 @@ impl Axis {
             self.latch = None;
         }
         self.act_acc = if self.fed {
-            (fb.actual_velocity - self.act_vel) / dt
+            (self.enc_k * fb.actual_velocity - self.act_vel) / dt
         } else {
             0.0
         };
         self.fed = true;
-        self.act_vel = fb.actual_velocity;
+        self.act_vel = self.enc_k * fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
         self.step_override_filter(dt);
@@ -117,9 +118,9 @@ impl Axis {
             enable: self.enable
                 && !(self.mode == Mode::ErrorStop && self.error == ErrorId::DRIVE_FAULT),
             fault_reset,
-            position: self.set.position - self.offset - correction,
-            velocity: self.set.velocity - correction_rate,
-            acceleration: self.set.acceleration,
+            position: (self.set.position - self.offset - correction) / self.enc_k,
+            velocity: (self.set.velocity - correction_rate) / self.enc_k,
+            acceleration: self.set.acceleration / self.enc_k,
             latch_enable: self.latch.is_some() || probe_armed,
             latch_source: match (self.latch, &self.probe) {
                 (Some(l), _) => l,

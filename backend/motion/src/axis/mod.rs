@@ -31,6 +31,7 @@ mod commands;
 mod correction;
 mod coupling;
 mod cycle;
+mod encoder;
 mod homing;
 mod job;
 mod monitoring;
@@ -185,6 +186,13 @@ pub struct Axis {
     phasing: Option<phasing::PhasingJob>,
     /// Position correction (§7.2): limiter, backlash and table compensation.
     corrections: correction::Corrections,
+    /// The encoder scaling (#1040) the axis was built with: the drive's positions are in it.
+    enc_base: f64,
+    /// The encoder scaling now ÷ `enc_base` (MC_SetEncoderScalingFactor).
+    enc_k: f64,
+    /// The part of `offset` that relative encoder scaling changes put there (an absolute
+    /// change counts from zero again and drops it).
+    enc_offset: f64,
 }
 
 impl Axis {
@@ -193,6 +201,7 @@ impl Axis {
         parameters.axis_cycle_time = cycle_time;
         let p = &parameters;
         let (last_dec, last_jerk) = (p.axis_dec, p.axis_jerk);
+        let enc_base = p.axis_encoder_scaling_factor;
         let mut axis = Box::new(Axis {
             config: AxisConfig {
                 modulo: config.modulo,
@@ -266,6 +275,9 @@ impl Axis {
             phase_planner: Planner::new(cycle_time),
             phasing: None,
             corrections: correction::Corrections::default(),
+            enc_base,
+            enc_k: 1.0,
+            enc_offset: 0.0,
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();

@@ -124,9 +124,12 @@ impl Axis {
         };
         let (phasing_active, absolute_phase_shift, covered_phase_shift) = self.phasing_status();
         let position_correction = self.correction_status();
+        let encoder_count = self.encoder_count();
         let s = &mut self.status;
         s.phasing_active = phasing_active;
         s.position_correction = position_correction;
+        s.encoder_count = encoder_count;
+        s.encoder_scaling_factor = p.axis_encoder_scaling_factor;
         s.absolute_phase_shift = absolute_phase_shift;
         s.covered_phase_shift = covered_phase_shift;
         s.op_modes = op_modes;

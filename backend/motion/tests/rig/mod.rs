@@ -315,7 +315,18 @@ impl Rig {
         let n = self.events.len();
         if matches!(
             kind,
-            CommandKind::SetPosition { .. } | CommandKind::Home { .. } | CommandKind::Reset
+            CommandKind::SetPosition { .. }
+                | CommandKind::Home { .. }
+                | CommandKind::Reset
+                // Absolute encoder scaling moves the coordinates (§4.5.9), like SetPosition.
+                | CommandKind::SetEncoderScalingFactor {
+                    relative: false,
+                    ..
+                }
+                | CommandKind::WriteParameter {
+                    number: 1040 | 1055 | 1056,
+                    ..
+                }
         ) {
             self.shifted[axis as usize] = true;
         }

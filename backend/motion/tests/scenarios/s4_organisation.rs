@@ -582,3 +582,92 @@ fn s4_5_4_override_filter_quantises_and_waits_for_its_recovery_time() {
     r.ok(0, filter(40000.0, 0.15));
     assert_eq!(r.st(0).power_override_percent, 100.0);
 }
+
+fn encoder_scaling(factor: f64, relative: bool) -> CommandKind {
+    CommandKind::SetEncoderScalingFactor { factor, relative }
+}
+
+/// §4.5.9 MC_SetEncoderScalingFactor: absolute mode makes the position jump with the new
+/// factor and is allowed at standstill only — the set position goes along, so nothing moves;
+/// relative mode moves no position, also in motion (within one cycle's acceleration of the
+/// drive's velocity step, else 0x70B2); the drive then travels in the new scale; #1040 reads
+/// the new factor, and writing it is the absolute mode.
+#[test]
+fn s4_5_9_encoder_scaling_absolute_jumps_at_rest_relative_never() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 200.0)));
+    r.until(3.0, |r| r.out(m).done);
+    let drive_before = r.sp[0].position;
+    r.ok(0, encoder_scaling(2.0, false));
+    let st = r.st(0);
+    assert!(
+        (st.actual_position - 200.0).abs() < 1e-9,
+        "{}",
+        st.actual_position
+    );
+    assert!((st.set_position - 200.0).abs() < 1e-9);
+    assert_eq!(st.encoder_scaling_factor, 2.0);
+    r.run(0.1);
+    assert!(
+        (r.sp[0].position - drive_before).abs() < 1e-9,
+        "the drive did not move"
+    );
+    assert!(r.st(0).following_error.abs() < 1e-9);
+    // 100 axis units further is 50 drive units now.
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(300.0, 200.0)));
+    r.until(3.0, |r| r.out(m).done);
+    assert!((r.sp[0].position - (drive_before + 50.0)).abs() < 1e-9);
+
+    // In motion: absolute refused, a large relative change refused, a small one smooth.
+    r.ok(0, velocity(50.0, Direction::Negative));
+    r.run(0.5);
+    assert_eq!(
+        r.rejected(0, encoder_scaling(2.5, false)),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+    assert_eq!(
+        r.rejected(0, encoder_scaling(4.0, true)),
+        ErrorId::ENCODER_SCALING_STEP_TOO_LARGE
+    );
+    let before = r.st(0).actual_position;
+    r.ok(0, encoder_scaling(2.02, true));
+    assert!((r.st(0).actual_position - before).abs() < 1e-9, "no jump");
+    let mut last = r.st(0).actual_position;
+    for _ in 0..100 {
+        r.step();
+        let a = r.st(0).actual_position;
+        assert!(
+            (a - last + 50.0 * DT).abs() < 0.01,
+            "actual steps by {}",
+            a - last
+        );
+        assert!(r.st(0).following_error.abs() < 0.01);
+        last = a;
+    }
+    r.ok(0, halt());
+    r.until(2.0, |r| r.st(0).state == AxisState::Standstill);
+    // Writing #1040 at standstill is the absolute mode.
+    // Absolute counts from zero again: the drive's position × the new factor (what the
+    // relative change put into the offset goes).
+    let drive = r.sp[0].position;
+    r.ok(
+        0,
+        CommandKind::WriteParameter {
+            number: 1040,
+            value: 1.01,
+        },
+    );
+    assert!(
+        (r.st(0).actual_position - drive * 1.01).abs() < 1e-5,
+        "{} vs {} ({:?})",
+        r.st(0).actual_position,
+        drive * 1.01,
+        r.k.parameters(0).unwrap().axis_encoder_scaling_factor
+    );
+    assert_eq!(r.st(0).encoder_scaling_factor, 1.01);
+    assert_eq!(
+        r.rejected(0, encoder_scaling(0.0, true)),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+}

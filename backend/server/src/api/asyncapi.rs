@@ -24,6 +24,8 @@ use super::ws;
     ws::EndReason,
     ws::RpcError,
     crate::app::CommandNotice,
+    crate::model::IncPosQuery,
+    crate::model::PositionQuery,
 )))]
 struct WsSchemas;
 
@@ -276,6 +278,33 @@ pub fn document() -> Value {
             "Validated, submitted and answered as over REST: the result is the command resource (final, or at its \
              milestone with `wait`); a refusal is an error whose `data` is the REST API's problem. A jog sent over \
              the socket is also released when the socket closes.",
+        );
+    }
+    for read in super::reads::READS {
+        let params = match read.params {
+            Some(q) => {
+                let mut p = schemas
+                    .get(q)
+                    .cloned()
+                    .unwrap_or_else(|| panic!("{q} is not in the components"));
+                p["properties"]["axis"] = json!({"type": ["string", "integer"], "description": "Axis id or name.", "example": "x"});
+                let required = p["required"].as_array().cloned().unwrap_or_default();
+                p["required"] = Value::Array([json!("axis")].into_iter().chain(required).collect());
+                p
+            }
+            None => json!({"type": "object", "required": ["axis"], "additionalProperties": false,
+                "properties": {"axis": {"type": ["string", "integer"], "description": "Axis id or name.", "example": "x"}}}),
+        };
+        d.rpc(
+            read.name,
+            params,
+            schema_ref(read.result),
+            read.summary,
+            &format!(
+                "As `GET /api/v1/axes/{{axis}}/{}`: answered from the axis's latest status and configuration; \
+                 a refusal is an error whose `data` is the REST API's problem.",
+                read.name
+            ),
         );
     }
     d.notification(

@@ -239,6 +239,8 @@ catalogue! {
         "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
     abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
         "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
+    set_encoder_scaling_factor: "set-encoder-scaling-factor", SetEncoderScalingFactorBody, SetEncoderScalingFactorBody::to_kind, Operator, Done,
+        "MC_SetEncoderScalingFactor: the encoder's units per increment; absolute (the position jumps, at standstill only) or relative (no jump, also in motion)";
     position_correction_limiter: "position-correction-limiter", PositionCorrectionLimiterBody, PositionCorrectionLimiterBody::to_kind, Operator, Active,
         "MC_PositionCorrectionLimiter: a correction added to the actual position and taken off the drive's setpoint, reached at once, as fast as an acceleration allows, or over a travel; active until DELETE /commands/{id}";
     backlash_compensation: "backlash-compensation", BacklashCompensationBody, BacklashCompensationBody::to_kind, Operator, Active,

@@ -640,6 +640,8 @@ error_sets! {
     }
     /// `GET /functions/…`.
     FunctionErrors { 422: FunctionInputInvalid }
+    /// `GET /axes/{axis}/convert-…`.
+    AxisFunctionErrors { 404: AxisNotFound, 422: FunctionInputInvalid }
     /// `GET /scope/setups/{name}`.
     ScopeSetupReadErrors { 404: ScopeSetupNotFound, 503: AuditUnavailable }
     /// `PUT /scope/setups/{name}`.

@@ -11,6 +11,7 @@ pub mod commands;
 pub mod errors;
 pub mod functions;
 pub mod guard;
+pub mod reads;
 pub mod scope;
 pub mod shape;
 pub mod simulation;
@@ -314,6 +315,18 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .delete(auth::release_control),
         )
         .route(
+            "/axes/{axis}/convert-inc-pos-to-pos",
+            get(reads::convert_inc_pos_to_pos),
+        )
+        .route(
+            "/axes/{axis}/convert-pos-to-inc-pos",
+            get(reads::convert_pos_to_inc_pos),
+        )
+        .route(
+            "/axes/{axis}/read-axis-components",
+            get(reads::read_axis_components),
+        )
+        .route(
             "/functions/calc-dynamics-by-ramp-time",
             get(functions::calc_dynamics_by_ramp_time_fb),
         )
@@ -519,6 +532,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,
         functions::calc_dynamics_by_ramp_time_fb,
+        reads::convert_inc_pos_to_pos, reads::convert_pos_to_inc_pos, reads::read_axis_components,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,

@@ -715,6 +715,19 @@ fn handle(
             });
             None
         }
+        name if super::reads::READS.iter().any(|r| r.name == name) => {
+            let axis = match params.remove("axis") {
+                Some(Value::String(a)) => a,
+                Some(Value::Number(n)) => n.to_string(),
+                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            };
+            let r = super::reads::dispatch(s, name, &axis, Value::Object(params))
+                .expect("a read of the list");
+            Some(match r {
+                Ok(v) => rpc_result(&id, v),
+                Err(e) => api_error(&id, e),
+            })
+        }
         name => {
             let Some(block) = blocks::find(name) else {
                 return Some(rpc_error(

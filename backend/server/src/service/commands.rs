@@ -415,6 +415,19 @@ impl GearInBody {
     }
 }
 
+impl SetEncoderScalingFactorBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.scaling_factor.is_finite() && (1e-12..=1e12).contains(&self.scaling_factor)) {
+            c.fail("scaling_factor", "must be a number from 1e-12 to 1e12");
+        }
+        c.done(CommandKind::SetEncoderScalingFactor {
+            factor: self.scaling_factor,
+            relative: self.mode == EncoderScalingMode::Relative,
+        })
+    }
+}
+
 impl PositionCorrectionLimiterBody {
     pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
@@ -990,6 +1003,12 @@ async fn submit(
             // Accepted only now, so that the end row (queued by the pump once the command
             // counts as accepted and is final) comes after the outcome.
             outcome("accepted".into());
+            if let CommandKind::SetEncoderScalingFactor { factor, .. } = kind {
+                // The kernel recorded the factor in #1040; so does the server's mirror.
+                if let Some(e) = s.registry_write().axes.get_mut(&axis_id) {
+                    let _ = e.params.write(1040, factor);
+                }
+            }
             let final_audit = s.commands.lock().unwrap().map.get_mut(&id).and_then(|r| {
                 r.accepted = true;
                 r.accepted_cycle = reply.cycle;

@@ -7,5 +7,6 @@ pub mod cams;
 pub mod commands;
 pub mod control;
 pub mod idempotency;
+pub mod reads;
 pub mod scope;
 pub mod simulation;
