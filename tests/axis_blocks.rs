@@ -29,6 +29,27 @@ async fn until_status(s: &Server, axis: &str, what: &str, f: impl Fn(&Value) -> 
     }
 }
 
+/// One JSON-RPC call over a fresh websocket: its answer.
+async fn ws_call(s: &Server, method: &str, params: Value) -> Value {
+    use futures_util::{SinkExt, StreamExt};
+    let (mut ws, _) = tokio_tungstenite::connect_async(s.url("/api/v1/ws").replace("http", "ws"))
+        .await
+        .expect("websocket");
+    let call = json!({"jsonrpc": "2.0", "id": 7, "method": method, "params": params});
+    ws.send(tokio_tungstenite::tungstenite::Message::Text(
+        call.to_string().into(),
+    ))
+    .await
+    .unwrap();
+    loop {
+        let m = ws.next().await.expect("answer").expect("frame");
+        let v: Value = serde_json::from_str(m.to_text().unwrap()).unwrap();
+        if v["id"] == 7 {
+            return v;
+        }
+    }
+}
+
 /// §5.6: y coupled 1:1 to x is shifted by 5 mm while x runs; the shift stays; a relative
 /// phasing sent over the websocket adds 2; phasing on an uncoupled axis is a 409 with its
 /// code; a bad velocity a 422 at its field.
@@ -77,24 +98,12 @@ async fn phasing_shifts_a_gear_slave_against_its_master() {
     assert_eq!(st["status"]["phasing_active"], false);
 
     // The websocket method of the same block family.
-    let (mut ws, _) = tokio_tungstenite::connect_async(s.url("/api/v1/ws").replace("http", "ws"))
-        .await
-        .expect("websocket");
-    use futures_util::{SinkExt, StreamExt};
-    let call = json!({"jsonrpc": "2.0", "id": 7, "method": "phasing-relative",
-        "params": {"axis": "y", "master": "x", "phase_shift": 2.0, "velocity": 10.0, "wait": true, "timeout_ms": 20000}});
-    ws.send(tokio_tungstenite::tungstenite::Message::Text(
-        call.to_string().into(),
-    ))
-    .await
-    .unwrap();
-    let answer = loop {
-        let m = ws.next().await.expect("answer").expect("frame");
-        let v: Value = serde_json::from_str(m.to_text().unwrap()).unwrap();
-        if v["id"] == 7 {
-            break v;
-        }
-    };
+    let answer = ws_call(
+        &s,
+        "phasing-relative",
+        json!({"axis": "y", "master": "x", "phase_shift": 2.0, "velocity": 10.0, "wait": true, "timeout_ms": 20000}),
+    )
+    .await;
     assert_eq!(answer["result"]["state"], "done", "{answer}");
     let st = status(&s, "y").await;
     let shift = st["status"]["absolute_phase_shift"].as_f64().unwrap();
@@ -381,23 +390,7 @@ async fn encoder_scaling_conversions_and_components() {
     assert_eq!(c.field_error(), (422, Some("position")), "{}", c.text);
     assert_eq!(c.json["error_id"], 0x70B3, "{}", c.text);
 
-    let (mut ws, _) = tokio_tungstenite::connect_async(s.url("/api/v1/ws").replace("http", "ws"))
-        .await
-        .expect("websocket");
-    use futures_util::{SinkExt, StreamExt};
-    let call = json!({"jsonrpc": "2.0", "id": 3, "method": "read-axis-components", "params": {"axis": "y"}});
-    ws.send(tokio_tungstenite::tungstenite::Message::Text(
-        call.to_string().into(),
-    ))
-    .await
-    .unwrap();
-    let answer = loop {
-        let m = ws.next().await.expect("answer").expect("frame");
-        let v: Value = serde_json::from_str(m.to_text().unwrap()).unwrap();
-        if v["id"] == 3 {
-            break v;
-        }
-    };
+    let answer = ws_call(&s, "read-axis-components", json!({"axis": "y"})).await;
     assert_eq!(answer["result"]["drive"]["kind"], "simulated", "{answer}");
     assert_eq!(
         answer["result"]["encoder"]["scaling_factor"], 0.5,
