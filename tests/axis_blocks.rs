@@ -415,3 +415,103 @@ async fn encoder_scaling_conversions_and_components() {
     assert_problem(&r, 409, "axis_cannot_be_started");
     s.stop();
 }
+
+/// §5.7.1 and §4.5.1/§4.5.7 on the simulated drive over HTTP: torque control builds up its
+/// torque (wait answers at in_torque), the drive reports torque mode, the velocity stays within
+/// the limits; MC_Halt brings the axis back to position control and the drive to position
+/// mode; the drive can be switched to velocity mode and back; torque through
+/// write-drive-operation-mode and a second control loop are refused.
+#[tokio::test(flavor = "multi_thread")]
+async fn torque_control_and_the_drive_operation_mode() {
+    let s = Server::start();
+    power_on(&s, "y").await;
+    let t = post(
+        &s,
+        "/api/v1/axes/y/torque-control?wait=true&timeout_ms=20000",
+        json!({"torque": 5.0, "torque_ramp": 50.0, "velocity_limit_high": 30.0, "velocity_limit_low": -30.0}),
+    )
+    .await;
+    assert_eq!(t.status, 202, "{}", t.text);
+    assert_eq!(t.json["outputs"]["in_torque"], true, "{}", t.text);
+    let m = get(&s, "/api/v1/axes/y/read-drive-operation-mode").await;
+    assert_eq!(m.json["drive_operation_mode"], "torque", "{}", m.text);
+    assert_eq!(m.json["code"], 1);
+    let st = until_status(&s, "y", "velocity limited", |st| {
+        st["torque_velocity_limited"] == true
+    })
+    .await;
+    assert!(
+        st["status"]["actual_velocity"].as_f64().unwrap() <= 30.0 + 1e-6,
+        "{st}"
+    );
+    assert_eq!(st["status"]["state"], "continuous_motion");
+    assert_eq!(st["status"]["control_loop_closed"], false);
+    let h = post(
+        &s,
+        "/api/v1/axes/y/halt?wait=true&timeout_ms=20000",
+        json!({}),
+    )
+    .await;
+    assert_eq!(h.json["state"], "done", "{}", h.text);
+    let fin = until_final(&s, t.json["id"].as_u64().unwrap(), 10).await;
+    assert_eq!(fin["state"], "aborted", "{fin}");
+    let m = get(&s, "/api/v1/axes/y/read-drive-operation-mode").await;
+    assert_eq!(m.json["drive_operation_mode"], "position", "{}", m.text);
+
+    let w = post(
+        &s,
+        "/api/v1/axes/y/write-drive-operation-mode?wait=true",
+        json!({"drive_operation_mode": "velocity"}),
+    )
+    .await;
+    assert_eq!(w.json["state"], "done", "{}", w.text);
+    let m = ws_call(&s, "read-drive-operation-mode", json!({"axis": "y"})).await;
+    assert_eq!(m["result"]["drive_operation_mode"], "velocity", "{m}");
+    let mv = post(
+        &s,
+        "/api/v1/axes/y/move-relative?wait=true&timeout_ms=20000",
+        json!({"distance": 10.0, "velocity": 50.0}),
+    )
+    .await;
+    assert_eq!(
+        mv.json["state"], "done",
+        "a move in velocity mode: {}",
+        mv.text
+    );
+    let w = post(
+        &s,
+        "/api/v1/axes/y/write-drive-operation-mode?wait=true",
+        json!({"drive_operation_mode": "configured"}),
+    )
+    .await;
+    assert_eq!(w.json["state"], "done", "{}", w.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/write-drive-operation-mode",
+        json!({"drive_operation_mode": "torque"}),
+    )
+    .await;
+    assert_problem(&r, 409, "invalid_mode");
+    let r = post(
+        &s,
+        "/api/v1/axes/y/select-control-loop",
+        json!({"encoder_index": 1}),
+    )
+    .await;
+    assert_problem(&r, 409, "control_loop_unknown");
+    let r = post(
+        &s,
+        "/api/v1/axes/y/select-control-loop?wait=true",
+        json!({"encoder_index": 0}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let r = post(&s, "/api/v1/axes/y/torque-control", json!({"torque": 5.0, "torque_ramp": 50.0, "velocity_limit_high": -10.0, "velocity_limit_low": 10.0})).await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("velocity_limit_low")),
+        "{}",
+        r.text
+    );
+    s.stop();
+}

@@ -90,6 +90,8 @@ describe('axis configuration form', () => {
         reference_cam: { start: 20, end: 25 },
         index_pulse: { period: 10, offset: 0 },
         limit_switches: { negative: null, positive: null, fault_on_hit: false },
+        torque: { acceleration_per_percent: 250, friction: 2, viscous: 0.01 },
+        velocity_mode_position_gain: 80,
       },
     };
     const { config, errors } = configOf(formOf(cfg as never));

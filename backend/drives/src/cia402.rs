@@ -6,7 +6,7 @@
 //! probe 0x60B8–0x60BB. Pure logic on the process data: no I/O, so it is tested without a
 //! network; an EtherCAT bus maps [`RxPdo`] / [`TxPdo`] onto a SubDevice's process image.
 
-use motion::{DriveFeedback, DriveSetpoint, LatchSource};
+use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 use serde::{Deserialize, Serialize};
 
 use crate::sim::FieldError;
@@ -143,6 +143,8 @@ pub struct TxPdo {
     pub velocity_actual: i32,
     /// 0x6061.
     pub mode_display: i8,
+    /// 0x6077, per mille of the rated torque.
+    pub torque_actual: i16,
     /// 0x603F.
     pub error_code: u16,
     /// 0x60FD: bit 0 negative limit switch, bit 1 positive limit switch, bit 2 home switch.
@@ -232,6 +234,36 @@ pub struct Cia402Drive {
     /// Cycles the fault reset (controlword bit 7) is still held: a drive samples the
     /// controlword at its SYNC0, so a one-cycle pulse could fall between two samples.
     reset_hold: core::cell::Cell<u32>,
+    /// Torque control held the velocity at a limit in the last outputs.
+    limited: core::cell::Cell<bool>,
+}
+
+/// How the drive is run in a cycle: the configured mode, or what the kernel asks for
+/// (MC_WriteDriveOperationMode, MC_TorqueControl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Run {
+    /// A cyclic synchronous position-based mode as configured (CSP, CSV, or CST with motiond's
+    /// position and velocity loops).
+    Loops(Cia402Mode),
+    /// MC_TorqueControl: CST with the kernel's torque, the velocity kept within limits.
+    Torque,
+}
+
+impl Run {
+    fn of(config: &Cia402Config, mode: DriveMode) -> Run {
+        match mode {
+            DriveMode::Configured => Run::Loops(config.mode),
+            DriveMode::Position => Run::Loops(Cia402Mode::Csp),
+            DriveMode::Velocity => Run::Loops(Cia402Mode::Csv),
+            DriveMode::Torque => Run::Torque,
+        }
+    }
+    fn code(self) -> i8 {
+        match self {
+            Run::Loops(m) => m.code(),
+            Run::Torque => Cia402Mode::Cst.code(),
+        }
+    }
 }
 
 /// Cycles a fault reset is held while the drive still reports the fault.
@@ -246,6 +278,7 @@ impl Cia402Drive {
             seen: false,
             last: TxPdo::default(),
             reset_hold: core::cell::Cell::new(0),
+            limited: core::cell::Cell::new(false),
         }
     }
 
@@ -275,11 +308,20 @@ impl Cia402Drive {
         let fault = matches!(state, Cia402State::Fault | Cia402State::FaultReactionActive);
         let (latch_valid, latch_raw) = self.latched(tx);
         let latch_position = self.position + latch_raw.wrapping_sub(tx.position_actual) as i64;
+        // A cyclic synchronous mode we run the drive in (a switch between them, asked by the
+        // kernel, is on the fly: the drive stays enabled through it).
+        let known = [8, 9, 10].contains(&tx.mode_display);
         DriveFeedback {
             ready: !fault && state != Cia402State::NotReadyToSwitchOn,
-            // Following our setpoints only in the mode we send them for.
-            enabled: state == Cia402State::OperationEnabled
-                && tx.mode_display == self.config.mode.code(),
+            enabled: state == Cia402State::OperationEnabled && known,
+            mode: match tx.mode_display {
+                8 => DriveMode::Position,
+                9 => DriveMode::Velocity,
+                10 => DriveMode::Torque,
+                _ => DriveMode::Configured,
+            },
+            actual_torque: tx.torque_actual as f64 / 10.0,
+            velocity_limited: self.limited.get(),
             fault,
             bus_error: false,
             fault_code: if fault { tx.error_code as u32 } else { 0 },
@@ -365,25 +407,42 @@ impl Cia402Drive {
             // new enable starts the sequence again from there.
             QuickStopActive => DISABLE_VOLTAGE,
         };
-        let following = state == OperationEnabled && tx.mode_display == self.config.mode.code();
-        // Until the drive follows, it is told to stay where it is: no jump when it enables.
+        let run = Run::of(&self.config, sp.mode);
+        let following = state == OperationEnabled && tx.mode_display == run.code();
+        self.limited.set(false);
+        // Until the drive follows (enabling, or switching modes), it is told to stay where it
+        // is: no jump when it enables, none while the mode changes.
         let (target, velocity, torque) = if following {
             let target = (sp.position * self.config.increments_per_unit).round() as i64;
             let actual = self.position as f64 / self.config.increments_per_unit;
+            let v_act = tx.velocity_actual as f64 / self.velocity_scale();
             let c = &self.config;
-            match c.mode {
-                Cia402Mode::Csp => (target, sp.velocity, 0.0),
-                Cia402Mode::Csv => (
+            match run {
+                Run::Loops(Cia402Mode::Csp) => (target, sp.velocity, 0.0),
+                Run::Loops(Cia402Mode::Csv) => (
                     target,
                     sp.velocity + c.position_gain * (sp.position - actual),
                     0.0,
                 ),
-                Cia402Mode::Cst => {
+                Run::Loops(Cia402Mode::Cst) => {
                     let v_cmd = sp.velocity + c.position_gain * (sp.position - actual);
-                    let v_act = tx.velocity_actual as f64 / self.velocity_scale();
                     let t = c.velocity_gain * (v_cmd - v_act)
                         + c.acceleration_feed_forward * sp.acceleration;
                     (target, sp.velocity, t.clamp(-c.max_torque, c.max_torque))
+                }
+                Run::Torque => {
+                    // Percent → per mille; beyond a velocity limit the velocity loop's torque
+                    // towards the limit takes over where it asks for less.
+                    let mut t = sp.torque * 10.0;
+                    let (high, low) = (sp.velocity_limit_high, sp.velocity_limit_low);
+                    if v_act > high {
+                        t = t.min(c.velocity_gain * (high - v_act));
+                        self.limited.set(true);
+                    } else if v_act < low {
+                        t = t.max(c.velocity_gain * (low - v_act));
+                        self.limited.set(true);
+                    }
+                    (self.position, 0.0, t.clamp(-c.max_torque, c.max_torque))
                 }
             }
         } else {
@@ -409,7 +468,7 @@ impl Cia402Drive {
                 .round()
                 .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
             target_torque: torque.round() as i16,
-            mode: self.config.mode.code(),
+            mode: run.code(),
             touch_probe_function,
         }
     }

@@ -66,7 +66,7 @@
 use std::f64::consts::PI;
 use std::fmt;
 
-use motion::{DriveFeedback, DriveSetpoint, LatchSource};
+use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 use serde::{Deserialize, Serialize};
 
 /// Fault code reported for an injected [`SimFault::DriveFault`] with code 0 (CiA 301
@@ -131,6 +131,39 @@ pub struct SimDriveConfig {
     pub index_pulse: Option<IndexPulse>,
     /// Hardware limit switches.
     pub limit_switches: LimitSwitches,
+    /// The load in torque mode (MC_TorqueControl).
+    pub torque: TorqueModel,
+    /// Velocity mode (MC_WriteDriveOperationMode Velo1, CSV): the gain (1/s, > 0) of the
+    /// position loop closed on motiond's side — velocity = feed-forward + gain × (set − actual).
+    pub velocity_mode_position_gain: f64,
+}
+
+/// The load as torque moves it (torque mode): what 1 % of rated torque accelerates it by,
+/// and the friction it has to overcome. An injected load force counts as that many percent
+/// of torque against the motion's positive direction.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "schema", schema(example = json!({"acceleration_per_percent": 100.0, "friction": 1.0, "viscous": 0.0})))]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TorqueModel {
+    /// Acceleration per percent of rated torque (units/s² per %, > 0): rated torque over the
+    /// load's inertia.
+    pub acceleration_per_percent: f64,
+    /// Coulomb friction, percent of rated torque (≥ 0): the load stays at rest until the
+    /// torque overcomes it.
+    pub friction: f64,
+    /// Viscous friction, percent of rated torque per unit/s (≥ 0).
+    pub viscous: f64,
+}
+
+impl Default for TorqueModel {
+    fn default() -> Self {
+        TorqueModel {
+            acceleration_per_percent: 100.0,
+            friction: 1.0,
+            viscous: 0.0,
+        }
+    }
 }
 
 impl Default for SimDriveConfig {
@@ -153,6 +186,8 @@ impl Default for SimDriveConfig {
                 offset: 0.0,
             }),
             limit_switches: LimitSwitches::default(),
+            torque: TorqueModel::default(),
+            velocity_mode_position_gain: 100.0,
         }
     }
 }
@@ -364,6 +399,27 @@ impl SimDriveConfig {
                 );
             }
         }
+        let t = self.torque;
+        check(
+            positive_up_to(t.acceleration_per_percent, 1e9),
+            "torque.acceleration_per_percent",
+            "must be > 0 and ≤ 1e9",
+        );
+        check(
+            within(t.friction, 0.0, 1000.0),
+            "torque.friction",
+            "must be between 0 and 1000 %",
+        );
+        check(
+            within(t.viscous, 0.0, 1e6),
+            "torque.viscous",
+            "must be between 0 and 1e6 % per unit/s",
+        );
+        check(
+            positive_up_to(self.velocity_mode_position_gain, 1e6),
+            "velocity_mode_position_gain",
+            "must be > 0 and ≤ 1e6 1/s",
+        );
         if errors.is_empty() {
             Ok(())
         } else {
@@ -483,6 +539,12 @@ pub struct SimDrive {
 
     latch_valid: bool,
     latch_position: f64,
+
+    /// The operation mode the drive runs in (`Configured`: position, the default).
+    mode: DriveMode,
+    /// Torque mode: the torque applied (percent), and whether a velocity limit reduced it.
+    torque: f64,
+    velocity_limited: bool,
 }
 
 impl SimDrive {
@@ -571,6 +633,9 @@ impl SimDrive {
             last_limit_negative: false,
             latch_valid: false,
             latch_position: 0.0,
+            mode: DriveMode::Position,
+            torque: 0.0,
+            velocity_limited: false,
             config,
         };
         drive.set_actual_position(0.0);
@@ -601,6 +666,9 @@ impl SimDrive {
             limit_negative,
             latch_valid: self.latch_valid,
             latch_position: self.latch_position,
+            mode: self.mode,
+            actual_torque: self.torque,
+            velocity_limited: self.velocity_limited,
         }
     }
 
@@ -639,12 +707,34 @@ impl SimDrive {
             }
         }
 
+        // The mode switches at once (on the fly, as drives that support MC_TorqueControl
+        // do); back in a position mode the reference starts where the load is.
+        let mode = match setpoint.mode {
+            DriveMode::Configured => DriveMode::Position,
+            m => m,
+        };
+        if mode != self.mode {
+            if self.mode == DriveMode::Torque || mode == DriveMode::Torque {
+                self.restart_reference();
+            }
+            self.mode = mode;
+        }
+        self.velocity_limited = false;
         // The power stage is on for this whole cycle only if it was on at its start.
         let powered = self.enabled;
-        if powered {
-            self.follow(setpoint, latch);
-        } else {
+        if !powered {
+            self.torque = 0.0;
             self.coast(latch);
+        } else {
+            match self.mode {
+                DriveMode::Torque => self.torque_control(setpoint, latch),
+                DriveMode::Velocity => self.velocity_control(setpoint, latch),
+                _ => {
+                    self.follow(setpoint, latch);
+                    // What holding the load against its force takes.
+                    self.torque = self.load_force;
+                }
+            }
         }
 
         let (limit_positive, limit_negative) = self.limit_levels();
@@ -844,6 +934,75 @@ impl SimDrive {
         }
     }
 
+    /// Torque mode: the load accelerates with the torque (less friction and the load force),
+    /// its velocity held within the setpoint's limits by reducing the torque.
+    fn torque_control(&mut self, setpoint: &DriveSetpoint, mut latch: Option<LatchSource>) {
+        let m = self.config.torque;
+        let finite = |x: f64, d: f64| if x.is_finite() { x } else { d };
+        let asked = finite(setpoint.torque, 0.0);
+        let high = finite(setpoint.velocity_limit_high, 0.0);
+        let low = finite(setpoint.velocity_limit_low, 0.0).min(high);
+        let n = self.substeps.max(10);
+        let h = self.cycle_time / n as f64;
+        let mut applied = asked;
+        for _ in 0..n {
+            let before = self.position;
+            let v0 = self.velocity;
+            let drive = asked - self.load_force - m.viscous * v0;
+            let net = if v0 != 0.0 {
+                drive - m.friction * v0.signum()
+            } else if drive.abs() <= m.friction {
+                0.0 // static friction holds the load
+            } else {
+                drive - m.friction * drive.signum()
+            };
+            let mut v1 = v0 + net * m.acceleration_per_percent * h;
+            if v0 != 0.0 && v1.signum() != v0.signum() && (drive.abs() <= m.friction) {
+                v1 = 0.0; // friction stops the load, it does not reverse it
+            }
+            if v1 > high || v1 < low {
+                let limit = v1.clamp(low, high);
+                // The torque that keeps the limit instead of the one asked for.
+                applied = asked - (v1 - limit) / (m.acceleration_per_percent * h);
+                v1 = limit;
+                self.velocity_limited = true;
+            }
+            self.position += 0.5 * (v0 + v1) * h;
+            self.velocity = v1;
+            self.probe(&mut latch, before, self.position);
+        }
+        self.torque = if self.velocity_limited {
+            applied
+        } else {
+            asked
+        };
+    }
+
+    /// Velocity mode (CSV): the load follows the velocity setpoint with the position loop
+    /// closed on the controller's side (its gain in the configuration).
+    fn velocity_control(&mut self, setpoint: &DriveSetpoint, mut latch: Option<LatchSource>) {
+        let finite = |x: f64, d: f64| if x.is_finite() { x } else { d };
+        let target = finite(setpoint.position, self.position);
+        let vff = finite(setpoint.velocity, 0.0);
+        let n = self.substeps;
+        let h = self.cycle_time / n as f64;
+        let k = self.config.velocity_mode_position_gain;
+        // The set position moves from the last cycle's to this one's over the cycle.
+        let start = self.reference.position;
+        for i in 0..n {
+            let before = self.position;
+            let s = (i + 1) as f64 / n as f64;
+            let v = vff + k * (start + (target - start) * s - self.position);
+            self.velocity = v;
+            self.position += v * h;
+            self.probe(&mut latch, before, self.position);
+        }
+        self.torque = self.load_force;
+        // A switch back to position mode starts from here.
+        self.restart_reference();
+        self.reference = Sample::hold(target);
+    }
+
     /// Power stage off: the load slows down at the coast deceleration.
     fn coast(&mut self, mut latch: Option<LatchSource>) {
         let n = self.substeps;
@@ -956,6 +1115,115 @@ mod tests {
         period: 10.0,
         offset: 2.5,
     };
+
+    fn enabled_drive() -> SimDrive {
+        let mut d = SimDrive::new(
+            SimDriveConfig {
+                reference_cam: None,
+                index_pulse: None,
+                ..SimDriveConfig::default()
+            },
+            0.001,
+        );
+        let sp = DriveSetpoint {
+            enable: true,
+            ..DriveSetpoint::default()
+        };
+        while !d.feedback().enabled {
+            d.apply(&sp);
+        }
+        d
+    }
+
+    fn torque_setpoint(torque: f64, high: f64, low: f64) -> DriveSetpoint {
+        DriveSetpoint {
+            enable: true,
+            mode: DriveMode::Torque,
+            torque,
+            velocity_limit_high: high,
+            velocity_limit_low: low,
+            ..DriveSetpoint::default()
+        }
+    }
+
+    /// Torque mode (MC_TorqueControl): 10 % against 1 % friction at 100 u/s² per % gives
+    /// 900 u/s²; the velocity is held at the high limit with a smaller torque applied; a
+    /// torque below the friction leaves the load at rest; back in position mode the load
+    /// is held where it is (no jump).
+    #[test]
+    fn torque_mode_accelerates_against_friction_within_the_velocity_limits() {
+        let mut d = enabled_drive();
+        for _ in 0..100 {
+            d.apply(&torque_setpoint(10.0, 500.0, -500.0));
+        }
+        let fb = d.feedback();
+        assert_eq!(fb.mode, DriveMode::Torque);
+        assert!(
+            (fb.actual_velocity - 90.0).abs() < 0.5,
+            "{}",
+            fb.actual_velocity
+        );
+        assert_eq!(fb.actual_torque, 10.0);
+        assert!(!fb.velocity_limited);
+        for _ in 0..200 {
+            d.apply(&torque_setpoint(10.0, 100.0, -500.0));
+        }
+        let fb = d.feedback();
+        assert_eq!(fb.actual_velocity, 100.0);
+        assert!(fb.velocity_limited);
+        assert!(fb.actual_torque < 10.0, "{}", fb.actual_torque);
+        // Held at rest by limits of 0, then back to position mode where the load is.
+        d.apply(&torque_setpoint(10.0, 0.0, 0.0));
+        assert_eq!(d.feedback().actual_velocity, 0.0);
+        let at = d.feedback().actual_position;
+        d.apply(&DriveSetpoint {
+            enable: true,
+            position: at,
+            ..DriveSetpoint::default()
+        });
+        assert_eq!(d.feedback().mode, DriveMode::Position);
+        assert!(
+            (d.feedback().actual_position - at).abs() < 1e-9,
+            "{} vs {at}",
+            d.feedback().actual_position
+        );
+
+        let mut d = enabled_drive();
+        for _ in 0..100 {
+            d.apply(&torque_setpoint(0.5, 500.0, -500.0));
+        }
+        assert_eq!(d.feedback().actual_velocity, 0.0, "static friction holds");
+        assert_eq!(d.feedback().actual_position, 0.0);
+    }
+
+    /// Velocity mode (CSV, MC_WriteDriveOperationMode Velo1): the load follows the setpoint's
+    /// velocity with the position loop's correction and reports the mode.
+    #[test]
+    fn velocity_mode_follows_the_setpoint() {
+        let mut d = enabled_drive();
+        for k in 1..=500 {
+            d.apply(&DriveSetpoint {
+                enable: true,
+                mode: DriveMode::Velocity,
+                position: 20.0 * k as f64 * 0.001,
+                velocity: 20.0,
+                ..DriveSetpoint::default()
+            });
+        }
+        let fb = d.feedback();
+        assert_eq!(fb.mode, DriveMode::Velocity);
+        assert!(
+            (fb.actual_velocity - 20.0).abs() < 0.5,
+            "{} at {}",
+            fb.actual_velocity,
+            fb.actual_position
+        );
+        assert!(
+            (fb.actual_position - 10.0).abs() < 0.3,
+            "{}",
+            fb.actual_position
+        );
+    }
 
     #[test]
     fn index_crossing_in_both_directions() {

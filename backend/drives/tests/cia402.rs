@@ -28,6 +28,8 @@ struct Device {
     tp_neg: i32,
     /// The index pulse every this many increments (for the probe).
     index_period: i64,
+    /// 0x6077: in CST the target torque it was given.
+    torque: i16,
 }
 
 impl Device {
@@ -46,6 +48,7 @@ impl Device {
             tp_pos: 0,
             tp_neg: 0,
             index_period: 10_000,
+            torque: 0,
         }
     }
 
@@ -69,6 +72,7 @@ impl Device {
             position_actual: self.position,
             velocity_actual: self.velocity,
             mode_display: self.mode_display,
+            torque_actual: self.torque,
             error_code: self.error_code,
             digital_inputs: self.digital_inputs,
             touch_probe_status: self.tp_status,
@@ -137,6 +141,7 @@ impl Device {
                     self.fraction -= whole;
                     self.position = self.position.wrapping_add(whole as i32);
                 }
+                10 => self.torque = rx.target_torque,
                 _ => {}
             }
         } else {
@@ -317,16 +322,74 @@ fn a_drive_in_another_mode_is_not_taken_as_following() {
         cycle(&mut drive, &mut device, &here);
     }
     assert_eq!(device.position, 1_000);
-    // The drive reports CST (10), e.g. left so after torque mode.
+    // The drive reports CST (10), e.g. left so after torque mode: a mode we run drives in,
+    // so it counts as enabled (a mode switch is on the fly), but until it is back in CSP it
+    // is held where it is, and CSP is asked for again.
     device.mode_display = 10;
     let fb = drive.feedback(&device.tx());
-    assert!(!fb.enabled, "{fb:?}");
+    assert!(fb.enabled, "{fb:?}");
+    assert_eq!(fb.mode, DriveMode::Torque);
     let rx = drive.outputs(&DriveSetpoint {
         position: 50.0,
         ..enable()
     });
     assert_eq!(rx.target_position, 1_000, "held where it is");
+    assert_eq!(rx.target_torque, 0);
     assert_eq!(rx.mode, 8, "CSP asked for again");
+    // A mode the drive is never run in (profile position, 1) is not taken as enabled.
+    device.mode_display = 1;
+    assert!(!drive.feedback(&device.tx()).enabled);
+}
+
+/// MC_TorqueControl on a CiA-402 drive: CST (10) is asked for; while the drive still shows
+/// CSP it is held (torque 0); in CST the target torque is the setpoint in per mille; beyond
+/// the high velocity limit the velocity loop's torque towards the limit takes over and the
+/// feedback says the velocity is limited; 0x6077 is the actual torque. MC_WriteDriveOperation-
+/// Mode Velo1 asks for CSV (9).
+#[test]
+fn torque_control_runs_the_drive_in_cst_within_its_velocity_limits() {
+    let mut device = Device::new(0);
+    let mut drive = Cia402Drive::new(Cia402Config {
+        velocity_gain: 10.0,
+        ..config()
+    });
+    drive.feedback(&device.tx());
+    for _ in 0..5 {
+        cycle(&mut drive, &mut device, &enable());
+    }
+    assert_eq!(device.mode_display, 8);
+    let torque = DriveSetpoint {
+        mode: DriveMode::Torque,
+        torque: 12.5,
+        velocity_limit_high: 100.0,
+        velocity_limit_low: -100.0,
+        ..enable()
+    };
+    let rx = drive.outputs(&torque);
+    assert_eq!(
+        (rx.mode, rx.target_torque),
+        (10, 0),
+        "held until the drive shows CST"
+    );
+    device.apply(&rx);
+    let fb = drive.feedback(&device.tx());
+    assert!(fb.enabled && fb.mode == DriveMode::Torque, "{fb:?}");
+    let rx = drive.outputs(&torque);
+    assert_eq!(rx.target_torque, 125);
+    device.apply(&rx);
+    assert_eq!(drive.feedback(&device.tx()).actual_torque, 12.5);
+    // 110 mm/s against a limit of 100: 10 × (100 − 110) = −100 ‰ instead of 125.
+    device.velocity = 110_000;
+    drive.feedback(&device.tx());
+    let rx = drive.outputs(&torque);
+    assert_eq!(rx.target_torque, -100);
+    device.apply(&rx);
+    assert!(drive.feedback(&device.tx()).velocity_limited);
+    let rx = drive.outputs(&DriveSetpoint {
+        mode: DriveMode::Velocity,
+        ..enable()
+    });
+    assert_eq!(rx.mode, 9);
 }
 
 #[test]

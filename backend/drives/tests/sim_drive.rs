@@ -1214,7 +1214,9 @@ fn default_config_json_shape() {
             "load_stiffness": 1000.0,
             "reference_cam": { "start": 20.0, "end": 25.0 },
             "index_pulse": { "period": 10.0, "offset": 0.0 },
-            "limit_switches": { "negative": null, "positive": null, "fault_on_hit": false }
+            "limit_switches": { "negative": null, "positive": null, "fault_on_hit": false },
+            "torque": { "acceleration_per_percent": 100.0, "friction": 1.0, "viscous": 0.0 },
+            "velocity_mode_position_gain": 100.0
         })
     );
 }
@@ -1244,6 +1246,12 @@ fn config_round_trips_through_json() {
                 positive: Some(505.0),
                 fault_on_hit: true,
             },
+            torque: drives::sim::TorqueModel {
+                acceleration_per_percent: 20.0,
+                friction: 0.5,
+                viscous: 0.01,
+            },
+            velocity_mode_position_gain: 50.0,
         },
         SimDriveConfig {
             plant: PlantModel::Ideal,

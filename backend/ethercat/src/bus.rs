@@ -235,6 +235,7 @@ impl Layout {
             position_actual: i32_at(1),
             velocity_actual: i32_at(2),
             mode_display: b(self.tx[4], 1)[0] as i8,
+            torque_actual: u16_at(3) as i16,
             error_code: u16_at(5),
             digital_inputs: i32_at(6) as u32,
             touch_probe_status: u16_at(7),

@@ -367,6 +367,19 @@ pub enum CommandKind {
     TouchProbe(TouchProbe),
     /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
     AbortTrigger,
+    /// MC_TorqueControl (§5.7.1): the drive in torque mode with a torque ramped to `torque`
+    /// at `torque_ramp` (percent/s), the load's velocity kept within the limits by the drive.
+    /// MC_Halt, MC_Stop or any motion command brings the axis back to position control.
+    TorqueControl(TorqueControl),
+    /// MC_WriteDriveOperationMode (§4.5.1): the drive's position-based mode (torque is
+    /// MC_TorqueControl's); Done once the drive reports it.
+    WriteDriveOperationMode {
+        mode: crate::DriveMode,
+    },
+    /// MC_SelectControlLoop (§4.5.7): an axis has the one control loop of its drive (index 0).
+    SelectControlLoop {
+        index: u16,
+    },
     /// MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment; absolute
     /// (the position jumps with it, at rest only) or relative (no jump; in motion too).
     SetEncoderScalingFactor {
@@ -455,6 +468,9 @@ impl CommandKind {
             CommandKind::TouchProbe(_) => "touch-probe",
             CommandKind::AbortTrigger => "abort-trigger",
             CommandKind::SetEncoderScalingFactor { .. } => "set-encoder-scaling-factor",
+            CommandKind::TorqueControl(_) => "torque-control",
+            CommandKind::WriteDriveOperationMode { .. } => "write-drive-operation-mode",
+            CommandKind::SelectControlLoop { .. } => "select-control-loop",
             CommandKind::PositionCorrectionLimiter { .. } => "position-correction-limiter",
             CommandKind::BacklashCompensation { .. } => "backlash-compensation",
             CommandKind::TableBasedPositionCompensation { .. } => {
@@ -511,6 +527,22 @@ pub enum DisableMode {
     Hold,
     /// The correction returns to 0 at once (a jump of the drive's setpoint).
     Reset,
+}
+
+/// MC_TorqueControl's inputs (§5.7.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TorqueControl {
+    /// Percent of rated torque (Relative: the change); positive drives the positive way.
+    pub torque: f64,
+    /// Rate of change of the torque setpoint, percent/s (> 0).
+    pub torque_ramp: f64,
+    pub relative: bool,
+    /// The load's velocity is kept within [low, high] (units/s).
+    pub velocity_limit_high: f64,
+    pub velocity_limit_low: f64,
+    /// `Options.EnableManualTorqueStartValue`: start the ramp here instead of at the drive's
+    /// actual torque.
+    pub manual_start: Option<f64>,
 }
 
 /// Which phasing block (`E_PhasingType`, §6.8).
@@ -572,6 +604,8 @@ pub struct FbOutputs {
     pub in_sync: bool,
     /// MoveContinuous*: target reached, running at end velocity.
     pub in_end_velocity: bool,
+    /// TorqueControl: the torque setpoint is built up and no velocity limit is active.
+    pub in_torque: bool,
     /// Power: axis ready for operation.
     pub status: bool,
     /// MoveSuperImposed: not completed as asked (executed as far as possible).

@@ -19,6 +19,44 @@ pub struct DriveSetpoint {
     /// Arm the drive's probe: latch the position at the next event of `latch_source`.
     pub latch_enable: bool,
     pub latch_source: LatchSource,
+    /// The operation mode the drive is to run in (MC_WriteDriveOperationMode, and torque
+    /// while MC_TorqueControl runs).
+    pub mode: DriveMode,
+    /// `DriveMode::Torque`: the torque setpoint, percent of the drive's rated torque.
+    pub torque: f64,
+    /// `DriveMode::Torque`: the velocity the drive keeps the load within (units/s; high ≥
+    /// low), by reducing the torque.
+    pub velocity_limit_high: f64,
+    pub velocity_limit_low: f64,
+}
+
+/// A drive's operation mode (`E_DriveOperationMode`, §6.2; CiA-402 0x6060/0x6061).
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DriveMode {
+    /// `DriveOperationMode_Default`: the mode the drive is configured for (a setpoint only).
+    #[default]
+    Configured,
+    /// `DriveOperationMode_Pos1`: cyclic synchronous position (CSP, 8) — the drive closes the
+    /// position loop.
+    Position,
+    /// `DriveOperationMode_Velo1`: cyclic synchronous velocity (CSV, 9) — motiond closes it.
+    Velocity,
+    /// `DriveOperationMode_Torque`: cyclic synchronous torque (CST, 10).
+    Torque,
+}
+
+impl DriveMode {
+    /// The `E_DriveOperationMode` number.
+    pub fn code(self) -> i32 {
+        match self {
+            DriveMode::Configured => 0,
+            DriveMode::Torque => 1,
+            DriveMode::Velocity => 2,
+            DriveMode::Position => 4,
+        }
+    }
 }
 
 /// What a drive latch (touch probe) reacts to.
@@ -60,4 +98,12 @@ pub struct DriveFeedback {
     /// A latch armed by `latch_enable` has captured `latch_position`.
     pub latch_valid: bool,
     pub latch_position: f64,
+    /// The operation mode the drive runs in (0x6061); `Configured` from a drive that does not
+    /// say (its position-based mode as configured).
+    pub mode: DriveMode,
+    /// The actual torque, percent of rated torque.
+    pub actual_torque: f64,
+    /// In torque mode: the drive is holding the velocity at a limit (the torque asked for
+    /// is not what it applies).
+    pub velocity_limited: bool,
 }

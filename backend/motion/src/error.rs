@@ -147,6 +147,10 @@ error_table! {
     ENCODER_SCALING_STEP_TOO_LARGE = 0x70B2, "encoder_scaling_step_too_large", "this encoder scaling change in motion would step the drive's velocity; change it at standstill or in smaller steps";
     /// MC_ConvertPosToIncPos: the position is so far from the actual one that the encoder counter would overflow on the way.
     POSITION_OUT_OF_COUNTER_RANGE = 0x70B3, "position_out_of_counter_range", "the position is too far from the actual position for the encoder counter";
+    /// The drive did not report the operation mode asked for (MC_WriteDriveOperationMode, MC_TorqueControl) within 0.5 s.
+    DRIVE_MODE_NOT_REACHED = 0x70B4, "drive_mode_not_reached", "the drive did not switch to the operation mode asked for";
+    /// MC_SelectControlLoop: the axis has one control loop (its drive), index 0.
+    CONTROL_LOOP_UNKNOWN = 0x70B5, "control_loop_unknown", "the axis has no control loop with this index (it has one: 0)";
 }
 
 impl fmt::Display for ErrorId {

@@ -76,7 +76,7 @@ pub mod status;
 pub use axis::{Axis, AxisConfig};
 pub use command::*;
 pub use compensation::{CompensationTable, WorkDirection};
-pub use drive::{DriveFeedback, DriveSetpoint, LatchSource};
+pub use drive::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 pub use error::ErrorId;
 pub use kernel::Kernel;
 pub use params::AxisParameters;

@@ -198,6 +198,15 @@ pub struct AxisStatus {
     pub encoder_count: u32,
     /// The encoder scaling now (#1040, units per increment; MC_SetEncoderScalingFactor).
     pub encoder_scaling_factor: f64,
+    /// The operation mode the drive reports (MC_ReadDriveOperationMode); `configured` from a
+    /// drive that does not say.
+    pub drive_operation_mode: crate::DriveMode,
+    /// The drive's actual torque, percent of rated torque.
+    pub actual_torque: f64,
+    /// MC_TorqueControl's torque setpoint now (0 when it does not run).
+    pub set_torque: f64,
+    /// MC_TorqueControl: the drive holds the velocity at a limit.
+    pub torque_velocity_limited: bool,
 }
 
 /// The position correction of an axis and its sources (MC_PositionCorrectionLimiter,

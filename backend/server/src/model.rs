@@ -432,7 +432,7 @@ impl CommandState {
 /// A change of a command's outputs.
 #[derive(Clone, Copy, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
-    "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
+    "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "in_torque": false, "status": false,
     "warning": false, "warning_id": 0}}))]
 pub struct CommandEventDto {
     /// The kernel cycle it happened in.
@@ -493,13 +493,13 @@ impl ClientInfo {
     "parameters": {"position": 100.0, "velocity": 200.0},
     "state": "done", "final": true,
     "outputs": {"busy": false, "active": false, "done": true, "command_aborted": false, "error": false,
-                "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
+                "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "in_torque": false, "status": false,
                 "warning": false, "warning_id": 0},
     "accepted_cycle": 1200, "last_cycle": 1873,
     "submitted_at": "2025-01-01T12:00:00.000Z", "finished_at": "2025-01-01T12:00:00.673Z",
     "client": {"addr": "127.0.0.1:50312", "via": "rest"},
     "events": [{"cycle": 1200, "outputs": {"busy": true, "active": true, "done": false, "command_aborted": false,
-                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "status": false,
+                "error": false, "error_id": 0, "in_velocity": false, "in_gear": false, "in_sync": false, "in_end_velocity": false, "in_torque": false, "status": false,
                 "warning": false, "warning_id": 0}}]
 }))]
 pub struct CommandResource {
@@ -626,6 +626,84 @@ pub struct TouchProbeBody {
     /// the window repeats every period and wraps when first > last.
     #[serde(default)]
     pub modulo_positions: bool,
+}
+
+/// MC_TorqueControl (§5.7.1): the drive switched to torque mode (CST) with a torque ramped at
+/// `torque_ramp`; the load's velocity is kept within the limits by the drive. Busy until
+/// MC_Halt, MC_Stop or another motion command takes the axis back to position control (from
+/// where it is, at its speed). BufferMode Aborting only: a further torque-control is the
+/// manual's ContinuousUpdate (it takes over from the running setpoint; `relative` adds to
+/// its target). `?wait=true` answers at InTorque (`in_torque`: the torque built up, no
+/// velocity limit active).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"torque": 35.0, "torque_ramp": 10.0, "velocity_limit_high": 400.0, "velocity_limit_low": -500.0}))]
+pub struct TorqueControlBody {
+    /// Percent of rated torque (relative: the change); positive drives the positive way.
+    #[schema(minimum = -1000, maximum = 1000)]
+    pub torque: f64,
+    /// Rate of change of the torque setpoint, percent/s (> 0).
+    #[schema(exclusive_minimum = 0, maximum = 1e9)]
+    pub torque_ramp: f64,
+    #[serde(default)]
+    pub relative: bool,
+    /// The velocity (units/s) the drive keeps the load below; within ±AxisVeloMax, ≥ low.
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub velocity_limit_high: f64,
+    /// The velocity (units/s) the drive keeps the load above.
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub velocity_limit_low: f64,
+    /// `Options.ManualTorqueStartValue`: start the ramp here (percent) instead of at the
+    /// drive's actual torque.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = -1000, maximum = 1000)]
+    pub manual_start_torque: Option<f64>,
+}
+
+/// MC_WriteDriveOperationMode (§4.5.1): the drive's position-based operation mode, at rest;
+/// Done once the drive reports it (409 drive_mode_not_reached after 0.5 s). `torque` is
+/// MC_TorqueControl's (409 invalid_mode here), so a drive is never left in torque mode
+/// without a torque under control.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"drive_operation_mode": "position"}))]
+pub struct WriteDriveOperationModeBody {
+    /// `configured` (DriveOperationMode_Default: the drive's configured mode), `position`
+    /// (Pos1, CSP), `velocity` (Velo1, CSV).
+    pub drive_operation_mode: motion::DriveMode,
+}
+
+/// `E_SelectControlLoopType` (§6.10): only the standard switch is usable (as in TwinCAT).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SelectControlLoopType {
+    #[default]
+    Standard,
+}
+
+/// MC_SelectControlLoop (§4.5.7): an axis has the one control loop of its drive, index 0;
+/// another index is a 409 control_loop_unknown.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"encoder_index": 0}))]
+pub struct SelectControlLoopBody {
+    /// The control loop's index (0..9).
+    #[schema(minimum = 0, maximum = 9)]
+    pub encoder_index: u16,
+    #[serde(default)]
+    pub select_type: SelectControlLoopType,
+}
+
+/// MC_ReadDriveOperationMode (§4.5.1): the mode the drive reports (CiA-402 0x6061).
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"drive_operation_mode": "position", "code": 4, "cycle": 52000}))]
+pub struct DriveOperationModeResource {
+    /// `position` (CSP), `velocity` (CSV), `torque` (CST), `configured` (a drive that does
+    /// not say: its configured position-based mode).
+    pub drive_operation_mode: motion::DriveMode,
+    /// The `E_DriveOperationMode` number (0 default, 1 torque, 2 velo1, 4 pos1).
+    pub code: i32,
+    pub cycle: u64,
 }
 
 /// `E_SetScalingFactorMode` (§6.11.6).

@@ -53,4 +53,6 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28849, "compensation_table_missing", "the axis has no position compensation table"],
   [28850, "encoder_scaling_step_too_large", "this encoder scaling change in motion would step the drive's velocity; change it at standstill or in smaller steps"],
   [28851, "position_out_of_counter_range", "the position is too far from the actual position for the encoder counter"],
+  [28852, "drive_mode_not_reached", "the drive did not switch to the operation mode asked for"],
+  [28853, "control_loop_unknown", "the axis has no control loop with this index (it has one: 0)"],
 ];

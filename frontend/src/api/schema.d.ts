@@ -370,7 +370,7 @@ export interface paths {
         };
         /**
          * MC_ConvertPosToIncPos: the encoder count of an axis position
-         * @description Counted from the encoder count of the latest cycle; a position half the counter's range or more away from the actual one is a 422 `position_out_of_counter_range` (the counter would overflow on the way). Also the websocket method `convert-pos-to-inc-pos` {axis, position}.
+         * @description Counted from the encoder count of the latest cycle; a position half the counter's range or more away from the actual one is a 422 at `position` with `error_id` 0x70B3 position_out_of_counter_range (the counter would overflow on the way). Also the websocket method `convert-pos-to-inc-pos` {axis, position}.
          */
         get: operations["convert_pos_to_inc_pos"];
         put?: never;
@@ -776,6 +776,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/read-drive-operation-mode": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /**
+         * MC_ReadDriveOperationMode: the operation mode the drive reports
+         * @description From the drive's feedback of the latest cycle (CiA-402 0x6061; the simulated drive says which mode it runs in). Check it after MC_TorqueControl before enabling again (the manual's warning about drives left in torque mode). Also the websocket method `read-drive-operation-mode` {axis}.
+         */
+        get: operations["read_drive_operation_mode"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/reset": {
         parameters: {
             query?: never;
@@ -787,6 +807,23 @@ export interface paths {
         put?: never;
         /** MC_Reset: clear an axis error */
         post: operations["reset"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/select-control-loop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_SelectControlLoop: an axis has the one control loop of its drive (index 0) */
+        post: operations["select_control_loop"];
         delete?: never;
         options?: never;
         head?: never;
@@ -935,6 +972,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/torque-control": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_TorqueControl: the drive in torque mode with a ramped torque, the velocity kept within limits (wait returns at in_torque); MC_Halt, MC_Stop or a move returns to position control */
+        post: operations["torque_control"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/touch-probe": {
         parameters: {
             query?: never;
@@ -946,6 +1000,23 @@ export interface paths {
         put?: never;
         /** MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result` */
         post: operations["touch_probe"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/write-drive-operation-mode": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_WriteDriveOperationMode: the drive's position-based mode (configured, position, velocity), at rest; Done once the drive reports it */
+        post: operations["write_drive_operation_mode"];
         delete?: never;
         options?: never;
         head?: never;
@@ -1797,7 +1868,13 @@ export interface components {
          *             "end": 25,
          *             "start": 20
          *           },
-         *           "velocity_feed_forward": 1
+         *           "torque": {
+         *             "acceleration_per_percent": 100,
+         *             "friction": 1,
+         *             "viscous": 0
+         *           },
+         *           "velocity_feed_forward": 1,
+         *           "velocity_mode_position_gain": 100
          *         },
          *         "dynamics": {
          *           "acceleration": 2500,
@@ -1851,6 +1928,7 @@ export interface components {
          *       "active_command": 42,
          *       "actual_acceleration": 0,
          *       "actual_position": 64.109,
+         *       "actual_torque": 0,
          *       "actual_velocity": 199.98,
          *       "cam": {
          *         "active": false,
@@ -1946,6 +2024,7 @@ export interface components {
          *       "decelerating": false,
          *       "drive_error_code": 0,
          *       "drive_fault": false,
+         *       "drive_operation_mode": "configured",
          *       "enable_negative": true,
          *       "enable_positive": true,
          *       "encoder_count": 0,
@@ -2021,12 +2100,14 @@ export interface components {
          *       "set_override_factor": 0,
          *       "set_position": 64.111,
          *       "set_position_offset": 0,
+         *       "set_torque": 0,
          *       "set_velocity": 200,
          *       "soft_limit_max_exceeded": false,
          *       "soft_limit_min_exceeded": false,
          *       "state": "discrete_motion",
          *       "superimposed_distance": 0,
-         *       "target_position": 250
+         *       "target_position": 250,
+         *       "torque_velocity_limited": false
          *     }
          */
         AxisStatus: {
@@ -2230,6 +2311,23 @@ export interface components {
              * @description The encoder scaling now (#1040, units per increment; MC_SetEncoderScalingFactor).
              */
             encoder_scaling_factor: number;
+            /**
+             * @description The operation mode the drive reports (MC_ReadDriveOperationMode); `configured` from a
+             *     drive that does not say.
+             */
+            drive_operation_mode: components["schemas"]["DriveMode"];
+            /**
+             * Format: double
+             * @description The drive's actual torque, percent of rated torque.
+             */
+            actual_torque: number;
+            /**
+             * Format: double
+             * @description MC_TorqueControl's torque setpoint now (0 when it does not run).
+             */
+            set_torque: number;
+            /** @description MC_TorqueControl: the drive holds the velocity at a limit. */
+            torque_velocity_limited: boolean;
         };
         /**
          * @description MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): the backlash is applied while
@@ -3300,6 +3398,7 @@ export interface components {
          *         "in_end_velocity": false,
          *         "in_gear": false,
          *         "in_sync": false,
+         *         "in_torque": false,
          *         "in_velocity": false,
          *         "status": false,
          *         "warning": false,
@@ -3338,6 +3437,7 @@ export interface components {
          *             "in_end_velocity": false,
          *             "in_gear": false,
          *             "in_sync": false,
+         *             "in_torque": false,
          *             "in_velocity": false,
          *             "status": false,
          *             "warning": false,
@@ -3359,6 +3459,7 @@ export interface components {
          *         "in_end_velocity": false,
          *         "in_gear": false,
          *         "in_sync": false,
+         *         "in_torque": false,
          *         "in_velocity": false,
          *         "status": false,
          *         "warning": false,
@@ -3490,7 +3591,13 @@ export interface components {
          *             "end": 25,
          *             "start": 20
          *           },
-         *           "velocity_feed_forward": 1
+         *           "torque": {
+         *             "acceleration_per_percent": 100,
+         *             "friction": 1,
+         *             "viscous": 0
+         *           },
+         *           "velocity_feed_forward": 1,
+         *           "velocity_mode_position_gain": 100
          *         },
          *         "dynamics": {
          *           "acceleration": 2500,
@@ -3593,7 +3700,13 @@ export interface components {
          *                 "end": 25,
          *                 "start": 20
          *               },
-         *               "velocity_feed_forward": 1
+         *               "torque": {
+         *                 "acceleration_per_percent": 100,
+         *                 "friction": 1,
+         *                 "viscous": 0
+         *               },
+         *               "velocity_feed_forward": 1,
+         *               "velocity_mode_position_gain": 100
          *             },
          *             "dynamics": {
          *               "acceleration": 2500,
@@ -3647,7 +3760,13 @@ export interface components {
          *                 "end": 25,
          *                 "start": 20
          *               },
-         *               "velocity_feed_forward": 1
+         *               "torque": {
+         *                 "acceleration_per_percent": 100,
+         *                 "friction": 1,
+         *                 "viscous": 0
+         *               },
+         *               "velocity_feed_forward": 1,
+         *               "velocity_mode_position_gain": 100
          *             },
          *             "dynamics": {
          *               "acceleration": 2500,
@@ -3695,7 +3814,13 @@ export interface components {
          *                 "end": 25,
          *                 "start": 20
          *               },
-         *               "velocity_feed_forward": 1
+         *               "torque": {
+         *                 "acceleration_per_percent": 100,
+         *                 "friction": 1,
+         *                 "viscous": 0
+         *               },
+         *               "velocity_feed_forward": 1,
+         *               "velocity_mode_position_gain": 100
          *             },
          *             "dynamics": {
          *               "acceleration": 18000,
@@ -3900,7 +4025,13 @@ export interface components {
          *         "end": 25,
          *         "start": 20
          *       },
-         *       "velocity_feed_forward": 1
+         *       "torque": {
+         *         "acceleration_per_percent": 100,
+         *         "friction": 1,
+         *         "viscous": 0
+         *       },
+         *       "velocity_feed_forward": 1,
+         *       "velocity_mode_position_gain": 100
          *     }
          */
         DriveConfig: {
@@ -3961,6 +4092,15 @@ export interface components {
             index_pulse?: null | components["schemas"]["IndexPulse"];
             /** @description Hardware limit switches. Default: `{"fault_on_hit":false,"negative":null,"positive":null}`. */
             limit_switches?: components["schemas"]["LimitSwitches"];
+            /** @description The load in torque mode (MC_TorqueControl). Default: `{"acceleration_per_percent":100.0,"friction":1.0,"viscous":0.0}`. */
+            torque?: components["schemas"]["TorqueModel"];
+            /**
+             * Format: double
+             * @description Velocity mode (MC_WriteDriveOperationMode Velo1, CSV): the gain (1/s, > 0) of the
+             *     position loop closed on motiond's side — velocity = feed-forward + gain × (set − actual).
+             * @default 100
+             */
+            velocity_mode_position_gain: number;
         } | {
             /**
              * @description A CiA-402 servo drive on the EtherCAT bus (`--bus ethercat` or `--bus emulated`).
@@ -4027,6 +4167,33 @@ export interface components {
             input_bytes: number;
         };
         /**
+         * @description A drive's operation mode (`E_DriveOperationMode`, §6.2; CiA-402 0x6060/0x6061).
+         * @enum {string}
+         */
+        DriveMode: "configured" | "position" | "velocity" | "torque";
+        /**
+         * @description MC_ReadDriveOperationMode (§4.5.1): the mode the drive reports (CiA-402 0x6061).
+         * @example {
+         *       "code": 4,
+         *       "cycle": 52000,
+         *       "drive_operation_mode": "position"
+         *     }
+         */
+        DriveOperationModeResource: {
+            /**
+             * @description `position` (CSP), `velocity` (CSV), `torque` (CST), `configured` (a drive that does
+             *     not say: its configured position-based mode).
+             */
+            drive_operation_mode: components["schemas"]["DriveMode"];
+            /**
+             * Format: int32
+             * @description The `E_DriveOperationMode` number (0 default, 1 torque, 2 velo1, 4 pos1).
+             */
+            code: number;
+            /** Format: int64 */
+            cycle: number;
+        };
+        /**
          * @description MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
          * @example {}
          */
@@ -4073,6 +4240,7 @@ export interface components {
          *       "in_end_velocity": false,
          *       "in_gear": false,
          *       "in_sync": false,
+         *       "in_torque": false,
          *       "in_velocity": false,
          *       "status": false,
          *       "warning": false,
@@ -4098,6 +4266,8 @@ export interface components {
             in_sync: boolean;
             /** @description MoveContinuous*: target reached, running at end velocity. */
             in_end_velocity: boolean;
+            /** @description TorqueControl: the torque setpoint is built up and no velocity limit is active. */
+            in_torque: boolean;
             /** @description Power: axis ready for operation. */
             status: boolean;
             /** @description MoveSuperImposed: not completed as asked (executed as far as possible). */
@@ -4374,6 +4544,7 @@ export interface components {
          *       "active_command": 42,
          *       "actual_acceleration": 0,
          *       "actual_position": 64.109,
+         *       "actual_torque": 0,
          *       "actual_velocity": 199.98,
          *       "cam": {
          *         "active": false,
@@ -4469,6 +4640,7 @@ export interface components {
          *       "decelerating": false,
          *       "drive_error_code": 0,
          *       "drive_fault": false,
+         *       "drive_operation_mode": "configured",
          *       "enable_negative": true,
          *       "enable_positive": true,
          *       "encoder_count": 0,
@@ -4545,12 +4717,14 @@ export interface components {
          *       "set_override_factor": 0,
          *       "set_position": 64.111,
          *       "set_position_offset": 0,
+         *       "set_torque": 0,
          *       "set_velocity": 200,
          *       "soft_limit_max_exceeded": false,
          *       "soft_limit_min_exceeded": false,
          *       "state": "discrete_motion",
          *       "superimposed_distance": 0,
-         *       "target_position": 250
+         *       "target_position": 250,
+         *       "torque_velocity_limited": false
          *     }
          */
         LiveStatus: components["schemas"]["AxisStatus"] & {
@@ -5882,6 +6056,26 @@ export interface components {
             size: number;
         };
         /**
+         * @description MC_SelectControlLoop (§4.5.7): an axis has the one control loop of its drive, index 0;
+         *     another index is a 409 control_loop_unknown.
+         * @example {
+         *       "encoder_index": 0
+         *     }
+         */
+        SelectControlLoopBody: {
+            /**
+             * Format: int32
+             * @description The control loop's index (0..9).
+             */
+            encoder_index: number;
+            select_type?: components["schemas"]["SelectControlLoopType"];
+        };
+        /**
+         * @description `E_SelectControlLoopType` (§6.10): only the standard switch is usable (as in TwinCAT).
+         * @enum {string}
+         */
+        SelectControlLoopType: "standard";
+        /**
          * @description Who the client is.
          * @example {
          *       "auth_enabled": true,
@@ -6061,6 +6255,7 @@ export interface components {
          *         "active_command": 42,
          *         "actual_acceleration": 0,
          *         "actual_position": 64.109,
+         *         "actual_torque": 0,
          *         "actual_velocity": 199.98,
          *         "cam": {
          *           "active": false,
@@ -6156,6 +6351,7 @@ export interface components {
          *         "decelerating": false,
          *         "drive_error_code": 0,
          *         "drive_fault": false,
+         *         "drive_operation_mode": "configured",
          *         "enable_negative": true,
          *         "enable_positive": true,
          *         "encoder_count": 0,
@@ -6232,12 +6428,14 @@ export interface components {
          *         "set_override_factor": 0,
          *         "set_position": 64.111,
          *         "set_position_offset": 0,
+         *         "set_torque": 0,
          *         "set_velocity": 200,
          *         "soft_limit_max_exceeded": false,
          *         "soft_limit_min_exceeded": false,
          *         "state": "discrete_motion",
          *         "superimposed_distance": 0,
-         *         "target_position": 250
+         *         "target_position": 250,
+         *         "torque_velocity_limited": false
          *       },
          *       "unit": "mm"
          *     }
@@ -6603,6 +6801,82 @@ export interface components {
             revoked_at?: string | null;
         };
         /**
+         * @description MC_TorqueControl (§5.7.1): the drive switched to torque mode (CST) with a torque ramped at
+         *     `torque_ramp`; the load's velocity is kept within the limits by the drive. Busy until
+         *     MC_Halt, MC_Stop or another motion command takes the axis back to position control (from
+         *     where it is, at its speed). BufferMode Aborting only: a further torque-control is the
+         *     manual's ContinuousUpdate (it takes over from the running setpoint; `relative` adds to
+         *     its target). `?wait=true` answers at InTorque (`in_torque`: the torque built up, no
+         *     velocity limit active).
+         * @example {
+         *       "torque": 35,
+         *       "torque_ramp": 10,
+         *       "velocity_limit_high": 400,
+         *       "velocity_limit_low": -500
+         *     }
+         */
+        TorqueControlBody: {
+            /**
+             * Format: double
+             * @description Percent of rated torque (relative: the change); positive drives the positive way.
+             */
+            torque: number;
+            /**
+             * Format: double
+             * @description Rate of change of the torque setpoint, percent/s (> 0).
+             */
+            torque_ramp: number;
+            relative?: boolean;
+            /**
+             * Format: double
+             * @description The velocity (units/s) the drive keeps the load below; within ±AxisVeloMax, ≥ low.
+             */
+            velocity_limit_high: number;
+            /**
+             * Format: double
+             * @description The velocity (units/s) the drive keeps the load above.
+             */
+            velocity_limit_low: number;
+            /**
+             * Format: double
+             * @description `Options.ManualTorqueStartValue`: start the ramp here (percent) instead of at the
+             *     drive's actual torque.
+             */
+            manual_start_torque?: number | null;
+        };
+        /**
+         * @description The load as torque moves it (torque mode): what 1 % of rated torque accelerates it by,
+         *     and the friction it has to overcome. An injected load force counts as that many percent
+         *     of torque against the motion's positive direction.
+         * @example {
+         *       "acceleration_per_percent": 100,
+         *       "friction": 1,
+         *       "viscous": 0
+         *     }
+         */
+        TorqueModel: {
+            /**
+             * Format: double
+             * @description Acceleration per percent of rated torque (units/s² per %, > 0): rated torque over the
+             *     load's inertia.
+             * @default 100
+             */
+            acceleration_per_percent: number;
+            /**
+             * Format: double
+             * @description Coulomb friction, percent of rated torque (≥ 0): the load stays at rest until the
+             *     torque overcomes it.
+             * @default 1
+             */
+            friction: number;
+            /**
+             * Format: double
+             * @description Viscous friction, percent of rated torque per unit/s (≥ 0).
+             * @default 0
+             */
+            viscous: number;
+        };
+        /**
          * @description MC_TouchProbe (§4.3.1): the trigger (signal, edge, modulo positions) and the window.
          * @example {
          *       "edge": "rising",
@@ -6701,6 +6975,22 @@ export interface components {
          * @enum {string}
          */
         WorkDirection: "both" | "positive" | "negative";
+        /**
+         * @description MC_WriteDriveOperationMode (§4.5.1): the drive's position-based operation mode, at rest;
+         *     Done once the drive reports it (409 drive_mode_not_reached after 0.5 s). `torque` is
+         *     MC_TorqueControl's (409 invalid_mode here), so a drive is never left in torque mode
+         *     without a torque under control.
+         * @example {
+         *       "drive_operation_mode": "position"
+         *     }
+         */
+        WriteDriveOperationModeBody: {
+            /**
+             * @description `configured` (DriveOperationMode_Default: the drive's configured mode), `position`
+             *     (Pos1, CSP), `velocity` (Velo1, CSV).
+             */
+            drive_operation_mode: components["schemas"]["DriveMode"];
+        };
         /**
          * @description MC_WriteMotionFunction: points to replace, by their `point_index`.
          * @example {
@@ -10268,6 +10558,35 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
         };
     };
+    read_drive_operation_mode: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["DriveOperationModeResource"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["AxisNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
     reset: {
         parameters: {
             query?: {
@@ -10302,6 +10621,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    select_control_loop: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SelectControlLoopBody"];
             };
         };
         responses: {
@@ -10735,6 +11114,66 @@ export interface operations {
             503: components["responses"]["CommandUnavailable"];
         };
     };
+    torque_control: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TorqueControlBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
     touch_probe: {
         parameters: {
             query?: {
@@ -10769,6 +11208,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["TouchProbeBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    write_drive_operation_mode: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["WriteDriveOperationModeBody"];
             };
         };
         responses: {

@@ -75,7 +75,9 @@ export interface ConfigForm {
   time_constant: string;
   natural_frequency_hz: string;
   damping: string;
-  drive: Record<'dead_time' | 'velocity_feed_forward' | 'acceleration_feed_forward' | 'enable_delay' | 'coast_deceleration' | 'load_stiffness', string>;
+  drive: Record<'dead_time' | 'velocity_feed_forward' | 'acceleration_feed_forward' | 'enable_delay' | 'coast_deceleration' | 'load_stiffness' | 'velocity_mode_position_gain', string>;
+  /** `drive.torque`: the load in torque mode (MC_TorqueControl). */
+  torque: Record<TorqueField, string>;
   dead_time_compensation: boolean;
   refCam: boolean;
   camStart: string;
@@ -98,6 +100,8 @@ export interface ConfigForm {
   jogDeadmanMax: string;
 }
 
+type TorqueField = 'acceleration_per_percent' | 'friction' | 'viscous';
+
 type CiaField = 'subdevice' | 'increments_per_unit' | 'velocity_increments_per_unit' | 'position_gain' | 'velocity_gain' | 'acceleration_feed_forward' | 'max_torque';
 
 export const DEFAULT_FORM: ConfigForm = {
@@ -115,7 +119,8 @@ export const DEFAULT_FORM: ConfigForm = {
   time_constant: '0.005',
   natural_frequency_hz: '50',
   damping: '0.8',
-  drive: { dead_time: '0.001', velocity_feed_forward: '1', acceleration_feed_forward: '0', enable_delay: '0.005', coast_deceleration: '10000', load_stiffness: '1000' },
+  drive: { dead_time: '0.001', velocity_feed_forward: '1', acceleration_feed_forward: '0', enable_delay: '0.005', coast_deceleration: '10000', load_stiffness: '1000', velocity_mode_position_gain: '100' },
+  torque: { acceleration_per_percent: '100', friction: '1', viscous: '0' },
   dead_time_compensation: true,
   refCam: true,
   camStart: '20',
@@ -165,6 +170,12 @@ export function formOf(c: AxisConfig): ConfigForm {
       enable_delay: n(d.enable_delay, '0.005'),
       coast_deceleration: n(d.coast_deceleration, '10000'),
       load_stiffness: n(d.load_stiffness, '1000'),
+      velocity_mode_position_gain: n(d.velocity_mode_position_gain, '100'),
+    },
+    torque: {
+      acceleration_per_percent: n(d.torque?.acceleration_per_percent, '100'),
+      friction: n(d.torque?.friction, '1'),
+      viscous: n(d.torque?.viscous, '0'),
     },
     dead_time_compensation: d.dead_time_compensation ?? true,
     refCam: !!d.reference_cam,
@@ -256,6 +267,12 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
       enable_delay: num('drive.enable_delay', f.drive.enable_delay),
       coast_deceleration: num('drive.coast_deceleration', f.drive.coast_deceleration),
       load_stiffness: num('drive.load_stiffness', f.drive.load_stiffness),
+      velocity_mode_position_gain: num('drive.velocity_mode_position_gain', f.drive.velocity_mode_position_gain),
+      torque: {
+        acceleration_per_percent: num('drive.torque.acceleration_per_percent', f.torque.acceleration_per_percent),
+        friction: num('drive.torque.friction', f.torque.friction),
+        viscous: num('drive.torque.viscous', f.torque.viscous),
+      },
       reference_cam: f.refCam ? { start: num('drive.reference_cam.start', f.camStart), end: num('drive.reference_cam.end', f.camEnd) } : null,
       index_pulse: f.index ? { period: num('drive.index_pulse.period', f.indexPeriod), offset: num('drive.index_pulse.offset', f.indexOffset) } : null,
       limit_switches: { negative: opt('drive.limit_switches.negative', f.limitNeg), positive: opt('drive.limit_switches.positive', f.limitPos), fault_on_hit: f.faultOnHit },
@@ -324,6 +341,13 @@ const DRIVE_LABELS: [keyof ConfigForm['drive'], string, string][] = [
   ['acceleration_feed_forward', 'Acceleration feed-forward', '0 … 2 (PT2 only)'],
   ['coast_deceleration', 'Coast deceleration (u/s²)', 'power stage off'],
   ['load_stiffness', 'Load stiffness', '> 0'],
+  ['velocity_mode_position_gain', 'Velocity-mode position gain (1/s)', 'CSV: motiond closes the loop'],
+];
+
+const TORQUE_LABELS: [TorqueField, string, string][] = [
+  ['acceleration_per_percent', 'Torque mode: acceleration per % (u/s²)', 'rated torque ÷ inertia'],
+  ['friction', 'Torque mode: friction (%)', 'Coulomb, ≥ 0'],
+  ['viscous', 'Torque mode: viscous friction (% per u/s)', '≥ 0'],
 ];
 
 /** A dry run waiting for the user's word: its answer and the configuration it was asked for. */
@@ -769,6 +793,7 @@ function DriveFields({ form, setForm, bus, axis, err, num }: {
           {form.plant === 'pt2' && num('drive.plant.natural_frequency_hz', form.natural_frequency_hz, (v) => set('natural_frequency_hz', v), 'Natural frequency (Hz)', '> 0 and ≤ 1000')}
           {form.plant === 'pt2' && num('drive.plant.damping', form.damping, (v) => set('damping', v), 'Damping', '1 = critically damped')}
           {DRIVE_LABELS.map(([k, label, hint]) => num(`drive.${k}`, form.drive[k], (v) => set('drive', { ...form.drive, [k]: v }), label, hint))}
+          {TORQUE_LABELS.map(([k, label, hint]) => num(`drive.torque.${k}`, form.torque[k], (v) => set('torque', { ...form.torque, [k]: v }), label, hint))}
           <label class="check">
             <input type="checkbox" name="drive.dead_time_compensation" checked={form.dead_time_compensation} onChange={(e) => set('dead_time_compensation', (e.target as HTMLInputElement).checked)} /> dead-time
             compensation

@@ -215,6 +215,18 @@ impl Axis {
                 cx.report(cmd.id, DONE);
                 Ok(())
             }
+            CommandKind::TorqueControl(tc) => self.submit_torque_control(cx, cmd.id, tc),
+            CommandKind::WriteDriveOperationMode { mode } => {
+                self.submit_drive_mode(cx, cmd.id, mode)
+            }
+            CommandKind::SelectControlLoop { index } => {
+                // The drive is the axis's one encoder, controller and drive: loop 0.
+                if index != 0 {
+                    return Err(ErrorId::CONTROL_LOOP_UNKNOWN);
+                }
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
             CommandKind::SetEncoderScalingFactor { factor, relative } => {
                 self.set_encoder_scaling(factor, relative, (1040, factor))?;
                 cx.report(cmd.id, DONE);

@@ -163,15 +163,7 @@ impl Axis {
         if let Some(mut old) = source.cmd.take() {
             old.end(cx, End::Aborted);
         }
-        source.cmd = Some(Held::start(
-            cx,
-            id,
-            FbOutputs {
-                busy: true,
-                active: true,
-                ..FbOutputs::default()
-            },
-        ));
+        source.cmd = Some(Held::start_active(cx, id));
         self.correction_targets();
         Ok(())
     }

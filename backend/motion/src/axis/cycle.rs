@@ -36,6 +36,7 @@ impl Axis {
         };
         self.cycle = cycle;
         self.io_data_invalid = fb.bus_error;
+        self.torque.read(fb);
         // The drive answers the setpoint sent last cycle, which carried that cycle's correction.
         // Read through the encoder scaling (1 unless MC_SetEncoderScalingFactor changed it).
         self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.sent;
@@ -55,6 +56,7 @@ impl Axis {
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
         self.step_override_filter(dt);
+        self.step_drive_mode(cx, dt);
         // Power and drive readiness (notes 1, 2, 5).
         self.step_power(cx, dt, fb);
 
@@ -121,6 +123,12 @@ impl Axis {
             position: (self.set.position - self.offset - correction) / self.enc_k,
             velocity: (self.set.velocity - correction_rate) / self.enc_k,
             acceleration: self.set.acceleration / self.enc_k,
+            mode: self
+                .torque
+                .drive_mode(self.job.is_some_and(|j| j.kind == JobKind::Torque)),
+            torque: self.torque.set,
+            velocity_limit_high: self.torque.limit_high,
+            velocity_limit_low: self.torque.limit_low,
             latch_enable: self.latch.is_some() || probe_armed,
             latch_source: match (self.latch, &self.probe) {
                 (Some(l), _) => l,
@@ -170,6 +178,11 @@ impl Axis {
         if job.kind == JobKind::Gear {
             self.follow_master(cx, &mut job, master, dt);
             self.job = Some(job);
+            return;
+        }
+        if job.kind == JobKind::Torque {
+            self.job = Some(job);
+            self.step_torque(cx, dt, fb);
             return;
         }
 
@@ -371,7 +384,7 @@ impl Axis {
                     }
                 }
             }
-            JobKind::Home | JobKind::Gear => unreachable!(),
+            JobKind::Home | JobKind::Gear | JobKind::Torque => unreachable!(),
         }
     }
 

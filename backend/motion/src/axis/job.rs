@@ -49,6 +49,8 @@ pub(super) enum JobKind {
     Halt,
     Home,
     Gear,
+    /// MC_TorqueControl: the drive in torque mode; the set position follows the actual one.
+    Torque,
 }
 
 /// Where a job is in its life.
@@ -148,7 +150,7 @@ impl Job {
 
     pub(super) fn is_endless(&self) -> bool {
         match self.kind {
-            JobKind::Velocity | JobKind::JogHeld { .. } | JobKind::Gear => true,
+            JobKind::Velocity | JobKind::JogHeld { .. } | JobKind::Gear | JobKind::Torque => true,
             JobKind::Positioning { continuous } => continuous,
             _ => false,
         }
@@ -227,6 +229,19 @@ impl Held {
         held
     }
 
+    /// A command that is busy and active from now on (an Enable-type block, a phasing).
+    pub(super) fn start_active(cx: &mut Ctx<'_, impl EventSink>, id: CommandId) -> Held {
+        Held::start(
+            cx,
+            id,
+            FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            },
+        )
+    }
+
     pub(super) fn end(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
         self.emit(cx, ended(self.out, end));
     }
@@ -266,6 +281,7 @@ fn ended(out: FbOutputs, end: End) -> FbOutputs {
         in_gear: out.in_gear && ok,
         in_sync: out.in_sync && ok,
         in_end_velocity: out.in_end_velocity && ok,
+        in_torque: false,
         status: false,
         warning: out.warning && error == 0,
         warning_id: if error == 0 { out.warning_id } else { 0 },
@@ -283,6 +299,7 @@ pub(super) const DONE: FbOutputs = FbOutputs {
     in_gear: false,
     in_sync: false,
     in_end_velocity: false,
+    in_torque: false,
     status: false,
     warning: false,
     warning_id: 0,

@@ -41,6 +41,7 @@ mod planning;
 mod probe;
 mod status;
 mod superposition;
+mod torque;
 
 use coupling::Coupling;
 pub use coupling::{Master, MasterSample};
@@ -193,6 +194,9 @@ pub struct Axis {
     /// The part of `offset` that relative encoder scaling changes put there (an absolute
     /// change counts from zero again and drops it).
     enc_offset: f64,
+    /// MC_TorqueControl's torque setpoint and limits (while a Torque job runs), the drive's
+    /// position-based mode (MC_WriteDriveOperationMode) and what the drive reported.
+    torque: torque::TorqueState,
 }
 
 impl Axis {
@@ -278,6 +282,7 @@ impl Axis {
             enc_base,
             enc_k: 1.0,
             enc_offset: 0.0,
+            torque: torque::TorqueState::default(),
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();
@@ -324,7 +329,8 @@ impl Axis {
                     }
                     JobKind::Positioning { continuous: true }
                     | JobKind::Velocity
-                    | JobKind::JogHeld { .. } => AxisState::ContinuousMotion,
+                    | JobKind::JogHeld { .. }
+                    | JobKind::Torque => AxisState::ContinuousMotion,
                     JobKind::Home => AxisState::Homing,
                     JobKind::Gear => AxisState::SynchronizedMotion,
                 },

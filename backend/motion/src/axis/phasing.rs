@@ -98,15 +98,7 @@ impl Axis {
         if let Some(mut old) = self.phasing.take() {
             old.cmd.end(cx, End::Aborted);
         }
-        let cmd = Held::start(
-            cx,
-            id,
-            FbOutputs {
-                busy: true,
-                active: true,
-                ..FbOutputs::default()
-            },
-        );
+        let cmd = Held::start_active(cx, id);
         self.phasing = Some(PhasingJob {
             cmd,
             target: if ph.kind == PhasingKind::Halt {

@@ -92,7 +92,7 @@ impl Axis {
                     },
                 )
             }
-            JobKind::Gear => return true,
+            JobKind::Gear | JobKind::Torque => return true,
         };
         match res {
             Ok(_) => {

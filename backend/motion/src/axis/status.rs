@@ -125,16 +125,23 @@ impl Axis {
         let (phasing_active, absolute_phase_shift, covered_phase_shift) = self.phasing_status();
         let position_correction = self.correction_status();
         let encoder_count = self.encoder_count();
+        let (drive_mode, actual_torque, set_torque, velocity_limited) = self.torque_status();
+        let torque_job = self.job.is_some_and(|j| j.kind == JobKind::Torque);
         let s = &mut self.status;
         s.phasing_active = phasing_active;
         s.position_correction = position_correction;
         s.encoder_count = encoder_count;
+        s.drive_operation_mode = drive_mode;
+        s.actual_torque = actual_torque;
+        s.set_torque = set_torque;
+        s.torque_velocity_limited = velocity_limited;
         s.encoder_scaling_factor = p.axis_encoder_scaling_factor;
         s.absolute_phase_shift = absolute_phase_shift;
         s.covered_phase_shift = covered_phase_shift;
         s.op_modes = op_modes;
         s.operational = s.power_status && matches!(self.mode, Mode::Enabled | Mode::Stopping);
-        s.control_loop_closed = s.operational;
+        // Torque control leaves the position loop open.
+        s.control_loop_closed = s.operational && !torque_job;
         s.not_moving = !s.moving;
         s.has_been_stopped = self.has_been_stopped;
         s.homing_busy = state == AxisState::Homing;

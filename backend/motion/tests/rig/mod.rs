@@ -38,6 +38,14 @@ pub struct Plant {
     latch_pos: f64,
     prev_pos: f64,
     prev_cam: bool,
+    /// Torque mode (the last setpoint asked for it): the load accelerates with
+    /// `torque_acceleration` per percent, less `friction` percent against the motion, and the
+    /// drive holds the velocity within the setpoint's limits.
+    pub torque_mode: bool,
+    pub torque_acceleration: f64,
+    pub friction: f64,
+    torque: f64,
+    velocity_limited: bool,
 }
 
 impl Default for Plant {
@@ -58,6 +66,11 @@ impl Default for Plant {
             limit_negative: false,
             load_lag: 0.0,
             probe_mark: None,
+            torque_mode: false,
+            torque_acceleration: 100.0,
+            friction: 1.0,
+            torque: 0.0,
+            velocity_limited: false,
             latch_valid: false,
             latch_pos: 0.0,
             prev_pos: 0.0,
@@ -85,6 +98,13 @@ impl Plant {
             limit_negative: self.limit_negative,
             latch_valid: self.latch_valid,
             latch_position: self.latch_pos,
+            mode: if self.torque_mode {
+                DriveMode::Torque
+            } else {
+                DriveMode::Configured
+            },
+            actual_torque: self.torque,
+            velocity_limited: self.velocity_limited,
         }
     }
 
@@ -104,7 +124,23 @@ impl Plant {
             self.pending = 0;
         }
         self.prev_pos = self.pos;
-        if self.enabled {
+        self.torque_mode = sp.mode == DriveMode::Torque && self.enabled;
+        self.velocity_limited = false;
+        if self.torque_mode {
+            let drag = if self.vel != 0.0 {
+                self.friction * self.vel.signum()
+            } else {
+                0.0
+            };
+            let mut v = self.vel + (sp.torque - drag) * self.torque_acceleration * dt;
+            if v > sp.velocity_limit_high || v < sp.velocity_limit_low {
+                v = v.clamp(sp.velocity_limit_low, sp.velocity_limit_high);
+                self.velocity_limited = true;
+            }
+            self.pos += 0.5 * (self.vel + v) * dt;
+            self.vel = v;
+            self.torque = sp.torque;
+        } else if self.enabled {
             let target = sp.position;
             let new = if self.tau > 0.0 {
                 self.pos + (target - self.pos) * (1.0 - (-dt / self.tau).exp())
@@ -763,7 +799,11 @@ impl Rig {
                 s.set_acceleration,
                 b.acceleration
             );
+            // Torque control follows the load the drive moves (the position loop open, its
+            // take-over and hand-back are the documented steps).
             let settled = !self.shifted[i]
+                && (s.control_loop_closed || !s.operational)
+                && (p.control_loop_closed || !p.operational)
                 && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop)
                 && !matches!(p.state, AxisState::Disabled | AxisState::ErrorStop)
                 && p.homed == s.homed

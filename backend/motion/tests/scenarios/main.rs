@@ -24,6 +24,7 @@ mod s5_3_homing;
 mod s5_4_jog;
 mod s5_5_coupling;
 mod s5_6_phasing;
+mod s5_7_torque_control;
 mod s8_3_fault_behaviour;
 
 use motion::*;

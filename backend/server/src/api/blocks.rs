@@ -239,6 +239,12 @@ catalogue! {
         "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
     abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
         "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
+    torque_control: "torque-control", TorqueControlBody, TorqueControlBody::to_kind, Operator, InTorque,
+        "MC_TorqueControl: the drive in torque mode with a ramped torque, the velocity kept within limits (wait returns at in_torque); MC_Halt, MC_Stop or a move returns to position control";
+    write_drive_operation_mode: "write-drive-operation-mode", WriteDriveOperationModeBody, WriteDriveOperationModeBody::to_kind, Operator, Done,
+        "MC_WriteDriveOperationMode: the drive's position-based mode (configured, position, velocity), at rest; Done once the drive reports it";
+    select_control_loop: "select-control-loop", SelectControlLoopBody, SelectControlLoopBody::to_kind, Operator, Done,
+        "MC_SelectControlLoop: an axis has the one control loop of its drive (index 0)";
     set_encoder_scaling_factor: "set-encoder-scaling-factor", SetEncoderScalingFactorBody, SetEncoderScalingFactorBody::to_kind, Operator, Done,
         "MC_SetEncoderScalingFactor: the encoder's units per increment; absolute (the position jumps, at standstill only) or relative (no jump, also in motion)";
     position_correction_limiter: "position-correction-limiter", PositionCorrectionLimiterBody, PositionCorrectionLimiterBody::to_kind, Operator, Active,

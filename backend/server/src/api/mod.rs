@@ -327,6 +327,10 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(reads::read_axis_components),
         )
         .route(
+            "/axes/{axis}/read-drive-operation-mode",
+            get(reads::read_drive_operation_mode),
+        )
+        .route(
             "/functions/calc-dynamics-by-ramp-time",
             get(functions::calc_dynamics_by_ramp_time_fb),
         )
@@ -533,6 +537,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,
         functions::calc_dynamics_by_ramp_time_fb,
         reads::convert_inc_pos_to_pos, reads::convert_pos_to_inc_pos, reads::read_axis_components,
+        reads::read_drive_operation_mode,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,

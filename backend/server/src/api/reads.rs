@@ -42,7 +42,27 @@ pub const READS: &[Read] = &[
         result: "AxisComponents",
         summary: "MC_ReadAxisComponents: the encoder, controller and drive of the axis",
     },
+    Read {
+        name: "read-drive-operation-mode",
+        params: None,
+        result: "DriveOperationModeResource",
+        summary: "MC_ReadDriveOperationMode: the operation mode the drive reports",
+    },
 ];
+
+#[utoipa::path(get, path = "/api/v1/axes/{axis}/read-drive-operation-mode", tag = "axes",
+    summary = "MC_ReadDriveOperationMode: the operation mode the drive reports",
+    description = "From the drive's feedback of the latest cycle (CiA-402 0x6061; the simulated drive says which \
+mode it runs in). Check it after MC_TorqueControl before enabling again (the manual's warning about drives left in \
+torque mode). Also the websocket method `read-drive-operation-mode` {axis}.",
+    params(("axis" = String, Path, description = "axis id or name", example = "x")),
+    responses((status = 200, body = DriveOperationModeResource), super::errors::ReadErrors))]
+pub async fn read_drive_operation_mode(
+    State(s): State<Arc<AppState>>,
+    Path(axis): Path<String>,
+) -> AppResult<Json<DriveOperationModeResource>> {
+    Ok(Json(reads::read_drive_operation_mode(&s, &axis)?))
+}
 
 #[utoipa::path(get, path = "/api/v1/axes/{axis}/convert-inc-pos-to-pos", tag = "axes",
     summary = "MC_ConvertIncPosToPos: the axis position of an encoder count",
@@ -103,10 +123,15 @@ pub fn dispatch(s: &AppState, method: &str, axis: &str, params: Value) -> Option
         "convert-pos-to-inc-pos" => json(
             query::<PositionQuery>(params).and_then(|q| reads::convert_pos_to_inc_pos(s, axis, &q)),
         ),
-        "read-axis-components" => match params.as_object().map(|m| m.is_empty()) {
-            Some(true) => json(reads::read_axis_components(s, axis)),
-            _ => Err(AppError::field("params", "takes only `axis`")),
-        },
+        "read-axis-components" | "read-drive-operation-mode" => {
+            match params.as_object().map(|m| m.is_empty()) {
+                Some(true) if method == "read-axis-components" => {
+                    json(reads::read_axis_components(s, axis))
+                }
+                Some(true) => json(reads::read_drive_operation_mode(s, axis)),
+                _ => Err(AppError::field("params", "takes only `axis`")),
+            }
+        }
         _ => return None,
     })
 }

@@ -152,6 +152,8 @@ pub enum Milestone {
     Status,
     /// An Enable-type block is active (a compensation applied from now on).
     Active,
+    /// MC_TorqueControl: the torque built up, no velocity limit active.
+    InTorque,
 }
 
 impl Milestone {
@@ -165,6 +167,7 @@ impl Milestone {
             Milestone::InEndVelocity => o.in_end_velocity,
             Milestone::Status => o.status,
             Milestone::Active => o.active,
+            Milestone::InTorque => o.in_torque,
         };
         o.done || o.error || o.command_aborted || arrived
     }

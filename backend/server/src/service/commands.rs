@@ -415,6 +415,62 @@ impl GearInBody {
     }
 }
 
+impl TorqueControlBody {
+    pub fn to_kind(&self, _: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        let bounded = |x: f64, m: f64| x.is_finite() && x.abs() <= m;
+        if !bounded(self.torque, 1000.0) {
+            c.fail("torque", "must be from -1000 to 1000 %");
+        }
+        c.positive("torque_ramp", self.torque_ramp);
+        let vmax = axis.params.axis_velo_max;
+        for (field, v) in [
+            ("velocity_limit_high", self.velocity_limit_high),
+            ("velocity_limit_low", self.velocity_limit_low),
+        ] {
+            if !bounded(v, vmax) {
+                c.fail(field, &format!("must be within ±{vmax} (AxisVeloMax)"));
+            }
+        }
+        if self.velocity_limit_low > self.velocity_limit_high {
+            c.fail("velocity_limit_low", "must not exceed velocity_limit_high");
+        }
+        if let Some(t) = self.manual_start_torque {
+            if !bounded(t, 1000.0) {
+                c.fail("manual_start_torque", "must be from -1000 to 1000 %");
+            }
+        }
+        c.done(CommandKind::TorqueControl(motion::TorqueControl {
+            torque: self.torque,
+            torque_ramp: self.torque_ramp,
+            relative: self.relative,
+            velocity_limit_high: self.velocity_limit_high,
+            velocity_limit_low: self.velocity_limit_low,
+            manual_start: self.manual_start_torque,
+        }))
+    }
+}
+
+impl WriteDriveOperationModeBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        Ok(CommandKind::WriteDriveOperationMode {
+            mode: self.drive_operation_mode,
+        })
+    }
+}
+
+impl SelectControlLoopBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if self.encoder_index > 9 {
+            c.fail("encoder_index", "must be from 0 to 9");
+        }
+        c.done(CommandKind::SelectControlLoop {
+            index: self.encoder_index,
+        })
+    }
+}
+
 impl SetEncoderScalingFactorBody {
     pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();

@@ -131,3 +131,16 @@ pub fn read_axis_components(s: &AppState, axis: &str) -> AppResult<AxisComponent
         active_control_loop: 0,
     })
 }
+
+/// MC_ReadDriveOperationMode (§4.5.1): what the drive reports in the latest cycle.
+pub fn read_drive_operation_mode(
+    s: &AppState,
+    axis: &str,
+) -> AppResult<DriveOperationModeResource> {
+    let (cycle, st, _) = status_and_mask(s, axis)?;
+    Ok(DriveOperationModeResource {
+        drive_operation_mode: st.drive_operation_mode,
+        code: st.drive_operation_mode.code(),
+        cycle,
+    })
+}
