@@ -367,6 +367,23 @@ pub enum CommandKind {
     TouchProbe(TouchProbe),
     /// MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture.
     AbortTrigger,
+    /// MC_ExtSetPointGenEnable (§4.4.1): the axis takes its setpoints from samples fed by a
+    /// client; `target` (absolute, or relative to the set position) is monitored for
+    /// InTargetPosition; the stream stalls (the axis stops) after `timeout` s without one.
+    ExtSetPointGenEnable {
+        target: Option<f64>,
+        relative: bool,
+        timeout: f64,
+    },
+    /// MC_ExtSetPointGenDisable (§4.4.2).
+    ExtSetPointGenDisable,
+    /// MC_ExtSetPointGenFeed (§4.4.3): the sample for now; `direction` −1, 0, +1.
+    ExtSetPointGenFeed {
+        position: f64,
+        velocity: f64,
+        acceleration: f64,
+        direction: i8,
+    },
     /// MC_TorqueControl (§5.7.1): the drive in torque mode with a torque ramped to `torque`
     /// at `torque_ramp` (percent/s), the load's velocity kept within the limits by the drive.
     /// MC_Halt, MC_Stop or any motion command brings the axis back to position control.
@@ -469,6 +486,9 @@ impl CommandKind {
             CommandKind::AbortTrigger => "abort-trigger",
             CommandKind::SetEncoderScalingFactor { .. } => "set-encoder-scaling-factor",
             CommandKind::TorqueControl(_) => "torque-control",
+            CommandKind::ExtSetPointGenEnable { .. } => "ext-setpoint-gen-enable",
+            CommandKind::ExtSetPointGenDisable => "ext-setpoint-gen-disable",
+            CommandKind::ExtSetPointGenFeed { .. } => "ext-setpoint-gen-feed",
             CommandKind::WriteDriveOperationMode { .. } => "write-drive-operation-mode",
             CommandKind::SelectControlLoop { .. } => "select-control-loop",
             CommandKind::PositionCorrectionLimiter { .. } => "position-correction-limiter",
@@ -528,6 +548,10 @@ pub enum DisableMode {
     /// The correction returns to 0 at once (a jump of the drive's setpoint).
     Reset,
 }
+
+/// How long an external setpoint stream may pause before the axis stops, unless
+/// MC_ExtSetPointGenEnable says otherwise (s).
+pub const DEFAULT_EXT_FEED_TIMEOUT: f64 = 0.05;
 
 /// MC_TorqueControl's inputs (§5.7.1).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -151,6 +151,14 @@ error_table! {
     DRIVE_MODE_NOT_REACHED = 0x70B4, "drive_mode_not_reached", "the drive did not switch to the operation mode asked for";
     /// MC_SelectControlLoop: the axis has one control loop (its drive), index 0.
     CONTROL_LOOP_UNKNOWN = 0x70B5, "control_loop_unknown", "the axis has no control loop with this index (it has one: 0)";
+    /// A sample of the external setpoint generator would make the axis jump or exceed its maximum velocity (or a first sample is not where the axis stands).
+    EXT_SETPOINT_INVALID = 0x70B6, "ext_setpoint_invalid", "external setpoint not continuous or beyond the maximum velocity";
+    /// The external setpoint stream paused longer than its timeout: the axis stopped.
+    EXT_SETPOINT_STALLED = 0x70B7, "ext_setpoint_stalled", "the external setpoint stream stalled";
+    /// A sample was fed while the external setpoint generator is not enabled.
+    EXT_SETPOINT_GEN_NOT_ENABLED = 0x70B8, "ext_setpoint_gen_not_enabled", "the external setpoint generator is not enabled";
+    /// A motion command to an axis moved by the external setpoint generator without AxisAllowMotionCmdToExtSetAxis (#1066).
+    EXT_SETPOINT_AXIS_COMMAND_NOT_ALLOWED = 0x70B9, "ext_setpoint_axis_command_not_allowed", "motion commands to an axis fed by the external setpoint generator are not allowed (#1066)";
 }
 
 impl fmt::Display for ErrorId {

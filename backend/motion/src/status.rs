@@ -207,6 +207,9 @@ pub struct AxisStatus {
     pub set_torque: f64,
     /// MC_TorqueControl: the drive holds the velocity at a limit.
     pub torque_velocity_limited: bool,
+    /// StateDWord bit 14: the external setpoint generator is enabled (MC_ExtSetPointGen-
+    /// Enable's `Enabled`).
+    pub ext_setpoint_gen_enabled: bool,
 }
 
 /// The position correction of an axis and its sources (MC_PositionCorrectionLimiter,

@@ -82,6 +82,8 @@ pub fn required(method: &Method, path: &str) -> Option<Role> {
         "/control" => Operator,
         "/commands/{id}" | "/commands/{id}/keepalive" => Operator,
         "/axes/{axis}/status/following-error-peak/reset" => Operator,
+        // The external setpoint generator's samples, fed like a jog's keepalives.
+        "/axes/{axis}/ext-setpoint-gen-feed" => Operator,
         _ if p.starts_with("/scope/") => Operator,
         _ => match p
             .strip_prefix("/axes/{axis}/")

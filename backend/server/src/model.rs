@@ -628,6 +628,70 @@ pub struct TouchProbeBody {
     pub modulo_positions: bool,
 }
 
+/// `E_PositionType` of MC_ExtSetPointGenEnable's monitored position.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionType {
+    #[default]
+    Absolute,
+    /// Relative to the set position at the enable.
+    Relative,
+}
+
+/// MC_ExtSetPointGenEnable (§4.4.1): from now on the axis takes its setpoints from samples a
+/// client feeds (`POST /axes/{axis}/ext-setpoint-gen-feed`, or the websocket method of that
+/// name — at up to the cycle rate; a sample is extrapolated with its velocity and
+/// acceleration until the next arrives). The first sample must be where the axis stands.
+/// A stream that pauses longer than `feed_timeout` while it moves the axis stops it in
+/// ErrorStop (0x70B7); a sample that jumps or exceeds the maximum velocity stops it (0x70B6),
+/// as does one heading into an enabled software limit (0x7003). Enabled at standstill.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 250.0, "feed_timeout": 0.05}))]
+pub struct ExtSetPointGenEnableBody {
+    /// Monitored for InTargetPosition (the axis does not go there by itself); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub position: Option<f64>,
+    #[serde(default)]
+    pub position_type: PositionType,
+    /// Seconds without a sample after which a moving axis stops (default 0.05).
+    #[serde(default = "default_feed_timeout")]
+    #[schema(exclusive_minimum = 0, maximum = 10, default = 0.05)]
+    pub feed_timeout: f64,
+}
+
+fn default_feed_timeout() -> f64 {
+    motion::DEFAULT_EXT_FEED_TIMEOUT
+}
+
+/// MC_ExtSetPointGenFeed (§4.4.3): the sample for now. Not a command: it is applied in the
+/// next cycle (or refused) and answered with that cycle.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"position": 12.5, "velocity": 40.0, "acceleration": 0.0, "direction": 1}))]
+pub struct ExtSetPointFeedBody {
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub position: f64,
+    /// Units/s, within AxisVeloMax.
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub velocity: f64,
+    #[serde(default)]
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub acceleration: f64,
+    /// −1, 0 or +1 (standstill); absent: the velocity's sign.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = -1, maximum = 1)]
+    pub direction: Option<i8>,
+}
+
+/// The answer to a fed sample: the kernel cycle it takes effect in.
+#[derive(Debug, Serialize, ToSchema)]
+#[schema(example = json!({"cycle": 1873}))]
+pub struct FeedResult {
+    pub cycle: u64,
+}
+
 /// MC_TorqueControl (§5.7.1): the drive switched to torque mode (CST) with a torque ramped at
 /// `torque_ramp`; the load's velocity is kept within the limits by the drive. Busy until
 /// MC_Halt, MC_Stop or another motion command takes the axis back to position control (from

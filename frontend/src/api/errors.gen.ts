@@ -55,4 +55,8 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28851, "position_out_of_counter_range", "the position is too far from the actual position for the encoder counter"],
   [28852, "drive_mode_not_reached", "the drive did not switch to the operation mode asked for"],
   [28853, "control_loop_unknown", "the axis has no control loop with this index (it has one: 0)"],
+  [28854, "ext_setpoint_invalid", "external setpoint not continuous or beyond the maximum velocity"],
+  [28855, "ext_setpoint_stalled", "the external setpoint stream stalled"],
+  [28856, "ext_setpoint_gen_not_enabled", "the external setpoint generator is not enabled"],
+  [28857, "ext_setpoint_axis_command_not_allowed", "motion commands to an axis fed by the external setpoint generator are not allowed (#1066)"],
 ];

@@ -381,6 +381,60 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/ext-setpoint-gen-disable": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_ExtSetPointGenDisable: the axis no longer takes samples (one moving by them stops on its ramp) */
+        post: operations["ext_setpoint_gen_disable"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/ext-setpoint-gen-enable": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_ExtSetPointGenEnable: the axis takes its setpoints from samples fed to ext-setpoint-gen-feed (extrapolated between feeds; a stalled stream stops a moving axis in ErrorStop) */
+        post: operations["ext_setpoint_gen_enable"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/axes/{axis}/ext-setpoint-gen-feed": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * MC_ExtSetPointGenFeed: a sample for an axis whose external setpoint generator is enabled
+         * @description Applied in the next cycle (answered with it) or refused: 409 ext_setpoint_gen_not_enabled, axis_cannot_be_started (a first sample while the axis is not at standstill), ext_setpoint_invalid (a first sample elsewhere than where the axis stands); 422 for a velocity beyond AxisVeloMax or a direction other than the velocity's sign. Between samples the axis extrapolates the last one with its velocity and acceleration; while it moves, a pause longer than the enable's `feed_timeout` stops it in ErrorStop. Also the websocket method `ext-setpoint-gen-feed` {axis, position, velocity, acceleration, direction} — sent without an id it is not answered (a stream). Needs control when control is held.
+         */
+        post: operations["ext_setpoint_gen_feed"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/gear-in": {
         parameters: {
             query?: never;
@@ -2030,6 +2084,7 @@ export interface components {
          *       "encoder_count": 0,
          *       "encoder_scaling_factor": 0,
          *       "error_id": 0,
+         *       "ext_setpoint_gen_enabled": false,
          *       "external_latch_valid": false,
          *       "following_error": 0.002,
          *       "following_error_max": 0.0219,
@@ -2328,6 +2383,11 @@ export interface components {
             set_torque: number;
             /** @description MC_TorqueControl: the drive holds the velocity at a limit. */
             torque_velocity_limited: boolean;
+            /**
+             * @description StateDWord bit 14: the external setpoint generator is enabled (MC_ExtSetPointGen-
+             *     Enable's `Enabled`).
+             */
+            ext_setpoint_gen_enabled: boolean;
         };
         /**
          * @description MC_BacklashCompensation (§4.5.2, appendix §7, Enable-type): the backlash is applied while
@@ -4229,6 +4289,59 @@ export interface components {
          */
         EncoderScalingMode: "absolute" | "relative";
         /**
+         * @description MC_ExtSetPointGenFeed (§4.4.3): the sample for now. Not a command: it is applied in the
+         *     next cycle (or refused) and answered with that cycle.
+         * @example {
+         *       "acceleration": 0,
+         *       "direction": 1,
+         *       "position": 12.5,
+         *       "velocity": 40
+         *     }
+         */
+        ExtSetPointFeedBody: {
+            /** Format: double */
+            position: number;
+            /**
+             * Format: double
+             * @description Units/s, within AxisVeloMax.
+             */
+            velocity: number;
+            /** Format: double */
+            acceleration?: number;
+            /**
+             * Format: int32
+             * @description −1, 0 or +1 (standstill); absent: the velocity's sign.
+             */
+            direction?: number | null;
+        };
+        /**
+         * @description MC_ExtSetPointGenEnable (§4.4.1): from now on the axis takes its setpoints from samples a
+         *     client feeds (`POST /axes/{axis}/ext-setpoint-gen-feed`, or the websocket method of that
+         *     name — at up to the cycle rate; a sample is extrapolated with its velocity and
+         *     acceleration until the next arrives). The first sample must be where the axis stands.
+         *     A stream that pauses longer than `feed_timeout` while it moves the axis stops it in
+         *     ErrorStop (0x70B7); a sample that jumps or exceeds the maximum velocity stops it (0x70B6),
+         *     as does one heading into an enabled software limit (0x7003). Enabled at standstill.
+         * @example {
+         *       "feed_timeout": 0.05,
+         *       "position": 250
+         *     }
+         */
+        ExtSetPointGenEnableBody: {
+            /**
+             * Format: double
+             * @description Monitored for InTargetPosition (the axis does not go there by itself); absent: none.
+             */
+            position?: number | null;
+            position_type?: components["schemas"]["PositionType"];
+            /**
+             * Format: double
+             * @description Seconds without a sample after which a moving axis stops (default 0.05).
+             * @default 0.05
+             */
+            feed_timeout: number;
+        };
+        /**
          * @description The outputs of a function block (`ST_McOutputs` plus the milestone flags).
          * @example {
          *       "active": true,
@@ -4278,6 +4391,16 @@ export interface components {
              *     dead-man fired; the jog then ends with that error at rest).
              */
             warning_id: number;
+        };
+        /**
+         * @description The answer to a fed sample: the kernel cycle it takes effect in.
+         * @example {
+         *       "cycle": 1873
+         *     }
+         */
+        FeedResult: {
+            /** Format: int64 */
+            cycle: number;
         };
         /**
          * @description One invalid field of a configuration.
@@ -4646,6 +4769,7 @@ export interface components {
          *       "encoder_count": 0,
          *       "encoder_scaling_factor": 0,
          *       "error_id": 0,
+         *       "ext_setpoint_gen_enabled": false,
          *       "external_latch_valid": false,
          *       "following_error": 0.002,
          *       "following_error_max": 0.0219,
@@ -5512,6 +5636,11 @@ export interface components {
             table_limiting: boolean;
         };
         /**
+         * @description `E_PositionType` of MC_ExtSetPointGenEnable's monitored position.
+         * @enum {string}
+         */
+        PositionType: "absolute" | "relative";
+        /**
          * @description MC_Power.
          * @example {
          *       "enable": true
@@ -6357,6 +6486,7 @@ export interface components {
          *         "encoder_count": 0,
          *         "encoder_scaling_factor": 0,
          *         "error_id": 0,
+         *         "ext_setpoint_gen_enabled": false,
          *         "external_latch_valid": false,
          *         "following_error": 0.002,
          *         "following_error_max": 0.0219,
@@ -7478,6 +7608,18 @@ export interface components {
                  *       "type": "urn:motiond:problem:validation_failed"
                  *     }
                  */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description A fed sample the axis refuses (`error_id` the PLCopen ErrorID), or control held by
+         *     another client.
+         */
+        FeedRefused: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -9218,6 +9360,166 @@ export interface operations {
             404: components["responses"]["AxisNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["FunctionInputInvalid"];
+        };
+    };
+    ext_setpoint_gen_disable: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    ext_setpoint_gen_enable: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["ExtSetPointGenEnableBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    ext_setpoint_gen_feed: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ExtSetPointFeedBody"];
+            };
+        };
+        responses: {
+            /** @description Taken */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["FeedResult"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["FeedRefused"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     gear_in: {

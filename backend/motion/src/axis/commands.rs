@@ -215,7 +215,40 @@ impl Axis {
                 cx.report(cmd.id, DONE);
                 Ok(())
             }
-            CommandKind::TorqueControl(tc) => self.submit_torque_control(cx, cmd.id, tc),
+            CommandKind::TorqueControl(tc) => {
+                self.admit_to_external()?;
+                self.submit_torque_control(cx, cmd.id, tc)
+            }
+            CommandKind::ExtSetPointGenEnable {
+                target,
+                relative,
+                timeout,
+            } => {
+                self.submit_ext_enable(target, relative, timeout)?;
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::ExtSetPointGenDisable => {
+                self.submit_ext_disable(cx);
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
+            CommandKind::ExtSetPointGenFeed {
+                position,
+                velocity,
+                acceleration,
+                direction,
+            } => self.submit_ext_feed(
+                cx,
+                cmd.id,
+                Kinematics {
+                    position,
+                    velocity,
+                    acceleration,
+                    jerk: 0.0,
+                },
+                direction,
+            ),
             CommandKind::WriteDriveOperationMode { mode } => {
                 self.submit_drive_mode(cx, cmd.id, mode)
             }

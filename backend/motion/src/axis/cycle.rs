@@ -185,6 +185,11 @@ impl Axis {
             self.step_torque(cx, dt, fb);
             return;
         }
+        if job.kind == JobKind::External {
+            self.job = Some(job);
+            self.step_external(cx, dt);
+            return;
+        }
 
         // Override changes re-plan (never a velocity jump).
         let endless_holding =
@@ -384,7 +389,7 @@ impl Axis {
                     }
                 }
             }
-            JobKind::Home | JobKind::Gear | JobKind::Torque => unreachable!(),
+            JobKind::Home | JobKind::Gear | JobKind::Torque | JobKind::External => unreachable!(),
         }
     }
 

@@ -51,6 +51,8 @@ pub(super) enum JobKind {
     Gear,
     /// MC_TorqueControl: the drive in torque mode; the set position follows the actual one.
     Torque,
+    /// The external setpoint generator moves the axis (§4.4).
+    External,
 }
 
 /// Where a job is in its life.
@@ -150,7 +152,11 @@ impl Job {
 
     pub(super) fn is_endless(&self) -> bool {
         match self.kind {
-            JobKind::Velocity | JobKind::JogHeld { .. } | JobKind::Gear | JobKind::Torque => true,
+            JobKind::Velocity
+            | JobKind::JogHeld { .. }
+            | JobKind::Gear
+            | JobKind::Torque
+            | JobKind::External => true,
             JobKind::Positioning { continuous } => continuous,
             _ => false,
         }

@@ -32,6 +32,7 @@ mod correction;
 mod coupling;
 mod cycle;
 mod encoder;
+mod external;
 mod homing;
 mod job;
 mod monitoring;
@@ -197,6 +198,8 @@ pub struct Axis {
     /// MC_TorqueControl's torque setpoint and limits (while a Torque job runs), the drive's
     /// position-based mode (MC_WriteDriveOperationMode) and what the drive reported.
     torque: torque::TorqueState,
+    /// The external setpoint generator (§4.4).
+    ext: external::ExtGen,
 }
 
 impl Axis {
@@ -283,6 +286,7 @@ impl Axis {
             enc_k: 1.0,
             enc_offset: 0.0,
             torque: torque::TorqueState::default(),
+            ext: external::ExtGen::default(),
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();
@@ -330,7 +334,8 @@ impl Axis {
                     JobKind::Positioning { continuous: true }
                     | JobKind::Velocity
                     | JobKind::JogHeld { .. }
-                    | JobKind::Torque => AxisState::ContinuousMotion,
+                    | JobKind::Torque
+                    | JobKind::External => AxisState::ContinuousMotion,
                     JobKind::Home => AxisState::Homing,
                     JobKind::Gear => AxisState::SynchronizedMotion,
                 },

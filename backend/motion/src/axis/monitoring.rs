@@ -270,6 +270,10 @@ impl Axis {
         let p = self.p();
         let Some(job) = self.job else { return };
         let v = self.set.velocity;
+        if job.kind == JobKind::External {
+            // Checked against the samples themselves (`step_external`).
+            return;
+        }
         if job.kind == JobKind::Gear {
             // A slave follows its master and cannot brake for a limit of its own while
             // coupled. Crossing one (moving outwards beyond it) decouples it and stops it on

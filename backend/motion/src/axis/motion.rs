@@ -96,6 +96,9 @@ impl Axis {
         cx: &mut Ctx<'_, impl EventSink>,
         cmd: Command,
     ) -> Result<(), ErrorId> {
+        if !matches!(cmd.kind, CommandKind::Halt { .. }) {
+            self.admit_to_external()?;
+        }
         let mut job;
         match cmd.kind {
             CommandKind::MoveAbsolute(m)

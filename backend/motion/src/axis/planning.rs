@@ -92,7 +92,7 @@ impl Axis {
                     },
                 )
             }
-            JobKind::Gear | JobKind::Torque => return true,
+            JobKind::Gear | JobKind::Torque | JobKind::External => return true,
         };
         match res {
             Ok(_) => {

@@ -127,6 +127,8 @@ impl Axis {
         let encoder_count = self.encoder_count();
         let (drive_mode, actual_torque, set_torque, velocity_limited) = self.torque_status();
         let torque_job = self.job.is_some_and(|j| j.kind == JobKind::Torque);
+        let ext_enabled = self.ext.enabled;
+        let ext_target = self.ext.target.filter(|_| self.ext.enabled);
         let s = &mut self.status;
         s.phasing_active = phasing_active;
         s.position_correction = position_correction;
@@ -135,6 +137,15 @@ impl Axis {
         s.actual_torque = actual_torque;
         s.set_torque = set_torque;
         s.torque_velocity_limited = velocity_limited;
+        s.ext_setpoint_gen_enabled = ext_enabled;
+        if let Some(t) = ext_target {
+            // §4.4.1: the position given to the enable is monitored, the axis does not go
+            // there by itself.
+            s.target_position = t;
+            s.remaining_distance = (t - s.set_position).abs();
+            s.in_target_position =
+                s.in_target_position && s.remaining_distance <= p.axis_target_position_window;
+        }
         s.encoder_scaling_factor = p.axis_encoder_scaling_factor;
         s.absolute_phase_shift = absolute_phase_shift;
         s.covered_phase_shift = covered_phase_shift;

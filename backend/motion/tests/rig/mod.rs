@@ -804,6 +804,9 @@ impl Rig {
             let settled = !self.shifted[i]
                 && (s.control_loop_closed || !s.operational)
                 && (p.control_loop_closed || !p.operational)
+                // The external setpoint generator's samples are the client's motion.
+                && !s.ext_setpoint_gen_enabled
+                && !p.ext_setpoint_gen_enabled
                 && !matches!(s.state, AxisState::Disabled | AxisState::ErrorStop)
                 && !matches!(p.state, AxisState::Disabled | AxisState::ErrorStop)
                 && p.homed == s.homed

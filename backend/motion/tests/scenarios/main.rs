@@ -16,6 +16,7 @@ mod s3_11_done_criterion;
 mod s3_8_buffer_modes;
 mod s3_fb_protocol;
 mod s4_3_touch_probe;
+mod s4_4_external_setpoints;
 mod s4_5_compensation;
 mod s4_organisation;
 mod s5_1_point_to_point;

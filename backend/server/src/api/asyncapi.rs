@@ -280,6 +280,25 @@ pub fn document() -> Value {
              the socket is also released when the socket closes.",
         );
     }
+    d.rpc(
+        "ext-setpoint-gen-feed",
+        {
+            let mut p = schemas
+                .get("ExtSetPointFeedBody")
+                .cloned()
+                .expect("ExtSetPointFeedBody is in the components");
+            p["properties"]["axis"] = json!({"type": ["string", "integer"], "description": "Axis id or name.", "example": "x"});
+            let required = p["required"].as_array().cloned().unwrap_or_default();
+            p["required"] = Value::Array([json!("axis")].into_iter().chain(required).collect());
+            p.as_object_mut().unwrap().remove("example");
+            p
+        },
+        schema_ref("FeedResult"),
+        "MC_ExtSetPointGenFeed: a sample for the external setpoint generator",
+        "As `POST /api/v1/axes/{axis}/ext-setpoint-gen-feed`; sent without an id (a JSON-RPC notification) it is \
+         carried out and not answered, for a stream at up to the cycle rate. A refusal is an error whose `data` is \
+         the REST API's problem.",
+    );
     for read in super::reads::READS {
         let params = match read.params {
             Some(q) => {

@@ -130,14 +130,15 @@ macro_rules! catalogue {
             }
         )+
 
-        /// The routes of every block (under `/api/v1`).
+        /// The routes of every block (under `/api/v1`), and the external setpoint feed.
         pub fn routes(r: Router<Arc<AppState>>) -> Router<Arc<AppState>> {
             r$(.route(concat!("/axes/{axis}/", $name), post($fn)))+
+                .route("/axes/{axis}/ext-setpoint-gen-feed", post(ext_setpoint_gen_feed))
         }
 
         /// The blocks' OpenAPI operations, nested into `ApiDoc`.
         #[derive(utoipa::OpenApi)]
-        #[openapi(paths($($fn),+))]
+        #[openapi(paths($($fn),+, ext_setpoint_gen_feed))]
         pub struct BlockDoc;
 
         /// A block sent over the websocket: `params` read as its body; `None` for a method
@@ -239,6 +240,10 @@ catalogue! {
         "MC_TouchProbe: latch the position at one edge of a signal (window optional); Done with `result`";
     abort_trigger: "abort-trigger", EmptyBody, |_, _, _| Ok(CommandKind::AbortTrigger), Operator, Done,
         "MC_AbortTrigger: end the running probe cycle (CommandAborted) without a capture";
+    ext_setpoint_gen_enable: "ext-setpoint-gen-enable", ExtSetPointGenEnableBody, ExtSetPointGenEnableBody::to_kind, Operator, Done,
+        "MC_ExtSetPointGenEnable: the axis takes its setpoints from samples fed to ext-setpoint-gen-feed (extrapolated between feeds; a stalled stream stops a moving axis in ErrorStop)";
+    ext_setpoint_gen_disable: "ext-setpoint-gen-disable", EmptyBody, |_, _, _| Ok(CommandKind::ExtSetPointGenDisable), Operator, Done,
+        "MC_ExtSetPointGenDisable: the axis no longer takes samples (one moving by them stops on its ramp)";
     torque_control: "torque-control", TorqueControlBody, TorqueControlBody::to_kind, Operator, InTorque,
         "MC_TorqueControl: the drive in torque mode with a ramped torque, the velocity kept within limits (wait returns at in_torque); MC_Halt, MC_Stop or a move returns to position control";
     write_drive_operation_mode: "write-drive-operation-mode", WriteDriveOperationModeBody, WriteDriveOperationModeBody::to_kind, Operator, Done,
@@ -259,6 +264,29 @@ catalogue! {
         "MC_PhasingRelative: change the phase shift of this coupled slave by phase_shift (covered so far: status covered_phase_shift)";
     halt_phasing: "halt-phasing", HaltPhasingBody, HaltPhasingBody::to_kind, Operator, Done,
         "MC_HaltPhasing: bring the phase motion to rest (aborts the running phasing; the shift stays where it stops)";
+}
+
+/// MC_ExtSetPointGenFeed's endpoint (a FUNCTION in Tc2_MC2, not a block: no command record).
+#[utoipa::path(post, path = "/api/v1/axes/{axis}/ext-setpoint-gen-feed", tag = "axes",
+    summary = "MC_ExtSetPointGenFeed: a sample for an axis whose external setpoint generator is enabled",
+    description = "Applied in the next cycle (answered with it) or refused: 409 ext_setpoint_gen_not_enabled, \
+axis_cannot_be_started (a first sample while the axis is not at standstill), ext_setpoint_invalid (a first \
+sample elsewhere than where the axis stands); 422 for a velocity beyond AxisVeloMax or a direction other than \
+the velocity's sign. Between samples the axis extrapolates the last one with its velocity and acceleration; \
+while it moves, a pause longer than the enable's `feed_timeout` stops it in ErrorStop. Also the websocket method \
+`ext-setpoint-gen-feed` {axis, position, velocity, acceleration, direction} — sent without an id it is not \
+answered (a stream). Needs control when control is held.",
+    params(("axis" = String, Path, description = "axis id or name", example = "x")),
+    request_body = ExtSetPointFeedBody,
+    responses((status = 200, description = "Taken", body = FeedResult), super::errors::FeedErrors))]
+pub async fn ext_setpoint_gen_feed(
+    State(s): State<Arc<AppState>>,
+    Path(axis): Path<String>,
+    client: Client,
+    JsonBody(body, _raw): JsonBody<ExtSetPointFeedBody>,
+) -> AppResult<Json<FeedResult>> {
+    let cycle = commands::ext_feed(&s, &axis, &body, &client.0).await?;
+    Ok(Json(FeedResult { cycle }))
 }
 
 /// The catalogue entry of a block (websocket method) name.

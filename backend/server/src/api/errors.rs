@@ -226,6 +226,16 @@ problem_responses! {
         ("control_held" = (summary = "Another client holds control of the machine (stop, halt and disabling always pass)",
             value = json!(control_held())))));
 
+    /// A fed sample the axis refuses (`error_id` the PLCopen ErrorID), or control held by
+    /// another client.
+    FeedRefused(examples(
+        ("ext_setpoint_gen_not_enabled" = (summary = "The generator is not enabled",
+            value = json!(p(AppError::rejected(ErrorId::EXT_SETPOINT_GEN_NOT_ENABLED))))),
+        ("ext_setpoint_invalid" = (summary = "A first sample elsewhere than where the axis stands",
+            value = json!(p(AppError::rejected(ErrorId::EXT_SETPOINT_INVALID))))),
+        ("control_held" = (summary = "Another client holds control of the machine",
+            value = json!(control_held())))));
+
     /// The axis is not (and was not) coupled through a cam.
     CamNotCoupled(example = json!(p(AppError::rejected(ErrorId::CAM_NOT_COUPLED))));
 
@@ -640,6 +650,11 @@ error_sets! {
     }
     /// `GET /functions/…`.
     FunctionErrors { 422: FunctionInputInvalid }
+    /// `POST /axes/{axis}/ext-setpoint-gen-feed`.
+    FeedErrors {
+        400: MalformedJson, 404: AxisNotFound, 409: FeedRefused, 413: PayloadTooLarge,
+        422: CommandInvalid, 503: CommandUnavailable,
+    }
     /// `GET /axes/{axis}/convert-…`.
     AxisFunctionErrors { 404: AxisNotFound, 422: FunctionInputInvalid }
     /// `GET /scope/setups/{name}`.

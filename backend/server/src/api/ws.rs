@@ -590,7 +590,7 @@ fn handle(
     #[allow(clippy::redundant_closure_call)]
     let need = match method.as_str() {
         "subscribe" | "unsubscribe" => Role::Viewer,
-        "keepalive" | "release" => Role::Operator,
+        "keepalive" | "release" | "ext-setpoint-gen-feed" => Role::Operator,
         name => blocks::find(name).map_or(Role::Viewer, |b| b.role),
     };
     if let Err(e) = may(s, client, need) {
@@ -709,6 +709,36 @@ fn handle(
                     Err(e) => api_error(&id, e),
                 };
                 if !notification {
+                    let _ = out.send(msg).await;
+                }
+                drop(permit);
+            });
+            None
+        }
+        "ext-setpoint-gen-feed" => {
+            let axis = match params.remove("axis") {
+                Some(Value::String(a)) => a,
+                Some(Value::Number(n)) => n.to_string(),
+                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            };
+            let body: ExtSetPointFeedBody = match super::from_value(Value::Object(params)) {
+                Ok((b, _)) => b,
+                Err(e) => return Some(api_error(&id, e)),
+            };
+            let permit = match in_flight.clone().try_acquire_owned() {
+                Ok(p) => p,
+                Err(_) => return Some(too_many_in_flight(&id)),
+            };
+            let s = s.clone();
+            let out = out_tx.clone();
+            let client = client.clone();
+            tokio::spawn(async move {
+                let r = commands::ext_feed(&s, &axis, &body, &client).await;
+                if !notification {
+                    let msg = match r {
+                        Ok(cycle) => rpc_result(&id, json!(FeedResult { cycle })),
+                        Err(e) => api_error(&id, e),
+                    };
                     let _ = out.send(msg).await;
                 }
                 drop(permit);

@@ -415,6 +415,73 @@ impl GearInBody {
     }
 }
 
+impl ExtSetPointGenEnableBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if let Some(p) = self.position {
+            c.finite("position", p);
+        }
+        if !(self.feed_timeout.is_finite() && self.feed_timeout > 0.0 && self.feed_timeout <= 10.0)
+        {
+            c.fail("feed_timeout", "must be above 0 and at most 10 s");
+        }
+        c.done(CommandKind::ExtSetPointGenEnable {
+            target: self.position,
+            relative: self.position_type == PositionType::Relative,
+            timeout: self.feed_timeout,
+        })
+    }
+}
+
+/// MC_ExtSetPointGenFeed: checked, admitted like a motion command (control), handed to the
+/// kernel without a command record (a stream of them at up to the cycle rate); the cycle it
+/// takes effect in.
+pub async fn ext_feed(
+    s: &AppState,
+    axis: &str,
+    body: &ExtSetPointFeedBody,
+    client: &ClientInfo,
+) -> AppResult<u64> {
+    let (slot, vmax) = {
+        let reg = s.registry.read().unwrap();
+        let e = reg
+            .find(axis)
+            .ok_or_else(|| AppError::not_found("axis", axis))?;
+        (e.slot, e.params.axis_velo_max)
+    };
+    let mut c = Check::default();
+    c.finite("position", body.position);
+    c.finite("acceleration", body.acceleration);
+    if !(body.velocity.is_finite() && body.velocity.abs() <= vmax) {
+        c.fail("velocity", &format!("must be within ±{vmax} (AxisVeloMax)"));
+    }
+    let sign = |v: f64| {
+        if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    let direction = body.direction.unwrap_or(sign(body.velocity));
+    if ![-1, 0, 1].contains(&direction) {
+        c.fail("direction", "must be -1, 0 or 1");
+    } else if direction != sign(body.velocity) && body.velocity != 0.0 {
+        c.fail("direction", "must be the velocity's sign");
+    } else if direction == 0 && body.velocity != 0.0 {
+        c.fail("direction", "0 means standstill: the velocity must be 0");
+    }
+    let kind = c.done(CommandKind::ExtSetPointGenFeed {
+        position: body.position,
+        velocity: body.velocity,
+        acceleration: body.acceleration,
+        direction,
+    })?;
+    s.control.admit(client, &kind)?;
+    s.kernel_command(slot, kind).await
+}
+
 impl TorqueControlBody {
     pub fn to_kind(&self, _: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();

@@ -254,6 +254,8 @@ impl Control {
                 // A probe moves nothing.
                 | CommandKind::TouchProbe(_)
                 | CommandKind::AbortTrigger
+                // Switching the external generator off stops what it moves.
+                | CommandKind::ExtSetPointGenDisable
                 // Halting a phase motion is a stop.
                 | CommandKind::Phasing {
                     motion: motion::PhasingMotion {
