@@ -592,9 +592,15 @@ async fn an_external_setpoint_stream_moves_the_axis_and_its_stall_stops_it() {
     // stream had already stalled; both are what the manual and the decision say.
     if answer["result"]["cycle"].is_u64() {
         let st = status(&s, "y").await;
-        assert!(st["status"]["set_position"].as_f64().unwrap() > 4.0, "moved along: {st}");
+        assert!(
+            st["status"]["set_position"].as_f64().unwrap() > 4.0,
+            "moved along: {st}"
+        );
     } else {
-        assert_eq!(answer["error"]["data"]["code"], "ext_setpoint_gen_not_enabled", "{answer}");
+        assert_eq!(
+            answer["error"]["data"]["code"], "ext_setpoint_gen_not_enabled",
+            "{answer}"
+        );
     }
     // Then nothing more: the stream has stalled while the axis moved.
     let st = until_status(&s, "y", "stalled", |st| st["state"] == "error_stop").await;

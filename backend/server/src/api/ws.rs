@@ -272,6 +272,15 @@ fn rpc_error(id: &Value, code: i64, message: &str, data: Option<Value>) -> Strin
     json!({"jsonrpc": "2.0", "id": id, "error": error}).to_string()
 }
 
+/// The `axis` of a method's params (an id or a name), taken out of them.
+fn take_axis(params: &mut Map<String, Value>) -> Option<String> {
+    match params.remove("axis") {
+        Some(Value::String(a)) => Some(a),
+        Some(Value::Number(n)) => Some(n.to_string()),
+        _ => None,
+    }
+}
+
 fn api_error(id: &Value, e: AppError) -> String {
     let code = match e.status().as_u16() {
         422 | 400 => -32602,
@@ -716,10 +725,8 @@ fn handle(
             None
         }
         "ext-setpoint-gen-feed" => {
-            let axis = match params.remove("axis") {
-                Some(Value::String(a)) => a,
-                Some(Value::Number(n)) => n.to_string(),
-                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            let Some(axis) = take_axis(&mut params) else {
+                return Some(rpc_error(&id, -32602, "axis is required", None));
             };
             let body: ExtSetPointFeedBody = match super::from_value(Value::Object(params)) {
                 Ok((b, _)) => b,
@@ -746,10 +753,8 @@ fn handle(
             None
         }
         name if super::reads::READS.iter().any(|r| r.name == name) => {
-            let axis = match params.remove("axis") {
-                Some(Value::String(a)) => a,
-                Some(Value::Number(n)) => n.to_string(),
-                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            let Some(axis) = take_axis(&mut params) else {
+                return Some(rpc_error(&id, -32602, "axis is required", None));
             };
             let r = super::reads::dispatch(s, name, &axis, Value::Object(params))
                 .expect("a read of the list");
@@ -767,10 +772,8 @@ fn handle(
                     None,
                 ));
             };
-            let axis = match params.remove("axis") {
-                Some(Value::String(a)) => a,
-                Some(Value::Number(n)) => n.to_string(),
-                _ => return Some(rpc_error(&id, -32602, "axis is required", None)),
+            let Some(axis) = take_axis(&mut params) else {
+                return Some(rpc_error(&id, -32602, "axis is required", None));
             };
             // The REST query's rules (`?wait=true&timeout_ms=N`), from the params.
             let query: Map<String, Value> = ["wait", "timeout_ms"]
