@@ -200,7 +200,7 @@ include-operation-id = ["create_axis", "replace_axis", "import_config", "write_p
     "move_modulo", "jog", "home", "create_user", "update_user", "change_password", "create_token",
     "touch_probe", "put_setup", "analyse", "sdo_write", "inject_bus_fault", "phasing_absolute",
     "phasing_relative", "halt_phasing", "position_correction_limiter", "override_filter",
-    "torque_control", "convert_pos_to_inc_pos", "ext_setpoint_gen_feed"]
+    "torque_control", "convert_pos_to_inc_pos", "ext_setpoint_gen_feed", "gear_in_multi_master"]
 checks.positive_data_acceptance.expected-statuses = ["2XX", "3XX", 401, 403, 404, 409, 422, 429, "5XX"]
 
 [[operations]]

@@ -1022,7 +1022,7 @@ async fn openapi_json_is_current() {
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 91, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 92, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }
@@ -1148,7 +1148,7 @@ async fn asyncapi_json_is_current() {
             "{method}"
         );
     }
-    assert_eq!(commands, 43);
+    assert_eq!(commands, 44);
     let s = Server::start();
     let served = get(&s, "/asyncapi.json").await;
     assert_eq!(served.status, 200);

@@ -607,3 +607,57 @@ async fn an_external_setpoint_stream_moves_the_axis_and_its_stall_stops_it() {
     assert_eq!(st["status"]["error_id"], 0x70B7, "{st}");
     s.stop();
 }
+
+/// §5.5.4 over HTTP: the spindle follows x and y with their ratios; the ratios show in its
+/// status; a master named twice is a 422 at its field, the slave itself too.
+#[tokio::test(flavor = "multi_thread")]
+async fn gear_in_multi_master_follows_the_sum_of_its_masters() {
+    let s = Server::start();
+    for a in ["x", "y", "spindle"] {
+        power_on(&s, a).await;
+    }
+    let r = post(&s, "/api/v1/axes/spindle/gear-in-multi-master", json!({"masters": [{"master": "x", "gear_ratio": 1.0}, {"master": "x", "gear_ratio": 2.0}]})).await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("masters[1].master")),
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/spindle/gear-in-multi-master",
+        json!({"masters": [{"master": "spindle", "gear_ratio": 1.0}]}),
+    )
+    .await;
+    assert_eq!(
+        r.field_error(),
+        (422, Some("masters[0].master")),
+        "{}",
+        r.text
+    );
+    let g = post(
+        &s,
+        "/api/v1/axes/spindle/gear-in-multi-master?wait=true",
+        json!({"masters": [{"master": "x", "gear_ratio": 2.0}, {"master": "y", "gear_ratio": -1.0}]}),
+    )
+    .await;
+    assert_eq!(g.json["outputs"]["in_gear"], true, "{}", g.text);
+    for (a, p) in [("x", 30.0), ("y", 10.0)] {
+        let m = post(
+            &s,
+            &format!("/api/v1/axes/{a}/move-absolute?wait=true&timeout_ms=20000"),
+            json!({"position": p, "velocity": 100.0}),
+        )
+        .await;
+        assert_eq!(m.json["state"], "done", "{}", m.text);
+    }
+    let st = status(&s, "spindle").await;
+    // 2 × 30 − 10 = 50 degrees of travel.
+    assert!(
+        (st["status"]["set_position"].as_f64().unwrap() - 50.0).abs() < 1e-6,
+        "{st}"
+    );
+    assert_eq!(st["status"]["gear_ratios"], json!([2.0, -1.0, 0.0, 0.0]));
+    assert_eq!(st["status"]["state"], "synchronized_motion");
+    s.stop();
+}

@@ -341,6 +341,10 @@ pub enum CommandKind {
         gear_ratio: f64,
         acceleration: f64,
     },
+    /// MC_GearInMultiMaster (Enable-type, §5.5.4): the slave follows the sum of up to four
+    /// masters' travel times their ratios; a further one to the same masters while enabled
+    /// changes the ratios; `Release` freezes them (the slave stays coupled).
+    GearInMultiMaster(GearInMultiMaster),
     /// MC_GearOut.
     GearOut,
     /// MC_CamIn: couple this axis to a master through a cam table, or switch the cam.
@@ -468,6 +472,7 @@ impl CommandKind {
             CommandKind::Home { .. } => "home",
             CommandKind::GearIn { .. } => "gear-in",
             CommandKind::GearInDyn { .. } => "gear-in-dyn",
+            CommandKind::GearInMultiMaster(_) => "gear-in-multi-master",
             CommandKind::GearOut => "gear-out",
             CommandKind::CamIn(_) => "cam-in",
             CommandKind::CamOut => "cam-out",
@@ -547,6 +552,41 @@ pub enum DisableMode {
     Hold,
     /// The correction returns to 0 at once (a jump of the drive's setpoint).
     Reset,
+}
+
+/// `E_GearInMultiMasterSyncMode` (§5.5.4, §6.4): what a slave with AdvancedSlaveDynamics
+/// makes up of a position difference between it and its masters.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MultiMasterSyncMode {
+    /// Velocity-synchronous: no difference is made up.
+    #[default]
+    Velosync,
+    /// Velocity- and position-synchronous once coupled: a difference that limiting builds up
+    /// is made up; the one from coupling in motion or from ratio changes is not.
+    Possync1,
+    /// Position-synchronous: every difference is made up (coupling in motion, ratio changes,
+    /// limiting) — the slave goes where the masters' travel since the coupling puts it.
+    Possync2,
+}
+
+/// MC_GearInMultiMaster's inputs (§5.5.4): up to four masters and their ratios.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GearInMultiMaster {
+    /// Master1…Master4; `None` for an empty AXIS_REF (at least one is given).
+    pub masters: [Option<AxisSlot>; 4],
+    pub ratios: [f64; 4],
+    /// ≥ 0; 0 = the axis's default. Without AdvancedSlaveDynamics: the limit of the slave
+    /// acceleration a ratio change causes at the masters' maximum velocity.
+    pub acceleration: f64,
+    /// AdvancedSlaveDynamics only; 0 = default.
+    pub deceleration: f64,
+    pub jerk: f64,
+    /// `Options.AdvancedSlaveDynamics`: the slave follows within its own dynamics (and may
+    /// couple onto moving masters).
+    pub advanced_slave_dynamics: bool,
+    pub sync_mode: MultiMasterSyncMode,
 }
 
 /// How long an external setpoint stream may pause before the axis stops, unless

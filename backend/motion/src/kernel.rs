@@ -67,11 +67,12 @@ impl StepOrder {
                     self.placed[i] = true;
                     continue;
                 };
-                if let Some(m) = axis.master_slot() {
+                let waits = axis.coupled_masters().iter().flatten().any(|&m| {
                     let master_there = axes.get(m as usize).is_some_and(|a| a.is_some());
-                    if master_there && !self.placed[m as usize] {
-                        continue; // wait for the master
-                    }
+                    master_there && !self.placed[m as usize]
+                });
+                if waits {
+                    continue; // wait for the masters
                 }
                 self.push(i);
                 progressed = true;
@@ -275,6 +276,23 @@ impl Kernel {
     /// outputs follow as events (the first one in this call).
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
         let slot = cmd.axis as usize;
+        if let CommandKind::GearInMultiMaster(g) = cmd.kind {
+            let mut samples = [None; 4];
+            for (i, m) in g.masters.iter().enumerate() {
+                let Some(m) = *m else { continue };
+                let twice = g.masters[..i].contains(&Some(m));
+                if m as usize == slot || twice || self.follows(m, slot) {
+                    return Verdict::Rejected(ErrorId::MASTER_INVALID);
+                }
+                match self.axis(m) {
+                    Some(a) => samples[i] = Some(MasterSample::of(a)),
+                    None => return Verdict::Rejected(ErrorId::MASTER_INVALID),
+                }
+            }
+            if let Some(axis) = self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
+                axis.offer_masters(samples);
+            }
+        }
         let master = match cmd.kind {
             CommandKind::GearIn { master, .. }
             | CommandKind::GearInDyn { master, .. }
@@ -284,15 +302,8 @@ impl Kernel {
                     return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }
                 // A master that (through its own masters) follows this axis would close a loop.
-                let mut m = Some(master);
-                for _ in 0..self.axes.len() {
-                    match m {
-                        Some(x) if x as usize == slot => {
-                            return Verdict::Rejected(ErrorId::MASTER_INVALID);
-                        }
-                        Some(x) => m = self.axis(x).and_then(|a| a.master_slot()),
-                        None => break,
-                    }
+                if self.follows(master, slot) {
+                    return Verdict::Rejected(ErrorId::MASTER_INVALID);
                 }
                 match self.axis(master) {
                     Some(m) => Some((master, MasterSample::of(m))),
@@ -316,6 +327,43 @@ impl Kernel {
         }
     }
 
+    /// Whether axis `from` follows axis `target` through its masters, theirs and so on (a
+    /// coupling of `target` to `from` would close a loop). Without allocating: the set of
+    /// axes reached grows in passes (a bitset of up to 1024 slots).
+    fn follows(&self, from: AxisSlot, target: usize) -> bool {
+        let n = self.axes.len().min(1024);
+        let mut reached = [0u64; 16];
+        let mark = |r: &mut [u64; 16], i: usize| {
+            let new = r[i / 64] & (1 << (i % 64)) == 0;
+            r[i / 64] |= 1 << (i % 64);
+            new
+        };
+        if (from as usize) >= n {
+            return false;
+        }
+        mark(&mut reached, from as usize);
+        for _ in 0..n {
+            let mut grew = false;
+            for i in 0..n {
+                if reached[i / 64] & (1 << (i % 64)) == 0 {
+                    continue;
+                }
+                let Some(a) = self.axes[i].as_deref() else {
+                    continue;
+                };
+                for m in a.coupled_masters().into_iter().flatten() {
+                    if (m as usize) < n {
+                        grew |= mark(&mut reached, m as usize);
+                    }
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        target < n && reached[target / 64] & (1 << (target % 64)) != 0
+    }
+
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
     /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
     /// a drive that is not ready / left untouched).
@@ -337,17 +385,43 @@ impl Kernel {
                 continue;
             };
             let coupled_to = axis.master_slot();
+            let masters = axis.coupled_masters();
+            // Stepped before this slave in this cycle (the order sees to it).
+            let sample = |m: AxisSlot| {
+                self.axes
+                    .get(m as usize)
+                    .and_then(|a| a.as_deref())
+                    .map(MasterSample::of)
+            };
+            let mut samples = [None; 4];
+            let mut vanished = false;
+            let mut failed = false;
+            for (j, m) in masters.iter().enumerate().skip(1) {
+                if let Some(m) = *m {
+                    samples[j] = sample(m);
+                    vanished |= samples[j].is_none();
+                    failed |= samples[j].is_some_and(|s| s.error);
+                }
+            }
             let master = match coupled_to {
                 _ if k >= self.order.in_loop => Master::Lost,
                 None => Master::Uncoupled,
-                // Stepped before this slave in this cycle (the order sees to it).
-                Some(m) => match self.axes.get(m as usize).and_then(|a| a.as_deref()) {
-                    Some(ma) => Master::Sample(MasterSample::of(ma)),
+                Some(_) if vanished => Master::Lost, // a further master vanished
+                Some(m) => match sample(m) {
+                    Some(mut s) => {
+                        samples[0] = Some(s);
+                        // A further master in ErrorStop loses the slave like the first.
+                        s.error |= failed;
+                        Master::Sample(s)
+                    }
                     None => Master::Lost, // master vanished
                 },
             };
             let fb = feedback.get(i).copied().unwrap_or_default();
             let axis = self.axes[i].as_deref_mut().expect("checked above");
+            if coupled_to.is_some() {
+                axis.offer_masters(samples);
+            }
             let sp = axis.step(dt, &fb, master, &self.cams, cycle, events);
             if let Some(out) = setpoints.get_mut(i) {
                 *out = sp;

@@ -129,6 +129,9 @@ pub struct AxisStatus {
     #[serde(skip)]
     pub master: Option<u16>,
     pub gear_ratio: f64,
+    /// MC_GearInMultiMaster: the ratio of each coupled master in force (Master1… in the
+    /// order of `masters`; 0 for none).
+    pub gear_ratios: [f64; 4],
     /// A superposition (MC_MoveSuperImposed) is running (StateDWord bit 13 Compensating).
     pub compensating: bool,
     /// Distance superimposed so far by the running superposition.

@@ -1384,6 +1384,50 @@ pub struct GearInBody {
     pub ratio_denominator: u16,
 }
 
+/// One master of MC_GearInMultiMaster and its ratio.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[schema(example = json!({"master": "x", "gear_ratio": 1.0}))]
+#[serde(deny_unknown_fields)]
+pub struct MasterRatio {
+    /// Master axis id or name.
+    pub master: String,
+    /// GearRatio of this master (changeable while enabled).
+    #[schema(minimum = -1e12, maximum = 1e12)]
+    pub gear_ratio: f64,
+}
+
+/// MC_GearInMultiMaster (§5.5.4, Enable-type): the slave follows Σ gear_ratio_i × master_i's
+/// travel; stays active until released with `DELETE /commands/{id}` (the ratios freeze, the
+/// slave stays coupled). A further gear-in-multi-master to the same masters while enabled
+/// changes the ratios (limited by `acceleration` without advanced slave dynamics).
+/// Without `advanced_slave_dynamics` the masters and the slave must stand when it couples
+/// (409 master_moving); with it the slave synchronises within its acceleration, deceleration
+/// and jerk, `sync_mode` saying which position differences it makes up.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"masters": [{"master": "x", "gear_ratio": 1.0}, {"master": "spindle", "gear_ratio": 0.1}],
+    "advanced_slave_dynamics": true, "sync_mode": "possync2", "acceleration": 1000.0}))]
+pub struct GearInMultiMasterBody {
+    /// Master1…Master4 in order, 1 to 4 of them.
+    #[schema(min_items = 1, max_items = 4)]
+    pub masters: Vec<MasterRatio>,
+    /// ≥ 0, 0 = the axis default.
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub acceleration: f64,
+    /// With advanced slave dynamics; ≥ 0, 0 = the axis default.
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub deceleration: f64,
+    #[serde(default)]
+    #[schema(minimum = 0)]
+    pub jerk: f64,
+    #[serde(default)]
+    pub advanced_slave_dynamics: bool,
+    #[serde(default)]
+    pub sync_mode: motion::MultiMasterSyncMode,
+}
+
 /// MC_GearInDyn (Enable-type): stays active until released with `DELETE /commands/{id}`
 /// (Enable FALSE: the ratio freezes, the slave stays coupled). A further gear-in-dyn to the
 /// same master while this one is enabled takes over and changes the ratio.

@@ -469,6 +469,23 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/axes/{axis}/gear-in-multi-master": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GearInMultiMaster: follow the sum of up to four masters times their ratios (ratios changeable while enabled; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratios frozen, still coupled) */
+        post: operations["gear_in_multi_master"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/axes/{axis}/gear-out": {
         parameters: {
             query?: never;
@@ -2090,6 +2107,12 @@ export interface components {
          *       "following_error_max": 0.0219,
          *       "following_error_min": -0.0001,
          *       "gear_ratio": 0,
+         *       "gear_ratios": [
+         *         0,
+         *         0,
+         *         0,
+         *         0
+         *       ],
          *       "has_been_stopped": false,
          *       "has_job": true,
          *       "homed": true,
@@ -2259,6 +2282,11 @@ export interface components {
             coupled: boolean;
             /** Format: double */
             gear_ratio: number;
+            /**
+             * @description MC_GearInMultiMaster: the ratio of each coupled master in force (Master1… in the
+             *     order of `masters`; 0 for none).
+             */
+            gear_ratios: number[];
             /** @description A superposition (MC_MoveSuperImposed) is running (StateDWord bit 13 Compensating). */
             compensating: boolean;
             /**
@@ -4456,6 +4484,48 @@ export interface components {
             acceleration?: number;
         };
         /**
+         * @description MC_GearInMultiMaster (§5.5.4, Enable-type): the slave follows Σ gear_ratio_i × master_i's
+         *     travel; stays active until released with `DELETE /commands/{id}` (the ratios freeze, the
+         *     slave stays coupled). A further gear-in-multi-master to the same masters while enabled
+         *     changes the ratios (limited by `acceleration` without advanced slave dynamics).
+         *     Without `advanced_slave_dynamics` the masters and the slave must stand when it couples
+         *     (409 master_moving); with it the slave synchronises within its acceleration, deceleration
+         *     and jerk, `sync_mode` saying which position differences it makes up.
+         * @example {
+         *       "acceleration": 1000,
+         *       "advanced_slave_dynamics": true,
+         *       "masters": [
+         *         {
+         *           "gear_ratio": 1,
+         *           "master": "x"
+         *         },
+         *         {
+         *           "gear_ratio": 0.1,
+         *           "master": "spindle"
+         *         }
+         *       ],
+         *       "sync_mode": "possync2"
+         *     }
+         */
+        GearInMultiMasterBody: {
+            /** @description Master1…Master4 in order, 1 to 4 of them. */
+            masters: components["schemas"]["MasterRatio"][];
+            /**
+             * Format: double
+             * @description ≥ 0, 0 = the axis default.
+             */
+            acceleration?: number;
+            /**
+             * Format: double
+             * @description With advanced slave dynamics; ≥ 0, 0 = the axis default.
+             */
+            deceleration?: number;
+            /** Format: double */
+            jerk?: number;
+            advanced_slave_dynamics?: boolean;
+            sync_mode?: components["schemas"]["MultiMasterSyncMode"];
+        };
+        /**
          * @description MC_Halt.
          * @example {
          *       "deceleration": 1000
@@ -4775,6 +4845,12 @@ export interface components {
          *       "following_error_max": 0.0219,
          *       "following_error_min": -0.0001,
          *       "gear_ratio": 0,
+         *       "gear_ratios": [
+         *         0,
+         *         0,
+         *         0,
+         *         0
+         *       ],
          *       "has_been_stopped": false,
          *       "has_job": true,
          *       "homed": true,
@@ -4891,6 +4967,22 @@ export interface components {
         MasterPositionResource: {
             master_low: components["schemas"]["CamMasterData"];
             master_high: components["schemas"]["CamMasterData"];
+        };
+        /**
+         * @description One master of MC_GearInMultiMaster and its ratio.
+         * @example {
+         *       "gear_ratio": 1,
+         *       "master": "x"
+         *     }
+         */
+        MasterRatio: {
+            /** @description Master axis id or name. */
+            master: string;
+            /**
+             * Format: double
+             * @description GearRatio of this master (changeable while enabled).
+             */
+            gear_ratio: number;
         };
         /**
          * @description Modulo (rotary) axis: positions wrap at `period`.
@@ -5189,6 +5281,12 @@ export interface components {
             buffer_mode?: components["schemas"]["BufferMode"];
             options?: components["schemas"]["MoveOptions"];
         };
+        /**
+         * @description `E_GearInMultiMasterSyncMode` (§5.5.4, §6.4): what a slave with AdvancedSlaveDynamics
+         *     makes up of a position difference between it and its masters.
+         * @enum {string}
+         */
+        MultiMasterSyncMode: "velosync" | "possync1" | "possync2";
         /**
          * @description A new token: the only time its secret is shown.
          * @example {
@@ -6492,6 +6590,12 @@ export interface components {
          *         "following_error_max": 0.0219,
          *         "following_error_min": -0.0001,
          *         "gear_ratio": 0,
+         *         "gear_ratios": [
+         *           0,
+         *           0,
+         *           0,
+         *           0
+         *         ],
          *         "has_been_stopped": false,
          *         "has_job": true,
          *         "homed": true,
@@ -9616,6 +9720,66 @@ export interface operations {
         requestBody: {
             content: {
                 "application/json": components["schemas"]["GearInDynBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["AxisNotFound"];
+            409: components["responses"]["CommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    gear_in_multi_master: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters. A retry with the key of a command sent within 24 h gets that command's answer (202 with the command as it stands now, header `Idempotent-Replayed: true`, or its refusal) and nothing is done again; the key with another request is a 409 `idempotency_key_reused`, while the first is still being answered a 409 `idempotency_key_in_flight`, after a restart a 409 `idempotency_key_replayed` naming the command.
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description axis id or name
+                 * @example x
+                 */
+                axis: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GearInMultiMasterBody"];
             };
         };
         responses: {

@@ -819,6 +819,7 @@ impl Axis {
         let mut set = CamSet::single(law, v2);
         set.ramp = ramp;
         self.coupling = Some(Coupling {
+            more_masters: [None; 3],
             master,
             law: CouplingLaw::Cam(set),
             dyn_command: 0,

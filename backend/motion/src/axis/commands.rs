@@ -320,6 +320,7 @@ impl Axis {
                 Ok(())
             }
             CommandKind::GearOut => self.submit_gear_out(cx, cmd.id),
+            CommandKind::GearInMultiMaster(g) => self.submit_gear_in_multi(cx, cmd.id, g),
             CommandKind::GearIn {
                 master: master_slot,
                 ratio_numerator,

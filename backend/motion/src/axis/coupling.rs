@@ -55,7 +55,7 @@ impl MasterSample {
     /// The master motion a slave follows: its setpoints, or with #1064
     /// (AxisCoupleSlaveToActualValues) its actual position and velocity (no acceleration or
     /// jerk: the actual values carry none the slave could use).
-    fn followed(&self, actual_values: bool) -> Kinematics {
+    pub(super) fn followed(&self, actual_values: bool) -> Kinematics {
         if actual_values {
             Kinematics {
                 position: self.actual_position,
@@ -73,6 +73,8 @@ impl MasterSample {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Coupling {
     pub(super) master: AxisSlot,
+    /// MC_GearInMultiMaster's Master2…Master4 (`master` is Master1 or the first given).
+    pub(super) more_masters: [Option<AxisSlot>; 3],
     pub(super) law: CouplingLaw,
     /// The GearInDyn command that still has Enable TRUE (0 when none): a further GearInDyn to
     /// the same master changes this coupling's ratio instead of coupling anew.
@@ -93,6 +95,8 @@ pub(super) enum CouplingLaw {
     /// MC_CamIn, MC_CamIn_V2: through one or (multi-cam) several superimposed cam tables
     /// (`axis/camming.rs`).
     Cam(super::camming::CamSet),
+    /// MC_GearInMultiMaster: the sum of up to four masters (`axis/multimaster.rs`).
+    Multi(super::multimaster::MultiGear),
 }
 
 /// slave = slave_start + ratio · (master − master_start): the slave follows the master's
@@ -122,7 +126,7 @@ impl CouplingLaw {
     fn gear_mut(&mut self) -> Option<&mut Gear> {
         match self {
             CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => Some(g),
-            CouplingLaw::Cam(_) => None,
+            CouplingLaw::Cam(_) | CouplingLaw::Multi(_) => None,
         }
     }
 
@@ -141,6 +145,8 @@ impl CouplingLaw {
         }
         Some(match self {
             CouplingLaw::Cam(set) => set.eval(cams, master)?,
+            // Followed in `follow_master` (it needs every master).
+            CouplingLaw::Multi(_) => return None,
             CouplingLaw::Gear(g) => g.follow(master, 0.0),
             CouplingLaw::GearDyn {
                 gear: g,
@@ -171,6 +177,7 @@ impl CouplingLaw {
     pub(super) fn ratio(&self) -> f64 {
         match self {
             CouplingLaw::Gear(g) | CouplingLaw::GearDyn { gear: g, .. } => g.ratio,
+            CouplingLaw::Multi(m) => m.ratio(0),
             CouplingLaw::Cam(_) => 0.0,
         }
     }
@@ -178,7 +185,7 @@ impl CouplingLaw {
     /// Still changing towards what it was asked for (a GearInDyn ratio ramp).
     fn ramping(&self) -> bool {
         match self {
-            CouplingLaw::Gear(_) | CouplingLaw::Cam(_) => false,
+            CouplingLaw::Gear(_) | CouplingLaw::Cam(_) | CouplingLaw::Multi(_) => false,
             CouplingLaw::GearDyn {
                 gear, target_ratio, ..
             } => gear.ratio != *target_ratio,
@@ -186,9 +193,10 @@ impl CouplingLaw {
     }
 
     /// What InGear reports when a command takes this coupling over.
-    fn in_gear(&self) -> bool {
+    pub(super) fn in_gear(&self) -> bool {
         match self {
             CouplingLaw::Gear(_) | CouplingLaw::Cam(_) => true,
+            CouplingLaw::Multi(m) => m.in_gear(),
             CouplingLaw::GearDyn {
                 gear, target_ratio, ..
             } => (gear.ratio - target_ratio).abs() < 1e-12,
@@ -209,6 +217,9 @@ impl CouplingLaw {
 
     /// GearInDyn's Enable fell: the ratio stays where the ramp has brought it.
     pub(super) fn freeze(&mut self) {
+        if let CouplingLaw::Multi(m) = self {
+            m.freeze();
+        }
         if let CouplingLaw::GearDyn {
             gear, target_ratio, ..
         } = self
@@ -222,6 +233,7 @@ impl CouplingLaw {
     pub(super) fn shift_slave(&mut self, d: f64) {
         match self {
             CouplingLaw::Cam(set) => set.shift_slave(d),
+            CouplingLaw::Multi(m) => m.shift_slave(d),
             _ => {
                 if let Some(g) = self.gear_mut() {
                     g.slave_start += d;
@@ -236,6 +248,9 @@ impl CouplingLaw {
         if let Some(g) = self.gear_mut() {
             g.slave_start = slave_position;
             g.master_start = f64::NAN;
+        }
+        if let CouplingLaw::Multi(m) = self {
+            m.rebase(slave_position);
         }
     }
 }
@@ -333,21 +348,7 @@ impl Axis {
             .filter(|c| c.master == master_slot && c.dyn_command != 0)
         {
             c.law.retarget(gear_ratio, rate);
-            let old = c.dyn_command;
-            c.dyn_command = id;
-            if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
-                // The earlier instance hands over to this one.
-                let mut prev = Job { id: old, ..*j };
-                prev.finish_done(cx);
-                j.id = id;
-                j.out = FbOutputs::default();
-                j.activate(cx);
-                let out = FbOutputs {
-                    in_gear: c.law.in_gear(),
-                    ..j.out
-                };
-                j.emit(cx, out);
-            }
+            self.hand_over_enabled_coupling(cx, id);
             return Ok(());
         }
         let m = self.admit_coupling(master)?;
@@ -372,6 +373,31 @@ impl Axis {
         };
         self.couple(cx, id, master_slot, law, id);
         Ok(())
+    }
+
+    /// A further Enable-type coupling command (MC_GearInDyn, MC_GearInMultiMaster) on the
+    /// coupling an earlier one still enables: the earlier instance hands over to `id` (Done),
+    /// which reports the coupling from now on.
+    pub(super) fn hand_over_enabled_coupling(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+    ) {
+        let Some(c) = self.coupling.as_mut() else {
+            return;
+        };
+        let old = c.dyn_command;
+        c.dyn_command = id;
+        let in_gear = c.law.in_gear();
+        if let Some(j) = self.job.as_mut().filter(|j| j.kind == JobKind::Gear) {
+            let mut prev = Job { id: old, ..*j };
+            prev.finish_done(cx);
+            j.id = id;
+            j.out = FbOutputs::default();
+            j.activate(cx);
+            let out = FbOutputs { in_gear, ..j.out };
+            j.emit(cx, out);
+        }
     }
 
     /// State and master checks shared by both couplings.
@@ -407,7 +433,7 @@ impl Axis {
     }
 
     /// Aborts what runs and couples this axis to `master_slot` from here on.
-    fn couple(
+    pub(super) fn couple(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
@@ -419,6 +445,7 @@ impl Axis {
         self.abort_all(cx);
         self.coupling = Some(Coupling {
             master: master_slot,
+            more_masters: [None; 3],
             law,
             dyn_command,
         });
@@ -453,6 +480,13 @@ impl Axis {
         master: Master,
         dt: f64,
     ) {
+        if self
+            .coupling
+            .is_some_and(|c| matches!(c.law, CouplingLaw::Multi(_)))
+        {
+            self.follow_multi(cx, job, master, dt);
+            return;
+        }
         let (Some(mut c), Master::Sample(m)) = (self.coupling, master) else {
             return;
         };

@@ -37,6 +37,7 @@ mod homing;
 mod job;
 mod monitoring;
 mod motion;
+mod multimaster;
 mod phasing;
 mod planning;
 mod probe;
@@ -200,6 +201,8 @@ pub struct Axis {
     torque: torque::TorqueState,
     /// The external setpoint generator (§4.4).
     ext: external::ExtGen,
+    /// What the kernel saw of this axis's masters (`offer_masters`).
+    offered: [Option<MasterSample>; 4],
 }
 
 impl Axis {
@@ -287,6 +290,7 @@ impl Axis {
             enc_offset: 0.0,
             torque: torque::TorqueState::default(),
             ext: external::ExtGen::default(),
+            offered: [None; 4],
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();

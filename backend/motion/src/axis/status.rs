@@ -79,6 +79,10 @@ impl Axis {
         s.coupled = self.coupling.is_some();
         s.master = self.coupling.map(|c| c.master);
         s.gear_ratio = self.coupling.map(|c| c.law.ratio()).unwrap_or(0.0);
+        s.gear_ratios = match self.coupling.map(|c| c.law) {
+            Some(coupling::CouplingLaw::Multi(m)) => m.ratios(),
+            _ => [s.gear_ratio, 0.0, 0.0, 0.0],
+        };
         s.compensating = self.superimposed.is_some();
         s.superimposed_distance = self.superimposed.map(|x| x.applied).unwrap_or(0.0);
         s.error_id = if self.mode == Mode::ErrorStop {

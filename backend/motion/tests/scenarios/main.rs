@@ -23,6 +23,7 @@ mod s5_1_point_to_point;
 mod s5_2_superposition;
 mod s5_3_homing;
 mod s5_4_jog;
+mod s5_5_4_multi_master;
 mod s5_5_coupling;
 mod s5_6_phasing;
 mod s5_7_torque_control;

@@ -214,6 +214,8 @@ catalogue! {
         "MC_GearIn: couple to a master (wait returns at in_gear)";
     gear_in_dyn: "gear-in-dyn", GearInDynBody, GearInDynBody::to_kind, Operator, InGear,
         "MC_GearInDyn: couple with a ratio that may change while enabled (a further gear-in-dyn to the same master changes it; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratio frozen, still coupled)";
+    gear_in_multi_master: "gear-in-multi-master", GearInMultiMasterBody, GearInMultiMasterBody::to_kind, Operator, InGear,
+        "MC_GearInMultiMaster: follow the sum of up to four masters times their ratios (ratios changeable while enabled; wait returns at in_gear); DELETE /commands/{id} = Enable FALSE (ratios frozen, still coupled)";
     gear_out: "gear-out", EmptyBody, |_, _, _| Ok(CommandKind::GearOut), Operator, Done,
         "MC_GearOut";
     cam_in: "cam-in", CamInBody, CamInBody::to_kind, Operator, InSync,

@@ -657,6 +657,47 @@ impl HaltPhasingBody {
     }
 }
 
+impl GearInMultiMasterBody {
+    pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if self.masters.is_empty() || self.masters.len() > 4 {
+            c.fail("masters", "must name 1 to 4 masters");
+        }
+        let mut masters = [None; 4];
+        let mut ratios = [0.0; 4];
+        for (i, m) in self.masters.iter().take(4).enumerate() {
+            let mut one = Check::default();
+            let slot = master_slot(&mut one, reg, axis, &m.master);
+            for e in one.0 {
+                c.fail(&format!("masters[{i}].{}", e.field), &e.message);
+            }
+            if masters[..i].contains(&Some(slot)) {
+                c.fail(&format!("masters[{i}].master"), "names a master twice");
+            }
+            masters[i] = Some(slot);
+            if !(m.gear_ratio.is_finite() && m.gear_ratio.abs() <= MAX_MAGNITUDE) {
+                c.fail(
+                    &format!("masters[{i}].gear_ratio"),
+                    "must be a number from -1e12 to 1e12",
+                );
+            }
+            ratios[i] = m.gear_ratio;
+        }
+        c.non_negative("acceleration", self.acceleration);
+        c.non_negative("deceleration", self.deceleration);
+        c.non_negative("jerk", self.jerk);
+        c.done(CommandKind::GearInMultiMaster(motion::GearInMultiMaster {
+            masters,
+            ratios,
+            acceleration: self.acceleration,
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+            advanced_slave_dynamics: self.advanced_slave_dynamics,
+            sync_mode: self.sync_mode,
+        }))
+    }
+}
+
 impl GearInDynBody {
     pub fn to_kind(&self, reg: &Registry, axis: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
