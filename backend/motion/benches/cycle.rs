@@ -315,5 +315,134 @@ fn cams(c: &mut Criterion) {
     assert!(m.k.status(1).unwrap().coupled && m.k.status(2).unwrap().coupled);
 }
 
-criterion_group!(benches, cycle, cams);
+/// 64 axes with the single-axis blocks of issue 9 running, in groups of four: a velocity
+/// axis with the position-correction limiter and backlash compensation, a second velocity
+/// axis, a multi-master slave of both with AdvancedSlaveDynamics in POSSYNC2 (replanned every
+/// cycle), and a gear slave of the first being phased.
+fn issue9_machine() -> Machine {
+    let mut m = Machine::new(1);
+    let n = 64;
+    let mut k = Kernel::new(0.001, n);
+    for i in 0..n {
+        let mut p = AxisParameters::default();
+        p.axis_max_pos_lag_value = 1e6;
+        p.axis_velo_max = 1e6;
+        p.axis_enable_pos_correction = true;
+        k.insert_axis(
+            i as u16,
+            Axis::new(
+                AxisConfig {
+                    modulo: false,
+                    parameters: p,
+                    compensation_table: None,
+                },
+                0.001,
+            ),
+        )
+        .unwrap();
+    }
+    m.k = k;
+    m.fb = vec![DriveFeedback::default(); n];
+    m.sp = vec![DriveSetpoint::default(); n];
+    m.n = 0; // no command traffic in cycle_once
+    for a in 0..n as u16 {
+        m.submit(
+            a,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+                buffer_mode: BufferMode::Aborting,
+            },
+        );
+    }
+    for _ in 0..10 {
+        m.cycle_once();
+    }
+    let velocity = |v: f64| CommandKind::MoveVelocity {
+        velocity: v,
+        dynamics: Dynamics::default(),
+        direction: Direction::Positive,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    };
+    for g in (0..n as u16).step_by(4) {
+        let accepted = [
+            m.submit(
+                g + 2,
+                CommandKind::GearInMultiMaster(GearInMultiMaster {
+                    masters: [Some(g), Some(g + 1), None, None],
+                    ratios: [0.5, 0.25, 0.0, 0.0],
+                    acceleration: 1000.0,
+                    deceleration: 1000.0,
+                    jerk: 10_000.0,
+                    advanced_slave_dynamics: true,
+                    sync_mode: MultiMasterSyncMode::Possync2,
+                }),
+            ),
+            m.submit(
+                g + 3,
+                CommandKind::GearIn {
+                    master: g,
+                    ratio_numerator: 1.0,
+                    ratio_denominator: 1,
+                },
+            ),
+            m.submit(g, velocity(300.0)),
+            m.submit(g + 1, velocity(100.0)),
+            m.submit(
+                g,
+                CommandKind::PositionCorrectionLimiter {
+                    value: 1e6,
+                    mode: PositionCorrectionMode::Fast,
+                    acceleration: 1000.0,
+                    correction_length: 0.0,
+                },
+            ),
+            m.submit(
+                g,
+                CommandKind::BacklashCompensation {
+                    backlash: Some(0.1),
+                    compensate_in_positive_direction: true,
+                    ramp: 1.0,
+                    disable_mode: DisableMode::Hold,
+                },
+            ),
+            m.submit(
+                g + 3,
+                CommandKind::Phasing {
+                    master: g,
+                    motion: PhasingMotion {
+                        kind: PhasingKind::Absolute,
+                        phase_shift: 1e6,
+                        velocity: 10.0,
+                        acceleration: 0.0,
+                        deceleration: 0.0,
+                        jerk: 0.0,
+                    },
+                },
+            ),
+        ];
+        assert!(
+            accepted.iter().all(|v| *v == Verdict::Accepted),
+            "{accepted:?}"
+        );
+    }
+    for _ in 0..100 {
+        m.cycle_once();
+    }
+    m
+}
+
+fn issue9(c: &mut Criterion) {
+    let mut m = issue9_machine();
+    c.bench_function("step_64_axes_issue9_blocks", |b| b.iter(|| m.cycle_once()));
+    let st = m.k.status(2).unwrap();
+    assert!(st.coupled && st.gear_ratios[1] == 0.25);
+    assert!(m.k.status(3).unwrap().phasing_active);
+    assert!(m.k.status(0).unwrap().position_correction.limiter_limiting);
+}
+
+criterion_group!(benches, cycle, cams, issue9);
 criterion_main!(benches);

@@ -66,6 +66,10 @@ impl MultiGear {
     fn retarget(&mut self, ratios: [f64; 4], rate: [f64; 4]) {
         self.target = ratios;
         self.rate = rate;
+        if !self.advanced {
+            // InGear again once the ratios have ramped there.
+            self.in_gear = self.ratio == self.target;
+        }
     }
 
     /// The law's position, velocity and acceleration for the masters' motion in this cycle
