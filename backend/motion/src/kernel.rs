@@ -385,7 +385,6 @@ impl Kernel {
                 continue;
             };
             let coupled_to = axis.master_slot();
-            let masters = axis.coupled_masters();
             // Stepped before this slave in this cycle (the order sees to it).
             let sample = |m: AxisSlot| {
                 self.axes
@@ -393,34 +392,40 @@ impl Kernel {
                     .and_then(|a| a.as_deref())
                     .map(MasterSample::of)
             };
-            let mut samples = [None; 4];
-            let mut vanished = false;
-            let mut failed = false;
-            for (j, m) in masters.iter().enumerate().skip(1) {
-                if let Some(m) = *m {
-                    samples[j] = sample(m);
-                    vanished |= samples[j].is_none();
-                    failed |= samples[j].is_some_and(|s| s.error);
-                }
-            }
+            let mut samples = None;
             let master = match coupled_to {
                 _ if k >= self.order.in_loop => Master::Lost,
                 None => Master::Uncoupled,
-                Some(_) if vanished => Master::Lost, // a further master vanished
-                Some(m) => match sample(m) {
-                    Some(mut s) => {
-                        samples[0] = Some(s);
-                        // A further master in ErrorStop loses the slave like the first.
-                        s.error |= failed;
-                        Master::Sample(s)
+                Some(m) => {
+                    let masters = axis.coupled_masters();
+                    let mut all = [None; 4];
+                    let mut vanished = false;
+                    let mut failed = false;
+                    for (j, m) in masters.iter().enumerate().skip(1) {
+                        if let Some(m) = *m {
+                            all[j] = sample(m);
+                            vanished |= all[j].is_none();
+                            failed |= all[j].is_some_and(|s| s.error);
+                        }
                     }
-                    None => Master::Lost, // master vanished
-                },
+                    all[0] = sample(m);
+                    samples = Some(all);
+                    match all[0] {
+                        // A further master that vanished loses the slave like the first.
+                        _ if vanished => Master::Lost,
+                        // And one in ErrorStop.
+                        Some(s) => Master::Sample(MasterSample {
+                            error: s.error || failed,
+                            ..s
+                        }),
+                        None => Master::Lost, // master vanished
+                    }
+                }
             };
             let fb = feedback.get(i).copied().unwrap_or_default();
             let axis = self.axes[i].as_deref_mut().expect("checked above");
-            if coupled_to.is_some() {
-                axis.offer_masters(samples);
+            if let Some(all) = samples {
+                axis.offer_masters(all);
             }
             let sp = axis.step(dt, &fb, master, &self.cams, cycle, events);
             if let Some(out) = setpoints.get_mut(i) {

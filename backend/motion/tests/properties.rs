@@ -85,6 +85,20 @@ fn command() -> impl Strategy<Value = CommandKind> {
         2 => cam_in().prop_map(CommandKind::CamIn),
         1 => Just(CommandKind::CamOut),
         1 => cam_scaling().prop_map(CommandKind::CamScaling),
+        // Issue 9's blocks: their effects interleaved with everything above.
+        1 => (0.0..=1.0f64, 0.1..=1.0f64, 0.1..=1.0f64).prop_map(|(velocity_factor, acceleration_factor, jerk_factor)| CommandKind::SetOverride { velocity_factor, acceleration_factor, jerk_factor }),
+        1 => (0.0..40000.0f64, 0.0..0.3f64).prop_map(|(raw, recovery_time)| CommandKind::OverrideFilter { raw, lower_threshold: 0.0, upper_threshold: 32767.0, steps: 200, recovery_time }),
+        1 => (0usize..3, -50.0..50.0f64, 0.01..100.0f64).prop_map(|(k, phase_shift, velocity)| CommandKind::Phasing { master: 0, motion: PhasingMotion { kind: [PhasingKind::Absolute, PhasingKind::Relative, PhasingKind::Halt][k], phase_shift, velocity, acceleration: 0.0, deceleration: 0.0, jerk: 0.0 } }),
+        1 => (-2.0..2.0f64, any::<bool>(), 0usize..3, 0.0..3000.0f64).prop_map(|(r, advanced, m, acceleration)| CommandKind::GearInMultiMaster(GearInMultiMaster { masters: [Some(0), None, None, None], ratios: [r, 0.0, 0.0, 0.0], acceleration, deceleration: 0.0, jerk: 0.0, advanced_slave_dynamics: advanced, sync_mode: [MultiMasterSyncMode::Velosync, MultiMasterSyncMode::Possync1, MultiMasterSyncMode::Possync2][m] })),
+        1 => Just(CommandKind::WriteParameter { number: 1046, value: 1.0 }),
+        1 => (-2.0..2.0f64, 0usize..3, 0.0..5000.0f64).prop_map(|(value, m, acceleration)| CommandKind::PositionCorrectionLimiter { value, mode: [PositionCorrectionMode::Unlimited, PositionCorrectionMode::Fast, PositionCorrectionMode::FullLength][m], acceleration, correction_length: 10.0 }),
+        1 => (-0.5..0.5f64, any::<bool>(), 0.1..10.0f64, any::<bool>()).prop_map(|(b, positive, ramp, reset)| CommandKind::BacklashCompensation { backlash: Some(b), compensate_in_positive_direction: positive, ramp, disable_mode: if reset { DisableMode::Reset } else { DisableMode::Hold } }),
+        1 => (-30.0..30.0f64, 10.0..1000.0f64, 0.0..300.0f64, any::<bool>()).prop_map(|(torque, torque_ramp, limit, relative)| CommandKind::TorqueControl(TorqueControl { torque, torque_ramp, relative, velocity_limit_high: limit, velocity_limit_low: -limit, manual_start: None })),
+        1 => prop_oneof![Just(DriveMode::Configured), Just(DriveMode::Position), Just(DriveMode::Velocity)].prop_map(|mode| CommandKind::WriteDriveOperationMode { mode }),
+        1 => (0.5..2.0f64, any::<bool>()).prop_map(|(factor, relative)| CommandKind::SetEncoderScalingFactor { factor, relative }),
+        1 => (0.01..0.5f64).prop_map(|timeout| CommandKind::ExtSetPointGenEnable { target: None, relative: false, timeout }),
+        1 => Just(CommandKind::ExtSetPointGenDisable),
+        1 => (-5.0..5.0f64, -50.0..50.0f64).prop_map(|(position, velocity)| CommandKind::ExtSetPointGenFeed { position, velocity, acceleration: 0.0, direction: if velocity > 0.0 { 1 } else { -1 } }),
     ]
 }
 

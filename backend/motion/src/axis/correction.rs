@@ -221,6 +221,18 @@ impl Axis {
         }
     }
 
+    /// MC_Power off ends the correction blocks (CommandAborted), each leaving its correction
+    /// as its DisableMode says: an enable that is gone cannot keep a block active.
+    pub(super) fn end_corrections(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        let c = &mut self.corrections;
+        c.limiter.disable_mode = DisableMode::Hold;
+        for s in [&mut c.limiter, &mut c.backlash, &mut c.table] {
+            if s.cmd.is_some() {
+                s.end(cx, End::Aborted);
+            }
+        }
+    }
+
     /// One cycle of the corrections, after the motion: the travel direction, each source one
     /// step towards its target. Returns the total for this cycle's setpoint.
     pub(super) fn step_corrections(&mut self) -> f64 {

@@ -482,6 +482,7 @@ impl Axis {
     ) {
         if self
             .coupling
+            .as_ref()
             .is_some_and(|c| matches!(c.law, CouplingLaw::Multi(_)))
         {
             self.follow_multi(cx, job, master, dt);

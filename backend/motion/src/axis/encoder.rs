@@ -47,6 +47,7 @@ impl Axis {
         // The drive position the actual one was read from.
         let drive = (self.act_pos - self.offset - self.corrections.sent) / k_old;
         self.enc_k = k_new;
+        self.enc_count_scale = 1.0 / (k_new * self.enc_base);
         if relative {
             // No jump: the offset takes up what the new factor would change.
             let d = (k_old - k_new) * drive;
@@ -81,13 +82,12 @@ impl Axis {
     /// The raw encoder count (masked by #1043) of the drive position now: drive position /
     /// the scaling the axis was built with.
     pub(super) fn encoder_count(&self) -> u32 {
-        let drive = (self.act_pos - self.offset - self.corrections.sent) / self.enc_k;
-        let incs = (drive / self.enc_base).round();
-        let incs = if incs.is_finite() {
-            incs.rem_euclid(4_294_967_296.0) as u64
-        } else {
-            0
-        };
+        // Increments = drive position / build-time factor = (reading − offsets) / (k · base):
+        // one multiplication by the reciprocal kept with k (this runs every cycle). The low 32
+        // bits of the count (two's complement wraps as the counter does; a cast, not a
+        // floating-point remainder).
+        let x = (self.act_pos - self.offset - self.corrections.sent) * self.enc_count_scale;
+        let incs = (x + 0.5f64.copysign(x)) as i64; // rounded half away from zero
         (incs as u32) & self.p().axis_encoder_mask
     }
 }

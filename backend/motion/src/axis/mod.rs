@@ -185,7 +185,8 @@ pub struct Axis {
     new_target: bool,
     /// The phase shift against the master (AbsPhasingPos) and its motion (§5.6).
     phase: Kinematics,
-    phase_planner: Planner,
+    /// Boxed: a planner is large, and the axis's hot fields stay close together without it.
+    phase_planner: Box<Planner>,
     phasing: Option<phasing::PhasingJob>,
     /// Position correction (§7.2): limiter, backlash and table compensation.
     corrections: correction::Corrections,
@@ -193,6 +194,8 @@ pub struct Axis {
     enc_base: f64,
     /// The encoder scaling now ÷ `enc_base` (MC_SetEncoderScalingFactor).
     enc_k: f64,
+    /// 1 / (enc_k · enc_base): increments per unit of the reading.
+    enc_count_scale: f64,
     /// The part of `offset` that relative encoder scaling changes put there (an absolute
     /// change counts from zero again and drops it).
     enc_offset: f64,
@@ -282,11 +285,12 @@ impl Axis {
             has_been_stopped: false,
             new_target: false,
             phase: Kinematics::default(),
-            phase_planner: Planner::new(cycle_time),
+            phase_planner: Box::new(Planner::new(cycle_time)),
             phasing: None,
             corrections: correction::Corrections::default(),
             enc_base,
             enc_k: 1.0,
+            enc_count_scale: 1.0 / enc_base,
             enc_offset: 0.0,
             torque: torque::TorqueState::default(),
             ext: external::ExtGen::default(),
@@ -320,7 +324,10 @@ impl Axis {
     }
 
     pub fn master_slot(&self) -> Option<AxisSlot> {
-        self.coupling.map(|c| c.master).or(self.cam_master())
+        self.coupling
+            .as_ref()
+            .map(|c| c.master)
+            .or(self.cam_master())
     }
 
     /// The PLCopen state, derived from the mode and the active job.

@@ -10,6 +10,7 @@ impl Axis {
     pub(super) fn disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         self.enable = false;
         self.disable_when_idle = false;
+        self.end_corrections(cx);
         self.last_target = None;
         self.abort_superposition(cx);
         self.abort_all(cx);

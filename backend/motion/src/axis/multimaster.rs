@@ -116,7 +116,7 @@ impl Axis {
     /// The masters this axis follows (Master1…Master4 of a multi-master coupling; the one
     /// master of any other coupling first).
     pub fn coupled_masters(&self) -> [Option<AxisSlot>; 4] {
-        match self.coupling {
+        match self.coupling.as_ref() {
             Some(c) => [
                 Some(c.master),
                 c.more_masters[0],

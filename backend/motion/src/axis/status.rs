@@ -77,9 +77,10 @@ impl Axis {
         s.soft_limit_min_exceeded =
             p.axis_en_min_soft_pos_limit && set.position < p.axis_min_soft_pos_limit;
         s.coupled = self.coupling.is_some();
-        s.master = self.coupling.map(|c| c.master);
-        s.gear_ratio = self.coupling.map(|c| c.law.ratio()).unwrap_or(0.0);
-        s.gear_ratios = match self.coupling.map(|c| c.law) {
+        s.master = self.coupling.as_ref().map(|c| c.master);
+        s.gear_ratio = self.coupling.as_ref().map(|c| c.law.ratio()).unwrap_or(0.0);
+        // By reference: a coupling (a cam set) is large to copy every cycle.
+        s.gear_ratios = match self.coupling.as_ref().map(|c| &c.law) {
             Some(coupling::CouplingLaw::Multi(m)) => m.ratios(),
             _ => [s.gear_ratio, 0.0, 0.0, 0.0],
         };
