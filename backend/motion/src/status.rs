@@ -198,6 +198,7 @@ pub struct AxisStatus {
     pub position_correction: PositionCorrectionStatus,
     /// The raw encoder count (drive position ÷ the scaling the axis was built with, masked
     /// by #1043): what MC_ConvertIncPosToPos / MC_ConvertPosToIncPos count from.
+    #[cfg_attr(feature = "schema", schema(value_type = i64, minimum = 0, maximum = 4294967295_u64))]
     pub encoder_count: u32,
     /// The encoder scaling now (#1040, units per increment; MC_SetEncoderScalingFactor).
     pub encoder_scaling_factor: f64,

@@ -802,8 +802,8 @@ pub struct SetEncoderScalingFactorBody {
 #[serde(deny_unknown_fields)]
 pub struct IncPosQuery {
     /// The encoder count (UDINT, masked by AxisEncoderMask #1043).
-    #[param(minimum = 0, maximum = 4294967295_u64)]
-    #[schema(minimum = 0, maximum = 4294967295_u64)]
+    #[param(value_type = i64, minimum = 0, maximum = 4294967295_u64)]
+    #[schema(value_type = i64, minimum = 0, maximum = 4294967295_u64)]
     pub inc_pos: u32,
 }
 
@@ -825,9 +825,12 @@ pub struct PositionQuery {
     "encoder_count": 100000, "actual_position": 100.0, "encoder_scaling_factor": 0.001}))]
 pub struct PositionConversion {
     pub position: f64,
+    /// A UDINT (0 … 4294967295).
+    #[schema(value_type = i64, minimum = 0, maximum = 4294967295_u64)]
     pub inc_pos: u32,
     pub cycle: u64,
     /// The count and actual position the conversion counted from.
+    #[schema(value_type = i64, minimum = 0, maximum = 4294967295_u64)]
     pub encoder_count: u32,
     pub actual_position: f64,
     pub encoder_scaling_factor: f64,
@@ -863,6 +866,7 @@ pub struct EncoderComponent {
     /// AxisEncoderScalingFactor (#1040), units per increment.
     pub scaling_factor: f64,
     /// AxisEncoderMask (#1043).
+    #[schema(value_type = i64, minimum = 0, maximum = 4294967295_u64)]
     pub mask: u32,
 }
 
@@ -1062,9 +1066,9 @@ pub struct OverrideFilterBody {
     #[serde(default = "default_upper_threshold")]
     #[schema(minimum = -1e12, maximum = 1e12, default = 32767.0)]
     pub upper_threshold: f64,
-    /// OverrideSteps (default 200 = 0.5 %), at least 2.
+    /// OverrideSteps (default 200 = 0.5 %), 2 to 1 000 000.
     #[serde(default = "default_override_steps")]
-    #[schema(minimum = 2, default = 200)]
+    #[schema(minimum = 2, maximum = 1000000, default = 200)]
     pub steps: u32,
     /// OverrideRecoveryTime in seconds (default 0.15).
     #[serde(default = "default_recovery_time")]

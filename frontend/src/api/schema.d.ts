@@ -2384,7 +2384,7 @@ export interface components {
              */
             position_correction: components["schemas"]["PositionCorrectionStatus"];
             /**
-             * Format: int32
+             * Format: int64
              * @description The raw encoder count (drive position ÷ the scaling the axis was built with, masked
              *     by #1043): what MC_ConvertIncPosToPos / MC_ConvertPosToIncPos count from.
              */
@@ -4306,7 +4306,7 @@ export interface components {
              */
             scaling_factor: number;
             /**
-             * Format: int32
+             * Format: int64
              * @description AxisEncoderMask (#1043).
              */
             mask: number;
@@ -5384,7 +5384,7 @@ export interface components {
             upper_threshold: number;
             /**
              * Format: int32
-             * @description OverrideSteps (default 200 = 0.5 %), at least 2.
+             * @description OverrideSteps (default 200 = 0.5 %), 2 to 1 000 000.
              * @default 200
              */
             steps: number;
@@ -5642,12 +5642,15 @@ export interface components {
         PositionConversion: {
             /** Format: double */
             position: number;
-            /** Format: int32 */
+            /**
+             * Format: int64
+             * @description A UDINT (0 … 4294967295).
+             */
             inc_pos: number;
             /** Format: int64 */
             cycle: number;
             /**
-             * Format: int32
+             * Format: int64
              * @description The count and actual position the conversion counted from.
              */
             encoder_count: number;

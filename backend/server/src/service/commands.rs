@@ -143,8 +143,8 @@ impl OverrideFilterBody {
         if self.upper_threshold <= self.lower_threshold {
             c.fail("upper_threshold", "must be above lower_threshold");
         }
-        if self.steps <= 1 {
-            c.fail("steps", "must be at least 2");
+        if !(2..=1_000_000).contains(&self.steps) {
+            c.fail("steps", "must be from 2 to 1000000");
         }
         if !(self.recovery_time.is_finite() && (0.0..=3600.0).contains(&self.recovery_time)) {
             c.fail("recovery_time", "must be between 0 and 3600 s");
