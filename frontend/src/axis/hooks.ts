@@ -12,6 +12,15 @@ export function useForm(init: Form): [Form, (k: string, v: string) => void, (f: 
   return [f, (k, v) => setF((o) => ({ ...o, [k]: v })), setF];
 }
 
+/**
+ * The running (not final) command `name` of an axis in the command log — an Enable-type block
+ * this page or another client started — or null.
+ */
+export function useRunning(axis: string, name: string): LogEntry | null {
+  const log = useStore(commandLog);
+  return log.find((e) => e.axis === axis && e.command === name && e.id !== null && !e.final) ?? null;
+}
+
 /** The command log's entry of a command (follows its events), or null. */
 export function useLogEntry(id: number | null | undefined): LogEntry | null {
   const log = useStore(commandLog);

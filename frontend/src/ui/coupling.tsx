@@ -1,6 +1,7 @@
 // The axis "Coupling" tab (TwinCAT XAE: the axis's Coupling tab and its superposition): MC_GearIn,
 // MC_GearInDyn (released with DELETE /commands/{id}), MC_GearOut, MC_CamIn / MC_CamOut /
-// MC_CamScaling, MC_MoveSuperImposed / MC_AbortSuperposition, and the coupling as the live
+// MC_CamScaling, MC_MoveSuperImposed / MC_AbortSuperposition, MC_PhasingAbsolute / Relative /
+// MC_HaltPhasing and MC_GearInMultiMaster (coupling-blocks.tsx), and the coupling as the live
 // status shows it (master, gear ratio, InGear/InSync of the running command, MC_CamInfo).
 import type { ComponentChildren } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
@@ -33,19 +34,20 @@ import {
   type Form,
 } from '../axis/bodies';
 import { useCommand, useForm } from '../axis/hooks';
+import { MultiMasterPanel, PhasingPanel } from './coupling-blocks';
 
 /** A text input of a form record with its field error. */
-export function NumField({ f, set, k, label: l, errors, hint, name, placeholder }: { f: Form; set: (k: string, v: string) => void; k: string; label: ComponentChildren; errors: Record<string, string>; hint?: string; name?: string; placeholder?: string }) {
+export function NumField({ f, set, k, label: l, errors, hint, name, placeholder, disabled }: { f: Form; set: (k: string, v: string) => void; k: string; label: ComponentChildren; errors: Record<string, string>; hint?: string; name?: string; placeholder?: string; disabled?: boolean }) {
   const n = name ?? k;
   return (
     <Field label={l} error={errors[k]} name={n}>
-      <NumberInput name={n} value={f[k] ?? ''} onValue={(v) => set(k, v)} placeholder={placeholder} title={hint} />
+      <NumberInput name={n} value={f[k] ?? ''} onValue={(v) => set(k, v)} placeholder={placeholder} title={hint} disabled={disabled} />
     </Field>
   );
 }
 
 /** A select of a form record with its field error. */
-export function SelectField({ f, set, k, label: l, errors, options, name, blank }: {
+export function SelectField({ f, set, k, label: l, errors, options, name, blank, disabled, title }: {
   f: Form;
   set: (k: string, v: string) => void;
   k: string;
@@ -54,11 +56,13 @@ export function SelectField({ f, set, k, label: l, errors, options, name, blank 
   options: (string | [string, string])[];
   name?: string;
   blank?: string;
+  disabled?: boolean;
+  title?: string;
 }) {
   const n = name ?? k;
   return (
     <Field label={l} error={errors[k]} name={n}>
-      <select name={n} value={f[k] ?? ''} onChange={(e) => set(k, (e.target as HTMLSelectElement).value)}>
+      <select name={n} value={f[k] ?? ''} disabled={disabled} title={title} onChange={(e) => set(k, (e.target as HTMLSelectElement).value)}>
         {blank !== undefined && <option value="">{blank}</option>}
         {options.map((o) => {
           const [v, t] = Array.isArray(o) ? o : [o, label(o)];
@@ -88,7 +92,8 @@ export function useSender(axis: string, setBanner: (s: string | null) => void) {
   };
 }
 
-const COUPLING_COMMANDS = new Set(['gear-in', 'gear-in-dyn', 'cam-in', 'cam-in-v2', 'cam-exchange', 'cam-add']);
+/** The commands that couple an axis as a slave. */
+export const COUPLING_COMMANDS = new Set(['gear-in', 'gear-in-dyn', 'gear-in-multi-master', 'cam-in', 'cam-in-v2', 'cam-exchange', 'cam-add']);
 
 export function CouplingTab({ axis: a }: { axis: AxisResource }) {
   const axis = a.config.name;
@@ -159,7 +164,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
             </div>
             <div class="led-grid coupling-leds">
               <Led on={s?.coupled} label="Coupled" tone="blue" />
-              <Led on={inGear} label="InGear" title="InGear of the coupling command (MC_GearIn / MC_GearInDyn)" />
+              <Led on={inGear} label="InGear" title="InGear of the coupling command (MC_GearIn / MC_GearInDyn / MC_GearInMultiMaster)" />
               <Led on={inSync} label="InSync" title="InSync of the coupling command (MC_CamIn)" />
               <Led on={s?.cam?.active} label="Cam active" tone="blue" />
             </div>
@@ -176,6 +181,20 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
               <dd class="mono" data-testid="coupling-ratio">
                 {s?.coupled ? num(s.gear_ratio, 6) : '—'}
               </dd>
+              {s?.coupled && (s.gear_ratios ?? []).filter((r) => r !== 0).length > 1 && (
+                <>
+                  <dt>Gear ratios</dt>
+                  <dd class="mono" data-testid="coupling-ratios" title="MC_GearInMultiMaster: the ratio of Master1…Master4 in force">
+                    {s.gear_ratios.map((r) => num(r, 4)).join(' · ')}
+                  </dd>
+                </>
+              )}
+              {s?.coupled && s.absolute_phase_shift !== 0 && (
+                <>
+                  <dt>Phase shift</dt>
+                  <dd class="mono">{num(s.absolute_phase_shift, 4)}</dd>
+                </>
+              )}
               <dt>Command</dt>
               <dd data-testid="running-command">
                 {running ? (
@@ -201,6 +220,8 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
               </table>
             )}
           </Panel>
+
+          <PhasingPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} />
 
           <Panel title="Superposition" class="superposition">
             <div class="led-grid">
@@ -300,6 +321,8 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
               </div>
             </form>
           </Panel>
+
+          <MultiMasterPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} />
 
           <Panel title="Cam" class="cam">
             <h4 class="sub">MC_CamIn · MC_CamOut</h4>

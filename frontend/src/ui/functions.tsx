@@ -1,7 +1,9 @@
 // The axis "Functions" tab (TwinCAT XAE: the axis's Functions tab): the reversing sequence for
 // tuning (two positions, velocity, dwell, repeats or endless; run by this page as waited
 // MC_MoveAbsolute calls, stopped by Stop with an MC_Halt and ended when the page leaves) and
-// MC_Home with its mode and options, the homing phase live and the reason a homing failed.
+// MC_Home with its mode and options, the homing phase live and the reason a homing failed;
+// MC_TorqueControl with the drive's operation mode, the position correction and the encoder
+// (function-blocks.tsx).
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { command, statuses } from '../services';
@@ -15,6 +17,7 @@ import { HOME_DEFAULTS, REFERENCE_MODES, homeBody } from '../axis/bodies';
 import { abortableSleep, reversingConfig, runReversing, type ReversingEnd, type ReversingStep } from '../axis/reversing';
 import { useCommand, useForm } from '../axis/hooks';
 import { NumField, SelectField, useSender } from './coupling';
+import { EncoderPanel, PositionCorrectionPanel, TorquePanel } from './function-blocks';
 
 /** Longest wait for one move of the sequence (the server's limit). */
 const MOVE_TIMEOUT_MS = 600000;
@@ -128,116 +131,126 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
     ['negative', 'negative'],
   ];
   const stale = liveStatus?.stale || offline;
+  const blocks = { axis: a, s, online, send, setBanner };
 
   return (
     <div class={`functions ${stale ? 'stale' : ''}`}>
       <ErrorBanner error={banner} onClose={() => setBanner(null)} />
       <div class="functions-grid">
-        <Panel title="Reversing sequence" class="reversing" actions={<LiveIndicator cycle={liveStatus?.cycle} stale={stale} />}>
-          <form
-            class="row"
-            onSubmit={(e) => {
-              e.preventDefault();
-              if (online && !running) void start();
-            }}
-          >
-            <NumField f={rev} set={setRev} k="position1" label={`Position 1 (${u})`} errors={revErr} name="rev-position1" />
-            <NumField f={rev} set={setRev} k="position2" label={`Position 2 (${u})`} errors={revErr} name="rev-position2" />
-            <NumField f={rev} set={setRev} k="velocity" label={`Velocity (${u}/s)`} errors={revErr} name="rev-velocity" />
-            <NumField f={rev} set={setRev} k="dwell" label="Dwell time (s)" errors={revErr} name="rev-dwell" />
-            <Field label="Repeats" error={revErr.repeats} name="rev-repeats">
-              <NumberInput name="rev-repeats" value={rev.endless === '1' ? '' : rev.repeats} placeholder={rev.endless === '1' ? 'endless' : ''} disabled={rev.endless === '1'} onValue={(v) => setRev('repeats', v)} />
-            </Field>
-            <label class="check">
-              <input type="checkbox" name="rev-endless" checked={rev.endless === '1'} onChange={(e) => setRev('endless', (e.target as HTMLInputElement).checked ? '1' : '')} /> endless
-            </label>
-            <div class="row-buttons">
-              <button type="submit" class="btn btn-primary" name="rev-start" disabled={offline || running} title="Start: move to position 1, dwell, to position 2, dwell … (MC_MoveAbsolute)">
-                Start
-              </button>
-              <ActionButton name="rev-stop" kind="danger" disabled={offline} title="Stop the sequence (MC_Halt)" onClick={stop}>
-                Stop
-              </ActionButton>
-            </div>
-          </form>
-          <div class="rev-status" data-testid="reversing-status" data-state={run.kind}>
-            <span>
-              Cycle <b class="mono" data-testid="reversing-count">{cycles}</b>
-              {rev.endless === '1' ? ' of ∞' : rev.repeats ? ` of ${rev.repeats}` : ''}
-            </span>
-            <span class="muted" data-testid="reversing-state">
-              {runText}
-            </span>
-            <span class="mono small">
-              at {pos(s?.actual_position)} {u}
-            </span>
-          </div>
-          <p class="small muted panel-note">
-            The <a href={href({ page: 'scope' })}>Scope</a> page records the sequence (positions, velocities, following error) for tuning. The sequence runs in this page: leaving it
-            stops it.
-          </p>
-        </Panel>
-
-        <Panel title="Homing" class="homing">
-          <form
-            class="row"
-            onSubmit={(e) => {
-              e.preventDefault();
-              if (online) void startHome();
-            }}
-          >
-            <SelectField
-              f={home}
-              set={setHome}
-              k="mode"
-              label="Mode"
-              errors={homeErr}
-              name="home-mode"
-              options={[
-                ['default', 'default (#1076)'],
-                ['direct', 'direct'],
-                ['force_calibration', 'force calibration'],
-                ['reset_calibration', 'reset calibration'],
-              ]}
-            />
-            <Field label={`Home position (${u})`} error={homeErr.position} name="home-position">
-              <NumberInput name="home-position" value={home.position} onValue={(v) => setHome('position', v)} placeholder="#1075" />
-            </Field>
-            <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank="axis (#1076)" />
-            <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank="axis (#1073)" />
-            <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder="#1012" />
-            <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank="axis (#1074)" />
-            <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder="#1013" />
-            <label class="check" title="MC_Direct only: set position = actual position afterwards">
-              <input type="checkbox" name="home-clear-lag" checked={home.clear_position_lag === '1'} onChange={(e) => setHome('clear_position_lag', (e.target as HTMLInputElement).checked ? '1' : '')} /> clear lag
-            </label>
-            <div class="row-buttons">
-              <button type="submit" class="btn btn-primary" name="home-start" disabled={offline} title="MC_Home">
-                Start
-              </button>
-            </div>
-          </form>
-          <div class="led-grid">
-            <Led on={s?.homed} label="Homed" />
-            <Led on={!!s && s.homing_phase !== 'idle'} label="Homing" tone="blue" />
-          </div>
-          <dl class="kv">
-            <dt>Homing phase</dt>
-            <dd class="mono" data-testid="homing-phase">
-              {s?.homing_phase ?? '—'}
-            </dd>
-            <dt>Last homing</dt>
-            <dd data-testid="homing-result">{homeCmd ? `#${homeCmd.id} ${homeCmd.state}` : <span class="muted">—</span>}</dd>
-          </dl>
-          {homeFailed && (
-            <div class="banner banner-error" role="alert" data-testid="homing-error">
+        <div class="functions-col">
+          <Panel title="Reversing sequence" class="reversing" actions={<LiveIndicator cycle={liveStatus?.cycle} stale={stale} />}>
+            <form
+              class="row"
+              onSubmit={(e) => {
+                e.preventDefault();
+                if (online && !running) void start();
+              }}
+            >
+              <NumField f={rev} set={setRev} k="position1" label={`Position 1 (${u})`} errors={revErr} name="rev-position1" />
+              <NumField f={rev} set={setRev} k="position2" label={`Position 2 (${u})`} errors={revErr} name="rev-position2" />
+              <NumField f={rev} set={setRev} k="velocity" label={`Velocity (${u}/s)`} errors={revErr} name="rev-velocity" />
+              <NumField f={rev} set={setRev} k="dwell" label="Dwell time (s)" errors={revErr} name="rev-dwell" />
+              <Field label="Repeats" error={revErr.repeats} name="rev-repeats">
+                <NumberInput name="rev-repeats" value={rev.endless === '1' ? '' : rev.repeats} placeholder={rev.endless === '1' ? 'endless' : ''} disabled={rev.endless === '1'} onValue={(v) => setRev('repeats', v)} />
+              </Field>
+              <label class="check">
+                <input type="checkbox" name="rev-endless" checked={rev.endless === '1'} onChange={(e) => setRev('endless', (e.target as HTMLInputElement).checked ? '1' : '')} /> endless
+              </label>
+              <div class="row-buttons">
+                <button type="submit" class="btn btn-primary" name="rev-start" disabled={offline || running} title="Start: move to position 1, dwell, to position 2, dwell … (MC_MoveAbsolute)">
+                  Start
+                </button>
+                <ActionButton name="rev-stop" kind="danger" disabled={offline} title="Stop the sequence (MC_Halt)" onClick={stop}>
+                  Stop
+                </ActionButton>
+              </div>
+            </form>
+            <div class="rev-status" data-testid="reversing-status" data-state={run.kind}>
               <span>
-                <b>Homing failed</b> · <b>{errorInfo(homeFailed.outputs.error_id).hex}</b> <code>{homeFailed.error_code ?? errorInfo(homeFailed.outputs.error_id).code}</code> —{' '}
-                {errorInfo(homeFailed.outputs.error_id).text}
+                Cycle <b class="mono" data-testid="reversing-count">{cycles}</b>
+                {rev.endless === '1' ? ' of ∞' : rev.repeats ? ` of ${rev.repeats}` : ''}
+              </span>
+              <span class="muted" data-testid="reversing-state">
+                {runText}
+              </span>
+              <span class="mono small">
+                at {pos(s?.actual_position)} {u}
               </span>
             </div>
-          )}
-        </Panel>
+            <p class="small muted panel-note">
+              The <a href={href({ page: 'scope' })}>Scope</a> page records the sequence (positions, velocities, following error) for tuning. The sequence runs in this page: leaving it
+              stops it.
+            </p>
+          </Panel>
+
+          <TorquePanel {...blocks} />
+
+          <EncoderPanel {...blocks} />
+        </div>
+        <div class="functions-col">
+          <Panel title="Homing" class="homing">
+            <form
+              class="row"
+              onSubmit={(e) => {
+                e.preventDefault();
+                if (online) void startHome();
+              }}
+            >
+              <SelectField
+                f={home}
+                set={setHome}
+                k="mode"
+                label="Mode"
+                errors={homeErr}
+                name="home-mode"
+                options={[
+                  ['default', 'default (#1076)'],
+                  ['direct', 'direct'],
+                  ['force_calibration', 'force calibration'],
+                  ['reset_calibration', 'reset calibration'],
+                ]}
+              />
+              <Field label={`Home position (${u})`} error={homeErr.position} name="home-position">
+                <NumberInput name="home-position" value={home.position} onValue={(v) => setHome('position', v)} placeholder="#1075" />
+              </Field>
+              <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank="axis (#1076)" />
+              <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank="axis (#1073)" />
+              <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder="#1012" />
+              <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank="axis (#1074)" />
+              <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder="#1013" />
+              <label class="check" title="MC_Direct only: set position = actual position afterwards">
+                <input type="checkbox" name="home-clear-lag" checked={home.clear_position_lag === '1'} onChange={(e) => setHome('clear_position_lag', (e.target as HTMLInputElement).checked ? '1' : '')} /> clear lag
+              </label>
+              <div class="row-buttons">
+                <button type="submit" class="btn btn-primary" name="home-start" disabled={offline} title="MC_Home">
+                  Start
+                </button>
+              </div>
+            </form>
+            <div class="led-grid">
+              <Led on={s?.homed} label="Homed" />
+              <Led on={!!s && s.homing_phase !== 'idle'} label="Homing" tone="blue" />
+            </div>
+            <dl class="kv">
+              <dt>Homing phase</dt>
+              <dd class="mono" data-testid="homing-phase">
+                {s?.homing_phase ?? '—'}
+              </dd>
+              <dt>Last homing</dt>
+              <dd data-testid="homing-result">{homeCmd ? `#${homeCmd.id} ${homeCmd.state}` : <span class="muted">—</span>}</dd>
+            </dl>
+            {homeFailed && (
+              <div class="banner banner-error" role="alert" data-testid="homing-error">
+                <span>
+                  <b>Homing failed</b> · <b>{errorInfo(homeFailed.outputs.error_id).hex}</b> <code>{homeFailed.error_code ?? errorInfo(homeFailed.outputs.error_id).code}</code> —{' '}
+                  {errorInfo(homeFailed.outputs.error_id).text}
+                </span>
+              </div>
+            )}
+          </Panel>
+
+          <PositionCorrectionPanel {...blocks} />
+        </div>
       </div>
     </div>
   );
