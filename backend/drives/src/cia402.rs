@@ -236,6 +236,9 @@ pub struct Cia402Drive {
     reset_hold: core::cell::Cell<u32>,
     /// Torque control held the velocity at a limit in the last outputs.
     limited: core::cell::Cell<bool>,
+    /// MC_TorqueControl's open torque was asked for in the last outputs (CST as configured,
+    /// with motiond's loops, is the position-based mode, not torque control).
+    torque_control: core::cell::Cell<bool>,
 }
 
 /// How the drive is run in a cycle: the configured mode, or what the kernel asks for
@@ -279,6 +282,7 @@ impl Cia402Drive {
             last: TxPdo::default(),
             reset_hold: core::cell::Cell::new(0),
             limited: core::cell::Cell::new(false),
+            torque_control: core::cell::Cell::new(false),
         }
     }
 
@@ -317,7 +321,11 @@ impl Cia402Drive {
             mode: match tx.mode_display {
                 8 => DriveMode::Position,
                 9 => DriveMode::Velocity,
-                10 => DriveMode::Torque,
+                // CST is torque control only when MC_TorqueControl asked for it; a drive
+                // configured for CST runs motiond's position loops through it.
+                10 if self.torque_control.get() || self.config.mode != Cia402Mode::Cst => {
+                    DriveMode::Torque
+                }
                 _ => DriveMode::Configured,
             },
             actual_torque: tx.torque_actual as f64 / 10.0,
@@ -408,6 +416,7 @@ impl Cia402Drive {
             QuickStopActive => DISABLE_VOLTAGE,
         };
         let run = Run::of(&self.config, sp.mode);
+        self.torque_control.set(run == Run::Torque);
         let following = state == OperationEnabled && tx.mode_display == run.code();
         self.limited.set(false);
         // Until the drive follows (enabling, or switching modes), it is told to stay where it

@@ -316,9 +316,10 @@ impl Kernel {
         let cycle = self.cycle + 1;
         match self.axes.get_mut(slot).and_then(|a| a.as_deref_mut()) {
             Some(axis) => {
-                let coupled_to = axis.master_slot();
+                // All masters: a further one changing re-orders the step too.
+                let coupled_to = axis.coupled_masters();
                 let verdict = axis.submit(cmd, master, &self.cams, cycle, events);
-                if axis.master_slot() != coupled_to {
+                if axis.coupled_masters() != coupled_to {
                     self.order.stale = true;
                 }
                 verdict
@@ -385,6 +386,7 @@ impl Kernel {
                 continue;
             };
             let coupled_to = axis.master_slot();
+            let all_masters = axis.coupled_masters();
             // Stepped before this slave in this cycle (the order sees to it).
             let sample = |m: AxisSlot| {
                 self.axes
@@ -431,7 +433,7 @@ impl Kernel {
             if let Some(out) = setpoints.get_mut(i) {
                 *out = sp;
             }
-            if axis.master_slot() != coupled_to {
+            if axis.coupled_masters() != all_masters {
                 // It left its coupling (master lost, an error, a limit): next cycle it is
                 // stepped where an uncoupled axis is.
                 self.order.stale = true;

@@ -168,9 +168,15 @@ impl Axis {
                 if !position.is_finite() {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
+                let client_motion = self
+                    .job
+                    .is_some_and(|j| matches!(j.kind, JobKind::External | JobKind::Torque));
                 match self.state() {
                     AxisState::Disabled | AxisState::Standstill | AxisState::ErrorStop => {}
-                    AxisState::DiscreteMotion | AxisState::ContinuousMotion if relative => {}
+                    // Not under samples a client feeds or a torque: their positions are the
+                    // client's and the drive's, not ours to shift.
+                    AxisState::DiscreteMotion | AxisState::ContinuousMotion
+                        if relative && !client_motion => {}
                     _ => return Err(ErrorId::AXIS_CANNOT_BE_STARTED),
                 }
                 let shift = if relative {
@@ -387,6 +393,10 @@ impl Axis {
             return Ok(());
         }
         if self.power.as_ref().is_some_and(|p| p.id == target) {
+            if self.disable_when_idle {
+                // The command is a disable already waiting for the job: its Enable is FALSE.
+                return Ok(());
+            }
             if self.power_buffer_mode != BufferMode::Aborting && self.executes_job() {
                 self.disable_when_idle = true;
             } else {

@@ -57,6 +57,9 @@ impl Source {
 pub(super) struct Corrections {
     /// The total sent with the last setpoint: the actual position read now answers it.
     pub(super) sent: f64,
+    /// The total the latest actual position was read with (`sent` before this cycle's step):
+    /// what turns the reading back into the drive's position.
+    pub(super) read: f64,
     pub(super) limiter: Source,
     limiter_mode: PositionCorrectionMode,
     limiter_acceleration: f64,
@@ -69,7 +72,9 @@ pub(super) struct Corrections {
     /// The set position's last travel direction (+1, −1; 0 before the first travel), kept
     /// at standstill: backlash and directional tables depend on it.
     direction: f64,
-    last_set: f64,
+    pub(super) last_set: f64,
+    /// `last_set` holds a set position (false before the first cycle: no travel yet).
+    started: bool,
 }
 
 impl Corrections {
@@ -121,6 +126,10 @@ impl Axis {
         }
         if !p.axis_enable_pos_correction {
             return Err(ErrorId::INVALID_MODE);
+        }
+        // "Should only be used on enabled axes" (§4.5.5), and MC_Power off ends them.
+        if !self.enable {
+            return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
         }
         let axis_backlash = p.axis_backlash;
         let c = &mut self.corrections;
@@ -238,8 +247,17 @@ impl Axis {
     pub(super) fn step_corrections(&mut self) -> f64 {
         let dt = self.cycle_time;
         let set = self.set.position;
+        // While the set position follows the actual one (disabled, torque control) the
+        // reading moves with the correction itself: no travel of the axis's own.
+        let follows_actual =
+            self.mode == Mode::Disabled || self.job.is_some_and(|j| j.kind == JobKind::Torque);
         let c = &mut self.corrections;
-        let travel = set - c.last_set;
+        let travel = if c.started && !follows_actual {
+            set - c.last_set
+        } else {
+            0.0
+        };
+        c.started = true;
         c.last_set = set;
         if travel.abs() > 1e-12 {
             c.direction = travel.signum();

@@ -408,6 +408,7 @@ impl Axis {
         let Some(m) = master else {
             return Err(ErrorId::MASTER_INVALID);
         };
+        self.admit_to_external()?;
         match self.state() {
             AxisState::Standstill
             | AxisState::DiscreteMotion

@@ -22,7 +22,7 @@ impl Axis {
             // A drive that reports no number is a faulty drive; keep the last good values.
             let fb = DriveFeedback {
                 fault: true,
-                actual_position: (self.act_pos - self.offset - self.corrections.sent) / self.enc_k,
+                actual_position: (self.act_pos - self.offset - self.corrections.read) / self.enc_k,
                 actual_velocity: 0.0,
                 ..*fb
             };
@@ -39,7 +39,8 @@ impl Axis {
         self.torque.read(fb);
         // The drive answers the setpoint sent last cycle, which carried that cycle's correction.
         // Read through the encoder scaling (1 unless MC_SetEncoderScalingFactor changed it).
-        self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.sent;
+        self.corrections.read = self.corrections.sent;
+        self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.read;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
         if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {

@@ -45,7 +45,7 @@ impl Axis {
         }
         self.config.parameters.write(write.0, write.1)?;
         // The drive position the actual one was read from.
-        let drive = (self.act_pos - self.offset - self.corrections.sent) / k_old;
+        let drive = (self.act_pos - self.offset - self.corrections.read) / k_old;
         self.enc_k = k_new;
         self.enc_count_scale = 1.0 / (k_new * self.enc_base);
         if relative {
@@ -86,7 +86,7 @@ impl Axis {
         // one multiplication by the reciprocal kept with k (this runs every cycle). The low 32
         // bits of the count (two's complement wraps as the counter does; a cast, not a
         // floating-point remainder).
-        let x = (self.act_pos - self.offset - self.corrections.sent) * self.enc_count_scale;
+        let x = (self.act_pos - self.offset - self.corrections.read) * self.enc_count_scale;
         let incs = (x + 0.5f64.copysign(x)) as i64; // rounded half away from zero
         (incs as u32) & self.p().axis_encoder_mask
     }

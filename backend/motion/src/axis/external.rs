@@ -96,7 +96,9 @@ impl Axis {
             if (sample.position - self.set.position).abs() > vmax * self.cycle_time {
                 return Err(ErrorId::EXT_SETPOINT_INVALID);
             }
-            self.check_feed_enable(sample.velocity.signum())?;
+            if sample.velocity != 0.0 {
+                self.check_feed_enable(sample.velocity.signum())?;
+            }
             let mut job = Job::new(id, JobKind::External);
             job.buffer_mode = BufferMode::Aborting;
             job.velocity = p.axis_velo_max;
@@ -152,10 +154,15 @@ impl Axis {
             p.axis_fast_dec.max(p.axis_dec),
             p.axis_fast_jerk.max(p.axis_jerk),
         );
-        let reach = stop_distance(next.velocity, next.acceleration, dec, jerk)
-            + 2.0 * next.velocity.abs() * dt;
-        let ahead_max = if next.velocity > 0.0 { reach } else { 0.0 };
-        let ahead_min = if next.velocity < 0.0 { reach } else { 0.0 };
+        // The velocity the samples really move at, whatever they declare.
+        let v = if step.abs() > next.velocity.abs() {
+            step
+        } else {
+            next.velocity
+        };
+        let reach = stop_distance(v, next.acceleration, dec, jerk) + 2.0 * v.abs() * dt;
+        let ahead_max = if v > 0.0 { reach } else { 0.0 };
+        let ahead_min = if v < 0.0 { reach } else { 0.0 };
         let beyond = (p.axis_en_max_soft_pos_limit
             && next.position + ahead_max > p.axis_max_soft_pos_limit)
             || (p.axis_en_min_soft_pos_limit

@@ -309,7 +309,7 @@ impl Axis {
         }
         if fb.latch_valid {
             self.latch = None;
-            return Some(self.enc_k * fb.latch_position + self.offset + self.corrections.sent);
+            return Some(self.enc_k * fb.latch_position + self.offset + self.corrections.read);
         }
         None
     }

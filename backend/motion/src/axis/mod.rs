@@ -187,6 +187,8 @@ pub struct Axis {
     phase: Kinematics,
     /// Boxed: a planner is large, and the axis's hot fields stay close together without it.
     phase_planner: Box<Planner>,
+    /// A new phasing is planned here first and swapped in when it succeeds.
+    phase_scratch: Box<Planner>,
     phasing: Option<phasing::PhasingJob>,
     /// Position correction (§7.2): limiter, backlash and table compensation.
     corrections: correction::Corrections,
@@ -286,6 +288,7 @@ impl Axis {
             new_target: false,
             phase: Kinematics::default(),
             phase_planner: Box::new(Planner::new(cycle_time)),
+            phase_scratch: Box::new(Planner::new(cycle_time)),
             phasing: None,
             corrections: correction::Corrections::default(),
             enc_base,
@@ -382,6 +385,8 @@ impl Axis {
         if let Some(t) = self.last_target.as_mut() {
             *t += shift;
         }
+        // A coordinate shift is no travel (backlash direction, FULLLENGTH).
+        self.corrections.last_set += shift;
         if self.planner.is_planned() && !self.ramping_in() {
             self.planner.shift(shift);
         }

@@ -376,7 +376,8 @@ impl Axis {
 
     pub(super) fn start_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, mut job: Job) {
         job.activate(cx);
-        if job.kind != JobKind::Halt {
+        if job.kind != JobKind::Halt && job.id != 0 {
+            // A motion command clears it; an internal job (a monitoring stop's) does not.
             self.has_been_stopped = false;
         }
         self.new_target = job.is_positioning() && self.set.velocity.abs() > EPS_V;

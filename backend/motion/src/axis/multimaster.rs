@@ -44,6 +44,12 @@ impl MultiGear {
         self.in_gear
     }
 
+    /// Phasing needs dynamic ratios with AdvancedSlaveDynamics and a slave that makes up
+    /// positions (§5.6).
+    pub(super) fn takes_phasing(&self) -> bool {
+        self.advanced && self.sync != MultiMasterSyncMode::Velosync
+    }
+
     pub(super) fn shift_slave(&mut self, d: f64) {
         self.slave_start += d;
         if let Some(k) = self.last_ideal.as_mut() {

@@ -42,8 +42,15 @@ impl Axis {
         if ph.kind != PhasingKind::Halt && ph.velocity < 0.01 {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
-        let coupled = match self.coupling {
-            Some(c) if c.master == master => !matches!(c.law, CouplingLaw::GearDyn { .. }),
+        // §5.6: a gear or a cam; dynamic ratios only with MC_GearInMultiMaster's
+        // AdvancedSlaveDynamics, and only where the slave makes up positions (POSSYNC): a
+        // velocity-synchronous slave would never establish a shift.
+        let coupled = match self.coupling.as_ref() {
+            Some(c) if c.master == master => match &c.law {
+                CouplingLaw::GearDyn { .. } => false,
+                CouplingLaw::Multi(m) => m.takes_phasing(),
+                _ => true,
+            },
             _ => false,
         };
         if !coupled || self.mode != Mode::Enabled {
@@ -62,8 +69,8 @@ impl Axis {
         };
         let (planned, target) = match ph.kind {
             PhasingKind::Halt => {
-                let r = self.phase_planner.plan_velocity(from, 0.0, &limits);
-                (r, self.phase_planner.end_state().position)
+                let r = self.phase_scratch.plan_velocity(from, 0.0, &limits);
+                (r, self.phase_scratch.end_state().position)
             }
             kind => {
                 let target = if kind == PhasingKind::Absolute {
@@ -76,25 +83,16 @@ impl Axis {
                     ..limits
                 };
                 (
-                    self.phase_planner.plan_position(from, target, 0.0, &limits),
+                    self.phase_scratch.plan_position(from, target, 0.0, &limits),
                     target,
                 )
             }
         };
+        // Planned on the spare planner: a refusal leaves the running phase as it was.
         if planned.is_err() {
-            // The checks above leave the solver nothing it cannot solve; should it fail all
-            // the same, the running phase (whose plan the attempt overwrote) stops on the
-            // closed-form ramp and its command ends with the error.
-            if let Some(mut old) = self.phasing.take() {
-                old.cmd.end(cx, End::Error(ErrorId::PLANNING_FAILED));
-            }
-            if from.velocity != 0.0 || from.acceleration != 0.0 {
-                self.phase_planner.plan_fallback_stop(from, dec, jerk);
-            } else {
-                self.phase_planner.clear();
-            }
             return Err(ErrorId::PLANNING_FAILED);
         }
+        core::mem::swap(&mut self.phase_planner, &mut self.phase_scratch);
         if let Some(mut old) = self.phasing.take() {
             old.cmd.end(cx, End::Aborted);
         }
@@ -129,13 +127,21 @@ impl Axis {
             return;
         };
         let d = k.position - self.phase.position;
+        // A multi-master slave with advanced dynamics follows its law within its own limits:
+        // the phase moves the law, and the slave catches up as it makes up any offset.
+        let law_only = self
+            .coupling
+            .as_ref()
+            .is_some_and(|c| matches!(c.law, CouplingLaw::Multi(_)));
         if let Some(c) = self.coupling.as_mut() {
             c.law.shift_slave(d);
         }
-        self.set.position += d;
-        self.set.velocity += k.velocity;
-        self.set.acceleration += k.acceleration;
-        self.set.jerk += k.jerk;
+        if !law_only {
+            self.set.position += d;
+            self.set.velocity += k.velocity;
+            self.set.acceleration += k.acceleration;
+            self.set.jerk += k.jerk;
+        }
         self.phase = k;
         if self.phase_planner.finished() {
             let ph = self.phasing.take();
@@ -148,7 +154,9 @@ impl Axis {
             if let Some(c) = self.coupling.as_mut() {
                 c.law.shift_slave(rest);
             }
-            self.set.position += rest;
+            if !law_only {
+                self.set.position += rest;
+            }
             self.phase = Kinematics {
                 position: at,
                 ..Kinematics::default()

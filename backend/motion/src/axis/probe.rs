@@ -91,7 +91,7 @@ impl Axis {
             return false;
         }
         if p.sent && fb.latch_valid {
-            let absolute = self.enc_k * fb.latch_position + self.offset + self.corrections.sent;
+            let absolute = self.enc_k * fb.latch_position + self.offset + self.corrections.read;
             let modulo = if period > 0.0 {
                 absolute.rem_euclid(period)
             } else {

@@ -70,6 +70,14 @@ impl Axis {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
         match self.state() {
+            // Not over a torque or a client's samples: neither is a planned motion to lay a
+            // distance on.
+            _ if self
+                .job
+                .is_some_and(|j| matches!(j.kind, JobKind::Torque | JobKind::External)) =>
+            {
+                return Err(ErrorId::AXIS_CANNOT_BE_STARTED);
+            }
             AxisState::DiscreteMotion
             | AxisState::ContinuousMotion
             | AxisState::SynchronizedMotion => {}

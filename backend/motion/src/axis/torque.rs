@@ -138,10 +138,12 @@ impl Axis {
         dt: f64,
         fb: &DriveFeedback,
     ) {
+        // With the load's acceleration: a software limit's braking distance needs it.
         self.set = Kinematics {
             position: self.act_pos,
             velocity: self.act_vel,
-            ..Kinematics::default()
+            acceleration: self.act_acc,
+            jerk: 0.0,
         };
         let t = &mut self.torque;
         if fb.mode == DriveMode::Torque {

@@ -161,3 +161,39 @@ fn s4_4_motion_commands_need_1066_but_a_stop_never_does() {
     r.until(3.0, |r| r.out(m).done);
     assert_eq!(r.st(0).set_position, 0.0);
 }
+
+/// A relative MC_SetPosition while the generator moves the axis would shift the axis under
+/// the client's samples (the drive would jump back to them): refused, as a superposition is.
+#[test]
+fn s4_4_no_set_position_or_superposition_under_a_stream() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    r.ok(0, enable(None, 0.5));
+    r.ok(0, feed(0.0, 50.0));
+    r.run(0.05);
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::SetPosition {
+                position: 0.3,
+                relative: true,
+                clear_position_lag: false,
+                clear_position_offset: false
+            }
+        ),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+    assert_eq!(
+        r.rejected(
+            0,
+            CommandKind::MoveSuperImposed(Superposition {
+                distance: 1.0,
+                velocity_diff: 10.0,
+                velocity_process: 50.0,
+                length: 100.0,
+                ..Superposition::default()
+            })
+        ),
+        ErrorId::AXIS_CANNOT_BE_STARTED
+    );
+}

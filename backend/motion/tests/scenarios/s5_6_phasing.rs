@@ -214,3 +214,63 @@ fn s5_6_gear_out_aborts_phasing_and_a_new_coupling_starts_at_zero_shift() {
     r.ok(1, gear_in(0, 1.0, 1));
     assert_eq!(r.st(1).absolute_phase_shift, 0.0);
 }
+
+/// §5.6 on MC_GearInMultiMaster: with AdvancedSlaveDynamics in a position-synchronous mode the
+/// phase moves the law and the slave, following within its own limits, ends the shift ahead
+/// of its master; without advanced dynamics, or in VELOSYNC (a slave that makes up no
+/// position), phasing is refused (0x70B0).
+#[test]
+fn s5_6_phasing_on_a_multi_master_slave_needs_advanced_position_sync() {
+    let multi = |advanced: bool, sync: MultiMasterSyncMode| {
+        CommandKind::GearInMultiMaster(GearInMultiMaster {
+            masters: [Some(0), None, None, None],
+            ratios: [1.0, 0.0, 0.0, 0.0],
+            acceleration: 1000.0,
+            deceleration: 1000.0,
+            jerk: 10_000.0,
+            advanced_slave_dynamics: advanced,
+            sync_mode: sync,
+        })
+    };
+    for (advanced, sync) in [
+        (false, MultiMasterSyncMode::Possync2),
+        (true, MultiMasterSyncMode::Velosync),
+    ] {
+        let mut r = Rig::new(2);
+        r.power_on(0);
+        r.power_on(1);
+        r.until(1.0, |r| r.st(1).state == AxisState::Standstill);
+        r.ok(1, multi(advanced, sync));
+        assert_eq!(
+            r.rejected(1, phasing(PhasingKind::Relative, 1.0, 10.0)),
+            ErrorId::PHASING_NOT_COUPLED,
+            "{advanced} {sync:?}"
+        );
+    }
+    let mut r = Rig::new(2);
+    r.power_on(0);
+    r.power_on(1);
+    r.until(1.0, |r| r.st(1).state == AxisState::Standstill);
+    let g = r.ok(1, multi(true, MultiMasterSyncMode::Possync2));
+    let v = r.ok(0, velocity(50.0, Direction::Positive));
+    r.until(2.0, |r| r.out(v).in_velocity && r.out(g).in_gear);
+    let ph = r.ok(1, phasing(PhasingKind::Relative, 10.0, 50.0));
+    let before = phase(&r).0;
+    let mut max_v: f64 = 0.0;
+    r.until(5.0, |r| {
+        max_v = max_v.max(r.st(1).set_velocity);
+        !r.out(ph).busy
+    });
+    assert!(r.out(ph).done);
+    r.run(1.0);
+    assert!(
+        (phase(&r).0 - before - 10.0).abs() < 0.01,
+        "the slave ended 10 ahead: {}",
+        phase(&r).0 - before
+    );
+    assert!(
+        (r.st(1).set_velocity - 50.0).abs() < 1e-6,
+        "and runs with the master again"
+    );
+    assert!(max_v < 50.0 + 50.0 + 1.0, "no runaway: {max_v}");
+}
