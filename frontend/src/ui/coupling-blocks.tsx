@@ -108,7 +108,7 @@ export function PhasingPanel({ axis: a, s, online, send, masters }: BlockProps &
         </div>
       </form>
       <p class="small muted panel-note">
-        For a slave coupled to this master by GearIn, a cam or GearInMultiMaster (not GearInDyn). The shift stays when the phasing ends; a new coupling starts at 0.
+        For a slave coupled to this master by GearIn, a cam, or GearInMultiMaster with advanced slave dynamics in possync1/2 (not GearInDyn). The shift stays when the phasing ends; a new coupling starts at 0.
       </p>
     </Panel>
   );
