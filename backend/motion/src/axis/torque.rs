@@ -22,6 +22,8 @@ pub(super) struct TorqueState {
     pub(super) limit_low: f64,
     /// Seconds the running torque job has waited for the drive to report torque mode.
     waiting: f64,
+    /// Seconds the drive has kept reporting torque mode with no torque control running.
+    leaving: f64,
     /// The position-based mode the drive is to run in (MC_WriteDriveOperationMode).
     position_mode: DriveMode,
     /// MC_WriteDriveOperationMode waiting for the drive to report its mode.
@@ -201,6 +203,22 @@ impl Axis {
     /// MC_WriteDriveOperationMode's end: the drive reports the mode (Done) or does not within
     /// the timeout (0x70B4).
     pub(super) fn step_drive_mode(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
+        // The manual's danger note (§5.7.1): a drive left in torque mode after torque control
+        // moves unplanned. Asked back to its position mode, it must show it within the
+        // timeout, or the axis goes to ErrorStop.
+        let torque_job = self.job.is_some_and(|j| j.kind == JobKind::Torque);
+        if !torque_job
+            && self.torque.reported == DriveMode::Torque
+            && matches!(self.mode, Mode::Enabled | Mode::Stopping)
+        {
+            self.torque.leaving += dt;
+            if self.torque.leaving > MODE_SWITCH_TIMEOUT {
+                self.torque.leaving = 0.0;
+                self.enter_error(cx, ErrorId::DRIVE_MODE_NOT_REACHED);
+            }
+        } else {
+            self.torque.leaving = 0.0;
+        }
         let Some((mut held, mode, waited)) = self.torque.pending.take() else {
             return;
         };

@@ -42,6 +42,9 @@ pub struct Plant {
     /// `torque_acceleration` per percent, less `friction` percent against the motion, and the
     /// drive holds the velocity within the setpoint's limits.
     pub torque_mode: bool,
+    /// A drive that does not leave torque mode when asked back to position (the manual's
+    /// danger note): it stays in it with no torque.
+    pub stays_in_torque: bool,
     pub torque_acceleration: f64,
     pub friction: f64,
     torque: f64,
@@ -67,6 +70,7 @@ impl Default for Plant {
             load_lag: 0.0,
             probe_mark: None,
             torque_mode: false,
+            stays_in_torque: false,
             torque_acceleration: 100.0,
             friction: 1.0,
             torque: 0.0,
@@ -124,22 +128,29 @@ impl Plant {
             self.pending = 0;
         }
         self.prev_pos = self.pos;
-        self.torque_mode = sp.mode == DriveMode::Torque && self.enabled;
+        self.torque_mode = (sp.mode == DriveMode::Torque
+            || (self.stays_in_torque && self.torque_mode))
+            && self.enabled;
         self.velocity_limited = false;
         if self.torque_mode {
+            let torque = if sp.mode == DriveMode::Torque {
+                sp.torque
+            } else {
+                0.0
+            };
             let drag = if self.vel != 0.0 {
                 self.friction * self.vel.signum()
             } else {
                 0.0
             };
-            let mut v = self.vel + (sp.torque - drag) * self.torque_acceleration * dt;
+            let mut v = self.vel + (torque - drag) * self.torque_acceleration * dt;
             if v > sp.velocity_limit_high || v < sp.velocity_limit_low {
                 v = v.clamp(sp.velocity_limit_low, sp.velocity_limit_high);
                 self.velocity_limited = true;
             }
             self.pos += 0.5 * (self.vel + v) * dt;
             self.vel = v;
-            self.torque = sp.torque;
+            self.torque = torque;
         } else if self.enabled {
             let target = sp.position;
             let new = if self.tau > 0.0 {

@@ -178,3 +178,19 @@ fn s4_5_1_write_drive_operation_mode_and_select_control_loop() {
         ErrorId::CONTROL_LOOP_UNKNOWN
     );
 }
+
+/// §5.7.1's danger note: a drive that stays in torque mode after torque control ends (here
+/// one that ignores the request to go back to position mode) puts the axis in ErrorStop with
+/// 0x70B4 once the timeout (0.5 s) has passed, instead of being taken as position-controlled.
+#[test]
+fn s5_7_1_a_drive_left_in_torque_mode_is_an_axis_error() {
+    let mut r = Rig::new(1);
+    power(&mut r);
+    r.plants[0].stays_in_torque = true;
+    let t = r.ok(0, torque(2.0, 1000.0, 20.0, -20.0));
+    r.until(1.0, |r| r.out(t).in_torque);
+    r.ok(0, halt());
+    let cycles = r.until(2.0, |r| r.st(0).state == AxisState::ErrorStop);
+    assert_eq!(r.st(0).error_id, ErrorId::DRIVE_MODE_NOT_REACHED.0);
+    assert!((500..=503).contains(&cycles), "{cycles}");
+}
