@@ -183,11 +183,9 @@ fn cycle(c: &mut Criterion) {
     });
 }
 
-/// One master at constant velocity and 63 cam slaves: odd ones through a periodic 20-segment
-/// motion function, even ones through a periodic 100 000-row spline table.
-fn cam_machine() -> Machine {
-    use motion::cam::*;
-    use std::sync::Arc;
+/// 64 powered axes at rest with no command traffic of the benchmark's own (`n` = 0), their
+/// parameters as `tune` leaves them, the kernel's cam tables put in by `cams`.
+fn powered_64(tune: impl Fn(&mut AxisParameters), cams: impl FnOnce(&mut Kernel)) -> Machine {
     let mut m = Machine::new(1);
     let n = 64;
     let mut k = Kernel::new(0.001, n);
@@ -195,6 +193,7 @@ fn cam_machine() -> Machine {
         let mut p = AxisParameters::default();
         p.axis_max_pos_lag_value = 1e6;
         p.axis_velo_max = 1e6;
+        tune(&mut p);
         k.insert_axis(
             i as u16,
             Axis::new(
@@ -208,6 +207,35 @@ fn cam_machine() -> Machine {
         )
         .unwrap();
     }
+    cams(&mut k);
+    m.k = k;
+    m.fb = vec![DriveFeedback::default(); n];
+    m.sp = vec![DriveSetpoint::default(); n];
+    m.n = 0; // no command traffic in cycle_once
+    for a in 0..n as u16 {
+        m.submit(
+            a,
+            CommandKind::Power {
+                enable: true,
+                enable_positive: true,
+                enable_negative: true,
+                override_percent: 100.0,
+                buffer_mode: BufferMode::Aborting,
+            },
+        );
+    }
+    for _ in 0..10 {
+        m.cycle_once();
+    }
+    m
+}
+
+/// One master at constant velocity and 63 cam slaves: odd ones through a periodic 20-segment
+/// motion function, even ones through a periodic 100 000-row spline table.
+fn cam_machine() -> Machine {
+    use motion::cam::*;
+    use std::sync::Arc;
+    let n = 64;
     let laws = [
         MotionFunctionType::Polynom5,
         MotionFunctionType::Bestehorn,
@@ -240,28 +268,14 @@ fn cam_machine() -> Machine {
     let mut table = CamTableData::positions(rows, false);
     table.periodic = true;
     table.interpolation = InterpolationType::Spline;
-    k.insert_cam(1, Arc::new(Cam::build(&mf).unwrap())).unwrap();
-    k.insert_cam(2, Arc::new(Cam::build(&table).unwrap()))
-        .unwrap();
-    m.k = k;
-    m.fb = vec![DriveFeedback::default(); n];
-    m.sp = vec![DriveSetpoint::default(); n];
-    m.n = 0; // no command traffic in cycle_once
-    for a in 0..n as u16 {
-        m.submit(
-            a,
-            CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent: 100.0,
-                buffer_mode: BufferMode::Aborting,
-            },
-        );
-    }
-    for _ in 0..10 {
-        m.cycle_once();
-    }
+    let mut m = powered_64(
+        |_| {},
+        |k| {
+            k.insert_cam(1, Arc::new(Cam::build(&mf).unwrap())).unwrap();
+            k.insert_cam(2, Arc::new(Cam::build(&table).unwrap()))
+                .unwrap();
+        },
+    );
     for a in 1..n as u16 {
         let v = m.submit(
             a,
@@ -320,46 +334,8 @@ fn cams(c: &mut Criterion) {
 /// axis, a multi-master slave of both with AdvancedSlaveDynamics in POSSYNC2 (replanned every
 /// cycle), and a gear slave of the first being phased.
 fn issue9_machine() -> Machine {
-    let mut m = Machine::new(1);
     let n = 64;
-    let mut k = Kernel::new(0.001, n);
-    for i in 0..n {
-        let mut p = AxisParameters::default();
-        p.axis_max_pos_lag_value = 1e6;
-        p.axis_velo_max = 1e6;
-        p.axis_enable_pos_correction = true;
-        k.insert_axis(
-            i as u16,
-            Axis::new(
-                AxisConfig {
-                    modulo: false,
-                    parameters: p,
-                    compensation_table: None,
-                },
-                0.001,
-            ),
-        )
-        .unwrap();
-    }
-    m.k = k;
-    m.fb = vec![DriveFeedback::default(); n];
-    m.sp = vec![DriveSetpoint::default(); n];
-    m.n = 0; // no command traffic in cycle_once
-    for a in 0..n as u16 {
-        m.submit(
-            a,
-            CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent: 100.0,
-                buffer_mode: BufferMode::Aborting,
-            },
-        );
-    }
-    for _ in 0..10 {
-        m.cycle_once();
-    }
+    let mut m = powered_64(|p| p.axis_enable_pos_correction = true, |_| {});
     let velocity = |v: f64| CommandKind::MoveVelocity {
         velocity: v,
         dynamics: Dynamics::default(),

@@ -962,7 +962,8 @@ pub struct TableCompensationBody {
 
 /// MC_PhasingAbsolute / MC_PhasingRelative (§5.6.2, §5.6.3): a phase shift of this slave
 /// against its master made by a jerk-limited superimposed motion (the slave coupled by
-/// gear-in or a cam, not gear-in-dyn). BufferMode is Aborting only: a new phasing command
+/// gear-in, a cam, or gear-in-multi-master with advanced slave dynamics in possync1/2 — not
+/// gear-in-dyn). BufferMode is Aborting only: a new phasing command
 /// takes over from the running one's velocity, which is also how ContinuousUpdate is
 /// served. The shift reached is the status's `absolute_phase_shift` / `covered_phase_shift`.
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]

@@ -768,7 +768,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in or a cam) */
+        /** MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in, a cam, or gear-in-multi-master with advanced slave dynamics in possync1/2) */
         post: operations["phasing_absolute"];
         delete?: never;
         options?: never;
@@ -5565,7 +5565,8 @@ export interface components {
         /**
          * @description MC_PhasingAbsolute / MC_PhasingRelative (§5.6.2, §5.6.3): a phase shift of this slave
          *     against its master made by a jerk-limited superimposed motion (the slave coupled by
-         *     gear-in or a cam, not gear-in-dyn). BufferMode is Aborting only: a new phasing command
+         *     gear-in, a cam, or gear-in-multi-master with advanced slave dynamics in possync1/2 — not
+         *     gear-in-dyn). BufferMode is Aborting only: a new phasing command
          *     takes over from the running one's velocity, which is also how ContinuousUpdate is
          *     served. The shift reached is the status's `absolute_phase_shift` / `covered_phase_shift`.
          * @example {

@@ -188,7 +188,7 @@ impl Axis {
         let c = &mut self.corrections;
         let mine = |s: &Source| s.cmd.is_some_and(|h| h.id == target);
         if mine(&c.limiter) {
-            c.limiter.disable_mode = DisableMode::Hold;
+            // (The limiter's DisableMode is never set: it holds.)
             c.limiter.end(cx, End::Done);
         } else if mine(&c.backlash) {
             c.backlash.end(cx, End::Done);
@@ -234,7 +234,6 @@ impl Axis {
     /// as its DisableMode says: an enable that is gone cannot keep a block active.
     pub(super) fn end_corrections(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         let c = &mut self.corrections;
-        c.limiter.disable_mode = DisableMode::Hold;
         for s in [&mut c.limiter, &mut c.backlash, &mut c.table] {
             if s.cmd.is_some() {
                 s.end(cx, End::Aborted);

@@ -6,7 +6,7 @@
 //! what it makes up: VELOSYNC only the velocity, POSSYNC1 also positions lost to limiting once
 //! coupled, POSSYNC2 everything (coupling in motion, ratio changes, limiting).
 
-use super::coupling::{Coupling, CouplingLaw, Master};
+use super::coupling::{CouplingLaw, Master};
 use super::*;
 use crate::command::{GearInMultiMaster, MultiMasterSyncMode};
 
@@ -178,18 +178,11 @@ impl Axis {
                 _ => return Err(ErrorId::MASTER_INVALID),
             }
         }
-        let masters_of = |c: &Coupling| {
-            [
-                Some(c.master),
-                c.more_masters[0],
-                c.more_masters[1],
-                c.more_masters[2],
-            ]
-        };
         // Enable still TRUE on the same masters: new ratios.
         let order = self.multi_order(&g.masters);
+        let same_masters = self.coupled_masters() == order.0;
         if let Some(c) = self.coupling.as_mut().filter(|c| {
-            c.dyn_command != 0 && matches!(c.law, CouplingLaw::Multi(_)) && masters_of(c) == order.0
+            same_masters && c.dyn_command != 0 && matches!(c.law, CouplingLaw::Multi(_))
         }) {
             if let CouplingLaw::Multi(m) = &mut c.law {
                 m.retarget(permute(ratios, order.1), permute(rate, order.1));
@@ -270,9 +263,10 @@ impl Axis {
         master: Master,
         dt: f64,
     ) {
-        let Some(mut c) = self.coupling else { return };
-        let CouplingLaw::Multi(mut law) = c.law else {
-            return;
+        // The law alone is copied (a coupling carries a cam set's size).
+        let mut law = match self.coupling.as_ref().map(|c| &c.law) {
+            Some(CouplingLaw::Multi(m)) => *m,
+            _ => return,
         };
         if !matches!(master, Master::Sample(_)) {
             return;
@@ -367,8 +361,9 @@ impl Axis {
             };
             job.emit(cx, out);
         }
-        c.law = CouplingLaw::Multi(law);
-        self.coupling = Some(c);
+        if let Some(c) = self.coupling.as_mut() {
+            c.law = CouplingLaw::Multi(law);
+        }
     }
 }
 

@@ -261,7 +261,7 @@ catalogue! {
     table_based_position_compensation: "table-based-position-compensation", TableCompensationBody, TableCompensationBody::to_kind, Operator, Active,
         "MC_TableBasedPositionCompensation: apply the axis's position compensation table at the set position, at most at `ramp`; active until DELETE /commands/{id}";
     phasing_absolute: "phasing-absolute", PhasingBody, PhasingBody::absolute, Operator, Done,
-        "MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in or a cam)";
+        "MC_PhasingAbsolute: establish a phase shift of this coupled slave against its master by a jerk-limited superimposed motion (409 phasing_not_coupled unless coupled to that master by gear-in, a cam, or gear-in-multi-master with advanced slave dynamics in possync1/2)";
     phasing_relative: "phasing-relative", PhasingBody, PhasingBody::relative, Operator, Done,
         "MC_PhasingRelative: change the phase shift of this coupled slave by phase_shift (covered so far: status covered_phase_shift)";
     halt_phasing: "halt-phasing", HaltPhasingBody, HaltPhasingBody::to_kind, Operator, Done,

@@ -110,8 +110,15 @@ pub async fn read_axis_components(
 /// A read sent over the websocket: `params` without `axis` read as its query; `None` for a
 /// method that is not a read.
 pub fn dispatch(s: &AppState, method: &str, axis: &str, params: Value) -> Option<AppResult<Value>> {
-    fn query<T: serde::de::DeserializeOwned>(params: Value) -> AppResult<T> {
-        serde_json::from_value(params).map_err(|e| AppError::field("params", &e.to_string()))
+    // As a REST body is read: the same field errors.
+    fn query<T: serde::de::DeserializeOwned + utoipa::ToSchema>(params: Value) -> AppResult<T> {
+        super::from_value::<T>(params).map(|(t, _)| t)
+    }
+    fn no_params(params: &Value) -> AppResult<()> {
+        match params.as_object() {
+            Some(m) if m.is_empty() => Ok(()),
+            _ => Err(AppError::field("params", "takes only `axis`")),
+        }
     }
     fn json<T: serde::Serialize>(v: AppResult<T>) -> AppResult<Value> {
         v.map(|r| serde_json::to_value(r).unwrap_or(Value::Null))
@@ -123,14 +130,11 @@ pub fn dispatch(s: &AppState, method: &str, axis: &str, params: Value) -> Option
         "convert-pos-to-inc-pos" => json(
             query::<PositionQuery>(params).and_then(|q| reads::convert_pos_to_inc_pos(s, axis, &q)),
         ),
-        "read-axis-components" | "read-drive-operation-mode" => {
-            match params.as_object().map(|m| m.is_empty()) {
-                Some(true) if method == "read-axis-components" => {
-                    json(reads::read_axis_components(s, axis))
-                }
-                Some(true) => json(reads::read_drive_operation_mode(s, axis)),
-                _ => Err(AppError::field("params", "takes only `axis`")),
-            }
+        "read-axis-components" => {
+            json(no_params(&params).and_then(|()| reads::read_axis_components(s, axis)))
+        }
+        "read-drive-operation-mode" => {
+            json(no_params(&params).and_then(|()| reads::read_drive_operation_mode(s, axis)))
         }
         _ => return None,
     })
