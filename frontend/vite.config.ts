@@ -1,6 +1,6 @@
 import type { ProxyOptions } from 'vite';
 import { defineConfig } from 'vitest/config';
-import { asMotiondsOwn } from './dev-proxy';
+import { asMotiondsOwn } from './dev-proxy.ts';
 
 // Development: `npm run dev` serves the UI with a proxy to a running motiond
 // (MOTIOND_URL, default http://127.0.0.1:8080). `npm run preview` serves dist/ the same way.
