@@ -2303,3 +2303,96 @@ async fn metrics_count_commands_and_describe_axes_and_process() {
     );
     assert!(om.text().await.unwrap().ends_with("# EOF\n"));
 }
+
+/// `?wait=true` says how the wait ended (issue 28, defect 2): a power on an axis in
+/// error_stop cannot reach Status before a reset — the answer comes at once with
+/// `wait.reached: false`, the reason, the axis state and its error — and a wait that reaches
+/// its milestone says so.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_wait_says_why_it_ended_early() {
+    let s = Server::start();
+    let r = post(&s, "/api/v1/axes/x/power?wait=true", json!({})).await;
+    assert_eq!(r.json["wait"]["reached"], true, "{}", r.text);
+    assert_eq!(r.json["wait"]["milestone"], "status", "{}", r.text);
+    assert!(r.json["wait"]["reason"].is_null(), "{}", r.text);
+    let r = post(&s, "/api/v1/axes/x/simulation/fault", json!({"kind": "drive_fault", "code": 8976})).await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    until_status(&s, "x", 20, |st| st["state"] == "error_stop").await;
+    let r = post(&s, "/api/v1/axes/x/power?wait=true&timeout_ms=30000", json!({})).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["state"], "active", "{}", r.text);
+    assert_eq!(r.json["outputs"]["status"], false, "{}", r.text);
+    let w = &r.json["wait"];
+    assert_eq!(w["reached"], false, "{}", r.text);
+    assert_eq!(w["reason"], "axis_error_stop", "{}", r.text);
+    assert_eq!(w["axis_state"], "error_stop", "{}", r.text);
+    assert_eq!(w["axis_error_id"], 0x7010, "{}", r.text);
+    assert_eq!(w["axis_error_code"], "drive_fault", "{}", r.text);
+    // A wait that runs out says `timeout`: a long move waited for 50 ms.
+    let r = post(&s, "/api/v1/axes/y/power?wait=true", json!({})).await;
+    assert_eq!(r.json["wait"]["reached"], true, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/move-absolute?wait=true&timeout_ms=50",
+        json!({"position": 900.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_eq!(r.json["wait"]["reached"], false, "{}", r.text);
+    assert_eq!(r.json["wait"]["reason"], "timeout", "{}", r.text);
+    assert_eq!(r.json["wait"]["milestone"], "done", "{}", r.text);
+    // Without wait there is no `wait`.
+    let r = post(&s, "/api/v1/axes/y/halt", json!({})).await;
+    assert!(r.json.get("wait").is_none(), "{}", r.text);
+    s.stop();
+}
+
+/// A command the axis refuses names what is in the way and what to do (issue 28, defect 3).
+#[tokio::test(flavor = "multi_thread")]
+async fn refusals_say_what_is_in_the_way() {
+    let s = Server::start();
+    let mv = json!({"position": 10.0, "velocity": 100.0});
+    let r = post(&s, "/api/v1/axes/x/move-absolute", mv.clone()).await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    let d = r.json["detail"].as_str().unwrap();
+    assert!(d.contains("disabled") && d.contains("power"), "{d}");
+    power_on(&s, "x").await;
+    let stop = post(&s, "/api/v1/axes/x/stop?wait=true", json!({})).await;
+    assert_eq!(stop.json["state"], "done", "{}", stop.text);
+    let id = stop.json["id"].as_u64().unwrap();
+    let r = post(&s, "/api/v1/axes/x/move-absolute", mv.clone()).await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    let d = r.json["detail"].as_str().unwrap();
+    assert!(
+        d.contains(&format!("MC_Stop (command {id})")) && d.contains(&format!("DELETE /api/v1/commands/{id}")),
+        "{d}"
+    );
+    let r = post(&s, "/api/v1/axes/x/simulation/fault", json!({"kind": "drive_fault", "code": 8976})).await;
+    assert_eq!(r.status, 204);
+    until_status(&s, "x", 20, |st| st["state"] == "error_stop").await;
+    let r = post(&s, "/api/v1/axes/x/move-absolute", mv.clone()).await;
+    let d = r.json["detail"].as_str().unwrap();
+    assert!(d.contains("error_stop with 0x7010 drive_fault") && d.contains("reset"), "{d}");
+    // A cam that would make the slave jump says where the slave must be.
+    let table = json!({"name": "lift", "table_type": "motion_function", "points": [
+        {"point_index": 1, "function_type": "polynom5", "point_type": "rest", "master_pos": 0, "slave_pos": 10},
+        {"point_index": 2, "function_type": "polynom5", "point_type": "rest", "master_pos": 200, "slave_pos": 100}]});
+    assert_eq!(post(&s, "/api/v1/cam-tables", table).await.status, 201);
+    power_on(&s, "y").await;
+    power_on(&s, "spindle").await;
+    let r = post(&s, "/api/v1/axes/y/cam-in", json!({"master": "spindle", "cam_table": "lift"})).await;
+    assert_problem(&r, 409, "cam_slave_would_jump");
+    let d = r.json["detail"].as_str().unwrap();
+    assert!(d.contains("puts the slave at 10 ") && d.contains("the slave is at 0"), "{d}");
+    // A cam table id out of 1..255 carries its number (docs/errors.md 0x4B32).
+    for id in [0, 256] {
+        let r = post(
+            &s,
+            "/api/v1/cam-tables",
+            json!({"name": format!("t{id}"), "id": id, "table_type": "non_equidistant", "rows": [[0.0, 0.0], [1.0, 1.0]]}),
+        )
+        .await;
+        assert_problem(&r, 422, "validation_failed");
+        assert_eq!(r.json["error_id"], 0x4B32, "{}", r.text);
+    }
+    s.stop();
+}

@@ -661,6 +661,35 @@ async fn remote_listening_needs_a_user_and_serves_only_tls() {
     let log = s.log.lock().unwrap().join("\n");
     assert!(log.contains(&fp), "{log}");
     s.stop();
+    // A name it does not carry (issue 28, defect 8): renewed, said in the log, and the new
+    // certificate is valid for the new name (and the earlier ones); a name given twice is one.
+    let s = Server::start_with(
+        db,
+        &["--tls", "--public-name", "cell-7.example", "--public-name", "machine.example", "--public-name", "cell-7.example"],
+    );
+    let log = s.log.lock().unwrap().join("\n");
+    assert!(!log.contains(&fp), "renewed: {log}");
+    assert!(log.contains("does not name cell-7.example"), "{log}");
+    let made = log
+        .lines()
+        .find(|l| l.contains("made a self-signed TLS certificate for"))
+        .unwrap_or_default()
+        .to_owned();
+    assert_eq!(made.matches("cell-7.example").count(), 1, "{made}");
+    assert!(made.contains("machine.example"), "{made}");
+    let fp2 = log
+        .split("SHA-256 fingerprint ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap()
+        .to_owned();
+    s.stop();
+    // The same names again: kept.
+    let s = Server::start_with(db, &["--tls", "--public-name", "cell-7.example"]);
+    let log = s.log.lock().unwrap().join("\n");
+    assert!(log.contains(&fp2), "{log}");
+    assert!(!log.contains("making a new one"), "{log}");
+    s.stop();
 }
 
 /// One request over TLS accepting any certificate (the test pins the fingerprint itself):
@@ -733,4 +762,65 @@ async fn tls_request(addr: &str, request: &str) -> (Vec<u8>, String) {
     let _ = tls.read_to_end(&mut out).await;
     let text = String::from_utf8_lossy(&out).into_owned();
     (digest, text)
+}
+
+/// A token made while authentication was off (no user: anyone on loopback could make it) ends
+/// when the first user turns authentication on (decision 118): afterwards it is a 401, it is
+/// listed as revoked, and the audit log says why. Tokens made after that are kept.
+#[tokio::test(flavor = "multi_thread")]
+async fn tokens_made_in_open_mode_end_when_authentication_turns_on() {
+    let s = Server::start();
+    let r = call(
+        &s,
+        "POST",
+        "/api/v1/tokens",
+        None,
+        "c",
+        Some(json!({"name": "made-anonymously", "role": "admin"})),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let open = r.json["token"].as_str().unwrap().to_owned();
+    let r = call(&s, "GET", "/api/v1/axes", Some(&open), "c", None).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    // The first user, an admin (authentication on from now).
+    let r = call(
+        &s,
+        "POST",
+        "/api/v1/users",
+        None,
+        "c",
+        Some(json!({"name": "anna", "role": "admin", "password": "secret-pass-1"})),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let r = call(&s, "GET", "/api/v1/axes", Some(&open), "c", None).await;
+    assert_eq!(r.status, 401, "the open-mode token ends: {}", r.text);
+    let r = call(&s, "POST", "/api/v1/axes/x/power", Some(&open), "c", Some(json!({}))).await;
+    assert_eq!(r.status, 401, "{}", r.text);
+    let cookie = login(&s, "anna", "secret-pass-1").await;
+    let tokens = call(&s, "GET", "/api/v1/tokens", Some(&cookie), "c", None).await;
+    let t = tokens.json.as_array().unwrap().iter().find(|t| t["name"] == "made-anonymously").cloned().unwrap();
+    assert!(t["revoked_at"].is_string(), "{t}");
+    let audit = call(&s, "GET", "/api/v1/audit?limit=20", Some(&cookie), "c", None).await;
+    assert!(
+        audit.text.contains("authentication turned on") && audit.text.contains("made-anonymously"),
+        "{}",
+        audit.text
+    );
+    // A token the admin makes now is kept, also when a second user is added.
+    let kept = token(&s, &cookie, "line-3", "operator").await;
+    let r = call(
+        &s,
+        "POST",
+        "/api/v1/users",
+        Some(&cookie),
+        "c",
+        Some(json!({"name": "ben", "role": "viewer", "password": "secret-pass-2"})),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let r = call(&s, "GET", "/api/v1/axes", Some(&kept), "c", None).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    s.stop();
 }

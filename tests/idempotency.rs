@@ -9,8 +9,22 @@ use serde_json::{Value, json};
 
 /// POST with an `Idempotency-Key`; the response and whether it says it is a replay.
 async fn post_keyed(s: &Server, path: &str, key: &str, body: Value) -> (Resp, bool) {
-    let r = reqwest::Client::new()
-        .post(s.url(path))
+    post_keyed_as(s, None, path, key, body).await
+}
+
+/// The same with an `X-Client-Id` (another client, when given).
+async fn post_keyed_as(
+    s: &Server,
+    client: Option<&str>,
+    path: &str,
+    key: &str,
+    body: Value,
+) -> (Resp, bool) {
+    let mut req = reqwest::Client::new().post(s.url(path));
+    if let Some(c) = client {
+        req = req.header("x-client-id", c);
+    }
+    let r = req
         .header("content-type", "application/json")
         .header("idempotency-key", key)
         .body(body.to_string())
@@ -234,4 +248,44 @@ async fn a_client_that_gave_up_waiting_gets_the_answer_on_retry() {
     assert_eq!((r.status, replayed), (202, true), "{}", r.text);
     assert_eq!(r.json["state"], "done", "{}", r.text);
     assert_eq!(position(&status(&s, "x").await), 40.0);
+}
+
+/// A key belongs to its sender (issue 28, defect 7): another client (another `X-Client-Id`, or
+/// none) sending the same key and body gets a command of its own, not the first client's
+/// answer; its own retry is a replay of its own command. Also after a restart.
+#[tokio::test(flavor = "multi_thread")]
+async fn keys_are_scoped_per_client() {
+    let dir = temp_dir();
+    let db = dir.join("keys.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+    power_on(&s, "x").await;
+    let mv = json!({"distance": 10.0, "velocity": 100.0});
+    let path = "/api/v1/axes/x/move-relative?wait=true";
+    let (a, replayed) = post_keyed_as(&s, Some("line-1"), path, "order-7", mv.clone()).await;
+    assert_eq!(a.status, 202, "{}", a.text);
+    assert!(!replayed);
+    let (b, replayed) = post_keyed_as(&s, Some("line-2"), path, "order-7", mv.clone()).await;
+    assert_eq!(b.status, 202, "{}", b.text);
+    assert!(!replayed, "another client's key is another key: {}", b.text);
+    assert_ne!(a.json["id"], b.json["id"]);
+    let (c, replayed) = post_keyed_as(&s, None, path, "order-7", mv.clone()).await;
+    assert_eq!(c.status, 202, "{}", c.text);
+    assert!(!replayed);
+    assert_eq!(position(&status(&s, "x").await), 30.0);
+    // Each client's own retry is its own command again.
+    let (b2, replayed) = post_keyed_as(&s, Some("line-2"), path, "order-7", mv.clone()).await;
+    assert!(replayed, "{}", b2.text);
+    assert_eq!(b2.json["id"], b.json["id"]);
+    assert_eq!(position(&status(&s, "x").await), 30.0);
+    s.stop();
+    // After a restart: the stored key is found for its sender only.
+    let s = Server::start_with(db, &[]);
+    power_on(&s, "x").await;
+    let (a3, _) = post_keyed_as(&s, Some("line-1"), path, "order-7", mv.clone()).await;
+    assert_eq!(a3.json["code"], "idempotency_key_replayed", "{}", a3.text);
+    let (d, replayed) = post_keyed_as(&s, Some("line-3"), path, "order-7", mv.clone()).await;
+    assert_eq!(d.status, 202, "{}", d.text);
+    assert!(!replayed);
+    s.stop();
 }

@@ -7,6 +7,20 @@ mod common;
 use common::*;
 use serde_json::json;
 
+/// The probe command once its result is there (read from the status of the cycle that
+/// recorded it).
+async fn with_result(s: &Server, id: u64) -> serde_json::Value {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    loop {
+        let c = get(s, &format!("/api/v1/commands/{id}")).await.json;
+        if c["result"].is_object() {
+            return c;
+        }
+        assert!(std::time::Instant::now() < deadline, "no result: {c}");
+        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    }
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn a_touch_probe_records_where_the_load_passed_the_mark() {
     let s = Server::start();
@@ -41,15 +55,7 @@ async fn a_touch_probe_records_where_the_load_passed_the_mark() {
     let fin = until_final(&s, id, 10).await;
     assert_eq!(fin["state"], "done", "{fin}");
     // The result is read from the status of the cycle that recorded it.
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
-    let fin = loop {
-        let c = get(&s, &format!("/api/v1/commands/{id}")).await.json;
-        if c["result"].is_object() {
-            break c;
-        }
-        assert!(std::time::Instant::now() < deadline, "no result: {c}");
-        tokio::time::sleep(std::time::Duration::from_millis(20)).await;
-    };
+    let fin = with_result(&s, id).await;
     assert_eq!(fin["result"]["recorded_position"], 123.456, "{fin}");
     assert_eq!(fin["result"]["counter"], 1);
     let st = status(&s, "x").await;
@@ -124,5 +130,41 @@ async fn calc_dynamics_by_ramp_time_gives_the_ramp_of_the_manual() {
     assert_problem(&r, 422, "validation_failed");
     assert_eq!(r.json["error_id"], 0x4B06);
     assert_eq!(r.json["errors"][0]["field"], "stiffness");
+    s.stop();
+}
+
+/// A mark is given where the axis reads it: after homing moved the reference (the README's
+/// order: home, then probe), the probe records the mark at the position given, not at the
+/// drive's raw coordinate of it (issue 28, defect 1).
+#[tokio::test(flavor = "multi_thread")]
+async fn a_mark_after_homing_is_recorded_where_it_was_given() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    let h = post(&s, "/api/v1/axes/x/home?wait=true&timeout_ms=20000", json!({})).await;
+    assert_eq!(h.json["state"], "done", "{}", h.text);
+    let st = status(&s, "x").await;
+    assert_eq!(st["status"]["homed"], true, "{st}");
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "probe_mark", "position": 123.456}),
+    )
+    .await;
+    assert_eq!(r.status, 204, "{}", r.text);
+    let p = post(&s, "/api/v1/axes/x/touch-probe", json!({"signal": "input1", "edge": "rising"})).await;
+    assert_eq!(p.status, 202, "{}", p.text);
+    let id = p.json["id"].as_u64().unwrap();
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 200.0, "velocity": 300.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let fin = until_final(&s, id, 10).await;
+    assert_eq!(fin["state"], "done", "the probe saw the mark: {fin}");
+    let fin = with_result(&s, id).await;
+    let recorded = fin["result"]["recorded_position"].as_f64().unwrap();
+    assert!((recorded - 123.456).abs() < 1e-6, "{fin}");
     s.stop();
 }

@@ -787,3 +787,58 @@ async fn a_socket_names_its_client_by_header_or_query() {
     }
     s.stop();
 }
+
+/// Reads raw text messages until one parses to a JSON array; it and the messages before it.
+async fn next_raw(ws: &mut Ws) -> Value {
+    loop {
+        match tokio::time::timeout(Duration::from_secs(20), ws.stream.next()).await {
+            Ok(Some(Ok(Message::Text(t)))) => return serde_json::from_str(&t).unwrap(),
+            Ok(Some(Ok(_))) => continue,
+            other => panic!("no message: {other:?}"),
+        }
+    }
+}
+
+/// A client's JSON-RPC 2.0 batch (issue 28): each call started in order (a command does not
+/// wait for the one before it) and answered with one array of the responses once all are in
+/// (a waited command's answer too); a call without an id is
+/// not answered; an empty batch is an invalid request; a batch of notifications alone gets
+/// no answer (the next message is the answer to the next request).
+#[tokio::test(flavor = "multi_thread")]
+async fn a_batch_of_requests_gets_one_array_of_responses() {
+    let s = Server::start();
+    let mut ws = connect(&s).await;
+    let batch = json!([
+        {"jsonrpc": "2.0", "id": 1, "method": "power", "params": {"axis": "x", "wait": true}},
+        {"jsonrpc": "2.0", "method": "power", "params": {"axis": "y"}},
+        {"jsonrpc": "2.0", "id": 3, "method": "read-drive-operation-mode", "params": {"axis": "spindle"}},
+        {"jsonrpc": "2.0", "id": 4, "method": "no-such-method", "params": {}},
+        7
+    ]);
+    ws.send(Message::Text(batch.to_string().into())).await.unwrap();
+    let answer = next_raw(&mut ws).await;
+    let answers = answer.as_array().unwrap_or_else(|| panic!("an array: {answer}"));
+    assert_eq!(answers.len(), 4, "{answer}");
+    let by_id = |id: Value| answers.iter().find(|a| a["id"] == id).cloned().unwrap_or_else(|| panic!("{id}: {answer}"));
+    assert_eq!(by_id(json!(1))["result"]["outputs"]["status"], true, "{answer}");
+    assert!(by_id(json!(3))["result"].is_object(), "{answer}");
+    assert_eq!(by_id(json!(4))["error"]["code"], -32601, "{answer}");
+    assert_eq!(by_id(Value::Null)["error"]["code"], -32600, "{answer}");
+    // The notification was carried out.
+    let deadline = std::time::Instant::now() + Duration::from_secs(20);
+    while status(&s, "y").await["status"]["state"] != "standstill" {
+        assert!(std::time::Instant::now() < deadline, "y was not enabled");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    // An empty batch.
+    ws.send(Message::Text("[]".into())).await.unwrap();
+    let e = next_raw(&mut ws).await;
+    assert_eq!(e["error"]["code"], -32600, "{e}");
+    // Notifications alone: no answer — the next message answers the next request.
+    let only = json!([{"jsonrpc": "2.0", "method": "reset", "params": {"axis": "x"}}]);
+    ws.send(Message::Text(only.to_string().into())).await.unwrap();
+    send(&mut ws, 9, "reset", json!({"axis": "y"})).await;
+    let m = next_raw(&mut ws).await;
+    assert_eq!(m["id"], 9, "{m}");
+    s.stop();
+}

@@ -233,3 +233,20 @@ pub fn assert_problem(r: &Resp, status: u16, code: &str) {
         r.text
     );
 }
+
+/// A test that cannot run on this machine (no privileges, no tool): under CI (`CI` set and not
+/// `false`/`0`) it fails; elsewhere it says SKIPPED on stdout (shown by `--nocapture`) and adds
+/// a line to `MOTIOND_SKIPPED_LOG` (test-all's summary lists them), then the caller returns.
+pub fn cannot_run(test: &str, why: &str) {
+    if std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0") {
+        panic!("{test} cannot run here and CI is set: {why}");
+    }
+    println!("SKIPPED {test}: {why}");
+    eprintln!("SKIPPED {test}: {why}");
+    if let Ok(path) = std::env::var("MOTIOND_SKIPPED_LOG") {
+        use std::io::Write;
+        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+            let _ = writeln!(f, "{test}: {why}");
+        }
+    }
+}

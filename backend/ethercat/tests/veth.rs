@@ -43,13 +43,30 @@ fn private_veth() -> Result<(), String> {
     Ok(())
 }
 
+/// Under CI (`CI` set) a test that cannot run fails; elsewhere it says SKIPPED and adds a line
+/// to `MOTIOND_SKIPPED_LOG` (test-all's summary). The same rule as `tests/common::cannot_run`.
+fn cannot_run(why: &str) {
+    if std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0") {
+        panic!("veth test cannot run here and CI is set: {why}");
+    }
+    println!("SKIPPED veth::the_maindevice_on_a_veth_pair: {why}");
+    if let Ok(path) = std::env::var("MOTIOND_SKIPPED_LOG") {
+        use std::io::Write;
+        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+            let _ = writeln!(f, "veth::the_maindevice_on_a_veth_pair: {why}");
+        }
+    }
+}
+
 #[test]
 fn the_maindevice_on_a_veth_pair_reads_the_emulated_identity_and_moves_the_drive() {
     static STORAGE: PduStorage<16, { PduStorage::element_size(1100) }> = PduStorage::new();
     // Everything that opens a socket runs on this thread, inside the namespace.
     let t = std::thread::spawn(|| {
         if let Err(why) = private_veth() {
-            eprintln!("SKIPPED: the raw-socket tier needs a network namespace: {why}");
+            cannot_run(&format!(
+                "the raw-socket tier needs a network namespace: {why}"
+            ));
             return;
         }
         let start = Instant::now();

@@ -79,6 +79,17 @@ pub use compensation::{CompensationTable, WorkDirection};
 pub use drive::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 pub use error::ErrorId;
 pub use kernel::Kernel;
+
+/// Why a command was refused beyond its error number, for the answer to say what to do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RefusalHint {
+    /// 0x7084: the cam wanted the slave at `position` moving at `velocity` (within `window`).
+    CamSlave {
+        position: f64,
+        velocity: f64,
+        window: f64,
+    },
+}
 pub use params::AxisParameters;
 pub use status::{
     AxisOpModes, AxisState, AxisStatus, HomingPhase, PositionCorrectionStatus, ProbeStatus,

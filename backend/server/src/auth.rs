@@ -691,7 +691,7 @@ impl Auth {
     ) -> AppResult<UserView> {
         check_name("name", name)?;
         check_password("password", password)?;
-        {
+        let first = {
             let books = self.books.read().unwrap();
             if books.users.values().any(|u| u.name == name) {
                 return Err(AppError::conflict(
@@ -705,14 +705,53 @@ impl Auth {
                     "the first user must be an admin (it turns authentication on)",
                 ));
             }
-        }
+            books.users.is_empty()
+        };
         let hash = hash_off_thread(password).await?;
         let now = store::now_rfc3339();
         let mut tx = self.db.begin().await.map_err(AppError::storage)?;
         let id = store::auth::insert_user(&mut *tx, name, role.as_str(), &hash, &now)
             .await
             .map_err(|e| taken(e, "user_exists", format!("a user {name} exists")))?;
+        // The first user turns authentication on: tokens made before it were made by nobody in
+        // particular (open mode) and end now, in the same transaction (decision 118).
+        let mut open_mode_tokens = Vec::new();
+        if first {
+            open_mode_tokens = store::auth::revoke_all_tokens(&mut *tx, &now)
+                .await
+                .map_err(AppError::storage)?;
+            if !open_mode_tokens.is_empty() {
+                let revoked = store::AuditEntry {
+                    action: "token.revoke".into(),
+                    target: None,
+                    detail: serde_json::json!({
+                        "reason": "authentication turned on: tokens made while it was off end",
+                        "tokens": open_mode_tokens,
+                    })
+                    .to_string(),
+                    outcome: Some("done".into()),
+                    ..audit.clone()
+                };
+                store::audit(&mut *tx, &revoked)
+                    .await
+                    .map_err(AppError::storage)?;
+            }
+        }
         audit_and_commit(tx, &audit).await?;
+        if !open_mode_tokens.is_empty() {
+            tracing::warn!(
+                "authentication is on (first user {name}): {} API token(s) made while it was off \
+                 are revoked ({}); make new ones as an authenticated admin",
+                open_mode_tokens.len(),
+                open_mode_tokens.join(", ")
+            );
+            let mut books = self.books.write().unwrap();
+            for t in books.tokens.iter_mut() {
+                if open_mode_tokens.contains(&t.name) {
+                    t.revoked.get_or_insert_with(|| now.clone());
+                }
+            }
+        }
         let user = User {
             id,
             name: name.to_owned(),

@@ -102,6 +102,8 @@ pub struct Reply {
     /// snapshot of that step carries it.
     pub cycle: u64,
     pub result: Result<(), ErrorId>,
+    /// What a refused command needed (the kernel's hint), for the answer's `detail`.
+    pub hint: Option<motion::RefusalHint>,
 }
 
 pub enum Garbage {
@@ -502,7 +504,10 @@ impl CycleThread {
                         Verdict::Accepted => Ok(()),
                         Verdict::Rejected(e) => Err(e),
                     };
+                    // Taken also after an acceptance, so that no stale hint stays behind.
+                    let hint = self.kernel.axis(cmd.axis).and_then(|a| a.take_refusal_hint());
                     Reply {
+                        hint: hint.filter(|_| result.is_err()),
                         ticket: cmd.id,
                         cycle,
                         result,
@@ -519,6 +524,7 @@ impl CycleThread {
                         self.discard(Garbage::Axis(axis));
                         self.discard(Garbage::Drive(drive));
                         Reply {
+                            hint: None,
                             ticket,
                             cycle,
                             result: Err(ErrorId::AXIS_CANNOT_BE_STARTED),
@@ -542,6 +548,7 @@ impl CycleThread {
                                     }
                                 };
                                 Reply {
+                                    hint: None,
                                     ticket,
                                     cycle,
                                     result,
@@ -551,6 +558,7 @@ impl CycleThread {
                                 self.discard(Garbage::Axis(axis));
                                 self.discard(Garbage::Drive(drive));
                                 Reply {
+                                    hint: None,
                                     ticket,
                                     cycle,
                                     result: Err(ErrorId::AXIS_UNKNOWN),
@@ -566,6 +574,7 @@ impl CycleThread {
                 } => {
                     if require_disabled && !self.kernel.is_disabled(slot) {
                         Reply {
+                            hint: None,
                             ticket,
                             cycle,
                             result: Err(ErrorId::AXIS_CANNOT_BE_STARTED),
@@ -578,6 +587,7 @@ impl CycleThread {
                             self.discard(Garbage::Drive(old));
                         }
                         Reply {
+                            hint: None,
                             ticket,
                             cycle,
                             result: Ok(()),
@@ -589,18 +599,28 @@ impl CycleThread {
                     slot,
                     fault,
                 } => {
+                    // A mark is given where the axis reads it (after homing, a set position, a
+                    // correction …); the simulated load carries it in the drive's coordinates.
+                    let fault = match (fault, self.kernel.axis(slot)) {
+                        (SimFault::ProbeMark { position: Some(p) }, Some(a)) => SimFault::ProbeMark {
+                            position: Some(a.drive_position_of(p)),
+                        },
+                        (f, _) => f,
+                    };
                     let result = match self.bus.inject(slot as usize, fault) {
                         Ok(()) => Ok(()),
                         Err(BusError::NoDrive) => Err(ErrorId::AXIS_UNKNOWN),
                         Err(BusError::Unsupported) => Err(ErrorId::COMMAND_NOT_PERMITTED),
                     };
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result,
                     }
                 }
                 Request::ResetFollowingErrorPeak { ticket, slot } => Reply {
+                    hint: None,
                     ticket,
                     cycle,
                     result: match self.kernel.reset_following_error_peak(slot) {
@@ -622,6 +642,7 @@ impl CycleThread {
                         }
                     };
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result,
@@ -634,6 +655,7 @@ impl CycleThread {
                         }
                     });
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result,
@@ -650,12 +672,14 @@ impl CycleThread {
                         ErrorId::CAM_TABLE_IN_USE
                     });
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result,
                     }
                 }
                 Request::ProbeCamChange { ticket, id } => Reply {
+                    hint: None,
                     ticket,
                     cycle,
                     result: if self.kernel.cam_change_pending(id) {
@@ -667,6 +691,7 @@ impl CycleThread {
                 Request::DropCamData { ticket, id } => {
                     self.kernel.drop_cam_data(id);
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result: Ok(()),
@@ -675,6 +700,7 @@ impl CycleThread {
                 Request::ScopeConfig { ticket, config } => {
                     self.scope = config;
                     Reply {
+                        hint: None,
                         ticket,
                         cycle,
                         result: Ok(()),

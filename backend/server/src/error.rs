@@ -49,8 +49,14 @@ pub enum AppError {
         message: String,
         id: ErrorId,
     },
+    /// 422 `validation_failed`: the fields at fault, one of them a condition with a number of
+    /// its own (a cam table id out of 1..255 is 0x4B32) given as `error_id`.
+    InvalidNumbered { errors: Vec<FieldError>, id: ErrorId },
     /// 409: the axis refused the command (its PLCopen ErrorID is the code).
     Rejected(ErrorId),
+    /// 409: the axis refused the command, with what was in the way (the axis state, its error,
+    /// the stop lock …) and what to do, after the error's own text.
+    RejectedBecause { id: ErrorId, why: String },
     /// A kernel error number under another status or title (an axis the cycle thread did not
     /// take …).
     Kernel {
@@ -172,9 +178,11 @@ impl AppError {
     /// failure of the transport).
     pub fn kernel_error(&self) -> Option<ErrorId> {
         match self {
-            AppError::Rejected(id) | AppError::Kernel { id, .. } | AppError::Refused { id, .. } => {
-                Some(*id)
-            }
+            AppError::Rejected(id)
+            | AppError::RejectedBecause { id, .. }
+            | AppError::InvalidNumbered { id, .. }
+            | AppError::Kernel { id, .. }
+            | AppError::Refused { id, .. } => Some(*id),
             _ => None,
         }
     }
@@ -183,8 +191,8 @@ impl AppError {
         use AppError::*;
         match self {
             NotFound { .. } => StatusCode::NOT_FOUND,
-            Invalid(_) | Refused { .. } => StatusCode::UNPROCESSABLE_ENTITY,
-            Rejected(_) | Conflict { .. } => StatusCode::CONFLICT,
+            Invalid(_) | InvalidNumbered { .. } | Refused { .. } => StatusCode::UNPROCESSABLE_ENTITY,
+            Rejected(_) | RejectedBecause { .. } | Conflict { .. } => StatusCode::CONFLICT,
             Kernel { status, .. } | Http { status, .. } => *status,
             Unavailable { .. } | Storage(_) => StatusCode::SERVICE_UNAVAILABLE,
             BadJson(_) => StatusCode::BAD_REQUEST,
@@ -201,8 +209,12 @@ impl AppError {
         use AppError::*;
         let (code, title): (String, &str) = match self {
             NotFound { what, .. } => (format!("{what}_not_found"), "Not found"),
-            Invalid(_) | Refused { .. } => ("validation_failed".into(), "Invalid request"),
-            Rejected(id) => (id.code().into(), "Command rejected by the axis"),
+            Invalid(_) | InvalidNumbered { .. } | Refused { .. } => {
+                ("validation_failed".into(), "Invalid request")
+            }
+            Rejected(id) | RejectedBecause { id, .. } => {
+                (id.code().into(), "Command rejected by the axis")
+            }
             Kernel { title, id, .. } => (id.code().into(), title),
             Conflict { code, .. } => ((*code).into(), "Conflict"),
             Unavailable { code, .. } => ((*code).into(), "Service unavailable"),
@@ -219,7 +231,7 @@ impl AppError {
             Http { code, title, .. } => (code.clone(), title),
         };
         let errors = match self {
-            Invalid(errors) => errors.clone(),
+            Invalid(errors) | InvalidNumbered { errors, .. } => errors.clone(),
             Refused { field, message, .. } => vec![FieldError {
                 field: field.to_string(),
                 message: message.clone(),
@@ -244,7 +256,7 @@ impl fmt::Display for AppError {
         use AppError::*;
         match self {
             NotFound { what, key } => write!(f, "no {what} '{key}'"),
-            Invalid(errors) => {
+            Invalid(errors) | InvalidNumbered { errors, .. } => {
                 for (i, e) in errors.iter().enumerate() {
                     if i > 0 {
                         f.write_str("; ")?;
@@ -255,6 +267,7 @@ impl fmt::Display for AppError {
             }
             Refused { field, message, .. } => write!(f, "{field}: {message}"),
             Rejected(id) | Kernel { id, .. } => f.write_str(id.text()),
+            RejectedBecause { id, why } => write!(f, "{}: {why}", id.text()),
             TooLarge { limit } => write!(f, "the body is larger than {limit} bytes"),
             MethodNotAllowed { method, path } => write!(
                 f,

@@ -655,6 +655,9 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     ));
 
     load_axes(&state, args.no_demo).await?;
+    if let Some(notice) = api::bus::idle_drives_notice(&state) {
+        tracing::warn!("{notice}");
+    }
     let cams = service::cams::load(&state).await?;
     if cams > 0 {
         tracing::info!("{cams} cam tables loaded");
@@ -731,10 +734,62 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// Serves connections until shutdown: at most `max` at once (one more is answered 503 and
-/// closed, so that a flood of idle connections cannot make motiond answer nobody), each closed
-/// when a client takes longer than `read_timeout` to send a request's headers or the next
-/// request. The client's address reaches the handlers as axum's `ConnectInfo`.
+/// An open connection as the accept loop knows it: whether a request of it is being served,
+/// when it last did something, and how to close it.
+struct OpenConn {
+    /// Requests being served (0: reading headers, or idle between requests).
+    busy: std::sync::atomic::AtomicUsize,
+    /// Opened, or its last request answered (for the oldest idle one to go first).
+    last_active: std::sync::Mutex<std::time::Instant>,
+    close: tokio::sync::Notify,
+}
+
+/// The open connections (by a running number), for making room under a flood.
+#[derive(Default)]
+struct OpenConns {
+    next: std::sync::atomic::AtomicU64,
+    map: std::sync::Mutex<std::collections::HashMap<u64, Arc<OpenConn>>>,
+}
+
+impl OpenConns {
+    fn open(self: &Arc<Self>) -> (u64, Arc<OpenConn>) {
+        let id = self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let c = Arc::new(OpenConn {
+            busy: Default::default(),
+            last_active: std::sync::Mutex::new(std::time::Instant::now()),
+            close: tokio::sync::Notify::new(),
+        });
+        self.map.lock().unwrap().insert(id, c.clone());
+        (id, c)
+    }
+
+    /// Closes the connection that has been idle longest (no request in service: a client
+    /// sending headers slowly, or a keep-alive connection between requests). `false` when
+    /// every connection is serving a request.
+    fn close_oldest_idle(&self) -> bool {
+        let map = self.map.lock().unwrap();
+        let oldest = map
+            .values()
+            .filter(|c| c.busy.load(std::sync::atomic::Ordering::Relaxed) == 0)
+            .min_by_key(|c| *c.last_active.lock().unwrap());
+        match oldest {
+            Some(c) => {
+                // Stored if the connection's task is not waiting yet: it closes when it does.
+                c.close.notify_one();
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// Serves connections until shutdown: at most `max` at once. One more makes room by closing
+/// the connection idle longest — one that has not finished sending a request's headers, or a
+/// keep-alive connection between requests — so that a flood of half-sent requests cannot lock
+/// a real client out (decision 69); only when every connection is serving a request is one
+/// more answered 503 and closed. A client that takes longer than `read_timeout` to send a
+/// request's headers or the next request is disconnected. The client's address reaches the
+/// handlers as axum's `ConnectInfo`.
 async fn accept_loop(
     listener: tokio::net::TcpListener,
     app: axum::Router,
@@ -744,8 +799,10 @@ async fn accept_loop(
     tls: Option<tokio_rustls::TlsAcceptor>,
 ) {
     use hyper_util::rt::TokioIo;
+    use std::sync::atomic::Ordering::Relaxed;
     use tokio::io::AsyncWriteExt;
     let max = permits.available_permits();
+    let conns = Arc::new(OpenConns::default());
     loop {
         let (mut stream, addr) = tokio::select! {
             r = listener.accept() => match r {
@@ -759,10 +816,23 @@ async fn accept_loop(
             },
             _ = async { let _ = stopping.wait_for(|s| *s).await; } => return,
         };
-        let Ok(permit) = permits.clone().try_acquire_owned() else {
+        let permit = match permits.clone().try_acquire_owned() {
+            Ok(p) => Some(p),
+            // Full: the connection idle longest gives its place (its task ends at once and
+            // gives the permit back).
+            Err(_) if conns.close_oldest_idle() => tokio::time::timeout(
+                std::time::Duration::from_secs(1),
+                permits.clone().acquire_owned(),
+            )
+            .await
+            .ok()
+            .and_then(Result::ok),
+            Err(_) => None,
+        };
+        let Some(permit) = permit else {
             tokio::spawn(async move {
                 let body = format!(
-                    r#"{{"type":"urn:motiond:problem:too_many_connections","title":"Service unavailable","status":503,"detail":"motiond serves at most {max} connections at once; try again","code":"too_many_connections"}}"#
+                    r#"{{"type":"urn:motiond:problem:too_many_connections","title":"Service unavailable","status":503,"detail":"motiond serves at most {max} connections at once, all of them serving requests; try again","code":"too_many_connections"}}"#
                 );
                 let head = format!(
                     "HTTP/1.1 503 Service Unavailable\r\ncontent-type: application/problem+json\r\ncontent-length: {}\r\nretry-after: 1\r\nconnection: close\r\n\r\n",
@@ -774,30 +844,50 @@ async fn accept_loop(
             });
             continue;
         };
-        let svc = tower::ServiceExt::map_request(
-            app.clone(),
-            move |mut r: hyper::Request<hyper::body::Incoming>| {
-                r.extensions_mut().insert(axum::extract::ConnectInfo(addr));
-                r
-            },
-        );
+        let (conn_id, conn) = conns.open();
+        let served = conn.clone();
+        let app = app.clone();
+        let svc = tower::service_fn(move |mut r: hyper::Request<hyper::body::Incoming>| {
+            r.extensions_mut().insert(axum::extract::ConnectInfo(addr));
+            let (app, conn) = (app.clone(), served.clone());
+            async move {
+                conn.busy.fetch_add(1, Relaxed);
+                let answer = tower::ServiceExt::oneshot(app, r).await;
+                *conn.last_active.lock().unwrap() = std::time::Instant::now();
+                conn.busy.fetch_sub(1, Relaxed);
+                answer
+            }
+        });
         let stop = stopping.clone();
         let tls = tls.clone();
+        let conns = conns.clone();
         tokio::spawn(async move {
             let _permit = permit;
-            match tls {
-                None => serve_connection(TokioIo::new(stream), svc, read_timeout, stop).await,
-                Some(acceptor) => {
-                    // The handshake is bounded like a request's headers.
-                    match tokio::time::timeout(read_timeout, acceptor.accept(stream)).await {
-                        Ok(Ok(s)) => {
-                            serve_connection(TokioIo::new(s), svc, read_timeout, stop).await
+            let serve = async {
+                match tls {
+                    None => serve_connection(TokioIo::new(stream), svc, read_timeout, stop).await,
+                    Some(acceptor) => {
+                        // The handshake is bounded like a request's headers.
+                        match tokio::time::timeout(read_timeout, acceptor.accept(stream)).await {
+                            Ok(Ok(s)) => {
+                                serve_connection(TokioIo::new(s), svc, read_timeout, stop).await
+                            }
+                            Ok(Err(e)) => tracing::debug!("TLS handshake with {addr} failed: {e}"),
+                            Err(_) => tracing::debug!("TLS handshake with {addr} timed out"),
                         }
-                        Ok(Err(e)) => tracing::debug!("TLS handshake with {addr} failed: {e}"),
-                        Err(_) => tracing::debug!("TLS handshake with {addr} timed out"),
                     }
                 }
+            };
+            let mut serve = std::pin::pin!(serve);
+            loop {
+                tokio::select! {
+                    _ = &mut serve => break,
+                    // Closed to make room — never while one of its requests is served (it
+                    // may have started one since it was chosen).
+                    _ = conn.close.notified() => if conn.busy.load(Relaxed) == 0 { break },
+                }
             }
+            conns.map.lock().unwrap().remove(&conn_id);
         });
     }
 }

@@ -532,6 +532,32 @@ pub struct CommandResource {
     /// RecordedData); absent for other blocks and before it is done.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub result: Option<ProbeResult>,
+    /// With `?wait=true`: whether the answer comes at the milestone, and if not why — the
+    /// command may still be busy (a power waiting on an axis in error_stop, a move still
+    /// running at the timeout). Absent without `wait`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wait: Option<WaitOutcome>,
+}
+
+/// How a `?wait=true` ended.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"milestone": "status", "reached": false, "reason": "axis_error_stop",
+    "axis_state": "error_stop", "axis_error_id": 28688, "axis_error_code": "drive_fault"}))]
+pub struct WaitOutcome {
+    /// The output waited for besides the command's end (`done`: only the end).
+    pub milestone: crate::app::Milestone,
+    /// The command reached its milestone or its end (done, error or aborted: see `state`).
+    pub reached: bool,
+    /// Why not: `timeout` (still on its way at `timeout_ms`), `axis_error_stop` (the axis is
+    /// in error_stop: nothing reaches the milestone before a reset), `axis_disabled`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<&'static str>,
+    /// The axis's state when the answer was made.
+    pub axis_state: motion::AxisState,
+    /// The axis's error (0: none) and its code.
+    pub axis_error_id: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_error_code: Option<&'static str>,
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -45,8 +45,9 @@ fn self_signed_paths(db: &str) -> Result<(PathBuf, PathBuf), String> {
     ))
 }
 
-/// Makes a self-signed certificate for the names motiond serves.
-fn make_self_signed(args: &ServeArgs, cert: &Path, key: &Path) -> Result<(), String> {
+/// The names a self-signed certificate must carry: loopback, the listening address, every
+/// `--public-name` (once each).
+fn served_names(args: &ServeArgs) -> Vec<String> {
     let mut names = vec![
         "localhost".to_string(),
         "127.0.0.1".to_string(),
@@ -60,7 +61,37 @@ fn make_self_signed(args: &ServeArgs, cert: &Path, key: &Path) -> Result<(), Str
             .iter()
             .map(|n| n.trim_matches(['[', ']']).to_string()),
     );
-    names.dedup();
+    // Not only adjacent duplicates: the order of the rest is kept.
+    let mut seen = std::collections::HashSet::new();
+    names.retain(|n| seen.insert(n.clone()));
+    names
+}
+
+/// The served names a kept certificate is not valid for (all of them when it cannot be read).
+fn names_missing(cert: &Path, names: &[String]) -> Vec<String> {
+    let Some(der) = CertificateDer::pem_file_iter(cert)
+        .ok()
+        .and_then(|mut it| it.next())
+        .and_then(Result::ok)
+    else {
+        return names.to_vec();
+    };
+    let Ok(ee) = webpki::EndEntityCert::try_from(&der) else {
+        return names.to_vec();
+    };
+    names
+        .iter()
+        .filter(|n| {
+            rustls_pki_types::ServerName::try_from(n.as_str())
+                .map_or(true, |sn| ee.verify_is_valid_for_subject_name(&sn).is_err())
+        })
+        .cloned()
+        .collect()
+}
+
+/// Makes a self-signed certificate for the names motiond serves.
+fn make_self_signed(args: &ServeArgs, cert: &Path, key: &Path) -> Result<(), String> {
+    let names = served_names(args);
     let ck = rcgen::generate_simple_self_signed(names.clone())
         .map_err(|e| format!("cannot make a self-signed certificate: {e}"))?;
     // The key first, readable by the owner only.
@@ -97,6 +128,20 @@ pub fn acceptor(args: &ServeArgs) -> Result<TlsAcceptor, String> {
             let (c, k) = self_signed_paths(&args.db)?;
             if !c.exists() || !k.exists() {
                 make_self_signed(args, &c, &k)?;
+            } else {
+                // `--listen` or `--public-name` changed since it was made: a certificate that
+                // does not name what motiond now serves is renewed (its fingerprint changes;
+                // a name dropped since keeps the certificate, and its fingerprint, as it is).
+                let missing = names_missing(&c, &served_names(args));
+                if !missing.is_empty() {
+                    tracing::warn!(
+                        "the self-signed TLS certificate {} does not name {}: making a new one \
+                         (its fingerprint changes: pin the new one in browsers and clients)",
+                        c.display(),
+                        missing.join(", ")
+                    );
+                    make_self_signed(args, &c, &k)?;
+                }
             }
             (c, k)
         }

@@ -1633,7 +1633,7 @@ export interface paths {
         };
         /**
          * Websocket: JSON-RPC 2.0 subscriptions and commands
-         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). A request without an id is a notification: carried out, never answered. The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. A message over 256 KiB closes the socket with code 1009 (message too big).
+         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). A request without an id is a notification: carried out, never answered. A client may send a JSON-RPC 2.0 batch (an array of requests): each is started in order (a command does not wait for the one before it to end) and the batch is answered with one array of the responses, once every one of them is in (nothing for a batch of notifications; an empty array is an invalid request). The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. A message over 256 KiB closes the socket with code 1009 (message too big).
          */
         get: operations["upgrade"];
         put?: never;
@@ -2456,8 +2456,9 @@ export interface components {
         BusFault: {
             /**
              * Format: int32
-             * @description The next frames to lose (not answered). The bus sends a frame up to three times
-             *     before it counts as lost; `max_errors_in_row` lost ones in a row fault the bus.
+             * @description The next cycles to go unanswered: each cycle's frame is lost with its retries, so the
+             *     bus counts that many lost frames; `max_errors_in_row` (3) in a row fault the bus
+             *     (`5` stops the axes on it with bus_error 0x70A0).
              */
             lose_frames?: number | null;
             /**
@@ -2553,6 +2554,12 @@ export interface components {
              */
             dc_cycle_offset_ns?: number | null;
             subdevices: components["schemas"]["SubDeviceResource"][];
+            /**
+             * @description What the engineer should know about the bus and the axes: CiA-402 drives that no axis
+             *     uses (an existing database keeps its simulated axes on `--bus emulated`/`ethercat`)
+             *     and how to put an axis on one. Absent when there is nothing to say.
+             */
+            notice?: string | null;
         };
         /**
          * @description The drive bus of a configuration document.
@@ -3592,6 +3599,7 @@ export interface components {
             /** @description Output changes in order (the most recent 64). */
             events: components["schemas"]["CommandEventDto"][];
             result?: null | components["schemas"]["ProbeResult"];
+            wait?: null | components["schemas"]["WaitOutcome"];
         };
         /**
          * @description A command's life as the API shows it.
@@ -4984,6 +4992,13 @@ export interface components {
              */
             gear_ratio: number;
         };
+        /**
+         * @description Where a `?wait=true` request answers for a command that stays busy (besides its end:
+         *     Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
+         *     InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
+         * @enum {string}
+         */
+        Milestone: "done" | "in_velocity" | "in_gear" | "in_sync" | "in_end_velocity" | "status" | "active" | "in_torque";
         /**
          * @description Modulo (rotary) axis: positions wrap at `period`.
          * @example {
@@ -7208,6 +7223,36 @@ export interface components {
          * @enum {string}
          */
         ValueSelect: "position" | "velocity" | "acceleration" | "jerk";
+        /**
+         * @description How a `?wait=true` ended.
+         * @example {
+         *       "axis_error_code": "drive_fault",
+         *       "axis_error_id": 28688,
+         *       "axis_state": "error_stop",
+         *       "milestone": "status",
+         *       "reached": false,
+         *       "reason": "axis_error_stop"
+         *     }
+         */
+        WaitOutcome: {
+            /** @description The output waited for besides the command's end (`done`: only the end). */
+            milestone: components["schemas"]["Milestone"];
+            /** @description The command reached its milestone or its end (done, error or aborted: see `state`). */
+            reached: boolean;
+            /**
+             * @description Why not: `timeout` (still on its way at `timeout_ms`), `axis_error_stop` (the axis is
+             *     in error_stop: nothing reaches the milestone before a reset), `axis_disabled`.
+             */
+            reason?: string | null;
+            /** @description The axis's state when the answer was made. */
+            axis_state: components["schemas"]["AxisState"];
+            /**
+             * Format: int32
+             * @description The axis's error (0: none) and its code.
+             */
+            axis_error_id: number;
+            axis_error_code?: string | null;
+        };
         /**
          * @description `E_WorkDirection` (§6.11.7): in which travel direction a compensation applies.
          * @enum {string}
@@ -11800,7 +11845,7 @@ export interface operations {
             };
         };
         responses: {
-            /** @description The segment will drop that many frames */
+            /** @description The segment will leave that many cycles unanswered */
             204: {
                 headers: {
                     [name: string]: unknown;
@@ -13297,6 +13342,7 @@ export interface operations {
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["QueryInvalid"];
             426: components["responses"]["WebsocketUpgradeRequired"];
         };
     };

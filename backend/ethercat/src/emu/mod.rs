@@ -51,11 +51,35 @@ pub trait Application: Send {
 /// Disturbances of the segment itself (the drives have their own).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SegmentFaults {
-    /// Frames to lose (no answer) from now on.
+    /// Frames to lose (no answer) from now on, one by one: a retry of a lost frame is a frame.
     pub drop_frames: u32,
+    /// Cycles to go unanswered from now on: each frame that carries process data (LRW, LRD,
+    /// LWR) with a new PDU index starts one, and it and its retries (the same index), and
+    /// whatever else is sent in it, get no answer — what a user means by "lose 5 frames":
+    /// five cycles without an answer, as the bus counts lost frames.
+    pub silent_cycles: u32,
     /// A SubDevice (by position) that drops to SAFE-OP with an error (AL status code 0x001B,
     /// SyncManager watchdog), at the next frame.
     pub safe_op: Option<usize>,
+}
+
+/// The command and PDU index of each datagram of an EtherCAT frame (after the Ethernet and
+/// EtherCAT headers; stops at a datagram that does not fit).
+fn datagrams(frame: &[u8]) -> impl Iterator<Item = (u8, u8)> + '_ {
+    let end = frame
+        .get(14..16)
+        .map_or(0, |h| (16 + (u16::from_le_bytes([h[0], h[1]]) & 0x7FF) as usize).min(frame.len()));
+    let mut p = Some(16);
+    std::iter::from_fn(move || {
+        let at = p?;
+        if at + 12 > end {
+            return None;
+        }
+        let len_flags = u16::from_le_bytes([frame[at + 6], frame[at + 7]]);
+        let next = at + 12 + (len_flags & 0x7FF) as usize;
+        p = (len_flags & 0x8000 != 0 && next <= end).then_some(next);
+        Some((frame[at], frame[at + 1]))
+    })
 }
 
 /// A line of emulated SubDevices, in bus order.
@@ -66,6 +90,8 @@ pub struct Segment {
     /// Frames answered and lost, for the tests.
     pub frames: u64,
     pub lost: u64,
+    /// The PDU index of the silent cycle's process-data frame (its retries are lost too).
+    silent_index: Option<u8>,
 }
 
 /// Per-device propagation (ns) through an ESC, for the DC port receive times.
@@ -112,6 +138,7 @@ impl Segment {
             faults: SegmentFaults::default(),
             frames: 0,
             lost: 0,
+            silent_index: None,
         }
     }
 
@@ -147,6 +174,21 @@ impl Segment {
             self.lost += 1;
             return None;
         }
+        // The PDU index of the frame's process-data datagram (LRD, LWR, LRW), if it has one.
+        let index = datagrams(frame)
+            .find(|&(cmd, _)| matches!(cmd, 10..=12))
+            .map(|(_, index)| index);
+        let process_data = index.is_some();
+        let retry = process_data && self.silent_index.is_some() && self.silent_index == index;
+        if retry || self.faults.silent_cycles > 0 {
+            if process_data && !retry {
+                self.faults.silent_cycles -= 1;
+                self.silent_index = index;
+            }
+            self.lost += 1;
+            return None;
+        }
+        self.silent_index = None;
         let mut out = frame.to_vec();
         out[6] |= 0x02;
         let end = (16 + (header & 0x7FF) as usize).min(out.len());

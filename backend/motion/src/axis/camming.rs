@@ -604,6 +604,12 @@ impl Axis {
         let dv = p.axis_acc * self.cycle_time * (1.0 + 1e-9) + 1e-9;
         if (at.position - from.position).abs() > window || (at.velocity - from.velocity).abs() > dv
         {
+            // Where the cam wanted the slave: the refusal's answer says so (pre-position there).
+            self.refusal_hint.set(Some(crate::RefusalHint::CamSlave {
+                position: at.position,
+                velocity: at.velocity,
+                window,
+            }));
             return Err(ErrorId::CAM_SLAVE_WOULD_JUMP);
         }
         Ok(())

@@ -145,6 +145,9 @@ pub struct Axis {
     reset_grace: u8,
     homed: bool,
     set_position_offset: f64,
+    /// What the last refused command needed and did not find (read once by the caller of
+    /// `Kernel::submit`; a `Cell` because the checks run on `&self`).
+    refusal_hint: std::cell::Cell<Option<crate::RefusalHint>>,
     last_target: Option<f64>,
     last_dec: f64,
     last_jerk: f64,
@@ -263,6 +266,7 @@ impl Axis {
             reset_grace: 0,
             homed: false,
             set_position_offset: 0.0,
+            refusal_hint: std::cell::Cell::new(None),
             last_target: None,
             last_dec,
             last_jerk,
@@ -334,6 +338,18 @@ impl Axis {
     }
 
     /// The PLCopen state, derived from the mode and the active job.
+    /// What the last refused command needed and did not find, once (then `None`).
+    pub fn take_refusal_hint(&self) -> Option<crate::RefusalHint> {
+        self.refusal_hint.take()
+    }
+
+    /// Where a position in the axis's coordinates (as the axis reads it now: homing, set
+    /// position, encoder scaling and position corrections applied) lies in the drive's own
+    /// coordinates — the inverse of how the actual position is read.
+    pub fn drive_position_of(&self, position: f64) -> f64 {
+        (position - self.offset - self.corrections.read) / self.enc_k
+    }
+
     pub fn state(&self) -> AxisState {
         match self.mode {
             Mode::Disabled => AxisState::Disabled,

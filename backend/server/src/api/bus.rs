@@ -118,6 +118,56 @@ pub struct BusResource {
     /// Where in its SYNC0 period the latest frame reached the reference clock (ns).
     pub dc_cycle_offset_ns: Option<u64>,
     pub subdevices: Vec<SubDeviceResource>,
+    /// What the engineer should know about the bus and the axes: CiA-402 drives that no axis
+    /// uses (an existing database keeps its simulated axes on `--bus emulated`/`ethercat`)
+    /// and how to put an axis on one. Absent when there is nothing to say.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub notice: Option<String>,
+}
+
+/// Drives on the bus that no axis uses, and how to put an axis on one (`None`: none, or
+/// the simulated bus). Logged at start-up and shown in `GET /bus`.
+pub fn idle_drives_notice(s: &AppState) -> Option<String> {
+    let (st, _) = s.info.bus.ethercat.as_ref()?;
+    let (used, simulated): (Vec<u16>, Vec<String>) = {
+        let reg = s.registry.read().unwrap();
+        let used = reg
+            .axes
+            .values()
+            .filter_map(|a| match &a.config.drive {
+                drives::DriveConfig::Cia402(c) => Some(c.subdevice),
+                _ => None,
+            })
+            .collect();
+        let simulated = reg
+            .axes
+            .values()
+            .filter(|a| !matches!(a.config.drive, drives::DriveConfig::Cia402(_)))
+            .map(|a| a.name.clone())
+            .collect();
+        (used, simulated)
+    };
+    let idle: Vec<String> = st
+        .subdevices
+        .iter()
+        .filter(|d| d.drive.is_some() && !used.contains(&d.position))
+        .map(|d| d.position.to_string())
+        .collect();
+    if idle.is_empty() {
+        return None;
+    }
+    let axes = if simulated.is_empty() {
+        "no axis".to_owned()
+    } else {
+        format!("the axes {} are simulated (made on the simulated bus)", simulated.join(", "))
+    };
+    Some(format!(
+        "the CiA-402 drive(s) at SubDevice position {} drive no axis: {axes}. Put an axis on a \
+         drive with PUT /api/v1/axes/{{axis}} and \"drive\": {{\"kind\": \"cia402\", \"subdevice\": N, \
+         \"increments_per_unit\": …}} (the UI's Configuration page, Drive), or start on a new \
+         database, where the demo axes are put on the drives",
+        idle.join(", ")
+    ))
 }
 
 pub fn bus_resource(s: &AppState) -> BusResource {
@@ -139,6 +189,7 @@ pub fn bus_resource(s: &AppState) -> BusResource {
             dc_system_time_ns: None,
             dc_cycle_offset_ns: None,
             subdevices: Vec::new(),
+            notice: None,
         };
     };
     let axes: Vec<(u16, String)> = s
@@ -200,6 +251,7 @@ pub fn bus_resource(s: &AppState) -> BusResource {
         dc_system_time_ns: Some(st.dc_system_time.load(Relaxed)),
         dc_cycle_offset_ns: Some(st.dc_cycle_offset.load(Relaxed)),
         subdevices,
+        notice: idle_drives_notice(s),
     }
 }
 
@@ -414,8 +466,9 @@ pub async fn sdo_write(
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"lose_frames": 5}))]
 pub struct BusFault {
-    /// The next frames to lose (not answered). The bus sends a frame up to three times
-    /// before it counts as lost; `max_errors_in_row` lost ones in a row fault the bus.
+    /// The next cycles to go unanswered: each cycle's frame is lost with its retries, so the
+    /// bus counts that many lost frames; `max_errors_in_row` (3) in a row fault the bus
+    /// (`5` stops the axes on it with bus_error 0x70A0).
     #[serde(default)]
     #[schema(minimum = 1, maximum = 100000)]
     pub lose_frames: Option<u32>,
@@ -429,7 +482,7 @@ pub struct BusFault {
 #[utoipa::path(post, path = "/api/v1/bus/faults", tag = "bus",
     summary = "Lose frames on the emulated EtherCAT segment, or drop a SubDevice to SAFE-OP (--bus emulated only)",
     request_body = BusFault,
-    responses((status = 204, description = "The segment will drop that many frames"), super::errors::BusFaultErrors))]
+    responses((status = 204, description = "The segment will leave that many cycles unanswered"), super::errors::BusFaultErrors))]
 pub async fn inject_bus_fault(
     State(s): State<Arc<AppState>>,
     client: Client,
@@ -455,7 +508,7 @@ pub async fn inject_bus_fault(
             }
             seg.faults.safe_op = Some(n as usize);
         }
-        seg.faults.drop_frames += f.lose_frames.unwrap_or(0);
+        seg.faults.silent_cycles += f.lose_frames.unwrap_or(0);
     }
     s.audit(audit_entry(&client.0, "bus.fault", "bus", raw.to_string()));
     Ok(StatusCode::NO_CONTENT)

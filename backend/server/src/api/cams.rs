@@ -33,13 +33,7 @@ impl<T: DeserializeOwned + utoipa::ToSchema, S: Send + Sync> FromRequest<S> for 
     async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
         let bytes = axum::body::Bytes::from_request(req, state)
             .await
-            .map_err(|e| {
-                if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
-                    AppError::too_large(CAM_BODY_LIMIT)
-                } else {
-                    AppError::bad_json(format!("cannot read the body: {e}"))
-                }
-            })?;
+            .map_err(|e| super::body_error(e, CAM_BODY_LIMIT))?;
         match bytes.iter().find(|b| !b.is_ascii_whitespace()) {
             Some(b'{') => {}
             None => return Err(AppError::field("body", "a cam table is required")),

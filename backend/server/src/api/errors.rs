@@ -597,7 +597,8 @@ error_sets! {
     MetricsErrors { 422: MetricsQueryInvalid }
     /// `GET /ws`: not a websocket handshake, or one from another origin.
     WebsocketErrors {
-        400: WebsocketHandshakeInvalid, 403: CrossOriginForbidden, 426: WebsocketUpgradeRequired,
+        400: WebsocketHandshakeInvalid, 403: CrossOriginForbidden, 422: QueryInvalid,
+        426: WebsocketUpgradeRequired,
     }
     /// `GET /auth/session`.
     SessionErrors { 401: Unauthenticated }

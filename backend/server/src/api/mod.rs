@@ -55,13 +55,7 @@ impl<T: DeserializeOwned + utoipa::ToSchema, S: Send + Sync> FromRequest<S> for 
     async fn from_request(req: Request, state: &S) -> Result<Self, AppError> {
         let bytes = axum::body::Bytes::from_request(req, state)
             .await
-            .map_err(|e| {
-                if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
-                    AppError::too_large(BODY_LIMIT)
-                } else {
-                    AppError::bad_json(format!("cannot read the body: {e}"))
-                }
-            })?;
+            .map_err(|e| body_error(e, BODY_LIMIT))?;
         let bytes: &[u8] = if bytes.iter().all(|b| b.is_ascii_whitespace()) {
             b"{}"
         } else {
@@ -75,6 +69,28 @@ impl<T: DeserializeOwned + utoipa::ToSchema, S: Send + Sync> FromRequest<S> for 
         let (t, value) = from_value(value)?;
         Ok(JsonBody(t, value))
     }
+}
+
+/// A body that could not be read: 413 over `limit`, 408 `request_timeout` when it stopped
+/// arriving for longer than `--read-timeout-s` (the body timeout layer's error, somewhere in
+/// the rejection's sources), else 400 `malformed_json`.
+pub fn body_error(e: axum::extract::rejection::BytesRejection, limit: usize) -> AppError {
+    if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
+        return AppError::too_large(limit);
+    }
+    let mut source: Option<&(dyn std::error::Error + 'static)> = Some(&e);
+    while let Some(s) = source {
+        if s.is::<tower_http::timeout::TimeoutError>() {
+            return AppError::new(
+                StatusCode::REQUEST_TIMEOUT,
+                "request_timeout",
+                "Request timeout",
+                "the body stopped arriving for longer than the read timeout (--read-timeout-s)",
+            );
+        }
+        source = s.source();
+    }
+    AppError::bad_json(format!("cannot read the body: {e}"))
 }
 
 /// Reads a body (or websocket `params`) that is a JSON object; a 422 names the JSON path of the

@@ -181,7 +181,9 @@ then only changed fields; `command_event` {cycle, command, axis, name, state, fi
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
 not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket \
 closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). \
-A request without an id is a notification: carried out, never answered. \
+A request without an id is a notification: carried out, never answered. A client may send a JSON-RPC 2.0 batch \
+(an array of requests): each is started in order (a command does not wait for the one before it to end) and \
+the batch is answered with one array of the responses, once every one of them is in (nothing for a batch of notifications; an empty array is an invalid request). \
 The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of \
 several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. \
 Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has \
@@ -335,7 +337,31 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                     (heard, pinged) = (Instant::now(), None);
                 }
                 match msg {
-                    Some(Ok(Message::Text(t))) => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
+                    Some(Ok(Message::Text(t))) => match batch_of(t.as_str()) {
+                        None => handle(&s, &mut subs, &mut notices, &client, &out_tx, &jogs, &in_flight, t.as_str()).into_iter().collect(),
+                        Some(Err(e)) => vec![e],
+                        Some(Ok(calls)) => {
+                            // A JSON-RPC 2.0 batch: every call handled in order, the answers
+                            // (those that come later too) sent as one array once all are in;
+                            // nothing when all were notifications.
+                            let (batch_tx, mut batch_rx) = mpsc::channel::<String>(calls.len().max(1));
+                            let mut answers: Vec<String> = calls
+                                .iter()
+                                .filter_map(|c| handle(&s, &mut subs, &mut notices, &client, &batch_tx, &jogs, &in_flight, &c.to_string()))
+                                .collect();
+                            drop(batch_tx);
+                            let out = out_tx.clone();
+                            tokio::spawn(async move {
+                                while let Some(a) = batch_rx.recv().await {
+                                    answers.push(a);
+                                }
+                                if !answers.is_empty() {
+                                    let _ = out.send(format!("[{}]", answers.join(","))).await;
+                                }
+                            });
+                            vec![]
+                        }
+                    },
                     Some(Ok(Message::Binary(_))) => vec![rpc_error(&Value::Null, -32600, "binary messages are not supported", None)],
                     Some(Ok(_)) => vec![],
                     Some(Err(e)) => {
@@ -550,6 +576,20 @@ fn write_update(m: &mut String, topic_json: &str, cycle: u64, full: bool, data: 
     });
     m.push_str(data);
     m.push_str("}}");
+}
+
+/// A message that is a JSON-RPC batch (an array): its calls, or the error to answer (an empty
+/// array is an invalid request, an array that does not parse a parse error). `None`: not a
+/// batch.
+fn batch_of(text: &str) -> Option<Result<Vec<Value>, String>> {
+    if !text.trim_start().starts_with('[') {
+        return None;
+    }
+    Some(match serde_json::from_str::<Value>(text) {
+        Ok(Value::Array(calls)) if !calls.is_empty() => Ok(calls),
+        Ok(_) => Err(rpc_error(&Value::Null, -32600, "invalid request: an empty batch", None)),
+        Err(e) => Err(rpc_error(&Value::Null, -32700, &format!("parse error: {e}"), None)),
+    })
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -64,6 +64,7 @@ impl CommandRecord {
                 modulo_position: p.modulo_position,
                 counter: p.counter,
             }),
+            wait: None,
         }
     }
 }
@@ -138,7 +139,7 @@ pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry 
 /// Where a `?wait=true` request answers for a command that stays busy (besides its end:
 /// Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
 /// InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, utoipa::ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Milestone {
     /// Only its end (Done, Error, CommandAborted).

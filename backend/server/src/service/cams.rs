@@ -25,6 +25,19 @@ pub const MAX_CAM_ID: u32 = 255;
 /// The most rows MC_ReadMotionFunctionValues answers with in one response.
 pub const MAX_VALUE_ROWS: usize = 100_000;
 
+/// The table's own checks failed: 422 with the fields, numbered 0x4B32 when the id is one of
+/// them (docs/errors.md).
+fn invalid(errs: Vec<FieldError>) -> AppError {
+    if errs.iter().any(|e| e.field.ends_with("id")) {
+        AppError::InvalidNumbered {
+            errors: errs,
+            id: motion::ErrorId::CAM_TABLE_ID_INVALID,
+        }
+    } else {
+        AppError::Invalid(errs)
+    }
+}
+
 fn refused(e: CamError) -> AppError {
     AppError::refused(e.field, e.id, e.message)
 }
@@ -135,7 +148,7 @@ pub async fn create(
 ) -> AppResult<CamTableResource> {
     let errs = check(&body, "");
     if !errs.is_empty() {
-        return Err(AppError::Invalid(errs));
+        return Err(invalid(errs));
     }
     let (data, cam) = build(body.data()).await?;
     let _guard = s.config_lock.lock().await;
@@ -180,7 +193,7 @@ async fn replace_locked(
 ) -> AppResult<CamTableResource> {
     let errs = check(&body, "");
     if !errs.is_empty() {
-        return Err(AppError::Invalid(errs));
+        return Err(invalid(errs));
     }
     let old = entry(s, key)?;
     if body.id.is_some_and(|id| id != old.id) {
@@ -653,7 +666,7 @@ pub async fn master_position(
 pub async fn analyse(body: CamTableBody, samples: usize) -> AppResult<CamAnalysisResource> {
     let errs = check(&body, "");
     if !errs.is_empty() {
-        return Err(AppError::Invalid(errs));
+        return Err(invalid(errs));
     }
     let (_, cam) = build(body.data()).await?;
     tokio::task::spawn_blocking(move || {

@@ -6,7 +6,8 @@ use std::collections::VecDeque;
 use std::time::Duration;
 
 use motion::{
-    AxisSlot, CommandId, CommandKind, Direction, FbOutputs, JogMode, Positioning, Superposition,
+    AxisSlot, CommandId, CommandKind, Direction, ErrorId, FbOutputs, JogMode, Positioning,
+    Superposition,
 };
 
 use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Milestone, Registry};
@@ -1028,7 +1029,10 @@ pub async fn run<B>(
     )
     .await?;
     let view = match wait {
-        Some(t) => wait_for(s, id, t).await,
+        Some(t) => wait_for(s, id, t).await.map(|mut v| {
+            v.wait = Some(wait_outcome(s, &v, milestone));
+            v
+        }),
         None => get(s, id),
     };
     view.ok_or_else(|| {
@@ -1083,7 +1087,14 @@ async fn submit(
         s.metrics.command(name, Verdict::rejected);
     })?;
     let id = s.next_id();
-    s.reserve_id(id).await?;
+    if let Err(e) = s.reserve_id(id).await {
+        // A stop is never refused (docs/decisions.md 116): its id comes from memory, unique in
+        // this run (after a crash it may be handed out again — its audit row is lost anyway).
+        if !crate::service::control::stops_motion(&kind) {
+            return Err(e);
+        }
+        tracing::error!("command {id} ({name}) acts although its id could not be reserved: {e}");
+    }
     let submitted_at = store::now_rfc3339();
     let audit = AuditEntry {
         at: submitted_at.clone(),
@@ -1189,8 +1200,103 @@ async fn submit(
         Err(e) => {
             s.commands.lock().unwrap().remove(id);
             outcome(format!("rejected:{}", e.code()));
-            Err(AppError::rejected(e))
+            let why = refusal_why(s, slot, e, reply.hint);
+            Err(AppError::RejectedBecause { id: e, why })
         }
+    }
+}
+
+/// What stood in the way of a refused command, and what to do: the axis's state as the latest
+/// snapshot shows it (the refused command changed nothing), its error, the stop lock and who
+/// holds it, a coupling, or what the kernel's check needed (issue 28, defect 3).
+pub fn refusal_why(
+    s: &AppState,
+    slot: AxisSlot,
+    e: ErrorId,
+    hint: Option<motion::RefusalHint>,
+) -> String {
+    use motion::AxisState as S;
+    if let Some(motion::RefusalHint::CamSlave {
+        position,
+        velocity,
+        window,
+    }) = hint
+    {
+        let (_, st) = s.status(slot);
+        let at = st.map(|st| st.set_position).unwrap_or(f64::NAN);
+        // Six decimals at most, without trailing zeros.
+        let n = |v: f64| {
+            let t = format!("{v:.6}");
+            let t = t.trim_end_matches('0').trim_end_matches('.');
+            if t == "-0" { "0".to_owned() } else { t.to_owned() }
+        };
+        return format!(
+            "the cam puts the slave at {} (velocity {}) now, the slave is at {}: move it there \
+             first (within {}), couple with autooffset, or start with start_mode ramp_in",
+            n(position),
+            n(velocity),
+            n(at),
+            n(window)
+        );
+    }
+    let (_, Some(st)) = s.status(slot) else {
+        return "the axis is not in the cycle".into();
+    };
+    let name = |st: S| {
+        serde_json::to_value(st)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_owned))
+            .unwrap_or_default()
+    };
+    let state = name(st.state);
+    match st.state {
+        S::ErrorStop => {
+            let err = ErrorId(st.error_id);
+            format!(
+                "the axis is in error_stop with 0x{:04X} {} ({}): remove the cause, then reset \
+                 it (POST …/reset)",
+                st.error_id,
+                err.code(),
+                err.text()
+            )
+        }
+        S::Disabled => {
+            "the axis is disabled: enable it first (POST …/power with enable true)".into()
+        }
+        S::Stopping if st.motion_commands_locked => {
+            // The lock's holder: the newest MC_Stop of this axis (its job ends at standstill,
+            // the lock stays until it is released).
+            let stop = {
+                let store = s.commands.lock().unwrap();
+                store
+                    .order
+                    .iter()
+                    .rev()
+                    .filter_map(|id| store.map.get(id))
+                    .find(|r| r.slot == slot && r.name == "stop" && r.accepted)
+                    .map_or(st.active_command, |r| r.id)
+            };
+            if st.moving {
+                format!("MC_Stop (command {stop}) is stopping the axis and holds it locked")
+            } else {
+                format!(
+                    "the axis stands locked by MC_Stop (command {stop}): release it \
+                     (DELETE /api/v1/commands/{stop}) or reset the axis"
+                )
+            }
+        }
+        S::Homing => format!(
+            "the axis is homing (command {}): wait for it to end or stop it",
+            st.active_command
+        ),
+        S::SynchronizedMotion if e == ErrorId::AXIS_CANNOT_BE_STARTED => {
+            "the axis is a coupled slave: decouple it first (gear-out, cam-out) or stop it".into()
+        }
+        _ if e == ErrorId::BUFFER_FULL => format!(
+            "the axis already executes command {} with one buffered after it",
+            st.active_command
+        ),
+        _ => format!("the axis is in {state}"),
     }
 }
 
@@ -1210,23 +1316,67 @@ pub fn find(s: &AppState, id: CommandId) -> AppResult<CommandResource> {
     get(s, id).ok_or_else(|| AppError::not_found("command", &id.to_string()))
 }
 
-/// Waits until the command is final or reaches its milestone, or the timeout.
+/// How a wait ended: at the milestone, or why not (the axis's state and error as they are).
+fn wait_outcome(s: &AppState, v: &CommandResource, milestone: Milestone) -> WaitOutcome {
+    let reached = v.is_final || milestone.reached(&v.outputs);
+    let st = s
+        .registry
+        .read()
+        .unwrap()
+        .find(&v.axis_id.to_string())
+        .map(|e| e.slot)
+        .and_then(|slot| s.status(slot).1)
+        .unwrap_or_default();
+    let reason = match st.state {
+        _ if reached => None,
+        motion::AxisState::ErrorStop => Some("axis_error_stop"),
+        motion::AxisState::Disabled => Some("axis_disabled"),
+        _ => Some("timeout"),
+    };
+    WaitOutcome {
+        milestone,
+        reached,
+        reason,
+        axis_state: st.state,
+        axis_error_id: st.error_id,
+        axis_error_code: (st.error_id != 0).then(|| ErrorId(st.error_id).code()),
+    }
+}
+
+/// Waits until the command is final or reaches its milestone, or the timeout — or until its
+/// axis is in error_stop, where nothing reaches a milestone before a reset (the answer then
+/// says so: `wait.reason`).
 pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<CommandResource> {
     let deadline = tokio::time::Instant::now() + timeout;
     let mut rx = s.notices.subscribe();
+    // The axis's state changes without an event of this command (a power waiting for Status
+    // while the axis stays in error_stop): looked at between notices too.
+    let mut look = tokio::time::interval(Duration::from_millis(20));
+    look.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
-        let (view, milestone) = {
+        let (view, milestone, slot) = {
             let store = s.commands.lock().unwrap();
             let r = store.map.get(&id).filter(|r| r.accepted)?;
-            (r.view(), r.milestone)
+            (r.view(), r.milestone, r.slot)
         };
         if view.is_final || milestone.reached(&view.outputs) {
             return Some(view);
         }
-        match tokio::time::timeout_at(deadline, rx.recv()).await {
-            Err(_) => return get(s, id),
-            Ok(Err(tokio::sync::broadcast::error::RecvError::Closed)) => return get(s, id),
-            Ok(_) => {}
+        let (cycle, st) = s.status(slot);
+        // A reset is what leaves error_stop (its drive may take cycles to clear the fault).
+        if cycle > view.accepted_cycle
+            && view.command != "reset"
+            && st.is_some_and(|st| st.state == motion::AxisState::ErrorStop)
+        {
+            return Some(view);
+        }
+        tokio::select! {
+            r = tokio::time::timeout_at(deadline, rx.recv()) => match r {
+                Err(_) => return get(s, id),
+                Ok(Err(tokio::sync::broadcast::error::RecvError::Closed)) => return get(s, id),
+                Ok(_) => {}
+            },
+            _ = look.tick() => {}
         }
     }
 }

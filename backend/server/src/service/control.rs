@@ -127,6 +127,28 @@ fn held(h: &Holder) -> AppError {
     )
 }
 
+/// A command that only ends motion (MC_Stop, MC_Halt, MC_Power off, switching the external
+/// generator off, MC_HaltPhasing): never refused for who holds control, nor because the store
+/// is down (safety first: a stop is never refused).
+pub fn stops_motion(kind: &CommandKind) -> bool {
+    matches!(
+        kind,
+        CommandKind::Stop { .. }
+            | CommandKind::Halt { .. }
+            | CommandKind::Power { enable: false, .. }
+            // Switching the external generator off stops what it moves.
+            | CommandKind::ExtSetPointGenDisable
+            // Halting a phase motion is a stop.
+            | CommandKind::Phasing {
+                motion: motion::PhasingMotion {
+                    kind: motion::PhasingKind::Halt,
+                    ..
+                },
+                ..
+            }
+    )
+}
+
 impl Control {
     pub fn new(enabled: bool) -> Control {
         Control {
@@ -246,26 +268,8 @@ impl Control {
         if !self.enabled {
             return Ok(());
         }
-        let always = matches!(
-            kind,
-            CommandKind::Stop { .. }
-                | CommandKind::Halt { .. }
-                | CommandKind::Power { enable: false, .. }
-                // A probe moves nothing.
-                | CommandKind::TouchProbe(_)
-                | CommandKind::AbortTrigger
-                // Switching the external generator off stops what it moves.
-                | CommandKind::ExtSetPointGenDisable
-                // Halting a phase motion is a stop.
-                | CommandKind::Phasing {
-                    motion: motion::PhasingMotion {
-                        kind: motion::PhasingKind::Halt,
-                        ..
-                    },
-                    ..
-                }
-        );
-        if always {
+        if stops_motion(kind) || matches!(kind, CommandKind::TouchProbe(_) | CommandKind::AbortTrigger) {
+            // A probe moves nothing.
             return Ok(());
         }
         let h = self.live();

@@ -3,7 +3,8 @@
 //! nothing is done again, for 24 h. The key is kept in memory with the answer, and stored with
 //! the command's submission row (committed before the command is acknowledged), so that a retry
 //! after a restart is recognised too: then the command cannot be shown any more, and the
-//! answer is a 409 naming it.
+//! answer is a 409 naming it. A key belongs to its sender (principal and `X-Client-Id`): the
+//! same key from another client is another key (decision 117).
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Mutex;
@@ -29,7 +30,8 @@ pub const MAX_KEY: usize = 255;
 #[derive(Clone, Debug)]
 enum Answer {
     Accepted(CommandResource),
-    Rejected(ErrorId),
+    /// Refused by the axis, with what was in the way then.
+    Rejected(ErrorId, Option<String>),
 }
 
 #[derive(Debug)]
@@ -132,19 +134,31 @@ pub async fn run_once<B>(
         return commands::run(s, sub, wait).await.map(|v| (v, false));
     };
     let fingerprint = format!("{}\n{}\n{}", sub.name, sub.axis, sub.raw);
+    let (principal, client_id) = (sub.client.principal.clone(), sub.client.id.clone());
+    // Remembered per sender: principal and client id before the key (neither contains a newline).
+    let scoped = format!(
+        "{}\n{}\n{key}",
+        principal.as_deref().unwrap_or(""),
+        client_id.as_deref().unwrap_or("")
+    );
     let reused = || {
         AppError::conflict(
             "idempotency_key_reused",
             format!("the Idempotency-Key {key:?} was sent with another request"),
         )
     };
-    match s.idempotency.begin(&key, &fingerprint) {
+    match s.idempotency.begin(&scoped, &fingerprint) {
         Begin::New => {}
         Begin::Replay(Answer::Accepted(first)) => {
             // The command as it stands now (as it was answered, once it left the history).
             return Ok((commands::get(s, first.id).unwrap_or(first), true));
         }
-        Begin::Replay(Answer::Rejected(id)) => return Err(AppError::rejected(id)),
+        Begin::Replay(Answer::Rejected(id, why)) => {
+            return Err(match why {
+                Some(why) => AppError::RejectedBecause { id, why },
+                None => AppError::rejected(id),
+            });
+        }
         Begin::InFlight => {
             return Err(AppError::conflict(
                 "idempotency_key_in_flight",
@@ -154,16 +168,23 @@ pub async fn run_once<B>(
         Begin::Reused => return Err(reused()),
     }
     // Not in memory: sent before a restart (or so long ago that memory let it go)?
-    let stored = match store::find_idempotency_key(&s.db, &key).await {
+    let stored = match store::find_idempotency_key(
+        &s.db,
+        &key,
+        principal.as_deref(),
+        client_id.as_deref(),
+    )
+    .await
+    {
         Ok(r) => r,
         Err(e) => {
-            s.idempotency.finish(&key, None);
+            s.idempotency.finish(&scoped, None);
             return Err(AppError::storage(e));
         }
     };
     let cutoff = humantime::format_rfc3339_millis(SystemTime::now() - TTL).to_string();
     if let Some((id, action, target, detail, outcome, at)) = stored.filter(|r| r.5 >= cutoff) {
-        s.idempotency.finish(&key, None);
+        s.idempotency.finish(&scoped, None);
         let axis = s
             .registry
             .read()
@@ -191,10 +212,13 @@ pub async fn run_once<B>(
     }
     let r = commands::run(s, sub, wait).await;
     s.idempotency.finish(
-        &key,
+        &scoped,
         match &r {
             Ok(v) => Some(Answer::Accepted(v.clone())),
-            Err(AppError::Rejected(id)) => Some(Answer::Rejected(*id)),
+            Err(AppError::Rejected(id)) => Some(Answer::Rejected(*id, None)),
+            Err(AppError::RejectedBecause { id, why }) => {
+                Some(Answer::Rejected(*id, Some(why.clone())))
+            }
             Err(_) => None,
         },
     );

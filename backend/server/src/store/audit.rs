@@ -66,12 +66,17 @@ pub enum AuditOp {
 pub async fn find_idempotency_key(
     pool: &SqlitePool,
     key: &str,
+    principal: Option<&str>,
+    client_id: Option<&str>,
 ) -> Result<Option<(u64, String, Option<String>, String, Option<String>, String)>, sqlx::Error> {
+    // A key is the sender's: the same key from another principal or client is another key.
     let row = sqlx::query(
         "SELECT command_id, action, target, detail, outcome, at FROM audit_log \
-         WHERE idempotency_key = ? ORDER BY id DESC LIMIT 1",
+         WHERE idempotency_key = ? AND principal IS ? AND client_id IS ? ORDER BY id DESC LIMIT 1",
     )
     .bind(key)
+    .bind(principal)
+    .bind(client_id)
     .fetch_optional(pool)
     .await?;
     Ok(row.map(|r| {
