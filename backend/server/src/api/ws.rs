@@ -258,7 +258,10 @@ struct Sub {
     /// every socket, so that subscribers share the feed's deltas).
     every: u64,
     due: u64,
+    /// The system topic: the object last sent (its delta is made here).
     last: Option<crate::app::StatusJson>,
+    /// An axis topic: the version (status cycle) last sent; the feed makes its delta.
+    seen: Option<u64>,
 }
 
 fn rpc_result(id: &Value, result: Value) -> String {
@@ -452,7 +455,7 @@ fn follow_axes(s: &AppState, subs: &mut Vec<Sub>, out: &mut Batch) {
                 if e.slot != *slot || e.name != *name {
                     // Another axis object now: start again with a full object.
                     (*slot, *name) = (e.slot, e.name.clone());
-                    sub.last = None;
+                    sub.seen = None;
                 }
                 true
             }
@@ -518,10 +521,10 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, 
         match &sub.topic {
             Topic::Commands => {}
             Topic::Axis { slot, .. } => {
-                let Some(p) = s.feed.piece(s, *slot, tick, sub.last.as_ref()) else {
+                let Some(p) = s.feed.piece(s, *slot, tick, sub.seen) else {
                     continue;
                 };
-                sub.last = Some(p.map);
+                sub.seen = Some(p.version);
                 if let Some(data) = p.data {
                     write_update(out.next(), &sub.key_json, p.cycle, p.full, &data);
                 }
@@ -707,6 +710,7 @@ fn handle(
                 every,
                 due: 0,
                 last: None,
+                seen: None,
             });
             let result = SubscribeResult {
                 topic: key,

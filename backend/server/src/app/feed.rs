@@ -1,58 +1,168 @@
-//! The websocket status feed: an axis's status object, its whole JSON and its delta from what a
-//! subscriber was sent before are made once per tick and shared by every socket that sends
-//! them, so that the cost of streaming grows with the axes, not with axes × subscribers.
+//! The websocket status feed. Each axis's status is written as JSON once per cycle that anyone
+//! asks for (straight from the status, no `serde_json::Value`), split into its top-level
+//! members, and kept with the last [`KEPT`] versions; the delta from an older version to the
+//! newest is made once and shared by every subscriber that has that older version. So the cost
+//! of streaming grows with axes × versions in flight (at most [`KEPT`]), never with axes ×
+//! subscribers — also when sockets fall out of step with each other. A subscriber whose
+//! version is older than what is kept gets the newest state whole (coalesced).
 //!
 //! Ticks are a grid every [`TICK`] from the feed's epoch; a subscription at a given rate is due
-//! on the same ticks in every socket (and a socket sleeps until its next one is due), so
-//! subscribers of one axis at one rate share one delta. A delta is keyed by the object it starts from (the
-//! `Arc` a subscriber was sent), never by a tick number alone, so a socket that runs late can
-//! never be handed another socket's delta.
+//! on the same ticks in every socket (and a socket sleeps until its next one is due). A
+//! subscriber is known here only by the version (the status's cycle) it was last sent.
 
+use std::collections::VecDeque;
 use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use serde_json::{Map, Value};
 use tokio::time::Instant;
 
-use super::{AppState, StatusJson};
+use super::AppState;
 use motion::AxisSlot;
 
 /// The websocket tick: the finest subscription grid (200 Hz; the highest rate is 100 Hz).
 pub const TICK: Duration = Duration::from_millis(5);
 
-/// One axis at the newest tick anyone asked for.
-#[derive(Default)]
-struct Frame {
-    tick: u64,
+/// Versions of an axis's status kept for deltas (a subscriber further behind gets it whole).
+pub const KEPT: usize = 8;
+
+/// One axis's status at one cycle, as JSON.
+struct Version {
     cycle: u64,
-    map: Option<StatusJson>,
-    /// The whole object as JSON (for first updates), made when first needed.
-    full: Option<Arc<str>>,
-    /// Deltas to `map` from the objects subscribers were sent before (`None`: no change).
-    deltas: Vec<(StatusJson, Option<Arc<str>>)>,
+    /// The whole object (what a first update sends).
+    json: Arc<str>,
+    /// Each top-level member `"key":value` of `json`: its start, where its value starts, its end.
+    members: Vec<(u32, u32, u32)>,
+}
+
+impl Version {
+    fn of(cycle: u64, status: &impl serde::Serialize) -> Option<Version> {
+        let json = serde_json::to_string(status).ok()?;
+        let members = members(&json)?;
+        Some(Version {
+            cycle,
+            json: json.into(),
+            members,
+        })
+    }
+
+    fn key(&self, i: usize) -> &str {
+        let (start, value, _) = self.members[i];
+        &self.json[start as usize..value as usize]
+    }
+
+    fn value(&self, i: usize) -> &str {
+        let (_, value, end) = self.members[i];
+        &self.json[value as usize..end as usize]
+    }
+
+    fn member(&self, i: usize) -> &str {
+        let (start, _, end) = self.members[i];
+        &self.json[start as usize..end as usize]
+    }
+}
+
+/// The top-level members of a JSON object as written by serde_json (compact): for each, where
+/// it starts, where its value starts (after the colon) and where it ends. `None` for anything
+/// that is not an object.
+fn members(json: &str) -> Option<Vec<(u32, u32, u32)>> {
+    let b = json.as_bytes();
+    if b.first() != Some(&b'{') || b.last() != Some(&b'}') {
+        return None;
+    }
+    let mut out = Vec::with_capacity(96);
+    let (mut depth, mut in_string, mut escaped) = (0usize, false, false);
+    let (mut start, mut value) = (1usize, 0usize);
+    for (i, &c) in b.iter().enumerate().skip(1) {
+        if in_string {
+            match c {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match c {
+            b'"' => in_string = true,
+            b'{' | b'[' => depth += 1,
+            b':' if depth == 0 => value = i + 1,
+            b',' if depth == 0 => {
+                out.push((start as u32, value as u32, i as u32));
+                start = i + 1;
+            }
+            b'}' if depth == 0 => {
+                // The object's end (it is the last byte).
+                if i > start {
+                    out.push((start as u32, value as u32, i as u32));
+                }
+            }
+            b'}' | b']' => depth = depth.checked_sub(1)?,
+            _ => {}
+        }
+    }
+    Some(out)
+}
+
+/// The members of `now` whose value differs from `before` (or that `before` lacks), as a JSON
+/// object; `None` when nothing changed.
+fn delta_json(before: &Version, now: &Version) -> Option<Arc<str>> {
+    let same_shape = before.members.len() == now.members.len()
+        && (0..now.members.len()).all(|i| before.key(i) == now.key(i));
+    let mut out = String::with_capacity(256);
+    for i in 0..now.members.len() {
+        let changed = if same_shape {
+            before.value(i) != now.value(i)
+        } else {
+            let key = now.key(i);
+            (0..before.members.len())
+                .find(|&j| before.key(j) == key)
+                .is_none_or(|j| before.value(j) != now.value(i))
+        };
+        if changed {
+            out.push(if out.is_empty() { '{' } else { ',' });
+            out.push_str(now.member(i));
+        }
+    }
+    if out.is_empty() {
+        return None;
+    }
+    out.push('}');
+    Some(out.into())
+}
+
+/// One axis: its recent versions and the deltas made to the newest.
+#[derive(Default)]
+struct AxisFeed {
+    /// The newest tick anyone asked for.
+    tick: u64,
+    /// Oldest first.
+    versions: VecDeque<Arc<Version>>,
+    /// Deltas to the newest version from the older ones asked for (`None`: no change).
+    deltas: Vec<(u64, Option<Arc<str>>)>,
 }
 
 /// What a subscription sends for one axis at a tick.
 pub struct Piece {
     pub cycle: u64,
-    /// `data` is the whole object (the first update, or after the axis object changed).
+    /// `data` is the whole object (the first update, or a subscriber too far behind).
     pub full: bool,
     /// The object (or the delta) as JSON; `None`: nothing changed, nothing to send.
     pub data: Option<Arc<str>>,
-    /// The object the subscriber has from now on.
-    pub map: StatusJson,
+    /// The version the subscriber has from now on.
+    pub version: u64,
 }
 
 pub struct Feed {
     epoch: Instant,
-    frames: Vec<RwLock<Frame>>,
+    axes: Vec<RwLock<AxisFeed>>,
 }
 
 impl Feed {
     pub fn new(slots: usize) -> Self {
         Feed {
             epoch: Instant::now(),
-            frames: (0..slots).map(|_| RwLock::default()).collect(),
+            axes: (0..slots).map(|_| RwLock::default()).collect(),
         }
     }
 
@@ -69,90 +179,135 @@ impl Feed {
             / TICK.as_nanos()) as u64
     }
 
-    /// The update of axis `slot` for a subscriber that was last sent `last` (`None`: nothing
-    /// yet); `None` when the axis has no status.
-    pub fn piece(
-        &self,
-        s: &AppState,
-        slot: AxisSlot,
-        tick: u64,
-        last: Option<&StatusJson>,
-    ) -> Option<Piece> {
-        let frame = self.frames.get(slot as usize)?;
+    /// The update of axis `slot` at `tick` for a subscriber that was last sent version `seen`
+    /// (`None`: nothing yet); `None` when the axis has no status.
+    pub fn piece(&self, s: &AppState, slot: AxisSlot, tick: u64, seen: Option<u64>) -> Option<Piece> {
+        let axis = self.axes.get(slot as usize)?;
         // Most subscribers find what they need made already: a shared read.
         {
-            let f = frame.read().unwrap();
-            if f.map.is_some() && tick <= f.tick {
-                if let Some(p) = f.answer(last) {
+            let f = axis.read().unwrap();
+            if !f.versions.is_empty() && tick <= f.tick {
+                if let Some(p) = f.answer(seen) {
                     return Some(p);
                 }
             }
         }
-        let mut f = frame.write().unwrap();
-        // A late socket uses the newer frame (newer data), never takes the feed back.
-        if f.map.is_none() || tick > f.tick {
-            let (cycle, map) = s.status_json(slot)?;
-            f.tick = tick;
-            if !f.map.as_ref().is_some_and(|m| Arc::ptr_eq(m, &map)) {
-                *f = Frame {
-                    tick,
-                    cycle,
-                    map: Some(map),
-                    ..Frame::default()
-                };
+        let mut f = axis.write().unwrap();
+        // A late socket uses the newer version (newer data), never takes the feed back.
+        if f.versions.is_empty() || tick > f.tick {
+            f.tick = f.tick.max(tick);
+            let (cycle, status) = s.status(slot);
+            let status = status?;
+            if f.versions.back().is_none_or(|v| v.cycle != cycle) {
+                let v = Version::of(cycle, &s.status_view(status))?;
+                if f.versions.len() == KEPT {
+                    f.versions.pop_front();
+                }
+                f.versions.push_back(Arc::new(v));
+                f.deltas.clear();
             }
         }
-        let map = f.map.clone()?;
-        match last {
-            None => {
-                if f.full.is_none() {
-                    f.full = Some(serde_json::to_string(&*map).unwrap_or_default().into());
-                }
-            }
-            Some(last) => {
-                if !Arc::ptr_eq(last, &map)
-                    && !f.deltas.iter().any(|(from, _)| Arc::ptr_eq(from, last))
-                {
-                    let d = delta(last, &map);
-                    let d = (!d.is_empty())
-                        .then(|| Arc::<str>::from(serde_json::to_string(&d).unwrap_or_default()));
-                    f.deltas.push((last.clone(), d));
+        if let Some(from) = seen {
+            let newest = f.versions.back()?.clone();
+            let made = from == newest.cycle || f.deltas.iter().any(|(c, _)| *c == from);
+            if !made {
+                if let Some(old) = f.versions.iter().find(|v| v.cycle == from).cloned() {
+                    let d = delta_json(&old, &newest);
+                    f.deltas.push((from, d));
                 }
             }
         }
-        f.answer(last)
+        f.answer(seen)
     }
 }
 
-impl Frame {
-    /// The update for a subscriber last sent `last`, if this frame has it made.
-    fn answer(&self, last: Option<&StatusJson>) -> Option<Piece> {
-        let map = self.map.clone()?;
-        let (data, full) = match last {
-            None => (Some(self.full.clone()?), true),
-            Some(last) if Arc::ptr_eq(last, &map) => (None, false),
-            Some(last) => (
-                self.deltas
-                    .iter()
-                    .find(|(from, _)| Arc::ptr_eq(from, last))?
-                    .1
-                    .clone(),
-                false,
-            ),
-        };
-        Some(Piece {
-            cycle: self.cycle,
+impl AxisFeed {
+    /// The update for a subscriber last sent version `seen`, if it is made (`None`: a delta
+    /// still to make).
+    fn answer(&self, seen: Option<u64>) -> Option<Piece> {
+        let newest = self.versions.back()?;
+        let piece = |full: bool, data: Option<Arc<str>>| Piece {
+            cycle: newest.cycle,
             full,
             data,
-            map,
-        })
+            version: newest.cycle,
+        };
+        match seen {
+            None => Some(piece(true, Some(newest.json.clone()))),
+            Some(c) if c == newest.cycle => Some(piece(false, None)),
+            Some(c) => match self.deltas.iter().find(|(from, _)| *from == c) {
+                Some((_, d)) => Some(piece(false, d.clone())),
+                None if self.versions.iter().any(|v| v.cycle == c) => None,
+                // Further behind than what is kept: the newest state, whole.
+                None => Some(piece(true, Some(newest.json.clone()))),
+            },
+        }
     }
 }
 
-/// The members of `now` that differ from `before`.
+/// The members of `now` that differ from `before` (the system topic's delta).
 pub fn delta(before: &Map<String, Value>, now: &Map<String, Value>) -> Map<String, Value> {
     now.iter()
         .filter(|(k, v)| before.get(*k) != Some(v))
         .map(|(k, v)| (k.clone(), v.clone()))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn version(cycle: u64, v: Value) -> Version {
+        Version::of(cycle, &v).unwrap()
+    }
+
+    #[test]
+    fn members_split_at_top_level_only() {
+        let v = version(
+            1,
+            json!({"a": 1, "b": {"c": [1, 2, {"d": "x,}]\"y"}]}, "e": "q\\\"", "f": null}),
+        );
+        let keys: Vec<&str> = (0..v.members.len()).map(|i| v.key(i)).collect();
+        assert_eq!(keys, [r#""a":"#, r#""b":"#, r#""e":"#, r#""f":"#]);
+        assert_eq!(v.value(1), r#"{"c":[1,2,{"d":"x,}]\"y"}]}"#);
+        assert_eq!(v.value(2), r#""q\\\"""#);
+        assert_eq!(v.value(3), "null");
+        assert!(members("[1]").is_none());
+        assert_eq!(members("{}").unwrap().len(), 0);
+    }
+
+    #[test]
+    fn a_delta_has_the_changed_members_and_parses_as_their_values() {
+        let a = version(1, json!({"p": 1.5, "s": "standstill", "n": {"x": 1}, "k": true}));
+        let b = version(2, json!({"p": 2.5, "s": "standstill", "n": {"x": 2}, "k": true}));
+        let d: Value = serde_json::from_str(&delta_json(&a, &b).unwrap()).unwrap();
+        assert_eq!(d, json!({"p": 2.5, "n": {"x": 2}}));
+        assert!(delta_json(&a, &a).is_none());
+        // Another shape (a member skipped in one of them): compared by key.
+        let c = version(3, json!({"s": "standstill", "p": 2.5, "m": "x"}));
+        let d: Value = serde_json::from_str(&delta_json(&a, &c).unwrap()).unwrap();
+        assert_eq!(d, json!({"p": 2.5, "m": "x"}));
+    }
+
+    #[test]
+    fn answers_come_from_kept_versions_and_a_subscriber_too_far_behind_gets_the_whole() {
+        let mut f = AxisFeed::default();
+        for c in 1..=(KEPT as u64 + 2) {
+            f.versions.push_back(Arc::new(version(c, json!({"c": c, "k": 0}))));
+            if f.versions.len() > KEPT {
+                f.versions.pop_front();
+            }
+        }
+        let newest = KEPT as u64 + 2;
+        let p = f.answer(None).unwrap();
+        assert!(p.full && p.version == newest);
+        assert!(f.answer(Some(newest)).unwrap().data.is_none());
+        // A kept version: its delta is to be made first.
+        assert!(f.answer(Some(newest - 1)).is_none());
+        // Older than what is kept: the newest, whole.
+        let p = f.answer(Some(1)).unwrap();
+        assert!(p.full);
+        assert_eq!(&*p.data.unwrap(), &*f.versions.back().unwrap().json);
+    }
 }

@@ -46,9 +46,7 @@ pub type StatusJson = Arc<serde_json::Map<String, serde_json::Value>>;
 pub struct AppState {
     pub shared: Arc<Shared>,
     snapshot: Mutex<triple_buffer::Output<Snapshot>>,
-    /// Per slot: the status of the latest cycle already turned into JSON.
-    status_json: Mutex<Vec<Option<(u64, StatusJson)>>>,
-    /// The websocket status feed (deltas made once per tick for every subscriber).
+    /// The websocket status feed (each axis's JSON and deltas made once for every subscriber).
     pub feed: feed::Feed,
     /// Counters for `/metrics` (the rest is read at scrape time).
     pub metrics: crate::metrics::Metrics,
@@ -97,7 +95,6 @@ impl AppState {
             scope,
             shared,
             snapshot: Mutex::new(snapshot),
-            status_json: Mutex::new(vec![None; MAX_AXES]),
             feed: feed::Feed::new(MAX_AXES),
             metrics: Default::default(),
             registry_writes: AtomicU64::new(0),
@@ -168,7 +165,6 @@ impl AppState {
         crate::model::LiveStatus { status, master }
     }
 
-    /// The latest status of a slot as JSON, serialised once per cycle whoever asks.
     /// The registry to change (counted, see [`AppState::registry_writes`]).
     pub fn registry_write(&self) -> std::sync::RwLockWriteGuard<'_, Registry> {
         self.registry_writes.fetch_add(1, Relaxed);
@@ -178,25 +174,6 @@ impl AppState {
     /// How often the registry has been written: unchanged, every axis is where it was.
     pub fn registry_writes(&self) -> u64 {
         self.registry_writes.load(Relaxed)
-    }
-
-    pub fn status_json(&self, slot: AxisSlot) -> Option<(u64, StatusJson)> {
-        let (cycle, status) = self.status(slot);
-        let status = status?;
-        let mut cache = self.status_json.lock().unwrap();
-        let entry = cache.get_mut(slot as usize)?;
-        if let Some((c, j)) = entry {
-            if *c == cycle {
-                return Some((cycle, j.clone()));
-            }
-        }
-        let view = self.status_view(status);
-        let serde_json::Value::Object(map) = serde_json::to_value(view).ok()? else {
-            return None;
-        };
-        let j = Arc::new(map);
-        *entry = Some((cycle, j.clone()));
-        Some((cycle, j))
     }
 
     pub fn with_snapshot<R>(&self, f: impl FnOnce(&Snapshot) -> R) -> R {
