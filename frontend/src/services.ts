@@ -2,7 +2,7 @@
 import { LiveClient } from './live/client';
 import { JogController } from './live/jog';
 import { Store } from './store';
-import { ApiError, api, del, enc, get, post } from './api/rest';
+import { ApiError, NotSentError, api, del, enc, get, post } from './api/rest';
 import { errorInfo } from './api/errors';
 import type { AxisLiveStatus, AxisResource, CommandEvent, CommandResource, PeakResetResource, SystemResource } from './api/types';
 import { RpcError } from './live/client';
@@ -197,6 +197,8 @@ export function logCommand(r: CommandResource): void {
 
 /** A command the server refused (no command resource exists for it). */
 export function logRejected(axis: string, command: string, parameters: unknown, e: unknown): void {
+  // Never sent (a number field's text is not a number): nothing the server refused.
+  if (e instanceof NotSentError) return;
   const p = e instanceof ApiError || e instanceof RpcError ? e.problem : null;
   const errorId = p?.error_id ?? 0;
   const text = p ? `${p.title}: ${p.detail}` : (e as Error).message;

@@ -44,7 +44,7 @@ describe('phasing', () => {
       velocity: 'must be ≥ 0.01',
       jerk: 'must be ≥ 0',
     });
-    expect(phasingBody({ ...PHASING_DEFAULTS, master: 'x', phase_shift: 'abc', velocity: '' }).errors).toEqual({ phase_shift: 'not a number', velocity: 'enter a value' });
+    expect(phasingBody({ ...PHASING_DEFAULTS, master: 'x', phase_shift: 'abc', velocity: '' }).errors).toEqual({ phase_shift: 'enter a number', velocity: 'enter a value' });
   });
   it('MC_HaltPhasing: master, deceleration and jerk only', () => {
     expect(haltPhasingBody({ ...PHASING_DEFAULTS, master: 'x', velocity: '10', deceleration: '500' })).toEqual({ body: { master: 'x', deceleration: 500 }, errors: {} });
@@ -158,7 +158,7 @@ describe('position correction', () => {
       ramp: 2,
       disable_mode: 'reset',
     });
-    expect(backlashBody({ ...BACKLASH_DEFAULTS, backlash: 'x', ramp: '0' }).errors).toEqual({ backlash: 'not a number', ramp: 'must be > 0' });
+    expect(backlashBody({ ...BACKLASH_DEFAULTS, backlash: 'x', ramp: '0' }).errors).toEqual({ backlash: 'enter a number', ramp: 'must be > 0' });
   });
   it('table compensation: the ramp must be > 0', () => {
     expect(tableCompensationBody({ ...TABLE_COMPENSATION_DEFAULTS, ramp: '1' })).toEqual({ body: { ramp: 1, disable_mode: 'hold' }, errors: {} });
@@ -190,6 +190,6 @@ describe('encoder', () => {
     expect(incPosQuery({ inc_pos: '-1' }).errors).toEqual({ inc_pos: 'must be ≥ 0' });
     expect(incPosQuery({ inc_pos: '' }).errors).toEqual({ inc_pos: 'enter a value' });
     expect(posQuery({ position: '12,5' })).toEqual({ body: 'position=12.5', errors: {} });
-    expect(posQuery({ position: 'abc' }).errors).toEqual({ position: 'not a number' });
+    expect(posQuery({ position: 'abc' }).errors).toEqual({ position: 'enter a number' });
   });
 });

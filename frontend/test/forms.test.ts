@@ -65,7 +65,7 @@ describe('parameters', () => {
       [1018, true, false],
     ]);
     expect(invalid).toEqual({});
-    expect(diff(list, { 1003: 'abc' }).invalid).toEqual({ 1003: 'not a number' });
+    expect(diff(list, { 1003: 'abc' }).invalid).toEqual({ 1003: 'enter a number' });
   });
 });
 
@@ -103,7 +103,7 @@ describe('axis configuration form', () => {
     const f = { ...DEFAULT_FORM, name: 'z', dyn: { ...DEFAULT_FORM.dyn, jerk: 'fast' }, damping: '' };
     const { config, errors } = configOf(f);
     expect(config).toBeNull();
-    expect(errors).toEqual({ 'dynamics.jerk': 'not a number', 'drive.plant.damping': 'required' });
+    expect(errors).toEqual({ 'dynamics.jerk': 'enter a number', 'drive.plant.damping': 'required' });
   });
 
   it('leaves range checks to the server (a negative jerk is sent)', () => {
@@ -146,7 +146,7 @@ describe('axis configuration form', () => {
     const old = formOf({ ...cfg, drive: { kind: 'cia402', subdevice: 1, increments_per_unit: 1000, mode: 'csv' } } as never);
     expect(old.cia).toMatchObject({ position_gain: '50', velocity_gain: '0', acceleration_feed_forward: '0', max_torque: '1000' });
     // typed text that is no number: named by its JSON path
-    expect(configOf({ ...f, cia: { ...f.cia, velocity_gain: 'fast', max_torque: '' } }).errors).toEqual({ 'drive.velocity_gain': 'not a number', 'drive.max_torque': 'required' });
+    expect(configOf({ ...f, cia: { ...f.cia, velocity_gain: 'fast', max_torque: '' } }).errors).toEqual({ 'drive.velocity_gain': 'enter a number', 'drive.max_torque': 'required' });
   });
 
   it('a CiA-402 drive: no simulated field is sent; the simulated one keeps what was typed while the kind is switched', () => {
@@ -166,7 +166,7 @@ describe('axis configuration form', () => {
     const f = { ...DEFAULT_FORM, name: 'z', driveKind: 'cia402' as const, damping: 'not checked', cia: { ...DEFAULT_FORM.cia, subdevice: '1.5', increments_per_unit: '', velocity_increments_per_unit: 'x' } };
     const { config, errors } = configOf(f);
     expect(config).toBeNull();
-    expect(errors).toEqual({ 'drive.subdevice': 'a whole number', 'drive.increments_per_unit': 'required', 'drive.velocity_increments_per_unit': 'not a number' });
+    expect(errors).toEqual({ 'drive.subdevice': 'a whole number', 'drive.increments_per_unit': 'required', 'drive.velocity_increments_per_unit': 'enter a number' });
     expect(configOf({ ...f, cia: { ...f.cia, subdevice: '' , increments_per_unit: '1', velocity_increments_per_unit: '' } }).errors).toEqual({ 'drive.subdevice': 'required' });
   });
 

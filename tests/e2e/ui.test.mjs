@@ -277,6 +277,40 @@ describe('commissioning UI', () => {
   });
 
   test('stop locks the axis until released; feed enables; override; home with a chosen mode', async () => {
+  test('a number field with text that is not a number: "enter a number" beside it, nothing sent, no serde text', async () => {
+    await enabled();
+    await atRest();
+    const page = await open(`/axes/${AXIS}`);
+    const sent = [];
+    page.on('request', (r) => r.method() === 'POST' && r.url().includes(`/axes/${AXIS}/move-absolute`) && sent.push(r.postDataJSON()));
+    await page.click('[data-move="move-absolute"]');
+    await page.fill('input[name="position"]', '20');
+    await page.fill('input[name="velocity"]', 'abc');
+    await page.click('button[name="start"]');
+    const said = page.locator('[data-field="velocity"] .field-error:visible');
+    await said.waitFor();
+    assert.equal((await said.textContent()).trim(), 'enter a number');
+    assert.equal(await page.getAttribute('input[name="velocity"]', 'aria-invalid'), 'true');
+    await picture(page, 'online-not-a-number');
+    // a number then: that one is sent — and it is the only move sent
+    const answered = page.waitForResponse((r) => r.request().method() === 'POST' && r.url().includes(`/axes/${AXIS}/move-absolute`));
+    await page.fill('input[name="velocity"]', '100');
+    await page.click('button[name="start"]');
+    assert.equal((await answered).status(), 202);
+    assert.deepEqual(sent.map((b) => b.velocity), [100], 'the move with "abc" was never sent');
+    await page.waitForSelector('[data-field="velocity"] .field-error', { state: 'detached' });
+    assert.equal(await page.locator('text=invalid type').count(), 0, 'no serde message anywhere');
+    assert.equal(await page.locator('[data-testid="command-log"] tr[data-state="rejected"][data-command="move-absolute"]', { hasText: 'enter a number' }).count(), 0, 'nothing logged as refused by the server');
+    // a block's field on another tab (Functions: homing's search velocity) says it the same way
+    await page.click('[data-tab="functions"]');
+    await page.fill('input[name="home-search-velocity"]', '12x');
+    await page.click('button[name="home-start"]');
+    await page.locator('[data-field="home-search-velocity"] .field-error:visible').waitFor();
+    assert.equal((await page.locator('[data-field="home-search-velocity"] .field-error:visible').textContent()).trim(), 'enter a number');
+    await atRest();
+    await page.close();
+  });
+
     await enabled();
     const page = await open(`/axes/${AXIS}`);
     // without the positive feed enable a forward jog is refused, with its error text

@@ -38,6 +38,38 @@ export function fieldErrors(p: Problem | null | undefined): Record<string, strin
   return out;
 }
 
+/** What a number field says when its text is not a number (the field itself and a refused send). */
+export const NOT_A_NUMBER = 'enter a number';
+
+/**
+ * The JSON paths (`velocity`, `masters[1].gear_ratio`) of the numbers in a body that JSON cannot
+ * carry: a text that is not a number parses to NaN, which JSON.stringify would send as null.
+ */
+export function nonFiniteFields(body: unknown, path = ''): string[] {
+  if (typeof body === 'number') return Number.isFinite(body) ? [] : [path || 'body'];
+  if (Array.isArray(body)) return body.flatMap((v, i) => nonFiniteFields(v, `${path}[${i}]`));
+  if (body && typeof body === 'object') return Object.entries(body).flatMap(([k, v]) => nonFiniteFields(v, path ? `${path}.${k}` : k));
+  return [];
+}
+
+/**
+ * A request that was not sent because a number field holds something else: a 422 made here,
+ * its fields saying "enter a number" as the server's would name them, so forms show it where
+ * they show the server's field errors.
+ */
+export class NotSentError extends ApiError {
+  constructor(paths: string[]) {
+    super(422, {
+      type: 'about:blank',
+      title: 'Not sent',
+      status: 422,
+      code: 'not_a_number',
+      detail: `${NOT_A_NUMBER}: ${paths.join(', ')}`,
+      errors: paths.map((field) => ({ field, message: NOT_A_NUMBER })),
+    });
+  }
+}
+
 export function isProblem(x: unknown): x is Problem {
   return !!x && typeof x === 'object' && typeof (x as Problem).status === 'number' &&
     typeof (x as Problem).code === 'string';
@@ -78,6 +110,9 @@ export function onUnauthorized(handler: ((e: ApiError) => void) | null): void {
 }
 
 export async function api<T>(method: string, path: string, body?: unknown): Promise<T> {
+  // Never send a number field's "abc" as null (the server would answer with serde's words).
+  const bad = nonFiniteFields(body);
+  if (bad.length) throw new NotSentError(bad);
   let res: Response;
   try {
     res = await fetch(url(path), {

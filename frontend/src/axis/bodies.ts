@@ -3,6 +3,7 @@
 // default applies; a text that is no number is sent as NaN → null for the server to refuse
 // at its field.
 import type { components } from '../api/schema';
+import { NOT_A_NUMBER } from '../api/rest';
 
 type S = components['schemas'];
 export type GearInBody = S['GearInBody'];
@@ -279,7 +280,7 @@ function checkNum(f: Form, key: string, errors: Record<string, string>, rule: Nu
     if (rule.required) errors[key] = 'enter a value';
     return rule.required ? NaN : undefined;
   }
-  if (!Number.isFinite(v)) errors[key] = 'not a number';
+  if (!Number.isFinite(v)) errors[key] = NOT_A_NUMBER;
   else if (rule.integer && !Number.isInteger(v)) errors[key] = 'must be a whole number';
   else if (rule.min !== undefined && (rule.above ? v <= rule.min : v < rule.min)) errors[key] = `must be ${rule.above ? '>' : '≥'} ${rule.min}`;
   else if (rule.max !== undefined && v > rule.max) errors[key] = `must be ≤ ${rule.max}`;

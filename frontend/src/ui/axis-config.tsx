@@ -13,7 +13,7 @@
 import { useEffect, useState } from 'preact/hooks';
 import type { JSX } from 'preact';
 import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../api/types';
-import { ApiError, del, enc, post, put } from '../api/rest';
+import { ApiError, NOT_A_NUMBER, del, enc, post, put } from '../api/rest';
 import { command, refreshAxes, statuses } from '../services';
 import { navigate } from '../router';
 import { useStore } from '../store';
@@ -210,7 +210,7 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
   const num = (path: string, s: string): number => {
     const t = s.trim().replace(',', '.');
     const v = t === '' ? NaN : Number(t);
-    if (!Number.isFinite(v)) errors[path] = t === '' ? 'required' : 'not a number';
+    if (!Number.isFinite(v)) errors[path] = t === '' ? 'required' : NOT_A_NUMBER;
     return v;
   };
   const opt = (path: string, s: string): number | null => (s.trim() === '' ? null : num(path, s));

@@ -2,7 +2,7 @@ import type { ComponentChildren } from 'preact';
 import { useState } from 'preact/hooks';
 import { stateLamp, STATE_LABEL } from '../format';
 import type { AxisState } from '../api/types';
-import { ApiError } from '../api/rest';
+import { ApiError, NOT_A_NUMBER } from '../api/rest';
 import { RpcError } from '../live/client';
 import { errorInfo } from '../api/errors';
 import { useStore } from '../store';
@@ -66,7 +66,18 @@ export function Field({ label, error, hint, children, class: cls, name }: { labe
   );
 }
 
-/** A number input that keeps the text as typed (so "1." or "-" can be entered). */
+/** Whether a number field's text is a number (blank is not: it is "nothing typed"). */
+export function isNumberText(s: string): boolean {
+  const t = s.trim().replace(',', '.');
+  return t !== '' && Number.isFinite(Number(t));
+}
+
+/**
+ * A number input that keeps the text as typed (so "1." or "-" can be entered). Text that is
+ * not a number is said beside the field in words ("enter a number") once the field is left —
+ * while typing "-" on the way to "-5" nothing flickers; a request with it is never sent
+ * (api/rest.ts: NotSentError, whose field error the form shows the same way).
+ */
 export function NumberInput({ value, onValue, name, placeholder, step = 'any', disabled, class: cls, title }: {
   value: string;
   onValue: (v: string) => void;
@@ -77,27 +88,39 @@ export function NumberInput({ value, onValue, name, placeholder, step = 'any', d
   class?: string;
   title?: string;
 }) {
+  const [focused, setFocused] = useState(false);
+  const invalid = value.trim() !== '' && !isNumberText(value);
   return (
-    <input
-      class={`num ${cls ?? ''}`}
-      type="text"
-      inputMode="decimal"
-      name={name}
-      value={value}
-      placeholder={placeholder}
-      disabled={disabled}
-      step={step}
-      title={title}
-      autocomplete="off"
-      spellcheck={false}
-      onInput={(e) => onValue((e.target as HTMLInputElement).value)}
-    />
+    <>
+      <input
+        class={`num ${invalid ? 'num-invalid' : ''} ${cls ?? ''}`}
+        type="text"
+        inputMode="decimal"
+        name={name}
+        value={value}
+        placeholder={placeholder}
+        disabled={disabled}
+        step={step}
+        title={title}
+        aria-invalid={invalid ? 'true' : undefined}
+        autocomplete="off"
+        spellcheck={false}
+        onFocus={() => setFocused(true)}
+        onBlur={() => setFocused(false)}
+        onInput={(e) => onValue((e.target as HTMLInputElement).value)}
+      />
+      {invalid && !focused && (
+        <span class="field-error num-error" role="alert" data-num-error={name}>
+          {NOT_A_NUMBER}
+        </span>
+      )}
+    </>
   );
 }
 
 /**
  * Parses an input: '' → the fallback (or NaN), otherwise the number. A text that is not a
- * number is sent as NaN→null so that the server's validation answers for it.
+ * number gives NaN, which the REST client refuses to send (NotSentError at that field).
  */
 export function parseNum(s: string, fallback?: number): number {
   const t = s.trim().replace(',', '.');

@@ -3,7 +3,7 @@
 // one edited here); edits are shown as a diff (old → new) and applied one PUT at a time; the
 // server's validation errors appear at the row.
 import { useEffect, useMemo, useState } from 'preact/hooks';
-import { get, put, enc } from '../api/rest';
+import { NOT_A_NUMBER, get, put, enc } from '../api/rest';
 import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
 import { ErrorBanner, errorText, fieldsOf, useOnline } from './common';
 import { inputNum } from '../format';
@@ -67,7 +67,7 @@ export function diff(list: ParameterResource[], edits: Record<number, string>): 
     if (text === undefined) continue;
     const next = parseValue(p, text);
     if (next === null) {
-      invalid[p.number] = p.type === 'bool' ? 'true or false' : 'not a number';
+      invalid[p.number] = p.type === 'bool' ? 'true or false' : NOT_A_NUMBER;
       continue;
     }
     if (next !== p.value) changes.push({ param: p, old: p.value, next });
