@@ -9,6 +9,7 @@ import { RpcError } from './live/client';
 import { ScopeSession } from './scope/session';
 import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
 import { TrendBuffer } from './live/trend';
+import { releaseWhenDone } from './axis/stop';
 import { clientId } from './auth/client-id';
 
 export interface LiveStatus {
@@ -271,6 +272,28 @@ export async function releaseCommand(id: number, axis: string): Promise<void> {
     logRejected(axis, 'release', { command: id }, e);
     throw e;
   }
+}
+
+/**
+ * MC_Stop from the Online tab (Stop, F6) as TwinCAT XAE's: sent, then released once the axis
+ * stands (axis/stop.ts), so the axis is ready for the next command. Resolves with the stop as
+ * sent; `followed` settles when it is released (or ended otherwise).
+ */
+export async function stopAndRelease(axis: string, body: Record<string, unknown>): Promise<{ stop: CommandResource; followed: Promise<'released' | 'ended'> }> {
+  const stop = await command(axis, 'stop', body);
+  const followed = releaseWhenDone(stop.id, {
+    read: (id) => get<CommandResource>(`/commands/${id}`),
+    watch: (id, on) => {
+      const check = () => {
+        const e = commandLog.get().find((x) => x.id === id);
+        if (e) on(e);
+      };
+      check();
+      return commandLog.subscribe(check);
+    },
+    release: (id) => releaseCommand(id, axis),
+  });
+  return { stop, followed };
 }
 
 /**

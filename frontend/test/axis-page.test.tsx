@@ -7,7 +7,7 @@ import { render } from 'preact';
 import { act } from 'preact/test-utils';
 import { mountPoint, unmount } from './dom';
 
-const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })) }));
+const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), stopAndRelease: vi.fn(async () => ({ stop: { id: 9 }, followed: Promise.resolve('released') })) }));
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
@@ -18,6 +18,7 @@ vi.mock('../src/services', async () => {
     system: new Store(null),
     live: { state: new Store({ kind: 'open', since: 0 }), lastMessageAt: null },
     command: h.command,
+    stopAndRelease: h.stopAndRelease,
     findHeldStop: vi.fn(),
     releaseCommand: vi.fn(),
     resetFollowingErrorPeak: vi.fn(),
@@ -189,5 +190,20 @@ describe('MC_Power from the Online tab', () => {
     expect(powerOverride(undefined)).toBe(100);
     expect(powerOverride({ power_override_percent: 0 })).toBe(0);
     expect(powerOverride({ power_override_percent: 37.5 })).toBe(37.5);
+  });
+});
+
+describe('Stop (F6) from the Online tab', () => {
+  it('is TwinCAT XAE’s: the stop is released at standstill (stopAndRelease), said in its tooltip', async () => {
+    h.stopAndRelease.mockClear();
+    axes.set([axis(1, 'x')]);
+    show('x');
+    type('stop-deceleration', '800');
+    await act(async () => button('stop').click());
+    expect(h.stopAndRelease).toHaveBeenCalledWith('x', { deceleration: 800, jerk: 0 });
+    expect(h.command).not.toHaveBeenCalledWith('x', 'stop', expect.anything());
+    expect(button('stop').title).toMatch(/standstill; there the UI releases the stop, so the axis is ready again/);
+    await act(async () => void window.dispatchEvent(new KeyboardEvent('keydown', { key: 'F6', bubbles: true })));
+    expect(h.stopAndRelease).toHaveBeenCalledTimes(2);
   });
 });

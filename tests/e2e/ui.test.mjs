@@ -276,7 +276,6 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
-  test('stop locks the axis until released; feed enables; override; home with a chosen mode', async () => {
   test('a number field with text that is not a number: "enter a number" beside it, nothing sent, no serde text', async () => {
     await enabled();
     await atRest();
@@ -311,6 +310,7 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
+  test('feed enables; override; Stop released at standstill (XAE), an API stop held until released; home with a chosen mode', async () => {
     await enabled();
     const page = await open(`/axes/${AXIS}`);
     // without the positive feed enable a forward jog is refused, with its error text
@@ -357,34 +357,49 @@ describe('commissioning UI', () => {
     await page.click('.override button:has-text("100")');
     await until(async () => (await status(stack.api, AXIS)).override_percent === 100, { what: 'override 100 % again' });
     await page.waitForSelector('[data-testid="override-power"]', { state: 'detached', timeout: 10000 });
-    // MC_Stop and its release
+    // Stop (TwinCAT XAE's F6): MC_Stop, and at standstill the UI releases it — the axis is
+    // ready again without a Release
+    assert.match(await page.getAttribute('button[name="stop"]', 'title'), /the UI releases the stop, so the axis is ready again/);
     await page.click('[data-move="move-velocity"]');
     await page.fill('input[name="velocity"]', '50');
     await page.click('button[name="start"]');
     await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'moving' });
+    const stopSent = page.waitForResponse((r) => r.request().method() === 'POST' && r.url().endsWith(`/axes/${AXIS}/stop`));
+    const released = page.waitForResponse((r) => r.request().method() === 'DELETE' && /\/commands\/\d+$/.test(r.url()));
     await page.click('button[name="stop"]');
-    await page.waitForSelector('[data-led="Stop lock"][data-on="1"]', { timeout: 10000 });
-    // PLCopen: the axis stays in Stopping while the stop is held
+    const stopId = (await (await stopSent).json()).id;
+    assert.ok((await released).url().endsWith(`/commands/${stopId}`), 'the page released its own stop');
+    const stopped = (await rest(stack.api, 'GET', `/commands/${stopId}`)).body;
+    assert.equal(stopped.state, 'done', 'released once done (at standstill)');
+    assert.equal(stopped.final, true);
+    const ready = await atRest();
+    assert.equal(ready.motion_commands_locked, false);
+    await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
+    assert.equal(await page.locator('button[name="release-stop"]').count(), 0);
+    // the next command is taken at once
+    await page.click('[data-move="move-relative"]');
+    await page.fill('input[name="distance"]', '5');
+    await page.click('button[name="start"]');
+    await page.waitForSelector('[data-testid="command-log"] tr[data-command="move-relative"][data-state="done"]', { timeout: 10000 });
+    await atRest();
+    // a stop sent over the API keeps its PLCopen lock: the axis stays in Stopping, a move is
+    // refused, until it is released — here from this page
+    const other = await rest(stack.api, 'POST', `/axes/${AXIS}/stop`, { deceleration: 1000 });
+    assert.equal(other.status, 202, JSON.stringify(other.body));
+    await page.waitForSelector('button[name="release-stop"]', { timeout: 10000 });
     await until(async () => {
       const s = await status(stack.api, AXIS);
       return s.set_velocity === 0 && s.state === 'stopping';
     }, { what: 'stopped and locked' });
-    assert.equal(await page.locator('[data-testid="axis-state"]').textContent(), 'Stopping');
-    await page.click('[data-move="move-relative"]');
+    await until(async () => (await page.locator('[data-testid="axis-state"]').textContent()) === 'Stopping', { what: 'Stopping shown' });
     await page.fill('input[name="distance"]', '10');
     await page.click('button[name="start"]');
     await page.waitForSelector('[data-testid="command-log"] tr[data-state="rejected"][data-command="move-relative"]');
-    await page.click('button[name="release-stop"]');
-    await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
-    assert.equal((await status(stack.api, AXIS)).motion_commands_locked, false);
-    await atRest();
-    // a stop from another client (with its own deceleration), released from this page
-    const other = await rest(stack.api, 'POST', `/axes/${AXIS}/stop`, { deceleration: 1000 });
-    assert.equal(other.status, 202, JSON.stringify(other.body));
-    await page.waitForSelector('button[name="release-stop"]', { timeout: 10000 });
+    assert.equal((await rest(stack.api, 'GET', `/commands/${other.body.id}`)).body.final, false, 'the API’s stop is not released by the page on its own');
     await page.click('button[name="release-stop"]');
     await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
     assert.ok((await rest(stack.api, 'GET', `/commands/${other.body.id}`)).body.final, 'the other client’s stop was released');
+    await atRest();
     // MC_Home, mode direct at 12.5
     await page.selectOption('select[name="home-mode"]', 'direct');
     await page.fill('input[name="home-position"]', '12.5');
@@ -433,7 +448,7 @@ describe('commissioning UI', () => {
     await page.close();
   });
 
-  test('TwinCAT function keys on the Online tab: F3/F2 held jog, F5 starts the move, F6 stops, F8 resets, F9 homes', async () => {
+  test('TwinCAT function keys on the Online tab: F3/F2 held jog, F5 starts the move, F6 stops (released at standstill), F9 homes, F8 resets', async () => {
     await enabled();
     await atRest();
     const page = await open(`/axes/${AXIS}`);
@@ -476,22 +491,25 @@ describe('commissioning UI', () => {
     await page.fill('input[name="stop-deceleration"]', '800');
     await page.keyboard.press('F5');
     await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'F5 started the velocity move' });
+    const stopSent = page.waitForResponse((r) => r.request().method() === 'POST' && r.url().endsWith(`/axes/${AXIS}/stop`));
     await page.keyboard.press('F6');
-    await page.waitForSelector('[data-led="Stop lock"][data-on="1"]', { timeout: 10000 });
-    const stop = (await rest(stack.api, 'GET', `/commands?axis=${AXIS}&limit=5`)).body.find((c) => c.command === 'stop');
+    const stop = await (await stopSent).json();
     assert.equal(stop.parameters.deceleration, 800);
-    await page.click('button[name="release-stop"]');
+    // as in TwinCAT XAE: at standstill the stop is released, the axis is ready — F9 homes at once
+    await until(async () => (await rest(stack.api, 'GET', `/commands/${stop.id}`)).body.final, { what: 'the F6 stop released at standstill' });
+    assert.equal((await rest(stack.api, 'GET', `/commands/${stop.id}`)).body.state, 'done');
+    await atRest();
     await page.waitForSelector('[data-led="Stop lock"][data-on="0"]', { timeout: 10000 });
     await page.fill('input[name="stop-deceleration"]', '');
-    // F8: MC_Reset
-    await page.keyboard.press('F8');
-    await page.waitForSelector('[data-testid="command-log"] tr[data-command="reset"]', { timeout: 10000 });
-    // F9: MC_Home with the chosen mode
-    await atRest();
+    // F9: MC_Home with the chosen mode, right after the stop
     await page.selectOption('select[name="home-mode"]', 'direct');
     await page.fill('input[name="home-position"]', '7');
     await page.keyboard.press('F9');
     await until(async () => Math.abs((await status(stack.api, AXIS)).set_position - 7) < 1e-9, { what: 'F9 homed at 7' });
+    await page.waitForSelector('[data-testid="command-log"] tr[data-command="home"][data-state="done"]', { timeout: 10000 });
+    // F8: MC_Reset
+    await page.keyboard.press('F8');
+    await page.waitForSelector('[data-testid="command-log"] tr[data-command="reset"]', { timeout: 10000 });
     await shot(page, 'online-function-keys');
     await page.close();
   });

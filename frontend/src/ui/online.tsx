@@ -2,7 +2,7 @@
 // moves, halt/stop, set position, home, TwinCAT's function keys, and the axis's command log.
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses } from '../services';
+import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses, stopAndRelease } from '../services';
 import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
 import { acc, pos, vel, num, inputNum } from '../format';
 import type { AxisLiveStatus, AxisResource, Direction, HomingMode } from '../api/types';
@@ -145,12 +145,25 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const [stopDec, setStopDec] = useState('');
   const [stopJerk, setStopJerk] = useState('');
   const [stopErrors, setStopErrors] = useState<Record<string, string>>({});
-  const haltOrStop = async (name: 'halt' | 'stop') => {
+  const stopBody = () => ({ deceleration: parseNum(stopDec, 0), jerk: parseNum(stopJerk, 0) });
+  const halt = async () => {
     setStopErrors({});
     try {
-      await run(name, { deceleration: parseNum(stopDec, 0), jerk: parseNum(stopJerk, 0) });
+      await run('halt', stopBody());
     } catch (e) {
       setStopErrors(fieldsOf(e));
+    }
+  };
+  // TwinCAT XAE's F6: MC_Stop, released by the UI once the axis stands (the next F9 is taken).
+  const stop = async () => {
+    setStopErrors({});
+    setError(null);
+    try {
+      const { followed } = await stopAndRelease(axis, stopBody());
+      followed.catch((e) => setError(`the stop was not released at standstill: ${errorText(e)}`));
+    } catch (e) {
+      setStopErrors(fieldsOf(e));
+      setError(errorText(e));
     }
   };
   const releaseStop = async () => {
@@ -219,7 +232,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
     release: (why) => jog.release(why),
     action: (what) => {
       if (what === 'start') void startMove();
-      else if (what === 'stop') void haltOrStop('stop');
+      else if (what === 'stop') void stop();
       else if (what === 'reset') void reset();
       else void home();
     },
@@ -410,14 +423,20 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Field label={`Stop jerk (${u}/s³)`} error={stopErrors.jerk} name="stop-jerk">
                 <NumberInput name="stop-jerk" value={stopJerk} onValue={setStopJerk} placeholder="default" title="MC_Halt / MC_Stop jerk; blank or 0 = default" />
               </Field>
-              <ActionButton name="halt" disabled={offline} title="MC_Halt: decelerate to standstill" onClick={() => haltOrStop('halt')}>
+              <ActionButton name="halt" disabled={offline} title="MC_Halt: decelerate to standstill" onClick={halt}>
                 Halt
               </ActionButton>
-              <ActionButton name="stop" kind="danger" disabled={offline} title={`MC_Stop: stop and lock motion until released${fk('stop')}`} onClick={() => haltOrStop('stop')}>
+              <ActionButton
+                name="stop"
+                kind="danger"
+                disabled={offline}
+                title={`MC_Stop${fk('stop')}: decelerate to standstill; there the UI releases the stop, so the axis is ready again (TwinCAT XAE's F6). A stop sent over the API keeps its lock until released.`}
+                onClick={stop}
+              >
                 Stop
               </ActionButton>
               {s?.motion_commands_locked && (
-                <ActionButton name="release-stop" kind="warn" disabled={offline} title="Release the MC_Stop (falling edge of Execute)" onClick={releaseStop}>
+                <ActionButton name="release-stop" kind="warn" disabled={offline} title="Release the MC_Stop that holds the lock — one sent over the API or by another client (falling edge of Execute)" onClick={releaseStop}>
                   Release stop
                 </ActionButton>
               )}
