@@ -3,6 +3,7 @@ import { describe, expect, it } from 'vitest';
 import { CAM_IN_DEFAULTS, CAM_SCALING_DEFAULTS, SUPERIMPOSED_DEFAULTS, camInBody, camInfoRows, camScalingBody, gearInBody, gearInDynBody, superimposedBody } from '../src/axis/bodies';
 import { parseRoute, href } from '../src/router';
 import { nonFiniteFields } from '../src/api/rest';
+import { couplingInForce } from '../src/axis/coupling-kind';
 
 describe('gear bodies', () => {
   it('MC_GearIn: master and ratio', () => {
@@ -83,5 +84,31 @@ describe('routes of the new tabs', () => {
     expect(parseRoute('#/axes/y/coupling')).toEqual({ page: 'axis', axis: 'y', tab: 'coupling' });
     expect(parseRoute('#/axes/y/functions')).toEqual({ page: 'axis', axis: 'y', tab: 'functions' });
     expect(href({ page: 'axis', axis: 'x', tab: 'coupling' })).toBe('#/axes/x/coupling');
+  });
+});
+
+describe('the coupling in force', () => {
+  const cam = (id: number, active = true) => ({ cam_table_id: id, active }) as never;
+  const st = (o: Record<string, unknown>) => ({ coupled: true, master: 'x', gear_ratio: 0, gear_ratios: [0, 0, 0, 0], cam: cam(0, false), ...o }) as never;
+  it('a cam slave is a cam coupling — its ratios of 0 are no multi-master gear', () => {
+    expect(couplingInForce(st({ cam: cam(3) }), { command: 'cam-in', state: 'active' })).toEqual({ kind: 'cam', master: 'x', text: 'cam table 3 (MC_CamIn)' });
+    expect(couplingInForce(st({ cam: cam(3) }), null)).toEqual({ kind: 'cam', master: 'x', text: 'cam table 3' });
+    // coupled by MC_CamIn, the cam not yet active (waiting for its activation)
+    expect(couplingInForce(st({}), { command: 'cam-in', state: 'active' }).kind).toBe('cam');
+  });
+  it('a multi-master coupling: by its command, or (no command known) by a second master’s ratio', () => {
+    expect(couplingInForce(st({ gear_ratio: 2, gear_ratios: [2, 0, 0, 0] }), { command: 'gear-in-multi-master', state: 'done' }).kind).toBe('multi-master');
+    expect(couplingInForce(st({ gear_ratio: 1, gear_ratios: [1, 0.5, 0, 0] }), null).kind).toBe('multi-master');
+    expect(couplingInForce(st({ gear_ratio: 1, gear_ratios: [1, 0, 0, 0] }), null).kind).toBe('gear');
+  });
+  it('a gear: its ratio and the block', () => {
+    expect(couplingInForce(st({ gear_ratio: 0.5, gear_ratios: [0.5, 0, 0, 0] }), { command: 'gear-in', state: 'done' })).toEqual({ kind: 'gear', master: 'x', text: 'gear ratio 0.5 (MC_GearIn)' });
+    expect(couplingInForce(st({ gear_ratio: 1.5 }), { command: 'gear-in-dyn', state: 'active' }).text).toBe('gear ratio 1.5 (MC_GearInDyn)');
+    // a coupling command that failed coupled nothing: what coupled the axis is not known
+    expect(couplingInForce(st({ gear_ratio: 0.5, gear_ratios: [0.5, 0, 0, 0] }), { command: 'gear-in-multi-master', state: 'error' }).kind).toBe('gear');
+  });
+  it('not coupled', () => {
+    expect(couplingInForce(st({ coupled: false, master: null }), { command: 'gear-in-multi-master', state: 'done' })).toEqual({ kind: 'none', master: null, text: 'not coupled' });
+    expect(couplingInForce(null, null).kind).toBe('none');
   });
 });

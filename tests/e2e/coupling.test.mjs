@@ -96,6 +96,41 @@ describe('coupling and functions tabs', () => {
     await page.close();
   });
 
+  test('y cam-coupled to x: the Coupling tab names the cam coupling, no multi-master table of "Master1 x, ratio 0"', async () => {
+    const t = await rest(stack.api, 'POST', '/cam-tables', {
+      name: 'kind',
+      table_type: 'motion_function',
+      periodic: true,
+      points: [
+        { point_index: 1, function_type: 'polynom5', point_type: 'rest', master_pos: 0, slave_pos: 0 },
+        { point_index: 2, function_type: 'polynom5', point_type: 'rest', master_pos: 180, slave_pos: 40 },
+        { point_index: 3, function_type: 'polynom5', point_type: 'rest', master_pos: 360, slave_pos: 0 },
+      ],
+    });
+    assert.equal(t.status, 201, JSON.stringify(t.body));
+    for (const [n, p] of [['x', 0], ['y', 0]]) await rest(stack.api, 'POST', `/axes/${n}/move-absolute?wait=true`, { position: p, velocity: 200 });
+    const c = await rest(stack.api, 'POST', '/axes/y/cam-in', { master: 'x', cam_table: 'kind' });
+    assert.ok(c.status < 300, JSON.stringify(c.body));
+    await until(async () => (await status(stack.api, 'y')).cam?.active, { what: 'y cam-coupled' });
+    const y = await status(stack.api, 'y');
+    assert.deepEqual(y.gear_ratios, [0, 0, 0, 0], 'what the status says of a cam slave');
+    await rest(stack.api, 'POST', '/axes/x/move-absolute?wait=true', { position: 90, velocity: 200 });
+    const page = await open(desk, '/axes/y/coupling');
+    await page.waitForSelector('[data-testid="coupling-kind"][data-kind="cam"]');
+    assert.equal(await page.locator('[data-testid="coupling-kind"]').textContent(), `cam table ${t.body.id} (MC_CamIn)`);
+    await page.waitForSelector('[data-testid="mm-in-force"][data-kind="cam"]');
+    assert.equal((await page.locator('[data-testid="mm-in-force"]').textContent()).trim(), `Coupled to x by cam table ${t.body.id} (MC_CamIn): not a multi-master gear.`);
+    assert.equal(await page.locator('[data-testid="gear-ratios"]').count(), 0, 'no multi-master table');
+    assert.equal(await page.locator('[data-testid="coupling-ratio"]').count(), 0, 'no gear ratio for a cam');
+    await picture(page, 'coupling-cam');
+    await rest(stack.api, 'POST', '/axes/y/cam-out', {});
+    await until(async () => !(await status(stack.api, 'y')).coupled, { what: 'y decoupled' });
+    await page.waitForSelector('[data-testid="mm-in-force"][data-kind="none"]');
+    await rest(stack.api, 'POST', '/axes/y/halt', {});
+    await until(async () => (await status(stack.api, 'y')).state === 'standstill', { what: 'y at rest' });
+    await page.close();
+  });
+
   test('x\'s reversing sequence between 10 and 30, 2 repeats, ends with the count 2', async () => {
     const page = await open(desk, '/axes/x/functions');
     await page.fill('input[name="rev-position1"]', '10');

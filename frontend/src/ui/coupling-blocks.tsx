@@ -22,7 +22,8 @@ import {
   type Form,
 } from '../axis/bodies';
 import { useCommand, useForm } from '../axis/hooks';
-import { COUPLING_COMMANDS, NumField, SelectField, type useSender } from './coupling';
+import { NumField, SelectField, couplerOf, type useSender } from './coupling';
+import { couplingInForce } from '../axis/coupling-kind';
 
 export type Sender = ReturnType<typeof useSender>;
 
@@ -146,10 +147,11 @@ export function MultiMasterPanel({ axis: a, s, online, send, setBanner, masters 
   };
   const adv = f.advanced_slave_dynamics === '1';
   const inGear = !!(s?.coupled && cmd?.outputs.in_gear);
-  // The masters of the coupling in force: the multi-master command's, if it made the coupling;
-  // else (MC_GearIn, a cam) the one master the status names.
-  const coupler = log.find((e) => e.axis === axis && e.id !== null && COUPLING_COMMANDS.has(e.command));
-  const names: Form = s?.coupled && coupler && coupler.id === cmd?.id ? multiMasterForm(cmd.parameters) : { master1: s?.coupled ? (s.master ?? '') : '' };
+  // The coupling in force: its masters and ratios only for a multi-master coupling (a cam or a
+  // single gear has no Master2…4, and a cam slave's ratios are 0), else what it is.
+  const coupler = couplerOf(log, axis);
+  const inForce = couplingInForce(s, coupler);
+  const names: Form = inForce.kind === 'multi-master' && coupler && coupler.id === cmd?.id ? multiMasterForm(cmd.parameters) : { master1: inForce.master ?? '' };
   const ratios = s?.gear_ratios ?? [];
 
   return (
@@ -218,24 +220,36 @@ export function MultiMasterPanel({ axis: a, s, online, send, setBanner, masters 
           )}
         </span>
       </div>
-      <table class="grid mm-ratios" data-testid="gear-ratios">
-        <thead>
-          <tr>
-            <th />
-            <th>Axis</th>
-            <th class="r">Ratio in force</th>
-          </tr>
-        </thead>
-        <tbody>
-          {MULTI_MASTER_ROWS.map((i) => (
-            <tr data-gear-ratio={i}>
-              <th>Master{i}</th>
-              <td>{names[`master${i}`] || <span class="muted">—</span>}</td>
-              <td class="mono r">{num(ratios[i - 1], 4)}</td>
+      {inForce.kind !== 'multi-master' ? (
+        <p class="small muted mm-none" data-testid="mm-in-force" data-kind={inForce.kind}>
+          {inForce.kind === 'none' ? (
+            'Not coupled.'
+          ) : (
+            <>
+              Coupled to {inForce.master ?? 'its master'} by {inForce.text}: not a multi-master gear.
+            </>
+          )}
+        </p>
+      ) : (
+        <table class="grid mm-ratios" data-testid="gear-ratios">
+          <thead>
+            <tr>
+              <th />
+              <th>Axis</th>
+              <th class="r">Ratio in force</th>
             </tr>
-          ))}
-        </tbody>
-      </table>
+          </thead>
+          <tbody>
+            {MULTI_MASTER_ROWS.map((i) => (
+              <tr data-gear-ratio={i}>
+                <th>Master{i}</th>
+                <td>{names[`master${i}`] || <span class="muted">—</span>}</td>
+                <td class="mono r">{num(ratios[i - 1], 4)}</td>
+              </tr>
+            ))}
+          </tbody>
+        </table>
+      )}
     </Panel>
   );
 }

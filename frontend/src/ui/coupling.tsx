@@ -6,7 +6,8 @@
 import type { ComponentChildren } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { axes, command, commandLog, releaseCommand, statuses } from '../services';
+import { axes, command, commandLog, releaseCommand, statuses, type LogEntry } from '../services';
+import { couplingInForce } from '../axis/coupling-kind';
 import { get } from '../api/rest';
 import type { AxisResource, CamTableResource } from '../api/types';
 import { href } from '../router';
@@ -95,6 +96,10 @@ export function useSender(axis: string, setBanner: (s: string | null) => void) {
 /** The commands that couple an axis as a slave. */
 export const COUPLING_COMMANDS = new Set(['gear-in', 'gear-in-dyn', 'gear-in-multi-master', 'cam-in', 'cam-in-v2', 'cam-exchange', 'cam-add']);
 
+/** The axis's latest coupling command in the command log (one that failed coupled nothing). */
+export const couplerOf = (log: LogEntry[], axis: string): LogEntry | undefined =>
+  log.find((e) => e.axis === axis && e.id !== null && COUPLING_COMMANDS.has(e.command) && e.state !== 'error');
+
 export function CouplingTab({ axis: a }: { axis: AxisResource }) {
   const axis = a.config.name;
   const u = a.config.unit;
@@ -139,11 +144,12 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
   const dynCmd = log.find((e) => e.axis === axis && e.command === 'gear-in-dyn' && !e.final && e.id !== null);
   // InGear / InSync: of the command that coupled the axis (MC_GearIn is done once in gear; the
   // axis's latest coupling command in the log, else its running command).
-  const coupler = log.find((e) => e.axis === axis && e.id !== null && COUPLING_COMMANDS.has(e.command));
+  const coupler = couplerOf(log, axis);
   const running = useCommand(coupler?.id ?? (s?.active_command || null), `${s?.coupled}/${s?.cam?.active}`);
   const inGear = !!(s?.coupled && running?.outputs.in_gear);
   const inSync = !!(s?.coupled && running?.outputs.in_sync);
   const camRows = camInfoRows(s?.cam);
+  const inForce = couplingInForce(s, coupler);
   const stale = liveStatus?.stale || offline;
 
   return (
@@ -177,15 +183,23 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
                   <span class="muted">—</span>
                 )}
               </dd>
-              <dt>Gear ratio</dt>
-              <dd class="mono" data-testid="coupling-ratio">
-                {s?.coupled ? num(s.gear_ratio, 6) : '—'}
+              <dt>Coupling</dt>
+              <dd data-testid="coupling-kind" data-kind={inForce.kind}>
+                {inForce.kind === 'none' ? <span class="muted">{inForce.text}</span> : inForce.text}
               </dd>
-              {s?.coupled && (s.gear_ratios ?? []).filter((r) => r !== 0).length > 1 && (
+              {(inForce.kind === 'gear' || inForce.kind === 'gear-dyn') && (
+                <>
+                  <dt>Gear ratio</dt>
+                  <dd class="mono" data-testid="coupling-ratio">
+                    {num(s?.gear_ratio, 6)}
+                  </dd>
+                </>
+              )}
+              {inForce.kind === 'multi-master' && (
                 <>
                   <dt>Gear ratios</dt>
                   <dd class="mono" data-testid="coupling-ratios" title="MC_GearInMultiMaster: the ratio of Master1…Master4 in force">
-                    {s.gear_ratios.map((r) => num(r, 4)).join(' · ')}
+                    {(s?.gear_ratios ?? []).map((r) => num(r, 4)).join(' · ')}
                   </dd>
                 </>
               )}
