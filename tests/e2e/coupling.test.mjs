@@ -131,6 +131,29 @@ describe('coupling and functions tabs', () => {
     await page.close();
   });
 
+  test('a blank field shows what the axis uses now (the parameter\'s value, its number in the tooltip), and follows a change', async () => {
+    const value = async (axis, n) => (await rest(stack.api, 'GET', `/axes/${axis}/parameters/${n}`)).body.value;
+    const page = await open(desk, '/axes/x/functions');
+    const search = page.locator('input[name="home-search-velocity"]');
+    await until(async () => (await search.getAttribute('placeholder')) === String(await value('x', 1012)), { what: 'the search velocity #1012 as placeholder' });
+    assert.match(await search.getAttribute('title'), /#1012 AxisCalibrationVelocityForward, now \d+/);
+    assert.equal(await page.getAttribute('input[name="home-sync-velocity"]', 'placeholder'), String(await value('x', 1013)));
+    assert.equal(await page.getAttribute('input[name="home-position"]', 'placeholder'), String(await value('x', 1075)));
+    assert.equal(await page.getAttribute('input[name="backlash-value"]', 'placeholder'), String(await value('x', 1036)));
+    assert.equal((await page.locator('select[name="home-search-direction"] option[value=""]').textContent()).trim(), 'axis: positive');
+    // changed online (another client): the placeholder follows
+    const was = await value('x', 1012);
+    assert.ok((await rest(stack.api, 'PUT', '/axes/x/parameters/1012', { value: 42 })).status < 300);
+    await until(async () => (await search.getAttribute('placeholder')) === '42', { what: 'the placeholder to follow #1012' });
+    await rest(stack.api, 'PUT', '/axes/x/parameters/1012', { value: was });
+    // the Coupling tab's blocks: the axis's acceleration, deceleration and jerk
+    await page.click('[data-tab="coupling"]');
+    for (const [name, n] of [['phasing-acceleration', 1004], ['phasing-deceleration', 1005], ['phasing-jerk', 1006], ['mm-acceleration', 1004]]) {
+      await until(async () => (await page.getAttribute(`input[name="${name}"]`, 'placeholder')) === String(await value('x', n)), { what: `${name}: #${n} as placeholder` });
+    }
+    await page.close();
+  });
+
   test('x\'s reversing sequence between 10 and 30, 2 repeats, ends with the count 2', async () => {
     const page = await open(desk, '/axes/x/functions');
     await page.fill('input[name="rev-position1"]', '10');

@@ -6,7 +6,8 @@ import type { ComponentChildren } from 'preact';
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { commandLog, releaseCommand } from '../services';
-import type { AxisLiveStatus, AxisResource } from '../api/types';
+import type { AxisLiveStatus, AxisResource, ParameterResource } from '../api/types';
+import { P_ACC, P_DEC, P_JERK, paramDefault } from './axis-params';
 import { ActionButton, Led, Panel, errorText } from './common';
 import { inputNum, num, pos } from '../format';
 import {
@@ -35,6 +36,13 @@ export interface BlockProps {
   online: boolean;
   send: Sender;
   setBanner: (s: string | null) => void;
+  /** The axis's parameters (what a blank field stands for), null while they load. */
+  params: Map<number, ParameterResource> | null;
+}
+
+/** The acceleration, deceleration and jerk a blank field of a block stands for (#1004–#1006). */
+export function dynamicsDefaults(params: Map<number, ParameterResource> | null) {
+  return { acceleration: paramDefault(params, P_ACC), deceleration: paramDefault(params, P_DEC), jerk: paramDefault(params, P_JERK) };
 }
 
 /** A live value: label, value, unit (the online tab's readout row). */
@@ -59,8 +67,9 @@ export async function release(id: number, axis: string, setBanner: (s: string | 
 }
 
 /** MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing of this slave against its master. */
-export function PhasingPanel({ axis: a, s, online, send, masters }: BlockProps & { masters: string[] }) {
+export function PhasingPanel({ axis: a, s, online, send, masters, params }: BlockProps & { masters: string[] }) {
   const u = a.config.unit;
+  const dyn = dynamicsDefaults(params);
   const offline = !online;
   const fast = a.config.dynamics?.jog_velocity_fast;
   const [f, set] = useForm({ ...PHASING_DEFAULTS, velocity: fast ? inputNum(fast) : '' });
@@ -93,9 +102,9 @@ export function PhasingPanel({ axis: a, s, online, send, masters }: BlockProps &
         <SelectField f={f} set={set} k="master" label="Master" errors={err} options={options} name="phasing-master" blank={options.length ? undefined : '(no other axis)'} />
         <NumField f={f} set={set} k="phase_shift" label={`Phase shift (${u})`} errors={err} name="phasing-shift" hint="absolute: the shift to establish; relative: its change" />
         <NumField f={f} set={set} k="velocity" label={`Velocity (${u}/s)`} errors={err} name="phasing-velocity" hint="≥ 0.01" />
-        <NumField f={f} set={set} k="acceleration" label={`Acc (${u}/s²)`} errors={err} name="phasing-acceleration" placeholder="#1004" hint="blank = the axis's" />
-        <NumField f={f} set={set} k="deceleration" label={`Dec (${u}/s²)`} errors={err} name="phasing-deceleration" placeholder="#1005" hint="blank = the axis's (also for Halt phasing)" />
-        <NumField f={f} set={set} k="jerk" label={`Jerk (${u}/s³)`} errors={err} name="phasing-jerk" placeholder="#1006" hint="blank = the axis's (also for Halt phasing)" />
+        <NumField f={f} set={set} k="acceleration" label={`Acc (${u}/s²)`} errors={err} name="phasing-acceleration" placeholder={dyn.acceleration.placeholder} hint={dyn.acceleration.title} />
+        <NumField f={f} set={set} k="deceleration" label={`Dec (${u}/s²)`} errors={err} name="phasing-deceleration" placeholder={dyn.deceleration.placeholder} hint={`${dyn.deceleration.title} (also for Halt phasing)`} />
+        <NumField f={f} set={set} k="jerk" label={`Jerk (${u}/s³)`} errors={err} name="phasing-jerk" placeholder={dyn.jerk.placeholder} hint={`${dyn.jerk.title} (also for Halt phasing)`} />
         <div class="row-buttons">
           <button type="submit" class="btn btn-primary" name="phasing-absolute" disabled={offline} title="MC_PhasingAbsolute: establish this phase shift against the master">
             Phasing absolute
@@ -116,8 +125,9 @@ export function PhasingPanel({ axis: a, s, online, send, masters }: BlockProps &
 }
 
 /** MC_GearInMultiMaster: up to four masters and their ratios. */
-export function MultiMasterPanel({ axis: a, s, online, send, setBanner, masters }: BlockProps & { masters: string[] }) {
+export function MultiMasterPanel({ axis: a, s, online, send, setBanner, masters, params }: BlockProps & { masters: string[] }) {
   const axis = a.config.name;
+  const dyn = dynamicsDefaults(params);
   const u = a.config.unit;
   const offline = !online;
   const log = useStore(commandLog);
@@ -184,9 +194,9 @@ export function MultiMasterPanel({ axis: a, s, online, send, setBanner, masters 
           ))}
         </div>
         <div class="row mm-options">
-          <NumField f={f} set={set} k="acceleration" label={`Acc (${u}/s²)`} errors={err} name="mm-acceleration" placeholder="#1004" hint="blank = the axis's" />
-          <NumField f={f} set={set} k="deceleration" label={`Dec (${u}/s²)`} errors={err} name="mm-deceleration" placeholder="#1005" disabled={!adv} hint="with advanced slave dynamics" />
-          <NumField f={f} set={set} k="jerk" label={`Jerk (${u}/s³)`} errors={err} name="mm-jerk" placeholder="#1006" disabled={!adv} hint="with advanced slave dynamics" />
+          <NumField f={f} set={set} k="acceleration" label={`Acc (${u}/s²)`} errors={err} name="mm-acceleration" placeholder={dyn.acceleration.placeholder} hint={dyn.acceleration.title} />
+          <NumField f={f} set={set} k="deceleration" label={`Dec (${u}/s²)`} errors={err} name="mm-deceleration" placeholder={dyn.deceleration.placeholder} disabled={!adv} hint={`with advanced slave dynamics; ${dyn.deceleration.title}`} />
+          <NumField f={f} set={set} k="jerk" label={`Jerk (${u}/s³)`} errors={err} name="mm-jerk" placeholder={dyn.jerk.placeholder} disabled={!adv} hint={`with advanced slave dynamics; ${dyn.jerk.title}`} />
           <SelectField f={f} set={set} k="sync_mode" label="Sync mode" errors={err} options={SYNC_MODES} name="mm-sync-mode" disabled={!adv} title="What a slave with advanced dynamics makes up: the velocity, or the position too" />
           <label class="check" title="The slave synchronises within acceleration, deceleration and jerk (also with the masters moving); without, masters and slave must stand">
             <input type="checkbox" name="mm-advanced" checked={adv} onChange={(e) => set('advanced_slave_dynamics', (e.target as HTMLInputElement).checked ? '1' : '')} /> advanced slave dynamics

@@ -8,6 +8,7 @@ import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { axes, command, commandLog, releaseCommand, statuses, type LogEntry } from '../services';
 import { couplingInForce } from '../axis/coupling-kind';
+import { P_ACC, paramDefault, useLiveParameters } from './axis-params';
 import { get } from '../api/rest';
 import type { AxisResource, CamTableResource } from '../api/types';
 import { href } from '../router';
@@ -113,6 +114,8 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
   const [banner, setBanner] = useState<string | null>(null);
   const send = useSender(axis, setBanner);
   const masters = list.map((x) => x.config.name).filter((n) => n !== axis);
+  const params = useLiveParameters(axis, a.id);
+  const accZero = paramDefault(params, P_ACC).title.replace(/^blank/, '0');
 
   const [tables, setTables] = useState<CamTableResource[]>([]);
   useEffect(() => {
@@ -235,7 +238,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
             )}
           </Panel>
 
-          <PhasingPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} />
+          <PhasingPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} params={params} />
 
           <Panel title="Superposition" class="superposition">
             <div class="led-grid">
@@ -309,7 +312,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
             >
               <SelectField f={dyn} set={setDyn} k="master" label="Master (dyn)" errors={dynErr} options={masters.map((m) => [m, m])} name="dyn-master" blank={masters.length ? undefined : '(no other axis)'} />
               <NumField f={dyn} set={setDyn} k="gear_ratio" label="Gear ratio" errors={dynErr} name="dyn-gear-ratio" />
-              <NumField f={dyn} set={setDyn} k="acceleration" label={`Acc (${u}/s²)`} errors={dynErr} hint="0 = #1004" name="dyn-acceleration" />
+              <NumField f={dyn} set={setDyn} k="acceleration" label={`Acc (${u}/s²)`} errors={dynErr} hint={accZero} name="dyn-acceleration" />
               <div class="row-buttons">
                 <button type="submit" class="btn btn-primary" name="gear-in-dyn" disabled={offline} title="MC_GearInDyn: a ratio that may change while coupled (again with the same master)">
                   GearInDyn
@@ -336,7 +339,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
             </form>
           </Panel>
 
-          <MultiMasterPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} />
+          <MultiMasterPanel axis={a} s={s} online={online} send={send} setBanner={setBanner} masters={masters} params={params} />
 
           <Panel title="Cam" class="cam">
             <h4 class="sub">MC_CamIn · MC_CamOut</h4>
@@ -365,7 +368,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
               {cam.start_mode?.startsWith('ramp_in') && (
                 <>
                   <NumField f={cam} set={setCam} k="ramp_velocity" label={`Ramp-in velocity (${u}/s)`} errors={{ ramp_velocity: camErr['ramp_in.velocity'] ?? camErr['ramp_in'] }} name="cam-ramp-velocity" />
-                  <NumField f={cam} set={setCam} k="ramp_acceleration" label={`Ramp-in acc (${u}/s²)`} errors={{ ramp_acceleration: camErr['ramp_in.acceleration'] }} hint="0 = #1004" name="cam-ramp-acceleration" />
+                  <NumField f={cam} set={setCam} k="ramp_acceleration" label={`Ramp-in acc (${u}/s²)`} errors={{ ramp_acceleration: camErr['ramp_in.acceleration'] }} hint={accZero} name="cam-ramp-acceleration" />
                 </>
               )}
               <div class="row-buttons">

@@ -36,6 +36,7 @@ import {
 import { useCommand, useForm, useRunning } from '../axis/hooks';
 import { NumField, SelectField } from './coupling';
 import { Readout, release, type BlockProps } from './coupling-blocks';
+import { P_BACKLASH, paramDefault } from './axis-params';
 
 const DRIVE_MODE_LABEL: Record<string, string> = {
   configured: 'configured (the drive’s own)',
@@ -167,9 +168,10 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
 }
 
 /** AxisEnablePosCorrection (#1046) and the three correction sources. */
-export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner }: BlockProps) {
+export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, params }: BlockProps) {
   const axis = a.config.name;
   const u = a.config.unit;
+  const backlash = paramDefault(params, P_BACKLASH);
   const offline = !online;
   const [param, setParam] = useState<boolean | null>(null);
   const [paramErr, setParamErr] = useState<string | null>(null);
@@ -297,7 +299,7 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner }:
           if (online) void start('backlash-compensation', backlashBody(bl), setBlErr);
         }}
       >
-        <NumField f={bl} set={setBl} k="backlash" label={`Backlash (${u})`} errors={blErr} name="backlash-value" placeholder="#1036" hint="blank = AxisBacklash (#1036)" />
+        <NumField f={bl} set={setBl} k="backlash" label={`Backlash (${u})`} errors={blErr} name="backlash-value" placeholder={backlash.placeholder} hint={backlash.title} />
         <NumField f={bl} set={setBl} k="ramp" label={`Ramp (${u}/s)`} errors={blErr} name="backlash-ramp" hint="> 0" />
         <SelectField f={bl} set={setBl} k="disable_mode" label="On release" errors={blErr} options={DISABLE_MODES} name="backlash-disable-mode" title="hold: the correction stays; reset: back to 0 at once" />
         <label class="check" title="false: compensated while travelling negative (left flank); true: while positive">

@@ -17,6 +17,7 @@ import { HOME_DEFAULTS, REFERENCE_MODES, homeBody } from '../axis/bodies';
 import { abortableSleep, reversingConfig, runReversing, type ReversingEnd, type ReversingStep } from '../axis/reversing';
 import { useCommand, useForm } from '../axis/hooks';
 import { NumField, SelectField, useSender } from './coupling';
+import { P_HOME_POSITION, P_HOME_SEARCH_INVERSE, P_HOME_SEARCH_VELOCITY, P_HOME_SYNC_INVERSE, P_HOME_SYNC_VELOCITY, P_REFERENCE_MODE, paramDefault, useLiveParameters } from './axis-params';
 import { EncoderPanel, PositionCorrectionPanel, TorquePanel } from './function-blocks';
 
 /** Longest wait for one move of the sequence (the server's limit). */
@@ -130,8 +131,24 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
     ['positive', 'positive'],
     ['negative', 'negative'],
   ];
+  // A blank homing field is the axis's parameter: its value now is the placeholder.
+  const params = useLiveParameters(axis, a.id);
+  const dirOf = (n: number) => {
+    const v = params?.get(n)?.value;
+    return typeof v === 'boolean' ? (v ? 'negative' : 'positive') : '';
+  };
+  const refMode = (() => {
+    const v = params?.get(P_REFERENCE_MODE)?.value;
+    return typeof v === 'number' ? (REFERENCE_MODES[v] ?? String(v)).replace(/_/g, ' ') : '';
+  })();
+  const homePos = paramDefault(params, P_HOME_POSITION);
+  const searchVelocity = paramDefault(params, P_HOME_SEARCH_VELOCITY);
+  const syncVelocity = paramDefault(params, P_HOME_SYNC_VELOCITY);
+  const searchDir = paramDefault(params, P_HOME_SEARCH_INVERSE, dirOf(P_HOME_SEARCH_INVERSE));
+  const syncDir = paramDefault(params, P_HOME_SYNC_INVERSE, dirOf(P_HOME_SYNC_INVERSE));
+  const refModeDefault = paramDefault(params, P_REFERENCE_MODE, refMode);
   const stale = liveStatus?.stale || offline;
-  const blocks = { axis: a, s, online, send, setBanner };
+  const blocks = { axis: a, s, online, send, setBanner, params };
 
   return (
     <div class={`functions ${stale ? 'stale' : ''}`}>
@@ -190,7 +207,7 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
         <div class="functions-col">
           <Panel title="Homing" class="homing">
             <form
-              class="row"
+              class="form-grid homing-form"
               onSubmit={(e) => {
                 e.preventDefault();
                 if (online) void startHome();
@@ -203,25 +220,26 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
                 label="Mode"
                 errors={homeErr}
                 name="home-mode"
+                title="default: the referencing sequence of the reference mode (#1076)"
                 options={[
-                  ['default', 'default (#1076)'],
+                  ['default', 'default: referencing'],
                   ['direct', 'direct'],
                   ['force_calibration', 'force calibration'],
                   ['reset_calibration', 'reset calibration'],
                 ]}
               />
               <Field label={`Home position (${u})`} error={homeErr.position} name="home-position">
-                <NumberInput name="home-position" value={home.position} onValue={(v) => setHome('position', v)} placeholder="#1075" />
+                <NumberInput name="home-position" value={home.position} onValue={(v) => setHome('position', v)} placeholder={homePos.placeholder} title={homePos.title} />
               </Field>
-              <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank="axis (#1076)" />
-              <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank="axis (#1073)" />
-              <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder="#1012" />
-              <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank="axis (#1074)" />
-              <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder="#1013" />
-              <label class="check" title="MC_Direct only: set position = actual position afterwards">
-                <input type="checkbox" name="home-clear-lag" checked={home.clear_position_lag === '1'} onChange={(e) => setHome('clear_position_lag', (e.target as HTMLInputElement).checked ? '1' : '')} /> clear lag
-              </label>
-              <div class="row-buttons">
+              <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank={`axis: ${refMode || '…'}`} title={refModeDefault.title} />
+              <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank={`axis: ${searchDir.placeholder || '…'}`} title={searchDir.title} />
+              <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder={searchVelocity.placeholder} hint={searchVelocity.title} />
+              <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank={`axis: ${syncDir.placeholder || '…'}`} title={syncDir.title} />
+              <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder={syncVelocity.placeholder} hint={syncVelocity.title} />
+              <div class="form-actions">
+                <label class="check" title="MC_Direct only: set position = actual position afterwards">
+                  <input type="checkbox" name="home-clear-lag" checked={home.clear_position_lag === '1'} onChange={(e) => setHome('clear_position_lag', (e.target as HTMLInputElement).checked ? '1' : '')} /> clear lag
+                </label>
                 <button type="submit" class="btn btn-primary" name="home-start" disabled={offline} title="MC_Home">
                   Start
                 </button>

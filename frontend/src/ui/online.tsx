@@ -14,7 +14,7 @@ import { Trend } from './trend';
 import { LiveIndicator } from './liveness';
 import { href } from '../router';
 import { hexId } from '../api/errors';
-import { P_JOG_FAST, P_JOG_SLOW, numParam, useParameters } from './axis-params';
+import { P_HOME_POSITION, P_JOG_FAST, P_JOG_SLOW, numParam, paramDefault, useLiveParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
 
 function Readout({ label, value, unit, name, extra }: { label: string; value: string; unit: string; name: string; extra?: preact.ComponentChildren }) {
@@ -62,7 +62,8 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const liveStatus = st.get(axis);
   const s = liveStatus?.status ?? null;
   const offline = !online;
-  const params = useParameters(axis, a.id);
+  const params = useLiveParameters(axis, a.id);
+  const homeDefault = paramDefault(params, P_HOME_POSITION);
   const [error, setError] = useState<string | null>(null);
 
   // --- enable -------------------------------------------------------------------------
@@ -472,15 +473,15 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               }}
             >
               <Field label="Homing mode" name="home-mode" error={homeErrors.mode} class="wide">
-                <select name="home-mode" value={homeMode} onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}>
-                  <option value="default">default: referencing sequence (#1076)</option>
+                <select name="home-mode" title="default: the referencing sequence of the reference mode (#1076)" value={homeMode} onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}>
+                  <option value="default">default: referencing</option>
                   <option value="direct">direct: set the position here</option>
                   <option value="force_calibration">force calibration: mark as homed</option>
                   <option value="reset_calibration">reset calibration: mark as not homed</option>
                 </select>
               </Field>
               <Field label={`Home position (${u})`} name="home-position" error={homeErrors.position}>
-                <NumberInput name="home-position" value={homePos} onValue={setHomePos} placeholder="#1075" title="blank = the calibration value (#1075)" />
+                <NumberInput name="home-position" value={homePos} onValue={setHomePos} placeholder={homeDefault.placeholder} title={homeDefault.title} />
               </Field>
               <button type="submit" class="btn" name="home-btn" disabled={offline} title={`MC_Home${fk('home')}`}>
                 Home
