@@ -1,32 +1,38 @@
 // Development helper: screenshots of every page against a running stack.
 // node tests/e2e/shoot.mjs [width height]
-import { startStack, launch, shot, rest, until, sleep } from './lib.mjs';
+// Each picture is taken once the page shows what it is for (its content, live values), never
+// after a fixed wait.
+import { startStack, launch, shot, rest, until } from './lib.mjs';
 
 const [w, h] = [Number(process.argv[2] ?? 1280), Number(process.argv[3] ?? 800)];
 const stack = await startStack({ noDemo: false });
 const { context, close } = await launch({ width: w, height: h });
+/** Every live indicator of the page says "live" (values have arrived). */
+const live = (page) => page.waitForFunction(() => [...document.querySelectorAll('.main .live-ind[data-live]')].every((e) => e.dataset.live === 'live'));
 try {
   const page = await context.newPage();
   page.on('console', (m) => m.type() === 'error' && console.log('console:', m.text()));
   page.on('pageerror', (e) => console.log('pageerror:', e.message));
   await page.goto(stack.url + '/#/');
   await page.waitForSelector('[data-conn="open"]');
-  await sleep(800);
+  await page.waitForSelector('.main [data-axis="x"] [data-col="actual_position"]:text-matches("[0-9]")');
   await shot(page, `dev-overview-${w}`);
   await rest(stack.api, 'POST', '/axes/x/power', {});
   await page.goto(stack.url + '/#/axes/x');
-  await sleep(500);
+  await page.waitForSelector('[data-led="Enabled"][data-on="1"]');
+  await live(page);
   await rest(stack.api, 'POST', '/axes/x/move-absolute', { position: 300, velocity: 200 });
-  await sleep(700);
+  // moving: the page shows a set position on the way
+  await until(async () => Number(await page.locator('[data-readout="set_position"] .dro-value').textContent()) > 50, { what: 'x on its way' });
   await shot(page, `dev-online-${w}`);
   await page.goto(stack.url + '/#/axes/x/parameters');
-  await sleep(800);
+  await page.waitForSelector('tr[data-param="AxisVeloMax"]');
   await shot(page, `dev-parameters-${w}`);
   await page.goto(stack.url + '/#/axes/y/config');
-  await sleep(500);
+  await page.waitForSelector('select[name="drive.plant.kind"]');
   await shot(page, `dev-config-${w}`);
   await page.goto(stack.url + '/#/scope');
-  await sleep(800);
+  await page.waitForSelector('[data-channel="0"]');
   await shot(page, `dev-scope-${w}`);
 } finally {
   await close();

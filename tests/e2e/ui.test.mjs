@@ -2,7 +2,7 @@
 // motiond binary. Live values are polled with generous deadlines; nothing asserts timing.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launch, overflowing, readout, rest, shot, startStack, status, until, sleep } from './lib.mjs';
+import { launch, overflowing, picture, readout, rest, shot, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
 
@@ -143,8 +143,12 @@ describe('commissioning UI', () => {
     await shot(page, 'online-jogging');
     await page.mouse.up();
     const rest1 = await atRest();
-    await sleep(300);
-    const rest2 = await status(stack.api, AXIS);
+    // the jog is over on the server and the kernel has run on for 300 more cycles: still there
+    await until(async () => (await rest(stack.api, 'GET', `/commands?axis=${AXIS}&limit=20`)).body.find((c) => c.command === 'jog')?.final, { what: 'the jog released' });
+    const rest2 = await until(async () => {
+      const s = await status(stack.api, AXIS);
+      return s.nc_cycle_counter >= rest1.nc_cycle_counter + 300 ? s : null;
+    }, { what: '300 cycles after the stop' });
     assert.equal(rest2.set_position, rest1.set_position, 'no motion after the release');
     await until(async () => Math.abs((await readout(page, 'set_position')) - rest2.set_position) < 1e-3, { what: 'the UI to show the stop' });
     // the log shows the jog, released
@@ -153,7 +157,10 @@ describe('commissioning UI', () => {
     await page.click('button[name="trend-pause"]');
     await page.waitForSelector('[data-testid="trend"][data-paused="1"]');
     const frozen = await drawn();
-    await sleep(300);
+    // the axis moves while paused: once the page shows where it went, the trend is still as it was
+    const before = (await status(stack.api, AXIS)).set_position;
+    assert.equal((await rest(stack.api, 'POST', `/axes/${AXIS}/move-relative`, { distance: 1, velocity: 10 })).status, 202);
+    await until(async () => Math.abs((await readout(page, 'set_position')) - (before + 1)) < 1e-3, { what: 'the page to receive the move while paused' });
     assert.deepEqual(await drawn(), frozen, 'a paused trend is not redrawn');
     await page.click('button[name="trend-clear"]');
     assert.equal((await drawn()).points, 0);
@@ -337,7 +344,8 @@ describe('commissioning UI', () => {
     await rest(stack.api, 'POST', `/axes/${AXIS}/power`, { override_percent: 50 });
     await until(async () => (await status(stack.api, AXIS)).override_percent === 15, { what: 'effective override 15 %' });
     await page.waitForSelector('[data-testid="override-power"]:has-text("50 %")', { timeout: 10000 });
-    await sleep(300);
+    // the page has the status with the effective 15 %: the slider still shows the factor
+    await until(async () => (await readout(page, 'override')) === 15, { what: 'the effective override 15 % shown' });
     assert.equal(await page.inputValue('input[name="override"]'), '30');
     // the UI's power keeps that override: enabling never changes the speed
     const powerSent = page.waitForRequest((r) => r.method() === 'POST' && r.url().endsWith(`/axes/${AXIS}/power`));
@@ -466,7 +474,8 @@ describe('commissioning UI', () => {
     await page.keyboard.down('F3');
     await until(async () => (await status(stack.api, AXIS)).set_velocity > 0, { what: 'F3 jogs forward' });
     await page.waitForSelector('[data-jog="slow-forward"].held');
-    await sleep(700); // beyond the dead-man: the key keeps it going like the button
+    // beyond the 0.5 s dead-man — 7 mm at 10 mm/s is 0.7 s of jogging: the key keeps it going
+    await until(async () => (await status(stack.api, AXIS)).set_position > start + 7, { what: 'F3 to jog 7 mm (0.7 s)' });
     assert.ok((await status(stack.api, AXIS)).set_velocity > 0, 'still jogging while F3 is held');
     await page.keyboard.up('F3');
     const s1 = await atRest();
@@ -713,7 +722,7 @@ describe('commissioning UI', () => {
       const page = await open('/', { width, height });
       // [name, route, what shows that its content has loaded (one selector or several)]
       const pagesToSee = [
-        ['overview', '/', `.main [data-axis="${AXIS}"]`],
+        ['overview', '/', `.main [data-axis="${AXIS}"] [data-col="actual_position"]:text-matches("[0-9]")`],
         ['online', `/axes/${AXIS}`, '[data-readout="actual_position"]'],
         ['coupling', `/axes/${AXIS}/coupling`, '[data-testid="coupling-kv"]'],
         ['functions', `/axes/${AXIS}/functions`, '[data-testid="homing-phase"]'],
@@ -733,7 +742,8 @@ describe('commissioning UI', () => {
         await page.waitForSelector('[data-conn="open"]');
         await page.waitForSelector('.main .page');
         for (const sel of [ready].flat()) await page.waitForSelector(sel);
-        await sleep(400); // let live values arrive for the picture
+        // live values there for the picture: every live indicator of the page says so
+        await page.waitForFunction(() => [...document.querySelectorAll('.main .live-ind[data-live]')].every((e) => e.dataset.live === 'live'));
         await shot(page, `${name}-${width}x${height}`);
         const o = await overflowing(page);
         assert.ok(o.doc <= 0 && o.main <= 0, `${name} at ${width}×${height} scrolls sideways: ${JSON.stringify(o)}`);
