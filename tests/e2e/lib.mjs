@@ -261,6 +261,74 @@ export async function overflowing(page) {
   });
 }
 
+/**
+ * Text cut off inside its own box — what `overflowing` cannot see, because the box itself fits
+ * the window: a label, table cell, heading, tag or button whose text is wider than the box
+ * (`scrollWidth > clientWidth`, also behind an ellipsis), a select whose chosen option does not
+ * fit (measured on a copy holding only that option, arrow and padding included), a text input
+ * whose value — or placeholder while empty — is wider than its content box. Elements of `.main`,
+ * the header and a floating banner; hidden ones, boxes that scroll sideways themselves and the
+ * one-line preview of a closed disclosure (`<summary>`, all of it shown when opened) are not
+ * counted. Returns one line per cut element.
+ */
+export async function clippedText(page) {
+  return page.evaluate(() => {
+    const roots = [document.querySelector('.main'), document.querySelector('.topbar'), ...document.querySelectorAll('.banner-float')].filter(Boolean);
+    const TEXT = 'label, .field-label, th, td, dt, dd, h2, h3, h4, button, .btn, .tag, .led, .kpi-label, .kpi-value, .dro-label, .dro-value, .seg-btn, .tab, summary, caption, .setup-name';
+    const name = (el) => {
+      const cls = [...el.classList].slice(0, 2).map((c) => '.' + c).join('');
+      const n = el.getAttribute('name') ?? el.closest('[name]')?.getAttribute('name');
+      return `${el.tagName.toLowerCase()}${cls}${n ? `[name=${n}]` : ''}`;
+    };
+    const visible = (el) => {
+      const r = el.getBoundingClientRect();
+      if (!(r.width > 0 && r.height > 0)) return false;
+      const cs = getComputedStyle(el);
+      return cs.visibility !== 'hidden' && cs.display !== 'none';
+    };
+    const ctx = document.createElement('canvas').getContext('2d');
+    const textWidth = (el, text) => {
+      const cs = getComputedStyle(el);
+      ctx.font = `${cs.fontStyle} ${cs.fontWeight} ${cs.fontSize} ${cs.fontFamily}`;
+      return ctx.measureText(text).width;
+    };
+    const cut = [];
+    for (const root of roots) {
+      for (const el of root.querySelectorAll(TEXT)) {
+        if (!visible(el)) continue;
+        const cs = getComputedStyle(el);
+        if (cs.display === 'inline' || cs.overflowX === 'auto' || cs.overflowX === 'scroll') continue;
+        if (el.tagName === 'SUMMARY' && !el.parentElement.open) continue;
+        const text = el.textContent.trim();
+        if (!text) continue;
+        if (el.scrollWidth > el.clientWidth + 1) cut.push(`${name(el)} "${text.slice(0, 40)}": ${el.scrollWidth} > ${el.clientWidth} px`);
+      }
+      for (const el of root.querySelectorAll('select')) {
+        if (!visible(el) || el.selectedIndex < 0) continue;
+        const copy = document.createElement('select');
+        copy.className = el.className;
+        copy.style.cssText = 'position:absolute;left:0;top:0;width:auto;min-width:0;max-width:none;visibility:hidden';
+        copy.appendChild(el.options[el.selectedIndex].cloneNode(true));
+        el.parentElement.appendChild(copy);
+        const need = copy.getBoundingClientRect().width;
+        copy.remove();
+        const has = el.getBoundingClientRect().width;
+        if (need > has + 0.5) cut.push(`${name(el)} "${el.options[el.selectedIndex].textContent.trim().slice(0, 40)}": needs ${Math.ceil(need)} > ${Math.floor(has)} px`);
+      }
+      for (const el of root.querySelectorAll('input:not([type]), input[type="text"], input[type="search"], input[type="password"]')) {
+        if (!visible(el)) continue;
+        const cs = getComputedStyle(el);
+        const text = el.value || el.placeholder;
+        if (!text || el.type === 'password') continue;
+        const room = el.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+        const need = textWidth(el, text);
+        if (need > room + 1) cut.push(`${name(el)} "${text.slice(0, 40)}": ${Math.ceil(need)} > ${Math.floor(room)} px`);
+      }
+    }
+    return cut;
+  });
+}
+
 /** Enables the axes (MC_Power) and waits until each one is. */
 export async function powerOn(api, names) {
   for (const n of names) {

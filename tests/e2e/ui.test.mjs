@@ -2,7 +2,7 @@
 // motiond binary. Live values are polled with generous deadlines; nothing asserts timing.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launch, overflowing, picture, readout, rest, shot, startStack, status, until } from './lib.mjs';
+import { clippedText, launch, overflowing, picture, readout, rest, shot, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: true });
 
@@ -67,6 +67,14 @@ async function atRest() {
     },
     { what: 'axis at rest' },
   );
+}
+
+/** The Online tab's absolute move with this target and velocity (as typed: any text), started. */
+async function startAbsolute(page, position, velocity) {
+  await page.click('[data-move="move-absolute"]');
+  await page.fill('input[name="position"]', position);
+  await page.fill('input[name="velocity"]', velocity);
+  await page.click('button[name="start"]');
 }
 
 async function holdJog(page, key) {
@@ -289,10 +297,7 @@ describe('commissioning UI', () => {
     const page = await open(`/axes/${AXIS}`);
     const sent = [];
     page.on('request', (r) => r.method() === 'POST' && r.url().includes(`/axes/${AXIS}/move-absolute`) && sent.push(r.postDataJSON()));
-    await page.click('[data-move="move-absolute"]');
-    await page.fill('input[name="position"]', '20');
-    await page.fill('input[name="velocity"]', 'abc');
-    await page.click('button[name="start"]');
+    await startAbsolute(page, '20', 'abc');
     const said = page.locator('[data-field="velocity"] .field-error:visible');
     await said.waitFor();
     assert.equal((await said.textContent()).trim(), 'enter a number');
@@ -316,6 +321,33 @@ describe('commissioning UI', () => {
     await atRest();
     await page.close();
   });
+
+  for (const [width, height] of [
+    [1280, 800],
+    [390, 844],
+  ]) {
+    test(`the error toast at ${width}×${height}: in the bottom corner, over neither the header nor the axis's name, state and tabs; × dismisses it`, async () => {
+      await enabled();
+      await atRest();
+      const page = await open(`/axes/${AXIS}`, { width, height });
+      await startAbsolute(page, '5000', '100');
+      const toast = page.locator('.banner-float');
+      await toast.waitFor();
+      assert.match(await toast.textContent(), /0x7001/);
+      const t = await toast.boundingBox();
+      for (const sel of ['.topbar', '.axis-head', '.tabs']) {
+        const r = await page.locator(sel).first().boundingBox();
+        const apart = t.x + t.width <= r.x || r.x + r.width <= t.x || t.y + t.height <= r.y || r.y + r.height <= t.y;
+        assert.ok(apart, `the toast ${JSON.stringify(t)} covers ${sel} ${JSON.stringify(r)}`);
+      }
+      assert.ok(t.y + t.height <= height && t.y >= height / 2, `in the lower half of the window: ${JSON.stringify(t)}`);
+      assert.ok(t.x >= 0 && t.x + t.width <= width, `inside the window: ${JSON.stringify(t)}`);
+      await picture(page, width < 700 ? 'online-error-toast-phone' : 'online-error-toast');
+      await page.click('button[name="dismiss-error"]');
+      await toast.waitFor({ state: 'detached' });
+      await page.close();
+    });
+  }
 
   test('feed enables; override; Stop released at standstill (XAE), an API stop held until released; home with a chosen mode', async () => {
     await enabled();
@@ -716,10 +748,14 @@ describe('commissioning UI', () => {
     [1024, 768],
     [390, 844],
   ]) {
-    test(`every page at ${width}×${height}: screenshots, nothing wider than the window`, async () => {
+    // At the largest and the smallest size also no text cut off inside its own box (a label,
+    // table cell, select, button or number field showing only part of what it holds).
+    const whole = (width === 1600 && height === 1000) || (width === 390 && height === 844);
+    test(`every page at ${width}×${height}: screenshots, nothing wider than the window${whole ? ', no text cut off' : ''}`, async () => {
       await enabled();
       await pagesCam();
       const page = await open('/', { width, height });
+      const cut = [];
       // [name, route, what shows that its content has loaded (one selector or several)]
       const pagesToSee = [
         ['overview', '/', `.main [data-axis="${AXIS}"] [data-col="actual_position"]:text-matches("[0-9]")`],
@@ -748,7 +784,20 @@ describe('commissioning UI', () => {
         const o = await overflowing(page);
         assert.ok(o.doc <= 0 && o.main <= 0, `${name} at ${width}×${height} scrolls sideways: ${JSON.stringify(o)}`);
         assert.deepEqual(o.wide, [], `${name} at ${width}×${height}: elements beyond the window's right edge`);
+        if (whole) cut.push(...(await clippedText(page)).map((c) => `${name}: ${c}`));
+        if (name === 'overview' && width < 700) {
+          // on a phone every value of the overview is on the screen, none behind a sideways scroll
+          const off = await page.$$eval('[data-testid="overview"] td', (tds) =>
+            tds.filter((td) => {
+              const r = td.getBoundingClientRect();
+              return r.width > 0 && (r.left < 0 || r.right > document.documentElement.clientWidth);
+            }).map((td) => td.dataset.col ?? td.textContent.trim()),
+          );
+          assert.deepEqual(off, [], 'overview cells off the screen at 390×844');
+          await picture(page, 'overview-phone');
+        }
       }
+      assert.deepEqual(cut, [], `text cut off at ${width}×${height}:\n${cut.join('\n')}`);
     });
   }
 

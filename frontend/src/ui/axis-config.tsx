@@ -619,11 +619,11 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
             </Panel>
           )}
           <Panel title="Further base parameters (MC_AxisParameter by name)" class="wide">
-            <table class="grid kv">
+            <table class="grid kv kv-params">
               <tbody>
                 {form.parameters.map((p, i) => (
                   <tr key={i}>
-                    <td>
+                    <td class="kv-key">
                       <input type="text" value={p.key} placeholder="AxisTargetPositionWindow" onInput={(e) => set('parameters', form.parameters.map((q, j) => (j === i ? { ...q, key: (e.target as HTMLInputElement).value } : q)))} />
                     </td>
                     <td>

@@ -182,7 +182,7 @@ export function ErrorBanner({ error, onClose }: { error: string | null; onClose?
     <div class="banner banner-error banner-float" role="alert">
       <span>{error}</span>
       {onClose && (
-        <button type="button" class="banner-close" onClick={onClose} aria-label="dismiss">
+        <button type="button" class="banner-close" name="dismiss-error" onClick={onClose} aria-label="dismiss" title="dismiss">
           ×
         </button>
       )}

@@ -47,7 +47,7 @@ export function Overview() {
                   data-axis={a.config.name}
                   onClick={() => navigate({ page: 'axis', axis: a.config.name, tab: 'online' })}
                 >
-                  <td>
+                  <td data-col="axis">
                     <a href={href({ page: 'axis', axis: a.config.name, tab: 'online' })} class="axis-name">
                       {a.config.name}
                     </a>
@@ -57,13 +57,13 @@ export function Overview() {
                     <Lamp state={s?.state ?? a.state} errorId={s?.error_id ?? 0} />
                     {STATE_LABEL[s?.state ?? a.state]}
                   </td>
-                  <td class="r mono" data-col="set_position">{pos(s?.set_position)}</td>
-                  <td class="r mono" data-col="actual_position">{pos(s?.actual_position)}</td>
-                  <td class="r mono" data-col="set_velocity">{vel(s?.set_velocity)}</td>
-                  <td class="r mono" data-col="actual_velocity">{vel(s?.actual_velocity)}</td>
-                  <td class="r mono" data-col="following_error">{pos(s?.following_error)}</td>
-                  <td>{s?.power_status ? <span class="tag tag-green">on</span> : <span class="tag">off</span>}</td>
-                  <td>{s?.homed ? <span class="tag tag-green">homed</span> : <span class="tag">no</span>}</td>
+                  <td class="r mono" data-col="set_position" data-label="Set position">{pos(s?.set_position)}</td>
+                  <td class="r mono" data-col="actual_position" data-label="Actual position">{pos(s?.actual_position)}</td>
+                  <td class="r mono" data-col="set_velocity" data-label="Set velocity">{vel(s?.set_velocity)}</td>
+                  <td class="r mono" data-col="actual_velocity" data-label="Actual velocity">{vel(s?.actual_velocity)}</td>
+                  <td class="r mono" data-col="following_error" data-label="Following error">{pos(s?.following_error)}</td>
+                  <td data-col="enabled" data-label="Enabled">{s?.power_status ? <span class="tag tag-green">on</span> : <span class="tag">off</span>}</td>
+                  <td data-col="homed" data-label="Homed">{s?.homed ? <span class="tag tag-green">homed</span> : <span class="tag">no</span>}</td>
                   <td class="err-cell" data-col="error">
                     {err ? (
                       <span class="err-text" title={err.code ?? undefined}>

@@ -2,6 +2,7 @@
 // configured (the axis configuration's start-up value), persistent and online (in force, the
 // one edited here); edits are shown as a diff (old → new) and applied one PUT at a time; the
 // server's validation errors appear at the row.
+import type { ComponentChildren } from 'preact';
 import { useEffect, useMemo, useState } from 'preact/hooks';
 import { NOT_A_NUMBER, get, put, enc } from '../api/rest';
 import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
@@ -51,6 +52,11 @@ export function parseValue(p: ParameterResource, text: string): ParamValue | nul
   if (t === '') return null;
   const v = Number(t);
   return Number.isNaN(v) ? null : v;
+}
+
+/** A parameter's name with a break opportunity before each word (AxisEncoder·Homing·Calib·Value). */
+export function camelBreaks(name: string): ComponentChildren[] {
+  return name.split(/(?=[A-Z][a-z])/).flatMap((w, i) => (i ? [<wbr />, w] : [w]));
 }
 
 export interface Change {
@@ -284,7 +290,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
                       <tr key={p.number} class={`${edited ? 'edited' : ''} ${err ? 'row-error' : ''} ${ro ? 'ro' : ''}`} data-param={p.name}>
                         <td class="r mono">{p.number}</td>
                         <td class="pname" onClick={() => setOpenHelp(openHelp === p.number ? null : p.number)} title={p.help}>
-                          {p.name}
+                          <span class="pname-text">{camelBreaks(p.name)}</span>
                           {p.storage && p.storage !== p.number ? <span class="muted small"> → #{p.storage}</span> : null}
                           <div class={`help ${openHelp === p.number ? 'help-open' : 'help-short'}`}>{p.help}</div>
                         </td>

@@ -742,6 +742,9 @@ export function AuditPanel() {
   );
 }
 
+/** A code with a line break allowed after each ':' and '_' (rejected:target_above_soft_limit). */
+const breakAfter = (code: string) => code.split(/(?<=[:_])/).flatMap((w, i) => (i ? [<wbr />, w] : [w]));
+
 const OUTCOME_TAG = { ok: 'tag-green', fail: 'tag-red', aborted: 'tag-amber', none: '' } as const;
 
 function AuditRow({ e }: { e: AuditRecord }) {
@@ -766,7 +769,7 @@ function AuditRow({ e }: { e: AuditRecord }) {
       <td class="audit-outcome">
         {e.outcome && (
           <span class={`tag ${OUTCOME_TAG[outcomeKind(e.outcome)]}`} title={e.outcome}>
-            {e.outcome}
+            {breakAfter(e.outcome)}
           </span>
         )}
       </td>
