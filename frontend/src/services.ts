@@ -10,6 +10,7 @@ import { ScopeSession } from './scope/session';
 import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
 import { TrendBuffer } from './live/trend';
 import { releaseWhenDone } from './axis/stop';
+import { LiveTrace } from './scope/live';
 import { clientId } from './auth/client-id';
 
 export interface LiveStatus {
@@ -54,6 +55,28 @@ export const system = new Store<SystemResource | null>(null, true);
 export const commandLog = new Store<LogEntry[]>([], true);
 /** Scope recordings followed across page changes. */
 export const scope = new ScopeSession({ list: listRecordings, get: getRecording, create: createRecording, cancel: cancelRecording });
+/**
+ * The trace of the armed or running recording, drawn from the status stream until the server's
+ * samples are there (scope/live.ts); null while none runs.
+ */
+export const scopeLive = new Store<LiveTrace | null>(null);
+
+scope.state.subscribe(() => {
+  const running = scope.state.get().running;
+  const trace = scopeLive.get();
+  if (!running) {
+    if (trace) scopeLive.set(null);
+    return;
+  }
+  if (trace && trace.id === running.id) {
+    trace.update(running);
+    return;
+  }
+  const next = new LiveTrace(running);
+  // What the axes stand at now: the trace starts with it, not with the next change.
+  for (const [name, l] of statuses.get()) if (l.status && !l.stale) next.push(name, l.status, l.cycle, clock());
+  scopeLive.set(next);
+});
 
 let focus: string | null = null;
 const subscribed = new Map<string, { rate: number; off: () => void }>();
@@ -77,7 +100,10 @@ function onStatus(name: string, value: AxisLiveStatus | null, stale: boolean, cy
   m.set(name, { status: value, cycle, stale });
   const trend = trendOf(name);
   if (stale || !value) trend.gap();
-  else trend.push(cycle, value.set_velocity, value.actual_velocity, value.following_error, clock());
+  else {
+    trend.push(cycle, value.set_velocity, value.actual_velocity, value.following_error, clock());
+    scopeLive.get()?.push(name, value, cycle, clock());
+  }
   statuses.emit();
 }
 
@@ -334,7 +360,10 @@ function wire(): void {
   live.on('commands_lagged', () => void refreshCommands());
   // Subscriptions are re-sent by the client on every (re)connection.
   live.subscribe<SystemResource>('system', 1, (v) => {
-    if (v) system.set(v);
+    if (v) {
+      system.set(v);
+      scopeLive.get()?.tick(v.cycle, clock());
+    }
   });
   live.subscribe('commands', 1, () => {});
   live.onOpen(() => {

@@ -146,6 +146,39 @@ describe('scope setups, stacked charts, rolling, compare', () => {
     await page.close();
   });
 
+  test('a recording is drawn while it records (TwinCAT Scope: live), not "No recording yet"; when done the server’s every-cycle samples replace it', async () => {
+    await rest(stack.api, 'POST', `/axes/${AXIS}/move-absolute?wait=true`, { position: 0, velocity: 400 });
+    const page = await open(desk, '/scope');
+    await page.waitForSelector('[data-channel="0"]');
+    await page.fill('input[name="duration_s"]', '3');
+    if (await page.isChecked('input[name="rolling-on"]')) await page.uncheck('input[name="rolling-on"]');
+    if (await page.isChecked('input[name="trigger-on"]')) await page.uncheck('input[name="trigger-on"]');
+    await page.click('button[name="record"]');
+    const rec = await until(async () => (await active())[0], { what: 'the recording to start' });
+    await rest(stack.api, 'POST', `/axes/${AXIS}/move-absolute`, { position: 200, velocity: 200 });
+    const chart = page.locator('[data-testid="scope-chart"]');
+    await page.waitForSelector('[data-testid="scope-chart"][data-mode="live"] canvas', { timeout: 10000 });
+    assert.equal(await page.locator('.chart-empty').count(), 0, 'no "No recording yet" while recording');
+    assert.equal(await page.getAttribute('[data-testid="live-info"]', 'data-recording'), String(rec.id));
+    // it grows as statuses come in, while the server is still recording
+    const p1 = await until(async () => {
+      const n = Number(await chart.getAttribute('data-live-points'));
+      return n >= 10 ? n : null;
+    }, { what: 'ten samples drawn live' });
+    await until(async () => Number(await chart.getAttribute('data-live-points')) > p1, { what: 'more samples drawn' });
+    const now = (await rest(stack.api, 'GET', `/scope/recordings/${rec.id}`)).body;
+    assert.equal(now.state, 'recording', 'drawn before the recording is done');
+    await until(async () => (await status(stack.api, AXIS)).in_target_position, { what: 'the move to end' });
+    await picture(page, 'scope-live');
+    // done: the recording itself, every cycle
+    await page.waitForSelector('[data-testid="scope-chart"][data-mode="single"] canvas', { timeout: 30000 });
+    const done = (await rest(stack.api, 'GET', `/scope/recordings/${rec.id}`)).body;
+    assert.equal(done.state, 'done');
+    assert.equal(await chart.getAttribute('data-samples'), String(done.samples));
+    assert.match(await page.locator('[data-testid="recording-info"]').textContent(), new RegExp(`recording ${rec.id} `));
+    await page.close();
+  });
+
   test('phone: the saved setup loads and the stacked recording reads', async () => {
     const page = await open(phone, '/scope');
     await page.waitForSelector(`[data-setup="${SETUP}"] button[name="setup-load"]`);

@@ -134,6 +134,14 @@ export class ScopeChart {
     }
   }
 
+  /** New values for the same series (a live trace growing); the view stays where it is. */
+  setData(t: ArrayLike<number>, values: ArrayLike<number | null>[]): void {
+    const r = this.range();
+    this.u.setData([Array.from(t), ...values.map((v) => Array.from(v))] as uPlot.AlignedData, true);
+    this.u.setScale('x', r);
+    this.el.dataset.samples = String(t.length);
+  }
+
   private resize(): void {
     const w = Math.max(300, this.el.clientWidth);
     if (Math.abs(w - this.u.width) > 2) this.u.setSize({ width: w, height: this.u.height });
@@ -404,6 +412,12 @@ export class ScopeStack {
       const r = opts.limits ?? { min: t.length ? t[0] : 0, max: t.length ? t[t.length - 1] : 1 };
       el.dataset.view = `${r.min},${r.max}`;
     }
+  }
+
+  /** New values for the panes' series, pane by pane in their order (a live trace growing). */
+  setData(t: ArrayLike<number>, panes: ArrayLike<number | null>[][]): void {
+    this.charts.forEach((c, i) => c.setData(t, panes[i] ?? []));
+    this.el.dataset.samples = String(t.length);
   }
 
   zoom(factor: number): void {

@@ -4,7 +4,7 @@
 // the page to move the axis does not lose an armed or running recording.
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { useStore } from '../store';
-import { axes, scope, system } from '../services';
+import { axes, scope, scopeLive, system } from '../services';
 import {
   MAX_CHANNELS,
   SIGNALS,
@@ -61,9 +61,11 @@ const rolling: Rolling = new Rolling({
 /** What the charts draw: one time axis, rows (each with its chart), the x range. */
 interface Plot {
   t: number[];
-  rows: (ChartSeries & { chart: number; data: (number | null)[] })[];
+  rows: (ChartSeries & { chart: number; index: number; data: (number | null)[] })[];
   limits?: { min: number; max: number };
   trigger: { chart: number; scale: string; level: number } | null;
+  /** Drawn from the status stream while the recording runs (redrawn in place). */
+  live?: boolean;
 }
 
 export function ScopePage() {
@@ -164,6 +166,10 @@ export function ScopePage() {
   }, [compareId]);
 
   const showRing = !!roll.ring && !!roll.request && (roll.active || view.rolling.enabled) && roll.ring.t.length > 0;
+  // While a recording is armed or running its trace is drawn live from the status stream
+  // (TwinCAT Scope draws as it records); the server's every-cycle samples replace it when done.
+  const trace = useStore(scopeLive);
+  const showLive = !showRing && !roll.active && !!running && !!trace && trace.id === running.id;
   const t = useMemo(() => (rec && rec.data ? timeAxis(rec) : null), [rec]);
   const problems = useMemo(() => (rec && rec.data ? checkRecording(rec) : []), [rec]);
 
@@ -177,11 +183,22 @@ export function ScopePage() {
       data: values,
       color: view.colors[i],
       chart: view.chart[i] ?? 0,
+      index: i,
       ...extra,
     };
   };
 
+  /** The trigger of a recording as drawn: the level on its channel's scale, in its chart. */
+  const triggerOf = (r: Pick<Recording, 'trigger' | 'channels'>): Plot['trigger'] => {
+    const c = r.trigger ? r.channels[r.trigger.channel] : undefined;
+    return r.trigger && c ? { chart: view.chart[r.trigger.channel] ?? 0, scale: scaleKey(c.signal as Signal, unitOf(c.axis)), level: r.trigger.level } : null;
+  };
+
   const plot = useMemo<Plot | null>(() => {
+    if (showLive && trace && running) {
+      const first = trace.series(performance.now());
+      return { t: first.t, rows: trace.channels.map((c, i) => seriesOf(c, i, first.data[i])), limits: first.limits, trigger: triggerOf(running), live: true };
+    }
     if (showRing && roll.ring && roll.request) {
       const ring = roll.ring;
       const end = ring.end ?? 0;
@@ -193,14 +210,7 @@ export function ScopePage() {
       };
     }
     if (!rec || !rec.data || !t) return null;
-    const trig =
-      rec.trigger && rec.channels[rec.trigger.channel]
-        ? {
-            chart: view.chart[rec.trigger.channel] ?? 0,
-            scale: scaleKey(rec.channels[rec.trigger.channel].signal as Signal, unitOf(rec.channels[rec.trigger.channel].axis)),
-            level: rec.trigger.level,
-          }
-        : null;
+    const trig = triggerOf(rec);
     if (other && other.data && other.id !== rec.id) {
       const m = mergeAligned(alignedTime(rec, align), rec.data, alignedTime(other, align), other.data);
       return {
@@ -213,7 +223,7 @@ export function ScopePage() {
       };
     }
     return { t, rows: rec.channels.map((c, i) => seriesOf(c, i, rec.data![i])), trigger: trig };
-  }, [rec, t, other, align, showRing, roll.ring, roll.request, roll.window_s, view.chart.join(), view.colors.join(), list]);
+  }, [showLive ? trace : rec, t, other, align, showRing, roll.ring, roll.request, roll.window_s, view.chart.join(), view.colors.join(), list]);
 
   useEffect(() => {
     chart.current?.destroy();
@@ -230,7 +240,21 @@ export function ScopePage() {
       limits: plot.limits,
       height: window.innerWidth < 600 ? 300 : 420,
     });
+    // Live: the trace grows ten times a second (and only when something new came).
+    let timer: ReturnType<typeof setInterval> | null = null;
+    if (plot.live && trace) {
+      const el = chartEl.current;
+      const redraw = () => {
+        const sr = trace.series(performance.now());
+        chart.current?.setData(sr.t, used.map((c) => plot.rows.filter((r) => r.chart === c).map((r) => sr.data[r.index])));
+        el.dataset.livePoints = String(sr.points);
+        el.dataset.armed = sr.armed ? '1' : '0';
+      };
+      redraw();
+      timer = setInterval(redraw, 100);
+    }
     return () => {
+      if (timer) clearInterval(timer);
       chart.current?.destroy();
       chart.current = null;
     };
@@ -680,7 +704,7 @@ export function ScopePage() {
                 ))}
               </select>
             )}
-            {rec && !showRing && done.length > 1 && (
+            {rec && !showRing && !showLive && done.length > 1 && (
               <>
                 <select name="compare" title="overlay a second recording (dashed)" value={compareId} onChange={(e) => setCompareId((e.target as HTMLSelectElement).value)}>
                   <option value="">compare with…</option>
@@ -700,7 +724,7 @@ export function ScopePage() {
                 )}
               </>
             )}
-            {rec && !showRing && (
+            {rec && !showRing && !showLive && (
               <>
                 <a class="btn btn-small" href={csvUrl(rec.id)} download={`scope-${rec.id}.csv`} data-testid="csv">
                   CSV
@@ -717,7 +741,7 @@ export function ScopePage() {
             )}
           </div>
           <div class="chart-box">
-            <div ref={chartEl} class="chart" data-testid="scope-chart" data-mode={showRing ? 'rolling' : other ? 'compare' : 'single'} />
+            <div ref={chartEl} class="chart" data-testid="scope-chart" data-mode={showLive ? 'live' : showRing ? 'rolling' : other ? 'compare' : 'single'} />
             {!plot && (
               <div class="chart-empty muted">
                 {rollingOn ? 'Press Start rolling: recordings of one chunk each, one after another, scroll by.' : 'No recording yet. Pick signals, set a duration and press Record; then move the axis.'}
@@ -734,7 +758,13 @@ export function ScopePage() {
               {roll.ring.gaps > 0 ? ` (${roll.ring.gaps} so far, ${sig((roll.ring.lostSamples * roll.ring.cycle) || 0)} s in all)` : ''}
             </div>
           )}
-          {rec && !showRing && (
+          {showLive && running && (
+            <div class="muted small" data-testid="live-info" data-recording={String(running.id)}>
+              recording {String(running.id)} · {running.state === 'armed' ? 'armed: the pre-trigger history scrolls until the trigger' : 'recording'} · drawn live from the
+              status stream (25–50 Hz); the server's every-cycle samples replace it when done ({running.samples_recorded ?? 0} / {running.samples} recorded)
+            </div>
+          )}
+          {rec && !showRing && !showLive && (
             <div class="muted small" data-testid="recording-info">
               recording {String(rec.id)} · {rec.samples} samples × {rec.channels.length} channels · cycle {(rec.cycle_time_s * 1000).toPrecision(3)} ms
               {rec.trigger ? ` · trigger ${channelLabel(rec.channels[rec.trigger.channel])} ${rec.trigger.edge} ${rec.trigger.level}, pre ${rec.trigger.pre_trigger_s} s` : ''}
