@@ -283,6 +283,18 @@ describe('cam editor', () => {
     const page = await open(desk, '/cams/follow');
     await page.waitForSelector('[data-testid="cam-slaves"][data-slaves="y"]');
     assert.equal(await text(page, '[data-slave="y"] a'), 'y');
+    // where y is on the table now (MC_CamInfo: the master's and the slave's cam position), and
+    // the plot's axes in x's and y's units
+    const marker = page.locator('.cam-marker[data-axis="y"]');
+    await marker.waitFor();
+    const markedAt = async () => [Number(await marker.getAttribute('data-master')), Number(await marker.getAttribute('data-slave'))];
+    const camNow = (await status(stack.api, 'y')).cam;
+    await until(async () => {
+      const [m, sl] = await markedAt();
+      return Math.abs(m - camNow.actual_master_cam_pos) < 1e-6 && Math.abs(sl - camNow.actual_slave_cam_pos) < 1e-6;
+    }, { what: 'the marker at y’s cam position' });
+    const units = Object.fromEntries((await rest(stack.api, 'GET', '/axes')).body.map((a) => [a.config.name, a.config.unit]));
+    assert.equal(await page.getAttribute('[data-chart="cam"]', 'data-units'), `${units.x}|${units.y}`);
     // the mode: from the master axis at 150
     await page.selectOption('select[name="online-activation-mode"]', 'at_master_axis_pos');
     await page.fill('input[name="online-activation-position"]', '150');
@@ -339,6 +351,12 @@ describe('cam editor', () => {
     const want = await camAt('follow', 270);
     assert.ok(Math.abs(want - 50) < 1e-6, `the new table at 270: ${want}`);
     await until(async () => Math.abs((await status(stack.api, 'y')).actual_position - want) < 0.05, { what: `y at ${want}, the new table's value (the old one's: 40)` });
+    // the marker went along: at master 270 on the table, at its value there
+    await until(async () => {
+      const [m, sl] = await markedAt();
+      return Math.abs(m - 270) < 1e-6 && Math.abs(sl - want) < 1e-6;
+    }, { what: 'the marker at master 270' });
+    await picture(page, 'cam-editor-coupled');
     await page.close();
   });
 

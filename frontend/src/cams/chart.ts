@@ -8,6 +8,29 @@ import type { Handle } from './data';
 
 export const CAM_COLORS = ['#1363c6', '#2b8a3e', '#d9480f', '#ae3ec9'];
 const NAMES = ['position', 'velocity', 'acceleration', 'jerk'];
+/** The axis labels with units (slave unit per master unit, its derivatives), short enough for a pane. */
+const SHORT = ['position', 'vel', 'acc', 'jerk'];
+const POWER = ['', '', '²', '³'];
+
+/** The units of the plot: a coupled slave's and its master's. */
+export interface CamUnits {
+  master: string;
+  slave: string;
+}
+
+/** Where a coupled slave is on the table now (drawn as a marker on the position plot). */
+export interface CamChartMarker {
+  axis: string;
+  x: number;
+  y: number;
+}
+
+/** The label of pane `i`'s y axis (and the master axis as `x`) in these units. */
+export function camAxisLabel(i: number | 'x', units: CamUnits | null): string {
+  if (i === 'x') return units ? `master (${units.master})` : 'master';
+  if (!units) return NAMES[i];
+  return i === 0 ? `${SHORT[0]} (${units.slave})` : `${SHORT[i]} (${units.slave}/${units.master}${POWER[i]})`;
+}
 
 export type DragPhase = 'start' | 'move' | 'end';
 
@@ -28,6 +51,8 @@ export class CamChart {
   private handles: Handle[] = [];
   private warn = new Set<number>();
   private marks: number[] = [];
+  private markers: CamChartMarker[] = [];
+  private units: CamUnits | null = null;
   private range: [number, number] = [0, 1];
   /** While a handle is dragged, the scales stay where they were when it was grabbed. */
   private frozen: { x: [number, number]; y: [number, number] } | null = null;
@@ -61,9 +86,9 @@ export class CamChart {
         },
         axes: [
           last
-            ? { label: 'master', labelSize: 14, size: 30, stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }
+            ? { label: camAxisLabel('x', null), labelSize: 14, size: 30, stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6' } }
             : { stroke: '#4a5563', grid: { stroke: '#e6e9ee' }, ticks: { stroke: '#c9cfd6', size: 4 }, size: 6, values: (_u, splits) => splits.map(() => '') },
-          { label: name, labelSize: 16, stroke: CAM_COLORS[i], grid: { stroke: '#eef0f3' }, ticks: { stroke: '#c9cfd6' }, size: 56, space: i === 0 ? 30 : 18 },
+          { label: camAxisLabel(i, null), labelSize: 16, labelFont: '11px system-ui, sans-serif', stroke: CAM_COLORS[i], grid: { stroke: '#eef0f3' }, ticks: { stroke: '#c9cfd6' }, size: 56, space: i === 0 ? 30 : 18 },
         ],
         series: [{ label: 'master' }, { label: name, stroke: CAM_COLORS[i], width: 1.5 }],
         hooks: {
@@ -114,6 +139,73 @@ export class CamChart {
     this.place();
   }
 
+  /**
+   * The units of the axes: a coupled slave's (position) per its master's (the master axis); null
+   * while no axis is coupled through the table. `data-units` says them for the tests.
+   */
+  setUnits(units: CamUnits | null): void {
+    if (this.units?.master === units?.master && this.units?.slave === units?.slave) return;
+    this.units = units;
+    this.panes.forEach((u, i) => {
+      u.axes[1].label = camAxisLabel(i, units);
+      if (i === this.panes.length - 1) u.axes[0].label = camAxisLabel('x', units);
+      u.redraw(false, true);
+    });
+    this.el.dataset.units = units ? `${units.master}|${units.slave}` : '';
+  }
+
+  /** Where the slaves coupled through the table are on it now (live, MC_CamInfo). */
+  setMarkers(markers: CamChartMarker[]): void {
+    this.markers = markers;
+    this.placeMarkers();
+    // the master position on the other plots: a line, drawn with the marks
+    this.panes.slice(1).forEach((u) => u.redraw(false, false));
+  }
+
+  /** Puts the marker elements (a dot and the slave's name) where the slaves are. */
+  private placeMarkers(): void {
+    const make = () => {
+      const m = document.createElement('div');
+      m.className = 'cam-marker';
+      m.appendChild(document.createElement('span'));
+      return m;
+    };
+    this.placeAll('cam-marker', this.markers, make, (m, p) => {
+      this.putAt(m, p.x, p.y);
+      m.dataset.axis = p.axis;
+      m.title = `${p.axis} now: master ${fmt(p.x)}, slave ${fmt(p.y)} (table coordinates)`;
+      m.firstElementChild!.textContent = p.axis;
+    });
+  }
+
+  /** One element of class `cls` per item in the position pane, made by `make`, set by `set`. */
+  private placeAll<T>(cls: string, items: T[], make: () => HTMLElement, set: (el: HTMLElement, item: T) => void): void {
+    const box = this.handleBox;
+    if (!box) return;
+    const els = [...box.querySelectorAll<HTMLElement>(`.${cls}`)];
+    while (els.length > items.length) els.pop()!.remove();
+    while (els.length < items.length) {
+      const el = make();
+      box.appendChild(el);
+      els.push(el);
+    }
+    items.forEach((item, k) => set(els[k], item));
+  }
+
+  /** An element of the position pane at (master, slave), hidden outside the plot; both values as data attributes. */
+  private putAt(el: HTMLElement, master: number, slave: number): void {
+    const u = this.panes[0];
+    const box = this.handleBox!;
+    const left = u.valToPos(master, 'x');
+    const top = u.valToPos(slave, 'y');
+    const inside = Number.isFinite(left) && Number.isFinite(top) && left >= -0.5 && left <= box.clientWidth + 0.5 && top >= -0.5 && top <= box.clientHeight + 0.5;
+    el.dataset.master = String(master);
+    el.dataset.slave = String(slave);
+    el.style.left = `${left}px`;
+    el.style.top = `${top}px`;
+    el.style.display = inside ? '' : 'none';
+  }
+
   /** The points to drag (and the ones with a warning). */
   setHandles(handles: Handle[], warn: Set<number> = new Set()): void {
     this.handles = handles;
@@ -135,32 +227,16 @@ export class CamChart {
 
   /** Puts the handle elements where their points are. */
   private place(): void {
-    const box = this.handleBox;
-    if (!box) return;
-    const u = this.panes[0];
-    const els = [...box.querySelectorAll<HTMLElement>('.cam-handle')];
-    while (els.length > this.handles.length) els.pop()!.remove();
-    while (els.length < this.handles.length) {
+    const make = () => {
       const h = document.createElement('div');
       h.className = 'cam-handle';
       h.tabIndex = -1;
       this.grab(h);
-      box.appendChild(h);
-      els.push(h);
-    }
-    const w = box.clientWidth;
-    const hgt = box.clientHeight;
-    this.handles.forEach((p, k) => {
-      const h = els[k];
-      const left = u.valToPos(p.master, 'x');
-      const top = u.valToPos(p.slave, 'y');
-      const inside = Number.isFinite(left) && Number.isFinite(top) && left >= -0.5 && left <= w + 0.5 && top >= -0.5 && top <= hgt + 0.5;
+      return h;
+    };
+    this.placeAll('cam-handle', this.handles, make, (h, p) => {
+      this.putAt(h, p.master, p.slave);
       h.dataset.handle = String(p.index);
-      h.dataset.master = String(p.master);
-      h.dataset.slave = String(p.slave);
-      h.style.left = `${left}px`;
-      h.style.top = `${top}px`;
-      h.style.display = inside ? '' : 'none';
       h.title = `point ${p.index + 1}: master ${p.master}, slave ${p.slave} — drag to move it`;
       h.classList.toggle('warn', this.warn.has(p.index));
       h.classList.toggle('dragging', this.dragging === p.index);
@@ -204,9 +280,27 @@ export class CamChart {
   }
 
   private drawMarks(u: uPlot, i: number): void {
-    if (i === 0) this.place();
-    if (!this.marks.length) return;
+    if (i === 0) {
+      this.place();
+      this.placeMarkers();
+    }
     const ctx = u.ctx;
+    if (i > 0 && this.markers.length) {
+      // where the coupled slaves' master is on the table: a line through the other plots
+      ctx.save();
+      ctx.strokeStyle = '#e03131';
+      ctx.lineWidth = uPlot.pxRatio;
+      for (const m of this.markers) {
+        const x = Math.round(u.valToPos(m.x, 'x', true));
+        if (x < u.bbox.left || x > u.bbox.left + u.bbox.width) continue;
+        ctx.beginPath();
+        ctx.moveTo(x, u.bbox.top);
+        ctx.lineTo(x, u.bbox.top + u.bbox.height);
+        ctx.stroke();
+      }
+      ctx.restore();
+    }
+    if (!this.marks.length) return;
     ctx.save();
     ctx.strokeStyle = '#d32f2f';
     ctx.lineWidth = uPlot.pxRatio;

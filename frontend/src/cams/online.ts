@@ -39,16 +39,57 @@ export interface CamSlave {
   queued: boolean;
 }
 
-/** The axes whose coupling runs on table `id` now (their live MC_CamInfo, multi-cam included). */
-export function slavesOf(statuses: Iterable<[string, { status: AxisLiveStatus | null }]>, id: number): CamSlave[] {
-  const out: CamSlave[] = [];
+type Statuses = Iterable<[string, { status: AxisLiveStatus | null }]>;
+type CamPos = Pick<NonNullable<AxisLiveStatus['cam']>, 'actual_master_cam_pos' | 'actual_slave_cam_pos'>;
+
+/**
+ * The axes whose coupling runs on table `id` now (live MC_CamInfo, multi-cam included), sorted
+ * by name, each with its status and where it is on that table (the multi-cam term of it).
+ */
+function coupledThrough(statuses: Statuses, id: number): { axis: string; s: AxisLiveStatus; at: CamPos | null }[] {
+  const out: { axis: string; s: AxisLiveStatus; at: CamPos | null }[] = [];
   for (const [axis, { status: s }] of statuses) {
     const cam = s?.cam;
     if (!s || !cam?.active) continue;
-    if (cam.cam_table_id !== id && !(cam.cams ?? []).some((c) => c.cam_table_id === id)) continue;
-    out.push({ axis, master: s.master ?? '', queued: s.cam_data_queued });
+    const term = (cam.cams ?? []).find((c) => c.cam_table_id === id);
+    if (cam.cam_table_id !== id && !term) continue;
+    out.push({ axis, s, at: term ?? (cam.cam_table_id === id ? cam : null) });
   }
   return out.sort((a, b) => a.axis.localeCompare(b.axis));
+}
+
+/** The axes whose coupling runs on table `id` now (their live MC_CamInfo, multi-cam included). */
+export function slavesOf(statuses: Statuses, id: number): CamSlave[] {
+  return coupledThrough(statuses, id).map(({ axis, s }) => ({ axis, master: s.master ?? '', queued: s.cam_data_queued }));
+}
+
+/** Where a slave coupled through a table is on it now: the table's master and slave position. */
+export interface CamMarker {
+  axis: string;
+  master: string;
+  /** In the table's own coordinates (one cycle, no offsets or scalings): what the plot shows. */
+  x: number;
+  y: number;
+}
+
+/** The live position on table `id` of every axis coupled through it (MC_CamInfo, multi-cam terms too). */
+export function camMarkers(statuses: Statuses, id: number): CamMarker[] {
+  return coupledThrough(statuses, id)
+    .filter(({ at }) => at && Number.isFinite(at.actual_master_cam_pos) && Number.isFinite(at.actual_slave_cam_pos))
+    .map(({ axis, s, at }) => ({ axis, master: s.master ?? '', x: at!.actual_master_cam_pos, y: at!.actual_slave_cam_pos }));
+}
+
+/**
+ * The units of the plot's axes: the master axis's and the slave axis's of the (first) coupled
+ * slave; null while no axis is coupled through the table (a table alone has no units).
+ */
+export function camUnits(markers: CamMarker[], axes: { config: { name: string; unit: string } }[]): { master: string; slave: string } | null {
+  const m = markers[0];
+  if (!m) return null;
+  const unit = (n: string) => axes.find((a) => a.config.name === n)?.config.unit;
+  const master = unit(m.master);
+  const slave = unit(m.axis);
+  return master && slave ? { master, slave } : null;
 }
 
 /** "y (master x)", "y (master x) and z (master x)". */

@@ -29,9 +29,9 @@ import {
 } from '../cams/data';
 import { LiveAnalysis, discontinuityText, errorsByRow, samplesFor, warningsByRow, type Analysis } from '../cams/analysis';
 import { canRedo, canUndo, historyKey, historyOf, record, redo, settle, undo, type History } from '../cams/history';
-import { ONLINE_MODES, ONLINE_MODE_TEXT, SCALING_MODES, onlineChangeText, slavesOf, takesActivationPosition, type CamSlave } from '../cams/online';
+import { ONLINE_MODES, ONLINE_MODE_TEXT, SCALING_MODES, camMarkers, camUnits, onlineChangeText, slavesOf, takesActivationPosition, type CamSlave } from '../cams/online';
 import { href, navigate } from '../router';
-import { statuses } from '../services';
+import { axes, statuses } from '../services';
 import { useStore } from '../store';
 import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, download, errorText, fieldsOf } from './common';
 import { sig } from '../format';
@@ -249,6 +249,21 @@ export function CamPage({ table }: { table: string }) {
       chart.current = null;
     };
   }, [hasChart]);
+  // The slaves coupled through this table: where they are on it now, and the axes' units.
+  const tableId = t?.id ?? null;
+  useEffect(() => {
+    if (tableId === null || !hasChart) return;
+    const show = () => {
+      const c = chart.current;
+      if (!c) return;
+      const m = camMarkers(statuses.get(), tableId);
+      c.setMarkers(m);
+      c.setUnits(camUnits(m, axes.get()));
+    };
+    show();
+    const offs = [statuses.subscribe(show), axes.subscribe(show)];
+    return () => offs.forEach((off) => off());
+  }, [tableId, hasChart]);
   const warnings = result?.discontinuities ?? [];
   useEffect(() => {
     if (!result || !chart.current) return;
