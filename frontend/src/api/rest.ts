@@ -64,7 +64,7 @@ export class NotSentError extends ApiError {
       title: 'Not sent',
       status: 422,
       code: 'not_a_number',
-      detail: `${NOT_A_NUMBER}: ${paths.join(', ')}`,
+      detail: `${NOT_A_NUMBER} in ${paths.join(', ')}`,
       errors: paths.map((field) => ({ field, message: NOT_A_NUMBER })),
     });
   }
