@@ -7,7 +7,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launch, loginCookie, rest, shot, startStack, status, until } from './lib.mjs';
+import { launch, loginCookie, picture, rest, startStack, status, until } from './lib.mjs';
 
 const stack = await startStack({ noDemo: false });
 const CLIENT = 'e2e-system';
@@ -93,7 +93,7 @@ describe('the System page', () => {
       ['y', 'simulated'],
       ['spindle', 'simulated'],
     ]);
-    await shot(page, 'system');
+    await picture(page, 'system');
   });
 
   test('the audit log lists a command sent through the API; the filters narrow the list', async () => {
@@ -153,7 +153,7 @@ describe('the System page', () => {
     assert.equal(await text('[data-testid="diff-summary"]'), '1 changed (1 field), 0 added, 0 removed');
     for (const other of ['y', 'spindle']) assert.equal(await page.locator(`[data-diff-item="${other}"]`).count(), 0, `${other} unchanged`);
     assert.equal((await rest(stack.api, 'GET', '/config')).body.axes.find((a) => a.config.name === 'x').config.dynamics.max_velocity, before, 'nothing imported yet');
-    await shot(page, 'system-import-diff');
+    await picture(page, 'system-import-diff');
     await page.click('button[name="import-confirm"]');
     await page.waitForSelector('[data-testid="import-problem"][data-status="409"]');
     assert.match(await text('[data-testid="import-problem"]'), /All axes must be disabled before an import\. axis 'x' is not disabled/);
@@ -206,7 +206,7 @@ describe('the System page', () => {
         return out;
       });
       assert.deepEqual(wide, []);
-      await shot(p, 'system-phone');
+      await picture(p, 'system-phone');
     } finally {
       await phone.close();
     }
