@@ -240,4 +240,5 @@ def main():
     json.dump(results, open(os.path.join(OUT, "results.json"), "w"), indent=2)
 
 
-main()
+if __name__ == "__main__":
+    main()
