@@ -741,6 +741,8 @@ struct OpenConn {
     busy: std::sync::atomic::AtomicUsize,
     /// Opened, or its last request answered (for the oldest idle one to go first).
     last_active: std::sync::Mutex<std::time::Instant>,
+    /// Chosen to make room (not chosen again while it closes).
+    closing: std::sync::atomic::AtomicBool,
     close: tokio::sync::Notify,
 }
 
@@ -757,6 +759,7 @@ impl OpenConns {
         let c = Arc::new(OpenConn {
             busy: Default::default(),
             last_active: std::sync::Mutex::new(std::time::Instant::now()),
+            closing: Default::default(),
             close: tokio::sync::Notify::new(),
         });
         self.map.lock().unwrap().insert(id, c.clone());
@@ -770,10 +773,14 @@ impl OpenConns {
         let map = self.map.lock().unwrap();
         let oldest = map
             .values()
-            .filter(|c| c.busy.load(std::sync::atomic::Ordering::Relaxed) == 0)
+            .filter(|c| {
+                c.busy.load(std::sync::atomic::Ordering::Relaxed) == 0
+                    && !c.closing.load(std::sync::atomic::Ordering::Relaxed)
+            })
             .min_by_key(|c| *c.last_active.lock().unwrap());
         match oldest {
             Some(c) => {
+                c.closing.store(true, std::sync::atomic::Ordering::Relaxed);
                 // Stored if the connection's task is not waiting yet: it closes when it does.
                 c.close.notify_one();
                 true
@@ -884,7 +891,13 @@ async fn accept_loop(
                     _ = &mut serve => break,
                     // Closed to make room — never while one of its requests is served (it
                     // may have started one since it was chosen).
-                    _ = conn.close.notified() => if conn.busy.load(Relaxed) == 0 { break },
+                    _ = conn.close.notified() => {
+                        if conn.busy.load(Relaxed) == 0 {
+                            break;
+                        }
+                        // It took a request meanwhile: it may be chosen again once idle.
+                        conn.closing.store(false, Relaxed);
+                    }
                 }
             }
             conns.map.lock().unwrap().remove(&conn_id);
