@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use drives::DriveBus;
-use ethercat::bus::{BusOptions, BusStatus, EthercatBus, Link, SdoAccess};
+use ethercat::bus::{BusControl, BusOptions, BusStatus, EthercatBus, Link, SdoAccess};
 use ethercat::emu::Segment;
 use ethercat::emu::drive::{self, Plant};
 use ethercat::emu::sii::Identity;
@@ -48,6 +48,8 @@ pub struct BusHandle {
     pub ethercat: Option<(Arc<BusStatus>, SdoAccess)>,
     /// The emulated segment (fault injection: lost frames).
     pub segment: Option<Arc<Mutex<Segment>>>,
+    /// EtherCAT: reset after a fault, stopping the TX/RX loop (a test's fault).
+    pub control: Option<BusControl>,
 }
 
 impl BusHandle {
@@ -56,6 +58,7 @@ impl BusHandle {
             kind: BusKind::Simulated,
             ethercat: None,
             segment: None,
+            control: None,
         }
     }
 
@@ -149,21 +152,40 @@ pub fn start(
             s.revision,
             s.serial,
             s.drive.map_or(String::new(), |l| format!(
-                ", CiA-402 drive ({} mapping)",
-                l.name
+                ", CiA-402 drive ({} mapping{}{})",
+                l.name,
+                if s.missing_objects.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; it has no {}",
+                        s.missing_objects
+                            .iter()
+                            .map(|i| format!("{i:#06x}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                },
+                s.refused
+                    .iter()
+                    .map(|r| format!("; refused {} at {}: {}", r.mapping, r.at, r.reason))
+                    .collect::<String>()
             ))
         );
     }
     tracing::info!(
-        "EtherCAT on {}: {} SubDevices in OP, DC SYNC0 every {} µs",
+        "EtherCAT on {}: {} SubDevices in OP, DC SYNC0 every {} µs; PDU timeout {} ms; TX/RX thread: {}",
         status.interface,
         status.subdevices.len(),
-        cycle.as_micros()
+        cycle.as_micros(),
+        status.pdu_timeout.as_millis(),
+        status.link.realtime()
     );
     let handle = BusHandle {
         kind,
         ethercat: Some((status, bus.sdo())),
         segment,
+        control: Some(bus.control()),
     };
     Ok((Box::new(bus), handle))
 }
