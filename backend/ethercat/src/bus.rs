@@ -461,7 +461,8 @@ impl BusControl {
                 .filter(|(_, a)| a.load(Relaxed) != 8)
                 .map(|(i, _)| i)
                 .collect();
-            if pending.is_empty() {
+            // In OP, and the bus clear (as many good frames in a row as it takes to fault).
+            if pending.is_empty() && !st.faulted.load(Relaxed) {
                 return Ok(started.elapsed());
             }
             if started.elapsed() > within {
@@ -578,6 +579,10 @@ impl EthercatBus {
             pdu_loop,
             Timeouts {
                 pdu: opts.pdu_timeout,
+                // ethercrab's EEPROM wait (10 ms) is shorter than a frame and its retries: one
+                // late reply during discovery would end the bring-up.
+                eeprom: (opts.pdu_timeout * (opts.retries as u32 + 2))
+                    .max(Timeouts::default().eeprom),
                 ..Timeouts::default()
             },
             MainDeviceConfig {

@@ -85,12 +85,18 @@ pub fn emulated_identity(i: u32) -> Identity {
     }
 }
 
-/// The emulated segment of `drives` CiA-402 servos, on the segment's own clock.
-fn emulated_segment(drives: u32) -> Arc<Mutex<Segment>> {
+/// The emulated segment of `drives` CiA-402 servos, on the segment's own clock (`strict`:
+/// drives without the optional objects that check their mapping at SAFE-OP).
+fn emulated_segment(drives: u32, strict: bool) -> Arc<Mutex<Segment>> {
     let start = Instant::now();
+    let make = if strict {
+        drive::strict_servo
+    } else {
+        drive::servo
+    };
     Segment::new(
         (0..drives)
-            .map(|i| drive::servo(emulated_identity(i), Plant::default()))
+            .map(|i| make(emulated_identity(i), Plant::default()))
             .collect(),
         Box::new(move || start.elapsed().as_nanos() as u64),
     )
@@ -98,12 +104,30 @@ fn emulated_segment(drives: u32) -> Arc<Mutex<Segment>> {
 }
 
 /// `motiond emulate-segment`: the emulated segment on a raw socket until the process ends.
-pub fn serve_emulated_segment(interface: &str, drives: u32) -> Result<(), String> {
+/// `late_reply_ms`: one answer in 100 comes that late (a link slow now and then: motiond
+/// sends the frame again and counts the answer it no longer waits for as late).
+pub fn serve_emulated_segment(
+    interface: &str,
+    drives: u32,
+    strict: bool,
+    late_reply_ms: Option<u32>,
+) -> Result<(), String> {
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let server =
-        ethercat::emu::transport::serve_raw_socket(interface, emulated_segment(drives), stop)
-            .map_err(|e| format!("cannot serve on {interface} (CAP_NET_RAW needed): {e}"))?;
-    println!("emulated EtherCAT segment of {drives} CiA-402 drives on {interface}");
+    let segment = emulated_segment(drives, strict);
+    if let Some(ms) = late_reply_ms {
+        let mut seg = segment.lock().unwrap_or_else(|e| e.into_inner());
+        seg.faults.late_every = 100;
+        seg.faults.reply_delay = Duration::from_millis(u64::from(ms));
+    }
+    let server = ethercat::emu::transport::serve_raw_socket(interface, segment, stop)
+        .map_err(|e| format!("cannot serve on {interface} (CAP_NET_RAW needed): {e}"))?;
+    println!(
+        "emulated EtherCAT segment of {drives} {}CiA-402 drives on {interface}{}",
+        if strict { "strict " } else { "" },
+        late_reply_ms.map_or(String::new(), |ms| format!(
+            ", one answer in 100 {ms} ms late"
+        ))
+    );
     server
         .join()
         .map_err(|_| "the emulated segment stopped".to_string())
@@ -127,7 +151,7 @@ pub fn start(
                 .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
                 .to_string(),
         ),
-        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES)),
+        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES, false)),
     };
     let segment = match &link {
         Link::Emulated(s) => Some(s.clone()),

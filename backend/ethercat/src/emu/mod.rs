@@ -72,6 +72,9 @@ pub struct SegmentFaults {
     pub reply_delay: std::time::Duration,
     /// Answers to send twice from now on.
     pub duplicate_replies: u32,
+    /// Every so many answers, one comes `reply_delay` late (0: never): a link that is slow
+    /// now and then, for as long as the segment runs.
+    pub late_every: u32,
 }
 
 /// The command and PDU index of each datagram of an EtherCAT frame (after the Ethernet and
@@ -101,6 +104,8 @@ pub struct Segment {
     /// Frames answered and lost, for the tests.
     pub frames: u64,
     pub lost: u64,
+    /// Answers sent (for `late_every`).
+    answers: u64,
     /// The PDU index of the silent cycle's process-data frame (its retries are lost too).
     silent_index: Option<u8>,
 }
@@ -149,6 +154,7 @@ impl Segment {
             faults: SegmentFaults::default(),
             frames: 0,
             lost: 0,
+            answers: 0,
             silent_index: None,
         }
     }
@@ -170,6 +176,10 @@ impl Segment {
     /// (the reply faults, one answer each).
     pub fn reply_plan(&mut self) -> (std::time::Duration, usize) {
         let mut plan = (std::time::Duration::ZERO, 1);
+        self.answers += 1;
+        if self.faults.late_every > 0 && self.answers % u64::from(self.faults.late_every) == 0 {
+            plan.0 = self.faults.reply_delay;
+        }
         if self.faults.late_replies > 0 {
             self.faults.late_replies -= 1;
             plan.0 = self.faults.reply_delay;
