@@ -1019,10 +1019,11 @@ async fn openapi_json_is_current() {
         "/api/v1/control",
         "/api/v1/scope/setups",
         "/api/v1/scope/setups/{name}",
+        "/api/v1/bus/reset",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    assert_eq!(paths.len(), 92, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 93, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -1,12 +1,14 @@
 // The System page's bus panel at the DOM level against a fetch double: the EtherCAT view (state,
-// counters, SubDevices, a faulted bus's banner), read again every second; the SDO tool (a read
+// counters, PDU timeout, TX/RX loop, notice, SubDevices with the mapping each drive took and the
+// ones it refused, a faulted bus's banner with its reason), read again every second; Reset bus
+// (disabled while it runs and on the simulated bus, the server's problem shown when it fails); the SDO tool (a read
 // shown as hex/unsigned/signed, an abort with the server's text, a write read back, Write for
 // the engineer role only); the simulated bus as its axes.
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
 import { enter, mountPoint, problem, settle, stubFetch, unmount, type FetchCall } from './dom';
-import { emulated, simulated } from './bus-fixture';
+import { emulated, simulated, strictDrive, sub } from './bus-fixture';
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
@@ -130,6 +132,141 @@ describe('the EtherCAT bus', () => {
     expect($$('[data-bus="simulated"] tr[data-axis]').map((r) => r.dataset.axis)).toEqual(['x']);
     expect($('[data-testid="subdevices"]')).toBeNull();
     expect($('button[name="sdo-open"]')).toBeNull();
+  });
+});
+
+describe('issue 22: the negotiated process image, the frame counters, the TX/RX loop and Reset bus', () => {
+  const stopped = () =>
+    emulated({
+      state: 'faulted',
+      fault_reason: 'the TX/RX loop was stopped (injected fault)',
+      lost_frames: 40,
+      faults: 1,
+      txrx: { running: false, restarts: 0, thread: 'SCHED_FIFO 79, pinned to CPU 0' },
+    });
+
+  it('PDU timeout, the TX/RX loop, the late/duplicate/malformed counters, the notice; a drive that refused the full mapping: a row under it with what it lacks and why', async () => {
+    bus = emulated({
+      late_replies: 12,
+      duplicate_replies: 3,
+      notice: 'CiA-402 drive 2 (motiond emulated servo 3) is used by no axis: give an axis drive.kind cia402 with drive.subdevice 2.',
+      subdevices: [sub(0, 'x', { drive: strictDrive() }), sub(1, 'y')],
+    });
+    await act(async () => render(<BusPanel />, root));
+    await settle();
+    expect(text('[data-testid="bus-pdu-timeout"]')).toBe('PDU timeout 10 ms');
+    expect($('[data-testid="bus-txrx"]')!.dataset.running).toBe('1');
+    expect($('[data-testid="bus-txrx"] [data-led]')!.dataset.led).toBe('running');
+    expect(text('[data-testid="bus-txrx-restarts"] b')).toBe('0');
+    expect(text('[data-testid="bus-txrx-thread"] b')).toBe('SCHED_FIFO 79, pinned to CPU 0');
+    expect($$('[data-testid="bus-counters"] .kpi-label').map((e) => e.textContent)).toEqual([
+      'Frames',
+      'Lost frames',
+      'Late replies',
+      'Duplicate replies',
+      'Malformed frames',
+      'Bus faults',
+      'WKC errors',
+      'WKC last / expected',
+      'Errors in a row / max',
+      'DC cycle offset',
+    ]);
+    expect(text('[data-kpi="late_replies"] .kpi-value')).toBe('12');
+    expect($('[data-kpi="late_replies"]')!.className).toMatch(/kpi-warn/);
+    expect(text('[data-kpi="duplicate_replies"] .kpi-value')).toBe('3');
+    expect(text('[data-kpi="malformed_frames"] .kpi-value')).toBe('0');
+    expect(text('[data-testid="bus-notice"]')).toBe(bus.notice!);
+    // SubDevice 0: the available mapping in its column and, in a row of its own (shown on a phone too), what it lacks and the refusal
+    expect(text('tr[data-subdevice="0"] [data-col="mapping"]')).toBe('available · 13 B out, 17 B in');
+    expect($('tr[data-subdevice="0"] [data-col="mapping"]')!.dataset.mapping).toBe('available');
+    const detail = $('tr[data-mapping-for="0"]')!;
+    expect(detail.querySelector('[data-testid="mapping-taken"]')!.textContent).toBe('Process data available · 13 B out, 17 B in');
+    expect(detail.querySelector('[data-testid="mapping-missing"]')!.textContent).toBe('Missing objects 0x60B8, 0x60B9, 0x60BA, 0x60BB, 0x60FD');
+    const refused = detail.querySelector('[data-testid="mapping-refused"]') as HTMLElement;
+    expect(refused.dataset.alCode).toBe('0x001D');
+    expect(refused.textContent).toBe('Refused full at PRE-OP to SAFE-OP — AL status 0x001D Invalid Output Configuration');
+    // SubDevice 1 took the full mapping: no row under it
+    expect($('tr[data-mapping-for="1"]')).toBeNull();
+    expect($('[data-testid="bus-banner"]')).toBeNull();
+  });
+
+  it('the TX/RX loop stopped: its reason in the banner; Reset bus posts {} to /bus/reset, is disabled while it runs, and shows the bus it answers (OP, 1 restart)', async () => {
+    bus = stopped();
+    let release: () => void = () => {};
+    const stub = globalThis.fetch;
+    asked = [];
+    vi.stubGlobal(
+      'fetch',
+      vi.fn(async (url: string, init?: RequestInit) => {
+        asked.push({ method: init?.method ?? 'GET', url, body: init?.body ? JSON.parse(String(init.body)) : undefined });
+        if (url === '/api/v1/bus/reset') {
+          await new Promise<void>((r) => (release = r));
+          bus = emulated({ lost_frames: 40, faults: 1, txrx: { running: true, restarts: 1, thread: 'SCHED_FIFO 79, pinned to CPU 0' } });
+          return new Response(JSON.stringify(bus), { status: 200, headers: { 'content-type': 'application/json' } });
+        }
+        return stub(url, init);
+      }),
+    );
+    await act(async () => render(<BusPanel />, root));
+    await settle();
+    expect($('[data-testid="bus-state"]')!.dataset.state).toBe('faulted');
+    expect(text('[data-testid="bus-banner"]')).toMatch(/^Bus faulted\. The TX\/RX loop was stopped \(injected fault\)\. No frame goes out: /);
+    expect(text('[data-testid="bus-banner"]')).toMatch(/Reset bus \(or an axis's MC_Reset\) starts the TX\/RX loop again/);
+    expect($('[data-testid="bus-txrx"]')!.dataset.running).toBe('0');
+    expect($('[data-testid="bus-txrx"] [data-led]')!.dataset.led).toBe('stopped');
+    const button = () => $('button[name="bus-reset"]') as HTMLButtonElement;
+    expect(button().disabled).toBe(false);
+    expect(button().textContent).toBe('Reset bus');
+    await click('button[name="bus-reset"]');
+    // running: disabled, says so
+    expect(button().disabled).toBe(true);
+    expect(button().textContent).toBe('Resetting…');
+    expect(button().title).toBe('the bus is being reset');
+    const posts = asked.filter((a) => a.method === 'POST');
+    expect(posts).toEqual([{ method: 'POST', url: '/api/v1/bus/reset', body: {} }]);
+    await act(async () => release());
+    await settle();
+    expect(button().disabled).toBe(false);
+    expect($('[data-testid="bus-state"]')!.dataset.state).toBe('op');
+    expect($('[data-testid="bus-banner"]')).toBeNull();
+    expect(text('[data-testid="bus-txrx-restarts"] b')).toBe('1');
+    expect($('[data-testid="bus-reset-result"]')!.dataset.ok).toBe('1');
+    expect(text('[data-testid="bus-reset-result"] span')).toBe('Bus reset: every SubDevice in OP again. Axes the fault stopped stay in ErrorStop until their reset (MC_Reset).');
+  });
+
+  it("a reset that fails shows the server's problem; the button can be pressed again", async () => {
+    bus = stopped();
+    const detail = 'SubDevice 1 (motiond emulated servo 2) still in SAFE-OP, AL status code 0x001b (Sync Manager Watchdog)';
+    asked = stubFetch((c) => (c.url === '/api/v1/bus' ? [200, bus] : c.url === '/api/v1/bus/reset' ? [503, problem(503, 'bus_reset_failed', 'Service Unavailable', detail)] : [404, null]));
+    await act(async () => render(<BusPanel />, root));
+    await settle();
+    await click('button[name="bus-reset"]');
+    expect($('[data-testid="bus-reset-result"]')!.dataset.ok).toBe('0');
+    expect($('[data-testid="bus-reset-result"]')!.getAttribute('role')).toBe('alert');
+    expect(text('[data-testid="bus-reset-result"] span')).toBe(`Bus reset failed — Service Unavailable: ${detail}`);
+    expect(($('button[name="bus-reset"]') as HTMLButtonElement).disabled).toBe(false);
+    expect($('[data-testid="bus-state"]')!.dataset.state).toBe('faulted');
+    await click('button[name="bus-reset-close"]');
+    expect($('[data-testid="bus-reset-result"]')).toBeNull();
+  });
+
+  it('Reset bus is disabled on the simulated bus (it has no segment) and for an operator', async () => {
+    bus = simulated;
+    await act(async () => render(<BusPanel />, root));
+    await settle();
+    const b = $('button[name="bus-reset"]') as HTMLButtonElement;
+    expect(b.disabled).toBe(true);
+    expect(b.title).toBe('motiond runs the simulated bus: there is no EtherCAT segment to reset');
+    expect($('[data-testid="bus-txrx"]')).toBeNull();
+    unmount(root);
+    root = mountPoint();
+    bus = emulated();
+    auth.set({ kind: 'app', session: { auth_enabled: true, principal: 'user:otto', role: 'operator' } as never });
+    await act(async () => render(<BusPanel />, root));
+    await settle();
+    expect(($('button[name="bus-reset"]') as HTMLButtonElement).disabled).toBe(true);
+    expect($('button[name="bus-reset"]')!.title).toBe('resetting the bus needs the engineer role');
+    expect(asked.some((a) => a.method === 'POST')).toBe(false);
   });
 });
 

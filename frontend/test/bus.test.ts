@@ -1,7 +1,7 @@
 // The bus view model (system/bus.ts): the EtherCAT figures, banners and SubDevice rows from
 // `GET /bus`, the drives the Configuration page offers, and the SDO tool's parsing and display.
 import { describe, expect, it } from 'vitest';
-import { emulated, simulated, sub } from './bus-fixture';
+import { emulated, simulated, strictDrive, sub } from './bus-fixture';
 import {
   busBanner,
   busCounters,
@@ -11,12 +11,17 @@ import {
   driveOptions,
   firstFreeDrive,
   hex,
+  mappingView,
   nsAsUs,
   parseSdoAddress,
   parseSdoValue,
+  refusedView,
+  resetUnavailable,
   sdoPath,
   sdoView,
+  sentence,
   subDeviceRows,
+  txrxView,
 } from '../src/system/bus';
 
 describe('the EtherCAT bus as shown', () => {
@@ -40,11 +45,55 @@ describe('the EtherCAT bus as shown', () => {
       serial: '539361280',
       al: { state: 'op', label: 'OP', tone: 'green' },
       mapping: 'full · 15 B out, 29 B in',
+      process: { mapping: 'full', tone: 'green', bytes: '15 B out, 29 B in', missing: [], refused: [] },
       dc: true,
       axis: 'x',
     });
     expect(rows[1].al).toEqual({ state: 'safe_op', label: 'SAFE-OP', tone: 'amber' });
-    expect(rows[2]).toMatchObject({ address: '0x1002', mapping: null, dc: false, axis: null });
+    expect(rows[2]).toMatchObject({ address: '0x1002', mapping: null, process: null, dc: false, axis: null });
+  });
+
+  it('a drive that refused the full mapping at SAFE-OP: the mapping taken (amber), the objects it lacks in upper-case hex, the AL status code apart from its meaning', () => {
+    expect(mappingView(strictDrive())).toEqual({
+      mapping: 'available',
+      tone: 'amber',
+      bytes: '13 B out, 17 B in',
+      missing: ['0x60B8', '0x60B9', '0x60BA', '0x60BB', '0x60FD'],
+      refused: [{ mapping: 'full', at: 'PRE-OP to SAFE-OP', code: '0x001D', meaning: 'Invalid Output Configuration' }],
+    });
+    // refused by an SDO abort of the mapping write: no AL status code, the SDO error as it is
+    expect(refusedView({ mapping: 'full', at: 'PDO mapping write', al_status_code: null, reason: 'SDO abort 0x06090030: value range exceeded' })).toEqual({
+      mapping: 'full',
+      at: 'PDO mapping write',
+      code: null,
+      meaning: 'SDO abort 0x06090030: value range exceeded',
+    });
+    // a reason that does not start with its code is kept whole
+    expect(refusedView({ mapping: 'available', at: 'PRE-OP to SAFE-OP', al_status_code: '0x001e', reason: 'Invalid Input Configuration' }).meaning).toBe('Invalid Input Configuration');
+    // an older server without the fields: nothing missing, nothing refused
+    expect(mappingView({ mapping: 'minimal', output_bytes: 7, input_bytes: 11 } as never)).toMatchObject({ tone: 'amber', missing: [], refused: [] });
+  });
+
+  it("motiond's TX/RX loop: running or stopped with its LED, restarts, the thread's scheduling; none on the simulated bus", () => {
+    expect(txrxView(emulated())).toEqual({ running: true, label: 'running', tone: 'green', restarts: '0', thread: 'SCHED_FIFO 79, pinned to CPU 0' });
+    expect(txrxView(emulated({ txrx: { running: false, restarts: 1234, thread: 'normal priority (SCHED_FIFO refused: EPERM)' } }))).toEqual({
+      running: false,
+      label: 'stopped',
+      tone: 'red',
+      restarts: '1,234',
+      thread: 'normal priority (SCHED_FIFO refused: EPERM)',
+    });
+    expect(txrxView(simulated)).toBeNull();
+  });
+
+  it('Reset bus: not on the simulated bus, not while a reset runs, not offline, the engineer role', () => {
+    const can = { busy: false, engineer: true, online: true };
+    expect(resetUnavailable(emulated(), can)).toBeNull();
+    expect(resetUnavailable(simulated, can)).toBe('motiond runs the simulated bus: there is no EtherCAT segment to reset');
+    expect(resetUnavailable(null, can)).toBe('the bus is not read yet');
+    expect(resetUnavailable(emulated(), { ...can, busy: true })).toBe('the bus is being reset');
+    expect(resetUnavailable(emulated(), { ...can, online: false })).toBe('motiond is not reachable');
+    expect(resetUnavailable(emulated(), { ...can, engineer: false })).toBe('resetting the bus needs the engineer role');
   });
 
   it('title and state', () => {
@@ -56,11 +105,14 @@ describe('the EtherCAT bus as shown', () => {
     expect(busState('degraded').tone).toBe('amber');
   });
 
-  it('the counters: lost frames, bus faults and WKC errors since start amber when any; red what is wrong now (working counter, errors in a row at the max)', () => {
+  it('the counters: lost, late, duplicate and malformed frames, bus faults and WKC errors since start amber when any; red what is wrong now (working counter, errors in a row at the max)', () => {
     const ok = Object.fromEntries(busCounters(emulated()).map((c) => [c.key, [c.value, c.tone]]));
     expect(ok).toEqual({
       frames: ['120,345', undefined],
       lost_frames: ['0', 'ok'],
+      late_replies: ['0', 'ok'],
+      duplicate_replies: ['0', 'ok'],
+      malformed_frames: ['0', 'ok'],
       faults: ['0', 'ok'],
       working_counter_errors: ['0', 'ok'],
       working_counter: ['9 / 9', 'ok'],
@@ -72,7 +124,15 @@ describe('the EtherCAT bus as shown', () => {
     );
     expect(bad.lost_frames).toEqual(['6', 'warn']);
     expect(bad.faults).toEqual(['1', 'warn']);
-    expect(busCounters(emulated()).map((c) => c.label).slice(1, 4)).toEqual(['Lost frames', 'Bus faults', 'WKC errors']);
+    expect(busCounters(emulated()).map((c) => c.label).slice(1, 7)).toEqual(['Lost frames', 'Late replies', 'Duplicate replies', 'Malformed frames', 'Bus faults', 'WKC errors']);
+    const disturbed = Object.fromEntries(busCounters(emulated({ late_replies: 1200, duplicate_replies: 3, malformed_frames: 1 })).map((c) => [c.key, [c.value, c.tone]]));
+    expect([disturbed.late_replies, disturbed.duplicate_replies, disturbed.malformed_frames]).toEqual([
+      ['1,200', 'warn'],
+      ['3', 'warn'],
+      ['1', 'warn'],
+    ]);
+    // the lost frames' title names the PDU timeout
+    expect(busCounters(emulated()).find((c) => c.key === 'lost_frames')!.title).toMatch(/within the PDU timeout \(10 ms\)/);
     expect(bad.working_counter_errors).toEqual(['2', 'warn']);
     expect(bad.working_counter).toEqual(['6 / 9', 'bad']);
     expect(bad.errors_in_row).toEqual(['1 / 3', 'warn']);
@@ -91,6 +151,21 @@ describe('the EtherCAT bus as shown', () => {
       '3 lost frames or wrong working counters in a row: the enabled EtherCAT axes were stopped (ErrorStop 0x70A0 bus_error) and stay in ErrorStop until they are reset (MC_Reset). ' +
         'The bus clears by itself after 3 good frames in a row.',
     );
+    // the server's reason leads
+    expect(busBanner(emulated({ state: 'faulted', fault_reason: '3 frames lost or with a wrong working counter in a row' }))!.text).toBe(
+      '3 frames lost or with a wrong working counter in a row: the enabled EtherCAT axes were stopped (ErrorStop 0x70A0 bus_error) and stay in ErrorStop until they are reset (MC_Reset). ' +
+        'The bus clears by itself after 3 good frames in a row.',
+    );
+    // the TX/RX loop stopped: it does not clear by itself; Reset bus starts it again
+    const t = busBanner(emulated({ state: 'faulted', fault_reason: 'the TX/RX loop was stopped (injected fault)', txrx: { running: false, restarts: 0, thread: 'SCHED_FIFO 79, pinned to CPU 0' } }))!;
+    expect(t).toEqual({
+      tone: 'error',
+      title: 'Bus faulted',
+      text:
+        'The TX/RX loop was stopped (injected fault). No frame goes out: the enabled EtherCAT axes were stopped (ErrorStop 0x70A0 bus_error) and stay in ErrorStop until they are reset (MC_Reset). ' +
+        "Reset bus (or an axis's MC_Reset) starts the TX/RX loop again and asks the SubDevices back to OP.",
+    });
+    expect(sentence('socket closed: EIO.')).toBe('Socket closed: EIO.');
     const d = busBanner(emulated({ state: 'degraded', subdevices: [sub(0, 'x'), sub(1, 'y', { al_state: 'safe_op' })] }))!;
     expect(d).toEqual({ tone: 'warn', title: 'Bus degraded', text: 'SubDevice 1 (motiond emulated servo 2, axis y) in SAFE-OP not in OP: its axis is stopped when enabled. Powering on or resetting the axis asks its SubDevice back to OP.',
     });

@@ -1,7 +1,9 @@
 // Browser tests of motiond on an emulated EtherCAT segment (`--bus emulated`): the demo axes x,
 // y and spindle have CiA-402 drives on SubDevices 0, 1 and 2. The System page's bus (SubDevices
 // in OP with identity and axis, SDO read/abort/write; lost frames fault the bus, which clears by
-// itself while x stays stopped until reset; a SubDevice in SAFE-OP asked back by a power-on), x moved
+// itself while x stays stopped until reset; a SubDevice in SAFE-OP asked back by a power-on; a
+// stopped TX/RX loop with its reason in the banner, back to OP with Reset bus; late and duplicate
+// replies counted while x moves on; the mapping, PDU timeout and TX/RX thread shown), x moved
 // through the Online tab on its emulated drive, x's Configuration page with its CiA-402 drive
 // (saved unchanged; a taken drive refused at its field), a drive fault's own code; and on the
 // default simulated bus, CiA-402 offered disabled with how to start motiond for it.
@@ -43,6 +45,23 @@ const text = async (page, sel) => ((await page.locator(sel).first().textContent(
 const num = (s) => Number(String(s).replace(/[^0-9.\-]/g, ''));
 const cells = (page, position) =>
   page.locator(`[data-testid="subdevices"] tr[data-subdevice="${position}"]`).evaluate((tr) => Object.fromEntries([...tr.querySelectorAll('[data-col]')].map((td) => [td.dataset.col, td.textContent.trim()])));
+
+/** x enabled at standstill: powered on if it is not. */
+async function xEnabled() {
+  if (!(await status(stack.api, 'x')).power_status) assert.equal((await rest(stack.api, 'POST', '/axes/x/power', {})).status, 202);
+  await until(async () => {
+    const s = await status(stack.api, 'x');
+    return s.power_status && s.state === 'standstill';
+  }, { what: 'x enabled at standstill' });
+}
+
+/** Text cut off inside the bus panel: a figure, label, fact or button narrower than its text. */
+const clippedText = (page) =>
+  page.locator('#bus').evaluate((bus) =>
+    [...bus.querySelectorAll('.kpi-label, .kpi-value, .bus-fact, .btn, .mapping-fact, [data-led]')]
+      .filter((el) => el.getBoundingClientRect().width > 0 && el.scrollWidth > el.clientWidth + 1)
+      .map((el) => `${el.className} "${el.textContent.trim()}" ${el.scrollWidth} > ${el.clientWidth}`),
+  );
 
 /** Opens the SDO tool of a SubDevice (once) and reads or writes an object with it. */
 async function sdo(page, position, { index, sub, value, size }) {
@@ -90,7 +109,28 @@ describe('motiond on an emulated EtherCAT segment', () => {
     // the working counter as expected; the frame count polled
     assert.equal(await text(page, '[data-kpi="working_counter"] .kpi-value'), `${bus.expected_working_counter} / ${bus.expected_working_counter}`);
     // the bus faults since start beside the lost frames and WKC errors
-    assert.deepEqual(await page.locator('[data-testid="bus-counters"] .kpi-label').allTextContents(), ['Frames', 'Lost frames', 'Bus faults', 'WKC errors', 'WKC last / expected', 'Errors in a row / max', 'DC cycle offset']);
+    assert.deepEqual(await page.locator('[data-testid="bus-counters"] .kpi-label').allTextContents(), [
+      'Frames',
+      'Lost frames',
+      'Late replies',
+      'Duplicate replies',
+      'Malformed frames',
+      'Bus faults',
+      'WKC errors',
+      'WKC last / expected',
+      'Errors in a row / max',
+      'DC cycle offset',
+    ]);
+    // the PDU timeout, motiond's TX/RX loop and its thread as the server reports them
+    assert.equal(await text(page, '[data-testid="bus-pdu-timeout"] b'), `${Number((bus.pdu_timeout * 1000).toPrecision(4))} ms`);
+    assert.equal(await page.getAttribute('[data-testid="bus-txrx"]', 'data-running'), '1');
+    assert.equal(await text(page, '[data-testid="bus-txrx"] [data-led]'), 'running');
+    assert.equal(await text(page, '[data-testid="bus-txrx-thread"] b'), bus.txrx.thread);
+    // the emulated drives take the full mapping: nothing missing, nothing refused, no row under them
+    assert.deepEqual(bus.subdevices.map((d) => [d.drive.mapping, d.drive.missing_objects.length, d.drive.refused.length]), [['full', 0, 0], ['full', 0, 0], ['full', 0, 0]]);
+    assert.equal(await page.locator('tr[data-mapping-for]').count(), 0);
+    assert.equal(await page.locator('[data-testid="bus-notice"]').count(), bus.notice ? 1 : 0);
+    assert.equal(await page.isDisabled('button[name="bus-reset"]'), false);
     const frames = num(await text(page, '[data-kpi="frames"] .kpi-value'));
     assert.ok(frames > 0);
     await until(async () => num(await text(page, '[data-kpi="frames"] .kpi-value')) > frames, { what: 'the bus to be read again' });
@@ -140,6 +180,7 @@ describe('motiond on an emulated EtherCAT segment', () => {
     const o = await overflowing(page);
     assert.ok(o.doc <= 0 && o.main <= 0, JSON.stringify(o));
     assert.deepEqual(o.wide, []);
+    assert.deepEqual(await clippedText(page), []);
     await picture(page, 'system-ethercat');
     await page.close();
   });
@@ -157,6 +198,7 @@ describe('motiond on an emulated EtherCAT segment', () => {
       // the SubDevice table needs no sideways scrolling of its own
       const t = await page.locator('#bus .table-fit').first().evaluate((el) => el.scrollWidth - el.clientWidth);
       assert.ok(t <= 0, `the SubDevice table scrolls sideways by ${t} px`);
+      assert.deepEqual(await clippedText(page), []);
       // name, state and axis stay
       assert.deepEqual(Object.entries(await cells(page, 0)).filter(([k]) => ['name', 'al', 'axis'].includes(k)).map(([, v]) => v), ['motiond emulated servo 1', 'OP', 'x']);
       await picture(page, 'system-ethercat-phone');
@@ -264,11 +306,7 @@ describe('motiond on an emulated EtherCAT segment', () => {
 
   test('lost frames fault the bus: x stopped with bus_error; the bus back in OP by itself while x stays in ErrorStop until reset', async () => {
     // x enabled (it is since its Online tab powered it)
-    if (!(await status(stack.api, 'x')).power_status) assert.equal((await rest(stack.api, 'POST', '/axes/x/power', {})).status, 202);
-    await until(async () => {
-      const s = await status(stack.api, 'x');
-      return s.power_status && s.state === 'standstill';
-    }, { what: 'x enabled at standstill' });
+    await xEnabled();
     const page = await open('/system');
     await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
     const b0 = (await rest(stack.api, 'GET', '/bus')).body;
@@ -340,6 +378,100 @@ describe('motiond on an emulated EtherCAT segment', () => {
     await until(async () => !(await status(stack.api, 'y')).power_status, { what: 'y disabled' });
     await page.close();
   });
+
+  test('the TX/RX loop stopped: the bus faulted with its reason in the banner, x stopped; Reset bus brings it back to OP, restarts 1', async () => {
+    await busInOp();
+    // x enabled at standstill (powered since its Online tab, reset after the lost frames)
+    await xEnabled();
+    const page = await open('/system');
+    await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
+    await page.waitForSelector('[data-testid="bus-txrx"][data-running="1"]');
+    const b0 = (await rest(stack.api, 'GET', '/bus')).body;
+    assert.equal(b0.txrx.restarts, 0);
+    assert.equal(await text(page, '[data-testid="bus-txrx-restarts"] b'), '0');
+    const r = await rest(stack.api, 'POST', '/bus/faults', { stop_txrx: true });
+    assert.equal(r.status, 204, JSON.stringify(r.body));
+    // faulted, and the page says why: the server's reason, the loop stopped, what to do
+    await page.waitForSelector('[data-testid="bus-state"][data-state="faulted"]', { timeout: 10000 });
+    await page.waitForSelector('[data-testid="bus-txrx"][data-running="0"]');
+    const b1 = (await rest(stack.api, 'GET', '/bus')).body;
+    assert.equal(b1.state, 'faulted');
+    assert.ok(b1.fault_reason, 'the server gives a reason');
+    const banner = page.locator('[data-testid="bus-banner"]');
+    await until(async () => ((await banner.textContent()) ?? '').includes(b1.fault_reason.slice(1)), { what: "the server's fault reason in the banner" });
+    assert.equal(await banner.getAttribute('data-tone'), 'error');
+    assert.match(await banner.textContent(), /^Bus faulted\. /);
+    assert.match(await banner.textContent(), /Reset bus \(or an axis's MC_Reset\) starts the TX\/RX loop again/);
+    assert.equal(await text(page, '[data-testid="bus-txrx"] [data-led]'), 'stopped');
+    await until(async () => {
+      const s = await status(stack.api, 'x');
+      return s.state === 'error_stop' && s.error_id === 0x70a0;
+    }, { what: 'x in ErrorStop with bus_error' });
+    await page.locator('#bus').evaluate((el) => el.scrollIntoView());
+    await shot(page, 'system-ethercat-txrx-stopped');
+    // Reset bus: disabled while it runs, then the bus it answered: OP, the loop running, 1 restart
+    const t0 = Date.now();
+    await page.click('button[name="bus-reset"]');
+    const result = page.locator('[data-testid="bus-reset-result"]');
+    await result.waitFor({ timeout: 15000 });
+    const took = Date.now() - t0;
+    assert.equal(await result.getAttribute('data-ok'), '1', await result.textContent());
+    assert.match(await result.textContent(), /^Bus reset: every SubDevice in OP again\./);
+    await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
+    await page.waitForSelector('[data-testid="bus-txrx"][data-running="1"]');
+    assert.equal(await text(page, '[data-testid="bus-txrx-restarts"] b'), '1');
+    assert.equal(await page.locator('[data-testid="bus-banner"]').count(), 0);
+    assert.equal(await page.isDisabled('button[name="bus-reset"]'), false);
+    const b2 = (await rest(stack.api, 'GET', '/bus')).body;
+    assert.deepEqual([b2.state, b2.fault_reason, b2.txrx.running, b2.txrx.restarts], ['op', null, true, 1]);
+    console.log(`# reset bus: OP again, answered in ${took} ms (click to result)`);
+    // x stays in ErrorStop until its own reset (MC_Reset), then stands still, enabled
+    assert.equal((await status(stack.api, 'x')).state, 'error_stop');
+    assert.equal((await rest(stack.api, 'POST', '/axes/x/reset', {})).status, 202);
+    await xEnabled();
+    await page.close();
+  });
+
+  test('late and duplicate replies: counted on the page and dropped while x moves on to its target; the bus stays in OP', async () => {
+    await busInOp();
+    const s0 = await status(stack.api, 'x');
+    assert.ok(s0.power_status && s0.state === 'standstill', JSON.stringify([s0.power_status, s0.state]));
+    const page = await open('/system');
+    await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
+    const b0 = (await rest(stack.api, 'GET', '/bus')).body;
+    const target = s0.actual_position > 50 ? 0 : 100;
+    // a move of about 5 s, the burst while it runs
+    const m = await rest(stack.api, 'POST', '/axes/x/move-absolute', { position: target, velocity: 20 });
+    assert.equal(m.status, 202, JSON.stringify(m.body));
+    await until(async () => (await status(stack.api, 'x')).state === 'discrete_motion', { what: 'x moving' });
+    const f = await rest(stack.api, 'POST', '/bus/faults', { late_replies: 20, duplicate_replies: 200 });
+    assert.equal(f.status, 204, JSON.stringify(f.body));
+    const kpi = async (k) => num(await text(page, `[data-kpi="${k}"] .kpi-value`));
+    await until(async () => (await kpi('late_replies')) > b0.late_replies && (await kpi('duplicate_replies')) > b0.duplicate_replies, {
+      what: 'the late and duplicate replies counted on the page',
+    });
+    // x still moving (not stopped by the bus) while they were counted
+    const during = await status(stack.api, 'x');
+    assert.equal(during.state, 'discrete_motion', JSON.stringify([during.state, during.error_id]));
+    assert.match(await page.getAttribute('[data-kpi="late_replies"]', 'class'), /kpi-warn/);
+    assert.match(await page.getAttribute('[data-kpi="duplicate_replies"]', 'class'), /kpi-warn/);
+    await page.locator('#bus').evaluate((el) => el.scrollIntoView());
+    await shot(page, 'system-ethercat-late-replies');
+    // x arrives; the bus never faulted and stays in OP
+    const done = await until(async () => {
+      const s = await status(stack.api, 'x');
+      return (s.state === 'error_stop' || (s.state === 'standstill' && Math.abs(s.actual_position - target) < 0.01)) && s;
+    }, { timeout: 30000, what: `x at ${target}` });
+    assert.equal(done.state, 'standstill', `x: ${JSON.stringify([done.state, done.error_id])}`);
+    const b1 = (await rest(stack.api, 'GET', '/bus')).body;
+    assert.equal(b1.state, 'op');
+    assert.equal(b1.faults, b0.faults, 'the bus did not fault');
+    assert.ok(b1.txrx.running);
+    assert.ok(b1.late_replies > b0.late_replies && b1.duplicate_replies > b0.duplicate_replies, JSON.stringify(b1));
+    await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
+    console.log(`# late ${b1.late_replies - b0.late_replies}, duplicate ${b1.duplicate_replies - b0.duplicate_replies}, lost frames ${b1.lost_frames - b0.lost_frames}, malformed ${b1.malformed_frames - b0.malformed_frames}`);
+    await page.close();
+  });
 });
 
 describe('on the default simulated bus', () => {
@@ -373,5 +505,11 @@ describe('on the default simulated bus', () => {
     await page.waitForSelector('[data-bus="simulated"] tr[data-axis]');
     assert.equal(await text(page, '[data-testid="bus-title"]'), 'Simulated bus: 3 axes');
     assert.equal(await page.locator('[data-testid="subdevices"]').count(), 0);
+    // no segment to reset: Reset bus disabled, and the server agrees
+    assert.equal(await page.isDisabled('button[name="bus-reset"]'), true);
+    assert.equal(await page.getAttribute('button[name="bus-reset"]', 'title'), 'motiond runs the simulated bus: there is no EtherCAT segment to reset');
+    const refusedReset = await rest(sim.api, 'POST', '/bus/reset', {});
+    assert.equal(refusedReset.status, 409, JSON.stringify(refusedReset.body));
+    assert.equal(refusedReset.body.code, 'bus_not_ethercat');
   });
 });

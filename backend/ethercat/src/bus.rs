@@ -24,6 +24,7 @@ use futures_lite::future::block_on;
 use motion::{DriveFeedback, DriveSetpoint};
 
 use crate::emu::{self, Segment};
+use crate::txrx::{self, LinkState, Opener, RawWire, SegmentWire, Wire};
 
 /// SubDevices on one segment (a power of two, as ethercrab wants).
 pub const MAX_SUBDEVICES: usize = 16;
@@ -119,12 +120,20 @@ pub struct BusOptions {
     pub retries: usize,
 }
 
+/// The PDU timeout for a cycle time: four cycles, at least 10 ms (the bring-up's mailbox
+/// traffic on a loaded machine) and at most 30 ms (ethercrab's own default), so that a frame
+/// and its two retries (3 × 30 ms) give up before the usual 100 ms SyncManager watchdog of a
+/// drive trips (decision 120).
+pub fn default_pdu_timeout(cycle: Duration) -> Duration {
+    (cycle * 4).clamp(Duration::from_millis(10), Duration::from_millis(30))
+}
+
 impl BusOptions {
     pub fn new(cycle: Duration) -> BusOptions {
         BusOptions {
             cycle,
             max_errors_in_row: 3,
-            pdu_timeout: (cycle * 4).max(Duration::from_millis(10)),
+            pdu_timeout: default_pdu_timeout(cycle),
             retries: 2,
         }
     }
@@ -199,6 +208,42 @@ impl Layout {
     pub fn minimal() -> Layout {
         Layout::of("minimal", &[0, 1, 4], &[0, 1, 4, 5])
     }
+    /// What the drive has of the full mapping (`missing`: object indices it does not have).
+    fn available(missing: &[u16]) -> Layout {
+        let has = |obj: u32| !missing.contains(&((obj >> 16) as u16));
+        let rx: Vec<usize> = (0..RX_OBJ.len()).filter(|&i| has(RX_OBJ[i])).collect();
+        let tx: Vec<usize> = (0..TX_OBJ.len()).filter(|&i| has(TX_OBJ[i])).collect();
+        Layout::of("available", &rx, &tx)
+    }
+    /// Whether the object (by index) is in this mapping.
+    pub fn maps(&self, index: u16) -> bool {
+        let hit = |offsets: &[Option<usize>], objects: &[u32]| {
+            offsets
+                .iter()
+                .zip(objects)
+                .any(|(o, obj)| o.is_some() && (obj >> 16) as u16 == index)
+        };
+        hit(&self.rx, &RX_OBJ) || hit(&self.tx, &TX_OBJ)
+    }
+    /// The mappings to try, largest first: full; what the drive has of it; minimal.
+    fn candidates(missing: &[u16]) -> Vec<Layout> {
+        let mut v: Vec<Layout> = Vec::new();
+        for l in [
+            Layout::full(),
+            Layout::available(missing),
+            Layout::minimal(),
+        ] {
+            let has_all = l
+                .rx_objects()
+                .iter()
+                .chain(&l.tx_objects())
+                .all(|o| !missing.contains(&((o >> 16) as u16)));
+            if has_all && !v.iter().any(|k| k.rx == l.rx && k.tx == l.tx) {
+                v.push(l);
+            }
+        }
+        v
+    }
     fn rx_objects(&self) -> Vec<u32> {
         in_image_order(&self.rx, &RX_OBJ)
     }
@@ -258,6 +303,28 @@ pub struct SubDeviceInfo {
     /// A CiA-402 drive (0x1000 device type profile 402) with its process data layout.
     pub drive: Option<Layout>,
     pub dc: bool,
+    /// Objects of the full mapping the drive does not have (SDO upload aborted 0x06020000).
+    pub missing_objects: Vec<u16>,
+    /// The mappings the drive refused before the one it took, in order.
+    pub refused: Vec<Refusal>,
+}
+
+/// A mapping a drive refused at bring-up.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal {
+    /// `full`, `available` or `minimal`.
+    pub mapping: &'static str,
+    /// `PDO mapping write` (an SDO abort) or `PRE-OP to SAFE-OP` (the AL status code).
+    pub at: &'static str,
+    pub al_status_code: Option<u16>,
+    /// The AL status code's ETG.1000 meaning, or the SDO error.
+    pub reason: String,
+}
+
+/// An AL status code with its ETG.1000 meaning (`0x001d: Invalid Output Configuration`).
+pub fn al_status_text(code: u16) -> String {
+    let c = ethercrab::AlStatusCode::from(code);
+    c.to_string()
 }
 
 /// What the bus shares with the rest of motiond (the bus page, metrics): written by the
@@ -281,6 +348,9 @@ pub struct BusStatus {
     /// Where in its SYNC0 period the last frame reached the reference clock (ns).
     pub dc_cycle_offset: AtomicU64,
     pub interface: String,
+    /// The TX/RX loop: late, duplicate and malformed replies, whether it runs, why not.
+    pub link: Arc<LinkState>,
+    pub pdu_timeout: Duration,
     pub cycle_ns: u64,
     pub max_errors_in_row: u32,
 }
@@ -352,6 +422,83 @@ impl SdoAccess {
     }
 }
 
+/// The bus from the async side: a reset after a fault, and stopping the TX/RX loop (a test's
+/// fault). Blocking calls: run them off the async runtime's threads.
+#[derive(Clone)]
+pub struct BusControl {
+    md: &'static MainDevice<'static>,
+    group: &'static Group,
+    status: Arc<BusStatus>,
+}
+
+impl BusControl {
+    /// Starts a stopped TX/RX loop again and asks every SubDevice that is not in OP back to
+    /// OP (acknowledging its error), until all are in OP as the cycle reads them; how long it
+    /// took. `Err` says what is still in the way after `within`.
+    pub fn reset(&self, within: Duration) -> Result<Duration, String> {
+        let started = Instant::now();
+        let st = &*self.status;
+        let poll = Duration::from_millis(2).max(Duration::from_nanos(st.cycle_ns));
+        if !st.link.alive() {
+            st.link.request_restart();
+            while !st.link.alive() {
+                if started.elapsed() > within {
+                    return Err(st
+                        .link
+                        .fault()
+                        .unwrap_or_else(|| "the TX/RX loop did not start again".into()));
+                }
+                std::thread::sleep(poll);
+            }
+        }
+        let mut asked = None::<Instant>;
+        loop {
+            // AL state 0: not read since the loop came back.
+            let pending: Vec<usize> = st
+                .al_states
+                .iter()
+                .enumerate()
+                .filter(|(_, a)| a.load(Relaxed) != 8)
+                .map(|(i, _)| i)
+                .collect();
+            // In OP, and the bus clear (as many good frames in a row as it takes to fault).
+            if pending.is_empty() && !st.faulted.load(Relaxed) {
+                return Ok(started.elapsed());
+            }
+            if started.elapsed() > within {
+                let i = pending[0];
+                let code = self
+                    .group
+                    .subdevice(self.md, i)
+                    .ok()
+                    .and_then(|sd| block_on(sd.status()).ok());
+                return Err(format!(
+                    "SubDevice {i} ({}) did not come back to OP{}",
+                    st.subdevices.get(i).map_or("", |s| s.name.as_str()),
+                    code.map_or(String::new(), |(state, code)| format!(
+                        ": it is in {state} with AL status code {code}"
+                    ))
+                ));
+            }
+            let read = pending.iter().all(|&i| st.al_states[i].load(Relaxed) != 0);
+            if read && asked.is_none_or(|t| t.elapsed() > Duration::from_millis(200)) {
+                for &i in &pending {
+                    if let Ok(sd) = self.group.subdevice(self.md, i) {
+                        let _ = block_on(sd.register_write(RegisterAddress::AlControl, 0x18u16));
+                    }
+                }
+                asked = Some(Instant::now());
+            }
+            std::thread::sleep(poll);
+        }
+    }
+
+    /// Stops the TX/RX loop as a failing socket would (fault injection).
+    pub fn kill_loop(&self) {
+        self.status.link.kill();
+    }
+}
+
 pub struct EthercatBus {
     md: &'static MainDevice<'static>,
     group: &'static Group,
@@ -371,6 +518,8 @@ pub struct EthercatBus {
     max_errors_in_row: u32,
     /// Per slot: enable and fault_reset of the last setpoint (their edges ask for OP).
     last_requests: Vec<(bool, bool)>,
+    /// The TX/RX loop was asked to start again: ask OP once frames flow.
+    op_after_restart: bool,
 }
 
 fn leak<T>(t: T) -> &'static T {
@@ -401,27 +550,39 @@ impl EthercatBus {
             Link::Emulated(s) => Some(s.clone()),
             Link::Interface(_) => None,
         };
-        let interface = match link {
+        // motiond's own TX/RX loop (never ethercrab's `tx_rx_task`: a late reply ends that).
+        let (interface, wire, reopen): (String, Box<dyn Wire>, Opener) = match link {
             Link::Interface(iface) => {
-                let task = ethercrab::std::tx_rx_task(&iface, tx, rx)
+                let wire = RawWire::open(&iface)
                     .map_err(|e| format!("cannot open {iface} (CAP_NET_RAW needed): {e}"))?;
-                std::thread::Builder::new()
-                    .name("ecat-txrx".into())
-                    .spawn(move || {
-                        let _ = block_on(task);
-                    })
-                    .map_err(|e| e.to_string())?;
-                iface
+                let again = iface.clone();
+                let reopen: Opener =
+                    Box::new(move || Ok(Box::new(RawWire::open(&again)?) as Box<dyn Wire>));
+                (iface, Box::new(wire), reopen)
             }
             Link::Emulated(segment) => {
-                emu::transport::spawn_in_process(tx, rx, segment).map_err(|e| e.to_string())?;
-                "emulated".to_string()
+                let again = segment.clone();
+                let reopen: Opener =
+                    Box::new(
+                        move || Ok(Box::new(SegmentWire::new(again.clone())) as Box<dyn Wire>),
+                    );
+                (
+                    "emulated".to_string(),
+                    Box::new(SegmentWire::new(segment)),
+                    reopen,
+                )
             }
         };
+        let link =
+            txrx::spawn(tx, rx, wire, reopen, opts.pdu_timeout).map_err(|e| e.to_string())?;
         let md: &'static MainDevice<'static> = leak(MainDevice::new(
             pdu_loop,
             Timeouts {
                 pdu: opts.pdu_timeout,
+                // ethercrab's EEPROM wait (10 ms) is shorter than a frame and its retries: one
+                // late reply during discovery would end the bring-up.
+                eeprom: (opts.pdu_timeout * (opts.retries as u32 + 2))
+                    .max(Timeouts::default().eeprom),
                 ..Timeouts::default()
             },
             MainDeviceConfig {
@@ -454,6 +615,8 @@ impl EthercatBus {
             dc_system_time: AtomicU64::new(0),
             dc_cycle_offset: AtomicU64::new(0),
             interface,
+            link,
+            pdu_timeout: opts.pdu_timeout,
             cycle_ns: opts.cycle.as_nanos() as u64,
             max_errors_in_row: opts.max_errors_in_row.max(1),
         });
@@ -471,11 +634,20 @@ impl EthercatBus {
             good_in_row: 0,
             max_errors_in_row: opts.max_errors_in_row.max(1),
             last_requests: vec![(false, false); slots],
+            op_after_restart: false,
         })
     }
 
     pub fn status(&self) -> Arc<BusStatus> {
         self.status.clone()
+    }
+
+    pub fn control(&self) -> BusControl {
+        BusControl {
+            md: self.md,
+            group: self.group,
+            status: self.status.clone(),
+        }
     }
 
     pub fn sdo(&self) -> SdoAccess {
@@ -498,10 +670,122 @@ impl EthercatBus {
     }
 }
 
+/// Why one bring-up attempt ended: a drive refused SAFE-OP with its mapping (try again with
+/// its next smaller one), or anything else.
+enum Attempt {
+    /// The SubDevice at this position and every mapping it refused so far (the last at
+    /// SAFE-OP).
+    Refused(usize, Vec<Refusal>),
+    Failed(String),
+}
+
+impl From<String> for Attempt {
+    fn from(s: String) -> Attempt {
+        Attempt::Failed(s)
+    }
+}
+
+/// Discovery, PDO mapping negotiated per drive, DC, SAFE-OP, OP: a drive that refuses SAFE-OP
+/// with its mapping (AL status code 0x001D/0x001E, as ETG.1000 allows a drive that took the
+/// mapping writes) gets its next smaller mapping and the segment is brought up again.
 async fn bring_up(
     md: &'static MainDevice<'static>,
     opts: &BusOptions,
 ) -> Result<(Group, Vec<SubDeviceInfo>), String> {
+    let mut refused: Vec<Vec<Refusal>> = vec![Vec::new(); MAX_SUBDEVICES];
+    for _ in 0..4 {
+        match bring_up_once(md, opts, &refused).await {
+            Ok(r) => return Ok(r),
+            Err(Attempt::Refused(position, r)) => refused[position] = r,
+            Err(Attempt::Failed(why)) => return Err(why),
+        }
+    }
+    Err("the drives refused every mapping motiond has".into())
+}
+
+/// Asks every SubDevice for SAFE-OP and waits until all are there, or one refuses with an AL
+/// status code: (position, code). Before ethercrab's own transition, which would only time out.
+async fn safe_op_refusal<S: std::ops::Deref<Target = ethercrab::SubDevice>>(
+    md: &'static MainDevice<'static>,
+    subdevices: &[ethercrab::SubDeviceRef<'_, S>],
+) -> Result<Option<(usize, u16)>, ethercrab::error::Error> {
+    for sd in subdevices {
+        sd.register_write(RegisterAddress::AlControl, 0x04u16)
+            .await?;
+    }
+    let deadline = Instant::now() + Duration::from_secs(5);
+    loop {
+        let mut all = true;
+        for (i, sd) in subdevices.iter().enumerate() {
+            let status: u16 = sd.register_read(RegisterAddress::AlStatus).await?;
+            if status & 0x10 != 0 {
+                let code: u16 = sd.register_read(RegisterAddress::AlStatusCode).await?;
+                return Ok(Some((i, code)));
+            }
+            all &= status & 0x0F == 4;
+        }
+        if all || Instant::now() > deadline {
+            return Ok(None);
+        }
+        let _ = md;
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+/// SAFE-OP asked of every SubDevice: `Ok` when all are there; a drive that refuses it with a
+/// smaller mapping left is `Refused` (acknowledged and back in PRE-OP for the next attempt);
+/// any other refusal names the SubDevice, the transition and the AL status code.
+async fn into_safe_op_checked<S: std::ops::Deref<Target = ethercrab::SubDevice>>(
+    md: &'static MainDevice<'static>,
+    subdevices: Vec<ethercrab::SubDeviceRef<'_, S>>,
+    infos: &[SubDeviceInfo],
+) -> Result<(), Attempt> {
+    let Some((i, code)) = safe_op_refusal(md, &subdevices)
+        .await
+        .map_err(|e| Attempt::Failed(format!("PRE-OP to SAFE-OP: {e}")))?
+    else {
+        return Ok(());
+    };
+    let _ = subdevices[i]
+        .register_write(RegisterAddress::AlControl, 0x12u16)
+        .await;
+    let info = &infos[i];
+    let text = al_status_text(code);
+    if let Some(l) = info.drive {
+        let candidates = Layout::candidates(&info.missing_objects);
+        let at = candidates.iter().position(|c| c.name == l.name);
+        if let Some(next) = at.and_then(|k| candidates.get(k + 1)) {
+            tracing::warn!(
+                "EtherCAT SubDevice {i} ({}) refused PRE-OP to SAFE-OP with its {} mapping: AL status code {text}; trying the {} mapping",
+                info.name,
+                l.name,
+                next.name
+            );
+            let mut refused = info.refused.clone();
+            refused.push(Refusal {
+                mapping: l.name,
+                at: "PRE-OP to SAFE-OP",
+                al_status_code: Some(code),
+                reason: text,
+            });
+            return Err(Attempt::Refused(i, refused));
+        }
+    }
+    Err(Attempt::Failed(format!(
+        "SubDevice {i} ({}): PRE-OP to SAFE-OP refused with AL status code {text}{}",
+        info.name,
+        info.drive.map_or(String::new(), |l| format!(
+            " (with the {} mapping, the smallest motiond has)",
+            l.name
+        ))
+    )))
+}
+
+async fn bring_up_once(
+    md: &'static MainDevice<'static>,
+    opts: &BusOptions,
+    refused: &[Vec<Refusal>],
+) -> Result<(Group, Vec<SubDeviceInfo>), Attempt> {
     let e = |what: &str| {
         let what = what.to_string();
         move |err: ethercrab::error::Error| format!("{what}: {err}")
@@ -523,12 +807,47 @@ async fn bring_up(
             serial: id.serial,
             drive: None,
             dc: sd.dc_support().any(),
+            missing_objects: Vec::new(),
+            refused: Vec::new(),
         };
         let device_type = sd.sdo_read::<u32>(0x1000, 0).await.unwrap_or(0);
         if device_type & 0xFFFF == 402 {
+            // What the drive has of the full mapping (SDO upload; 0x06020000: no such object).
+            let mut missing = Vec::new();
+            for obj in RX_OBJ.iter().chain(&TX_OBJ) {
+                let index = (obj >> 16) as u16;
+                let r = sd.sdo_read::<heapless::Vec<u8, 64>>(index, 0).await;
+                if let Err(ethercrab::error::Error::Mailbox(
+                    ethercrab::error::MailboxError::Aborted { code, .. },
+                )) = r
+                {
+                    if u32::from(code) == 0x0602_0000 && !missing.contains(&index) {
+                        missing.push(index);
+                    }
+                }
+            }
+            missing.sort_unstable();
+            let needed: Vec<String> = Layout::minimal()
+                .rx_objects()
+                .iter()
+                .chain(&Layout::minimal().tx_objects())
+                .map(|o| (o >> 16) as u16)
+                .filter(|i| missing.contains(i))
+                .map(|i| format!("{i:#06x}"))
+                .collect();
+            if !needed.is_empty() {
+                return Err(Attempt::Failed(format!(
+                    "SubDevice {position} ({}): a CiA-402 drive without {} (needed for CSP)",
+                    info.name,
+                    needed.join(", ")
+                )));
+            }
+            info.missing_objects = missing.clone();
+            info.refused = refused.get(position).cloned().unwrap_or_default();
+            let skip = info.refused.len();
             let mut chosen = None;
             let mut last_err = String::new();
-            for layout in [Layout::full(), Layout::minimal()] {
+            for layout in Layout::candidates(&missing).into_iter().skip(skip) {
                 let r = async {
                     sd.sdo_write(0x1C12, 0, 0u8).await?;
                     sd.sdo_write(0x1C13, 0, 0u8).await?;
@@ -544,15 +863,29 @@ async fn bring_up(
                         chosen = Some(layout);
                         break;
                     }
-                    Err(err) => last_err = err.to_string(),
+                    Err(err) => {
+                        last_err = err.to_string();
+                        info.refused.push(Refusal {
+                            mapping: layout.name,
+                            at: "PDO mapping write",
+                            al_status_code: None,
+                            reason: last_err.clone(),
+                        });
+                    }
                 }
             }
             let Some(layout) = chosen else {
-                return Err(format!(
-                    "SubDevice {position} ({}): the drive refused its PDO mapping: {last_err}",
-                    info.name
-                ));
+                return Err(Attempt::Failed(format!(
+                    "SubDevice {position} ({}): the drive refused every PDO mapping: {}",
+                    info.name,
+                    info.refused
+                        .iter()
+                        .map(|r| format!("{} at {}: {}", r.mapping, r.at, r.reason))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                )));
             };
+            let _ = last_err;
             // Optional objects: a drive without them keeps its own settings.
             let (value, index) = interpolation_period(opts.cycle);
             let _ = sd.sdo_write(0x60C2, 1, value).await;
@@ -577,20 +910,21 @@ async fn bring_up(
             let sd = group.subdevice(md, i).map_err(e("SubDevice"))?;
             let io = sd.io_raw();
             if io.outputs().len() != l.out_len || io.inputs().len() != l.in_len {
-                return Err(format!(
+                return Err(Attempt::Failed(format!(
                     "SubDevice {i} ({}): process data of {}/{} bytes, its mapping says {}/{}",
                     info.name,
                     io.outputs().len(),
                     io.inputs().len(),
                     l.out_len,
                     l.in_len
-                ));
+                )));
             }
         }
     }
     let deadline = Instant::now() + Duration::from_secs(10);
     if !infos.iter().any(|i| i.dc) {
         // No DC unit on the segment: free-running process data.
+        into_safe_op_checked(md, group.iter(md).collect(), &infos).await?;
         let group = group.into_safe_op(md).await.map_err(e("SAFE-OP"))?;
         let group = group.request_into_op(md).await.map_err(e("OP request"))?;
         loop {
@@ -599,7 +933,9 @@ async fn bring_up(
                 break;
             }
             if Instant::now() > deadline {
-                return Err("the SubDevices did not reach OP within 10 s".into());
+                return Err(Attempt::Failed(
+                    "the SubDevices did not reach OP within 10 s".into(),
+                ));
             }
             std::thread::sleep(opts.cycle);
         }
@@ -627,6 +963,7 @@ async fn bring_up(
         )
         .await
         .map_err(e("DC SYNC0"))?;
+    into_safe_op_checked(md, group.iter(md).collect(), &infos).await?;
     let group = group.into_safe_op(md).await.map_err(e("SAFE-OP"))?;
     let group = group.request_into_op(md).await.map_err(e("OP request"))?;
     loop {
@@ -635,7 +972,9 @@ async fn bring_up(
             break;
         }
         if Instant::now() > deadline {
-            return Err("the SubDevices did not reach OP within 10 s".into());
+            return Err(Attempt::Failed(
+                "the SubDevices did not reach OP within 10 s".into(),
+            ));
         }
         std::thread::sleep(r.extra.next_cycle_wait.min(opts.cycle));
     }
@@ -691,34 +1030,60 @@ impl DriveBus for EthercatBus {
             }
         }
         let st = &*self.status;
-        st.frames.fetch_add(1, Relaxed);
-        let good = match block_on(self.group.exchange(self.md)) {
-            Ok(r) => {
-                st.last_working_counter.store(r.working_counter, Relaxed);
-                if let Some((time, offset)) = r.dc {
-                    st.dc_system_time.store(time, Relaxed);
-                    st.dc_cycle_offset.store(offset, Relaxed);
-                }
-                for (a, s) in st.al_states.iter().zip(&r.states) {
-                    a.store(
-                        match s {
-                            SubDeviceState::Other(v) => *v,
-                            s => u8::from(*s),
-                        },
-                        Relaxed,
-                    );
-                }
-                let ok = r.working_counter == st.expected_working_counter;
-                if !ok {
-                    st.working_counter_errors.fetch_add(1, Relaxed);
-                }
-                ok
+        let link_up = st.link.alive();
+        if !link_up {
+            // The TX/RX loop stopped: nothing to wait for, the AL states are unknown, the bus
+            // faults at once. An axis's power-on or reset edge starts the loop again.
+            for a in &st.al_states {
+                a.store(0, Relaxed);
             }
-            Err(_) => {
-                st.lost_frames.fetch_add(1, Relaxed);
-                false
+            if want_op {
+                st.link.request_restart();
+                self.op_after_restart = true;
+                want_op = false;
             }
-        };
+            if !self.faulted {
+                self.faulted = true;
+                st.faulted.store(true, Relaxed);
+                st.faults.fetch_add(1, Relaxed);
+            }
+        } else {
+            st.frames.fetch_add(1, Relaxed);
+        }
+        let good = link_up
+            && match block_on(self.group.exchange(self.md)) {
+                Ok(r) => {
+                    st.last_working_counter.store(r.working_counter, Relaxed);
+                    if let Some((time, offset)) = r.dc {
+                        st.dc_system_time.store(time, Relaxed);
+                        st.dc_cycle_offset.store(offset, Relaxed);
+                    }
+                    for (a, s) in st.al_states.iter().zip(&r.states) {
+                        a.store(
+                            match s {
+                                SubDeviceState::Other(v) => *v,
+                                s => u8::from(*s),
+                            },
+                            Relaxed,
+                        );
+                    }
+                    let ok = r.working_counter == st.expected_working_counter;
+                    if !ok {
+                        st.working_counter_errors.fetch_add(1, Relaxed);
+                    }
+                    ok
+                }
+                Err(_) => {
+                    st.lost_frames.fetch_add(1, Relaxed);
+                    false
+                }
+            };
+        // Back after a restart: the SubDevices that left OP meanwhile (SyncManager watchdog)
+        // are asked back.
+        if good && self.op_after_restart {
+            self.op_after_restart = false;
+            want_op |= st.al_states.iter().any(|a| a.load(Relaxed) != 8);
+        }
         // Hysteresis: N bad frames in a row fault the bus, N good ones in a row clear it. The
         // axes that were enabled are latched in ErrorStop by the kernel until MC_Reset; a bus
         // fault with no axis enabled leaves nothing to latch.
@@ -739,7 +1104,7 @@ impl DriveBus for EthercatBus {
             }
         }
         st.errors_in_row.store(self.errors_in_row as u64, Relaxed);
-        if want_op {
+        if want_op && link_up {
             self.request_op();
         }
         for (slot, ((drive, layout), fb)) in self

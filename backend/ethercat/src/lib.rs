@@ -5,5 +5,7 @@
 
 pub mod bus;
 pub mod emu;
+pub mod raw;
+pub mod txrx;
 
 pub use ethercrab;

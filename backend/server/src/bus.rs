@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use drives::DriveBus;
-use ethercat::bus::{BusOptions, BusStatus, EthercatBus, Link, SdoAccess};
+use ethercat::bus::{BusControl, BusOptions, BusStatus, EthercatBus, Link, SdoAccess};
 use ethercat::emu::Segment;
 use ethercat::emu::drive::{self, Plant};
 use ethercat::emu::sii::Identity;
@@ -48,6 +48,8 @@ pub struct BusHandle {
     pub ethercat: Option<(Arc<BusStatus>, SdoAccess)>,
     /// The emulated segment (fault injection: lost frames).
     pub segment: Option<Arc<Mutex<Segment>>>,
+    /// EtherCAT: reset after a fault, stopping the TX/RX loop (a test's fault).
+    pub control: Option<BusControl>,
 }
 
 impl BusHandle {
@@ -56,6 +58,7 @@ impl BusHandle {
             kind: BusKind::Simulated,
             ethercat: None,
             segment: None,
+            control: None,
         }
     }
 
@@ -82,12 +85,18 @@ pub fn emulated_identity(i: u32) -> Identity {
     }
 }
 
-/// The emulated segment of `drives` CiA-402 servos, on the segment's own clock.
-fn emulated_segment(drives: u32) -> Arc<Mutex<Segment>> {
+/// The emulated segment of `drives` CiA-402 servos, on the segment's own clock (`strict`:
+/// drives without the optional objects that check their mapping at SAFE-OP).
+fn emulated_segment(drives: u32, strict: bool) -> Arc<Mutex<Segment>> {
     let start = Instant::now();
+    let make = if strict {
+        drive::strict_servo
+    } else {
+        drive::servo
+    };
     Segment::new(
         (0..drives)
-            .map(|i| drive::servo(emulated_identity(i), Plant::default()))
+            .map(|i| make(emulated_identity(i), Plant::default()))
             .collect(),
         Box::new(move || start.elapsed().as_nanos() as u64),
     )
@@ -95,12 +104,30 @@ fn emulated_segment(drives: u32) -> Arc<Mutex<Segment>> {
 }
 
 /// `motiond emulate-segment`: the emulated segment on a raw socket until the process ends.
-pub fn serve_emulated_segment(interface: &str, drives: u32) -> Result<(), String> {
+/// `late_reply_ms`: one answer in 100 comes that late (a link slow now and then: motiond
+/// sends the frame again and counts the answer it no longer waits for as late).
+pub fn serve_emulated_segment(
+    interface: &str,
+    drives: u32,
+    strict: bool,
+    late_reply_ms: Option<u32>,
+) -> Result<(), String> {
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let server =
-        ethercat::emu::transport::serve_raw_socket(interface, emulated_segment(drives), stop)
-            .map_err(|e| format!("cannot serve on {interface} (CAP_NET_RAW needed): {e}"))?;
-    println!("emulated EtherCAT segment of {drives} CiA-402 drives on {interface}");
+    let segment = emulated_segment(drives, strict);
+    if let Some(ms) = late_reply_ms {
+        let mut seg = segment.lock().unwrap_or_else(|e| e.into_inner());
+        seg.faults.late_every = 100;
+        seg.faults.reply_delay = Duration::from_millis(u64::from(ms));
+    }
+    let server = ethercat::emu::transport::serve_raw_socket(interface, segment, stop)
+        .map_err(|e| format!("cannot serve on {interface} (CAP_NET_RAW needed): {e}"))?;
+    println!(
+        "emulated EtherCAT segment of {drives} {}CiA-402 drives on {interface}{}",
+        if strict { "strict " } else { "" },
+        late_reply_ms.map_or(String::new(), |ms| format!(
+            ", one answer in 100 {ms} ms late"
+        ))
+    );
     server
         .join()
         .map_err(|_| "the emulated segment stopped".to_string())
@@ -124,7 +151,7 @@ pub fn start(
                 .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
                 .to_string(),
         ),
-        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES)),
+        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES, false)),
     };
     let segment = match &link {
         Link::Emulated(s) => Some(s.clone()),
@@ -149,21 +176,40 @@ pub fn start(
             s.revision,
             s.serial,
             s.drive.map_or(String::new(), |l| format!(
-                ", CiA-402 drive ({} mapping)",
-                l.name
+                ", CiA-402 drive ({} mapping{}{})",
+                l.name,
+                if s.missing_objects.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; it has no {}",
+                        s.missing_objects
+                            .iter()
+                            .map(|i| format!("{i:#06x}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                },
+                s.refused
+                    .iter()
+                    .map(|r| format!("; refused {} at {}: {}", r.mapping, r.at, r.reason))
+                    .collect::<String>()
             ))
         );
     }
     tracing::info!(
-        "EtherCAT on {}: {} SubDevices in OP, DC SYNC0 every {} µs",
+        "EtherCAT on {}: {} SubDevices in OP, DC SYNC0 every {} µs; PDU timeout {} ms; TX/RX thread: {}",
         status.interface,
         status.subdevices.len(),
-        cycle.as_micros()
+        cycle.as_micros(),
+        status.pdu_timeout.as_millis(),
+        status.link.realtime()
     );
     let handle = BusHandle {
         kind,
         ethercat: Some((status, bus.sdo())),
         segment,
+        control: Some(bus.control()),
     };
     Ok((Box::new(bus), handle))
 }

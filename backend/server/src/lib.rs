@@ -95,6 +95,15 @@ pub enum Cmd {
         /// Drives on the segment (1–16).
         #[arg(long, default_value_t = bus::EMULATED_DRIVES, value_parser = clap::value_parser!(u32).range(1..=16))]
         drives: u32,
+        /// Drives like many not written by motiond's authors: no touch probe (0x60B8–0x60BB)
+        /// and no digital inputs (0x60FD) in the dictionary; any mapping write is taken and
+        /// the mapping checked only at PRE-OP → SAFE-OP (AL status code 0x001D/0x001E).
+        #[arg(long)]
+        strict_drives: bool,
+        /// One answer in 100 comes this many ms after its frame (a link slow now and then:
+        /// more than the PDU timeout, and motiond counts late replies and drops them).
+        #[arg(long, value_name = "MS", value_parser = clap::value_parser!(u32).range(1..=1000))]
+        late_reply_ms: Option<u32>,
     },
 }
 
@@ -279,8 +288,18 @@ pub fn run() {
         Some(Cmd::Token { action }) => {
             return exit_with(admin_command(&cli.serve, Admin::Token(action)));
         }
-        Some(Cmd::EmulateSegment { on, drives }) => {
-            return exit_with(bus::serve_emulated_segment(&on, drives));
+        Some(Cmd::EmulateSegment {
+            on,
+            drives,
+            strict_drives,
+            late_reply_ms,
+        }) => {
+            return exit_with(bus::serve_emulated_segment(
+                &on,
+                drives,
+                strict_drives,
+                late_reply_ms,
+            ));
         }
         Some(Cmd::Serve) | None => cli.serve,
     };

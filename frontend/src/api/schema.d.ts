@@ -1120,8 +1120,28 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** Lose frames on the emulated EtherCAT segment, or drop a SubDevice to SAFE-OP (--bus emulated only) */
+        /** Disturb the bus: lost, late or duplicate answers or a SubDevice dropped to SAFE-OP (--bus emulated only); stop the TX/RX loop (any EtherCAT bus) */
         post: operations["inject_bus_fault"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/bus/reset": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Bring the EtherCAT segment back to OP after a fault, without restarting motiond
+         * @description Starts a stopped TX/RX loop again and asks every SubDevice that is not in OP back to OP (acknowledging its AL error); answers when all are in OP as the cycle reads them (within 10 s). The axes that the fault stopped stay in ErrorStop until their MC_Reset. Audited. 503 `bus_reset_failed` says what is still in the way (the SubDevice, its AL state and AL status code, or the link's error).
+         */
+        post: operations["reset_bus"];
         delete?: never;
         options?: never;
         head?: never;
@@ -2467,6 +2487,29 @@ export interface components {
              *     SyncManager watchdog), as a drive whose frames came late does: its axis stops.
              */
             safe_op?: number | null;
+            /**
+             * Format: int32
+             * @description The next answers of the segment to come back late, each `reply_delay_ms` after its
+             *     frame: motiond has sent the frame again by then, so one copy answers it and the other
+             *     is counted in `late_replies` and dropped.
+             */
+            late_replies?: number | null;
+            /**
+             * Format: int32
+             * @description The delay of a late answer (ms; default one and a half PDU timeouts).
+             */
+            reply_delay_ms?: number | null;
+            /**
+             * Format: int32
+             * @description The next answers to come back twice (counted in `duplicate_replies` and dropped).
+             */
+            duplicate_replies?: number | null;
+            /**
+             * @description Stops motiond's TX/RX loop as a failing socket would (any EtherCAT bus, not only the
+             *     emulated one): the bus faults with the reason, every axis on it goes to ErrorStop
+             *     (bus_error 0x70A0) until `POST /bus/reset` or MC_Reset.
+             */
+            stop_txrx?: boolean | null;
         };
         /** @enum {string} */
         BusKind: "simulated" | "emulated" | "ethercat";
@@ -2476,15 +2519,20 @@ export interface components {
          *       "cycle_time": 0.001,
          *       "dc_cycle_offset_ns": 12000,
          *       "dc_system_time_ns": 123456789000,
+         *       "duplicate_replies": 0,
          *       "errors_in_row": 0,
          *       "expected_working_counter": 9,
+         *       "fault_reason": null,
          *       "faults": 0,
          *       "frames": 120345,
          *       "interface": "emulated",
          *       "kind": "emulated",
          *       "last_working_counter": 9,
+         *       "late_replies": 0,
          *       "lost_frames": 0,
+         *       "malformed_frames": 0,
          *       "max_errors_in_row": 3,
+         *       "pdu_timeout": 0.01,
          *       "state": "op",
          *       "subdevices": [
          *         {
@@ -2495,7 +2543,9 @@ export interface components {
          *           "drive": {
          *             "input_bytes": 29,
          *             "mapping": "full",
-         *             "output_bytes": 15
+         *             "missing_objects": [],
+         *             "output_bytes": 15,
+         *             "refused": []
          *           },
          *           "name": "motiond emulated servo 1",
          *           "position": 0,
@@ -2505,6 +2555,11 @@ export interface components {
          *           "vendor_id": 16714446
          *         }
          *       ],
+         *       "txrx": {
+         *         "restarts": 0,
+         *         "running": true,
+         *         "thread": "SCHED_FIFO 79, pinned to CPU 0"
+         *       },
          *       "working_counter_errors": 0
          *     }
          */
@@ -2524,10 +2579,42 @@ export interface components {
              *     ErrorStop until MC_Reset).
              */
             state: string;
+            /**
+             * @description Why the bus is `faulted`: the TX/RX loop's failure (the socket's error, or an injected
+             *     stop), or lost frames / wrong working counters in a row. `null` otherwise.
+             */
+            fault_reason?: string | null;
             /** Format: int64 */
             frames: number;
-            /** Format: int64 */
+            /**
+             * Format: int64
+             * @description Cycles whose frame got no answer, retries included (`max_errors_in_row` in a row fault
+             *     the bus).
+             */
             lost_frames: number;
+            /**
+             * Format: int64
+             * @description Replies that came after their frame was answered or given up, a PDU timeout or more
+             *     after it was sent: counted and dropped.
+             */
+            late_replies: number;
+            /**
+             * Format: int64
+             * @description Replies that came twice (the same PDU index, sooner than the timeout): counted and
+             *     dropped.
+             */
+            duplicate_replies: number;
+            /**
+             * Format: int64
+             * @description EtherCAT frames received that did not parse: counted and dropped.
+             */
+            malformed_frames: number;
+            /**
+             * Format: double
+             * @description How long a frame may take to come back before it is sent again (seconds).
+             */
+            pdu_timeout: number;
+            txrx?: null | components["schemas"]["TxRxResource"];
             /** Format: int64 */
             working_counter_errors: number;
             /**
@@ -4246,21 +4333,37 @@ export interface components {
         /**
          * @description A CiA-402 drive's process data as motiond mapped it.
          * @example {
-         *       "input_bytes": 29,
-         *       "mapping": "full",
-         *       "output_bytes": 15
+         *       "input_bytes": 17,
+         *       "mapping": "available",
+         *       "missing_objects": [
+         *         "0x60b8",
+         *         "0x60b9",
+         *         "0x60ba",
+         *         "0x60bb",
+         *         "0x60fd"
+         *       ],
+         *       "output_bytes": 13,
+         *       "refused": []
          *     }
          */
         DriveMapping: {
             /**
-             * @description `full` (targets for CSP/CSV/CST, touch probe, digital inputs) or `minimal` (what a
-             *     drive refusing the full mapping takes: controlword, target, mode; statusword,
-             *     position, mode display, error code).
+             * @description `full` (targets for CSP/CSV/CST, touch probe, digital inputs), `available` (what the
+             *     drive has of the full one: its dictionary lacks `missing_objects`) or `minimal` (what
+             *     a drive refusing the others takes: controlword, target, mode; statusword, position,
+             *     mode display, error code).
              */
             mapping: string;
             /** @description RxPDO (outputs) and TxPDO (inputs) bytes. */
             output_bytes: number;
             input_bytes: number;
+            /**
+             * @description Objects of the full mapping the drive does not have (its SDO upload aborted
+             *     0x06020000): the features that need them are refused on its axis (409).
+             */
+            missing_objects: string[];
+            /** @description The larger mappings the drive refused, in the order tried. */
+            refused: components["schemas"]["RefusedMapping"][];
         };
         /**
          * @description A drive's operation mode (`E_DriveOperationMode`, §6.2; CiA-402 0x6060/0x6061).
@@ -6014,6 +6117,24 @@ export interface components {
          */
         ReferenceMode: "default" | "plc_cam" | "hardware_sync" | "hardware_latch_pos" | "hardware_latch_neg" | "software_sync" | "soft_drive_latch_pos" | "soft_drive_latch_neg";
         /**
+         * @description A mapping a drive refused at bring-up.
+         * @example {
+         *       "al_status_code": "0x001d",
+         *       "at": "PRE-OP to SAFE-OP",
+         *       "mapping": "full",
+         *       "reason": "0x001d: Invalid Output Configuration"
+         *     }
+         */
+        RefusedMapping: {
+            mapping: string;
+            /** @description `PDO mapping write` (an SDO abort) or `PRE-OP to SAFE-OP` (the drive's AL status code). */
+            at: string;
+            /** @description `0xNNNN` (ETG.1000), when refused at SAFE-OP. */
+            al_status_code?: string | null;
+            /** @description The AL status code with its ETG.1000 meaning, or the SDO error. */
+            reason: string;
+        };
+        /**
          * @description What a client must be allowed to do. Ordered: each role may do what the ones before it may.
          * @enum {string}
          */
@@ -6736,7 +6857,9 @@ export interface components {
          *       "drive": {
          *         "input_bytes": 29,
          *         "mapping": "full",
-         *         "output_bytes": 15
+         *         "missing_objects": [],
+         *         "output_bytes": 15,
+         *         "refused": []
          *       },
          *       "name": "motiond emulated servo 2",
          *       "position": 1,
@@ -7190,6 +7313,28 @@ export interface components {
             pre_trigger_s?: number;
         };
         /**
+         * @description motiond's TX/RX loop (its own thread: frames out, replies in).
+         * @example {
+         *       "restarts": 0,
+         *       "running": true,
+         *       "thread": "SCHED_FIFO 79, pinned to CPU 0"
+         *     }
+         */
+        TxRxResource: {
+            /**
+             * @description `false` after the loop stopped (socket error or injected): the bus is `faulted` until
+             *     `POST /bus/reset` or an axis's MC_Reset starts it again.
+             */
+            running: boolean;
+            /**
+             * Format: int64
+             * @description Times it was started again.
+             */
+            restarts: number;
+            /** @description What the thread got: SCHED_FIFO priority and CPU, or why not. */
+            thread: string;
+        };
+        /**
          * @description Physical unit of a parameter, relative to the axis unit `u` (mm, °, …).
          * @enum {string}
          */
@@ -7431,7 +7576,7 @@ export interface components {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
-        /** @description Not a number of frames to lose (1..100000), or no disturbance given. */
+        /** @description A count out of 1..100000 (a delay out of 1..1000 ms), or no disturbance given. */
         BusFaultInvalid: {
             headers: {
                 [name: string]: unknown;
@@ -7468,6 +7613,42 @@ export interface components {
                  *       "status": 409,
                  *       "title": "Conflict",
                  *       "type": "urn:motiond:problem:bus_not_emulated"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description motiond runs the simulated bus. */
+        BusNotEthercat: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "bus_not_ethercat",
+                 *       "detail": "motiond runs the simulated bus: there is no EtherCAT segment to reset",
+                 *       "status": 409,
+                 *       "title": "Conflict",
+                 *       "type": "urn:motiond:problem:bus_not_ethercat"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The segment did not come back to OP: what is in the way. */
+        BusResetFailed: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "bus_reset_failed",
+                 *       "detail": "SubDevice 0 (motiond emulated servo 1) did not come back to OP: it is in SAFE-OP with AL status code 0x001b: Sync manager watchdog",
+                 *       "status": 503,
+                 *       "title": "Service unavailable",
+                 *       "type": "urn:motiond:problem:bus_reset_failed"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -11845,7 +12026,7 @@ export interface operations {
             };
         };
         responses: {
-            /** @description The segment will leave that many cycles unanswered */
+            /** @description The disturbance is under way */
             204: {
                 headers: {
                     [name: string]: unknown;
@@ -11861,6 +12042,32 @@ export interface operations {
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["BusFaultInvalid"];
+        };
+    };
+    reset_bus: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The segment is in OP again; the bus as it is now */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["BusResource"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["BusNotEthercat"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["BusResetFailed"];
         };
     };
     sdo_read: {

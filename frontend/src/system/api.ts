@@ -1,12 +1,15 @@
 // `GET /metrics?buckets=fine`: Prometheus text (not under /api/v1), read with the tab's
-// client id; a refusal is an ApiError as for the JSON API. The drive bus (`GET /bus`) and SDO
+// client id; a refusal is an ApiError as for the JSON API. The drive bus (`GET /bus`, its reset) and SDO
 // access to its SubDevices.
-import { ApiError, get, headers, isProblem, put } from '../api/rest';
+import { ApiError, get, headers, isProblem, post, put } from '../api/rest';
 import type { BusResource, SdoValue, SdoWrite } from '../api/types';
 import { cycleHistograms, type CycleHistograms } from './prometheus';
 import { sdoPath } from './bus';
 
 export const getBus = () => get<BusResource>('/bus');
+
+/** Brings the EtherCAT segment back to OP (the TX/RX loop started again); the answer is the bus as it is then. */
+export const resetBus = () => post<BusResource>('/bus/reset', {});
 
 /** SDO upload of `index:sub` from the SubDevice at `position`. */
 export const sdoRead = (position: number, index: string, sub: number) => get<SdoValue>(sdoPath(position, index, sub));

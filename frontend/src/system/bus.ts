@@ -1,7 +1,9 @@
 // The drive bus of the System page, as `GET /api/v1/bus` describes it: its kind, interface and
-// state, the frame and working-counter figures, DC, and the SubDevices with identity, AL state,
-// process data and the axis whose drive each one is (the EtherCAT device view a commissioning
-// engineer knows from TwinCAT). On the simulated bus there are no SubDevices: the axes with
+// state (with the reason of a fault), the frame counters (lost, late, duplicate, malformed) and
+// working-counter figures, the PDU timeout, motiond's TX/RX loop, DC, and the SubDevices with
+// identity, AL state, the process data mapping each drive took (and the larger ones it refused,
+// with their AL status codes) and the axis whose drive each one is (the EtherCAT device view a
+// commissioning engineer knows from TwinCAT). On the simulated bus there are no SubDevices: the axes with
 // simulated drives are its view (also shown beside an EtherCAT bus when some axes have one).
 // Also the SDO tool's parsing and presentation, and the drives the Configuration page offers.
 import type { AlState, AxisResource, BusResource, PlantModel, SdoValue, SubDeviceResource } from '../api/types';
@@ -67,19 +69,30 @@ export interface BusBanner {
 
 const subdeviceName = (s: SubDeviceResource) => `${s.position} (${s.name}${s.axis ? `, axis ${s.axis}` : ''})`;
 
+const STOPPED_AXES = 'the enabled EtherCAT axes were stopped (ErrorStop 0x70A0 bus_error) and stay in ErrorStop until they are reset (MC_Reset).';
+
 /**
  * The banner a faulted or degraded bus needs, or null when it runs (or is simulated; also when
- * it runs again after faults: the `faults` figure tells that history).
+ * it runs again after faults: the `faults` figure tells that history). A faulted bus says why
+ * (`fault_reason`): a TX/RX loop that stopped needs Reset bus; bad frames in a row clear by
+ * themselves once good frames flow.
  */
 export function busBanner(b: BusResource): BusBanner | null {
   if (b.state === 'faulted') {
+    if (b.txrx && !b.txrx.running) {
+      return {
+        tone: 'error',
+        title: 'Bus faulted',
+        text:
+          `${sentence(b.fault_reason ?? 'the TX/RX loop stopped')} No frame goes out: ${STOPPED_AXES} ` +
+          "Reset bus (or an axis's MC_Reset) starts the TX/RX loop again and asks the SubDevices back to OP.",
+      };
+    }
+    const reason = b.fault_reason ?? `${b.max_errors_in_row} lost frames or wrong working counters in a row`;
     return {
       tone: 'error',
       title: 'Bus faulted',
-      text:
-        `${b.max_errors_in_row} lost frames or wrong working counters in a row: the enabled EtherCAT axes were stopped ` +
-        '(ErrorStop 0x70A0 bus_error) and stay in ErrorStop until they are reset (MC_Reset). ' +
-        `The bus clears by itself after ${b.max_errors_in_row} good frames in a row.`,
+      text: `${reason}: ${STOPPED_AXES} The bus clears by itself after ${b.max_errors_in_row} good frames in a row.`,
     };
   }
   if (b.state === 'degraded') {
@@ -108,6 +121,22 @@ export interface Counter {
 
 const count = (n: number) => n.toLocaleString('en-US');
 
+/** A server's phrase as a sentence: capital first letter, a full stop at the end. */
+export function sentence(t: string): string {
+  const s = t.trim();
+  if (!s) return s;
+  return s[0].toUpperCase() + s.slice(1) + (/[.!?]$/.test(s) ? '' : '.');
+}
+
+/** A figure that should stay zero: amber once any happened since start. */
+const sinceStart = (key: string, label: string, n: number | undefined, title: string): Counter => ({
+  key,
+  label,
+  value: count(n ?? 0),
+  tone: n ? 'warn' : 'ok',
+  title,
+});
+
 /** Nanoseconds as microseconds with one decimal; '—' when not known. */
 export function nsAsUs(ns: number | null | undefined): string {
   if (ns === null || ns === undefined || !Number.isFinite(ns)) return '—';
@@ -120,21 +149,12 @@ export function busCounters(b: BusResource): Counter[] {
   return [
     { key: 'frames', label: 'Frames', value: count(b.frames), title: 'frames exchanged since start (one per cycle)' },
     // Since start: amber once any happened; red is for what is wrong now (the rows below).
-    { key: 'lost_frames', label: 'Lost frames', value: count(b.lost_frames), tone: b.lost_frames ? 'warn' : 'ok', title: 'frames that did not come back in time, since start' },
-    {
-      key: 'faults',
-      label: 'Bus faults',
-      value: count(b.faults),
-      tone: b.faults ? 'warn' : 'ok',
-      title: 'times the bus faulted (lost frames or wrong working counters in a row) since start; each stopped the enabled EtherCAT axes',
-    },
-    {
-      key: 'working_counter_errors',
-      label: 'WKC errors',
-      value: count(b.working_counter_errors),
-      tone: b.working_counter_errors ? 'warn' : 'ok',
-      title: 'frames that came back with a wrong working counter, since start',
-    },
+    sinceStart('lost_frames', 'Lost frames', b.lost_frames, `frames that got no answer within the PDU timeout (${ms(b.pdu_timeout)}), retries included, since start`),
+    sinceStart('late_replies', 'Late replies', b.late_replies, 'answers that came after their frame was answered or given up (a PDU timeout or more after it was sent): counted and dropped, since start'),
+    sinceStart('duplicate_replies', 'Duplicate replies', b.duplicate_replies, 'answers that came twice (the same PDU index): counted and dropped, since start'),
+    sinceStart('malformed_frames', 'Malformed frames', b.malformed_frames, 'EtherCAT frames received that did not parse: counted and dropped, since start'),
+    sinceStart('faults', 'Bus faults', b.faults, 'times the bus faulted (lost frames or wrong working counters in a row, or the TX/RX loop stopped) since start; each stopped the enabled EtherCAT axes'),
+    sinceStart('working_counter_errors', 'WKC errors', b.working_counter_errors, 'frames that came back with a wrong working counter, since start'),
     {
       key: 'working_counter',
       label: 'WKC last / expected',
@@ -158,6 +178,77 @@ export function busCounters(b: BusResource): Counter[] {
   ];
 }
 
+export interface TxRxView {
+  running: boolean;
+  label: string;
+  tone: Tone;
+  restarts: string;
+  /** What the thread got: SCHED_FIFO priority and CPU, or why not. */
+  thread: string;
+}
+
+/** motiond's TX/RX loop as shown, or null when the server does not say (simulated bus). */
+export function txrxView(b: Pick<BusResource, 'txrx'>): TxRxView | null {
+  const t = b.txrx;
+  if (!t) return null;
+  return { running: t.running, label: t.running ? 'running' : 'stopped', tone: t.running ? 'green' : 'red', restarts: count(t.restarts), thread: t.thread };
+}
+
+/** `0x60b8` as TwinCAT writes an index: `0x60B8`. */
+export const objectIndex = (s: string): string => (/^0x[0-9a-f]+$/i.test(s) ? '0x' + s.slice(2).toUpperCase() : s);
+
+export interface RefusedView {
+  mapping: string;
+  /** `PDO mapping write` or `PRE-OP to SAFE-OP`. */
+  at: string;
+  /** `0x001D`, or null when refused by an SDO abort. */
+  code: string | null;
+  /** The AL status code's ETG.1000 meaning (the reason without its code), or the SDO error. */
+  meaning: string;
+}
+
+/** A refused mapping: its AL status code upper-case and its meaning apart (the server writes `0x001d: Invalid …`). */
+export function refusedView(r: { mapping: string; at: string; al_status_code?: string | null; reason: string }): RefusedView {
+  const code = r.al_status_code ? objectIndex(r.al_status_code) : null;
+  let meaning = r.reason.trim();
+  const c = r.al_status_code?.toLowerCase();
+  if (c && meaning.toLowerCase().startsWith(c)) meaning = meaning.slice(c.length).replace(/^\s*:\s*/, '');
+  return { mapping: r.mapping, at: r.at, code, meaning };
+}
+
+/** A drive's process data: the mapping it took, its sizes, the objects it lacks, the mappings it refused. */
+export interface MappingView {
+  mapping: string;
+  tone: Tone;
+  /** `15 B out, 29 B in`. */
+  bytes: string;
+  missing: string[];
+  refused: RefusedView[];
+}
+
+export function mappingView(d: NonNullable<SubDeviceResource['drive']>): MappingView {
+  return {
+    mapping: d.mapping,
+    tone: d.mapping === 'full' ? 'green' : 'amber',
+    bytes: `${d.output_bytes} B out, ${d.input_bytes} B in`,
+    missing: (d.missing_objects ?? []).map(objectIndex),
+    refused: (d.refused ?? []).map(refusedView),
+  };
+}
+
+/**
+ * Why Reset bus cannot be pressed now, or null: the simulated bus has no segment; a reset runs;
+ * it needs the engineer role and the server.
+ */
+export function resetUnavailable(b: Pick<BusResource, 'kind'> | null, o: { busy: boolean; engineer: boolean; online: boolean }): string | null {
+  if (!b) return 'the bus is not read yet';
+  if (!isEthercat(b)) return 'motiond runs the simulated bus: there is no EtherCAT segment to reset';
+  if (o.busy) return 'the bus is being reset';
+  if (!o.online) return 'motiond is not reachable';
+  if (!o.engineer) return 'resetting the bus needs the engineer role';
+  return null;
+}
+
 export interface SubDeviceRow {
   position: number;
   address: string;
@@ -169,6 +260,8 @@ export interface SubDeviceRow {
   al: { state: string; label: string; tone: Tone };
   /** The CiA-402 process data as mapped, or null when the SubDevice is no drive. */
   mapping: string | null;
+  /** The same in detail, or null when the SubDevice is no drive. */
+  process: MappingView | null;
   dc: boolean;
   axis: string | null;
 }
@@ -187,6 +280,7 @@ export function subDeviceRows(b: BusResource): SubDeviceRow[] {
       serial: String(s.serial >>> 0),
       al: { state: s.al_state, ...alState(s.al_state) },
       mapping: s.drive ? `${s.drive.mapping} · ${s.drive.output_bytes} B out, ${s.drive.input_bytes} B in` : null,
+      process: s.drive ? mappingView(s.drive) : null,
       dc: s.dc,
       axis: s.axis ?? null,
     }));

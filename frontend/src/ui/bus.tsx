@@ -1,8 +1,11 @@
 // The System page's drive bus (`GET /api/v1/bus`, every second while the page is shown): an
-// EtherCAT bus as TwinCAT's device view shows it — kind, interface and state with a banner when
-// faulted or degraded, the frame, working-counter and bus-fault figures, DC, the SubDevices with identity,
-// AL state, process data and their axis — and an SDO tool per SubDevice (read anyone, write
-// the engineer role). The simulated bus is the axes with simulated drives.
+// EtherCAT bus as TwinCAT's device view shows it — kind, interface, state with a banner when
+// faulted (saying why) or degraded, the PDU timeout, motiond's TX/RX loop (running, restarts, its
+// thread's priority), the frame counters (lost, late, duplicate, malformed), working-counter and
+// bus-fault figures, DC, the server's notice, the SubDevices with identity, AL state, the process
+// data mapping each drive took (the objects it lacks, the mappings it refused with their AL status
+// codes) and their axis — an SDO tool per SubDevice (read anyone, write the engineer role) and
+// Reset bus (`POST /bus/reset`, the engineer role). The simulated bus is the axes with simulated drives.
 import { Fragment } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
 import { ApiError } from '../api/rest';
@@ -12,7 +15,7 @@ import { axes, statuses } from '../services';
 import { auth, may } from '../auth/session';
 import { href } from '../router';
 import { Field, Kpi, Lamp, Led, Panel, errorText, fieldsOf, useOnline } from './common';
-import { getBus, sdoRead, sdoWrite } from '../system/api';
+import { getBus, resetBus, sdoRead, sdoWrite } from '../system/api';
 import {
   BUS_POLL_MS,
   busBanner,
@@ -25,9 +28,12 @@ import {
   parseSdoAddress,
   parseSdoValue,
   plantText,
+  resetUnavailable,
   sdoView,
   simulatedAxes,
   subDeviceRows,
+  txrxView,
+  type MappingView,
   type SdoView,
 } from '../system/bus';
 
@@ -35,7 +41,7 @@ import {
  * The bus resource: read at once, then every `pollMs` while the document is visible (no request
  * while hidden; read again as soon as it is shown), or once when `pollMs` is null.
  */
-export function useBus(pollMs: number | null): { bus: BusResource | null; error: string | null } {
+export function useBus(pollMs: number | null): { bus: BusResource | null; error: string | null; setBus: (b: BusResource) => void } {
   const [bus, setBus] = useState<BusResource | null>(null);
   const [error, setError] = useState<string | null>(null);
   useEffect(() => {
@@ -72,28 +78,68 @@ export function useBus(pollMs: number | null): { bus: BusResource | null; error:
       document.removeEventListener('visibilitychange', shown);
     };
   }, [pollMs]);
-  return { bus, error };
+  return { bus, error, setBus };
 }
 
 export function BusPanel() {
-  const { bus, error } = useBus(BUS_POLL_MS);
+  const { bus, error, setBus } = useBus(BUS_POLL_MS);
   const sims = simulatedAxes(useStore(axes));
   const onSimBus = bus?.kind === 'simulated';
+  const engineer = may(useStore(auth), 'engineer');
+  const online = useOnline();
+  const [resetting, setResetting] = useState(false);
+  /** The latest reset's outcome (a test waits for the next one). */
+  const [reset, setReset] = useState<{ n: number; ok: boolean; text: string } | null>(null);
+  const why = resetUnavailable(bus, { busy: resetting, engineer, online });
+  const doReset = async () => {
+    setResetting(true);
+    const n = (reset?.n ?? 0) + 1;
+    try {
+      const b = await resetBus();
+      setBus(b);
+      setReset({ n, ok: true, text: `Bus reset: ${b.state === 'op' ? 'every SubDevice in OP again' : `the bus is ${busState(b.state).label}`}. Axes the fault stopped stay in ErrorStop until their reset (MC_Reset).` });
+    } catch (e) {
+      setReset({ n, ok: false, text: `Bus reset failed — ${errorText(e)}` });
+    } finally {
+      setResetting(false);
+    }
+  };
   return (
     <Panel
       title="Bus"
       class="sys-bus"
       id="bus"
       actions={
-        <span class={`live-ind ${error ? 'live-stale' : bus ? 'live-live' : ''}`} title={`GET /bus every ${BUS_POLL_MS / 1000} s`}>
-          <span class="live-dot" />
-          {error ? 'not updated' : `every ${BUS_POLL_MS / 1000} s`}
-        </span>
+        <>
+          <span class={`live-ind ${error ? 'live-stale' : bus ? 'live-live' : ''}`} title={`GET /bus every ${BUS_POLL_MS / 1000} s`}>
+            <span class="live-dot" />
+            {error ? 'not updated' : `every ${BUS_POLL_MS / 1000} s`}
+          </span>
+          <button
+            type="button"
+            class={`btn btn-small btn-warn ${resetting ? 'busy' : ''}`}
+            name="bus-reset"
+            disabled={why !== null}
+            aria-busy={resetting}
+            title={why ?? 'start the TX/RX loop again and ask every SubDevice back to OP (POST /bus/reset)'}
+            onClick={() => void doReset()}
+          >
+            {resetting ? 'Resetting…' : 'Reset bus'}
+          </button>
+        </>
       }
     >
       {error && (
         <div class="banner banner-error" role="alert" data-testid="bus-error">
           <span>{error}</span>
+        </div>
+      )}
+      {reset && (
+        <div class={`banner ${reset.ok ? 'banner-ok' : 'banner-error'} bus-banner`} role={reset.ok ? 'status' : 'alert'} data-testid="bus-reset-result" data-ok={reset.ok ? '1' : '0'} data-n={reset.n}>
+          <span>{reset.text}</span>
+          <button type="button" class="banner-close" name="bus-reset-close" aria-label="close" onClick={() => setReset(null)}>
+            ×
+          </button>
         </div>
       )}
       {!bus && !error && <p class="muted">Loading…</p>}
@@ -108,6 +154,7 @@ function EthercatBus({ bus, stale }: { bus: BusResource; stale: boolean }) {
   const state = busState(bus.state);
   const banner = busBanner(bus);
   const rows = subDeviceRows(bus);
+  const txrx = txrxView(bus);
   const open = rows.find((r) => r.position === sdo) ?? null;
   return (
     <div class={`bus bus-ethercat ${stale ? 'stale' : ''}`} data-bus={bus.kind} data-state={bus.state}>
@@ -122,15 +169,36 @@ function EthercatBus({ bus, stale }: { bus: BusResource; stale: boolean }) {
         <span class="bus-fact">
           <span class="muted">Cycle (SYNC0)</span> <b class="mono">{ms(bus.cycle_time)}</b>
         </span>
+        <span class="bus-fact" data-testid="bus-pdu-timeout" title="how long a frame may take to come back before it is sent again (twice), then counted as lost">
+          <span class="muted">PDU timeout</span> <b class="mono">{ms(bus.pdu_timeout)}</b>
+        </span>
         <span class="bus-fact">
           <span class="muted">SubDevices</span> <b class="mono">{bus.subdevices.length}</b>
         </span>
       </div>
+      {txrx && (
+        <div class="bus-head bus-txrx" data-testid="bus-txrx" data-running={txrx.running ? '1' : '0'} title="motiond's TX/RX loop: its own thread sends the frames and takes the replies">
+          <span class="bus-fact">
+            <span class="muted">TX/RX loop</span> <Led on label={txrx.label} tone={txrx.tone} />
+          </span>
+          <span class="bus-fact" data-testid="bus-txrx-restarts" title="times the loop was started again (Reset bus or MC_Reset after it stopped)">
+            <span class="muted">Restarts</span> <b class="mono">{txrx.restarts}</b>
+          </span>
+          <span class="bus-fact bus-thread" data-testid="bus-txrx-thread" title="the thread's scheduling: SCHED_FIFO priority and CPU, or why not">
+            <span class="muted">Thread</span> <b class="mono">{txrx.thread}</b>
+          </span>
+        </div>
+      )}
       {banner && (
         <div class={`banner banner-${banner.tone} bus-banner`} role="alert" data-testid="bus-banner" data-tone={banner.tone}>
           <span>
             <b>{banner.title}.</b> {banner.text}
           </span>
+        </div>
+      )}
+      {bus.notice && (
+        <div class="banner banner-info bus-banner" data-testid="bus-notice">
+          <span>{bus.notice}</span>
         </div>
       )}
       <div class="sys-kpis bus-kpis" data-testid="bus-counters">
@@ -170,7 +238,9 @@ function EthercatBus({ bus, stale }: { bus: BusResource; stale: boolean }) {
                   <td class="nowrap" data-col="al">
                     <Led on label={r.al.label} tone={r.al.tone} title={`AL state ${r.al.label}`} />
                   </td>
-                  <td class="hide-phone small" data-col="mapping">{r.mapping ?? <span class="muted">no drive</span>}</td>
+                  <td class="hide-phone small" data-col="mapping" data-mapping={r.process?.mapping}>
+                    {r.process ? <MappingCell m={r.process} /> : <span class="muted">no drive</span>}
+                  </td>
                   <td class="hide-phone" data-col="dc">{r.dc ? 'SYNC0' : <span class="muted">—</span>}</td>
                   <td data-col="axis">
                     {r.axis ? (
@@ -194,6 +264,13 @@ function EthercatBus({ bus, stale }: { bus: BusResource; stale: boolean }) {
                     </button>
                   </td>
                 </tr>
+                {r.process && (r.process.missing.length > 0 || r.process.refused.length > 0) && (
+                  <tr class="mapping-row" data-mapping-for={r.position}>
+                    <td colSpan={12}>
+                      <MappingDetail m={r.process} />
+                    </td>
+                  </tr>
+                )}
                 {open && open.position === r.position && (
                   <tr class="sdo-row" data-sdo-for={r.position}>
                     <td colSpan={12}>
@@ -213,6 +290,48 @@ function EthercatBus({ bus, stale }: { bus: BusResource; stale: boolean }) {
           </tbody>
         </table>
       </div>
+    </div>
+  );
+}
+
+/** The mapping a drive took, with its sizes: `full · 15 B out, 29 B in` (amber when smaller than full). */
+function MappingCell({ m }: { m: MappingView }) {
+  return (
+    <span class={`mapping-taken mapping-${m.tone}`} title={m.mapping === 'full' ? 'the full mapping (CSP/CSV/CST targets, touch probe, digital inputs)' : 'a smaller mapping than the full one: see below the row'}>
+      <b>{m.mapping}</b> · {m.bytes}
+    </span>
+  );
+}
+
+/**
+ * Under a SubDevice whose drive took less than the full mapping: the mapping taken (also on a
+ * phone, where the column is hidden), the objects its dictionary lacks, and each refused mapping
+ * with where it was refused and the AL status code with its ETG.1000 meaning.
+ */
+function MappingDetail({ m }: { m: MappingView }) {
+  return (
+    <div class="mapping-detail">
+      <span class="mapping-fact" data-testid="mapping-taken">
+        <span class="muted">Process data</span> <MappingCell m={m} />
+      </span>
+      {m.missing.length > 0 && (
+        <span class="mapping-fact" data-testid="mapping-missing" title="objects of the full mapping this drive does not have (SDO abort 0x06020000): features needing them are refused on its axis (409)">
+          <span class="muted">Missing objects</span> <span class="mono">{m.missing.join(', ')}</span>
+        </span>
+      )}
+      {m.refused.map((r, i) => (
+        <span key={i} class="mapping-fact mapping-refused" data-testid="mapping-refused" data-mapping={r.mapping} data-al-code={r.code ?? ''}>
+          <span class="muted">Refused</span> <b>{r.mapping}</b> <span class="muted">at</span> {r.at}
+          {r.code ? (
+            <>
+              {' '}
+              <span class="muted">— AL status</span> <b class="mono">{r.code}</b> {r.meaning}
+            </>
+          ) : (
+            <> — {r.meaning}</>
+          )}
+        </span>
+      ))}
     </div>
   );
 }

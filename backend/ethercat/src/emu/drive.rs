@@ -72,7 +72,18 @@ pub struct Cia402Emu {
     probe_input: bool,
     last_probe_input: bool,
     pending_fault: Option<u16>,
+    /// A drive like many not written by motiond's authors: without the optional objects
+    /// ([`OPTIONAL_OBJECTS`]); it takes any mapping write and checks the mapping only at
+    /// PRE-OP → SAFE-OP (AL status code 0x001D/0x001E for an object it does not have).
+    pub strict: bool,
+    /// Entries one PDO may map, checked at PRE-OP → SAFE-OP (a drive with fewer mappable
+    /// entries than motiond's full mapping that says so only then).
+    pub max_entries_at_safe_op: Option<u8>,
 }
+
+/// What a [`Cia402Emu::strict`] drive lacks: touch probe function, status and edges,
+/// digital inputs.
+pub const OPTIONAL_OBJECTS: [u16; 5] = [0x60B8, 0x60B9, 0x60BA, 0x60BB, 0x60FD];
 
 const MAPPABLE_RX: &[(u16, usize)] = &[
     (0x6040, 2),
@@ -190,7 +201,43 @@ impl Cia402Emu {
             probe_input: false,
             last_probe_input: false,
             pending_fault: None,
+            strict: false,
+            max_entries_at_safe_op: None,
         }
+    }
+
+    /// The drive without [`OPTIONAL_OBJECTS`], checking its mapping at SAFE-OP only.
+    pub fn strict(id: &Identity, plant: Plant) -> Cia402Emu {
+        let mut d = Cia402Emu::new(id, plant);
+        for index in OPTIONAL_OBJECTS {
+            d.od.entries.remove(&(index, 0));
+        }
+        d.strict = true;
+        d
+    }
+
+    /// The mapped entries of the assigned PDOs that are not mappable objects of this drive:
+    /// 0x001D (outputs) or 0x001E (inputs), as a drive that checks at SAFE-OP answers.
+    fn check_mapping(&self) -> Result<(), u16> {
+        for (assign, rx, code) in [(0x1C12u16, true, 0x001Du16), (0x1C13, false, 0x001E)] {
+            for i in 1..=self.od.u8(assign, 0) {
+                let pdo = self.od.u16(assign, i);
+                if self
+                    .max_entries_at_safe_op
+                    .is_some_and(|n| self.od.u8(pdo, 0) > n)
+                {
+                    return Err(code);
+                }
+                for k in 1..=self.od.u8(pdo, 0) {
+                    let e = self.od.u32(pdo, k);
+                    let index = (e >> 16) as u16;
+                    if !mappable(index, e as u8, rx) || self.od.get(index, 0).is_none() {
+                        return Err(code);
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// A drive fault (overcurrent, encoder, …) with its 0x603F error code.
@@ -411,6 +458,8 @@ impl Cia402Emu {
 
 struct Rules {
     al_state: u8,
+    /// Mapping entries are taken as written (checked at SAFE-OP).
+    lax: bool,
 }
 
 fn mappable(index: u16, bits: u8, rx: bool) -> bool {
@@ -445,7 +494,7 @@ impl WriteRules for Rules {
             let mut bytes = 0;
             for k in 1..=v as u8 {
                 let e = od.u32(index, k);
-                if !mappable((e >> 16) as u16, e as u8, rx) {
+                if !self.lax && !mappable((e >> 16) as u16, e as u8, rx) {
                     return Err(abort::NOT_MAPPABLE);
                 }
                 bytes += (e & 0xFF) / 8;
@@ -484,12 +533,21 @@ impl Application for Cia402Emu {
     fn mailbox(&mut self, request: &[u8]) -> Option<Vec<u8>> {
         let rules = Rules {
             al_state: self.al_state,
+            lax: self.strict,
         };
         coe::serve(&mut self.od, &rules, request, MBOX_LEN as usize)
     }
 
     fn mailbox_layout(&self) -> ((u16, u16), (u16, u16)) {
         ((MBOX_OUT_START, MBOX_LEN), (MBOX_IN_START, MBOX_LEN))
+    }
+
+    fn check_safe_op(&self) -> Result<(), u16> {
+        if self.strict || self.max_entries_at_safe_op.is_some() {
+            self.check_mapping()
+        } else {
+            Ok(())
+        }
     }
 
     fn process_data_sizes(&self) -> (usize, usize) {
@@ -582,4 +640,10 @@ impl Application for Cia402Emu {
 pub fn servo(id: Identity, plant: Plant) -> (Vec<u8>, Box<dyn Application>) {
     let sii = super::sii::servo_drive(&id);
     (sii, Box::new(Cia402Emu::new(&id, plant)))
+}
+
+/// A [`Cia402Emu::strict`] drive as the emulated segment holds it.
+pub fn strict_servo(id: Identity, plant: Plant) -> (Vec<u8>, Box<dyn Application>) {
+    let sii = super::sii::servo_drive(&id);
+    (sii, Box::new(Cia402Emu::strict(&id, plant)))
 }

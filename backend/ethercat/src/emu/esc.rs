@@ -426,6 +426,7 @@ impl Esc {
     }
 
     fn check_process_data(&self) -> Result<(), u16> {
+        self.app.check_safe_op()?;
         let (out_len, in_len) = self.app.process_data_sizes();
         let (sm2, sm3) = (self.sm(2), self.sm(3));
         if out_len > 0 && (!sm2.enabled || sm2.len as usize != out_len || !sm2.ecat_writes()) {

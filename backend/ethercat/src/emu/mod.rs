@@ -31,6 +31,11 @@ pub trait Application: Send {
     fn process_data_sizes(&self) -> (usize, usize);
     /// The AL state changed.
     fn al_changed(&mut self, state: u8);
+    /// What the application says to PRE-OP → SAFE-OP beyond the SyncManagers (an AL status
+    /// code: a drive that checks its PDO mapping only now).
+    fn check_safe_op(&self) -> Result<(), u16> {
+        Ok(())
+    }
     /// The MainDevice wrote outputs (in OP).
     fn outputs_written(&mut self, _now: u64) {}
     /// After each frame: `mem` is the ESC's memory, `sm2`/`sm3` where outputs and inputs are,
@@ -61,14 +66,23 @@ pub struct SegmentFaults {
     /// A SubDevice (by position) that drops to SAFE-OP with an error (AL status code 0x001B,
     /// SyncManager watchdog), at the next frame.
     pub safe_op: Option<usize>,
+    /// Answers to send late from now on, each `reply_delay` after its frame (what a loaded
+    /// link or a slow switch does: the MainDevice has sent the frame again by then).
+    pub late_replies: u32,
+    pub reply_delay: std::time::Duration,
+    /// Answers to send twice from now on.
+    pub duplicate_replies: u32,
+    /// Every so many answers, one comes `reply_delay` late (0: never): a link that is slow
+    /// now and then, for as long as the segment runs.
+    pub late_every: u32,
 }
 
 /// The command and PDU index of each datagram of an EtherCAT frame (after the Ethernet and
 /// EtherCAT headers; stops at a datagram that does not fit).
 fn datagrams(frame: &[u8]) -> impl Iterator<Item = (u8, u8)> + '_ {
-    let end = frame
-        .get(14..16)
-        .map_or(0, |h| (16 + (u16::from_le_bytes([h[0], h[1]]) & 0x7FF) as usize).min(frame.len()));
+    let end = frame.get(14..16).map_or(0, |h| {
+        (16 + (u16::from_le_bytes([h[0], h[1]]) & 0x7FF) as usize).min(frame.len())
+    });
     let mut p = Some(16);
     std::iter::from_fn(move || {
         let at = p?;
@@ -90,6 +104,8 @@ pub struct Segment {
     /// Frames answered and lost, for the tests.
     pub frames: u64,
     pub lost: u64,
+    /// Answers sent (for `late_every`).
+    answers: u64,
     /// The PDU index of the silent cycle's process-data frame (its retries are lost too).
     silent_index: Option<u8>,
 }
@@ -138,6 +154,7 @@ impl Segment {
             faults: SegmentFaults::default(),
             frames: 0,
             lost: 0,
+            answers: 0,
             silent_index: None,
         }
     }
@@ -155,6 +172,25 @@ impl Segment {
     /// Passes an Ethernet frame through the segment; the frame that comes back (source MAC
     /// with the locally administered bit, as the first real SubDevice sets it), or `None` when
     /// it is not EtherCAT or is lost.
+    /// How the transport sends the answer just made: after what delay, in how many copies
+    /// (the reply faults, one answer each).
+    pub fn reply_plan(&mut self) -> (std::time::Duration, usize) {
+        let mut plan = (std::time::Duration::ZERO, 1);
+        self.answers += 1;
+        if self.faults.late_every > 0 && self.answers % u64::from(self.faults.late_every) == 0 {
+            plan.0 = self.faults.reply_delay;
+        }
+        if self.faults.late_replies > 0 {
+            self.faults.late_replies -= 1;
+            plan.0 = self.faults.reply_delay;
+        }
+        if self.faults.duplicate_replies > 0 {
+            self.faults.duplicate_replies -= 1;
+            plan.1 = 2;
+        }
+        plan
+    }
+
     pub fn process(&mut self, frame: &[u8]) -> Option<Vec<u8>> {
         if frame.len() < 16 || u16::from_be_bytes([frame[12], frame[13]]) != ETHERTYPE {
             return None;

@@ -45,22 +45,43 @@ impl AlState {
 
 /// A CiA-402 drive's process data as motiond mapped it.
 #[derive(Clone, Debug, Serialize, ToSchema)]
-#[schema(example = json!({"mapping": "full", "output_bytes": 15, "input_bytes": 29}))]
+#[schema(example = json!({"mapping": "available", "output_bytes": 13, "input_bytes": 17,
+    "missing_objects": ["0x60b8", "0x60b9", "0x60ba", "0x60bb", "0x60fd"], "refused": []}))]
 pub struct DriveMapping {
-    /// `full` (targets for CSP/CSV/CST, touch probe, digital inputs) or `minimal` (what a
-    /// drive refusing the full mapping takes: controlword, target, mode; statusword,
-    /// position, mode display, error code).
+    /// `full` (targets for CSP/CSV/CST, touch probe, digital inputs), `available` (what the
+    /// drive has of the full one: its dictionary lacks `missing_objects`) or `minimal` (what
+    /// a drive refusing the others takes: controlword, target, mode; statusword, position,
+    /// mode display, error code).
     pub mapping: &'static str,
     /// RxPDO (outputs) and TxPDO (inputs) bytes.
     pub output_bytes: usize,
     pub input_bytes: usize,
+    /// Objects of the full mapping the drive does not have (its SDO upload aborted
+    /// 0x06020000): the features that need them are refused on its axis (409).
+    pub missing_objects: Vec<String>,
+    /// The larger mappings the drive refused, in the order tried.
+    pub refused: Vec<RefusedMapping>,
+}
+
+/// A mapping a drive refused at bring-up.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"mapping": "full", "at": "PRE-OP to SAFE-OP", "al_status_code": "0x001d",
+    "reason": "0x001d: Invalid Output Configuration"}))]
+pub struct RefusedMapping {
+    pub mapping: &'static str,
+    /// `PDO mapping write` (an SDO abort) or `PRE-OP to SAFE-OP` (the drive's AL status code).
+    pub at: &'static str,
+    /// `0xNNNN` (ETG.1000), when refused at SAFE-OP.
+    pub al_status_code: Option<String>,
+    /// The AL status code with its ETG.1000 meaning, or the SDO error.
+    pub reason: String,
 }
 
 /// One SubDevice of the segment.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"position": 1, "configured_address": 4097, "name": "motiond emulated servo 2",
     "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264129,
-    "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29},
+    "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29, "missing_objects": [], "refused": []},
     "dc": true, "axis": "y"}))]
 pub struct SubDeviceResource {
     /// Position on the segment (0 = next to motiond); a CiA-402 drive's `subdevice`.
@@ -86,11 +107,13 @@ pub struct SubDeviceResource {
 #[schema(example = json!({
     "kind": "emulated", "interface": "emulated", "cycle_time": 0.001, "state": "op",
     "frames": 120345, "lost_frames": 0, "working_counter_errors": 0, "faults": 0, "errors_in_row": 0,
+    "fault_reason": null, "late_replies": 0, "duplicate_replies": 0, "malformed_frames": 0,
+    "pdu_timeout": 0.01, "txrx": {"running": true, "restarts": 0, "thread": "SCHED_FIFO 79, pinned to CPU 0"},
     "max_errors_in_row": 3, "expected_working_counter": 9, "last_working_counter": 9,
     "dc_system_time_ns": 123456789000u64, "dc_cycle_offset_ns": 12000,
     "subdevices": [{"position": 0, "configured_address": 4096, "name": "motiond emulated servo 1",
         "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264128,
-        "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29},
+        "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29, "missing_objects": [], "refused": []},
         "dc": true, "axis": "x"}]
 }))]
 pub struct BusResource {
@@ -104,8 +127,25 @@ pub struct BusResource {
     /// until as many good ones in a row: every enabled EtherCAT axis was stopped and stays in
     /// ErrorStop until MC_Reset).
     pub state: &'static str,
+    /// Why the bus is `faulted`: the TX/RX loop's failure (the socket's error, or an injected
+    /// stop), or lost frames / wrong working counters in a row. `null` otherwise.
+    pub fault_reason: Option<String>,
     pub frames: u64,
+    /// Cycles whose frame got no answer, retries included (`max_errors_in_row` in a row fault
+    /// the bus).
     pub lost_frames: u64,
+    /// Replies that came after their frame was answered or given up, a PDU timeout or more
+    /// after it was sent: counted and dropped.
+    pub late_replies: u64,
+    /// Replies that came twice (the same PDU index, sooner than the timeout): counted and
+    /// dropped.
+    pub duplicate_replies: u64,
+    /// EtherCAT frames received that did not parse: counted and dropped.
+    pub malformed_frames: u64,
+    /// How long a frame may take to come back before it is sent again (seconds).
+    pub pdu_timeout: f64,
+    /// motiond's TX/RX loop; `null` when simulated.
+    pub txrx: Option<TxRxResource>,
     pub working_counter_errors: u64,
     /// Times the bus faulted (`max_errors_in_row` bad frames in a row) since start.
     pub faults: u64,
@@ -123,6 +163,19 @@ pub struct BusResource {
     /// and how to put an axis on one. Absent when there is nothing to say.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub notice: Option<String>,
+}
+
+/// motiond's TX/RX loop (its own thread: frames out, replies in).
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"running": true, "restarts": 0, "thread": "SCHED_FIFO 79, pinned to CPU 0"}))]
+pub struct TxRxResource {
+    /// `false` after the loop stopped (socket error or injected): the bus is `faulted` until
+    /// `POST /bus/reset` or an axis's MC_Reset starts it again.
+    pub running: bool,
+    /// Times it was started again.
+    pub restarts: u64,
+    /// What the thread got: SCHED_FIFO priority and CPU, or why not.
+    pub thread: String,
 }
 
 /// Drives on the bus that no axis uses, and how to put an axis on one (`None`: none, or
@@ -159,7 +212,10 @@ pub fn idle_drives_notice(s: &AppState) -> Option<String> {
     let axes = if simulated.is_empty() {
         "no axis".to_owned()
     } else {
-        format!("the axes {} are simulated (made on the simulated bus)", simulated.join(", "))
+        format!(
+            "the axes {} are simulated (made on the simulated bus)",
+            simulated.join(", ")
+        )
     };
     Some(format!(
         "the CiA-402 drive(s) at SubDevice position {} drive no axis: {axes}. Put an axis on a \
@@ -178,8 +234,14 @@ pub fn bus_resource(s: &AppState) -> BusResource {
             interface: None,
             cycle_time: s.info.cycle_time_s,
             state: "simulated",
+            fault_reason: None,
             frames: 0,
             lost_frames: 0,
+            late_replies: 0,
+            duplicate_replies: 0,
+            malformed_frames: 0,
+            pdu_timeout: 0.0,
+            txrx: None,
             working_counter_errors: 0,
             faults: 0,
             errors_in_row: 0,
@@ -220,6 +282,21 @@ pub fn bus_resource(s: &AppState) -> BusResource {
                 mapping: l.name,
                 output_bytes: l.out_len,
                 input_bytes: l.in_len,
+                missing_objects: d
+                    .missing_objects
+                    .iter()
+                    .map(|i| format!("{i:#06x}"))
+                    .collect(),
+                refused: d
+                    .refused
+                    .iter()
+                    .map(|r| RefusedMapping {
+                        mapping: r.mapping,
+                        at: r.at,
+                        al_status_code: r.al_status_code.map(|c| format!("{c:#06x}")),
+                        reason: r.reason.clone(),
+                    })
+                    .collect(),
             }),
             dc: d.dc,
             axis: axes
@@ -228,7 +305,16 @@ pub fn bus_resource(s: &AppState) -> BusResource {
                 .map(|(_, n)| n.clone()),
         })
         .collect();
-    let state = if st.faulted.load(Relaxed) {
+    let link = &st.link;
+    let fault_reason = link.fault().or_else(|| {
+        st.faulted.load(Relaxed).then(|| {
+            format!(
+                "{} frames lost or with a wrong working counter in a row",
+                st.max_errors_in_row
+            )
+        })
+    });
+    let state = if st.faulted.load(Relaxed) || !link.alive() {
         "faulted"
     } else if subdevices.iter().any(|d| d.al_state != AlState::Op) {
         "degraded"
@@ -240,8 +326,18 @@ pub fn bus_resource(s: &AppState) -> BusResource {
         interface: Some(st.interface.clone()),
         cycle_time: st.cycle_ns as f64 * 1e-9,
         state,
+        fault_reason,
         frames: st.frames.load(Relaxed),
         lost_frames: st.lost_frames.load(Relaxed),
+        late_replies: link.late.load(Relaxed),
+        duplicate_replies: link.duplicate.load(Relaxed),
+        malformed_frames: link.malformed.load(Relaxed),
+        pdu_timeout: st.pdu_timeout.as_secs_f64(),
+        txrx: Some(TxRxResource {
+            running: link.alive(),
+            restarts: link.restarts.load(Relaxed),
+            thread: link.realtime(),
+        }),
         working_counter_errors: st.working_counter_errors.load(Relaxed),
         faults: st.faults.load(Relaxed),
         errors_in_row: st.errors_in_row.load(Relaxed),
@@ -477,30 +573,77 @@ pub struct BusFault {
     #[serde(default)]
     #[schema(minimum = 0, maximum = 65535)]
     pub safe_op: Option<u16>,
+    /// The next answers of the segment to come back late, each `reply_delay_ms` after its
+    /// frame: motiond has sent the frame again by then, so one copy answers it and the other
+    /// is counted in `late_replies` and dropped.
+    #[serde(default)]
+    #[schema(minimum = 1, maximum = 100000)]
+    pub late_replies: Option<u32>,
+    /// The delay of a late answer (ms; default one and a half PDU timeouts).
+    #[serde(default)]
+    #[schema(minimum = 1, maximum = 1000)]
+    pub reply_delay_ms: Option<u32>,
+    /// The next answers to come back twice (counted in `duplicate_replies` and dropped).
+    #[serde(default)]
+    #[schema(minimum = 1, maximum = 100000)]
+    pub duplicate_replies: Option<u32>,
+    /// Stops motiond's TX/RX loop as a failing socket would (any EtherCAT bus, not only the
+    /// emulated one): the bus faults with the reason, every axis on it goes to ErrorStop
+    /// (bus_error 0x70A0) until `POST /bus/reset` or MC_Reset.
+    #[serde(default)]
+    pub stop_txrx: Option<bool>,
 }
 
 #[utoipa::path(post, path = "/api/v1/bus/faults", tag = "bus",
-    summary = "Lose frames on the emulated EtherCAT segment, or drop a SubDevice to SAFE-OP (--bus emulated only)",
+    summary = "Disturb the bus: lost, late or duplicate answers or a SubDevice dropped to SAFE-OP (--bus emulated only); stop the TX/RX loop (any EtherCAT bus)",
     request_body = BusFault,
-    responses((status = 204, description = "The segment will leave that many cycles unanswered"), super::errors::BusFaultErrors))]
+    responses((status = 204, description = "The disturbance is under way"), super::errors::BusFaultErrors))]
 pub async fn inject_bus_fault(
     State(s): State<Arc<AppState>>,
     client: Client,
     JsonBody(f, raw): JsonBody<BusFault>,
 ) -> AppResult<StatusCode> {
-    if f.lose_frames.is_some_and(|n| !(1..=100_000).contains(&n)) {
-        return Err(AppError::field("lose_frames", "1..100000"));
+    for (field, v) in [
+        ("lose_frames", f.lose_frames),
+        ("late_replies", f.late_replies),
+        ("duplicate_replies", f.duplicate_replies),
+    ] {
+        if v.is_some_and(|n| !(1..=100_000).contains(&n)) {
+            return Err(AppError::field(field, "1..100000"));
+        }
     }
-    if f.lose_frames.is_none() && f.safe_op.is_none() {
-        return Err(AppError::field("body", "give lose_frames or safe_op"));
+    if f.reply_delay_ms.is_some_and(|n| !(1..=1000).contains(&n)) {
+        return Err(AppError::field("reply_delay_ms", "1..1000"));
     }
-    let Some(seg) = &s.info.bus.segment else {
-        return Err(AppError::conflict(
-            "bus_not_emulated",
-            "only the emulated segment (--bus emulated) takes injected faults",
-        ));
-    };
+    let stop = f.stop_txrx == Some(true);
+    if f.lose_frames.is_none()
+        && f.safe_op.is_none()
+        && f.late_replies.is_none()
+        && f.duplicate_replies.is_none()
+        && !stop
     {
+        return Err(AppError::field(
+            "body",
+            "give lose_frames, safe_op, late_replies, duplicate_replies or stop_txrx",
+        ));
+    }
+    let segment_faults = f.lose_frames.is_some()
+        || f.safe_op.is_some()
+        || f.late_replies.is_some()
+        || f.duplicate_replies.is_some();
+    if stop && s.info.bus.control.is_none() {
+        return Err(AppError::conflict(
+            "bus_not_ethercat",
+            "motiond runs the simulated bus: there is no TX/RX loop to stop",
+        ));
+    }
+    if segment_faults {
+        let Some(seg) = &s.info.bus.segment else {
+            return Err(AppError::conflict(
+                "bus_not_emulated",
+                "only the emulated segment (--bus emulated) takes injected faults",
+            ));
+        };
         let mut seg = seg.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(n) = f.safe_op {
             if n as usize >= seg.escs.len() {
@@ -509,7 +652,70 @@ pub async fn inject_bus_fault(
             seg.faults.safe_op = Some(n as usize);
         }
         seg.faults.silent_cycles += f.lose_frames.unwrap_or(0);
+        if let Some(n) = f.late_replies {
+            let timeout = s
+                .info
+                .bus
+                .ethercat
+                .as_ref()
+                .map_or(std::time::Duration::from_millis(10), |(st, _)| {
+                    st.pdu_timeout
+                });
+            seg.faults.late_replies += n;
+            seg.faults.reply_delay = f.reply_delay_ms.map_or(timeout * 3 / 2, |ms| {
+                std::time::Duration::from_millis(u64::from(ms))
+            });
+        }
+        seg.faults.duplicate_replies += f.duplicate_replies.unwrap_or(0);
+    }
+    if stop {
+        if let Some(c) = &s.info.bus.control {
+            c.kill_loop();
+        }
     }
     s.audit(audit_entry(&client.0, "bus.fault", "bus", raw.to_string()));
     Ok(StatusCode::NO_CONTENT)
+}
+
+#[utoipa::path(post, path = "/api/v1/bus/reset", tag = "bus",
+    summary = "Bring the EtherCAT segment back to OP after a fault, without restarting motiond",
+    description = "Starts a stopped TX/RX loop again and asks every SubDevice that is not in OP back to OP \
+(acknowledging its AL error); answers when all are in OP as the cycle reads them (within 10 s). The axes that \
+the fault stopped stay in ErrorStop until their MC_Reset. Audited. 503 `bus_reset_failed` says what is still in \
+the way (the SubDevice, its AL state and AL status code, or the link's error).",
+    responses((status = 200, description = "The segment is in OP again; the bus as it is now", body = BusResource),
+        super::errors::BusResetErrors))]
+pub async fn reset_bus(
+    State(s): State<Arc<AppState>>,
+    client: Client,
+) -> AppResult<Json<BusResource>> {
+    let Some(control) = s.info.bus.control.clone() else {
+        return Err(AppError::conflict(
+            "bus_not_ethercat",
+            "motiond runs the simulated bus: there is no EtherCAT segment to reset",
+        ));
+    };
+    let r = tokio::task::spawn_blocking(move || control.reset(std::time::Duration::from_secs(10)))
+        .await
+        .map_err(|e| AppError::unavailable("bus_reset_failed", e.to_string()))?;
+    s.audit(audit_entry(
+        &client.0,
+        "bus.reset",
+        "bus",
+        serde_json::json!({"result": match &r { Ok(t) => format!("op after {} ms", t.as_millis()), Err(e) => e.clone() }})
+            .to_string(),
+    ));
+    match r {
+        Ok(took) => {
+            tracing::info!(
+                "EtherCAT bus reset: every SubDevice in OP after {} ms",
+                took.as_millis()
+            );
+            Ok(Json(bus_resource(&s)))
+        }
+        Err(why) => {
+            tracing::warn!("EtherCAT bus reset failed: {why}");
+            Err(AppError::unavailable("bus_reset_failed", why))
+        }
+    }
 }

@@ -323,6 +323,12 @@ problem_responses! {
     /// The bus is not the emulated segment.
     BusNotEmulated(example = json!(p(AppError::conflict("bus_not_emulated",
         "only the emulated segment (--bus emulated) takes injected faults"))));
+    /// The segment did not come back to OP: what is in the way.
+    BusResetFailed(example = json!(p(AppError::unavailable("bus_reset_failed",
+        "SubDevice 0 (motiond emulated servo 1) did not come back to OP: it is in SAFE-OP with AL status code 0x001b: Sync manager watchdog"))));
+    /// motiond runs the simulated bus.
+    BusNotEthercat(example = json!(p(AppError::conflict("bus_not_ethercat",
+        "motiond runs the simulated bus: there is no EtherCAT segment to reset"))));
     /// The mailbox did not answer in time or the frame was lost.
     SdoUnavailable(example = json!(p(AppError::unavailable("sdo_failed",
         "SDO transfer of 0x1018:1 with SubDevice 0 failed: timeout"))));
@@ -367,7 +373,7 @@ problem_responses! {
     /// An object index that is not one, or a value that does not fit its size.
     SdoInvalid(example = json!(p(AppError::field("value", "does not fit 1 bytes (-128..255)"))));
 
-    /// Not a number of frames to lose (1..100000), or no disturbance given.
+    /// A count out of 1..100000 (a delay out of 1..1000 ms), or no disturbance given.
     BusFaultInvalid(example = json!(p(AppError::field("lose_frames", "1..100000"))));
 
     /// The configuration is invalid; `errors` lists every invalid field. Nothing was changed.
@@ -570,6 +576,8 @@ error_sets! {
         400: MalformedJson, 404: SubDeviceNotFound, 409: BusNotEmulated, 413: PayloadTooLarge,
         422: BusFaultInvalid,
     }
+    /// `POST /bus/reset`.
+    BusResetErrors { 409: BusNotEthercat, 503: BusResetFailed }
     /// `POST /cam-analysis`.
     CamAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: CamTableInvalid }
     /// `PUT /cam-tables/{table}`, its points.

@@ -357,6 +357,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(bus::sdo_read).put(bus::sdo_write),
         )
         .route("/bus/faults", post(bus::inject_bus_fault))
+        .route("/bus/reset", post(bus::reset_bus))
         .route("/audit", get(audit::audit_log))
         .route(
             "/config",
@@ -557,7 +558,7 @@ until the command finishes. Authentication is not implemented yet: motiond only 
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
-        axes::export_config, axes::import_config, system::system, bus::bus, bus::sdo_read, bus::sdo_write, bus::inject_bus_fault, audit::audit_log, system::metrics, ws::upgrade,
+        axes::export_config, axes::import_config, system::system, bus::bus, bus::sdo_read, bus::sdo_write, bus::inject_bus_fault, bus::reset_bus, audit::audit_log, system::metrics, ws::upgrade,
         auth::session, auth::login, auth::logout, auth::change_password,
         auth::list_users, auth::create_user, auth::get_user, auth::update_user, auth::delete_user,
         auth::list_tokens, auth::create_token, auth::revoke_token,
