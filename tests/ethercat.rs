@@ -506,3 +506,38 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
     assert!(notice.contains("position 1, 2 drive no axis"), "{}", bus.text);
     s.stop();
 }
+
+/// A drive without the touch probe and digital-input objects (issue 22): the segment comes up
+/// with the mapping the drive has (`available`, the missing objects named in `GET /bus`), the
+/// axes on it move, and a block that needs a missing object is a 409 naming the object —
+/// never run half-broken.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_drive_without_optional_objects_refuses_the_blocks_that_need_them() {
+    let s = Server::start_with(
+        ":memory:",
+        &["--bus", "emulated", "--emulated-strict-drives", "--bus-max-errors", "5", "--bus-timeout-ms", "50"],
+    );
+    let bus = get(&s, "/api/v1/bus").await;
+    assert_eq!(bus.json["state"], "op", "{}", bus.text);
+    let sd = &bus.json["subdevices"][0];
+    assert_eq!(sd["drive"]["mapping"], "available", "{}", bus.text);
+    let missing = sd["drive"]["missing_objects"].to_string().to_lowercase();
+    assert!(missing.contains("0x60b8") && missing.contains("0x60fd"), "{}", bus.text);
+    assert_eq!(sd["axis"], "x", "{}", bus.text);
+    power_on_retrying(&s, "x").await;
+    let r = post(&s, "/api/v1/axes/x/touch-probe", json!({"signal": "input1", "edge": "rising"})).await;
+    assert_problem(&r, 409, "drive_object_missing");
+    assert!(r.json["detail"].as_str().unwrap().contains("0x60B8"), "{}", r.text);
+    let r = post(&s, "/api/v1/axes/x/home", json!({})).await;
+    assert_problem(&r, 409, "drive_object_missing");
+    assert!(r.json["detail"].as_str().unwrap().contains("0x60FD"), "{}", r.text);
+    // Nothing was started; a move is not refused.
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 20.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    s.stop();
+}

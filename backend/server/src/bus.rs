@@ -62,6 +62,24 @@ impl BusHandle {
         }
     }
 
+    /// The objects of `needed` that the drive at `position` does not have in its process
+    /// image (missing from its dictionary, or left out of the mapping it took). Empty for a
+    /// drive that is not on the bus (the axis's own check says so).
+    pub fn unmapped(&self, position: u16, needed: &[u16]) -> Vec<u16> {
+        let Some((st, _)) = &self.ethercat else {
+            return Vec::new();
+        };
+        let Some(layout) = st
+            .subdevices
+            .iter()
+            .find(|s| s.position == position)
+            .and_then(|s| s.drive.as_ref())
+        else {
+            return Vec::new();
+        };
+        needed.iter().copied().filter(|&i| !layout.maps(i)).collect()
+    }
+
     /// Positions of the SubDevices that are CiA-402 drives.
     pub fn drive_positions(&self) -> Vec<u16> {
         self.ethercat.as_ref().map_or_else(Vec::new, |(st, _)| {
@@ -137,6 +155,7 @@ pub fn serve_emulated_segment(
 pub fn start(
     kind: BusKind,
     interface: Option<&str>,
+    strict_drives: bool,
     cycle: Duration,
     max_errors_in_row: u32,
     timeout: Option<Duration>,
@@ -151,7 +170,7 @@ pub fn start(
                 .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
                 .to_string(),
         ),
-        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES, false)),
+        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES, strict_drives)),
     };
     let segment = match &link {
         Link::Emulated(s) => Some(s.clone()),

@@ -216,6 +216,11 @@ pub struct ServeArgs {
     /// The network interface of the EtherCAT segment (`--bus ethercat`).
     #[arg(long, global = true, value_name = "IFACE")]
     pub interface: Option<String>,
+    /// `--bus emulated` with drives like many not written by motiond's authors: no touch probe
+    /// (0x60B8–0x60BB) and no digital inputs (0x60FD), the mapping checked only at SAFE-OP
+    /// (as `emulate-segment --strict-drives`).
+    #[arg(long = "emulated-strict-drives", global = true)]
+    pub emulated_strict_drives: bool,
     /// Lost frames or wrong working counters in a row after which every axis of the EtherCAT
     /// bus stops into ErrorStop (1–1000).
     #[arg(long = "bus-max-errors", global = true, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
@@ -539,7 +544,7 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let cycle_time = args.cycle_us as f64 * 1e-6;
     // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
     let (bus, bus_handle) = {
-        let (kind, iface) = (args.bus, args.interface.clone());
+        let (kind, iface, strict) = (args.bus, args.interface.clone(), args.emulated_strict_drives);
         let (cycle, max, timeout) = (
             std::time::Duration::from_micros(args.cycle_us as u64),
             args.bus_max_errors,
@@ -547,7 +552,7 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
                 .map(|ms| std::time::Duration::from_millis(ms as u64)),
         );
         tokio::task::spawn_blocking(move || {
-            bus::start(kind, iface.as_deref(), cycle, max, timeout, cycle::MAX_AXES)
+            bus::start(kind, iface.as_deref(), strict, cycle, max, timeout, cycle::MAX_AXES)
         })
         .await
         .map_err(|e| format!("the bus start-up failed: {e}"))?

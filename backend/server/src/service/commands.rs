@@ -1082,6 +1082,10 @@ async fn submit(
             build(&reg, e).map_err(invalid)?,
         )
     };
+    if let Some(e) = drive_lacks(s, axis_key, &kind) {
+        s.metrics.command(name, Verdict::rejected);
+        return Err(e);
+    }
     // One holder commands motion at a time (stop, halt and disabling always pass).
     s.control.admit(&client, &kind).inspect_err(|_| {
         s.metrics.command(name, Verdict::rejected);
@@ -1204,6 +1208,69 @@ async fn submit(
             Err(AppError::RejectedBecause { id: e, why })
         }
     }
+}
+
+/// The CiA-402 objects a block needs in the drive's process image: the touch probe
+/// (0x60B8 function, 0x60B9 status, 0x60BA position) for MC_TouchProbe and for homing that
+/// latches the reference in the drive, the digital inputs (0x60FD: the reference cam) for
+/// homing on the cam, the target torque (0x6071) for MC_TorqueControl.
+fn objects_needed(kind: &CommandKind, reference_mode: u32) -> &'static [u16] {
+    use motion::{HomingMode, ReferenceMode as R};
+    const PROBE: &[u16] = &[0x60B8, 0x60B9, 0x60BA];
+    const CAM_AND_PROBE: &[u16] = &[0x60FD, 0x60B8, 0x60B9, 0x60BA];
+    match kind {
+        CommandKind::TouchProbe(_) => PROBE,
+        CommandKind::TorqueControl(_) => &[0x6071],
+        CommandKind::Home {
+            mode: HomingMode::Default,
+            ..
+        } => match R::from_number(reference_mode).unwrap_or_default() {
+            R::PlcCam | R::SoftwareSync => &[0x60FD],
+            R::SoftDriveLatchPos | R::SoftDriveLatchNeg => PROBE,
+            R::Default | R::HardwareSync | R::HardwareLatchPos | R::HardwareLatchNeg => {
+                CAM_AND_PROBE
+            }
+        },
+        _ => &[],
+    }
+}
+
+/// 409 `drive_object_missing` when the axis's CiA-402 drive lacks an object the block needs
+/// in its process image (the drive's dictionary has no such object, or the mapping it took
+/// left it out): never run half-broken (issue 22).
+fn drive_lacks(s: &AppState, axis_key: &str, kind: &CommandKind) -> Option<AppError> {
+    let (subdevice, reference_mode, axis) = {
+        let reg = s.registry.read().unwrap();
+        let e = reg.find(axis_key)?;
+        let drives::DriveConfig::Cia402(c) = &e.config.drive else {
+            return None;
+        };
+        (
+            c.subdevice,
+            e.params.axis_encoder_reference_mode,
+            e.name.clone(),
+        )
+    };
+    let needed = objects_needed(kind, reference_mode);
+    if needed.is_empty() {
+        return None;
+    }
+    let missing = s.info.bus.unmapped(subdevice, needed);
+    if missing.is_empty() {
+        return None;
+    }
+    let list = missing
+        .iter()
+        .map(|i| format!("0x{i:04X}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some(AppError::conflict(
+        "drive_object_missing",
+        format!(
+            "axis {axis}'s drive (SubDevice {subdevice}) has no {list} in its process image \
+             (GET /api/v1/bus shows its mapping and missing objects): this block needs it"
+        ),
+    ))
 }
 
 /// What stood in the way of a refused command, and what to do: the axis's state as the latest
