@@ -541,3 +541,102 @@ async fn a_drive_without_optional_objects_refuses_the_blocks_that_need_them() {
     assert_eq!(m.json["state"], "done", "{}", m.text);
     s.stop();
 }
+
+/// Issue 22 over a veth pair, as a commissioning engineer meets a drive motiond did not
+/// write: `emulate-segment --strict-drives --late-reply-ms 15` (no touch probe or digital
+/// inputs, the mapping checked only at SAFE-OP; one answer in 100 late beyond the PDU
+/// timeout) on one end, `motiond --bus ethercat` on the other. OP is reached with the mapping
+/// the drive has; late replies are counted and dropped while an axis moves, the bus never
+/// faulting; a TX/RX loop stopped is reported (faulted, with its reason) and `POST /bus/reset`
+/// brings the segment back to OP without a restart, and the axis moves again.
+#[test]
+fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
+    let t = std::thread::spawn(|| {
+        if let Err(why) = private_veth() {
+            cannot_run(
+                "ethercat::a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives",
+                &format!("the veth tier needs a network namespace: {why}"),
+            );
+            return;
+        }
+        let mut emulator = Killed(
+            bin()
+                .args(["emulate-segment", "--on", "ecB", "--drives", "1", "--strict-drives", "--late-reply-ms", "15"])
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .expect("emulator"),
+        );
+        let mut ready = String::new();
+        let out = emulator.0.stdout.take().expect("piped");
+        std::io::BufRead::read_line(&mut std::io::BufReader::new(out), &mut ready).unwrap();
+        assert!(ready.contains("emulated EtherCAT segment"), "{ready}");
+        let s = Server::start_with(
+            ":memory:",
+            &["--bus", "ethercat", "--interface", "ecA", "--bus-max-errors", "50"],
+        );
+        let rt = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        rt.block_on(async {
+            let bus = get(&s, "/api/v1/bus").await;
+            assert_eq!(bus.json["state"], "op", "{}", bus.text);
+            let drive = &bus.json["subdevices"][0]["drive"];
+            assert_eq!(drive["mapping"], "available", "{}", bus.text);
+            assert!(drive["missing_objects"].to_string().to_lowercase().contains("0x60b8"), "{}", bus.text);
+            let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
+            cfg["name"] = json!("z");
+            cfg["soft_limits"] = Value::Null;
+            cfg["drive"] = json!({"kind": "cia402", "subdevice": 0, "increments_per_unit": 1000.0});
+            cfg["parameters"]["AxisMaxPosLagValue"] = json!(100.0);
+            cfg["parameters"]["AxisMaxPosLagFilterTime"] = json!(2.0);
+            let r = post(&s, "/api/v1/axes", cfg).await;
+            assert_eq!(r.status, 201, "{}", r.text);
+            power_on_retrying(&s, "z").await;
+            // A move long enough for late replies to come while it runs.
+            let m = post(
+                &s,
+                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
+                json!({"position": 100.0, "velocity": 50.0}),
+            )
+            .await;
+            assert_eq!(m.json["state"], "done", "{}", m.text);
+            let bus = get(&s, "/api/v1/bus").await;
+            assert!(bus.json["late_replies"].as_u64().unwrap() > 0, "{}", bus.text);
+            assert_eq!(bus.json["faults"], 0, "late replies never fault the bus: {}", bus.text);
+            // The loop stopped: reported, then brought back by a reset.
+            let r = post(&s, "/api/v1/bus/faults", json!({"stop_txrx": true})).await;
+            assert_eq!(r.status, 204, "{}", r.text);
+            let deadline = Instant::now() + Duration::from_secs(20);
+            let faulted = loop {
+                let b = get(&s, "/api/v1/bus").await;
+                if b.json["state"] == "faulted" {
+                    break b;
+                }
+                assert!(Instant::now() < deadline, "{}", b.text);
+                tokio::time::sleep(Duration::from_millis(20)).await;
+            };
+            assert!(faulted.json["fault_reason"].is_string(), "{}", faulted.text);
+            assert_eq!(faulted.json["txrx"]["running"], false, "{}", faulted.text);
+            let st = until_status(&s, "z", "bus error", |st| st["state"] == "error_stop").await;
+            assert_eq!(st["error_id"], 0x70A0);
+            let r = post(&s, "/api/v1/bus/reset", json!({})).await;
+            assert_eq!(r.status, 200, "{}", r.text);
+            assert_eq!(r.json["state"], "op", "{}", r.text);
+            assert_eq!(r.json["txrx"]["restarts"], 1, "{}", r.text);
+            reset_to_standstill(&s, "z").await;
+            power_on_retrying(&s, "z").await;
+            let m = post(
+                &s,
+                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
+                json!({"position": 50.0, "velocity": 100.0}),
+            )
+            .await;
+            assert_eq!(m.json["state"], "done", "{}", m.text);
+        });
+        s.stop();
+        drop(emulator);
+    });
+    t.join().expect("the test thread");
+}
