@@ -347,6 +347,38 @@ async fn the_simulated_bus_refuses_cia402_drives_and_sdos_clearly() {
     assert_eq!(r.json["errors"][0]["field"], "drive.kind", "{}", r.text);
 }
 
+/// `motiond emulate-segment --on ecB ARGS…`, once it says its socket is open.
+fn emulate_segment_on_ecb(args: &[&str]) -> Killed {
+    let mut emulator = Killed(
+        bin()
+            .args(["emulate-segment", "--on", "ecB"])
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("emulator"),
+    );
+    let mut ready = String::new();
+    let out = emulator.0.stdout.take().expect("piped");
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(out), &mut ready).unwrap();
+    assert!(ready.contains("emulated EtherCAT segment"), "{ready}");
+    emulator
+}
+
+/// Axis `z` (y's configuration) on the CiA-402 drive at `subdevice`, 1 µm per increment.
+async fn create_z_on_drive(s: &Server, subdevice: u16) {
+    let mut cfg = get(s, "/api/v1/axes/y").await.json["config"].clone();
+    cfg["name"] = json!("z");
+    cfg["soft_limits"] = Value::Null;
+    cfg["drive"] = json!({"kind": "cia402", "subdevice": subdevice, "increments_per_unit": 1000.0});
+    // The other end is a process on a loaded test machine: a frame late by tens of ms is a
+    // following error at speed. These tests are about the raw-socket path.
+    cfg["parameters"]["AxisMaxPosLagValue"] = json!(100.0);
+    cfg["parameters"]["AxisMaxPosLagFilterTime"] = json!(2.0);
+    let r = post(s, "/api/v1/axes", cfg).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+}
+
 /// A child process killed when this goes out of scope (also when a test panics).
 struct Killed(std::process::Child);
 
@@ -402,19 +434,7 @@ fn the_binary_drives_an_emulated_segment_over_a_veth_pair() {
             );
             return;
         }
-        let mut emulator = Killed(
-            bin()
-                .args(["emulate-segment", "--on", "ecB", "--drives", "2"])
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::null())
-                .spawn()
-                .expect("emulator"),
-        );
-        // It says so once its socket is open.
-        let mut ready = String::new();
-        let out = emulator.0.stdout.take().expect("piped");
-        std::io::BufRead::read_line(&mut std::io::BufReader::new(out), &mut ready).unwrap();
-        assert!(ready.contains("emulated EtherCAT segment"), "{ready}");
+        let emulator = emulate_segment_on_ecb(&["--drives", "2"]);
         let s = Server::start_with(
             ":memory:",
             &[
@@ -441,17 +461,8 @@ fn the_binary_drives_an_emulated_segment_over_a_veth_pair() {
             assert_eq!(v.json["unsigned"], 0x2026_0001u32, "{}", v.text);
             // The demo axes stay simulated on real EtherCAT (their scaling would be a guess);
             // an axis is created on drive 1.
-            let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
-            assert_eq!(cfg["drive"]["kind"], "simulated");
-            cfg["name"] = json!("z");
-            cfg["soft_limits"] = Value::Null;
-            cfg["drive"] = json!({"kind": "cia402", "subdevice": 1, "increments_per_unit": 1000.0});
-            // The other end is a process on a loaded test machine: a frame late by tens of ms
-            // is a following error at speed. This test is about the raw-socket path.
-            cfg["parameters"]["AxisMaxPosLagValue"] = json!(100.0);
-            cfg["parameters"]["AxisMaxPosLagFilterTime"] = json!(2.0);
-            let r = post(&s, "/api/v1/axes", cfg).await;
-            assert_eq!(r.status, 201, "{}", r.text);
+            assert_eq!(get(&s, "/api/v1/axes/y").await.json["config"]["drive"]["kind"], "simulated");
+            create_z_on_drive(&s, 1).await;
             power_on_retrying(&s, "z").await;
             let m = post(
                 &s,
@@ -559,18 +570,8 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             );
             return;
         }
-        let mut emulator = Killed(
-            bin()
-                .args(["emulate-segment", "--on", "ecB", "--drives", "1", "--strict-drives", "--late-reply-ms", "15"])
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::null())
-                .spawn()
-                .expect("emulator"),
-        );
-        let mut ready = String::new();
-        let out = emulator.0.stdout.take().expect("piped");
-        std::io::BufRead::read_line(&mut std::io::BufReader::new(out), &mut ready).unwrap();
-        assert!(ready.contains("emulated EtherCAT segment"), "{ready}");
+        let emulator =
+            emulate_segment_on_ecb(&["--drives", "1", "--strict-drives", "--late-reply-ms", "15"]);
         let s = Server::start_with(
             ":memory:",
             &["--bus", "ethercat", "--interface", "ecA", "--bus-max-errors", "50"],
@@ -585,14 +586,7 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             let drive = &bus.json["subdevices"][0]["drive"];
             assert_eq!(drive["mapping"], "available", "{}", bus.text);
             assert!(drive["missing_objects"].to_string().to_lowercase().contains("0x60b8"), "{}", bus.text);
-            let mut cfg = get(&s, "/api/v1/axes/y").await.json["config"].clone();
-            cfg["name"] = json!("z");
-            cfg["soft_limits"] = Value::Null;
-            cfg["drive"] = json!({"kind": "cia402", "subdevice": 0, "increments_per_unit": 1000.0});
-            cfg["parameters"]["AxisMaxPosLagValue"] = json!(100.0);
-            cfg["parameters"]["AxisMaxPosLagFilterTime"] = json!(2.0);
-            let r = post(&s, "/api/v1/axes", cfg).await;
-            assert_eq!(r.status, 201, "{}", r.text);
+            create_z_on_drive(&s, 0).await;
             power_on_retrying(&s, "z").await;
             // A move long enough for late replies to come while it runs.
             let m = post(
