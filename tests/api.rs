@@ -2357,6 +2357,11 @@ async fn refusals_say_what_is_in_the_way() {
     let d = r.json["detail"].as_str().unwrap();
     assert!(d.contains("disabled") && d.contains("power"), "{d}");
     power_on(&s, "x").await;
+    // A target beyond a software limit: the limit is named, not the (irrelevant) state.
+    let r = post(&s, "/api/v1/axes/x/move-absolute", json!({"position": 2000.0, "velocity": 100.0})).await;
+    assert_problem(&r, 409, "target_above_soft_limit");
+    let d = r.json["detail"].as_str().unwrap();
+    assert!(d.contains("SWLimitPos (#1019) is 1000") && !d.contains("standstill"), "{d}");
     let stop = post(&s, "/api/v1/axes/x/stop?wait=true", json!({})).await;
     assert_eq!(stop.json["state"], "done", "{}", stop.text);
     let id = stop.json["id"].as_u64().unwrap();

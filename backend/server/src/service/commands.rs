@@ -1204,8 +1204,10 @@ async fn submit(
         Err(e) => {
             s.commands.lock().unwrap().remove(id);
             outcome(format!("rejected:{}", e.code()));
-            let why = refusal_why(s, slot, e, reply.hint);
-            Err(AppError::RejectedBecause { id: e, why })
+            Err(match refusal_why(s, slot, e, reply.hint) {
+                Some(why) => AppError::RejectedBecause { id: e, why },
+                None => AppError::rejected(e),
+            })
         }
     }
 }
@@ -1281,7 +1283,7 @@ pub fn refusal_why(
     slot: AxisSlot,
     e: ErrorId,
     hint: Option<motion::RefusalHint>,
-) -> String {
+) -> Option<String> {
     use motion::AxisState as S;
     if let Some(motion::RefusalHint::CamSlave {
         position,
@@ -1297,18 +1299,42 @@ pub fn refusal_why(
             let t = t.trim_end_matches('0').trim_end_matches('.');
             if t == "-0" { "0".to_owned() } else { t.to_owned() }
         };
-        return format!(
+        return Some(format!(
             "the cam puts the slave at {} (velocity {}) now, the slave is at {}: move it there \
              first (within {}), couple with autooffset, or start with start_mode ramp_in",
             n(position),
             n(velocity),
             n(at),
             n(window)
-        );
+        ));
     }
     let (_, Some(st)) = s.status(slot) else {
-        return "the axis is not in the cycle".into();
+        return Some("the axis is not in the cycle".into());
     };
+    // A software limit: where it is (the refused target is in the request).
+    if e == ErrorId::TARGET_ABOVE_SOFT_LIMIT || e == ErrorId::TARGET_BELOW_SOFT_LIMIT {
+        let reg = s.registry.read().unwrap();
+        let p = &reg.by_slot(slot)?.params;
+        let (name, at) = if e == ErrorId::TARGET_ABOVE_SOFT_LIMIT {
+            ("SWLimitPos (#1019)", p.axis_max_soft_pos_limit)
+        } else {
+            ("SWLimitNeg (#1017)", p.axis_min_soft_pos_limit)
+        };
+        return Some(format!("{name} is {at}"));
+    }
+    // The state explains only refusals for the state (and is always the cause in error_stop
+    // or disabled); a refusal of the request's own values says enough by its number.
+    let for_state = [
+        ErrorId::AXIS_CANNOT_BE_STARTED,
+        ErrorId::COMMAND_NOT_PERMITTED,
+        ErrorId::AXIS_NOT_MOVING,
+        ErrorId::BUFFER_FULL,
+    ]
+    .contains(&e)
+        || matches!(st.state, S::ErrorStop | S::Disabled);
+    if !for_state {
+        return None;
+    }
     let name = |st: S| {
         serde_json::to_value(st)
             .ok()
@@ -1316,7 +1342,7 @@ pub fn refusal_why(
             .unwrap_or_default()
     };
     let state = name(st.state);
-    match st.state {
+    Some(match st.state {
         S::ErrorStop => {
             let err = ErrorId(st.error_id);
             format!(
@@ -1364,7 +1390,7 @@ pub fn refusal_why(
             st.active_command
         ),
         _ => format!("the axis is in {state}"),
-    }
+    })
 }
 
 /// An accepted command as it stands.
