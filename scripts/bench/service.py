@@ -139,7 +139,8 @@ def main():
         if os.path.exists(f):
             os.remove(f)
     proc, _ = start(["--db", db, "--max-connections", "4000"], log)
-    results = {"machine": {"cpus": os.cpu_count(), "kernel": os.uname().release}}
+    model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+    results = {"machine": {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release}}
     try:
         system = json.loads(http("GET", "/api/v1/system")[1])
         results["realtime"] = system["realtime"]
