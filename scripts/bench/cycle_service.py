@@ -45,7 +45,5 @@ def measure(name, binary):
     return rows
 
 
-model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-results = {"machine": {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release},
-           "window_s": window, "runs": {n: measure(n, b) for n, b in binaries}}
+results = {"machine": service.machine(), "window_s": window, "runs": {n: measure(n, b) for n, b in binaries}}
 json.dump(results, open(os.path.join(out, "cycle_service.json"), "w"), indent=1)

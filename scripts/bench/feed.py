@@ -22,11 +22,6 @@ service.WINDOW = window
 CASES = [(100, 16), (100, 32), (100, 48), (100, 64), (10, 64), (200, 64)]
 
 
-def machine():
-    model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    return {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release}
-
-
 def curve(name, binary):
     service.MOTIOND = binary
     os.makedirs(out, exist_ok=True)
@@ -62,7 +57,7 @@ def curve(name, binary):
 
 
 def main():
-    results = {"machine": machine(), "window_s": window, "runs": {}}
+    results = {"machine": service.machine(), "window_s": window, "runs": {}}
     for name, binary in binaries:
         results["runs"][name] = curve(name, binary)
     path = os.path.join(out, "feed.json")

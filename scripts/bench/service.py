@@ -67,6 +67,12 @@ def window_quantiles(before, after, name):
     return res
 
 
+def machine():
+    """What the figures were measured on (machines of one size differ 2-3x)."""
+    model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+    return {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release}
+
+
 def cpu_ticks(pid):
     """(process utime+stime, {thread name: ticks})."""
     def ticks(path):
@@ -139,8 +145,7 @@ def main():
         if os.path.exists(f):
             os.remove(f)
     proc, _ = start(["--db", db, "--max-connections", "4000"], log)
-    model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    results = {"machine": {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release}}
+    results = {"machine": machine()}
     try:
         system = json.loads(http("GET", "/api/v1/system")[1])
         results["realtime"] = system["realtime"]
