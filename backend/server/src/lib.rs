@@ -758,6 +758,9 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// How long a connection must have been idle before a new client may close it to make room.
+const IDLE_BEFORE_CLOSED: std::time::Duration = std::time::Duration::from_secs(1);
+
 /// An open connection as the accept loop knows it: whether a request of it is being served,
 /// when it last did something, and how to close it.
 struct OpenConn {
@@ -791,15 +794,18 @@ impl OpenConns {
     }
 
     /// Closes the connection that has been idle longest (no request in service: a client
-    /// sending headers slowly, or a keep-alive connection between requests). `false` when
-    /// every connection is serving a request.
+    /// sending headers slowly, or a keep-alive connection between requests) — one idle for
+    /// [`IDLE_BEFORE_CLOSED`] at least, so that a burst of new clients do not close each
+    /// other before they could send a request. `false` when there is none.
     fn close_oldest_idle(&self) -> bool {
         let map = self.map.lock().unwrap();
+        let now = std::time::Instant::now();
         let oldest = map
             .values()
             .filter(|c| {
                 c.busy.load(std::sync::atomic::Ordering::Relaxed) == 0
                     && !c.closing.load(std::sync::atomic::Ordering::Relaxed)
+                    && now.duration_since(*c.last_active.lock().unwrap()) >= IDLE_BEFORE_CLOSED
             })
             .min_by_key(|c| *c.last_active.lock().unwrap());
         match oldest {
@@ -815,10 +821,10 @@ impl OpenConns {
 }
 
 /// Serves connections until shutdown: at most `max` at once. One more makes room by closing
-/// the connection idle longest — one that has not finished sending a request's headers, or a
-/// keep-alive connection between requests — so that a flood of half-sent requests cannot lock
-/// a real client out (decision 69); only when every connection is serving a request is one
-/// more answered 503 and closed. A client that takes longer than `read_timeout` to send a
+/// the connection idle longest (for a second at least) — one that has not finished sending a
+/// request's headers, or a keep-alive connection between requests — so that a flood of
+/// half-sent requests cannot lock a real client out (decision 69); when there is none, one
+/// more is answered 503 (`Retry-After: 1`) and closed. A client that takes longer than `read_timeout` to send a
 /// request's headers or the next request is disconnected. The client's address reaches the
 /// handlers as axum's `ConnectInfo`.
 async fn accept_loop(
@@ -863,7 +869,7 @@ async fn accept_loop(
         let Some(permit) = permit else {
             tokio::spawn(async move {
                 let body = format!(
-                    r#"{{"type":"urn:motiond:problem:too_many_connections","title":"Service unavailable","status":503,"detail":"motiond serves at most {max} connections at once, all of them serving requests; try again","code":"too_many_connections"}}"#
+                    r#"{{"type":"urn:motiond:problem:too_many_connections","title":"Service unavailable","status":503,"detail":"motiond serves at most {max} connections at once, none of them idle for a second; try again","code":"too_many_connections"}}"#
                 );
                 let head = format!(
                     "HTTP/1.1 503 Service Unavailable\r\ncontent-type: application/problem+json\r\ncontent-length: {}\r\nretry-after: 1\r\nconnection: close\r\n\r\n",
