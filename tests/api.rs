@@ -2316,10 +2316,20 @@ async fn a_wait_says_why_it_ended_early() {
     assert_eq!(r.json["wait"]["reached"], true, "{}", r.text);
     assert_eq!(r.json["wait"]["milestone"], "status", "{}", r.text);
     assert!(r.json["wait"]["reason"].is_null(), "{}", r.text);
-    let r = post(&s, "/api/v1/axes/x/simulation/fault", json!({"kind": "drive_fault", "code": 8976})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "drive_fault", "code": 8976}),
+    )
+    .await;
     assert_eq!(r.status, 204, "{}", r.text);
     until_status(&s, "x", 20, |st| st["state"] == "error_stop").await;
-    let r = post(&s, "/api/v1/axes/x/power?wait=true&timeout_ms=30000", json!({})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/power?wait=true&timeout_ms=30000",
+        json!({}),
+    )
+    .await;
     assert_eq!(r.status, 202, "{}", r.text);
     assert_eq!(r.json["state"], "active", "{}", r.text);
     assert_eq!(r.json["outputs"]["status"], false, "{}", r.text);
@@ -2358,10 +2368,18 @@ async fn refusals_say_what_is_in_the_way() {
     assert!(d.contains("disabled") && d.contains("power"), "{d}");
     power_on(&s, "x").await;
     // A target beyond a software limit: the limit is named, not the (irrelevant) state.
-    let r = post(&s, "/api/v1/axes/x/move-absolute", json!({"position": 2000.0, "velocity": 100.0})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 2000.0, "velocity": 100.0}),
+    )
+    .await;
     assert_problem(&r, 409, "target_above_soft_limit");
     let d = r.json["detail"].as_str().unwrap();
-    assert!(d.contains("SWLimitPos (#1019) is 1000") && !d.contains("standstill"), "{d}");
+    assert!(
+        d.contains("SWLimitPos (#1019) is 1000") && !d.contains("standstill"),
+        "{d}"
+    );
     let stop = post(&s, "/api/v1/axes/x/stop?wait=true", json!({})).await;
     assert_eq!(stop.json["state"], "done", "{}", stop.text);
     let id = stop.json["id"].as_u64().unwrap();
@@ -2369,15 +2387,24 @@ async fn refusals_say_what_is_in_the_way() {
     assert_problem(&r, 409, "axis_cannot_be_started");
     let d = r.json["detail"].as_str().unwrap();
     assert!(
-        d.contains(&format!("MC_Stop (command {id})")) && d.contains(&format!("DELETE /api/v1/commands/{id}")),
+        d.contains(&format!("MC_Stop (command {id})"))
+            && d.contains(&format!("DELETE /api/v1/commands/{id}")),
         "{d}"
     );
-    let r = post(&s, "/api/v1/axes/x/simulation/fault", json!({"kind": "drive_fault", "code": 8976})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/simulation/fault",
+        json!({"kind": "drive_fault", "code": 8976}),
+    )
+    .await;
     assert_eq!(r.status, 204);
     until_status(&s, "x", 20, |st| st["state"] == "error_stop").await;
     let r = post(&s, "/api/v1/axes/x/move-absolute", mv.clone()).await;
     let d = r.json["detail"].as_str().unwrap();
-    assert!(d.contains("error_stop with 0x7010 drive_fault") && d.contains("reset"), "{d}");
+    assert!(
+        d.contains("error_stop with 0x7010 drive_fault") && d.contains("reset"),
+        "{d}"
+    );
     // A cam that would make the slave jump says where the slave must be.
     let table = json!({"name": "lift", "table_type": "motion_function", "points": [
         {"point_index": 1, "function_type": "polynom5", "point_type": "rest", "master_pos": 0, "slave_pos": 10},
@@ -2385,10 +2412,18 @@ async fn refusals_say_what_is_in_the_way() {
     assert_eq!(post(&s, "/api/v1/cam-tables", table).await.status, 201);
     power_on(&s, "y").await;
     power_on(&s, "spindle").await;
-    let r = post(&s, "/api/v1/axes/y/cam-in", json!({"master": "spindle", "cam_table": "lift"})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "spindle", "cam_table": "lift"}),
+    )
+    .await;
     assert_problem(&r, 409, "cam_slave_would_jump");
     let d = r.json["detail"].as_str().unwrap();
-    assert!(d.contains("puts the slave at 10 ") && d.contains("the slave is at 0"), "{d}");
+    assert!(
+        d.contains("puts the slave at 10 ") && d.contains("the slave is at 0"),
+        "{d}"
+    );
     // A cam table id out of 1..255 carries its number (docs/errors.md 0x4B32).
     for id in [0, 256] {
         let r = post(

@@ -665,7 +665,15 @@ async fn remote_listening_needs_a_user_and_serves_only_tls() {
     // certificate is valid for the new name (and the earlier ones); a name given twice is one.
     let s = Server::start_with(
         db,
-        &["--tls", "--public-name", "cell-7.example", "--public-name", "machine.example", "--public-name", "cell-7.example"],
+        &[
+            "--tls",
+            "--public-name",
+            "cell-7.example",
+            "--public-name",
+            "machine.example",
+            "--public-name",
+            "cell-7.example",
+        ],
     );
     let log = s.log.lock().unwrap().join("\n");
     assert!(!log.contains(&fp), "renewed: {log}");
@@ -796,13 +804,36 @@ async fn tokens_made_in_open_mode_end_when_authentication_turns_on() {
     assert_eq!(r.status, 201, "{}", r.text);
     let r = call(&s, "GET", "/api/v1/axes", Some(&open), "c", None).await;
     assert_eq!(r.status, 401, "the open-mode token ends: {}", r.text);
-    let r = call(&s, "POST", "/api/v1/axes/x/power", Some(&open), "c", Some(json!({}))).await;
+    let r = call(
+        &s,
+        "POST",
+        "/api/v1/axes/x/power",
+        Some(&open),
+        "c",
+        Some(json!({})),
+    )
+    .await;
     assert_eq!(r.status, 401, "{}", r.text);
     let cookie = login(&s, "anna", "secret-pass-1").await;
     let tokens = call(&s, "GET", "/api/v1/tokens", Some(&cookie), "c", None).await;
-    let t = tokens.json.as_array().unwrap().iter().find(|t| t["name"] == "made-anonymously").cloned().unwrap();
+    let t = tokens
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["name"] == "made-anonymously")
+        .cloned()
+        .unwrap();
     assert!(t["revoked_at"].is_string(), "{t}");
-    let audit = call(&s, "GET", "/api/v1/audit?limit=20", Some(&cookie), "c", None).await;
+    let audit = call(
+        &s,
+        "GET",
+        "/api/v1/audit?limit=20",
+        Some(&cookie),
+        "c",
+        None,
+    )
+    .await;
     assert!(
         audit.text.contains("authentication turned on") && audit.text.contains("made-anonymously"),
         "{}",

@@ -89,8 +89,10 @@ async fn a_flood_of_half_sent_requests_does_not_lock_a_client_out() {
         let mut tries = 0;
         let answer = loop {
             let mut c = TcpStream::connect(&s.addr).unwrap();
-            c.write_all(b"GET /api/v1/system HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")
-                .unwrap();
+            c.write_all(
+                b"GET /api/v1/system HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n",
+            )
+            .unwrap();
             let answer = read_to_close(c);
             if !answer.starts_with("HTTP/1.1 503") {
                 break answer;

@@ -461,7 +461,10 @@ fn the_binary_drives_an_emulated_segment_over_a_veth_pair() {
             assert_eq!(v.json["unsigned"], 0x2026_0001u32, "{}", v.text);
             // The demo axes stay simulated on real EtherCAT (their scaling would be a guess);
             // an axis is created on drive 1.
-            assert_eq!(get(&s, "/api/v1/axes/y").await.json["config"]["drive"]["kind"], "simulated");
+            assert_eq!(
+                get(&s, "/api/v1/axes/y").await.json["config"]["drive"]["kind"],
+                "simulated"
+            );
             create_z_on_drive(&s, 1).await;
             power_on_retrying(&s, "z").await;
             let m = post(
@@ -499,13 +502,35 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
     let s = Server::start_with(db, &[]);
     assert!(get(&s, "/api/v1/bus").await.json["notice"].is_null());
     s.stop();
-    let s = Server::start_with(db, &["--bus", "emulated", "--bus-max-errors", "5", "--bus-timeout-ms", "50"]);
+    let s = Server::start_with(
+        db,
+        &[
+            "--bus",
+            "emulated",
+            "--bus-max-errors",
+            "5",
+            "--bus-timeout-ms",
+            "50",
+        ],
+    );
     let bus = get(&s, "/api/v1/bus").await;
     let notice = bus.json["notice"].as_str().unwrap_or_default().to_owned();
-    assert!(notice.contains("position 0, 1, 2 drive no axis"), "{}", bus.text);
-    assert!(notice.contains("x, y, spindle") || notice.contains("simulated"), "{notice}");
+    assert!(
+        notice.contains("position 0, 1, 2 drive no axis"),
+        "{}",
+        bus.text
+    );
+    assert!(
+        notice.contains("x, y, spindle") || notice.contains("simulated"),
+        "{notice}"
+    );
     assert!(notice.contains("PUT /api/v1/axes/{axis}"), "{notice}");
-    let logged = s.log.lock().unwrap().iter().any(|l| l.contains("drive no axis"));
+    let logged = s
+        .log
+        .lock()
+        .unwrap()
+        .iter()
+        .any(|l| l.contains("drive no axis"));
     assert!(logged, "{:?}", s.log.lock().unwrap());
     // Put x on drive 0: only 1 and 2 are named.
     let mut cfg = get(&s, "/api/v1/axes/x").await.json["config"].clone();
@@ -514,7 +539,11 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
     assert_eq!(r.status, 200, "{}", r.text);
     let bus = get(&s, "/api/v1/bus").await;
     let notice = bus.json["notice"].as_str().unwrap_or_default();
-    assert!(notice.contains("position 1, 2 drive no axis"), "{}", bus.text);
+    assert!(
+        notice.contains("position 1, 2 drive no axis"),
+        "{}",
+        bus.text
+    );
     s.stop();
 }
 
@@ -526,22 +555,47 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
 async fn a_drive_without_optional_objects_refuses_the_blocks_that_need_them() {
     let s = Server::start_with(
         ":memory:",
-        &["--bus", "emulated", "--emulated-strict-drives", "--bus-max-errors", "5", "--bus-timeout-ms", "50"],
+        &[
+            "--bus",
+            "emulated",
+            "--emulated-strict-drives",
+            "--bus-max-errors",
+            "5",
+            "--bus-timeout-ms",
+            "50",
+        ],
     );
     let bus = get(&s, "/api/v1/bus").await;
     assert_eq!(bus.json["state"], "op", "{}", bus.text);
     let sd = &bus.json["subdevices"][0];
     assert_eq!(sd["drive"]["mapping"], "available", "{}", bus.text);
     let missing = sd["drive"]["missing_objects"].to_string().to_lowercase();
-    assert!(missing.contains("0x60b8") && missing.contains("0x60fd"), "{}", bus.text);
+    assert!(
+        missing.contains("0x60b8") && missing.contains("0x60fd"),
+        "{}",
+        bus.text
+    );
     assert_eq!(sd["axis"], "x", "{}", bus.text);
     power_on_retrying(&s, "x").await;
-    let r = post(&s, "/api/v1/axes/x/touch-probe", json!({"signal": "input1", "edge": "rising"})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/x/touch-probe",
+        json!({"signal": "input1", "edge": "rising"}),
+    )
+    .await;
     assert_problem(&r, 409, "drive_object_missing");
-    assert!(r.json["detail"].as_str().unwrap().contains("0x60B8"), "{}", r.text);
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("0x60B8"),
+        "{}",
+        r.text
+    );
     let r = post(&s, "/api/v1/axes/x/home", json!({})).await;
     assert_problem(&r, 409, "drive_object_missing");
-    assert!(r.json["detail"].as_str().unwrap().contains("0x60FD"), "{}", r.text);
+    assert!(
+        r.json["detail"].as_str().unwrap().contains("0x60FD"),
+        "{}",
+        r.text
+    );
     // Nothing was started; a move is not refused.
     let m = post(
         &s,
@@ -574,7 +628,14 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             emulate_segment_on_ecb(&["--drives", "1", "--strict-drives", "--late-reply-ms", "15"]);
         let s = Server::start_with(
             ":memory:",
-            &["--bus", "ethercat", "--interface", "ecA", "--bus-max-errors", "50"],
+            &[
+                "--bus",
+                "ethercat",
+                "--interface",
+                "ecA",
+                "--bus-max-errors",
+                "50",
+            ],
         );
         let rt = tokio::runtime::Builder::new_current_thread()
             .enable_all()
@@ -585,7 +646,14 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             assert_eq!(bus.json["state"], "op", "{}", bus.text);
             let drive = &bus.json["subdevices"][0]["drive"];
             assert_eq!(drive["mapping"], "available", "{}", bus.text);
-            assert!(drive["missing_objects"].to_string().to_lowercase().contains("0x60b8"), "{}", bus.text);
+            assert!(
+                drive["missing_objects"]
+                    .to_string()
+                    .to_lowercase()
+                    .contains("0x60b8"),
+                "{}",
+                bus.text
+            );
             create_z_on_drive(&s, 0).await;
             power_on_retrying(&s, "z").await;
             // A move long enough for late replies to come while it runs.
@@ -597,8 +665,16 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             .await;
             assert_eq!(m.json["state"], "done", "{}", m.text);
             let bus = get(&s, "/api/v1/bus").await;
-            assert!(bus.json["late_replies"].as_u64().unwrap() > 0, "{}", bus.text);
-            assert_eq!(bus.json["faults"], 0, "late replies never fault the bus: {}", bus.text);
+            assert!(
+                bus.json["late_replies"].as_u64().unwrap() > 0,
+                "{}",
+                bus.text
+            );
+            assert_eq!(
+                bus.json["faults"], 0,
+                "late replies never fault the bus: {}",
+                bus.text
+            );
             // The loop stopped: reported, then brought back by a reset.
             let r = post(&s, "/api/v1/bus/faults", json!({"stop_txrx": true})).await;
             assert_eq!(r.status, 204, "{}", r.text);

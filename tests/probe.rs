@@ -140,7 +140,12 @@ async fn calc_dynamics_by_ramp_time_gives_the_ramp_of_the_manual() {
 async fn a_mark_after_homing_is_recorded_where_it_was_given() {
     let s = Server::start();
     power_on(&s, "x").await;
-    let h = post(&s, "/api/v1/axes/x/home?wait=true&timeout_ms=20000", json!({})).await;
+    let h = post(
+        &s,
+        "/api/v1/axes/x/home?wait=true&timeout_ms=20000",
+        json!({}),
+    )
+    .await;
     assert_eq!(h.json["state"], "done", "{}", h.text);
     let st = status(&s, "x").await;
     assert_eq!(st["status"]["homed"], true, "{st}");
@@ -151,7 +156,12 @@ async fn a_mark_after_homing_is_recorded_where_it_was_given() {
     )
     .await;
     assert_eq!(r.status, 204, "{}", r.text);
-    let p = post(&s, "/api/v1/axes/x/touch-probe", json!({"signal": "input1", "edge": "rising"})).await;
+    let p = post(
+        &s,
+        "/api/v1/axes/x/touch-probe",
+        json!({"signal": "input1", "edge": "rising"}),
+    )
+    .await;
     assert_eq!(p.status, 202, "{}", p.text);
     let id = p.json["id"].as_u64().unwrap();
     let m = post(

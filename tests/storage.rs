@@ -107,7 +107,10 @@ fn start_in_sh(db: &str, script: &str) -> Server {
 /// (util-linux `prlimit` on the running process). `false` when it cannot be done here.
 fn fill_the_disk(s: &Server) -> bool {
     let pid = s.child.id().to_string();
-    match Command::new("prlimit").args(["--pid", &pid, "--fsize=0:0"]).output() {
+    match Command::new("prlimit")
+        .args(["--pid", &pid, "--fsize=0:0"])
+        .output()
+    {
         Ok(o) if o.status.success() => true,
         Ok(o) => {
             cannot_run(
@@ -136,12 +139,22 @@ async fn a_stop_acts_on_a_full_disk_past_the_reserved_ids() {
     let db = db.to_str().unwrap();
     let s = start_ignoring_xfsz(db);
     power_on(&s, "spindle").await;
-    let m = post(&s, "/api/v1/axes/spindle/move-velocity", json!({"velocity": 100.0})).await;
+    let m = post(
+        &s,
+        "/api/v1/axes/spindle/move-velocity",
+        json!({"velocity": 100.0}),
+    )
+    .await;
     assert_eq!(m.status, 202, "{}", m.text);
     if !fill_the_disk(&s) {
         return;
     }
-    let r = put(&s, "/api/v1/axes/x/parameters/AxisVeloMax", json!({"value": 700.0, "persistent": true})).await;
+    let r = put(
+        &s,
+        "/api/v1/axes/x/parameters/AxisVeloMax",
+        json!({"value": 700.0, "persistent": true}),
+    )
+    .await;
     assert_problem(&r, 503, "storage_unavailable");
     // Use up the block of reserved ids: commands that the axis refuses (y is disabled) take an
     // id each without moving anything. Eight at a time; the first 503 is the end of the block.
@@ -182,9 +195,19 @@ async fn a_stop_acts_on_a_full_disk_past_the_reserved_ids() {
     // The spindle still turns; a move is refused, the stop acts.
     let st = status(&s, "spindle").await["status"].clone();
     assert!(st["actual_velocity"].as_f64().unwrap() > 50.0, "{st}");
-    let r = post(&s, "/api/v1/axes/spindle/move-velocity", json!({"velocity": 50.0})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/spindle/move-velocity",
+        json!({"velocity": 50.0}),
+    )
+    .await;
     assert_problem(&r, 503, "storage_unavailable");
-    let r = post(&s, "/api/v1/axes/spindle/stop?wait=true&timeout_ms=20000", json!({})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/spindle/stop?wait=true&timeout_ms=20000",
+        json!({}),
+    )
+    .await;
     assert_eq!(r.status, 202, "{}", r.text);
     assert_eq!(r.json["state"], "done", "{}", r.text);
     let st = status(&s, "spindle").await["status"].clone();
@@ -193,13 +216,24 @@ async fn a_stop_acts_on_a_full_disk_past_the_reserved_ids() {
     // Halt and power-off act too.
     let r = post(&s, "/api/v1/axes/spindle/halt", json!({})).await;
     assert_ne!(r.status, 503, "{}", r.text);
-    let r = post(&s, "/api/v1/axes/spindle/power?wait=true", json!({"enable": false})).await;
+    let r = post(
+        &s,
+        "/api/v1/axes/spindle/power?wait=true",
+        json!({"enable": false}),
+    )
+    .await;
     assert_eq!(r.status, 202, "{}", r.text);
     assert_eq!(status(&s, "spindle").await["status"]["state"], "disabled");
     // The audit rows that could not be stored are counted.
-    let m = reqwest::get(s.url("/metrics")).await.unwrap().text().await.unwrap();
+    let m = reqwest::get(s.url("/metrics"))
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
     assert!(
-        m.lines().any(|l| l.starts_with("motiond_audit_dropped") && !l.ends_with(" 0")),
+        m.lines()
+            .any(|l| l.starts_with("motiond_audit_dropped") && !l.ends_with(" 0")),
         "{m}"
     );
     s.stop();

@@ -815,12 +815,26 @@ async fn a_batch_of_requests_gets_one_array_of_responses() {
         {"jsonrpc": "2.0", "id": 4, "method": "no-such-method", "params": {}},
         7
     ]);
-    ws.send(Message::Text(batch.to_string().into())).await.unwrap();
+    ws.send(Message::Text(batch.to_string().into()))
+        .await
+        .unwrap();
     let answer = next_raw(&mut ws).await;
-    let answers = answer.as_array().unwrap_or_else(|| panic!("an array: {answer}"));
+    let answers = answer
+        .as_array()
+        .unwrap_or_else(|| panic!("an array: {answer}"));
     assert_eq!(answers.len(), 4, "{answer}");
-    let by_id = |id: Value| answers.iter().find(|a| a["id"] == id).cloned().unwrap_or_else(|| panic!("{id}: {answer}"));
-    assert_eq!(by_id(json!(1))["result"]["outputs"]["status"], true, "{answer}");
+    let by_id = |id: Value| {
+        answers
+            .iter()
+            .find(|a| a["id"] == id)
+            .cloned()
+            .unwrap_or_else(|| panic!("{id}: {answer}"))
+    };
+    assert_eq!(
+        by_id(json!(1))["result"]["outputs"]["status"],
+        true,
+        "{answer}"
+    );
     assert!(by_id(json!(3))["result"].is_object(), "{answer}");
     assert_eq!(by_id(json!(4))["error"]["code"], -32601, "{answer}");
     assert_eq!(by_id(Value::Null)["error"]["code"], -32600, "{answer}");
@@ -836,7 +850,9 @@ async fn a_batch_of_requests_gets_one_array_of_responses() {
     assert_eq!(e["error"]["code"], -32600, "{e}");
     // Notifications alone: no answer — the next message answers the next request.
     let only = json!([{"jsonrpc": "2.0", "method": "reset", "params": {"axis": "x"}}]);
-    ws.send(Message::Text(only.to_string().into())).await.unwrap();
+    ws.send(Message::Text(only.to_string().into()))
+        .await
+        .unwrap();
     send(&mut ws, 9, "reset", json!({"axis": "y"})).await;
     let m = next_raw(&mut ws).await;
     assert_eq!(m["id"], 9, "{m}");

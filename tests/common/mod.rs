@@ -245,7 +245,11 @@ pub fn cannot_run(test: &str, why: &str) {
     eprintln!("SKIPPED {test}: {why}");
     if let Ok(path) = std::env::var("MOTIOND_SKIPPED_LOG") {
         use std::io::Write;
-        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
             let _ = writeln!(f, "{test}: {why}");
         }
     }

@@ -52,7 +52,11 @@ fn cannot_run(why: &str) {
     println!("SKIPPED veth::the_maindevice_on_a_veth_pair: {why}");
     if let Ok(path) = std::env::var("MOTIOND_SKIPPED_LOG") {
         use std::io::Write;
-        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
             let _ = writeln!(f, "veth::the_maindevice_on_a_veth_pair: {why}");
         }
     }

@@ -244,7 +244,10 @@ impl Kernel {
 
     /// One more than the highest slot that holds an axis (0: none).
     pub fn slots_in_use(&self) -> usize {
-        self.axes.iter().rposition(Option::is_some).map_or(0, |i| i + 1)
+        self.axes
+            .iter()
+            .rposition(Option::is_some)
+            .map_or(0, |i| i + 1)
     }
 
     pub fn status(&self, slot: AxisSlot) -> Option<AxisStatus> {

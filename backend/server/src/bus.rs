@@ -77,7 +77,11 @@ impl BusHandle {
         else {
             return Vec::new();
         };
-        needed.iter().copied().filter(|&i| !layout.maps(i)).collect()
+        needed
+            .iter()
+            .copied()
+            .filter(|&i| !layout.maps(i))
+            .collect()
     }
 
     /// Positions of the SubDevices that are CiA-402 drives.

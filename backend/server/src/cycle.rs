@@ -509,7 +509,10 @@ impl CycleThread {
                         Verdict::Rejected(e) => Err(e),
                     };
                     // Taken also after an acceptance, so that no stale hint stays behind.
-                    let hint = self.kernel.axis(cmd.axis).and_then(|a| a.take_refusal_hint());
+                    let hint = self
+                        .kernel
+                        .axis(cmd.axis)
+                        .and_then(|a| a.take_refusal_hint());
                     Reply {
                         hint: hint.filter(|_| result.is_err()),
                         ticket: cmd.id,
@@ -606,9 +609,11 @@ impl CycleThread {
                     // A mark is given where the axis reads it (after homing, a set position, a
                     // correction …); the simulated load carries it in the drive's coordinates.
                     let fault = match (fault, self.kernel.axis(slot)) {
-                        (SimFault::ProbeMark { position: Some(p) }, Some(a)) => SimFault::ProbeMark {
-                            position: Some(a.drive_position_of(p)),
-                        },
+                        (SimFault::ProbeMark { position: Some(p) }, Some(a)) => {
+                            SimFault::ProbeMark {
+                                position: Some(a.drive_position_of(p)),
+                            }
+                        }
                         (f, _) => f,
                     };
                     let result = match self.bus.inject(slot as usize, fault) {

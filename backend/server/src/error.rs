@@ -51,7 +51,10 @@ pub enum AppError {
     },
     /// 422 `validation_failed`: the fields at fault, one of them a condition with a number of
     /// its own (a cam table id out of 1..255 is 0x4B32) given as `error_id`.
-    InvalidNumbered { errors: Vec<FieldError>, id: ErrorId },
+    InvalidNumbered {
+        errors: Vec<FieldError>,
+        id: ErrorId,
+    },
     /// 409: the axis refused the command (its PLCopen ErrorID is the code).
     Rejected(ErrorId),
     /// 409: the axis refused the command, with what was in the way (the axis state, its error,
@@ -191,7 +194,9 @@ impl AppError {
         use AppError::*;
         match self {
             NotFound { .. } => StatusCode::NOT_FOUND,
-            Invalid(_) | InvalidNumbered { .. } | Refused { .. } => StatusCode::UNPROCESSABLE_ENTITY,
+            Invalid(_) | InvalidNumbered { .. } | Refused { .. } => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
             Rejected(_) | RejectedBecause { .. } | Conflict { .. } => StatusCode::CONFLICT,
             Kernel { status, .. } | Http { status, .. } => *status,
             Unavailable { .. } | Storage(_) => StatusCode::SERVICE_UNAVAILABLE,

@@ -544,7 +544,11 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     let cycle_time = args.cycle_us as f64 * 1e-6;
     // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
     let (bus, bus_handle) = {
-        let (kind, iface, strict) = (args.bus, args.interface.clone(), args.emulated_strict_drives);
+        let (kind, iface, strict) = (
+            args.bus,
+            args.interface.clone(),
+            args.emulated_strict_drives,
+        );
         let (cycle, max, timeout) = (
             std::time::Duration::from_micros(args.cycle_us as u64),
             args.bus_max_errors,
@@ -552,7 +556,15 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
                 .map(|ms| std::time::Duration::from_millis(ms as u64)),
         );
         tokio::task::spawn_blocking(move || {
-            bus::start(kind, iface.as_deref(), strict, cycle, max, timeout, cycle::MAX_AXES)
+            bus::start(
+                kind,
+                iface.as_deref(),
+                strict,
+                cycle,
+                max,
+                timeout,
+                cycle::MAX_AXES,
+            )
         })
         .await
         .map_err(|e| format!("the bus start-up failed: {e}"))?

@@ -590,8 +590,18 @@ fn batch_of(text: &str) -> Option<Result<Vec<Value>, String>> {
     }
     Some(match serde_json::from_str::<Value>(text) {
         Ok(Value::Array(calls)) if !calls.is_empty() => Ok(calls),
-        Ok(_) => Err(rpc_error(&Value::Null, -32600, "invalid request: an empty batch", None)),
-        Err(e) => Err(rpc_error(&Value::Null, -32700, &format!("parse error: {e}"), None)),
+        Ok(_) => Err(rpc_error(
+            &Value::Null,
+            -32600,
+            "invalid request: an empty batch",
+            None,
+        )),
+        Err(e) => Err(rpc_error(
+            &Value::Null,
+            -32700,
+            &format!("parse error: {e}"),
+            None,
+        )),
     })
 }
 

@@ -181,7 +181,13 @@ impl Feed {
 
     /// The update of axis `slot` at `tick` for a subscriber that was last sent version `seen`
     /// (`None`: nothing yet); `None` when the axis has no status.
-    pub fn piece(&self, s: &AppState, slot: AxisSlot, tick: u64, seen: Option<u64>) -> Option<Piece> {
+    pub fn piece(
+        &self,
+        s: &AppState,
+        slot: AxisSlot,
+        tick: u64,
+        seen: Option<u64>,
+    ) -> Option<Piece> {
         let axis = self.axes.get(slot as usize)?;
         // Most subscribers find what they need made already: a shared read.
         {
@@ -279,8 +285,14 @@ mod tests {
 
     #[test]
     fn a_delta_has_the_changed_members_and_parses_as_their_values() {
-        let a = version(1, json!({"p": 1.5, "s": "standstill", "n": {"x": 1}, "k": true}));
-        let b = version(2, json!({"p": 2.5, "s": "standstill", "n": {"x": 2}, "k": true}));
+        let a = version(
+            1,
+            json!({"p": 1.5, "s": "standstill", "n": {"x": 1}, "k": true}),
+        );
+        let b = version(
+            2,
+            json!({"p": 2.5, "s": "standstill", "n": {"x": 2}, "k": true}),
+        );
         let d: Value = serde_json::from_str(&delta_json(&a, &b).unwrap()).unwrap();
         assert_eq!(d, json!({"p": 2.5, "n": {"x": 2}}));
         assert!(delta_json(&a, &a).is_none());
@@ -294,7 +306,8 @@ mod tests {
     fn answers_come_from_kept_versions_and_a_subscriber_too_far_behind_gets_the_whole() {
         let mut f = AxisFeed::default();
         for c in 1..=(KEPT as u64 + 2) {
-            f.versions.push_back(Arc::new(version(c, json!({"c": c, "k": 0}))));
+            f.versions
+                .push_back(Arc::new(version(c, json!({"c": c, "k": 0}))));
             if f.versions.len() > KEPT {
                 f.versions.pop_front();
             }

@@ -1297,7 +1297,11 @@ pub fn refusal_why(
         let n = |v: f64| {
             let t = format!("{v:.6}");
             let t = t.trim_end_matches('0').trim_end_matches('.');
-            if t == "-0" { "0".to_owned() } else { t.to_owned() }
+            if t == "-0" {
+                "0".to_owned()
+            } else {
+                t.to_owned()
+            }
         };
         return Some(format!(
             "the cam puts the slave at {} (velocity {}) now, the slave is at {}: move it there \

@@ -268,7 +268,9 @@ impl Control {
         if !self.enabled {
             return Ok(());
         }
-        if stops_motion(kind) || matches!(kind, CommandKind::TouchProbe(_) | CommandKind::AbortTrigger) {
+        if stops_motion(kind)
+            || matches!(kind, CommandKind::TouchProbe(_) | CommandKind::AbortTrigger)
+        {
             // A probe moves nothing.
             return Ok(());
         }

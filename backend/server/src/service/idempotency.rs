@@ -168,20 +168,16 @@ pub async fn run_once<B>(
         Begin::Reused => return Err(reused()),
     }
     // Not in memory: sent before a restart (or so long ago that memory let it go)?
-    let stored = match store::find_idempotency_key(
-        &s.db,
-        &key,
-        principal.as_deref(),
-        client_id.as_deref(),
-    )
-    .await
-    {
-        Ok(r) => r,
-        Err(e) => {
-            s.idempotency.finish(&scoped, None);
-            return Err(AppError::storage(e));
-        }
-    };
+    let stored =
+        match store::find_idempotency_key(&s.db, &key, principal.as_deref(), client_id.as_deref())
+            .await
+        {
+            Ok(r) => r,
+            Err(e) => {
+                s.idempotency.finish(&scoped, None);
+                return Err(AppError::storage(e));
+            }
+        };
     let cutoff = humantime::format_rfc3339_millis(SystemTime::now() - TTL).to_string();
     if let Some((id, action, target, detail, outcome, at)) = stored.filter(|r| r.5 >= cutoff) {
         s.idempotency.finish(&scoped, None);

@@ -205,10 +205,11 @@ pub async fn revoke_all_tokens<'e, E: sqlx::SqliteExecutor<'e>>(
     e: E,
     at: &str,
 ) -> Result<Vec<String>, sqlx::Error> {
-    let rows = sqlx::query("UPDATE api_tokens SET revoked_at = ? WHERE revoked_at IS NULL RETURNING name")
-        .bind(at)
-        .fetch_all(e)
-        .await?;
+    let rows =
+        sqlx::query("UPDATE api_tokens SET revoked_at = ? WHERE revoked_at IS NULL RETURNING name")
+            .bind(at)
+            .fetch_all(e)
+            .await?;
     Ok(rows.iter().map(|r| r.get::<String, _>(0)).collect())
 }
 
