@@ -389,6 +389,24 @@ impl Drop for Killed {
     }
 }
 
+/// Runs `body` on a thread of its own inside a private network namespace with the veth pair
+/// (sockets made on that thread are in it); a test that cannot get one says so
+/// (`cannot_run`: it fails under CI).
+fn in_private_veth(test: &str, body: impl FnOnce() + Send + 'static) {
+    let test = test.to_owned();
+    let t = std::thread::spawn(move || {
+        if let Err(why) = private_veth() {
+            cannot_run(
+                &test,
+                &format!("the veth tier needs a network namespace: {why}"),
+            );
+            return;
+        }
+        body();
+    });
+    t.join().expect("the test thread");
+}
+
 /// Moves the calling thread into a new network namespace with loopback up and a veth pair
 /// `ecA`–`ecB`; `Err` says why not (then the raw-socket tier is skipped).
 fn private_veth() -> Result<(), String> {
@@ -422,73 +440,68 @@ fn private_veth() -> Result<(), String> {
 }
 
 /// The raw-socket tier: `motiond emulate-segment` answers on one end of a veth pair in a
-/// network namespace this test makes, `motiond --bus ethercat --interface` runs ethercrab's
-/// own raw-socket path on the other: bring-up to OP, an axis created on drive 1 moves there.
+/// network namespace this test makes, `motiond --bus ethercat --interface` runs its raw-socket
+/// TX/RX loop on the other: bring-up to OP, an axis created on drive 1 moves there.
 #[test]
 fn the_binary_drives_an_emulated_segment_over_a_veth_pair() {
-    let t = std::thread::spawn(|| {
-        if let Err(why) = private_veth() {
-            cannot_run(
-                "ethercat::the_binary_drives_an_emulated_segment_over_a_veth_pair",
-                &format!("the veth tier needs a network namespace: {why}"),
+    in_private_veth(
+        "ethercat::the_binary_drives_an_emulated_segment_over_a_veth_pair",
+        || {
+            let emulator = emulate_segment_on_ecb(&["--drives", "2"]);
+            let s = Server::start_with(
+                ":memory:",
+                &[
+                    "--bus",
+                    "ethercat",
+                    "--interface",
+                    "ecA",
+                    "--bus-max-errors",
+                    "50",
+                ],
             );
-            return;
-        }
-        let emulator = emulate_segment_on_ecb(&["--drives", "2"]);
-        let s = Server::start_with(
-            ":memory:",
-            &[
-                "--bus",
-                "ethercat",
-                "--interface",
-                "ecA",
-                "--bus-max-errors",
-                "50",
-            ],
-        );
-        // Sockets of this runtime are made on this thread: inside the namespace.
-        let rt = tokio::runtime::Builder::new_current_thread()
-            .enable_all()
-            .build()
-            .unwrap();
-        rt.block_on(async {
-            let bus = get(&s, "/api/v1/bus").await;
-            assert_eq!(bus.json["kind"], "ethercat", "{}", bus.text);
-            assert_eq!(bus.json["interface"], "ecA");
-            assert_eq!(bus.json["state"], "op", "{}", bus.text);
-            assert_eq!(bus.json["subdevices"].as_array().unwrap().len(), 2);
-            let v = get(&s, "/api/v1/bus/subdevices/1/sdo/0x1018/4").await;
-            assert_eq!(v.json["unsigned"], 0x2026_0001u32, "{}", v.text);
-            // The demo axes stay simulated on real EtherCAT (their scaling would be a guess);
-            // an axis is created on drive 1.
-            assert_eq!(
-                get(&s, "/api/v1/axes/y").await.json["config"]["drive"]["kind"],
-                "simulated"
-            );
-            create_z_on_drive(&s, 1).await;
-            power_on_retrying(&s, "z").await;
-            let m = post(
-                &s,
-                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=20000",
-                json!({"position": -40.0, "velocity": 200.0}),
-            )
-            .await;
-            assert_eq!(m.json["state"], "done", "{}", m.text);
-            until_status(&s, "z", "at -40", |st| {
-                (st["actual_position"].as_f64().unwrap() + 40.0).abs() < 0.002
-            })
-            .await;
-            let pos = get(&s, "/api/v1/bus/subdevices/1/sdo/0x6064/0").await;
-            assert!(
-                (pos.json["signed"].as_i64().unwrap() + 40_000).abs() <= 2,
-                "{}",
-                pos.text
-            );
-        });
-        s.stop();
-        drop(emulator);
-    });
-    t.join().expect("the test thread");
+            // Sockets of this runtime are made on this thread: inside the namespace.
+            let rt = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap();
+            rt.block_on(async {
+                let bus = get(&s, "/api/v1/bus").await;
+                assert_eq!(bus.json["kind"], "ethercat", "{}", bus.text);
+                assert_eq!(bus.json["interface"], "ecA");
+                assert_eq!(bus.json["state"], "op", "{}", bus.text);
+                assert_eq!(bus.json["subdevices"].as_array().unwrap().len(), 2);
+                let v = get(&s, "/api/v1/bus/subdevices/1/sdo/0x1018/4").await;
+                assert_eq!(v.json["unsigned"], 0x2026_0001u32, "{}", v.text);
+                // The demo axes stay simulated on real EtherCAT (their scaling would be a guess);
+                // an axis is created on drive 1.
+                assert_eq!(
+                    get(&s, "/api/v1/axes/y").await.json["config"]["drive"]["kind"],
+                    "simulated"
+                );
+                create_z_on_drive(&s, 1).await;
+                power_on_retrying(&s, "z").await;
+                let m = post(
+                    &s,
+                    "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=20000",
+                    json!({"position": -40.0, "velocity": 200.0}),
+                )
+                .await;
+                assert_eq!(m.json["state"], "done", "{}", m.text);
+                until_status(&s, "z", "at -40", |st| {
+                    (st["actual_position"].as_f64().unwrap() + 40.0).abs() < 0.002
+                })
+                .await;
+                let pos = get(&s, "/api/v1/bus/subdevices/1/sdo/0x6064/0").await;
+                assert!(
+                    (pos.json["signed"].as_i64().unwrap() + 40_000).abs() <= 2,
+                    "{}",
+                    pos.text
+                );
+            });
+            s.stop();
+            drop(emulator);
+        },
+    );
 }
 
 /// `--bus emulated` on a database made on the simulated bus keeps its (simulated) axes, and
@@ -616,97 +629,97 @@ async fn a_drive_without_optional_objects_refuses_the_blocks_that_need_them() {
 /// brings the segment back to OP without a restart, and the axis moves again.
 #[test]
 fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
-    let t = std::thread::spawn(|| {
-        if let Err(why) = private_veth() {
-            cannot_run(
-                "ethercat::a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives",
-                &format!("the veth tier needs a network namespace: {why}"),
+    in_private_veth(
+        "ethercat::a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives",
+        || {
+            let emulator = emulate_segment_on_ecb(&[
+                "--drives",
+                "1",
+                "--strict-drives",
+                "--late-reply-ms",
+                "15",
+            ]);
+            let s = Server::start_with(
+                ":memory:",
+                &[
+                    "--bus",
+                    "ethercat",
+                    "--interface",
+                    "ecA",
+                    "--bus-max-errors",
+                    "50",
+                ],
             );
-            return;
-        }
-        let emulator =
-            emulate_segment_on_ecb(&["--drives", "1", "--strict-drives", "--late-reply-ms", "15"]);
-        let s = Server::start_with(
-            ":memory:",
-            &[
-                "--bus",
-                "ethercat",
-                "--interface",
-                "ecA",
-                "--bus-max-errors",
-                "50",
-            ],
-        );
-        let rt = tokio::runtime::Builder::new_current_thread()
-            .enable_all()
-            .build()
-            .unwrap();
-        rt.block_on(async {
-            let bus = get(&s, "/api/v1/bus").await;
-            assert_eq!(bus.json["state"], "op", "{}", bus.text);
-            let drive = &bus.json["subdevices"][0]["drive"];
-            assert_eq!(drive["mapping"], "available", "{}", bus.text);
-            assert!(
-                drive["missing_objects"]
-                    .to_string()
-                    .to_lowercase()
-                    .contains("0x60b8"),
-                "{}",
-                bus.text
-            );
-            create_z_on_drive(&s, 0).await;
-            power_on_retrying(&s, "z").await;
-            // A move long enough for late replies to come while it runs.
-            let m = post(
-                &s,
-                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
-                json!({"position": 100.0, "velocity": 50.0}),
-            )
-            .await;
-            assert_eq!(m.json["state"], "done", "{}", m.text);
-            let bus = get(&s, "/api/v1/bus").await;
-            assert!(
-                bus.json["late_replies"].as_u64().unwrap() > 0,
-                "{}",
-                bus.text
-            );
-            assert_eq!(
-                bus.json["faults"], 0,
-                "late replies never fault the bus: {}",
-                bus.text
-            );
-            // The loop stopped: reported, then brought back by a reset.
-            let r = post(&s, "/api/v1/bus/faults", json!({"stop_txrx": true})).await;
-            assert_eq!(r.status, 204, "{}", r.text);
-            let deadline = Instant::now() + Duration::from_secs(20);
-            let faulted = loop {
-                let b = get(&s, "/api/v1/bus").await;
-                if b.json["state"] == "faulted" {
-                    break b;
-                }
-                assert!(Instant::now() < deadline, "{}", b.text);
-                tokio::time::sleep(Duration::from_millis(20)).await;
-            };
-            assert!(faulted.json["fault_reason"].is_string(), "{}", faulted.text);
-            assert_eq!(faulted.json["txrx"]["running"], false, "{}", faulted.text);
-            let st = until_status(&s, "z", "bus error", |st| st["state"] == "error_stop").await;
-            assert_eq!(st["error_id"], 0x70A0);
-            let r = post(&s, "/api/v1/bus/reset", json!({})).await;
-            assert_eq!(r.status, 200, "{}", r.text);
-            assert_eq!(r.json["state"], "op", "{}", r.text);
-            assert_eq!(r.json["txrx"]["restarts"], 1, "{}", r.text);
-            reset_to_standstill(&s, "z").await;
-            power_on_retrying(&s, "z").await;
-            let m = post(
-                &s,
-                "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
-                json!({"position": 50.0, "velocity": 100.0}),
-            )
-            .await;
-            assert_eq!(m.json["state"], "done", "{}", m.text);
-        });
-        s.stop();
-        drop(emulator);
-    });
-    t.join().expect("the test thread");
+            let rt = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap();
+            rt.block_on(async {
+                let bus = get(&s, "/api/v1/bus").await;
+                assert_eq!(bus.json["state"], "op", "{}", bus.text);
+                let drive = &bus.json["subdevices"][0]["drive"];
+                assert_eq!(drive["mapping"], "available", "{}", bus.text);
+                assert!(
+                    drive["missing_objects"]
+                        .to_string()
+                        .to_lowercase()
+                        .contains("0x60b8"),
+                    "{}",
+                    bus.text
+                );
+                create_z_on_drive(&s, 0).await;
+                power_on_retrying(&s, "z").await;
+                // A move long enough for late replies to come while it runs.
+                let m = post(
+                    &s,
+                    "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
+                    json!({"position": 100.0, "velocity": 50.0}),
+                )
+                .await;
+                assert_eq!(m.json["state"], "done", "{}", m.text);
+                let bus = get(&s, "/api/v1/bus").await;
+                assert!(
+                    bus.json["late_replies"].as_u64().unwrap() > 0,
+                    "{}",
+                    bus.text
+                );
+                assert_eq!(
+                    bus.json["faults"], 0,
+                    "late replies never fault the bus: {}",
+                    bus.text
+                );
+                // The loop stopped: reported, then brought back by a reset.
+                let r = post(&s, "/api/v1/bus/faults", json!({"stop_txrx": true})).await;
+                assert_eq!(r.status, 204, "{}", r.text);
+                let deadline = Instant::now() + Duration::from_secs(20);
+                let faulted = loop {
+                    let b = get(&s, "/api/v1/bus").await;
+                    if b.json["state"] == "faulted" {
+                        break b;
+                    }
+                    assert!(Instant::now() < deadline, "{}", b.text);
+                    tokio::time::sleep(Duration::from_millis(20)).await;
+                };
+                assert!(faulted.json["fault_reason"].is_string(), "{}", faulted.text);
+                assert_eq!(faulted.json["txrx"]["running"], false, "{}", faulted.text);
+                let st = until_status(&s, "z", "bus error", |st| st["state"] == "error_stop").await;
+                assert_eq!(st["error_id"], 0x70A0);
+                let r = post(&s, "/api/v1/bus/reset", json!({})).await;
+                assert_eq!(r.status, 200, "{}", r.text);
+                assert_eq!(r.json["state"], "op", "{}", r.text);
+                assert_eq!(r.json["txrx"]["restarts"], 1, "{}", r.text);
+                reset_to_standstill(&s, "z").await;
+                power_on_retrying(&s, "z").await;
+                let m = post(
+                    &s,
+                    "/api/v1/axes/z/move-absolute?wait=true&timeout_ms=30000",
+                    json!({"position": 50.0, "velocity": 100.0}),
+                )
+                .await;
+                assert_eq!(m.json["state"], "done", "{}", m.text);
+            });
+            s.stop();
+            drop(emulator);
+        },
+    );
 }

@@ -242,14 +242,6 @@ impl Kernel {
         self.axes.get(slot as usize).and_then(|a| a.as_deref())
     }
 
-    /// One more than the highest slot that holds an axis (0: none).
-    pub fn slots_in_use(&self) -> usize {
-        self.axes
-            .iter()
-            .rposition(Option::is_some)
-            .map_or(0, |i| i + 1)
-    }
-
     pub fn status(&self, slot: AxisSlot) -> Option<AxisStatus> {
         self.axis(slot).map(|a| *a.status())
     }

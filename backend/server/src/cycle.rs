@@ -539,6 +539,7 @@ impl CycleThread {
                     } else {
                         match self.kernel.insert_axis(slot, axis) {
                             Ok(old) => {
+                                self.published = self.published.max(slot as usize + 1);
                                 if let Some(old) = old {
                                     self.discard(Garbage::Axis(old));
                                 }
@@ -736,7 +737,6 @@ impl CycleThread {
         }
 
         let cycle = self.kernel.cycle();
-        self.published = self.published.max(self.kernel.slots_in_use());
         let snap = self.snapshot.input_buffer_mut();
         snap.cycle = cycle;
         // Only the slots in use, each status copied once into its place (not the whole array

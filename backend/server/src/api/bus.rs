@@ -616,21 +616,16 @@ pub async fn inject_bus_fault(
         return Err(AppError::field("reply_delay_ms", "1..1000"));
     }
     let stop = f.stop_txrx == Some(true);
-    if f.lose_frames.is_none()
-        && f.safe_op.is_none()
-        && f.late_replies.is_none()
-        && f.duplicate_replies.is_none()
-        && !stop
-    {
+    let segment_faults = f.lose_frames.is_some()
+        || f.safe_op.is_some()
+        || f.late_replies.is_some()
+        || f.duplicate_replies.is_some();
+    if !segment_faults && !stop {
         return Err(AppError::field(
             "body",
             "give lose_frames, safe_op, late_replies, duplicate_replies or stop_txrx",
         ));
     }
-    let segment_faults = f.lose_frames.is_some()
-        || f.safe_op.is_some()
-        || f.late_replies.is_some()
-        || f.duplicate_replies.is_some();
     if stop && s.info.bus.control.is_none() {
         return Err(AppError::conflict(
             "bus_not_ethercat",
