@@ -77,6 +77,9 @@ pub struct AppState {
     pub control: crate::service::control::Control,
     /// Done MC_TouchProbe commands (id, slot) whose recorded data is still to be read.
     pub probe_results: Mutex<Vec<(u64, u16)>>,
+    /// Passes of `drain` completed: a pass that begins after a snapshot was read has applied
+    /// every command event of that snapshot's cycle (the cycle thread pushes them first).
+    pub drains: AtomicU64,
 }
 
 impl AppState {
@@ -108,6 +111,7 @@ impl AppState {
             ids_reserved: AtomicU64::new(0),
             reserve_lock: tokio::sync::Mutex::new(()),
             db,
+            drains: AtomicU64::new(0),
             audit_tx,
             audit_dropped: Arc::new(AtomicU64::new(0)),
             info,

@@ -101,6 +101,8 @@ impl AppState {
         while let Some(g) = self.shared.garbage.pop() {
             drop(g);
         }
+        self.drains
+            .fetch_add(1, std::sync::atomic::Ordering::AcqRel);
     }
 }
 

@@ -1450,6 +1450,8 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
     // while the axis stays in error_stop): looked at between notices too.
     let mut look = tokio::time::interval(Duration::from_millis(20));
     look.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    // Set when the axis was first seen in error_stop: the drain count to wait for.
+    let mut error_stop_seen: Option<u64> = None;
     loop {
         let (view, milestone, slot) = {
             let store = s.commands.lock().unwrap();
@@ -1465,7 +1467,16 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
             && view.command != "reset"
             && st.is_some_and(|st| st.state == motion::AxisState::ErrorStop)
         {
-            return Some(view);
+            // The snapshot is published before the pump applies that cycle's events: the
+            // command's own error (the reason the axis stopped) may still be in the queue. A
+            // drain that begins after this snapshot was read has applied it; only then is the
+            // command as it stands the answer.
+            let drains = s.drains.load(std::sync::atomic::Ordering::Acquire);
+            match error_stop_seen {
+                Some(after) if drains >= after => return get(s, id),
+                Some(_) => {}
+                None => error_stop_seen = Some(drains + 2),
+            }
         }
         tokio::select! {
             r = tokio::time::timeout_at(deadline, rx.recv()) => match r {
