@@ -11,7 +11,8 @@ use motion::{DriveFeedback, DriveSetpoint};
 use serde::{Deserialize, Serialize};
 
 use crate::cia402::{Cia402Config, Cia402Drive};
-use crate::sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
+use crate::error::ConfigError;
+use crate::sim::{SimDrive, SimDriveConfig, SimFault};
 
 /// How an axis's drive is configured: an object whose `kind` names the drive (`simulated`, the
 /// only one yet; CiA-402 drives on EtherCAT will be a variant beside it) and whose other
@@ -34,7 +35,7 @@ impl Default for DriveConfig {
 
 impl DriveConfig {
     /// Checks every field; errors name the field by its JSON path below the drive object.
-    pub fn validate(&self) -> Result<(), Vec<FieldError>> {
+    pub fn validate(&self) -> Result<(), Vec<ConfigError>> {
         match self {
             DriveConfig::Simulated(c) => c.validate(),
             DriveConfig::Cia402(c) => c.validate(),

@@ -9,7 +9,7 @@
 use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 use serde::{Deserialize, Serialize};
 
-use crate::sim::FieldError;
+use crate::error::ConfigError;
 
 /// Cyclic synchronous mode of operation (0x6060).
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -94,11 +94,11 @@ impl Cia402Config {
     }
 
     /// Checks every field; errors name the field by its JSON path below the drive object.
-    pub fn validate(&self) -> Result<(), Vec<FieldError>> {
+    pub fn validate(&self) -> Result<(), Vec<ConfigError>> {
         let mut errors = Vec::new();
         let mut positive = |field: &str, v: f64| {
             if !(v.is_finite() && v > 0.0) {
-                errors.push(FieldError {
+                errors.push(ConfigError {
                     field: field.into(),
                     message: "must be a finite number > 0".into(),
                 });
@@ -113,13 +113,13 @@ impl Cia402Config {
             positive("velocity_gain", self.velocity_gain);
         }
         if !(self.max_torque.is_finite() && (1.0..=32767.0).contains(&self.max_torque)) {
-            errors.push(FieldError {
+            errors.push(ConfigError {
                 field: "max_torque".into(),
                 message: "1..32767 per mille of rated torque".into(),
             });
         }
         if !(self.acceleration_feed_forward.is_finite() && self.acceleration_feed_forward >= 0.0) {
-            errors.push(FieldError {
+            errors.push(ConfigError {
                 field: "acceleration_feed_forward".into(),
                 message: "must be a finite number >= 0".into(),
             });

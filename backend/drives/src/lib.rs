@@ -21,7 +21,9 @@
 
 pub mod bus;
 pub mod cia402;
+pub mod error;
 pub mod sim;
 
 pub use bus::{BusError, Drive, DriveBus, DriveConfig, SimBus, sync_correction_ns};
-pub use sim::{FieldError, SimDrive, SimDriveConfig, SimFault};
+pub use error::ConfigError;
+pub use sim::{SimDrive, SimDriveConfig, SimFault};

@@ -64,10 +64,11 @@
 //! Everything is deterministic and `feedback`/`apply` do not allocate.
 
 use std::f64::consts::PI;
-use std::fmt;
 
 use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
 use serde::{Deserialize, Serialize};
+
+use crate::error::ConfigError;
 
 /// Fault code reported for an injected [`SimFault::DriveFault`] with code 0 (CiA 301
 /// "generic error"): a fault must never read as code 0.
@@ -78,23 +79,6 @@ pub const LIMIT_SWITCH_FAULT_CODE: u32 = 0x8612;
 
 /// Longest accepted dead time (s); the setpoint ring is sized from it and the cycle time.
 pub const MAX_DEAD_TIME: f64 = 0.1;
-
-/// One invalid field of a configuration.
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FieldError {
-    /// JSON path of the field, e.g. `plant.time_constant`.
-    pub field: String,
-    pub message: String,
-}
-
-impl fmt::Display for FieldError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.field, self.message)
-    }
-}
-
-impl std::error::Error for FieldError {}
 
 /// Model of the simulated servo drive. Times in seconds, positions in the axis's units.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -276,11 +260,11 @@ pub struct LimitSwitches {
 
 impl SimDriveConfig {
     /// Checks every field; the errors name fields by JSON path (`plant.damping`).
-    pub fn validate(&self) -> Result<(), Vec<FieldError>> {
+    pub fn validate(&self) -> Result<(), Vec<ConfigError>> {
         let mut errors = Vec::new();
         let mut check = |ok: bool, field: &str, message: &str| {
             if !ok {
-                errors.push(FieldError {
+                errors.push(ConfigError {
                     field: field.into(),
                     message: message.into(),
                 });

@@ -1,6 +1,6 @@
 //! Who is asking, and may they (DESIGN §6): users with argon2id password hashes, browser
 //! sessions (an HttpOnly cookie), API tokens for machines (`Authorization: Bearer`), and the
-//! role each route needs ([`required`]).
+//! roles (the role each route needs is the API's: `api::roles::required`).
 //!
 //! Authentication is enabled as soon as one user exists (created with `motiond user add`, on
 //! first start from `MOTIOND_ADMIN_USER` / `MOTIOND_ADMIN_PASSWORD`, or through the API);
@@ -14,7 +14,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::{Mutex, RwLock};
 use std::time::{Duration, Instant, SystemTime};
 
-use axum::http::{HeaderMap, Method, StatusCode, header};
+use axum::http::{HeaderMap, StatusCode, header};
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 use sqlx::SqlitePool;
@@ -59,41 +59,6 @@ impl Role {
             _ => return None,
         })
     }
-}
-
-/// The role a request needs, from its method and route (the matched path, with `{axis}` …);
-/// `None`: public (the UI's files, the documents, login, logout and the session query).
-/// The OpenAPI document's `security` of every operation is made from this function too.
-pub fn required(method: &Method, path: &str) -> Option<Role> {
-    use Role::*;
-    if path == "/metrics" {
-        return Some(Viewer);
-    }
-    let p = path.strip_prefix("/api/v1")?;
-    let read = method == Method::GET || method == Method::HEAD;
-    Some(match p {
-        "/auth/login" | "/auth/logout" | "/auth/session" => return None,
-        "/auth/password" => Viewer,
-        _ if p.starts_with("/users") || p.starts_with("/tokens") => Admin,
-        "/audit" => Engineer,
-        // A computation that stores nothing: whoever may read the tables may analyse one.
-        "/cam-analysis" => Viewer,
-        _ if read => Viewer,
-        "/control" => Operator,
-        "/commands/{id}" | "/commands/{id}/keepalive" => Operator,
-        "/axes/{axis}/status/following-error-peak/reset" => Operator,
-        // The external setpoint generator's samples, fed like a jog's keepalives.
-        "/axes/{axis}/ext-setpoint-gen-feed" => Operator,
-        _ if p.starts_with("/scope/") => Operator,
-        _ => match p
-            .strip_prefix("/axes/{axis}/")
-            .and_then(crate::api::blocks::find)
-        {
-            Some(block) => block.role,
-            // Axes, parameters, cam tables, configuration, fault injection.
-            None => Engineer,
-        },
-    })
 }
 
 /// An authenticated client: a user (by session) or an API token.
@@ -1013,37 +978,6 @@ mod tests {
         assert!(verify_password("correct horse", &h));
         assert!(!verify_password("correct hors", &h));
         assert!(!verify_password("correct horse", "not a hash"));
-    }
-
-    #[test]
-    fn routes_need_the_roles_of_their_class() {
-        use Role::*;
-        let r = |m: Method, p: &str| required(&m, p);
-        assert_eq!(r(Method::GET, "/"), None);
-        assert_eq!(r(Method::GET, "/openapi.json"), None);
-        assert_eq!(r(Method::POST, "/api/v1/auth/login"), None);
-        assert_eq!(r(Method::GET, "/metrics"), Some(Viewer));
-        assert_eq!(r(Method::GET, "/api/v1/axes/{axis}/status"), Some(Viewer));
-        assert_eq!(r(Method::GET, "/api/v1/ws"), Some(Viewer));
-        assert_eq!(
-            r(Method::POST, "/api/v1/axes/{axis}/move-absolute"),
-            Some(Operator)
-        );
-        assert_eq!(r(Method::POST, "/api/v1/axes/{axis}/stop"), Some(Operator));
-        assert_eq!(
-            r(Method::POST, "/api/v1/axes/{axis}/simulation/fault"),
-            Some(Engineer)
-        );
-        assert_eq!(
-            r(Method::PUT, "/api/v1/axes/{axis}/parameters/{parameter}"),
-            Some(Engineer)
-        );
-        assert_eq!(r(Method::PUT, "/api/v1/config"), Some(Engineer));
-        assert_eq!(r(Method::GET, "/api/v1/audit"), Some(Engineer));
-        assert_eq!(r(Method::POST, "/api/v1/scope/recordings"), Some(Operator));
-        assert_eq!(r(Method::POST, "/api/v1/control"), Some(Operator));
-        assert_eq!(r(Method::GET, "/api/v1/users"), Some(Admin));
-        assert_eq!(r(Method::DELETE, "/api/v1/tokens/{id}"), Some(Admin));
     }
 
     #[test]

@@ -13,7 +13,6 @@ use prometheus_client::metrics::family::Family;
 use prometheus_client::metrics::info::Info;
 use prometheus_client::registry::{Registry, Unit};
 
-use crate::app::AppState;
 use crate::stats::Histogram;
 
 /// How the service answered a submitted command.
@@ -115,12 +114,12 @@ fn read_hist(h: &Histogram, fine: bool) -> Hist {
 }
 
 #[derive(Debug)]
-struct AxisFigures {
-    name: String,
-    state: u8,
-    error_id: u32,
-    following_error: f64,
-    following_error_peak: f64,
+pub struct AxisFigures {
+    pub name: String,
+    pub state: u8,
+    pub error_id: u32,
+    pub following_error: f64,
+    pub following_error_peak: f64,
 }
 
 /// The process's figures from `/proc/self` (Linux).
@@ -300,36 +299,28 @@ impl Collector for Scrape {
     }
 }
 
+/// What a scrape reads of the running server, gathered by its caller (the service layer reads
+/// the registry and the snapshot; this module only encodes).
+pub struct Sources<'a> {
+    pub stats: &'a crate::stats::CycleStats,
+    /// Every configured axis that has a status, sorted by name.
+    pub axes: Vec<AxisFigures>,
+    pub ethercat: Option<&'a ethercat::bus::BusStatus>,
+    pub audit_dropped: u64,
+    pub cycle_time_s: f64,
+    pub sched_fifo: bool,
+    pub metrics: &'a Metrics,
+}
+
 /// The whole `/metrics` text; `fine`: every bucket of the cycle timing histograms (for
 /// windowed quantiles in benchmarks) instead of the ~20 of a normal scrape.
-pub fn render(s: &AppState, fine: bool) -> String {
-    let st = &s.shared.stats;
-    let axes = {
-        let reg = s.registry.read().unwrap();
-        let mut axes: Vec<AxisFigures> = reg
-            .axes
-            .values()
-            .filter_map(|e| {
-                let status = s.status(e.slot).1?;
-                Some(AxisFigures {
-                    name: e.name.clone(),
-                    state: status.state as u8,
-                    error_id: status.error_id,
-                    following_error: status.following_error,
-                    following_error_peak: status
-                        .following_error_min
-                        .abs()
-                        .max(status.following_error_max.abs()),
-                })
-            })
-            .collect();
-        axes.sort_by(|a, b| a.name.cmp(&b.name));
-        axes
-    };
+pub fn render(s: Sources<'_>, fine: bool) -> String {
+    let st = s.stats;
+    let axes = s.axes;
     let axes_configured = axes.len() as f64;
     let mut bus_counters = Vec::new();
     let mut bus_gauges = Vec::new();
-    if let Some((b, _)) = &s.info.bus.ethercat {
+    if let Some(b) = s.ethercat {
         bus_counters = vec![
             (
                 "motiond_bus_frames",
@@ -416,7 +407,7 @@ pub fn render(s: &AppState, fine: bool) -> String {
             (
                 "motiond_audit_dropped",
                 "Audit entries lost (queue full or write failed)",
-                s.audit_dropped.load(Relaxed),
+                s.audit_dropped,
             ),
             (
                 "motiond_requests_expired",
@@ -432,14 +423,14 @@ pub fn render(s: &AppState, fine: bool) -> String {
                 "motiond_cycle_time",
                 "Configured cycle time",
                 Some(Unit::Seconds),
-                s.info.cycle_time_s,
+                s.cycle_time_s,
             ),
             ("motiond_axes", "Configured axes", None, axes_configured),
             (
                 "motiond_realtime_granted",
                 "SCHED_FIFO granted (1) or not (0)",
                 None,
-                s.info.realtime.sched_fifo as u8 as f64,
+                s.sched_fifo as u8 as f64,
             ),
         ]
         .into_iter()

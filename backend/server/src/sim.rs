@@ -1,3 +1,3 @@
 //! The simulated drive of `backend/drives` (plant model, reference cam, index pulse, faults).
 
-pub use drives::sim::{FieldError, LimitSwitches, SimDriveConfig, SimFault};
+pub use drives::sim::{LimitSwitches, SimDriveConfig, SimFault};

@@ -10,7 +10,7 @@ use rustls_pki_types::{CertificateDer, PrivateKeyDer};
 use tokio_rustls::TlsAcceptor;
 use tokio_rustls::rustls;
 
-use crate::ServeArgs;
+use crate::cli::ServeArgs;
 
 /// SHA-256 of a certificate, as browsers show it (`AB:CD:…`).
 pub fn fingerprint(der: &[u8]) -> String {

@@ -15,10 +15,10 @@ use super::{Client, JsonBody};
 use crate::app::AppState;
 use crate::auth::{self, NewToken, Role, TokenView, UserView};
 use crate::error::{AppError, AppResult};
-use crate::service::axes::audit_entry;
+use crate::service::audit_entry;
 use crate::service::control::{ControlState, TakeControl};
 
-/// Every routed request: the role its route needs ([`auth::required`]) against the client's
+/// Every routed request: the role its route needs ([`super::roles::required`]) against the client's
 /// credentials, while authentication is enabled. The principal goes into the request for the
 /// handlers (the audit log names it).
 pub async fn check_role(State(s): State<Arc<AppState>>, mut req: Request, next: Next) -> Response {
@@ -27,7 +27,7 @@ pub async fn check_role(State(s): State<Arc<AppState>>, mut req: Request, next: 
         .get::<MatchedPath>()
         .map(|m| m.as_str().to_owned())
         .unwrap_or_else(|| req.uri().path().to_owned());
-    let Some(need) = auth::required(req.method(), &path) else {
+    let Some(need) = super::roles::required(req.method(), &path) else {
         return next.run(req).await;
     };
     match s.auth.authorize(req.headers(), need) {

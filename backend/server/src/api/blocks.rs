@@ -23,7 +23,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::{Client, JsonBody, Q, WaitQuery};
-use crate::app::{AppState, Milestone};
+use crate::app::AppState;
 use crate::error::AppError;
 use crate::error::AppResult;
 use crate::model::*;
@@ -315,7 +315,7 @@ mod tests {
 
     #[test]
     fn the_document_has_one_operation_per_block_with_its_role() {
-        let doc = serde_json::to_value(super::super::ApiDoc::document()).unwrap();
+        let doc = serde_json::to_value(crate::api::ApiDoc::document()).unwrap();
         for b in BLOCKS {
             let op = &doc["paths"][b.path]["post"];
             let ext = &op["x-motiond-block"];

@@ -16,7 +16,7 @@ use super::{Client, JsonBody};
 use crate::app::AppState;
 use crate::bus::BusKind;
 use crate::error::{AppError, AppResult};
-use crate::service::axes::audit_entry;
+use crate::service::audit_entry;
 
 /// An EtherCAT state machine state (AL status).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]

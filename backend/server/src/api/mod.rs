@@ -12,10 +12,12 @@ pub mod errors;
 pub mod functions;
 pub mod guard;
 pub mod reads;
+pub mod roles;
 pub mod scope;
 pub mod shape;
 pub mod simulation;
 pub mod system;
+pub mod ui;
 pub mod ws;
 
 use std::net::SocketAddr;
@@ -39,7 +41,8 @@ use utoipa::{IntoParams, OpenApi};
 use crate::app::AppState;
 use crate::error::AppError;
 use crate::model::ClientInfo;
-use errors::{ErrorResponses, RequestChecks};
+use errors::ErrorResponses;
+use roles::RequestChecks;
 
 /// The largest request body (axum's default, set explicitly so that the 413 can name it).
 pub const BODY_LIMIT: usize = 2 * 1024 * 1024;
@@ -379,13 +382,13 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
         .route("/metrics", get(system::metrics))
         .merge(utoipa_swagger_ui::SwaggerUi::new("/docs").url("/openapi.json", ApiDoc::document()))
         .route("/asyncapi.json", get(asyncapi_document))
-        // Every route: the role it needs (crate::auth::required), once users exist.
+        // Every route: the role it needs (api::roles::required), once users exist.
         .route_layer(axum::middleware::from_fn_with_state(
             state.clone(),
             auth::check_role,
         ))
         // Everything else: the commissioning UI (`/api/…` stays a problem+json 404).
-        .fallback(crate::ui::serve)
+        .fallback(ui::serve)
         .layer(axum::middleware::from_fn(problem_errors))
         .layer(DefaultBodyLimit::max(BODY_LIMIT))
         // Outermost: a Host this server does not serve gets nothing else (DNS rebinding).
@@ -628,7 +631,8 @@ impl utoipa::Modify for ForeignExamples {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
         use serde_json::{json, to_value};
         use utoipa::openapi::{RefOr, schema::Schema};
-        let drives::DriveConfig::Simulated(drive) = crate::demo_axes().remove(0).drive else {
+        let drives::DriveConfig::Simulated(drive) = crate::model::demo::axes().remove(0).drive
+        else {
             unreachable!("the demo axes have simulated drives")
         };
         let examples = [
@@ -733,7 +737,7 @@ impl utoipa::Modify for ForeignExamples {
             ),
             (
                 "FieldError",
-                to_value(crate::sim::FieldError {
+                to_value(crate::error::FieldError {
                     field: "dynamics.jerk".into(),
                     message: "must be a finite number > 0".into(),
                 }),

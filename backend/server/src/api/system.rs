@@ -146,7 +146,7 @@ pub async fn metrics(
     headers: axum::http::HeaderMap,
     super::Q(q): super::Q<MetricsQuery>,
 ) -> impl IntoResponse {
-    let out = crate::metrics::render(&s, q.buckets == Some(MetricsBuckets::Fine));
+    let out = crate::service::metrics::text(&s, q.buckets == Some(MetricsBuckets::Fine));
     // OpenMetrics for those that ask for it (Prometheus does), else the classic text format.
     let openmetrics = headers
         .get_all(header::ACCEPT)

@@ -6,7 +6,7 @@ use std::collections::{HashMap, VecDeque};
 use motion::{AxisSlot, CommandEvent, CommandId, ErrorId, FbOutputs};
 use serde::Serialize;
 
-use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState};
+use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState, Milestone};
 use crate::store::{self, AuditEntry};
 
 /// How many commands `GET /commands` remembers.
@@ -133,44 +133,6 @@ pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry 
                 .unwrap_or_default(),
         }),
         idempotency_key: None,
-    }
-}
-
-/// Where a `?wait=true` request answers for a command that stays busy (besides its end:
-/// Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
-/// InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, utoipa::ToSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Milestone {
-    /// Only its end (Done, Error, CommandAborted).
-    Done,
-    InVelocity,
-    InGear,
-    /// MC_CamIn: coupled and the cam active.
-    InSync,
-    InEndVelocity,
-    /// MC_Power's Status: the axis is enabled.
-    Status,
-    /// An Enable-type block is active (a compensation applied from now on).
-    Active,
-    /// MC_TorqueControl: the torque built up, no velocity limit active.
-    InTorque,
-}
-
-impl Milestone {
-    /// Whether outputs `o` are at this milestone or the command's end.
-    pub fn reached(self, o: &FbOutputs) -> bool {
-        let arrived = match self {
-            Milestone::Done => false,
-            Milestone::InVelocity => o.in_velocity,
-            Milestone::InGear => o.in_gear,
-            Milestone::InSync => o.in_sync,
-            Milestone::InEndVelocity => o.in_end_velocity,
-            Milestone::Status => o.status,
-            Milestone::Active => o.active,
-            Milestone::InTorque => o.in_torque,
-        };
-        o.done || o.error || o.command_aborted || arrived
     }
 }
 

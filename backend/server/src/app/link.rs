@@ -10,11 +10,11 @@ use tokio::sync::oneshot;
 
 use super::AppState;
 use crate::cycle::{Reply, Request};
+use crate::error::FieldError;
 use crate::error::{AppError, AppResult};
 use crate::model::AxisConfigDto;
 use crate::params::{self, ParamValue};
 use crate::scope::{NewRecording, ScopeBusy, ScopeRecording};
-use crate::sim::FieldError;
 use drives::Drive;
 
 /// How long the async side waits for the cycle thread's verdict.

@@ -4,12 +4,14 @@
 //! the machinery they use.
 
 mod commands;
+pub mod control;
 pub mod feed;
+pub mod idempotency;
 mod link;
 mod pump;
 mod registry;
 
-pub use commands::{CommandNotice, CommandRecord, CommandStore, HISTORY, Milestone};
+pub use commands::{CommandNotice, CommandRecord, CommandStore, HISTORY};
 pub use pump::{audit_writer, pump};
 pub use registry::{AxisEntry, CamEntry, Registry};
 
@@ -53,7 +55,7 @@ pub struct AppState {
     /// Bumped whenever the registry is written (sockets re-check their subscriptions then).
     registry_writes: AtomicU64,
     /// Recent `Idempotency-Key`s of motion commands and their answers.
-    pub idempotency: crate::service::idempotency::Keys,
+    pub idempotency: idempotency::Keys,
     pub registry: RwLock<Registry>,
     /// Serialises configuration changes (axes, parameters, import).
     pub config_lock: tokio::sync::Mutex<()>,
@@ -74,7 +76,7 @@ pub struct AppState {
     /// Users, sessions, tokens.
     pub auth: Arc<crate::auth::Auth>,
     /// Who holds control of the machine.
-    pub control: crate::service::control::Control,
+    pub control: control::Control,
     /// Done MC_TouchProbe commands (id, slot) whose recorded data is still to be read.
     pub probe_results: Mutex<Vec<(u64, u16)>>,
     /// Passes of `drain` completed: a pass that begins after a snapshot was read has applied
@@ -116,7 +118,7 @@ impl AppState {
             audit_dropped: Arc::new(AtomicU64::new(0)),
             info,
             auth,
-            control: crate::service::control::Control::new(control_lease),
+            control: control::Control::new(control_lease),
             probe_results: Mutex::new(Vec::new()),
         };
         (Arc::new(state), audit_rx)

@@ -8,14 +8,15 @@ use std::collections::BTreeMap;
 use axum::http::StatusCode;
 use motion::{AxisState, AxisStatus, CommandKind};
 
+use super::audit_entry;
 use crate::app::{AppState, AxisEntry};
+use crate::error::FieldError;
 use crate::error::{AppError, AppResult};
 use crate::model::{
     AxisConfigDto, AxisResource, ClientInfo, ConfigAxis, ConfigChange, ConfigDocument,
     ParameterChange, ParameterResource, ParameterWrite, PeakResetResource, StatusResource,
 };
 use crate::params::{self, ParamValue};
-use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
 
 fn resource(s: &AppState, e: &AxisEntry) -> AxisResource {
@@ -26,26 +27,6 @@ fn resource(s: &AppState, e: &AxisEntry) -> AxisResource {
         state,
         config: e.config.clone(),
         change: None,
-    }
-}
-
-/// An audit row of a configuration change by `client`, committed with the change.
-pub(crate) fn audit_entry(
-    client: &ClientInfo,
-    action: &str,
-    target: &str,
-    detail: String,
-) -> AuditEntry {
-    AuditEntry {
-        at: store::now_rfc3339(),
-        client_addr: Some(client.addr.clone()),
-        client_id: client.id.clone(),
-        principal: client.principal.clone(),
-        action: action.into(),
-        target: Some(target.into()),
-        detail,
-        outcome: Some("committed".into()),
-        ..Default::default()
     }
 }
 

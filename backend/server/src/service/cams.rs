@@ -10,14 +10,14 @@ use motion::cam::{
     OnlineChange, TableType, ValueSelect,
 };
 
-use super::axes::audit_entry;
+use super::audit_entry;
 use crate::app::{AppState, CamEntry};
+use crate::error::FieldError;
 use crate::error::{AppError, AppResult};
 use crate::model::{
     CamAnalysisResource, CamTableBody, CamTableResource, CamValuesResource, ClientInfo,
     MasterPositionResource, SlaveDynamicsResource, valid_name,
 };
-use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
 
 /// MC_CAM_ID: 1..255.

@@ -10,11 +10,11 @@ use motion::{
     Superposition,
 };
 
-use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Milestone, Registry};
+use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Registry};
+use crate::error::FieldError;
 use crate::error::{AppError, AppResult};
 use crate::metrics::Verdict;
 use crate::model::*;
-use crate::sim::FieldError;
 use crate::store::{self, AuditEntry};
 
 /// Collects invalid fields of a command body.

@@ -12,13 +12,13 @@
 //! A client is known by its principal (`user:NAME`, `token:NAME`) and its `X-Client-Id`
 //! ([`ClientInfo::control_key`]): two browser tabs of one user send different client ids.
 
-use std::sync::Mutex;
 use std::time::{Duration, Instant, SystemTime};
 
 use motion::CommandKind;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::app::control::{Control, Holder};
 use crate::auth::Role;
 use crate::error::{AppError, AppResult};
 use crate::model::ClientInfo;
@@ -27,24 +27,6 @@ use crate::model::ClientInfo;
 pub const MIN_LEASE_MS: u64 = 500;
 pub const MAX_LEASE_MS: u64 = 60_000;
 pub const DEFAULT_LEASE_MS: u64 = 5_000;
-
-#[derive(Clone, Debug)]
-struct Holder {
-    key: String,
-    client_id: Option<String>,
-    principal: Option<String>,
-    addr: String,
-    since: SystemTime,
-    until: Instant,
-    lease: Duration,
-}
-
-/// The holder of the machine's control.
-pub struct Control {
-    /// `--control-lease` (default on).
-    pub enabled: bool,
-    holder: Mutex<Option<Holder>>,
-}
 
 /// `POST /api/v1/control`.
 #[derive(Debug, Default, Deserialize, ToSchema)]
@@ -150,13 +132,6 @@ pub fn stops_motion(kind: &CommandKind) -> bool {
 }
 
 impl Control {
-    pub fn new(enabled: bool) -> Control {
-        Control {
-            enabled,
-            holder: Mutex::new(None),
-        }
-    }
-
     /// The live holder (an expired lease is dropped here).
     fn live(&self) -> std::sync::MutexGuard<'_, Option<Holder>> {
         let mut h = self.holder.lock().unwrap();

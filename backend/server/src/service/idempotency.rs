@@ -6,15 +6,13 @@
 //! answer is a 409 naming it. A key belongs to its sender (principal and `X-Client-Id`): the
 //! same key from another client is another key (decision 117).
 
-use std::collections::{HashMap, VecDeque};
-use std::sync::Mutex;
 use std::time::{Duration, SystemTime};
 
-use motion::ErrorId;
 use tokio::time::Instant;
 
 use super::commands::{self, Submission};
 use crate::app::AppState;
+use crate::app::idempotency::{Answer, Keys, Remembered};
 use crate::error::{AppError, AppResult};
 use crate::model::CommandResource;
 use crate::store;
@@ -25,29 +23,6 @@ pub const TTL: Duration = Duration::from_secs(24 * 3600);
 pub const MAX_REMEMBERED: usize = 10_000;
 /// The longest key.
 pub const MAX_KEY: usize = 255;
-
-/// What a key's first request got.
-#[derive(Clone, Debug)]
-enum Answer {
-    Accepted(CommandResource),
-    /// Refused by the axis, with what was in the way then.
-    Rejected(ErrorId, Option<String>),
-}
-
-#[derive(Debug)]
-struct Remembered {
-    /// Block, axis and body as sent: the same key with another request is refused.
-    fingerprint: String,
-    at: Instant,
-    /// `None` while the first request is still being answered.
-    answer: Option<Answer>,
-}
-
-/// The keys of recent commands.
-#[derive(Default)]
-pub struct Keys {
-    inner: Mutex<(HashMap<String, Remembered>, VecDeque<(Instant, String)>)>,
-}
 
 enum Begin {
     New,

@@ -2,12 +2,12 @@
 //! the recorder (`crate::scope`, sampled by the cycle thread).
 
 use crate::app::AppState;
+use crate::error::FieldError;
 use crate::error::{AppError, AppResult};
 use crate::model::{ClientInfo, RecordingRequest, ScopeSetup, ScopeSetupResource};
 use crate::scope::{
     MAX_SAMPLES, NewRecording, SCOPE_CHANNELS, ScopeChannel, ScopeSignal, ScopeTrigger, TriggerEdge,
 };
-use crate::sim::FieldError;
 
 /// Checks a recording request: every field at fault is named (`channels[2].axis`).
 pub fn recording(s: &AppState, body: RecordingRequest) -> AppResult<NewRecording> {
@@ -188,7 +188,7 @@ pub async fn put_setup(
     let replaced = crate::store::scope_setups::put(&mut tx, name, &body, &at).await?;
     crate::store::audit(
         &mut *tx,
-        &crate::service::axes::audit_entry(client, "scope_setup.put", name, body),
+        &crate::service::audit_entry(client, "scope_setup.put", name, body),
     )
     .await?;
     tx.commit().await?;
@@ -210,7 +210,7 @@ pub async fn delete_setup(s: &AppState, name: &str, client: &ClientInfo) -> AppR
     }
     crate::store::audit(
         &mut *tx,
-        &crate::service::axes::audit_entry(client, "scope_setup.delete", name, String::new()),
+        &crate::service::audit_entry(client, "scope_setup.delete", name, String::new()),
     )
     .await?;
     tx.commit().await?;

@@ -51,15 +51,15 @@ fn looks_like_file(path: &str) -> bool {
 pub async fn serve(State(s): State<Arc<AppState>>, req: Request) -> Response {
     let path = req.uri().path().to_string();
     if path == "/api" || path.starts_with("/api/") {
-        return crate::api::not_found(req.uri().clone()).await;
+        return super::not_found(req.uri().clone()).await;
     }
     if req.method() != Method::GET && req.method() != Method::HEAD {
-        return crate::api::not_found(req.uri().clone()).await;
+        return super::not_found(req.uri().clone()).await;
     }
     let dir = &s.info.ui_dir;
     if !is_built(dir) {
         if looks_like_file(&path) && path != "/index.html" {
-            return crate::api::not_found(req.uri().clone()).await;
+            return super::not_found(req.uri().clone()).await;
         }
         return not_built(dir);
     }
@@ -72,7 +72,7 @@ pub async fn serve(State(s): State<Arc<AppState>>, req: Request) -> Response {
     };
     if resp.status() == StatusCode::NOT_FOUND {
         if looks_like_file(&path) {
-            return crate::api::not_found(again.uri().clone()).await;
+            return super::not_found(again.uri().clone()).await;
         }
         resp = match ServeFile::new(dir.join("index.html")).oneshot(again).await {
             Ok(r) => r.map(Body::new),

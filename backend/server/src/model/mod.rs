@@ -1,5 +1,7 @@
 //! The API's data types (DTOs). Kernel enums and structs are reused, not mirrored.
 
+pub mod demo;
+
 use std::collections::BTreeMap;
 
 use motion::{
@@ -9,9 +11,9 @@ use motion::{
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::error::FieldError;
 use crate::params::{self, ParamValue};
 use crate::scope::{ScopeSignal, TriggerEdge};
-use crate::sim::FieldError;
 use drives::DriveConfig;
 
 fn is_false(b: &bool) -> bool {
@@ -539,13 +541,51 @@ pub struct CommandResource {
     pub wait: Option<WaitOutcome>,
 }
 
+/// Where a `?wait=true` request answers for a command that stays busy (besides its end:
+/// Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
+/// InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Milestone {
+    /// Only its end (Done, Error, CommandAborted).
+    Done,
+    InVelocity,
+    InGear,
+    /// MC_CamIn: coupled and the cam active.
+    InSync,
+    InEndVelocity,
+    /// MC_Power's Status: the axis is enabled.
+    Status,
+    /// An Enable-type block is active (a compensation applied from now on).
+    Active,
+    /// MC_TorqueControl: the torque built up, no velocity limit active.
+    InTorque,
+}
+
+impl Milestone {
+    /// Whether outputs `o` are at this milestone or the command's end.
+    pub fn reached(self, o: &FbOutputs) -> bool {
+        let arrived = match self {
+            Milestone::Done => false,
+            Milestone::InVelocity => o.in_velocity,
+            Milestone::InGear => o.in_gear,
+            Milestone::InSync => o.in_sync,
+            Milestone::InEndVelocity => o.in_end_velocity,
+            Milestone::Status => o.status,
+            Milestone::Active => o.active,
+            Milestone::InTorque => o.in_torque,
+        };
+        o.done || o.error || o.command_aborted || arrived
+    }
+}
+
 /// How a `?wait=true` ended.
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"milestone": "status", "reached": false, "reason": "axis_error_stop",
     "axis_state": "error_stop", "axis_error_id": 28688, "axis_error_code": "drive_fault"}))]
 pub struct WaitOutcome {
     /// The output waited for besides the command's end (`done`: only the end).
-    pub milestone: crate::app::Milestone,
+    pub milestone: Milestone,
     /// The command reached its milestone or its end (done, error or aborted: see `state`).
     pub reached: bool,
     /// Why not: `timeout` (still on its way at `timeout_ms`), `axis_error_stop` (the axis is
@@ -1758,7 +1798,7 @@ pub struct LiveStatus {
 }
 
 /// Examples of the OpenAPI document that are built rather than written out: the demo machine's
-/// axes as `crate::demo_axes` makes them (what a new motiond answers), and the status example
+/// axes as `demo::axes` makes them (what a new motiond answers), and the status example
 /// of `motion::AxisStatus`, which `LiveStatus` extends.
 pub(crate) mod examples {
     use serde_json::{Value, json};
@@ -1776,17 +1816,17 @@ pub(crate) mod examples {
 
     /// The axis `x` of the demo machine, enabled.
     pub fn axis_resource() -> Value {
-        json!({"id": 1, "slot": 0, "state": "standstill", "config": crate::demo_axes()[0]})
+        json!({"id": 1, "slot": 0, "state": "standstill", "config": crate::model::demo::axes()[0]})
     }
 
     /// `x` with a persistent AxisVeloMax.
     pub fn config_axis() -> Value {
-        json!({"id": 1, "config": crate::demo_axes()[0], "persistent_parameters": {"AxisVeloMax": 400.0}})
+        json!({"id": 1, "config": crate::model::demo::axes()[0], "persistent_parameters": {"AxisVeloMax": 400.0}})
     }
 
     /// The demo machine (x with a persistent AxisVeloMax).
     pub fn config_document() -> Value {
-        let axes: Vec<Value> = crate::demo_axes()
+        let axes: Vec<Value> = crate::model::demo::axes()
             .into_iter()
             .enumerate()
             .map(|(i, config)| match i {

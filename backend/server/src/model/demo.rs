@@ -1,0 +1,86 @@
+//! The demo machine that a new motiond (empty database, no `--no-demo`) configures, and the
+//! examples of the OpenAPI document show.
+
+use std::collections::BTreeMap;
+
+use drives::DriveConfig;
+
+use super::{AxisConfigDto, AxisDynamics, ModuloConfig, SoftLimits};
+use crate::params::ParamValue;
+use crate::sim::{LimitSwitches, SimDriveConfig};
+
+/// The demo machine: two linear axes with limit switches just outside their travel (so that a
+/// homing search that misses the cam ends with homing_failed at a switch instead of running
+/// forever; the switches only report, they do not fault the drive) and a rotary spindle.
+pub fn axes() -> Vec<AxisConfigDto> {
+    let linear = |name: &str, limits: Option<SoftLimits>, switches: (f64, f64)| AxisConfigDto {
+        name: name.into(),
+        unit: "mm".into(),
+        modulo: None,
+        soft_limits: limits,
+        dynamics: AxisDynamics {
+            max_velocity: 500.0,
+            acceleration: 2500.0,
+            deceleration: 2500.0,
+            jerk: 25000.0,
+            jog_velocity_slow: 10.0,
+            jog_velocity_fast: 100.0,
+            jog_deadman_max: 1.0,
+        },
+        parameters: BTreeMap::from([(
+            "AxisTargetPositionWindow".to_string(),
+            ParamValue::Number(0.01),
+        )]),
+        drive: DriveConfig::Simulated(SimDriveConfig {
+            limit_switches: LimitSwitches {
+                negative: Some(switches.0),
+                positive: Some(switches.1),
+                fault_on_hit: false,
+            },
+            ..SimDriveConfig::default()
+        }),
+        position_compensation_table: None,
+    };
+    vec![
+        // Travel 0–1000 mm (software limits), switches 5 mm beyond.
+        linear(
+            "x",
+            Some(SoftLimits {
+                min: 0.0,
+                max: 1000.0,
+            }),
+            (-5.0, 1005.0),
+        ),
+        // No software limits; travel ±1000 mm between the switches.
+        linear("y", None, (-1005.0, 1005.0)),
+        AxisConfigDto {
+            name: "spindle".into(),
+            unit: "deg".into(),
+            modulo: Some(ModuloConfig { period: 360.0 }),
+            soft_limits: None,
+            dynamics: AxisDynamics {
+                max_velocity: 3600.0,
+                acceleration: 18000.0,
+                deceleration: 18000.0,
+                jerk: 180000.0,
+                jog_velocity_slow: 90.0,
+                jog_velocity_fast: 720.0,
+                jog_deadman_max: 1.0,
+            },
+            parameters: BTreeMap::new(),
+            drive: DriveConfig::default(),
+            position_compensation_table: None,
+        },
+    ]
+}
+
+/// The demo machine on the emulated EtherCAT segment: each axis's drive is the emulated
+/// CiA-402 servo at its position (1 µm per increment on the linear axes, 0.01° on the spindle).
+pub fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
+    for (i, a) in axes.iter_mut().enumerate() {
+        a.drive = DriveConfig::Cia402(drives::cia402::Cia402Config::csp(
+            i as u16,
+            if a.modulo.is_some() { 100.0 } else { 1000.0 },
+        ));
+    }
+}
