@@ -25,10 +25,11 @@ CRATES = {
 }
 
 # (crate, module prefix, module prefixes it must not import). The server's layers, top down:
-# api → service → store, with app (registry, pump, cycle link) below service; shared types
-# (errors, ids, validation errors) in leaf modules that import none of these.
+# api → blocks (the block families: bodies, checks, catalogue entries) → service → store, with
+# app (registry, pump, cycle link) below service; shared types (errors, ids, validation errors,
+# the command resource) in leaf modules that import none of these.
 LAYERS = [
-    ("server", "service", ["api"]),
+    ("server", "service", ["api", "blocks"]),
     ("server", "app", ["api", "service", "blocks"]),
     ("server", "store", ["api", "service", "app", "blocks"]),
     ("server", "blocks", ["api"]),

@@ -1,13 +1,14 @@
 //! motiond, the appliance: the cycle thread, the REST + websocket API and the SQLite store.
 //!
 //! Map: [`cycle`] (the real-time thread and its queues), [`app`] (the async side's state and
-//! the pump between the two), [`api`] (HTTP and websocket; [`api::blocks`] is the catalogue of
-//! function blocks), [`service`] (the rules of each request), [`store`] (SQLite), [`error`]
-//! (`AppError`), [`model`] (DTOs), [`sim`] / [`params`] (adapters to `drives` and
-//! `motion::params`).
+//! the pump between the two), [`api`] (HTTP and websocket; [`api::blocks`] makes the blocks'
+//! endpoints), [`blocks`] (the function blocks by family: bodies, checks, conversions,
+//! catalogue entries), [`service`] (the rules of each request), [`store`] (SQLite), [`error`]
+//! (`AppError`, `FieldError`), [`model`] (DTOs, the command resource), [`sim`] / [`params`]
+//! (adapters to `drives` and `motion::params`), [`cli`] (the command line).
 //!
-//! Every function block an axis takes is a catalogue entry; the REST endpoint, the websocket
-//! method and the OpenAPI operation all come from it:
+//! Every function block an axis takes is a catalogue entry of its family; the REST endpoint,
+//! the websocket method and the OpenAPI operation all come from it:
 //!
 //! ```
 //! use server::api::blocks::{self, Role};
@@ -26,6 +27,7 @@
 pub mod api;
 pub mod app;
 pub mod auth;
+pub mod blocks;
 pub mod bus;
 pub mod cli;
 pub mod cycle;

@@ -23,6 +23,7 @@ use utoipa::ToSchema;
 use super::blocks;
 use crate::app::AppState;
 use crate::auth::Role;
+use crate::blocks::torque::{ExtSetPointFeedBody, FeedResult};
 use crate::error::AppError;
 use crate::model::*;
 use crate::service::commands;
@@ -794,7 +795,8 @@ fn handle(
             let out = out_tx.clone();
             let client = client.clone();
             tokio::spawn(async move {
-                let r = commands::ext_feed(&s, &axis, &body, &client).await;
+                let r = commands::ext_feed(&s, &axis, &body, ExtSetPointFeedBody::to_kind, &client)
+                    .await;
                 if !notification {
                     let msg = match r {
                         Ok(cycle) => rpc_result(&id, json!(FeedResult { cycle })),
@@ -864,7 +866,7 @@ fn handle(
                     .expect("a block of the catalogue");
                 let msg = match r {
                     Ok(v) => {
-                        if block.name == "jog" {
+                        if block.keepalive {
                             let slot = s.registry.read().unwrap().find(&axis).map(|e| e.slot);
                             if let Some(slot) = slot {
                                 let mut held = jogs.lock().unwrap();

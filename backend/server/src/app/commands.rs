@@ -6,7 +6,8 @@ use std::collections::{HashMap, VecDeque};
 use motion::{AxisSlot, CommandEvent, CommandId, ErrorId, FbOutputs};
 use serde::Serialize;
 
-use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState, Milestone};
+use crate::model::Block;
+use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState};
 use crate::store::{self, AuditEntry};
 
 /// How many commands `GET /commands` remembers.
@@ -18,9 +19,10 @@ pub struct CommandRecord {
     pub axis_id: i64,
     pub axis_name: String,
     pub slot: AxisSlot,
-    pub name: &'static str,
-    /// Where a `?wait=true` answers (the catalogue entry's).
-    pub milestone: Milestone,
+    /// Its catalogue entry (name, milestone, flags).
+    pub block: &'static Block,
+    /// An MC_Stop: it holds its axis locked until released.
+    pub locks_axis: bool,
     pub parameters: serde_json::Value,
     pub client: ClientInfo,
     pub submitted_at: String,
@@ -46,7 +48,7 @@ impl CommandRecord {
             id: self.id,
             axis: self.axis_name.clone(),
             axis_id: self.axis_id,
-            command: self.name,
+            command: self.block.name,
             parameters: self.parameters.clone(),
             state: CommandState::of(o),
             is_final: self.is_final(),
@@ -153,7 +155,7 @@ pub(super) fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option
     Some(CommandNotice {
         command: r.id,
         axis: r.axis_name.clone(),
-        name: r.name,
+        name: r.block.name,
         cycle: ev.cycle,
         state: CommandState::of(&ev.outputs),
         is_final: !ev.outputs.busy,

@@ -31,8 +31,8 @@ impl AppState {
                 let Some(n) = apply_event(&mut store, &ev) else {
                     continue;
                 };
-                if n.is_final && n.outputs.done && n.name == "touch-probe" {
-                    if let Some(r) = store.map.get(&n.command) {
+                if n.is_final && n.outputs.done {
+                    if let Some(r) = store.map.get(&n.command).filter(|r| r.block.has_result) {
                         self.probe_results.lock().unwrap().push((r.id, r.slot));
                     }
                 }

@@ -238,15 +238,13 @@ impl Control {
     }
 
     /// Whether `client` may send `kind` now: a motion command of a client that does not hold
-    /// control while another does is refused; stop, halt and disabling never are.
+    /// control while another does is refused; stop, halt and disabling never are. (A block
+    /// whose catalogue entry is `lease_free` — it ends motion or moves nothing — is not asked.)
     pub fn admit(&self, client: &ClientInfo, kind: &CommandKind) -> AppResult<()> {
         if !self.enabled {
             return Ok(());
         }
-        if stops_motion(kind)
-            || matches!(kind, CommandKind::TouchProbe(_) | CommandKind::AbortTrigger)
-        {
-            // A probe moves nothing.
+        if stops_motion(kind) {
             return Ok(());
         }
         let h = self.live();

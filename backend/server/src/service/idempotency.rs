@@ -108,7 +108,7 @@ pub async fn run_once<B>(
     let Some(key) = sub.idempotency_key.clone() else {
         return commands::run(s, sub, wait).await.map(|v| (v, false));
     };
-    let fingerprint = format!("{}\n{}\n{}", sub.name, sub.axis, sub.raw);
+    let fingerprint = format!("{}\n{}\n{}", sub.block.name, sub.axis, sub.raw);
     let (principal, client_id) = (sub.client.principal.clone(), sub.client.id.clone());
     // Remembered per sender: principal and client id before the key (neither contains a newline).
     let scoped = format!(
@@ -162,7 +162,7 @@ pub async fn run_once<B>(
             .unwrap()
             .find(sub.axis)
             .map(|e| e.name.clone());
-        let same = action == format!("command.{}", sub.name)
+        let same = action == format!("command.{}", sub.block.name)
             && target == axis
             && serde_json::from_str::<serde_json::Value>(&detail)
                 .ok()
