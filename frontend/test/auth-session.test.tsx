@@ -6,13 +6,13 @@ import { render } from 'preact';
 import { act } from 'preact/test-utils';
 import { mountPoint, unmount } from './dom';
 
-vi.mock('../src/ui/app', () => ({ App: () => <div id="the-app">app</div> }));
+vi.mock('../src/ui/shell/app', () => ({ App: () => <div id="the-app">app</div> }));
 
 import { auth, checkSession, login, logout, may, roleAtLeast, sessionEnded, signedIn, viewOf, type AuthView, type SessionState } from '../src/auth/session';
-import { Root, loginErrorText } from '../src/ui/root';
+import { Root, loginErrorText } from '../src/ui/shell/root';
 import { ApiError } from '../src/api/rest';
 import { parseRoute, href } from '../src/router';
-import { tokenStatus } from '../src/ui/users';
+import { tokenStatus } from '../src/ui/auth/users';
 import { dateTime } from '../src/format';
 
 const off: SessionState = { auth_enabled: false, principal: null, name: null, kind: null, role: null, expires_at: null };

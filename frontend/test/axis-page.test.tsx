@@ -32,13 +32,13 @@ vi.mock('../src/services', async () => {
   };
 });
 // uPlot and the command log are not what is tested here.
-vi.mock('../src/ui/trend', () => ({ Trend: () => null }));
-vi.mock('../src/ui/command-log', () => ({ CommandLog: () => null }));
+vi.mock('../src/ui/axis/trend', () => ({ Trend: () => null }));
+vi.mock('../src/ui/shared/command-log', () => ({ CommandLog: () => null }));
 
 import { axes, statuses } from '../src/services';
-import { AxisPage } from '../src/ui/axis-page';
-import { powerOverride } from '../src/ui/online';
-import { useParameters } from '../src/ui/axis-params';
+import { AxisPage } from '../src/ui/axis/axis-page';
+import { powerOverride } from '../src/ui/axis/online';
+import { useParameters } from '../src/ui/axis/axis-params';
 import type { AxisLiveStatus, AxisResource, ParameterResource } from '../src/api/types';
 
 const axis = (id: number, name: string, modulo = false) =>

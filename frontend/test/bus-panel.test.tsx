@@ -21,7 +21,7 @@ vi.mock('../src/services', async () => {
 
 import { axes } from '../src/services';
 import { auth } from '../src/auth/session';
-import { BusPanel } from '../src/ui/bus';
+import { BusPanel } from '../src/ui/system/bus';
 import type { AxisResource, BusResource } from '../src/api/types';
 
 let asked: FetchCall[];

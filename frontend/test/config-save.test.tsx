@@ -20,7 +20,7 @@ vi.mock('../src/services', async () => {
 });
 
 import { statuses } from '../src/services';
-import { AxisConfigPage, DEFAULT_FORM, configOf } from '../src/ui/axis-config';
+import { AxisConfigPage, DEFAULT_FORM, configOf } from '../src/ui/config/axis-config';
 import type { AxisLiveStatus, AxisResource, ParameterResource } from '../src/api/types';
 import type { ConfigChange } from '../src/config/change';
 

@@ -7,7 +7,7 @@ import { useState } from 'preact/hooks';
 import { act } from 'preact/test-utils';
 import { mountPoint, unmount, enter } from './dom';
 import { ApiError, NotSentError, nonFiniteFields, post, put } from '../src/api/rest';
-import { Field, NumberInput, fieldsOf, isNumberText, parseNum } from '../src/ui/common';
+import { Field, NumberInput, fieldsOf, isNumberText, parseNum } from '../src/ui/shared/common';
 
 afterEach(() => vi.unstubAllGlobals());
 

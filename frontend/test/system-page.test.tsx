@@ -15,7 +15,7 @@ vi.mock('../src/services', async () => {
   };
 });
 
-import { AuditPanel, ConfigPanel } from '../src/ui/system';
+import { AuditPanel, ConfigPanel } from '../src/ui/system/system';
 import { parseRoute, href } from '../src/router';
 import { ms, plantText, simulatedAxes } from '../src/system/bus';
 

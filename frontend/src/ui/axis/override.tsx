@@ -4,10 +4,10 @@
 // reported by the server. It follows changes made elsewhere (another client, a power command)
 // unless the user is moving it.
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { command } from '../services';
-import { errorText } from './common';
-import { num } from '../format';
-import type { AxisStatus } from '../api/types';
+import { command } from '../../services';
+import { errorText } from '../shared/common';
+import { num } from '../../format';
+import type { AxisStatus } from '../../api/types';
 
 /** After the user's last input the slider waits this long for the axis to follow. */
 export const HOLD_MS = 600;

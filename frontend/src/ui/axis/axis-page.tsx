@@ -1,12 +1,12 @@
 import { useEffect, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { axes, axesLoaded, command, statuses } from '../services';
-import { href, type AxisTab } from '../router';
-import { ActionButton, Lamp, useOnline } from './common';
-import { STATE_LABEL, axisError } from '../format';
+import { useStore } from '../../store';
+import { axes, axesLoaded, command, statuses } from '../../services';
+import { href, type AxisTab } from '../../router';
+import { ActionButton, Lamp, useOnline } from '../shared/common';
+import { STATE_LABEL, axisError } from '../../format';
 import { OnlineTab } from './online';
-import { ParametersTab } from './parameters';
-import { AxisConfigPage } from './axis-config';
+import { ParametersTab } from '../config/parameters';
+import { AxisConfigPage } from '../config/axis-config';
 import { CouplingTab } from './coupling';
 import { FunctionsTab } from './functions';
 

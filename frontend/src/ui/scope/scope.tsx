@@ -3,8 +3,8 @@
 // The recordings are followed by services' `scope` (ScopeSession), not by this page: leaving
 // the page to move the axis does not lose an armed or running recording.
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { axes, scope, scopeLive, system } from '../services';
+import { useStore } from '../../store';
+import { axes, scope, scopeLive, system } from '../../services';
 import {
   MAX_CHANNELS,
   SIGNALS,
@@ -23,10 +23,10 @@ import {
   type RecordingRequest,
   type ScopeForm,
   type Signal,
-} from '../scope/data';
-import { csvUrl, deleteSetup, getRecording, listSetups, putSetup, scopeAvailable } from '../scope/api';
-import { ScopeStack, type ChartSeries, type StackPane } from '../scope/chart';
-import { Rolling, donePolling } from '../scope/rolling';
+} from '../../scope/data';
+import { csvUrl, deleteSetup, getRecording, listSetups, putSetup, scopeAvailable } from '../../scope/api';
+import { ScopeStack, type ChartSeries, type StackPane } from '../../scope/chart';
+import { Rolling, donePolling } from '../../scope/rolling';
 import {
   MAX_CHARTS,
   alignedTime,
@@ -41,9 +41,9 @@ import {
   type Align,
   type ScopeSetupResource,
   type ScopeView,
-} from '../scope/view';
-import { ErrorBanner, Field, NumberInput, Panel, download, errorText, fieldsOf, parseNum, useOnline } from './common';
-import { sig } from '../format';
+} from '../../scope/view';
+import { ErrorBanner, Field, NumberInput, Panel, download, errorText, fieldsOf, parseNum, useOnline } from '../shared/common';
+import { sig } from '../../format';
 
 
 /** Form state survives leaving the page. */

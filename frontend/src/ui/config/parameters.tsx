@@ -4,13 +4,13 @@
 // server's validation errors appear at the row.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useMemo, useState } from 'preact/hooks';
-import { NOT_A_NUMBER, get, put, enc } from '../api/rest';
-import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../api/types';
-import { ErrorBanner, errorText, fieldsOf, useOnline } from './common';
-import { inputNum } from '../format';
-import { ApiError } from '../api/rest';
-import { errorInfo } from '../api/errors';
-import { refreshAxes } from '../services';
+import { NOT_A_NUMBER, get, put, enc } from '../../api/rest';
+import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../../api/types';
+import { ErrorBanner, errorText, fieldsOf, useOnline } from '../shared/common';
+import { inputNum } from '../../format';
+import { ApiError } from '../../api/rest';
+import { errorInfo } from '../../api/errors';
+import { refreshAxes } from '../../services';
 
 export const GROUPS: { key: ParamGroup; label: string }[] = [
   { key: 'dynamics', label: 'Dynamics' },

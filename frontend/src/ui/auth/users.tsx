@@ -4,12 +4,12 @@
 // shown at the field, or at the form or row it concerns.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { del, enc, get, post, put } from '../api/rest';
-import type { components } from '../api/schema';
-import { useStore } from '../store';
-import { auth, checkSession, ROLES, signedIn, type Role } from '../auth/session';
-import { dateTime } from '../format';
-import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum } from './common';
+import { del, enc, get, post, put } from '../../api/rest';
+import type { components } from '../../api/schema';
+import { useStore } from '../../store';
+import { auth, checkSession, ROLES, signedIn, type Role } from '../../auth/session';
+import { dateTime } from '../../format';
+import { ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, parseNum } from '../shared/common';
 
 type S = components['schemas'];
 export type UserView = S['UserView'];

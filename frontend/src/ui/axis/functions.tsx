@@ -5,17 +5,17 @@
 // MC_TorqueControl with the drive's operation mode, the position correction and the encoder
 // (function-blocks.tsx).
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { command, statuses } from '../services';
-import type { AxisResource, CommandResource } from '../api/types';
-import { href } from '../router';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
-import { pos } from '../format';
-import { errorInfo } from '../api/errors';
-import { LiveIndicator } from './liveness';
-import { HOME_DEFAULTS, REFERENCE_MODES, homeBody } from '../axis/bodies';
-import { abortableSleep, reversingConfig, runReversing, type ReversingEnd, type ReversingStep } from '../axis/reversing';
-import { useCommand, useForm } from '../axis/hooks';
+import { useStore } from '../../store';
+import { command, statuses } from '../../services';
+import type { AxisResource, CommandResource } from '../../api/types';
+import { href } from '../../router';
+import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
+import { pos } from '../../format';
+import { errorInfo } from '../../api/errors';
+import { LiveIndicator } from '../shared/liveness';
+import { HOME_DEFAULTS, REFERENCE_MODES, homeBody } from '../../axis/bodies';
+import { abortableSleep, reversingConfig, runReversing, type ReversingEnd, type ReversingStep } from '../../axis/reversing';
+import { useCommand, useForm } from '../../axis/hooks';
 import { NumField, SelectField, useSender } from './coupling';
 import { P_HOME_POSITION, P_HOME_SEARCH_INVERSE, P_HOME_SEARCH_VELOCITY, P_HOME_SYNC_INVERSE, P_HOME_SYNC_VELOCITY, P_REFERENCE_MODE, paramDefault, useLiveParameters } from './axis-params';
 import { EncoderPanel, PositionCorrectionPanel, TorquePanel } from './function-blocks';

@@ -7,23 +7,23 @@
 // offered disabled, with how to start motiond for it.
 //
 // Saving an existing axis first asks the server what the save would do (`?dry_run=true`) and
-// shows it (config/save-panel.tsx): parameters written online on the running axis, or the axis
+// shows it (save-panel.tsx beside this file): parameters written online on the running axis, or the axis
 // re-created (then it must be disabled). The fields that are parameters show beside them the
 // online and persistent values where these differ from the configured (start-up) value.
 import { useEffect, useState } from 'preact/hooks';
 import type { JSX } from 'preact';
-import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../api/types';
-import { ApiError, NOT_A_NUMBER, del, enc, post, put } from '../api/rest';
-import { command, refreshAxes, statuses } from '../services';
-import { navigate } from '../router';
-import { useStore } from '../store';
-import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
-import { STATE_LABEL, inputNum } from '../format';
-import { useAxisParameters } from '../config/params';
-import { type ConfigChange, type SideValues, differingFields, rebuildBlockedText, sideText } from '../config/change';
-import { SavePanel, SaveResult } from '../config/save-panel';
-import { cia402Unavailable, driveOptions, firstFreeDrive } from '../system/bus';
-import { useBus } from './bus';
+import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../../api/types';
+import { ApiError, NOT_A_NUMBER, del, enc, post, put } from '../../api/rest';
+import { command, refreshAxes, statuses } from '../../services';
+import { navigate } from '../../router';
+import { useStore } from '../../store';
+import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
+import { STATE_LABEL, inputNum } from '../../format';
+import { useAxisParameters } from '../../config/params';
+import { type ConfigChange, type SideValues, differingFields, rebuildBlockedText, sideText } from '../../config/change';
+import { SavePanel, SaveResult } from './save-panel';
+import { cia402Unavailable, driveOptions, firstFreeDrive } from '../../system/bus';
+import { useBus } from '../system/bus';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
 

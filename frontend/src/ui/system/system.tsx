@@ -1,19 +1,19 @@
 // System: what a commissioning engineer checks before trusting the machine. The cycle's timing
 // (`GET /system` every 2 s: wake-up latency, compute time and period in µs, overruns), its
 // distributions (`GET /metrics?buckets=fine`), overruns over the last minutes (kept here), the
-// real-time grants, the drive bus (ui/bus.tsx), the audit log, and the configuration as one document:
+// real-time grants, the drive bus (bus.tsx beside this file), the audit log, and the configuration as one document:
 // download it, or import a file after seeing what it would change.
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { ApiError, get, put } from '../api/rest';
-import type { Problem } from '../api/types';
-import { useStore } from '../store';
-import { refreshAxes, statuses } from '../services';
-import { auth, may } from '../auth/session';
-import { Kpi, Led, Panel, errorText } from './common';
-import { getCycleHistograms } from '../system/api';
-import type { CycleHistograms } from '../system/prometheus';
-import { HistogramChart, OverrunChart } from '../system/charts';
-import { HISTORY_S, POLL_MS, QUANTILES, TimingHistory, level, us, uptime, type SystemResource } from '../system/timing';
+import { ApiError, get, put } from '../../api/rest';
+import type { Problem } from '../../api/types';
+import { useStore } from '../../store';
+import { refreshAxes, statuses } from '../../services';
+import { auth, may } from '../../auth/session';
+import { Kpi, Led, Panel, errorText } from '../shared/common';
+import { getCycleHistograms } from '../../system/api';
+import type { CycleHistograms } from '../../system/prometheus';
+import { HistogramChart, OverrunChart } from './charts';
+import { HISTORY_S, POLL_MS, QUANTILES, TimingHistory, level, us, uptime, type SystemResource } from '../../system/timing';
 import {
   ANY,
   FAILURES,
@@ -34,8 +34,8 @@ import {
   who,
   type AuditFilter,
   type AuditRecord,
-} from '../system/audit';
-import { diffConfig, diffCounts, exportName, importErrors, notADocument, valueText, type ConfigDiff, type ConfigDocument, type ItemDiff } from '../system/config-diff';
+} from '../../system/audit';
+import { diffConfig, diffCounts, exportName, importErrors, notADocument, valueText, type ConfigDiff, type ConfigDocument, type ItemDiff } from '../../system/config-diff';
 import { BusPanel } from './bus';
 
 /** Polls of this page, kept while the page is away (the gap is drawn as one). */

@@ -1,7 +1,7 @@
-import { useStore } from '../store';
-import { commandLog, type LogEntry } from '../services';
-import { time } from '../format';
-import { hexId } from '../api/errors';
+import { useStore } from '../../store';
+import { commandLog, type LogEntry } from '../../services';
+import { time } from '../../format';
+import { hexId } from '../../api/errors';
 
 function params(p: unknown): string {
   if (!p || typeof p !== 'object') return '';

@@ -9,9 +9,9 @@
 // mode (shown and editable here).
 import type { ComponentChildren } from 'preact';
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
-import { ApiError, del, enc, get, post, put } from '../api/rest';
-import type { CamAnalysisResource, CamCharacteristics, CamTableBody, CamTableResource, OnlineChange, TableType } from '../api/types';
-import { CamChart, type DragPhase } from '../cams/chart';
+import { ApiError, del, enc, get, post, put } from '../../api/rest';
+import type { CamAnalysisResource, CamCharacteristics, CamTableBody, CamTableResource, OnlineChange, TableType } from '../../api/types';
+import { CamChart, type DragPhase } from '../../cams/chart';
 import {
   LAWS,
   POINT_TYPES,
@@ -26,15 +26,15 @@ import {
   type Draft,
   type PointRow,
   type TableMeta,
-} from '../cams/data';
-import { LiveAnalysis, discontinuityText, errorsByRow, samplesFor, warningsByRow, type Analysis } from '../cams/analysis';
-import { canRedo, canUndo, historyKey, historyOf, record, redo, settle, undo, type History } from '../cams/history';
-import { ONLINE_MODES, ONLINE_MODE_TEXT, SCALING_MODES, camMarkers, camUnits, onlineChangeText, slavesOf, takesActivationPosition, type CamSlave } from '../cams/online';
-import { href, navigate } from '../router';
-import { axes, statuses } from '../services';
-import { useStore } from '../store';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, download, errorText, fieldsOf } from './common';
-import { sig } from '../format';
+} from '../../cams/data';
+import { LiveAnalysis, discontinuityText, errorsByRow, samplesFor, warningsByRow, type Analysis } from '../../cams/analysis';
+import { canRedo, canUndo, historyKey, historyOf, record, redo, settle, undo, type History } from '../../cams/history';
+import { ONLINE_MODES, ONLINE_MODE_TEXT, SCALING_MODES, camMarkers, camUnits, onlineChangeText, slavesOf, takesActivationPosition, type CamSlave } from '../../cams/online';
+import { href, navigate } from '../../router';
+import { axes, statuses } from '../../services';
+import { useStore } from '../../store';
+import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, download, errorText, fieldsOf } from '../shared/common';
+import { sig } from '../../format';
 
 const TYPES: [TableType, string][] = [
   ['motion_function', 'Motion function'],

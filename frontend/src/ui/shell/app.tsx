@@ -1,21 +1,21 @@
 import { useEffect, useState } from 'preact/hooks';
-import { href, useRoute, type Route } from '../router';
-import { useStore } from '../store';
-import { axes, axesLoaded, live, setFocus, statuses, system } from '../services';
-import { Lamp } from './common';
-import { pos } from '../format';
+import { href, useRoute, type Route } from '../../router';
+import { useStore } from '../../store';
+import { axes, axesLoaded, live, setFocus, statuses, system } from '../../services';
+import { Lamp } from '../shared/common';
+import { pos } from '../../format';
 import { Overview } from './overview';
-import { AxisPage } from './axis-page';
-import { AxisConfigPage } from './axis-config';
-import { ScopePage } from './scope';
-import { CamListPage, CamPage } from './cams';
-import type { ConnState } from '../live/client';
-import { ageText } from '../live/liveness';
-import { useLiveness } from './liveness';
-import { UsersPage } from './users';
-import { SystemPage } from './system';
-import { ControlBadge, UserBadge } from './header-auth';
-import { auth, may } from '../auth/session';
+import { AxisPage } from '../axis/axis-page';
+import { AxisConfigPage } from '../config/axis-config';
+import { ScopePage } from '../scope/scope';
+import { CamListPage, CamPage } from '../cams/cams';
+import type { ConnState } from '../../live/client';
+import { ageText } from '../../live/liveness';
+import { useLiveness } from '../shared/liveness';
+import { UsersPage } from '../auth/users';
+import { SystemPage } from '../system/system';
+import { ControlBadge, UserBadge } from '../auth/header-auth';
+import { auth, may } from '../../auth/session';
 
 function Connection() {
   const c = useStore(live.state);

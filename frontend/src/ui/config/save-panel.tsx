@@ -4,9 +4,9 @@
 // while the axis is not disabled, with the reason and a way to switch it off.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useRef } from 'preact/hooks';
-import { ActionButton } from '../ui/common';
-import type { ParameterResource } from '../api/types';
-import { type ConfigChange, changeRows, changeSummary, lostOnlineValues, valueText } from './change';
+import { ActionButton } from '../shared/common';
+import type { ParameterResource } from '../../api/types';
+import { type ConfigChange, changeRows, changeSummary, lostOnlineValues, valueText } from '../../config/change';
 
 export interface SavePanelProps {
   /** The dry run's answer. */

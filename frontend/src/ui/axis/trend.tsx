@@ -7,10 +7,10 @@
 // |set velocity| in it).
 import uPlot from 'uplot';
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { FOCUS_RATE_HZ, statuses, system, trendOf } from '../services';
-import { Panel } from './common';
-import { num } from '../format';
-import { TREND_WINDOW_S, presentCycle, trendRange, trendSeries } from '../live/trend';
+import { FOCUS_RATE_HZ, statuses, system, trendOf } from '../../services';
+import { Panel } from '../shared/common';
+import { num } from '../../format';
+import { TREND_WINDOW_S, presentCycle, trendRange, trendSeries } from '../../live/trend';
 
 const SERIES = [
   { key: 'set', label: 'Set velocity', short: 'set v', color: '#1363c6', width: 1.5, scale: 'v' },

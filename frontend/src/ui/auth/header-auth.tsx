@@ -2,10 +2,10 @@
 // machine (Take control / Release / Take over). Nothing of the first while authentication is
 // off, nothing of the second while motiond runs without control leases.
 import { useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { auth, logout, may, signedIn } from '../auth/session';
-import { control, controlKind, controlText, holderName } from '../auth/control';
-import { ErrorBanner, errorText } from './common';
+import { useStore } from '../../store';
+import { auth, logout, may, signedIn } from '../../auth/session';
+import { control, controlKind, controlText, holderName } from '../../auth/control';
+import { ErrorBanner, errorText } from '../shared/common';
 
 /** Gives control back (if held) and logs out; the login page follows. */
 export async function signOut(): Promise<void> {

@@ -2,10 +2,10 @@
 // pointerleave, pointercancel, lost focus of the window, a hidden tab, page hide, and the
 // socket closing (then the server stops the axis by itself).
 import { useEffect, useState } from 'preact/hooks';
-import type { JogDirection, JogMode } from '../api/types';
-import { jog, live } from '../services';
-import type { JogSnapshot } from '../live/jog';
-import { useStore } from '../store';
+import type { JogDirection, JogMode } from '../../api/types';
+import { jog, live } from '../../services';
+import type { JogSnapshot } from '../../live/jog';
+import { useStore } from '../../store';
 
 export interface JogButtonDef {
   label: string;

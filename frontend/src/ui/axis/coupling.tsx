@@ -5,16 +5,16 @@
 // status shows it (master, gear ratio, InGear/InSync of the running command, MC_CamInfo).
 import type { ComponentChildren } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { axes, command, commandLog, releaseCommand, statuses, type LogEntry } from '../services';
-import { couplingInForce } from '../axis/coupling-kind';
+import { useStore } from '../../store';
+import { axes, command, commandLog, releaseCommand, statuses, type LogEntry } from '../../services';
+import { couplingInForce } from '../../axis/coupling-kind';
 import { P_ACC, paramDefault, useLiveParameters } from './axis-params';
-import { get } from '../api/rest';
-import type { AxisResource, CamTableResource } from '../api/types';
-import { href } from '../router';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, useOnline } from './common';
-import { num, pos, vel } from '../format';
-import { LiveIndicator } from './liveness';
+import { get } from '../../api/rest';
+import type { AxisResource, CamTableResource } from '../../api/types';
+import { href } from '../../router';
+import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
+import { num, pos, vel } from '../../format';
+import { LiveIndicator } from '../shared/liveness';
 import {
   ABORT_OPTIONS,
   ACTIVATION_MODES,
@@ -34,8 +34,8 @@ import {
   takesPosition,
   type Built,
   type Form,
-} from '../axis/bodies';
-import { useCommand, useForm } from '../axis/hooks';
+} from '../../axis/bodies';
+import { useCommand, useForm } from '../../axis/hooks';
 import { MultiMasterPanel, PhasingPanel } from './coupling-blocks';
 
 /** A text input of a form record with its field error. */

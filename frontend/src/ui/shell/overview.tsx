@@ -1,10 +1,10 @@
-import { useStore } from '../store';
-import { axes, statuses } from '../services';
-import { Lamp } from './common';
-import { pos, vel, STATE_LABEL, axisError } from '../format';
-import { href, navigate } from '../router';
-import { CommandLog } from './command-log';
-import { Panel } from './common';
+import { useStore } from '../../store';
+import { axes, statuses } from '../../services';
+import { Lamp } from '../shared/common';
+import { pos, vel, STATE_LABEL, axisError } from '../../format';
+import { href, navigate } from '../../router';
+import { CommandLog } from '../shared/command-log';
+import { Panel } from '../shared/common';
 
 export function Overview() {
   const list = useStore(axes);

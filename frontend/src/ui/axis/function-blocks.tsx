@@ -5,11 +5,11 @@
 // DELETE /commands/{id}), and the encoder (MC_SetEncoderScalingFactor, MC_ConvertIncPosToPos /
 // MC_ConvertPosToIncPos).
 import { useEffect, useState } from 'preact/hooks';
-import { enc, get, put } from '../api/rest';
-import type { ParameterResource } from '../api/types';
-import { href } from '../router';
-import { ActionButton, Led, Panel, errorText, fieldsOf } from './common';
-import { inputNum, num, pos, sig, vel } from '../format';
+import { enc, get, put } from '../../api/rest';
+import type { ParameterResource } from '../../api/types';
+import { href } from '../../router';
+import { ActionButton, Led, Panel, errorText, fieldsOf } from '../shared/common';
+import { inputNum, num, pos, sig, vel } from '../../format';
 import {
   BACKLASH_DEFAULTS,
   CORRECTION_MODES,
@@ -32,8 +32,8 @@ import {
   type Built,
   type DriveOperationModeResource,
   type PositionConversion,
-} from '../axis/bodies';
-import { useCommand, useForm, useRunning } from '../axis/hooks';
+} from '../../axis/bodies';
+import { useCommand, useForm, useRunning } from '../../axis/hooks';
 import { NumField, SelectField } from './coupling';
 import { Readout, release, type BlockProps } from './coupling-blocks';
 import { P_BACKLASH, paramDefault } from './axis-params';

@@ -1,9 +1,9 @@
 // An axis's parameters for the axis tabs: jog velocities, inching steps, and what a blank field
 // of a block stands for (the parameter's value in force, shown as the field's placeholder).
 import { useEffect, useState } from 'preact/hooks';
-import { get, enc } from '../api/rest';
-import type { ParameterResource } from '../api/types';
-import { inputNum } from '../format';
+import { get, enc } from '../../api/rest';
+import type { ParameterResource } from '../../api/types';
+import { inputNum } from '../../format';
 
 /**
  * The axis's parameters by number; null until those of this axis (name and id: an import can

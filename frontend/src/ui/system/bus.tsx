@@ -8,14 +8,14 @@
 // Reset bus (`POST /bus/reset`, the engineer role). The simulated bus is the axes with simulated drives.
 import { Fragment } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
-import { ApiError } from '../api/rest';
-import type { AxisResource, BusResource } from '../api/types';
-import { useStore } from '../store';
-import { axes, statuses } from '../services';
-import { auth, may } from '../auth/session';
-import { href } from '../router';
-import { Field, Kpi, Lamp, Led, Panel, errorText, fieldsOf, useOnline } from './common';
-import { getBus, resetBus, sdoRead, sdoWrite } from '../system/api';
+import { ApiError } from '../../api/rest';
+import type { AxisResource, BusResource } from '../../api/types';
+import { useStore } from '../../store';
+import { axes, statuses } from '../../services';
+import { auth, may } from '../../auth/session';
+import { href } from '../../router';
+import { Field, Kpi, Lamp, Led, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
+import { getBus, resetBus, sdoRead, sdoWrite } from '../../system/api';
 import {
   BUS_POLL_MS,
   busBanner,
@@ -35,7 +35,7 @@ import {
   txrxView,
   type MappingView,
   type SdoView,
-} from '../system/bus';
+} from '../../system/bus';
 
 /**
  * The bus resource: read at once, then every `pollMs` while the document is visible (no request

@@ -1,12 +1,12 @@
 import type { ComponentChildren } from 'preact';
 import { useState } from 'preact/hooks';
-import { stateLamp, STATE_LABEL } from '../format';
-import type { AxisState } from '../api/types';
-import { ApiError, NOT_A_NUMBER } from '../api/rest';
-import { RpcError } from '../live/client';
-import { errorInfo } from '../api/errors';
-import { useStore } from '../store';
-import { live } from '../services';
+import { stateLamp, STATE_LABEL } from '../../format';
+import type { AxisState } from '../../api/types';
+import { ApiError, NOT_A_NUMBER } from '../../api/rest';
+import { RpcError } from '../../live/client';
+import { errorInfo } from '../../api/errors';
+import { useStore } from '../../store';
+import { live } from '../../services';
 
 /** Whether the socket to motiond is open: every command button is disabled while it is not. */
 export function useOnline(): boolean {

@@ -4,12 +4,12 @@
 // same masters, released with DELETE /commands/{id}) with the ratios in force.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { commandLog, releaseCommand } from '../services';
-import type { AxisLiveStatus, AxisResource, ParameterResource } from '../api/types';
+import { useStore } from '../../store';
+import { commandLog, releaseCommand } from '../../services';
+import type { AxisLiveStatus, AxisResource, ParameterResource } from '../../api/types';
 import { P_ACC, P_DEC, P_JERK, paramDefault } from './axis-params';
-import { ActionButton, Led, Panel, errorText } from './common';
-import { inputNum, num, pos } from '../format';
+import { ActionButton, Led, Panel, errorText } from '../shared/common';
+import { inputNum, num, pos } from '../../format';
 import {
   MULTI_MASTER_DEFAULTS,
   MULTI_MASTER_ROWS,
@@ -21,10 +21,10 @@ import {
   multiMasterForm,
   phasingBody,
   type Form,
-} from '../axis/bodies';
-import { useCommand, useForm } from '../axis/hooks';
+} from '../../axis/bodies';
+import { useCommand, useForm } from '../../axis/hooks';
 import { NumField, SelectField, couplerOf, type useSender } from './coupling';
-import { couplingInForce } from '../axis/coupling-kind';
+import { couplingInForce } from '../../axis/coupling-kind';
 
 export type Sender = ReturnType<typeof useSender>;
 

@@ -1,11 +1,11 @@
 // What the page shows before the app: the session check at start, and the login page while
 // authentication is on and nobody is logged in (at start, or after a 401 ended the session).
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { auth, login, type LoginReason } from '../auth/session';
-import { ApiError } from '../api/rest';
+import { useStore } from '../../store';
+import { auth, login, type LoginReason } from '../../auth/session';
+import { ApiError } from '../../api/rest';
 import { App } from './app';
-import { Field } from './common';
+import { Field } from '../shared/common';
 
 export function Root() {
   const view = useStore(auth);

@@ -2,10 +2,10 @@
 // steps start as #1015 AxisJogIncrementBackward and #1014 AxisJogIncrementForward; until the
 // parameters are known the buttons are disabled (a velocity of 0 would be refused anyway).
 import { useEffect, useState } from 'preact/hooks';
-import type { ParameterResource } from '../api/types';
-import { command } from '../services';
-import { ActionButton, Field, NumberInput, errorText, fieldsOf, parseNum } from './common';
-import { inputNum } from '../format';
+import type { ParameterResource } from '../../api/types';
+import { command } from '../../services';
+import { ActionButton, Field, NumberInput, errorText, fieldsOf, parseNum } from '../shared/common';
+import { inputNum } from '../../format';
 import { P_INC_BACKWARD, P_INC_FORWARD, P_JOG_SLOW, numParam } from './axis-params';
 
 export function Inching({ axis, unit, params, online, onError }: {

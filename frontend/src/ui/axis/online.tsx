@@ -1,19 +1,19 @@
 // The axis "Online" tab: live readouts, status LEDs, enable/override/reset, jog and inching,
 // moves, halt/stop, set position, home, TwinCAT's function keys, and the axis's command log.
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses, stopAndRelease } from '../services';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from './common';
-import { acc, pos, vel, num, inputNum } from '../format';
-import type { AxisLiveStatus, AxisResource, Direction, HomingMode } from '../api/types';
+import { useStore } from '../../store';
+import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, statuses, stopAndRelease } from '../../services';
+import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from '../shared/common';
+import { acc, pos, vel, num, inputNum } from '../../format';
+import type { AxisLiveStatus, AxisResource, Direction, HomingMode } from '../../api/types';
 import { JogButtons, type JogButtonDef } from './jog-buttons';
-import { CommandLog } from './command-log';
+import { CommandLog } from '../shared/command-log';
 import { OverrideControl } from './override';
 import { Inching } from './inching';
 import { Trend } from './trend';
-import { LiveIndicator } from './liveness';
-import { href } from '../router';
-import { hexId } from '../api/errors';
+import { LiveIndicator } from '../shared/liveness';
+import { href } from '../../router';
+import { hexId } from '../../api/errors';
 import { P_HOME_POSITION, P_JOG_FAST, P_JOG_SLOW, numParam, paramDefault, useLiveParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
 

@@ -1,9 +1,9 @@
 // The liveness of the live values: the latest cycle heard of and whether the socket still
 // speaks (src/live/liveness.ts), re-evaluated every second so that silence shows.
 import { useEffect, useState } from 'preact/hooks';
-import { useStore } from '../store';
-import { live, system } from '../services';
-import { ageText, latestCycle, liveness, type Liveness } from '../live/liveness';
+import { useStore } from '../../store';
+import { live, system } from '../../services';
+import { ageText, latestCycle, liveness, type Liveness } from '../../live/liveness';
 
 export function useLiveness(): Liveness {
   const conn = useStore(live.state);

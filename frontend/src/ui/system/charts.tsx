@@ -2,8 +2,8 @@
 // log scale so that the rare slow cycles show), and overruns over time (uPlot).
 import uPlot from 'uplot';
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { bars, quantile, trimBars, type Histogram } from './prometheus';
-import { usShort, type Point } from './timing';
+import { bars, quantile, trimBars, type Histogram } from '../../system/prometheus';
+import { usShort, type Point } from '../../system/timing';
 
 /** The width of an element, followed as it changes. */
 function useWidth(initial: number) {
