@@ -2,13 +2,12 @@
 // MC_PhasingRelative / MC_HaltPhasing on a coupled slave with the phase shift live, and
 // MC_GearInMultiMaster (Enable-type: coupled, its ratios changed by sending it again with the
 // same masters, released with DELETE /commands/{id}) with the ratios in force.
-import type { ComponentChildren } from 'preact';
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../../store';
-import { commandLog, releaseCommand } from '../../services';
-import type { AxisLiveStatus, AxisResource, ParameterResource } from '../../api/types';
+import { commandLog } from '../../services';
+import type { ParameterResource } from '../../api/types';
 import { P_ACC, P_DEC, P_JERK, paramDefault } from './axis-params';
-import { ActionButton, Led, Panel, errorText } from '../shared/common';
+import { ActionButton, Led, Panel } from '../shared/common';
 import { inputNum, num, pos } from '../../format';
 import {
   MULTI_MASTER_DEFAULTS,
@@ -23,47 +22,12 @@ import {
   type Form,
 } from '../../axis/bodies';
 import { useCommand, useForm } from '../../axis/hooks';
-import { NumField, SelectField, couplerOf, type useSender } from './coupling';
-import { couplingInForce } from '../../axis/coupling-kind';
-
-export type Sender = ReturnType<typeof useSender>;
-
-/** What the block panels of an axis tab share. */
-export interface BlockProps {
-  axis: AxisResource;
-  /** The axis's live status (null until it arrives). */
-  s: AxisLiveStatus | null;
-  online: boolean;
-  send: Sender;
-  setBanner: (s: string | null) => void;
-  /** The axis's parameters (what a blank field stands for), null while they load. */
-  params: Map<number, ParameterResource> | null;
-}
+import { NumField, Readout, SelectField, release, type BlockProps } from './block-form';
+import { couplerOf, couplingInForce } from '../../axis/coupling-kind';
 
 /** The acceleration, deceleration and jerk a blank field of a block stands for (#1004–#1006). */
 export function dynamicsDefaults(params: Map<number, ParameterResource> | null) {
   return { acceleration: paramDefault(params, P_ACC), deceleration: paramDefault(params, P_DEC), jerk: paramDefault(params, P_JERK) };
-}
-
-/** A live value: label, value, unit (the online tab's readout row). */
-export function Readout({ label, value, unit, name, title }: { label: ComponentChildren; value: string; unit?: string; name: string; title?: string }) {
-  return (
-    <div class="dro-row" data-readout={name} title={title}>
-      <span class="dro-label">{label}</span>
-      <span class="dro-value mono">{value}</span>
-      <span class="dro-unit">{unit ?? ''}</span>
-    </div>
-  );
-}
-
-/** Releases an Enable-type command (DELETE /commands/{id}); a refusal goes to the banner. */
-export async function release(id: number, axis: string, setBanner: (s: string | null) => void): Promise<void> {
-  try {
-    setBanner(null);
-    await releaseCommand(id, axis);
-  } catch (e) {
-    setBanner(errorText(e));
-  }
 }
 
 /** MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing of this slave against its master. */

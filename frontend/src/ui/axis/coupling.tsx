@@ -3,16 +3,15 @@
 // MC_CamScaling, MC_MoveSuperImposed / MC_AbortSuperposition, MC_PhasingAbsolute / Relative /
 // MC_HaltPhasing and MC_GearInMultiMaster (coupling-blocks.tsx), and the coupling as the live
 // status shows it (master, gear ratio, InGear/InSync of the running command, MC_CamInfo).
-import type { ComponentChildren } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../../store';
-import { axes, command, commandLog, releaseCommand, statuses, type LogEntry } from '../../services';
-import { couplingInForce } from '../../axis/coupling-kind';
+import { axes, commandLog, releaseCommand, statuses } from '../../services';
+import { couplerOf, couplingInForce } from '../../axis/coupling-kind';
 import { P_ACC, paramDefault, useLiveParameters } from './axis-params';
 import { get } from '../../api/rest';
 import type { AxisResource, CamTableResource } from '../../api/types';
 import { href } from '../../router';
-import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
+import { ActionButton, ErrorBanner, Led, Panel, errorText, useOnline } from '../shared/common';
 import { num, pos, vel } from '../../format';
 import { LiveIndicator } from '../shared/liveness';
 import {
@@ -29,77 +28,13 @@ import {
   camScalingBody,
   gearInBody,
   gearInDynBody,
-  label,
   superimposedBody,
   takesPosition,
-  type Built,
   type Form,
 } from '../../axis/bodies';
 import { useCommand, useForm } from '../../axis/hooks';
 import { MultiMasterPanel, PhasingPanel } from './coupling-blocks';
-
-/** A text input of a form record with its field error. */
-export function NumField({ f, set, k, label: l, errors, hint, name, placeholder, disabled }: { f: Form; set: (k: string, v: string) => void; k: string; label: ComponentChildren; errors: Record<string, string>; hint?: string; name?: string; placeholder?: string; disabled?: boolean }) {
-  const n = name ?? k;
-  return (
-    <Field label={l} error={errors[k]} name={n}>
-      <NumberInput name={n} value={f[k] ?? ''} onValue={(v) => set(k, v)} placeholder={placeholder} title={hint} disabled={disabled} />
-    </Field>
-  );
-}
-
-/** A select of a form record with its field error. */
-export function SelectField({ f, set, k, label: l, errors, options, name, blank, disabled, title }: {
-  f: Form;
-  set: (k: string, v: string) => void;
-  k: string;
-  label: ComponentChildren;
-  errors: Record<string, string>;
-  options: (string | [string, string])[];
-  name?: string;
-  blank?: string;
-  disabled?: boolean;
-  title?: string;
-}) {
-  const n = name ?? k;
-  return (
-    <Field label={l} error={errors[k]} name={n}>
-      <select name={n} value={f[k] ?? ''} disabled={disabled} title={title} onChange={(e) => set(k, (e.target as HTMLSelectElement).value)}>
-        {blank !== undefined && <option value="">{blank}</option>}
-        {options.map((o) => {
-          const [v, t] = Array.isArray(o) ? o : [o, label(o)];
-          return <option value={v}>{t}</option>;
-        })}
-      </select>
-    </Field>
-  );
-}
-
-/**
- * Sends a block from a form: the body's own checks first, then the server's answer; a refusal
- * is shown at its fields (problem+json errors[].field) and in the banner.
- */
-export function useSender(axis: string, setBanner: (s: string | null) => void) {
-  return async <T,>(name: string, built: Built<T>, setErrors: (e: Record<string, string>) => void) => {
-    setErrors(built.errors);
-    setBanner(null);
-    if (Object.keys(built.errors).length) return null;
-    try {
-      return await command(axis, name, built.body as Record<string, unknown>);
-    } catch (e) {
-      setErrors(fieldsOf(e));
-      setBanner(errorText(e));
-      return null;
-    }
-  };
-}
-
-/** The commands that couple an axis as a slave. */
-export const COUPLING_COMMANDS = new Set(['gear-in', 'gear-in-dyn', 'gear-in-multi-master', 'cam-in', 'cam-in-v2', 'cam-exchange', 'cam-add']);
-
-/** The axis's latest coupling command in the command log (one that failed coupled nothing). */
-export const couplerOf = (log: LogEntry[], axis: string): LogEntry | undefined =>
-  log.find((e) => e.axis === axis && e.id !== null && COUPLING_COMMANDS.has(e.command) && e.state !== 'error');
+import { NumField, SelectField, useSender } from './block-form';
 
 export function CouplingTab({ axis: a }: { axis: AxisResource }) {
   const axis = a.config.name;

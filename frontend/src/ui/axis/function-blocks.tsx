@@ -34,8 +34,7 @@ import {
   type PositionConversion,
 } from '../../axis/bodies';
 import { useCommand, useForm, useRunning } from '../../axis/hooks';
-import { NumField, SelectField } from './coupling';
-import { Readout, release, type BlockProps } from './coupling-blocks';
+import { NumField, Readout, SelectField, release, type BlockProps } from './block-form';
 import { P_BACKLASH, paramDefault } from './axis-params';
 
 const DRIVE_MODE_LABEL: Record<string, string> = {

@@ -16,7 +16,7 @@ import { LiveIndicator } from '../shared/liveness';
 import { HOME_DEFAULTS, REFERENCE_MODES, homeBody } from '../../axis/bodies';
 import { abortableSleep, reversingConfig, runReversing, type ReversingEnd, type ReversingStep } from '../../axis/reversing';
 import { useCommand, useForm } from '../../axis/hooks';
-import { NumField, SelectField, useSender } from './coupling';
+import { NumField, SelectField, useSender } from './block-form';
 import { P_HOME_POSITION, P_HOME_SEARCH_INVERSE, P_HOME_SEARCH_VELOCITY, P_HOME_SYNC_INVERSE, P_HOME_SYNC_VELOCITY, P_REFERENCE_MODE, paramDefault, useLiveParameters } from './axis-params';
 import { EncoderPanel, PositionCorrectionPanel, TorquePanel } from './function-blocks';
 
