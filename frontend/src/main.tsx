@@ -3,7 +3,7 @@ import './style.css';
 import 'uplot/dist/uPlot.min.css';
 import { Root } from './ui/shell/root';
 import { live, start, stop } from './services';
-import { onUnauthorized } from './api/rest';
+import { onUnauthorized } from './api/client';
 import { auth, checkSession, sessionEnded } from './auth/session';
 import { control } from './auth/control';
 

@@ -5,7 +5,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, unmount } from './dom';
+import { mountPoint, unmount, urlOf } from './dom';
 
 const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), stopAndRelease: vi.fn(async () => ({ stop: { id: 9 }, followed: Promise.resolve('released') })) }));
 
@@ -56,8 +56,8 @@ beforeEach(() => {
   vi.stubGlobal(
     'fetch',
     vi.fn(
-      (url: string) =>
-        new Promise<Response>((resolve) => waiting.push({ url, answer: (b) => resolve(new Response(JSON.stringify(b), { status: 200 })) })),
+      (input: RequestInfo | URL) =>
+        new Promise<Response>((resolve) => waiting.push({ url: urlOf(input), answer: (b) => resolve(new Response(JSON.stringify(b), { status: 200 })) })),
     ),
   );
   root = mountPoint();

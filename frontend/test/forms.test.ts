@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { fieldErrors } from '../src/api/rest';
+import { fieldErrors } from '../src/api/problem';
 import { errorInfo } from '../src/api/errors';
 import { diff, parseValue, rangeText } from '../src/ui/config/parameters';
 import { configOf, DEFAULT_FORM, formOf, shownFields } from '../src/ui/config/axis-config';

@@ -4,7 +4,7 @@
 // shown at the field, or at the form or row it concerns.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { del, enc, get, post, put } from '../../api/rest';
+import { api } from '../../api/client';
 import type { components } from '../../api/schema';
 import { useStore } from '../../store';
 import { auth, checkSession, ROLES, signedIn, type Role } from '../../auth/session';
@@ -15,6 +15,7 @@ type S = components['schemas'];
 export type UserView = S['UserView'];
 export type TokenView = S['TokenView'];
 export type NewToken = S['NewToken'];
+type TokenRequest = S['TokenRequest'];
 
 /** A token's state for the table: revoked, expired (at `now`) or active. */
 export function tokenStatus(t: TokenView, now = Date.now()): { kind: 'revoked' | 'expired' | 'active'; text: string; at: string | null } {
@@ -65,7 +66,7 @@ export function UsersPage() {
   const [error, setError] = useState<string | null>(null);
   const load = async () => {
     try {
-      const [u, t] = await Promise.all([get<UserView[]>('/users'), get<TokenView[]>('/tokens')]);
+      const [u, t] = await Promise.all([api.GET('/api/v1/users'), api.GET('/api/v1/tokens')]);
       setUsers(u);
       setTokens(t);
       setError(null);
@@ -159,11 +160,11 @@ function UserRow({ user, me, reload }: { user: UserView; me: boolean; reload: ()
       setBusy(false);
     }
   };
-  const setRole = (role: Role) => act(() => put<UserView>(`/users/${enc(user.name)}`, { role }), () => setDone(`role set to ${role}`));
+  const setRole = (role: Role) => act(() => api.PUT('/api/v1/users/{name}', { params: { path: { name: user.name } }, body: { role } }), () => setDone(`role set to ${role}`));
   const setPassword = (ev: Event) => {
     ev.preventDefault();
     void act(
-      () => put<UserView>(`/users/${enc(user.name)}`, { password: pw }),
+      () => api.PUT('/api/v1/users/{name}', { params: { path: { name: user.name } }, body: { password: pw } }),
       () => {
         setPw('');
         setPwOpen(false);
@@ -172,7 +173,7 @@ function UserRow({ user, me, reload }: { user: UserView; me: boolean; reload: ()
       },
     );
   };
-  const remove = () => act(() => del(`/users/${enc(user.name)}`));
+  const remove = () => act(() => api.DELETE('/api/v1/users/{name}', { params: { path: { name: user.name } } }));
   return (
     <>
       <tr data-user={user.name} class={error ? 'row-error' : ''}>
@@ -254,7 +255,7 @@ function AddUser({ first, authOn, reload }: { first: boolean; authOn: boolean; r
     setError(null);
     setFields({});
     try {
-      await post<UserView>('/users', { name: name.trim(), role, password });
+      await api.POST('/api/v1/users', { body: { name: name.trim(), role, password } });
       setName('');
       setPassword('');
       // The first user turns authentication on: this page must now log in.
@@ -351,7 +352,7 @@ function TokenRow({ token: t, reload }: { token: TokenView; reload: () => Promis
     setBusy(true);
     setError(null);
     try {
-      await del<TokenView>(`/tokens/${t.id}`);
+      await api.DELETE('/api/v1/tokens/{id}', { params: { path: { id: t.id } } });
       setConfirm(false);
       await reload();
     } catch (e) {
@@ -425,9 +426,9 @@ function NewTokenPanel({ fresh, onCreated, onDone }: { fresh: NewToken | null; o
     setError(null);
     setFields({});
     try {
-      const body: Record<string, unknown> = { name: name.trim(), role };
+      const body: TokenRequest = { name: name.trim(), role };
       if (days.trim()) body.expires_in_days = parseNum(days);
-      const t = await post<NewToken>('/tokens', body);
+      const t = await api.POST('/api/v1/tokens', { body });
       setName('');
       setDays('');
       await onCreated(t);

@@ -96,7 +96,7 @@ export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
             onClick={async () => {
               try {
                 setResetError(null);
-                await command(axis, 'reset');
+                await command(axis, 'reset', {});
               } catch (e) {
                 setResetError((e as Error).message);
               }

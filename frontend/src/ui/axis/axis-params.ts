@@ -1,7 +1,7 @@
 // An axis's parameters for the axis tabs: jog velocities, inching steps, and what a blank field
 // of a block stands for (the parameter's value in force, shown as the field's placeholder).
 import { useEffect, useState } from 'preact/hooks';
-import { get, enc } from '../../api/rest';
+import { api } from '../../api/client';
 import type { ParameterResource } from '../../api/types';
 import { inputNum } from '../../format';
 
@@ -14,7 +14,7 @@ export function useParameters(axis: string, id: number, version = 0): Map<number
   const [loaded, setLoaded] = useState<{ key: string; map: Map<number, ParameterResource> } | null>(null);
   useEffect(() => {
     let gone = false;
-    get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(
+    api.GET('/api/v1/axes/{axis}/parameters', { params: { path: { axis } } }).then(
       (list) => !gone && setLoaded({ key, map: new Map(list.map((p) => [p.number, p])) }),
       () => {},
     );

@@ -4,6 +4,7 @@
 import type { ComponentChildren } from 'preact';
 import { command, releaseCommand } from '../../services';
 import type { AxisLiveStatus, AxisResource, ParameterResource } from '../../api/types';
+import type { BlockBody, BlockName, BlockOptions } from '../../api/blocks';
 import { Field, NumberInput, errorText, fieldsOf } from '../shared/common';
 import { label, type Built, type Form } from '../../axis/bodies';
 
@@ -46,15 +47,16 @@ export function SelectField({ f, set, k, label: l, errors, options, name, blank,
 
 /**
  * Sends a block from a form: the body's own checks first, then the server's answer; a refusal
- * is shown at its fields (problem+json errors[].field) and in the banner.
+ * is shown at its fields (problem+json errors[].field) and in the banner. The body is checked by
+ * tsc against the block's (api/blocks.ts); `options.query`: `wait`, `timeout_ms`.
  */
 export function useSender(axis: string, setBanner: (s: string | null) => void) {
-  return async <T,>(name: string, built: Built<T>, setErrors: (e: Record<string, string>) => void) => {
+  return async <N extends BlockName>(name: N, built: Built<BlockBody<N>>, setErrors: (e: Record<string, string>) => void, options?: BlockOptions<N>) => {
     setErrors(built.errors);
     setBanner(null);
     if (Object.keys(built.errors).length) return null;
     try {
-      return await command(axis, name, built.body as Record<string, unknown>);
+      return await command(axis, name, built.body, options);
     } catch (e) {
       setErrors(fieldsOf(e));
       setBanner(errorText(e));

@@ -8,7 +8,7 @@ import { useStore } from '../../store';
 import { axes, commandLog, releaseCommand, statuses } from '../../services';
 import { couplerOf, couplingInForce } from '../../axis/coupling-kind';
 import { P_ACC, paramDefault, useLiveParameters } from './axis-params';
-import { get } from '../../api/rest';
+import { api } from '../../api/client';
 import type { AxisResource, CamTableResource } from '../../api/types';
 import { href } from '../../router';
 import { ActionButton, ErrorBanner, Led, Panel, errorText, useOnline } from '../shared/common';
@@ -54,7 +54,7 @@ export function CouplingTab({ axis: a }: { axis: AxisResource }) {
 
   const [tables, setTables] = useState<CamTableResource[]>([]);
   useEffect(() => {
-    get<CamTableResource[]>('/cam-tables').then(setTables, () => {});
+    api.GET('/api/v1/cam-tables').then(setTables, () => {});
   }, []);
 
   const [gear, setGear, setGearAll] = useForm({ master: '', ratio_numerator: '1', ratio_denominator: '1' });

@@ -5,8 +5,8 @@
 // DELETE /commands/{id}), and the encoder (MC_SetEncoderScalingFactor, MC_ConvertIncPosToPos /
 // MC_ConvertPosToIncPos).
 import { useEffect, useState } from 'preact/hooks';
-import { enc, get, put } from '../../api/rest';
-import type { ParameterResource } from '../../api/types';
+import { api } from '../../api/client';
+import type { BlockBody } from '../../api/blocks';
 import { href } from '../../router';
 import { ActionButton, Led, Panel, errorText, fieldsOf } from '../shared/common';
 import { inputNum, num, pos, sig, vel } from '../../format';
@@ -23,9 +23,9 @@ import {
   backlashBody,
   correctionRows,
   encoderScalingBody,
-  incPosQuery,
+  incPosParams,
   limiterBody,
-  posQuery,
+  posParams,
   tableCompensationBody,
   torqueControlBody,
   writeDriveModeBody,
@@ -64,7 +64,7 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
   const [dmErr, setDmErr] = useState<Record<string, string>>({});
   const readMode = async () => {
     try {
-      setRead(await get<DriveOperationModeResource>(`/axes/${enc(axis)}/read-drive-operation-mode`));
+      setRead(await api.GET('/api/v1/axes/{axis}/read-drive-operation-mode', { params: { path: { axis } } }));
       setReadErr(null);
     } catch (e) {
       setReadErr(errorText(e));
@@ -74,7 +74,7 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
     void readMode();
   }, [axis]);
   const writeMode = async () => {
-    await send('write-drive-operation-mode?wait=true&timeout_ms=2000', writeDriveModeBody(dm), setDmErr);
+    await send('write-drive-operation-mode', writeDriveModeBody(dm), setDmErr, { query: { wait: true, timeout_ms: 2000 } });
     await readMode();
   };
   const mode = s?.drive_operation_mode;
@@ -175,7 +175,7 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, p
   const [param, setParam] = useState<boolean | null>(null);
   const [paramErr, setParamErr] = useState<string | null>(null);
   const readParam = () =>
-    get<ParameterResource>(`/axes/${enc(axis)}/parameters/AxisEnablePosCorrection`).then(
+    api.GET('/api/v1/axes/{axis}/parameters/{parameter}', { params: { path: { axis, parameter: 'AxisEnablePosCorrection' } } }).then(
       (p) => setParam(p.value === true || p.value === 1),
       () => setParam(null),
     );
@@ -185,7 +185,7 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, p
   const enable = async () => {
     try {
       setParamErr(null);
-      const p = await put<ParameterResource>(`/axes/${enc(axis)}/parameters/AxisEnablePosCorrection`, { value: true });
+      const p = await api.PUT('/api/v1/axes/{axis}/parameters/{parameter}', { params: { path: { axis, parameter: 'AxisEnablePosCorrection' } }, body: { value: true } });
       setParam(p.value === true || p.value === 1);
     } catch (e) {
       setParamErr(errorText(e));
@@ -202,7 +202,7 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, p
   const blCmd = useRunning(axis, 'backlash-compensation');
   const tabCmd = useRunning(axis, 'table-based-position-compensation');
   // A refusal for want of #1046 (invalid_mode): read the parameter again, someone may have changed it.
-  const start = async <T,>(name: string, built: Built<T>, setErr: (e: Record<string, string>) => void) => {
+  const start = async <N extends 'position-correction-limiter' | 'backlash-compensation' | 'table-based-position-compensation'>(name: N, built: Built<BlockBody<N>>, setErr: (e: Record<string, string>) => void) => {
     const r = await send(name, built, setErr);
     if (!r) void readParam();
   };
@@ -366,14 +366,14 @@ export function EncoderPanel({ axis: a, s, online, send }: BlockProps) {
   const [toPos, setToPos] = useState<Conversion>(null);
   const [toInc, setToInc] = useState<Conversion>(null);
 
-  const convert = async (key: 'inc_pos' | 'position', built: Built<string>, path: string, setOut: (c: Conversion) => void) => {
+  const convert = async (key: 'inc_pos' | 'position', errors: Record<string, string>, read: () => Promise<PositionConversion>, setOut: (c: Conversion) => void) => {
     const others = Object.fromEntries(Object.entries(convErr).filter(([k]) => k !== key));
-    if (built.errors[key]) {
-      setConvErr({ ...others, ...built.errors });
+    if (errors[key]) {
+      setConvErr({ ...others, ...errors });
       return;
     }
     try {
-      setOut({ ok: await get<PositionConversion>(`/axes/${enc(axis)}/${path}?${built.body}`) });
+      setOut({ ok: await read() });
       setConvErr(others);
     } catch (e) {
       const fl = fieldsOf(e);
@@ -409,7 +409,8 @@ export function EncoderPanel({ axis: a, s, online, send }: BlockProps) {
         data-form="convert-inc-pos"
         onSubmit={(e) => {
           e.preventDefault();
-          void convert('inc_pos', incPosQuery(conv), 'convert-inc-pos-to-pos', setToPos);
+          const q = incPosParams(conv);
+          void convert('inc_pos', q.errors, () => api.GET('/api/v1/axes/{axis}/convert-inc-pos-to-pos', { params: { path: { axis }, query: q.body } }), setToPos);
         }}
       >
         <NumField f={conv} set={setConv} k="inc_pos" label="Encoder count (inc)" errors={convErr} name="convert-inc-pos" />
@@ -427,7 +428,8 @@ export function EncoderPanel({ axis: a, s, online, send }: BlockProps) {
         data-form="convert-position"
         onSubmit={(e) => {
           e.preventDefault();
-          void convert('position', posQuery(conv), 'convert-pos-to-inc-pos', setToInc);
+          const q = posParams(conv);
+          void convert('position', q.errors, () => api.GET('/api/v1/axes/{axis}/convert-pos-to-inc-pos', { params: { path: { axis }, query: q.body } }), setToInc);
         }}
       >
         <NumField f={conv} set={setConv} k="position" label={`Position (${u})`} errors={convErr} name="convert-position" />

@@ -73,7 +73,7 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
       {
         move: async (position, velocity) => {
           try {
-            const r: CommandResource = await command(axis, `move-absolute?wait=true&timeout_ms=${MOVE_TIMEOUT_MS}`, { position, velocity });
+            const r: CommandResource = await command(axis, 'move-absolute', { position, velocity }, { query: { wait: true, timeout_ms: MOVE_TIMEOUT_MS } });
             return r.state === 'done';
           } catch (e) {
             const f = fieldsOf(e);

@@ -6,6 +6,7 @@ import { command, findHeldStop, jog, releaseCommand, resetFollowingErrorPeak, st
 import { ActionButton, ErrorBanner, Field, Led, NumberInput, Panel, errorText, fieldsOf, parseNum, useOnline } from '../shared/common';
 import { acc, pos, vel, num, inputNum } from '../../format';
 import type { AxisLiveStatus, AxisResource, Direction, HomingMode } from '../../api/types';
+import type { BlockBody, BlockName } from '../../api/blocks';
 import { JogButtons, type JogButtonDef } from './jog-buttons';
 import { CommandLog } from '../shared/command-log';
 import { OverrideControl } from './override';
@@ -82,7 +83,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
     }
   }, [s]);
 
-  const run = async (name: string, body: Record<string, unknown> = {}) => {
+  const run = async <N extends BlockName>(name: N, body: BlockBody<N>) => {
     setError(null);
     try {
       return await command(axis, name, body);
@@ -114,7 +115,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   }, [params]);
   const startMove = async () => {
     const errs: Record<string, string> = {};
-    const body: Record<string, unknown> = {
+    const dynamics = {
       velocity: parseNum(velocity),
       acceleration: parseNum(accel, 0),
       deceleration: parseNum(decel, 0),
@@ -122,21 +123,16 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
     };
     // A relative move's input is its distance (PLCopen's name), the others' a target position.
     const position = { 'move-absolute': target, 'move-modulo': moduloTarget, 'move-relative': null, 'move-velocity': null }[moveKind];
-    if (position !== null) {
-      if (position.trim() === '') errs.position = 'enter a target position';
-      body.position = parseNum(position);
-    }
-    if (moveKind === 'move-relative') {
-      if (distance.trim() === '') errs.distance = 'enter a distance';
-      body.distance = parseNum(distance);
-    }
-    if (moveKind === 'move-velocity') body.direction = direction;
-    if (moveKind === 'move-modulo') body.direction = moduloDir;
+    if (position !== null && position.trim() === '') errs.position = 'enter a target position';
+    if (moveKind === 'move-relative' && distance.trim() === '') errs.distance = 'enter a distance';
     if (velocity.trim() === '') errs.velocity = 'enter a velocity';
     setMoveErrors(errs);
     if (Object.keys(errs).length) return;
     try {
-      await run(moveKind, body);
+      if (moveKind === 'move-absolute') await run(moveKind, { ...dynamics, position: parseNum(target) });
+      else if (moveKind === 'move-modulo') await run(moveKind, { ...dynamics, position: parseNum(moduloTarget), direction: moduloDir });
+      else if (moveKind === 'move-relative') await run(moveKind, { ...dynamics, distance: parseNum(distance) });
+      else await run(moveKind, { ...dynamics, direction });
     } catch (e) {
       setMoveErrors(fieldsOf(e));
     }
@@ -197,7 +193,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   };
   const home = async () => {
     setHomeErrors({});
-    const body: Record<string, unknown> = { mode: homeMode };
+    const body: BlockBody<'home'> = { mode: homeMode };
     if (homePos.trim() !== '') body.position = parseNum(homePos);
     try {
       await run('home', body);
@@ -205,7 +201,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       setHomeErrors(fieldsOf(err));
     }
   };
-  const reset = () => run('reset').catch(() => {});
+  const reset = () => run('reset', {}).catch(() => {});
   const resetPeak = async () => {
     setError(null);
     try {

@@ -9,7 +9,8 @@
 // mode (shown and editable here).
 import type { ComponentChildren } from 'preact';
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
-import { ApiError, del, enc, get, post, put } from '../../api/rest';
+import { ApiError } from '../../api/problem';
+import { api } from '../../api/client';
 import type { CamAnalysisResource, CamCharacteristics, CamTableBody, CamTableResource, OnlineChange, TableType } from '../../api/types';
 import { CamChart, type DragPhase } from '../../cams/chart';
 import {
@@ -55,11 +56,11 @@ export function CamListPage() {
   const [name, setName] = useState('');
   const [type, setType] = useState<TableType>('motion_function');
   const [fields, setFields] = useState<Record<string, string>>({});
-  const load = () => get<CamTableResource[]>('/cam-tables').then(setTables, (e) => setError(errorText(e)));
+  const load = () => api.GET('/api/v1/cam-tables').then(setTables, (e) => setError(errorText(e)));
   useEffect(() => void load(), []);
   const create = async () => {
     try {
-      const t = await post<CamTableResource>('/cam-tables', starter(name.trim(), type));
+      const t = await api.POST('/api/v1/cam-tables', { body: starter(name.trim(), type) });
       navigate({ page: 'cam', table: t.name });
     } catch (e) {
       setFields(fieldsOf(e));
@@ -95,7 +96,7 @@ export function CamListPage() {
                   <tr key={t.id} data-cam={t.name}>
                     <td>{t.id}</td>
                     <td>
-                      <a href={`#/cams/${enc(t.name)}`}>{t.name}</a>
+                      <a href={`#/cams/${encodeURIComponent(t.name)}`}>{t.name}</a>
                     </td>
                     <td>
                       {t.table_type.replace('_', ' ')}
@@ -176,7 +177,7 @@ export function CamPage({ table }: { table: string }) {
   // The live analysis: posts the table as edited, keeps only the latest answer.
   useEffect(() => {
     const a = new LiveAnalysis(
-      (body) => post<CamAnalysisResource>(`/cam-analysis?samples=${samplesFor(body)}`, body),
+      (body) => api.POST('/api/v1/cam-analysis', { params: { query: { samples: samplesFor(body) } }, body }),
       (x: Analysis) => {
         if (x.kind === 'ok') {
           setResult(x.result);
@@ -200,7 +201,7 @@ export function CamPage({ table }: { table: string }) {
 
   const load = async () => {
     try {
-      const one = await get<CamTableResource>(`/cam-tables/${enc(table)}`);
+      const one = await api.GET('/api/v1/cam-tables/{table}', { params: { path: { table } } });
       setT(one);
       meta.current = one;
       setHist(historyOf(draftOf(one)));
@@ -299,8 +300,9 @@ export function CamPage({ table }: { table: string }) {
     if (!t || !draft) return;
     setAsked(null);
     try {
-      await put<CamTableResource>(`/cam-tables/${t.id}`, bodyOf(t, draft));
-      const one = await get<CamTableResource>(`/cam-tables/${t.id}`);
+      const table = String(t.id);
+      await api.PUT('/api/v1/cam-tables/{table}', { params: { path: { table } }, body: bodyOf(t, draft) });
+      const one = await api.GET('/api/v1/cam-tables/{table}', { params: { path: { table } } });
       setT(one);
       meta.current = one;
       setHist((h) => h && record(h, draftOf(one)));
@@ -318,7 +320,7 @@ export function CamPage({ table }: { table: string }) {
     const slaves = slavesOf(statuses.get(), t.id);
     if (!slaves.length) return doSave();
     try {
-      const mode = await get<OnlineChange>(`/cam-tables/${t.id}/online-change-mode`);
+      const mode = await api.GET('/api/v1/cam-tables/{table}/online-change-mode', { params: { path: { table: String(t.id) } } });
       setAsked({ text: onlineChangeText(slaves, mode), slaves });
     } catch (e) {
       setError(errorText(e));
@@ -328,7 +330,7 @@ export function CamPage({ table }: { table: string }) {
   const remove = async () => {
     if (!t || !confirm(`Delete cam table '${t.name}'?`)) return;
     try {
-      await del(`/cam-tables/${t.id}`);
+      await api.DELETE('/api/v1/cam-tables/{table}', { params: { path: { table: String(t.id) } } });
       navigate({ page: 'cams' });
     } catch (e) {
       setError(errorText(e));
@@ -651,7 +653,7 @@ function OnlineChangePanel({ table: t }: { table: CamTableResource }) {
   const [banner, setBanner] = useState<string | null>(null);
   const [pos, setPos] = useState('0');
   const load = () =>
-    get<OnlineChange>(`/cam-tables/${t.id}/online-change-mode`).then(
+    api.GET('/api/v1/cam-tables/{table}/online-change-mode', { params: { path: { table: String(t.id) } } }).then(
       (m) => {
         setMode(m);
         setForm(m);
@@ -664,7 +666,7 @@ function OnlineChangePanel({ table: t }: { table: CamTableResource }) {
     setErrors({});
     setBanner(null);
     try {
-      const m = await put<OnlineChange>(`/cam-tables/${t.id}/online-change-mode`, body);
+      const m = await api.PUT('/api/v1/cam-tables/{table}/online-change-mode', { params: { path: { table: String(t.id) } }, body });
       setMode(m);
       setForm(m);
       setPos(String(m.activation_position ?? 0));

@@ -13,7 +13,8 @@
 import { useEffect, useState } from 'preact/hooks';
 import type { JSX } from 'preact';
 import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../../api/types';
-import { ApiError, NOT_A_NUMBER, del, enc, post, put } from '../../api/rest';
+import { ApiError, NOT_A_NUMBER } from '../../api/problem';
+import { api } from '../../api/client';
 import { command, refreshAxes, statuses } from '../../services';
 import { navigate } from '../../router';
 import { useStore } from '../../store';
@@ -441,7 +442,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     }
     if (creating) {
       try {
-        const r = await post<AxisResource>('/axes', config);
+        const r = await api.POST('/api/v1/axes', { body: config });
         await refreshAxes();
         navigate({ page: 'axis', axis: r.config.name, tab: 'online' });
       } catch (e) {
@@ -453,7 +454,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     // the values beside the fields and those a rebuild would lose, read anew
     setParamsVersion((v) => v + 1);
     try {
-      const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}?dry_run=true`, config);
+      const r = await api.PUT('/api/v1/axes/{axis}', { params: { path: { axis: axis.config.name }, query: { dry_run: true } }, body: config });
       if (!r.change) throw new Error('The server did not say what the save would change.');
       setPending({ change: r.change, config });
     } catch (e) {
@@ -468,7 +469,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     if (!axis || !pending) return;
     setSaving(true);
     try {
-      const r = await put<AxisResource>(`/axes/${enc(axis.config.name)}`, pending.config);
+      const r = await api.PUT('/api/v1/axes/{axis}', { params: { path: { axis: axis.config.name } }, body: pending.config });
       setPending(null);
       setFields({});
       setForm(formOf(r.config));
@@ -489,7 +490,7 @@ export function AxisConfigPage({ axis }: { axis: AxisResource | null }) {
     if (!axis) return;
     setError(null);
     try {
-      await del(`/axes/${enc(axis.config.name)}`);
+      await api.DELETE('/api/v1/axes/{axis}', { params: { path: { axis: axis.config.name } } });
       await refreshAxes();
       navigate({ page: 'overview' });
     } catch (e) {

@@ -4,11 +4,12 @@
 // server's validation errors appear at the row.
 import type { ComponentChildren } from 'preact';
 import { useEffect, useMemo, useState } from 'preact/hooks';
-import { NOT_A_NUMBER, get, put, enc } from '../../api/rest';
+import { NOT_A_NUMBER } from '../../api/problem';
+import { api } from '../../api/client';
 import type { AxisResource, ParamGroup, ParameterResource, ParamValue } from '../../api/types';
 import { ErrorBanner, errorText, fieldsOf, useOnline } from '../shared/common';
 import { inputNum } from '../../format';
-import { ApiError } from '../../api/rest';
+import { ApiError } from '../../api/problem';
 import { errorInfo } from '../../api/errors';
 import { refreshAxes } from '../../services';
 
@@ -99,7 +100,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
   const online = useOnline();
 
   const load = () =>
-    get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(setList, (e) => setError(errorText(e)));
+    api.GET('/api/v1/axes/{axis}/parameters', { params: { path: { axis } } }).then(setList, (e) => setError(errorText(e)));
   useEffect(() => {
     void load();
   }, [axis]);
@@ -126,7 +127,7 @@ export function ParametersTab({ axis: a }: { axis: AxisResource }) {
     const remaining: Record<number, string> = { ...edits };
     for (const c of changes) {
       try {
-        const r = await put<ParameterResource>(`/axes/${enc(axis)}/parameters/${c.param.number}`, { value: c.next, persistent });
+        const r = await api.PUT('/api/v1/axes/{axis}/parameters/{parameter}', { params: { path: { axis, parameter: String(c.param.number) } }, body: { value: c.next, persistent } });
         ok++;
         delete remaining[c.param.number];
         setList((l) => l && l.map((p) => (p.number === r.number ? r : p)));

@@ -2,7 +2,7 @@ import type { ComponentChildren } from 'preact';
 import { useState } from 'preact/hooks';
 import { stateLamp, STATE_LABEL } from '../../format';
 import type { AxisState } from '../../api/types';
-import { ApiError, NOT_A_NUMBER } from '../../api/rest';
+import { ApiError, NOT_A_NUMBER } from '../../api/problem';
 import { RpcError } from '../../live/client';
 import { errorInfo } from '../../api/errors';
 import { useStore } from '../../store';
@@ -76,7 +76,7 @@ export function isNumberText(s: string): boolean {
  * A number input that keeps the text as typed (so "1." or "-" can be entered). Text that is
  * not a number is said beside the field in words ("enter a number") once the field is left —
  * while typing "-" on the way to "-5" nothing flickers; a request with it is never sent
- * (api/rest.ts: NotSentError, whose field error the form shows the same way).
+ * (api/problem.ts: NotSentError, whose field error the form shows the same way).
  */
 export function NumberInput({ value, onValue, name, placeholder, step = 'any', disabled, class: cls, title }: {
   value: string;

@@ -3,7 +3,7 @@
 import { useEffect, useRef, useState } from 'preact/hooks';
 import { useStore } from '../../store';
 import { auth, login, type LoginReason } from '../../auth/session';
-import { ApiError } from '../../api/rest';
+import { ApiError } from '../../api/problem';
 import { App } from './app';
 import { Field } from '../shared/common';
 

@@ -8,7 +8,7 @@
 // Reset bus (`POST /bus/reset`, the engineer role). The simulated bus is the axes with simulated drives.
 import { Fragment } from 'preact';
 import { useEffect, useState } from 'preact/hooks';
-import { ApiError } from '../../api/rest';
+import { ApiError } from '../../api/problem';
 import type { AxisResource, BusResource } from '../../api/types';
 import { useStore } from '../../store';
 import { axes, statuses } from '../../services';

@@ -4,7 +4,8 @@
 // real-time grants, the drive bus (bus.tsx beside this file), the audit log, and the configuration as one document:
 // download it, or import a file after seeing what it would change.
 import { useEffect, useRef, useState } from 'preact/hooks';
-import { ApiError, get, put } from '../../api/rest';
+import { ApiError } from '../../api/problem';
+import { api } from '../../api/client';
 import type { Problem } from '../../api/types';
 import { useStore } from '../../store';
 import { refreshAxes, statuses } from '../../services';
@@ -21,7 +22,7 @@ import {
   PAGE,
   REFRESH_MS,
   actionSuggestions,
-  auditQuery,
+  auditParams,
   detailLine,
   distinct,
   filterEntries,
@@ -58,7 +59,7 @@ export function SystemPage() {
     let timer: ReturnType<typeof setTimeout> | undefined;
     const tick = async () => {
       if (typeof document === 'undefined' || !document.hidden) {
-        const [s, m] = await Promise.allSettled([get<SystemResource>('/system'), getCycleHistograms()]);
+        const [s, m] = await Promise.allSettled([api.GET('/api/v1/system'), getCycleHistograms()]);
         if (stopped) return;
         const h = m.status === 'fulfilled' ? m.value : null;
         if (s.status === 'fulfilled') {
@@ -299,7 +300,7 @@ export function ConfigPanel() {
   const download = async () => {
     setError(null);
     try {
-      const doc = await get<ConfigDocument>('/config');
+      const doc = await api.GET('/api/v1/config');
       downloadJson(exportName(), JSON.stringify(doc, null, 2) + '\n');
     } catch (e) {
       setError(errorText(e));
@@ -322,7 +323,7 @@ export function ConfigPanel() {
       }
       const bad = notADocument(doc);
       if (bad) throw new Error(`${f.name}: ${bad}`);
-      const current = await get<ConfigDocument>('/config');
+      const current = await api.GET('/api/v1/config');
       setState({ kind: 'diff', file: f.name, doc: doc as ConfigDocument, current, diff: diffConfig(current, doc as ConfigDocument) });
     } catch (e) {
       setState({ kind: 'idle' });
@@ -340,13 +341,13 @@ export function ConfigPanel() {
     try {
       // The diff shown must be the one that applies: if the configuration changed meanwhile,
       // show the new diff and ask again.
-      const now = await get<ConfigDocument>('/config');
+      const now = await api.GET('/api/v1/config');
       if (JSON.stringify(now) !== JSON.stringify(state.current)) {
         setState({ ...state, current: now, diff: diffConfig(now, state.doc) });
         setStale(true);
         return;
       }
-      const done = await put<ConfigDocument>('/config', state.doc);
+      const done = await api.PUT('/api/v1/config', { body: state.doc });
       setState({ kind: 'done', file: state.file, axes: done.axes.length, tables: state.doc.cam_tables ? (done.cam_tables ?? []).length : null });
       void refreshAxes();
     } catch (e) {
@@ -573,11 +574,11 @@ export function AuditPanel() {
     try {
       const since = newestId(list.current);
       if (since === null) {
-        const got = await get<AuditRecord[]>(auditQuery({ limit: PAGE }));
+        const got = await api.GET('/api/v1/audit', { params: { query: auditParams({ limit: PAGE }) } });
         set(got);
         setEnd(got.length < PAGE);
       } else {
-        const got = await get<AuditRecord[]>(auditQuery({ limit: PAGE, since }));
+        const got = await api.GET('/api/v1/audit', { params: { query: auditParams({ limit: PAGE, since }) } });
         // More new entries than a page: the ones between are not loaded; start again from these.
         if (got.length >= PAGE) {
           set(got);
@@ -594,7 +595,7 @@ export function AuditPanel() {
     if (before === null || loadingOlder) return;
     setLoadingOlder(true);
     try {
-      const got = await get<AuditRecord[]>(auditQuery({ limit: PAGE, before }));
+      const got = await api.GET('/api/v1/audit', { params: { query: auditParams({ limit: PAGE, before }) } });
       set(mergeEntries(list.current, got));
       if (got.length < PAGE) setEnd(true);
       setError(null);
