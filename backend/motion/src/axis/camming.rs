@@ -1,14 +1,15 @@
 //! Cam couplings (TwinCAT NC Camming, spec camming-tf5050.md): MC_CamIn (couple, or switch the
 //! cam of a coupled slave), MC_CamOut, MC_CamScaling, their activation modes, autooffset, and
 //! MC_CamInfo. The law — slave = (f((m + MO)/MS) + strokes)·SS + SO, on the master's set
-//! values — is a [`CouplingLaw`] like the gears, so admission, losing the master and the soft
-//! limits of a coupled slave are shared with them.
+//! values — is a coupling law like the gears (`CouplingLaw` in `coupling.rs`, which names this
+//! file's [`CamSet`]; this file reaches the coupling only through the axis's `cam_set`,
+//! `install_coupling`…), so admission, losing the master and the soft limits of a coupled
+//! slave are shared with them.
 //!
 //! A cam never makes the slave jump: where it takes effect (coupling, switch, scaling) the
 //! slave's position must match within the target window (#1026) and its velocity within one
 //! cycle's acceleration (#1004), else the command ends with 0x7084 and nothing changes.
 
-use super::coupling::{Coupling, CouplingLaw};
 use super::*;
 use crate::cam::{
     Cam, CamActivationMode as Act, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling,
@@ -377,17 +378,6 @@ impl Axis {
         coupled
             || self.cam_in.is_some_and(|p| p.ci.cam_table == id)
             || self.cam_switch.is_some_and(|p| p.what.cam_table == id)
-    }
-
-    /// The cams of a cam slave.
-    pub(super) fn cam_set(&self) -> Option<CamSet> {
-        match self.coupling {
-            Some(Coupling {
-                law: CouplingLaw::Cam(set),
-                ..
-            }) => Some(set),
-            _ => None,
-        }
     }
 
     /// A ramp-in runs: the planner holds the slave's deviation from its cams, which moves
@@ -824,12 +814,7 @@ impl Axis {
         self.abort_all(cx);
         let mut set = CamSet::single(law, v2);
         set.ramp = ramp;
-        self.coupling = Some(Coupling {
-            more_masters: [None; 3],
-            master,
-            law: CouplingLaw::Cam(set),
-            dyn_command: 0,
-        });
+        self.install_coupling(master, set, 0);
         if ramp {
             // The command keeps the axis (Active) until the slave has caught up (InSync).
             let out = FbOutputs {
@@ -866,11 +851,7 @@ impl Axis {
     }
 
     fn set_cam_term(&mut self, i: usize, law: CamLaw) {
-        if let Some(Coupling {
-            law: CouplingLaw::Cam(set),
-            ..
-        }) = self.coupling.as_mut()
-        {
+        if let Some(set) = self.cam_set_mut() {
             set.terms[i] = Some(law);
         }
     }
@@ -1565,11 +1546,7 @@ impl Axis {
     }
 
     fn set_cam_set(&mut self, set: CamSet) {
-        if let Some(Coupling {
-            law: CouplingLaw::Cam(s),
-            ..
-        }) = self.coupling.as_mut()
-        {
+        if let Some(s) = self.cam_set_mut() {
             *s = set;
         }
     }

@@ -35,6 +35,7 @@ mod encoder;
 mod external;
 mod homing;
 mod job;
+mod master;
 mod monitoring;
 mod motion;
 mod multimaster;
@@ -46,9 +47,9 @@ mod superposition;
 mod torque;
 
 use coupling::Coupling;
-pub use coupling::{Master, MasterSample};
 use homing::HomeSeq;
 use job::{Ctx, DONE, End, Held, Job, JobKind, Phase};
+pub use master::{Master, MasterSample};
 use superposition::Superimposed;
 
 /// Static configuration of an axis (the base configuration the parameters start from).
