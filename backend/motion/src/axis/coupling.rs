@@ -538,7 +538,7 @@ impl Axis {
         if let CouplingLaw::Cam(cams) = &mut c.law {
             self.step_ramp_in(cx, job, cams, dt);
         }
-        self.set_has_superposition = false;
+        self.superposition.main_motion_sampled();
         if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
             let out = FbOutputs {
                 in_gear: true,

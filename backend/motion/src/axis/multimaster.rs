@@ -331,7 +331,7 @@ impl Axis {
                 MultiMasterSyncMode::Possync2 => v_synced && p_synced,
             };
         }
-        self.set_has_superposition = false;
+        self.superposition.main_motion_sampled();
         if job.id != 0 && job.out.in_gear != law.in_gear {
             let out = FbOutputs {
                 in_gear: law.in_gear,
