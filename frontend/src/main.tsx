@@ -1,9 +1,9 @@
 import { render } from 'preact';
 import './style.css';
 import 'uplot/dist/uPlot.min.css';
-import { Root } from './ui/root';
+import { Root } from './ui/shell/root';
 import { live, start, stop } from './services';
-import { onUnauthorized } from './api/rest';
+import { onUnauthorized } from './api/client';
 import { auth, checkSession, sessionEnded } from './auth/session';
 import { control } from './auth/control';
 

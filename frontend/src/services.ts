@@ -2,7 +2,9 @@
 import { LiveClient } from './live/client';
 import { JogController } from './live/jog';
 import { Store } from './store';
-import { ApiError, NotSentError, api, del, enc, get, post } from './api/rest';
+import { ApiError, NotSentError } from './api/problem';
+import { api } from './api/client';
+import { postBlock, type BlockBody, type BlockName, type BlockOptions } from './api/blocks';
 import { errorInfo } from './api/errors';
 import type { AxisLiveStatus, AxisResource, CommandEvent, CommandResource, PeakResetResource, SystemResource } from './api/types';
 import { RpcError } from './live/client';
@@ -112,7 +114,7 @@ function onStatus(name: string, value: AxisLiveStatus | null, stale: boolean, cy
  * its status, kept over every cycle). Not a command: it changes no motion.
  */
 export function resetFollowingErrorPeak(axis: string): Promise<PeakResetResource> {
-  return api<PeakResetResource>('POST', `/axes/${enc(axis)}/status/following-error-peak/reset`);
+  return api.POST('/api/v1/axes/{axis}/status/following-error-peak/reset', { params: { path: { axis } } });
 }
 
 /** Keeps one status subscription per axis; the focused axis (online tab) at a higher rate. */
@@ -167,7 +169,7 @@ let axesApplied = 0;
 export async function refreshAxes(): Promise<void> {
   const n = ++axesAsked;
   try {
-    const list = await get<AxisResource[]>('/axes');
+    const list = await api.GET('/api/v1/axes');
     // An answer older than one already applied (requests overlap) would bring back the past.
     if (n < axesApplied) return;
     axesApplied = n;
@@ -263,24 +265,27 @@ function onCommandEvent(ev: CommandEvent): void {
   });
   if (!known && !fetchedDetails.has(ev.command)) {
     fetchedDetails.add(ev.command);
-    get<CommandResource>(`/commands/${ev.command}`).then(logCommand, () => {});
+    api.GET('/api/v1/commands/{id}', { params: { path: { id: ev.command } } }).then(logCommand, () => {});
   }
   if (ev.final) jog.commandFinal(ev.command, ev.state);
 }
 
 export async function refreshCommands(): Promise<void> {
   try {
-    const list = await get<CommandResource[]>('/commands?limit=100');
+    const list = await api.GET('/api/v1/commands', { params: { query: { limit: 100 } } });
     for (const r of list.reverse()) logCommand(r);
   } catch {
     /* shown by the connection state */
   }
 }
 
-/** Runs a command over REST, logging the outcome; rethrows the error for the form. */
-export async function command(axis: string, name: string, body: Record<string, unknown> = {}): Promise<CommandResource> {
+/**
+ * Runs block `name` on `axis` over REST (its body checked by tsc against the block's, api/blocks.ts),
+ * logging the outcome; rethrows the error for the form. `options.query`: `wait`, `timeout_ms`.
+ */
+export async function command<N extends BlockName>(axis: string, name: N, body: BlockBody<N>, options?: BlockOptions<N>): Promise<CommandResource> {
   try {
-    const r = await post<CommandResource>(`/axes/${enc(axis)}/${name}`, body);
+    const r = await postBlock(axis, name, body, options);
     logCommand(r);
     return r;
   } catch (e) {
@@ -292,7 +297,7 @@ export async function command(axis: string, name: string, body: Record<string, u
 /** Releases a command (DELETE /commands/{id}): unlocks a stop, ends a power or jog. */
 export async function releaseCommand(id: number, axis: string): Promise<void> {
   try {
-    const r = await del<CommandResource>(`/commands/${id}`);
+    const r = await api.DELETE('/api/v1/commands/{id}', { params: { path: { id } } });
     logCommand(r);
   } catch (e) {
     logRejected(axis, 'release', { command: id }, e);
@@ -305,10 +310,10 @@ export async function releaseCommand(id: number, axis: string): Promise<void> {
  * stands (axis/stop.ts), so the axis is ready for the next command. Resolves with the stop as
  * sent; `followed` settles when it is released (or ended otherwise).
  */
-export async function stopAndRelease(axis: string, body: Record<string, unknown>): Promise<{ stop: CommandResource; followed: Promise<'released' | 'ended'> }> {
+export async function stopAndRelease(axis: string, body: BlockBody<'stop'>): Promise<{ stop: CommandResource; followed: Promise<'released' | 'ended'> }> {
   const stop = await command(axis, 'stop', body);
   const followed = releaseWhenDone(stop.id, {
-    read: (id) => get<CommandResource>(`/commands/${id}`),
+    read: (id) => api.GET('/api/v1/commands/{id}', { params: { path: { id } } }),
     watch: (id, on) => {
       const check = () => {
         const e = commandLog.get().find((x) => x.id === id);
@@ -329,7 +334,7 @@ export async function stopAndRelease(axis: string, body: Record<string, unknown>
  */
 export async function findHeldStop(axis: string): Promise<number | null> {
   for (const state of ['active', 'done'] as const) {
-    const list = await get<CommandResource[]>(`/commands?axis=${enc(axis)}&state=${state}&limit=500`);
+    const list = await api.GET('/api/v1/commands', { params: { query: { axis, state, limit: 500 } } });
     const stop = list.find((c) => c.command === 'stop' && !c.final);
     if (stop) return stop.id;
   }

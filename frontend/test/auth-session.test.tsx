@@ -4,15 +4,15 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, unmount } from './dom';
+import { asSent, mountPoint, unmount } from './dom';
 
-vi.mock('../src/ui/app', () => ({ App: () => <div id="the-app">app</div> }));
+vi.mock('../src/ui/shell/app', () => ({ App: () => <div id="the-app">app</div> }));
 
 import { auth, checkSession, login, logout, may, roleAtLeast, sessionEnded, signedIn, viewOf, type AuthView, type SessionState } from '../src/auth/session';
-import { Root, loginErrorText } from '../src/ui/root';
-import { ApiError } from '../src/api/rest';
+import { Root, loginErrorText } from '../src/ui/shell/root';
+import { ApiError } from '../src/api/problem';
 import { parseRoute, href } from '../src/router';
-import { tokenStatus } from '../src/ui/users';
+import { tokenStatus } from '../src/ui/auth/users';
 import { dateTime } from '../src/format';
 
 const off: SessionState = { auth_enabled: false, principal: null, name: null, kind: null, role: null, expires_at: null };
@@ -28,10 +28,10 @@ function serve(answer: (method: string, url: string, body: unknown) => [number, 
   asked = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string, init?: RequestInit) => {
-      const method = init?.method ?? 'GET';
+    vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+      const { method, url, body } = await asSent(input, init);
       asked.push(`${method} ${url}`);
-      const a = answer(method, url, init?.body ? JSON.parse(String(init.body)) : undefined);
+      const a = answer(method, url, body ? JSON.parse(body) : undefined);
       if (a instanceof Error) throw a;
       return new Response(a[1] === null ? null : JSON.stringify(a[1]), { status: a[0] });
     }),

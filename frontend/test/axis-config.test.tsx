@@ -20,7 +20,7 @@ vi.mock('../src/services', async () => {
 });
 
 import { statuses } from '../src/services';
-import { AxisConfigPage, DEFAULT_FORM, configOf, reconfigureBlocked } from '../src/ui/axis-config';
+import { AxisConfigPage, DEFAULT_FORM, configOf, reconfigureBlocked } from '../src/ui/config/axis-config';
 import type { AxisLiveStatus, AxisResource } from '../src/api/types';
 
 const config = configOf({ ...DEFAULT_FORM, name: 'x' }).config!;

@@ -5,7 +5,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, unmount } from './dom';
+import { mountPoint, unmount, urlOf } from './dom';
 
 const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), stopAndRelease: vi.fn(async () => ({ stop: { id: 9 }, followed: Promise.resolve('released') })) }));
 
@@ -32,13 +32,13 @@ vi.mock('../src/services', async () => {
   };
 });
 // uPlot and the command log are not what is tested here.
-vi.mock('../src/ui/trend', () => ({ Trend: () => null }));
-vi.mock('../src/ui/command-log', () => ({ CommandLog: () => null }));
+vi.mock('../src/ui/axis/trend', () => ({ Trend: () => null }));
+vi.mock('../src/ui/shared/command-log', () => ({ CommandLog: () => null }));
 
 import { axes, statuses } from '../src/services';
-import { AxisPage } from '../src/ui/axis-page';
-import { powerOverride } from '../src/ui/online';
-import { useParameters } from '../src/ui/axis-params';
+import { AxisPage } from '../src/ui/axis/axis-page';
+import { powerOverride } from '../src/ui/axis/online';
+import { useParameters } from '../src/ui/axis/axis-params';
 import type { AxisLiveStatus, AxisResource, ParameterResource } from '../src/api/types';
 
 const axis = (id: number, name: string, modulo = false) =>
@@ -56,8 +56,8 @@ beforeEach(() => {
   vi.stubGlobal(
     'fetch',
     vi.fn(
-      (url: string) =>
-        new Promise<Response>((resolve) => waiting.push({ url, answer: (b) => resolve(new Response(JSON.stringify(b), { status: 200 })) })),
+      (input: RequestInfo | URL) =>
+        new Promise<Response>((resolve) => waiting.push({ url: urlOf(input), answer: (b) => resolve(new Response(JSON.stringify(b), { status: 200 })) })),
     ),
   );
   root = mountPoint();

@@ -1,7 +1,7 @@
 // What a blank field of a block stands for: the parameter's value in force as the placeholder
 // (what the axis uses now — not "#1012"), its number and name in the tooltip.
 import { describe, expect, it } from 'vitest';
-import { paramDefault, paramText } from '../src/ui/axis-params';
+import { paramDefault, paramText } from '../src/ui/axis/axis-params';
 import type { ParameterResource } from '../src/api/types';
 
 const p = (number: number, name: string, value: number | boolean, unit_text = '') => [number, { number, name, value, unit_text } as ParameterResource] as const;

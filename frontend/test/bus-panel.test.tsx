@@ -7,7 +7,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { enter, mountPoint, problem, settle, stubFetch, unmount, type FetchCall } from './dom';
+import { asSent, enter, mountPoint, problem, settle, stubFetch, unmount, type FetchCall } from './dom';
 import { emulated, simulated, strictDrive, sub } from './bus-fixture';
 
 vi.mock('../src/services', async () => {
@@ -21,7 +21,7 @@ vi.mock('../src/services', async () => {
 
 import { axes } from '../src/services';
 import { auth } from '../src/auth/session';
-import { BusPanel } from '../src/ui/bus';
+import { BusPanel } from '../src/ui/system/bus';
 import type { AxisResource, BusResource } from '../src/api/types';
 
 let asked: FetchCall[];
@@ -197,14 +197,15 @@ describe('issue 22: the negotiated process image, the frame counters, the TX/RX 
     asked = [];
     vi.stubGlobal(
       'fetch',
-      vi.fn(async (url: string, init?: RequestInit) => {
-        asked.push({ method: init?.method ?? 'GET', url, body: init?.body ? JSON.parse(String(init.body)) : undefined });
+      vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+        const { method, url, body } = await asSent(input, init);
+        asked.push({ method, url, body: body ? JSON.parse(body) : undefined });
         if (url === '/api/v1/bus/reset') {
           await new Promise<void>((r) => (release = r));
           bus = emulated({ lost_frames: 40, faults: 1, txrx: { running: true, restarts: 1, thread: 'SCHED_FIFO 79, pinned to CPU 0' } });
           return new Response(JSON.stringify(bus), { status: 200, headers: { 'content-type': 'application/json' } });
         }
-        return stub(url, init);
+        return stub(input, init);
       }),
     );
     await act(async () => render(<BusPanel />, root));

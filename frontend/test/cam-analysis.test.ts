@@ -1,7 +1,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { LiveAnalysis, discontinuityText, errorsByRow, samplesFor, warningsByRow, type Analysis } from '../src/cams/analysis';
 import { ONLINE_MODES, onlineChangeText, slavesOf } from '../src/cams/online';
-import { ApiError } from '../src/api/rest';
+import { ApiError } from '../src/api/problem';
 import type { AxisLiveStatus, CamAnalysisResource, CamTableBody } from '../src/api/types';
 
 const body = (slave: number): CamTableBody => ({ name: 'c', table_type: 'motion_function', points: [{ point_index: 1, function_type: 'polynom5', master_pos: 0, slave_pos: slave }] });

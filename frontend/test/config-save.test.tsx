@@ -5,7 +5,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, unmount } from './dom';
+import { asSent, mountPoint, unmount } from './dom';
 
 const h = vi.hoisted(() => ({ command: vi.fn(async () => ({ id: 1 })), refreshAxes: vi.fn(async () => {}) }));
 
@@ -20,7 +20,7 @@ vi.mock('../src/services', async () => {
 });
 
 import { statuses } from '../src/services';
-import { AxisConfigPage, DEFAULT_FORM, configOf } from '../src/ui/axis-config';
+import { AxisConfigPage, DEFAULT_FORM, configOf } from '../src/ui/config/axis-config';
 import type { AxisLiveStatus, AxisResource, ParameterResource } from '../src/api/types';
 import type { ConfigChange } from '../src/config/change';
 
@@ -51,9 +51,10 @@ beforeEach(() => {
   calls = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string, init?: RequestInit) => {
-      const method = init?.method ?? 'GET';
-      const body = init?.body ? JSON.parse(String(init.body)) : undefined;
+    vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+      const sent = await asSent(input, init);
+      const { method, url } = sent;
+      const body = sent.body ? JSON.parse(sent.body) : undefined;
       calls.push({ method, url, body });
       if (method === 'GET' && url === '/api/v1/axes/x/parameters') return json(PARAMS);
       if (method === 'PUT' && url === '/api/v1/axes/x?dry_run=true') {

@@ -15,7 +15,7 @@ import {
   type ControlDeps,
   type ControlState,
 } from '../src/auth/control';
-import { ApiError } from '../src/api/rest';
+import { ApiError } from '../src/api/problem';
 
 const holder = (over: Partial<NonNullable<ControlState['holder']>> = {}) => ({
   client_id: 'ui-aaaaaaaa',

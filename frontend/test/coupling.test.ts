@@ -2,7 +2,7 @@
 import { describe, expect, it } from 'vitest';
 import { CAM_IN_DEFAULTS, CAM_SCALING_DEFAULTS, SUPERIMPOSED_DEFAULTS, camInBody, camInfoRows, camScalingBody, gearInBody, gearInDynBody, superimposedBody } from '../src/axis/bodies';
 import { parseRoute, href } from '../src/router';
-import { nonFiniteFields } from '../src/api/rest';
+import { nonFiniteFields } from '../src/api/problem';
 import { couplingInForce } from '../src/axis/coupling-kind';
 
 describe('gear bodies', () => {

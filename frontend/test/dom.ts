@@ -18,6 +18,21 @@ export function unmount(root: HTMLElement): void {
 
 export type FetchCall = { method: string; url: string; body: unknown };
 
+/** The URL a fetch double is asked for, as the path and query (the REST client passes a Request). */
+export function urlOf(input: RequestInfo | URL): string {
+  const u = new URL(typeof input === 'string' ? input : input instanceof URL ? input.href : input.url, location.href);
+  return u.origin === location.origin ? u.pathname + u.search : u.href;
+}
+
+/** What a fetch double is given: method, URL (path and query), headers and body text (none: undefined). */
+export async function asSent(input: RequestInfo | URL, init?: RequestInit): Promise<{ method: string; url: string; headers: Headers; body: string | undefined }> {
+  if (input instanceof Request) {
+    const body = input.body === null ? undefined : await input.clone().text();
+    return { method: input.method, url: urlOf(input), headers: input.headers, body };
+  }
+  return { method: init?.method ?? 'GET', url: urlOf(input), headers: new Headers(init?.headers), body: init?.body == null ? undefined : String(init.body) };
+}
+
 /**
  * Replaces `fetch` by a double: `answer` gives each request's status and JSON body (null: none).
  * Returns the requests made, in order.
@@ -26,8 +41,9 @@ export function stubFetch(answer: (c: FetchCall) => [number, unknown]): FetchCal
   const calls: FetchCall[] = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string, init?: RequestInit) => {
-      const c = { method: init?.method ?? 'GET', url, body: init?.body ? JSON.parse(String(init.body)) : undefined };
+    vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+      const r = await asSent(input, init);
+      const c = { method: r.method, url: r.url, body: r.body ? JSON.parse(r.body) : undefined };
       calls.push(c);
       const [status, json] = answer(c);
       const type = status < 300 ? 'application/json' : 'application/problem+json';

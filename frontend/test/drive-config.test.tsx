@@ -20,7 +20,7 @@ vi.mock('../src/services', async () => {
 });
 vi.mock('../src/router', async (orig) => ({ ...(await orig<typeof import('../src/router')>()), navigate: vi.fn() }));
 
-import { AxisConfigPage } from '../src/ui/axis-config';
+import { AxisConfigPage } from '../src/ui/config/axis-config';
 import type { AxisConfig, AxisResource, BusResource } from '../src/api/types';
 
 let calls: FetchCall[];

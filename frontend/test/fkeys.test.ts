@@ -1,6 +1,6 @@
 // TwinCAT's function keys of the Online tab (installFunctionKeys), on a happy-dom window.
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
-import { installFunctionKeys, keyOf, type FunctionKeyHandlers } from '../src/ui/fkeys';
+import { installFunctionKeys, keyOf, type FunctionKeyHandlers } from '../src/ui/axis/fkeys';
 
 let h: FunctionKeyHandlers & { on: boolean };
 let off: () => void;

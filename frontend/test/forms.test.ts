@@ -1,8 +1,8 @@
 import { describe, expect, it } from 'vitest';
-import { fieldErrors } from '../src/api/rest';
+import { fieldErrors } from '../src/api/problem';
 import { errorInfo } from '../src/api/errors';
-import { diff, parseValue, rangeText } from '../src/ui/parameters';
-import { configOf, DEFAULT_FORM, formOf, shownFields } from '../src/ui/axis-config';
+import { diff, parseValue, rangeText } from '../src/ui/config/parameters';
+import { configOf, DEFAULT_FORM, formOf, shownFields } from '../src/ui/config/axis-config';
 import type { ParameterResource } from '../src/api/types';
 
 describe('problem+json field errors', () => {

@@ -22,7 +22,7 @@ vi.mock('../src/services', async () => {
   };
 });
 
-import { JogButtons, type JogButtonDef } from '../src/ui/jog-buttons';
+import { JogButtons, type JogButtonDef } from '../src/ui/axis/jog-buttons';
 
 const buttons: JogButtonDef[] = [
   { key: 'fast-backward', label: '−−', direction: 'backward', mode: 'standard_fast', velocity: 100 },

@@ -15,7 +15,7 @@ vi.mock('../src/services', async () => {
 
 import { live, system } from '../src/services';
 import { STALE_AFTER_MS, ageText, latestCycle, liveness } from '../src/live/liveness';
-import { LiveIndicator } from '../src/ui/liveness';
+import { LiveIndicator } from '../src/ui/shared/liveness';
 
 describe('liveness', () => {
   it('is live until no message came for longer than STALE_AFTER_MS, offline while closed', () => {

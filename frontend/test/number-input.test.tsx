@@ -6,8 +6,9 @@ import { render } from 'preact';
 import { useState } from 'preact/hooks';
 import { act } from 'preact/test-utils';
 import { mountPoint, unmount, enter } from './dom';
-import { ApiError, NotSentError, nonFiniteFields, post, put } from '../src/api/rest';
-import { Field, NumberInput, fieldsOf, isNumberText, parseNum } from '../src/ui/common';
+import { ApiError, NotSentError, nonFiniteFields } from '../src/api/problem';
+import { api } from '../src/api/client';
+import { Field, NumberInput, fieldsOf, isNumberText, parseNum } from '../src/ui/shared/common';
 
 afterEach(() => vi.unstubAllGlobals());
 
@@ -24,14 +25,15 @@ describe('the REST client sends no number that is not one', () => {
   it('refuses the request before fetch: a 422 made here with "enter a number" at the field', async () => {
     const fetch = vi.fn(async () => new Response('{}', { status: 200 }));
     vi.stubGlobal('fetch', fetch);
-    const e = await post('/axes/x/move-absolute', { position: parseNum('abc'), velocity: 10 }).catch((x) => x);
+    const move = (position: number) => api.POST('/api/v1/axes/{axis}/move-absolute', { params: { path: { axis: 'x' } }, body: { position, velocity: 10 } });
+    const e = await move(parseNum('abc')).catch((x) => x);
     expect(e).toBeInstanceOf(NotSentError);
     expect(e).toBeInstanceOf(ApiError);
     expect((e as ApiError).status).toBe(422);
     expect(fieldsOf(e)).toEqual({ position: 'enter a number' });
-    await expect(put('/axes/x/parameters/1001', { value: NaN })).rejects.toBeInstanceOf(NotSentError);
+    await expect(api.PUT('/api/v1/axes/{axis}/parameters/{parameter}', { params: { path: { axis: 'x', parameter: '1001' } }, body: { value: NaN } })).rejects.toBeInstanceOf(NotSentError);
     expect(fetch).not.toHaveBeenCalled();
-    await post('/axes/x/move-absolute', { position: parseNum('1,5'), velocity: 10 });
+    await move(parseNum('1,5'));
     expect(fetch).toHaveBeenCalledTimes(1);
   });
 

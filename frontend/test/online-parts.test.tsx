@@ -15,8 +15,8 @@ vi.mock('../src/services', async () => {
   };
 });
 
-import { OverrideControl, factorPercent, HOLD_MS, type OverrideStatus } from '../src/ui/override';
-import { Inching } from '../src/ui/inching';
+import { OverrideControl, factorPercent, HOLD_MS, type OverrideStatus } from '../src/ui/axis/override';
+import { Inching } from '../src/ui/axis/inching';
 import type { ParameterResource } from '../src/api/types';
 
 let root: HTMLElement;

@@ -5,6 +5,7 @@
 import { afterEach, describe, expect, it, vi } from 'vitest';
 import { axes, findHeldStop, live, refreshAxes, resetFollowingErrorPeak, statuses, trendOf } from '../src/services';
 import type { CommandResource } from '../src/api/types';
+import { asSent } from './dom';
 
 const cmd = (id: number, command: string, state: CommandResource['state'], final: boolean, parameters: object = {}, axis = 'x') =>
   ({ id, axis, command, state, final, parameters, outputs: { error_id: 0 }, last_cycle: id, submitted_at: '' }) as unknown as CommandResource;
@@ -14,8 +15,9 @@ function serve(byQuery: (url: string) => unknown) {
   asked = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string, init?: RequestInit) => {
-      asked.push(`${init?.method ?? 'GET'} ${url}`);
+    vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+      const { method, url } = await asSent(input, init);
+      asked.push(`${method} ${url}`);
       return new Response(JSON.stringify(byQuery(url)), { status: 200 });
     }),
   );

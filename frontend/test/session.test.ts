@@ -2,7 +2,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { ScopeSession, type ScopeApi } from '../src/scope/session';
 import type { Recording } from '../src/scope/data';
-import { ApiError } from '../src/api/rest';
+import { ApiError } from '../src/api/problem';
 
 const rec = (id: number, state: Recording['state'], extra: Partial<Recording> = {}): Recording => ({
   id,

@@ -4,7 +4,7 @@
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { render } from 'preact';
 import { act } from 'preact/test-utils';
-import { mountPoint, problem, unmount } from './dom';
+import { asSent, mountPoint, problem, unmount } from './dom';
 
 vi.mock('../src/services', async () => {
   const { Store } = await import('../src/store');
@@ -15,7 +15,7 @@ vi.mock('../src/services', async () => {
   };
 });
 
-import { AuditPanel, ConfigPanel } from '../src/ui/system';
+import { AuditPanel, ConfigPanel } from '../src/ui/system/system';
 import { parseRoute, href } from '../src/router';
 import { ms, plantText, simulatedAxes } from '../src/system/bus';
 
@@ -28,9 +28,10 @@ beforeEach(() => {
   asked = [];
   vi.stubGlobal(
     'fetch',
-    vi.fn(async (url: string, init?: RequestInit) => {
-      const method = init?.method ?? 'GET';
-      const body = init?.body ? JSON.parse(String(init.body)) : undefined;
+    vi.fn(async (input: RequestInfo | URL, init?: RequestInit) => {
+      const sent = await asSent(input, init);
+      const { method, url } = sent;
+      const body = sent.body ? JSON.parse(sent.body) : undefined;
       asked.push({ method, url, body });
       const [status, json] = answer(method, url, body);
       return new Response(json === null ? null : JSON.stringify(json), { status });

@@ -16,6 +16,9 @@ use motion::{DriveFeedback, DriveSetpoint};
 
 const CYCLE: Duration = Duration::from_millis(1);
 
+/// One cycle of the bus as the tests drive it (exchange, then wait a cycle).
+type Exchange = dyn FnMut(&mut EthercatBus, &[DriveSetpoint], &mut [DriveFeedback]);
+
 #[test]
 fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
     let seg = servos(2, true);
@@ -35,21 +38,20 @@ fn an_axis_slot_drives_an_emulated_cia402_drive_through_faults_and_reset() {
         bus.exchange(sp, fb);
         std::thread::sleep(CYCLE);
     };
-    let until =
-        |what: &str,
-         bus: &mut EthercatBus,
-         sp: &mut Vec<DriveSetpoint>,
-         fb: &mut Vec<DriveFeedback>,
-         f: &dyn Fn(&DriveFeedback) -> bool,
-         cycle: &mut dyn FnMut(&mut EthercatBus, &[DriveSetpoint], &mut [DriveFeedback])| {
-            for _ in 0..5000 {
-                cycle(bus, sp, fb);
-                if f(&fb[2]) {
-                    return;
-                }
+    let until = |what: &str,
+                 bus: &mut EthercatBus,
+                 sp: &mut Vec<DriveSetpoint>,
+                 fb: &mut Vec<DriveFeedback>,
+                 f: &dyn Fn(&DriveFeedback) -> bool,
+                 cycle: &mut Exchange| {
+        for _ in 0..5000 {
+            cycle(bus, sp, fb);
+            if f(&fb[2]) {
+                return;
             }
-            panic!("{what}: {:?}", fb[2]);
-        };
+        }
+        panic!("{what}: {:?}", fb[2]);
+    };
     until(
         "ready",
         &mut bus,

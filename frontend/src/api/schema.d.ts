@@ -4478,7 +4478,7 @@ export interface components {
              * @description Seconds without a sample after which a moving axis stops (default 0.05).
              * @default 0.05
              */
-            feed_timeout: number;
+            feed_timeout?: number;
         };
         /**
          * @description The outputs of a function block (`ST_McOutputs` plus the milestone flags).
@@ -4648,12 +4648,12 @@ export interface components {
              * @description 0 = that of the running job.
              * @default 0
              */
-            deceleration: number;
+            deceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            jerk: number;
+            jerk?: number;
             /** @description Default `aborting`. */
             buffer_mode?: components["schemas"]["BufferMode"];
             /** @description Default: none set. */
@@ -4711,25 +4711,25 @@ export interface components {
              * @description MC_Direct only: set = actual afterwards.
              * @default false
              */
-            clear_position_lag: boolean;
+            clear_position_lag?: boolean;
             /** @default null */
-            search_direction: null | components["schemas"]["Direction"];
+            search_direction?: null | components["schemas"]["Direction"];
             /**
              * Format: double
              * @description Overrides the cam-search velocity (#1012).
              * @default null
              */
-            search_velocity: number | null;
+            search_velocity?: number | null;
             /** @default null */
-            sync_direction: null | components["schemas"]["Direction"];
+            sync_direction?: null | components["schemas"]["Direction"];
             /**
              * Format: double
              * @description Overrides the sync velocity (#1013).
              * @default null
              */
-            sync_velocity: number | null;
+            sync_velocity?: number | null;
             /** @default null */
-            reference_mode: null | components["schemas"]["ReferenceMode"];
+            reference_mode?: null | components["schemas"]["ReferenceMode"];
         };
         /**
          * @description Phase of a referencing sequence (`NcToPlc.HomingState`).
@@ -4778,35 +4778,35 @@ export interface components {
              * @description Inching distance (inching modes).
              * @default 0
              */
-            position: number;
+            position?: number;
             /**
              * Format: double
              * @description Continuous mode velocity.
              * @default 0
              */
-            velocity: number;
+            velocity?: number;
             /**
              * Format: double
              * @default 0
              */
-            acceleration: number;
+            acceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            deceleration: number;
+            deceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            jerk: number;
+            jerk?: number;
             /**
              * Format: double
              * @description Seconds without keepalive after which the jog stops (0.05 s up to the axis's
              *     `dynamics.jog_deadman_max`, at most 10; default 0.5).
              * @default 0.5
              */
-            deadman_timeout: number;
+            deadman_timeout?: number;
         };
         /** @enum {string} */
         JogDirection: "forward" | "backward";
@@ -5295,17 +5295,17 @@ export interface components {
              * @description Blend at this position instead of the previous command's target.
              * @default null
              */
-            blending_position: number | null;
+            blending_position?: number | null;
             /**
              * @description Done at the logical end of positioning, without waiting for the target window.
              * @default false
              */
-            ignore_position_monitoring: boolean;
+            ignore_position_monitoring?: boolean;
             /**
              * @description Halt/Stop: wait for the target window at the stop position before Done.
              * @default false
              */
-            enable_stop_position_monitoring: boolean;
+            enable_stop_position_monitoring?: boolean;
         };
         /**
          * @description MC_MoveRelative / MC_MoveAdditive: a distance (PLCopen's `Distance`), from the set position
@@ -5493,25 +5493,25 @@ export interface components {
              * @description LowerOverrideThreshold (default 0).
              * @default 0
              */
-            lower_threshold: number;
+            lower_threshold?: number;
             /**
              * Format: double
              * @description UpperOverrideThreshold (default 32767), above lower_threshold.
              * @default 32767
              */
-            upper_threshold: number;
+            upper_threshold?: number;
             /**
              * Format: int32
              * @description OverrideSteps (default 200 = 0.5 %), 2 to 1 000 000.
              * @default 200
              */
-            steps: number;
+            steps?: number;
             /**
              * Format: double
              * @description OverrideRecoveryTime in seconds (default 0.15).
              * @default 0.15
              */
-            recovery_time: number;
+            recovery_time?: number;
         };
         /**
          * @description UI group of a parameter (no meaning for the kernel).
@@ -5868,19 +5868,19 @@ export interface components {
          */
         PowerBody: {
             /** @default true */
-            enable: boolean;
+            enable?: boolean;
             /** @default true */
-            enable_positive: boolean;
+            enable_positive?: boolean;
             /** @default true */
-            enable_negative: boolean;
+            enable_negative?: boolean;
             /**
              * Format: double
              * @description Velocity override in percent (0–100).
              * @default 100
              */
-            override_percent: number;
+            override_percent?: number;
             /** @default null */
-            buffer_mode: null | components["schemas"]["BufferMode"];
+            buffer_mode?: null | components["schemas"]["BufferMode"];
         };
         /**
          * @description `MC_TouchProbeRecordedData` of a done probe cycle.
@@ -6027,22 +6027,22 @@ export interface components {
              * Format: double
              * @default 0
              */
-            velocity: number;
+            velocity?: number;
             /**
              * Format: double
              * @default 0
              */
-            acceleration: number;
+            acceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            deceleration: number;
+            deceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            jerk: number;
+            jerk?: number;
         };
         /**
          * @description What real-time facilities the OS granted.
@@ -6499,13 +6499,13 @@ export interface components {
              *     after it (not MC_Halt or MC_Stop).
              * @default 1
              */
-            acceleration_factor: number;
+            acceleration_factor?: number;
             /**
              * Format: double
              * @description (0, 1], default 1: scales the jerk of motion commands started after it.
              * @default 1
              */
-            jerk_factor: number;
+            jerk_factor?: number;
         };
         /**
          * @description MC_SetPosition.
@@ -6838,12 +6838,12 @@ export interface components {
              * Format: double
              * @default 0
              */
-            deceleration: number;
+            deceleration?: number;
             /**
              * Format: double
              * @default 0
              */
-            jerk: number;
+            jerk?: number;
             /** @description Default: none set. */
             options?: components["schemas"]["MoveOptions"];
         };

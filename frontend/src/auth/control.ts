@@ -4,7 +4,8 @@
 // closes gives control back at once (fetch keepalive). Other clients' motion commands are
 // refused with 409 `control_held` while this tab holds it; stop, halt and power off never are.
 import { Store } from '../store';
-import { ApiError, del, get, headers, post, url } from '../api/rest';
+import { ApiError } from '../api/problem';
+import { api } from '../api/client';
 import type { components } from '../api/schema';
 
 export type ControlState = components['schemas']['ControlState'];
@@ -282,12 +283,12 @@ export class ControlLease {
 }
 
 export const control = new ControlLease({
-  get: () => get<ControlState>('/control'),
-  take: (body) => post<ControlState>('/control', body),
-  release: () => del<ControlState>('/control'),
+  get: () => api.GET('/api/v1/control'),
+  take: (body) => api.POST('/api/v1/control', { body }),
+  release: () => api.DELETE('/api/v1/control'),
   releaseOnUnload: () => {
     try {
-      void fetch(url('/control'), { method: 'DELETE', keepalive: true, headers: headers('DELETE') }).catch(() => {});
+      void api.DELETE('/api/v1/control', { keepalive: true }).catch(() => {});
     } catch {
       /* the lease runs out instead */
     }

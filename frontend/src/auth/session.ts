@@ -3,7 +3,8 @@
 // app, and any 401 later (the session expired, was logged out elsewhere, the user deleted)
 // brings it back. While authentication is off every client may do everything.
 import { Store } from '../store';
-import { ApiError, get, post } from '../api/rest';
+import { ApiError } from '../api/problem';
+import { api } from '../api/client';
 import type { components } from '../api/schema';
 
 export type SessionState = components['schemas']['SessionState'];
@@ -67,7 +68,7 @@ let checking: Promise<void> | null = null;
 export function checkSession(): Promise<void> {
   return (checking ??= (async () => {
     try {
-      const s = await get<SessionState>('/auth/session');
+      const s = await api.GET('/api/v1/auth/session');
       auth.set(viewOf(s, auth.get()));
     } catch (e) {
       if (e instanceof ApiError && e.status === 401) sessionEnded();
@@ -87,7 +88,7 @@ export function sessionEnded(): void {
 
 /** Logs in; the server's error (401 invalid_credentials, 429 …) is thrown for the form. */
 export async function login(name: string, password: string): Promise<SessionState> {
-  const s = await post<SessionState>('/auth/login', { name, password });
+  const s = await api.POST('/api/v1/auth/login', { body: { name, password } });
   auth.set({ kind: 'app', session: s });
   return s;
 }
@@ -95,7 +96,7 @@ export async function login(name: string, password: string): Promise<SessionStat
 /** Logs out (the server clears the cookie); the login page follows whatever it answered. */
 export async function logout(): Promise<void> {
   try {
-    await post<void>('/auth/logout');
+    await api.POST('/api/v1/auth/logout');
   } finally {
     auth.set({ kind: 'login', reason: 'logged-out' });
   }

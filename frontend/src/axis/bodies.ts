@@ -3,7 +3,7 @@
 // default applies; a text that is no number is sent as NaN → null for the server to refuse
 // at its field.
 import type { components } from '../api/schema';
-import { NOT_A_NUMBER } from '../api/rest';
+import { NOT_A_NUMBER } from '../api/problem';
 
 type S = components['schemas'];
 export type GearInBody = S['GearInBody'];
@@ -490,16 +490,25 @@ export function encoderScalingBody(f: Form): Built<SetEncoderScalingFactorBody> 
   return { body, errors };
 }
 
-/** MC_ConvertIncPosToPos's query: an encoder count (UDINT). */
-export function incPosQuery(f: Form): Built<string> {
+/** MC_ConvertIncPosToPos's query parameters: an encoder count (UDINT). */
+export function incPosParams(f: Form): Built<{ inc_pos: number }> {
   const errors: Record<string, string> = {};
-  const v = checkNum(f, 'inc_pos', errors, { required: true, integer: true, min: 0, max: 4294967295 });
-  return { body: `inc_pos=${v}`, errors };
+  const v = checkNum(f, 'inc_pos', errors, { required: true, integer: true, min: 0, max: 4294967295 }) as number;
+  return { body: { inc_pos: v }, errors };
 }
 
-/** MC_ConvertPosToIncPos's query: an axis position. */
-export function posQuery(f: Form): Built<string> {
+/** MC_ConvertPosToIncPos's query parameters: an axis position. */
+export function posParams(f: Form): Built<{ position: number }> {
   const errors: Record<string, string> = {};
-  const v = checkNum(f, 'position', errors, { required: true, min: -1e12, max: 1e12 });
-  return { body: `position=${v}`, errors };
+  const v = checkNum(f, 'position', errors, { required: true, min: -1e12, max: 1e12 }) as number;
+  return { body: { position: v }, errors };
 }
+
+/** A query's parameters as its text: `{ inc_pos: 100 }` → `inc_pos=100`. */
+const queryText = <T extends object>(b: Built<T>): Built<string> => ({ body: new URLSearchParams(Object.entries(b.body).map(([k, v]) => [k, String(v)])).toString(), errors: b.errors });
+
+/** MC_ConvertIncPosToPos's query as sent: `inc_pos=100`. */
+export const incPosQuery = (f: Form): Built<string> => queryText(incPosParams(f));
+
+/** MC_ConvertPosToIncPos's query as sent: `position=12.5`. */
+export const posQuery = (f: Form): Built<string> => queryText(posParams(f));

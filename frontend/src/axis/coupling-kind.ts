@@ -19,6 +19,13 @@ export interface Coupler {
   state: string;
 }
 
+/** The commands that couple an axis as a slave. */
+export const COUPLING_COMMANDS = new Set(['gear-in', 'gear-in-dyn', 'gear-in-multi-master', 'cam-in', 'cam-in-v2', 'cam-exchange', 'cam-add']);
+
+/** The axis's latest coupling command in the command log (one that failed coupled nothing). */
+export const couplerOf = <E extends Coupler & { axis: string; id: number | null }>(log: readonly E[], axis: string): E | undefined =>
+  log.find((e) => e.axis === axis && e.id !== null && COUPLING_COMMANDS.has(e.command) && e.state !== 'error');
+
 const CAM_COMMANDS: Record<string, string> = {
   'cam-in': 'MC_CamIn',
   'cam-in-v2': 'MC_CamIn_V2',

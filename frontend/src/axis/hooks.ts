@@ -2,7 +2,7 @@
 import { useEffect, useState } from 'preact/hooks';
 import { useStore } from '../store';
 import { commandLog, type LogEntry } from '../services';
-import { get } from '../api/rest';
+import { api } from '../api/client';
 import type { CommandResource } from '../api/types';
 import type { Form } from './bodies';
 
@@ -44,7 +44,7 @@ export function useCommand(id: number | null | undefined, key = ''): CommandReso
     let live = true;
     let timer: ReturnType<typeof setTimeout> | null = null;
     const read = (tries: number) =>
-      get<CommandResource>(`/commands/${id}`).then(
+      api.GET('/api/v1/commands/{id}', { params: { path: { id } } }).then(
         (c) => live && setR(c),
         () => {
           if (live && tries > 0) timer = setTimeout(() => void read(tries - 1), 1000);

@@ -2,7 +2,7 @@
 // `POST /cam-analysis` (debounced), only the answer to the latest request counts; a 422 names
 // the rows at fault. Also the texts of what the analysis finds (discontinuities, row errors).
 import type { CamAnalysisResource, CamDiscontinuity, CamTableBody } from '../api/types';
-import { ApiError } from '../api/rest';
+import { ApiError } from '../api/problem';
 import { sig } from '../format';
 
 /** What the latest answered request says about the table as edited. */

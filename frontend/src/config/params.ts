@@ -1,6 +1,6 @@
 // An axis's parameters (online, persistent and configured values) for the Configuration page.
 import { useEffect, useState } from 'preact/hooks';
-import { get, enc } from '../api/rest';
+import { api } from '../api/client';
 import type { ParameterResource } from '../api/types';
 
 /**
@@ -13,7 +13,7 @@ export function useAxisParameters(axis: string | null, id: number, version: numb
   useEffect(() => {
     if (axis === null || key === null) return;
     let gone = false;
-    get<ParameterResource[]>(`/axes/${enc(axis)}/parameters`).then(
+    api.GET('/api/v1/axes/{axis}/parameters', { params: { path: { axis } } }).then(
       (list) => !gone && setLoaded({ key, map: new Map(list.map((p) => [p.number, p])) }),
       () => {},
     );

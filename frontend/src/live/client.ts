@@ -2,7 +2,7 @@
 // subscriptions that are re-sent on every (re)connection, and merged topic values.
 import { Store } from '../store';
 import type { Problem, SubscriptionEnded } from '../api/types';
-import { fieldErrors } from '../api/rest';
+import { fieldErrors } from '../api/problem';
 import { DeltaMerger, type Update } from './merge';
 
 export type ConnState =

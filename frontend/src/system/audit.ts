@@ -18,13 +18,19 @@ export function mergeEntries(have: AuditRecord[], got: AuditRecord[]): AuditReco
 export const newestId = (l: AuditRecord[]): number | null => (l.length ? Math.max(...l.map((e) => e.id)) : null);
 export const oldestId = (l: AuditRecord[]): number | null => (l.length ? Math.min(...l.map((e) => e.id)) : null);
 
-/** The query of a page: the newest, those after `since`, or those before `before`. */
-export function auditQuery(q: { limit?: number; since?: number | null; before?: number | null }): string {
-  const p = new URLSearchParams();
-  p.set('limit', String(q.limit ?? PAGE));
-  if (q.since !== undefined && q.since !== null) p.set('since_id', String(q.since));
-  if (q.before !== undefined && q.before !== null) p.set('before_id', String(q.before));
-  return `/audit?${p}`;
+type PageAsked = { limit?: number; since?: number | null; before?: number | null };
+
+/** The query parameters of a page: the newest, those after `since`, or those before `before`. */
+export function auditParams(q: PageAsked): { limit: number; since_id?: number; before_id?: number } {
+  const p: { limit: number; since_id?: number; before_id?: number } = { limit: q.limit ?? PAGE };
+  if (q.since !== undefined && q.since !== null) p.since_id = q.since;
+  if (q.before !== undefined && q.before !== null) p.before_id = q.before;
+  return p;
+}
+
+/** The page's query as the path it reads: `/audit?limit=100&since_id=9`. */
+export function auditQuery(q: PageAsked): string {
+  return `/audit?${new URLSearchParams(Object.entries(auditParams(q)).map(([k, v]) => [k, String(v)]))}`;
 }
 
 /** Outcome filter values besides a literal outcome. */

@@ -1,14 +1,15 @@
 //! Cam couplings (TwinCAT NC Camming, spec camming-tf5050.md): MC_CamIn (couple, or switch the
 //! cam of a coupled slave), MC_CamOut, MC_CamScaling, their activation modes, autooffset, and
 //! MC_CamInfo. The law — slave = (f((m + MO)/MS) + strokes)·SS + SO, on the master's set
-//! values — is a [`CouplingLaw`] like the gears, so admission, losing the master and the soft
-//! limits of a coupled slave are shared with them.
+//! values — is a coupling law like the gears (`CouplingLaw` in `coupling.rs`, which names this
+//! file's [`CamSet`]; this file reaches the coupling only through the axis's `cam_set`,
+//! `install_coupling`…), so admission, losing the master and the soft limits of a coupled
+//! slave are shared with them.
 //!
 //! A cam never makes the slave jump: where it takes effect (coupling, switch, scaling) the
 //! slave's position must match within the target window (#1026) and its velocity within one
 //! cycle's acceleration (#1004), else the command ends with 0x7084 and nothing changes.
 
-use super::coupling::{Coupling, CouplingLaw};
 use super::*;
 use crate::cam::{
     Cam, CamActivationMode as Act, CamIn, CamInV2, CamInfo, CamOperationMode, CamScaling,
@@ -301,6 +302,54 @@ pub(super) struct PendingData {
     due: bool,
 }
 
+/// A cam slave's state besides its cams (those are the coupling's law, [`CamSet`]): what
+/// waits for its activation, and what MC_CamInfo keeps.
+#[derive(Debug, Default)]
+pub(super) struct CamState {
+    /// MC_CamIn waiting for its activation (the axis is not coupled yet).
+    cam_in: Option<PendingCamIn>,
+    /// MC_CamIn on a cam slave waiting for its activation (CamTableQueued).
+    switch: Option<PendingChange<CamIn>>,
+    /// MC_CamScaling waiting for its activation (CamScalingPending).
+    scaling: Option<PendingChange<CamScaling>>,
+    /// The cam (term) a queued MC_CamScaling(_V2) scales.
+    scaling_term: usize,
+    /// Data written to the coupled table waiting to take effect here (CamDataQueued).
+    data: Option<PendingData>,
+    /// MC_CamIn_V2 / MC_CamAdd / MC_CamExchange / MC_CamRemove waiting for its activation.
+    v2_op: Option<PendingChange<CamInV2>>,
+    /// The master's set values in the latest cycle (a scaling at once uses them).
+    last_master: Kinematics,
+    /// MC_CamInfo of the last cam coupling, kept after an error ended it (until MC_CamOut).
+    last_info: CamInfo,
+}
+
+impl CamState {
+    /// A coupling waits for its activation (the axis executes a job, §4.1.1).
+    pub(super) fn waits_for_coupling(&self) -> bool {
+        self.cam_in.is_some()
+    }
+
+    /// MC_CamInfo of the cam coupling `info` reports, or, decoupled otherwise than by
+    /// MC_CamOut, the last valid one (no longer active, nothing queued).
+    pub(super) fn kept_info(&mut self, mut info: CamInfo) -> CamInfo {
+        if info.cam_table_id != 0 {
+            info.active = true;
+            self.last_info = info;
+        } else if self.last_info.cam_table_id != 0 {
+            // Decoupled otherwise than by MC_CamOut: the last valid state stays readable.
+            info = CamInfo {
+                active: false,
+                cam_data_queued: false,
+                cam_table_queued: false,
+                scaling_pending: false,
+                ..self.last_info
+            };
+        }
+        info
+    }
+}
+
 fn finite_scaling(v: f64) -> bool {
     v.is_finite() && v != 0.0
 }
@@ -308,7 +357,7 @@ fn finite_scaling(v: f64) -> bool {
 impl Axis {
     /// The slave's master while coupled through a cam, or waiting to be.
     pub(super) fn cam_master(&self) -> Option<AxisSlot> {
-        self.cam_in.map(|p| p.master)
+        self.cam.cam_in.map(|p| p.master)
     }
 
     /// Runs generation `generation` of cam table `id` (the kernel retires data no slave runs).
@@ -323,7 +372,7 @@ impl Axis {
 
     /// Data written to table `id` waits to take effect on this slave.
     pub fn cam_data_queued_for(&self, id: u32) -> bool {
-        self.cam_data.is_some_and(|d| {
+        self.cam.data.is_some_and(|d| {
             self.cam_set()
                 .and_then(|set| set.terms[d.term])
                 .is_some_and(|l| l.table == id)
@@ -350,7 +399,7 @@ impl Axis {
             Act::AsSoonAsPossible => Act::Instantaneous,
             other => other,
         };
-        self.cam_data = Some(PendingData {
+        self.cam.data = Some(PendingData {
             term,
             generation,
             act: Activation::new(mode, change.activation_position, m, law.raw(m)),
@@ -365,7 +414,7 @@ impl Axis {
     /// this slave stays out of it.
     pub fn drop_cam_data(&mut self, id: u32) {
         if self.cam_set().is_some_and(|set| set.find(id).is_some())
-            && self.cam_data.take().is_some()
+            && self.cam.data.take().is_some()
         {
             self.update_status();
         }
@@ -375,19 +424,8 @@ impl Axis {
     pub fn uses_cam(&self, id: u32) -> bool {
         let coupled = self.cam_set().is_some_and(|set| set.find(id).is_some());
         coupled
-            || self.cam_in.is_some_and(|p| p.ci.cam_table == id)
-            || self.cam_switch.is_some_and(|p| p.what.cam_table == id)
-    }
-
-    /// The cams of a cam slave.
-    pub(super) fn cam_set(&self) -> Option<CamSet> {
-        match self.coupling {
-            Some(Coupling {
-                law: CouplingLaw::Cam(set),
-                ..
-            }) => Some(set),
-            _ => None,
-        }
+            || self.cam.cam_in.is_some_and(|p| p.ci.cam_table == id)
+            || self.cam.switch.is_some_and(|p| p.what.cam_table == id)
     }
 
     /// A ramp-in runs: the planner holds the slave's deviation from its cams, which moves
@@ -638,7 +676,7 @@ impl Axis {
         if !finite_scaling(ci.master_scaling) || !finite_scaling(ci.slave_scaling) {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
-        if self.cam_set().is_some_and(|s| s.v2) || self.cam_in.is_some_and(|p| p.v2) {
+        if self.cam_set().is_some_and(|s| s.v2) || self.cam.cam_in.is_some_and(|p| p.v2) {
             return Err(ErrorId::CAM_FAMILY_MIXED);
         }
         let law_now = self.cam_law();
@@ -677,7 +715,7 @@ impl Axis {
         if switching {
             let law = law_now.expect("switching");
             if ci.activation_mode == Act::DeleteQueuedData {
-                if let Some(mut q) = self.cam_switch.take() {
+                if let Some(mut q) = self.cam.switch.take() {
                     q.cmd.end(cx, End::Aborted);
                 }
                 let mut h = Held::start(
@@ -701,7 +739,7 @@ impl Axis {
                 m.set.position,
                 law.raw(m.set.position),
             );
-            if let Some(mut q) = self.cam_switch.take() {
+            if let Some(mut q) = self.cam.switch.take() {
                 // A newer switch replaces a queued one.
                 q.cmd.end(cx, End::Aborted);
             }
@@ -744,7 +782,7 @@ impl Axis {
                     }
                 }
             } else {
-                self.cam_switch = Some(pending);
+                self.cam.switch = Some(pending);
             }
             return Ok(());
         }
@@ -799,7 +837,7 @@ impl Axis {
                     ..FbOutputs::default()
                 },
             );
-            self.cam_in = Some(PendingCamIn {
+            self.cam.cam_in = Some(PendingCamIn {
                 cmd,
                 v2,
                 master: ci.master,
@@ -824,12 +862,7 @@ impl Axis {
         self.abort_all(cx);
         let mut set = CamSet::single(law, v2);
         set.ramp = ramp;
-        self.coupling = Some(Coupling {
-            more_masters: [None; 3],
-            master,
-            law: CouplingLaw::Cam(set),
-            dyn_command: 0,
-        });
+        self.install_coupling(master, set, 0);
         if ramp {
             // The command keeps the axis (Active) until the slave has caught up (InSync).
             let out = FbOutputs {
@@ -866,18 +899,14 @@ impl Axis {
     }
 
     fn set_cam_term(&mut self, i: usize, law: CamLaw) {
-        if let Some(Coupling {
-            law: CouplingLaw::Cam(set),
-            ..
-        }) = self.coupling.as_mut()
-        {
+        if let Some(set) = self.cam_set_mut() {
             set.terms[i] = Some(law);
         }
     }
 
     /// Ends a coupling that waits for its activation (a new command took the axis, an error).
     pub(super) fn cancel_cam_in(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
-        if let Some(mut p) = self.cam_in.take() {
+        if let Some(mut p) = self.cam.cam_in.take() {
             p.cmd.end(cx, end);
         }
     }
@@ -887,19 +916,19 @@ impl Axis {
         if self.cam_law().is_some() {
             return;
         }
-        self.cam_data = None;
+        self.cam.data = None;
         let end = if self.mode == Mode::ErrorStop {
             End::Error(self.error)
         } else {
             End::Aborted
         };
-        if let Some(mut q) = self.cam_switch.take() {
+        if let Some(mut q) = self.cam.switch.take() {
             q.cmd.end(cx, end);
         }
-        if let Some(mut q) = self.cam_scaling.take() {
+        if let Some(mut q) = self.cam.scaling.take() {
             q.cmd.end(cx, end);
         }
-        if let Some(mut q) = self.cam_v2_op.take() {
+        if let Some(mut q) = self.cam.v2_op.take() {
             q.cmd.end(cx, end);
         }
         if self.mode == Mode::ErrorStop || self.mode == Mode::Disabled {
@@ -915,7 +944,7 @@ impl Axis {
         id: CommandId,
     ) -> Result<(), ErrorId> {
         if self.cam_law().is_none() {
-            if self.cam_in.is_none() {
+            if self.cam.cam_in.is_none() {
                 return Err(ErrorId::CAM_NOT_COUPLED);
             }
             self.cancel_cam_in(cx, End::Aborted);
@@ -928,7 +957,7 @@ impl Axis {
             self.settle_cam(cx);
             self.continue_at_current_velocity(cx);
         }
-        self.cam_last = CamInfo::default();
+        self.cam.last_info = CamInfo::default();
         cx.report(id, DONE);
         Ok(())
     }
@@ -943,7 +972,7 @@ impl Axis {
         if self.cam_set().is_some_and(|s| s.v2) {
             return Err(ErrorId::CAM_FAMILY_MIXED);
         }
-        self.cam_scaling_term = 0;
+        self.cam.scaling_term = 0;
         self.queue_cam_scaling(cx, id, sc)
     }
 
@@ -954,7 +983,7 @@ impl Axis {
         id: CommandId,
         sc: CamScaling,
     ) -> Result<(), ErrorId> {
-        let Some(law) = self.cam_term(self.cam_scaling_term) else {
+        let Some(law) = self.cam_term(self.cam.scaling_term) else {
             return Err(ErrorId::CAM_NOT_COUPLED);
         };
         for v in [sc.master_offset, sc.slave_offset, sc.activation_position] {
@@ -979,7 +1008,7 @@ impl Axis {
             }
             _ => return Err(ErrorId::CAM_MODE_INVALID),
         }
-        if let Some(mut q) = self.cam_scaling.take() {
+        if let Some(mut q) = self.cam.scaling.take() {
             q.cmd.end(cx, End::Aborted);
         }
         let m = law.master_pos;
@@ -993,12 +1022,12 @@ impl Axis {
                 ..FbOutputs::default()
             },
         );
-        self.cam_scaling = Some(PendingChange { cmd, what: sc, act });
+        self.cam.scaling = Some(PendingChange { cmd, what: sc, act });
         if act.at_once(m, law.raw(m)) {
             let master = Kinematics {
                 position: m,
-                velocity: self.last_master.velocity,
-                acceleration: self.last_master.acceleration,
+                velocity: self.cam.last_master.velocity,
+                acceleration: self.cam.last_master.acceleration,
                 jerk: 0.0,
             };
             self.apply_scaling(cx, &master);
@@ -1047,8 +1076,8 @@ impl Axis {
     }
 
     fn apply_scaling(&mut self, cx: &mut Ctx<'_, impl EventSink>, master: &Kinematics) {
-        let term = self.cam_scaling_term;
-        let (Some(law), Some(mut q)) = (self.cam_term(term), self.cam_scaling.take()) else {
+        let term = self.cam.scaling_term;
+        let (Some(law), Some(mut q)) = (self.cam_term(term), self.cam.scaling.take()) else {
             return;
         };
         let Some(cam) = cx.cams.get_gen(law.table, law.generation) else {
@@ -1075,13 +1104,13 @@ impl Axis {
         master: Master,
     ) {
         let Master::Sample(m) = master else {
-            if let (Some(_), Master::Lost) = (self.cam_in, master) {
+            if let (Some(_), Master::Lost) = (self.cam.cam_in, master) {
                 self.cancel_cam_in(cx, End::Error(ErrorId::MASTER_LOST));
             }
             return;
         };
-        self.last_master = m.set;
-        if let Some(mut p) = self.cam_in.take() {
+        self.cam.last_master = m.set;
+        if let Some(mut p) = self.cam.cam_in.take() {
             if m.error {
                 p.cmd.end(cx, End::Error(ErrorId::MASTER_INVALID));
             } else if let Some(cam) = cx.cams.get(p.ci.cam_table) {
@@ -1107,7 +1136,7 @@ impl Axis {
                         Err(e) => p.cmd.end(cx, End::Error(e)),
                     }
                 } else {
-                    self.cam_in = Some(p);
+                    self.cam.cam_in = Some(p);
                 }
             } else {
                 p.cmd.end(cx, End::Error(ErrorId::CAM_TABLE_ID_INVALID));
@@ -1120,7 +1149,7 @@ impl Axis {
             return;
         };
         let raw = law.raw(m.set.position);
-        if let Some(mut q) = self.cam_switch.take() {
+        if let Some(mut q) = self.cam.switch.take() {
             if q.act.reached(m.set.position, raw, cam) {
                 match cx.cams.get(q.what.cam_table) {
                     Some(new_cam) => {
@@ -1154,11 +1183,11 @@ impl Axis {
                     None => q.cmd.end(cx, End::Error(ErrorId::CAM_TABLE_ID_INVALID)),
                 }
             } else {
-                self.cam_switch = Some(q);
+                self.cam.switch = Some(q);
             }
         }
         self.step_cam_v2(cx, &m.set, raw, cam);
-        if let Some(mut d) = self.cam_data {
+        if let Some(mut d) = self.cam.data {
             match self.cam_term(d.term) {
                 Some(term) => {
                     let term_cam = cx.cams.get_gen(term.table, term.generation);
@@ -1166,21 +1195,21 @@ impl Axis {
                     if let Some(tc) = term_cam {
                         d.due = d.act.reached(m.set.position, raw_t, tc) || d.due;
                     }
-                    self.cam_data = Some(d);
+                    self.cam.data = Some(d);
                     if let (true, Some(tc), Some(new_cam)) =
                         (d.due, term_cam, cx.cams.get_gen(term.table, d.generation))
                     {
                         self.take_cam_data(d, term, tc, new_cam, &m.set);
                     }
                 }
-                None => self.cam_data = None,
+                None => self.cam.data = None,
             }
         }
-        if let Some(mut q) = self.cam_scaling {
+        if let Some(mut q) = self.cam.scaling {
             if q.act.reached(m.set.position, raw, cam) {
                 self.apply_scaling(cx, &m.set);
             } else {
-                self.cam_scaling = Some(q);
+                self.cam.scaling = Some(q);
             }
         }
     }
@@ -1229,7 +1258,7 @@ impl Axis {
         new.slave_coupling_pos = law.slave_coupling_pos;
         if self.check_no_jump(&mut new, new_cam, m, now).is_ok() {
             self.set_cam_term(d.term, new);
-            self.cam_data = None;
+            self.cam.data = None;
         }
     }
 
@@ -1239,24 +1268,24 @@ impl Axis {
             (Some(l), Some(master)) => l.info(master, self.set.position),
             _ => CamInfo::default(),
         };
-        if let Some(q) = &self.cam_scaling {
+        if let Some(q) = &self.cam.scaling {
             info.scaling_pending = true;
             info.scaling_activation_mode = q.act.mode;
             info.scaling_activation_pos = q.act.position;
         }
-        if let Some(q) = &self.cam_switch {
+        if let Some(q) = &self.cam.switch {
             info.cam_table_queued = true;
             info.cam_exchange_cam_table_id = q.what.cam_table;
             info.cam_exchange_activation_mode = q.act.mode;
             info.cam_exchange_activation_pos = q.act.position;
         }
-        if let Some(q) = &self.cam_v2_op {
+        if let Some(q) = &self.cam.v2_op {
             info.cam_table_queued = true;
             info.cam_exchange_cam_table_id = q.what.cam_table;
             info.cam_exchange_activation_mode = q.act.mode;
             info.cam_exchange_activation_pos = q.act.position;
         }
-        info.cam_data_queued = self.cam_data.is_some();
+        info.cam_data_queued = self.cam.data.is_some();
         if let Some(set) = self.cam_set() {
             info.multi_cam = set.v2;
             for (k, t) in set.terms.iter().enumerate() {
@@ -1276,8 +1305,8 @@ impl Axis {
                 }
             }
         }
-        let queued = self.cam_switch.is_some() || self.cam_v2_op.is_some();
-        (info, queued, self.cam_scaling.is_some())
+        let queued = self.cam.switch.is_some() || self.cam.v2_op.is_some();
+        (info, queued, self.cam.scaling.is_some())
     }
 }
 
@@ -1361,7 +1390,7 @@ impl Axis {
         }
         let ci = as_cam_in(&op);
         let Some(set) = self.cam_set() else {
-            if self.cam_in.is_some_and(|p| !p.v2) {
+            if self.cam.cam_in.is_some_and(|p| !p.v2) {
                 return Err(ErrorId::CAM_FAMILY_MIXED);
             }
             // Not coupled: the first call couples (additive); nothing to exchange or remove.
@@ -1391,7 +1420,7 @@ impl Axis {
         }
         let m = self.admit_coupling(master)?;
         if op.activation_mode == Act::DeleteQueuedData {
-            if let Some(mut q) = self.cam_v2_op.take() {
+            if let Some(mut q) = self.cam.v2_op.take() {
                 q.cmd.end(cx, End::Aborted);
             }
             let mut h = Held::start(
@@ -1429,7 +1458,7 @@ impl Axis {
             self.v2_end(cx, &mut h, &op, Ok(()));
             return Ok(());
         }
-        if let Some(mut q) = self.cam_v2_op.take() {
+        if let Some(mut q) = self.cam.v2_op.take() {
             q.cmd.end(cx, End::Aborted);
         }
         let cmd = Held::start(
@@ -1441,7 +1470,7 @@ impl Axis {
                 ..FbOutputs::default()
             },
         );
-        self.cam_v2_op = Some(PendingChange { cmd, what: op, act });
+        self.cam.v2_op = Some(PendingChange { cmd, what: op, act });
         Ok(())
     }
 
@@ -1565,11 +1594,7 @@ impl Axis {
     }
 
     fn set_cam_set(&mut self, set: CamSet) {
-        if let Some(Coupling {
-            law: CouplingLaw::Cam(s),
-            ..
-        }) = self.coupling.as_mut()
-        {
+        if let Some(s) = self.cam_set_mut() {
             *s = set;
         }
     }
@@ -1605,11 +1630,11 @@ impl Axis {
         raw: f64,
         cam: &Cam,
     ) {
-        let Some(mut q) = self.cam_v2_op.take() else {
+        let Some(mut q) = self.cam.v2_op.take() else {
             return;
         };
         if !q.act.reached(m.position, raw, cam) {
-            self.cam_v2_op = Some(q);
+            self.cam.v2_op = Some(q);
             return;
         }
         let r = self
@@ -1650,13 +1675,13 @@ impl Axis {
             master_scaling: d.master_scaling,
             slave_scaling: d.slave_scaling,
         };
-        if self.cam_scaling.is_some() && self.cam_scaling_term != term {
+        if self.cam.scaling.is_some() && self.cam.scaling_term != term {
             // One queued scaling per slave: a new one replaces it.
-            if let Some(mut q) = self.cam_scaling.take() {
+            if let Some(mut q) = self.cam.scaling.take() {
                 q.cmd.end(cx, End::Aborted);
             }
         }
-        self.cam_scaling_term = term;
+        self.cam.scaling_term = term;
         self.queue_cam_scaling(cx, id, scaling)
     }
 }

@@ -147,8 +147,7 @@ impl Axis {
                 if !(recovery_time.is_finite() && recovery_time >= 0.0) {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
-                self.override_filter.recovery_time = recovery_time;
-                self.override_filter.pending = Some(percent);
+                self.override_filter.queue(recovery_time, percent);
                 self.step_override_filter(0.0);
                 cx.report(cmd.id, DONE);
                 Ok(())
@@ -474,7 +473,7 @@ impl Axis {
         self.coupling = None;
         // The phase belongs to the coupling: a new one starts without a shift.
         self.end_phasing(cx, End::Aborted);
-        self.phase = Kinematics::default();
+        self.phasing.clear_shift();
         self.cancel_cam_in(cx, End::Aborted);
         self.settle_cam(cx);
     }

@@ -7,67 +7,9 @@
 //! and its `submit_*`, while what every coupling shares — admission, aborting what runs,
 //! InGear, losing the master, soft limits — stays as it is.
 
+use super::camming::CamSet;
+use super::multimaster::MultiGear;
 use super::*;
-
-/// What a slave sees of its master in a cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MasterSample {
-    pub set: Kinematics,
-    pub actual_position: f64,
-    pub actual_velocity: f64,
-    pub moving: bool,
-    pub error: bool,
-    /// The master's AxisVeloMax (GearInDyn scales its ratio-change limit with it).
-    pub max_velocity: f64,
-}
-
-/// A slave's master input in a cycle. The kernel steps masters before their slaves, so a
-/// sample is the master's state after its step in the same cycle.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Master {
-    /// The axis follows no master.
-    Uncoupled,
-    /// The axis is coupled but its master cannot be followed: its slot is empty, or it is
-    /// part of a coupling loop. A coupled slave stops in ErrorStop (0x7043 master lost).
-    Lost,
-    /// The master, stepped in this cycle.
-    Sample(MasterSample),
-}
-
-impl MasterSample {
-    pub fn of(axis: &Axis) -> Self {
-        let s = axis.status();
-        MasterSample {
-            set: Kinematics {
-                position: s.set_position,
-                velocity: s.set_velocity,
-                acceleration: s.set_acceleration,
-                jerk: s.set_jerk,
-            },
-            actual_position: s.actual_position,
-            actual_velocity: s.actual_velocity,
-            moving: s.moving,
-            error: s.state == AxisState::ErrorStop,
-            max_velocity: axis.parameters().axis_velo_max,
-        }
-    }
-
-    /// The master motion a slave follows: its setpoints, or with #1064
-    /// (AxisCoupleSlaveToActualValues) its actual position and velocity (no acceleration or
-    /// jerk: the actual values carry none the slave could use).
-    pub(super) fn followed(&self, actual_values: bool) -> Kinematics {
-        if actual_values {
-            Kinematics {
-                position: self.actual_position,
-                velocity: self.actual_velocity,
-                acceleration: 0.0,
-                jerk: 0.0,
-            }
-        } else {
-            self.set
-        }
-    }
-}
 
 /// A slave's coupling to its master.
 #[derive(Clone, Copy, Debug)]
@@ -94,9 +36,9 @@ pub(super) enum CouplingLaw {
     },
     /// MC_CamIn, MC_CamIn_V2: through one or (multi-cam) several superimposed cam tables
     /// (`axis/camming.rs`).
-    Cam(super::camming::CamSet),
+    Cam(CamSet),
     /// MC_GearInMultiMaster: the sum of up to four masters (`axis/multimaster.rs`).
-    Multi(super::multimaster::MultiGear),
+    Multi(MultiGear),
 }
 
 /// slave = slave_start + ratio · (master − master_start): the slave follows the master's
@@ -252,6 +194,105 @@ impl CouplingLaw {
         if let CouplingLaw::Multi(m) = self {
             m.rebase(slave_position);
         }
+    }
+}
+
+impl From<CamSet> for CouplingLaw {
+    fn from(set: CamSet) -> Self {
+        CouplingLaw::Cam(set)
+    }
+}
+
+impl From<MultiGear> for CouplingLaw {
+    fn from(law: MultiGear) -> Self {
+        CouplingLaw::Multi(law)
+    }
+}
+
+/// The coupling as the laws' own files see it: `camming.rs` and `multimaster.rs` reach their
+/// law in the coupling through these, so that only this file names the coupling (the
+/// dependency points one way: the coupling knows its laws, a law does not know the coupling).
+impl Axis {
+    /// The cams of a cam slave.
+    pub(super) fn cam_set(&self) -> Option<CamSet> {
+        match self.coupling {
+            Some(Coupling {
+                law: CouplingLaw::Cam(set),
+                ..
+            }) => Some(set),
+            _ => None,
+        }
+    }
+
+    pub(super) fn cam_set_mut(&mut self) -> Option<&mut CamSet> {
+        match self.coupling.as_mut() {
+            Some(Coupling {
+                law: CouplingLaw::Cam(set),
+                ..
+            }) => Some(set),
+            _ => None,
+        }
+    }
+
+    pub(super) fn multi_gear(&self) -> Option<&MultiGear> {
+        match self.coupling.as_ref().map(|c| &c.law) {
+            Some(CouplingLaw::Multi(m)) => Some(m),
+            _ => None,
+        }
+    }
+
+    pub(super) fn multi_gear_mut(&mut self) -> Option<&mut MultiGear> {
+        match self.coupling.as_mut().map(|c| &mut c.law) {
+            Some(CouplingLaw::Multi(m)) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The multi-master law of a coupling that an Enable-type command still holds.
+    pub(super) fn enabled_multi_gear(&mut self) -> Option<&mut MultiGear> {
+        match self.coupling.as_mut().filter(|c| c.dyn_command != 0) {
+            Some(Coupling {
+                law: CouplingLaw::Multi(m),
+                ..
+            }) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The masters this axis follows (Master1…Master4 of a multi-master coupling; the one
+    /// master of any other coupling first).
+    pub fn coupled_masters(&self) -> [Option<AxisSlot>; 4] {
+        match self.coupling.as_ref() {
+            Some(c) => [
+                Some(c.master),
+                c.more_masters[0],
+                c.more_masters[1],
+                c.more_masters[2],
+            ],
+            None => [self.master_slot(), None, None, None],
+        }
+    }
+
+    /// MC_GearInMultiMaster's Master2…Master4 of the coupling just made.
+    pub(super) fn couple_more_masters(&mut self, more: [Option<AxisSlot>; 3]) {
+        if let Some(c) = self.coupling.as_mut() {
+            c.more_masters = more;
+        }
+    }
+
+    /// The axis follows `master` through `law` from now on (what runs is the caller's).
+    pub(super) fn install_coupling(
+        &mut self,
+        master: AxisSlot,
+        law: impl Into<CouplingLaw>,
+        dyn_command: CommandId,
+    ) {
+        self.coupling = Some(Coupling {
+            master,
+            more_masters: [None; 3],
+            law: law.into(),
+            dyn_command,
+        });
     }
 }
 
@@ -439,17 +480,13 @@ impl Axis {
         cx: &mut Ctx<'_, impl EventSink>,
         id: CommandId,
         master_slot: AxisSlot,
-        law: CouplingLaw,
+        law: impl Into<CouplingLaw>,
         dyn_command: CommandId,
     ) {
+        let law = law.into();
         self.abort_superposition(cx);
         self.abort_all(cx);
-        self.coupling = Some(Coupling {
-            master: master_slot,
-            more_masters: [None; 3],
-            law,
-            dyn_command,
-        });
+        self.install_coupling(master_slot, law, dyn_command);
         let mut j = Job::new(id, JobKind::Gear);
         j.activate(cx);
         let out = FbOutputs {
@@ -501,7 +538,7 @@ impl Axis {
         if let CouplingLaw::Cam(cams) = &mut c.law {
             self.step_ramp_in(cx, job, cams, dt);
         }
-        self.set_has_superposition = false;
+        self.superposition.main_motion_sampled();
         if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
             let out = FbOutputs {
                 in_gear: true,

@@ -238,7 +238,7 @@ impl Axis {
 
         if let Some(k) = self.planner.step(dt) {
             self.set = k;
-            self.set_has_superposition = false;
+            self.superposition.main_motion_sampled();
         }
         // An end or blending velocity that could not be reached moving only towards the
         // target was adjusted to the best reachable one: say so.

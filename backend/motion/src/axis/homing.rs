@@ -158,7 +158,7 @@ impl Axis {
         let mut fail = None;
         if let Some(k) = self.planner.step(dt) {
             self.set = k;
-            self.set_has_superposition = false;
+            self.superposition.main_motion_sampled();
         }
         let stopped = self.planner.finished() && self.set.velocity.abs() <= EPS_V;
         // A limit switch ahead ends the sequence in every phase (no reference without it).

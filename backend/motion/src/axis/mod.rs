@@ -35,6 +35,7 @@ mod encoder;
 mod external;
 mod homing;
 mod job;
+mod master;
 mod monitoring;
 mod motion;
 mod multimaster;
@@ -46,10 +47,9 @@ mod superposition;
 mod torque;
 
 use coupling::Coupling;
-pub use coupling::{Master, MasterSample};
 use homing::HomeSeq;
 use job::{Ctx, DONE, End, Held, Job, JobKind, Phase};
-use superposition::Superimposed;
+pub use master::{Master, MasterSample};
 
 /// Static configuration of an axis (the base configuration the parameters start from).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -65,19 +65,6 @@ pub struct AxisConfig {
 const EPS_V: f64 = 1e-9;
 /// How long a drive may take to report "operation enabled" after MC_Power.
 const POWER_ON_TIMEOUT: f64 = 1.0;
-
-/// MC_OverrideFilter between calls (§4.5.4): after every change of the filtered override a
-/// new value waits until `recovery_time` has passed since it (0 % and 100 % never wait).
-#[derive(Clone, Copy, Debug, Default)]
-struct OverrideFilterState {
-    recovery_time: f64,
-    /// Seconds since the filtered override last changed.
-    since_change: f64,
-    /// The latest filtered value (percent) not yet applied.
-    pending: Option<f64>,
-    /// The last value applied (percent).
-    applied: Option<f64>,
-}
 
 /// The axis's own mode; the PLCopen state is derived from it and the active job.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -122,7 +109,7 @@ pub struct Axis {
     acc_factor: f64,
     jerk_factor: f64,
     /// MC_OverrideFilter's quiet time and the value waiting for its end.
-    override_filter: OverrideFilterState,
+    override_filter: monitoring::OverrideFilterState,
     power_on_timer: f64,
     set: Kinematics,
     /// The setpoint position sent last cycle: the actual position read now answers it, so
@@ -154,30 +141,14 @@ pub struct Axis {
     lag_timer: f64,
     in_window_timer: f64,
     coupling: Option<Coupling>,
-    superimposed: Option<Superimposed>,
-    /// `set` includes what the superposition added (true between its step and the next
-    /// sample of the main motion).
-    set_has_superposition: bool,
+    /// MC_MoveSuperImposed (`superposition.rs`).
+    superposition: superposition::SuperpositionState,
     latch: Option<LatchSource>,
     /// MC_TouchProbe's running cycle.
     probe: Option<probe::Probe>,
     prev_cam: bool,
-    /// MC_CamIn waiting for its activation (the axis is not coupled yet).
-    cam_in: Option<camming::PendingCamIn>,
-    /// MC_CamIn on a cam slave waiting for its activation (CamTableQueued).
-    cam_switch: Option<camming::PendingChange<crate::cam::CamIn>>,
-    /// MC_CamScaling waiting for its activation (CamScalingPending).
-    cam_scaling: Option<camming::PendingChange<crate::cam::CamScaling>>,
-    /// The master's set values in the latest cycle (a scaling at once uses them).
-    last_master: Kinematics,
-    /// Data written to the coupled table waiting to take effect here (CamDataQueued).
-    cam_data: Option<camming::PendingData>,
-    /// MC_CamIn_V2 / MC_CamAdd / MC_CamExchange / MC_CamRemove waiting for its activation.
-    cam_v2_op: Option<camming::PendingChange<crate::cam::CamInV2>>,
-    /// The cam (term) a queued MC_CamScaling(_V2) scales.
-    cam_scaling_term: usize,
-    /// MC_CamInfo of the last cam coupling, kept after an error ended it (until MC_CamOut).
-    cam_last: crate::cam::CamInfo,
+    /// MC_CamIn/MC_CamScaling/… waiting for their activation, MC_CamInfo kept (`camming.rs`).
+    cam: camming::CamState,
     /// The cycle of the latest step (the status's NcCycleCounter).
     cycle: u64,
     /// The drive's process data were invalid in the latest cycle (bus error).
@@ -186,24 +157,15 @@ pub struct Axis {
     has_been_stopped: bool,
     /// The running job got its target while the axis moved (NewTargetPosition).
     new_target: bool,
-    /// The phase shift against the master (AbsPhasingPos) and its motion (§5.6).
-    phase: Kinematics,
-    /// Boxed: a planner is large, and the axis's hot fields stay close together without it.
-    phase_planner: Box<Planner>,
-    /// A new phasing is planned here first and swapped in when it succeeds.
-    phase_scratch: Box<Planner>,
-    phasing: Option<phasing::PhasingJob>,
+    /// The phase shift against the master and MC_Phasing* (`phasing.rs`).
+    phasing: phasing::PhasingState,
     /// Position correction (§7.2): limiter, backlash and table compensation.
     corrections: correction::Corrections,
-    /// The encoder scaling (#1040) the axis was built with: the drive's positions are in it.
-    enc_base: f64,
-    /// The encoder scaling now ÷ `enc_base` (MC_SetEncoderScalingFactor).
+    /// The encoder scaling now ÷ the one the axis was built with (MC_SetEncoderScalingFactor):
+    /// every reading and setpoint goes through it.
     enc_k: f64,
-    /// 1 / (enc_k · enc_base): increments per unit of the reading.
-    enc_count_scale: f64,
-    /// The part of `offset` that relative encoder scaling changes put there (an absolute
-    /// change counts from zero again and drops it).
-    enc_offset: f64,
+    /// The rest of the encoder scaling's state (`encoder.rs`).
+    encoder: encoder::EncoderScaling,
     /// MC_TorqueControl's torque setpoint and limits (while a Torque job runs), the drive's
     /// position-based mode (MC_WriteDriveOperationMode) and what the drive reported.
     torque: torque::TorqueState,
@@ -251,7 +213,7 @@ impl Axis {
             override_factor: 1.0,
             acc_factor: 1.0,
             jerk_factor: 1.0,
-            override_filter: OverrideFilterState::default(),
+            override_filter: monitoring::OverrideFilterState::default(),
             power_on_timer: 0.0,
             set: Kinematics::default(),
             sent_position: 0.0,
@@ -273,32 +235,19 @@ impl Axis {
             lag_timer: 0.0,
             in_window_timer: 0.0,
             coupling: None,
-            superimposed: None,
-            set_has_superposition: false,
+            superposition: superposition::SuperpositionState::default(),
             latch: None,
             probe: None,
             prev_cam: false,
-            cam_in: None,
-            cam_switch: None,
-            cam_scaling: None,
-            last_master: Kinematics::default(),
-            cam_data: None,
-            cam_v2_op: None,
-            cam_scaling_term: 0,
-            cam_last: crate::cam::CamInfo::default(),
+            cam: camming::CamState::default(),
             cycle: 0,
             io_data_invalid: false,
             has_been_stopped: false,
             new_target: false,
-            phase: Kinematics::default(),
-            phase_planner: Box::new(Planner::new(cycle_time)),
-            phase_scratch: Box::new(Planner::new(cycle_time)),
-            phasing: None,
+            phasing: phasing::PhasingState::new(cycle_time),
             corrections: correction::Corrections::default(),
-            enc_base,
             enc_k: 1.0,
-            enc_count_scale: 1.0 / enc_base,
-            enc_offset: 0.0,
+            encoder: encoder::EncoderScaling::new(enc_base),
             torque: torque::TorqueState::default(),
             ext: external::ExtGen::default(),
             offered: [None; 4],

@@ -5,6 +5,47 @@
 
 use super::*;
 
+/// MC_OverrideFilter between calls (§4.5.4): after every change of the filtered override a
+/// new value waits until `recovery_time` has passed since it (0 % and 100 % never wait).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct OverrideFilterState {
+    recovery_time: f64,
+    /// Seconds since the filtered override last changed.
+    since_change: f64,
+    /// The latest filtered value (percent) not yet applied.
+    pending: Option<f64>,
+    /// The last value applied (percent).
+    applied: Option<f64>,
+}
+
+impl OverrideFilterState {
+    /// A new filtered value (MC_OverrideFilter called) and the quiet time it keeps.
+    pub(super) fn queue(&mut self, recovery_time: f64, percent: f64) {
+        self.recovery_time = recovery_time;
+        self.pending = Some(percent);
+    }
+
+    /// `dt` has passed: the value to apply as MC_Power's override, once the quiet time after
+    /// the last change has passed (0 % and 100 % at once).
+    fn step(&mut self, dt: f64) -> Option<f64> {
+        self.since_change += dt;
+        let v = self.pending?;
+        if self.applied == Some(v) {
+            self.pending = None;
+        } else if v == 0.0
+            || v == 100.0
+            || self.applied.is_none()
+            || self.since_change >= self.recovery_time - 1e-9
+        {
+            self.pending = None;
+            self.applied = Some(v);
+            self.since_change = 0.0;
+            return Some(v);
+        }
+        None
+    }
+}
+
 impl Axis {
     /// Note 2: Enable FALSE → Disabled (ErrorStop stays ErrorStop).
     pub(super) fn disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
@@ -33,21 +74,7 @@ impl Axis {
     /// MC_OverrideFilter (§4.5.4): a filtered value waiting for the quiet time after the last
     /// change is applied as MC_Power's override once it has passed; 0 % and 100 % at once.
     pub(super) fn step_override_filter(&mut self, dt: f64) {
-        let f = &mut self.override_filter;
-        f.since_change += dt;
-        let Some(v) = f.pending else {
-            return;
-        };
-        if f.applied == Some(v) {
-            f.pending = None;
-        } else if v == 0.0
-            || v == 100.0
-            || f.applied.is_none()
-            || f.since_change >= f.recovery_time - 1e-9
-        {
-            f.pending = None;
-            f.applied = Some(v);
-            f.since_change = 0.0;
+        if let Some(v) = self.override_filter.step(dt) {
             self.power_override = v;
         }
     }
@@ -58,8 +85,8 @@ impl Axis {
         self.job.is_some()
             || self.next.is_some()
             || self.coupling.is_some()
-            || self.superimposed.is_some()
-            || self.cam_in.is_some()
+            || self.superposition.running.is_some()
+            || self.cam.waits_for_coupling()
     }
 
     /// A buffered disable takes effect once the axis no longer executes a job.
@@ -109,7 +136,7 @@ impl Axis {
         self.error = e;
         self.has_been_stopped = true;
         self.end_phasing(cx, End::Error(e));
-        if let Some(mut sp) = self.superimposed.take() {
+        if let Some(mut sp) = self.superposition.running.take() {
             sp.cmd.end(cx, End::Error(e));
         }
         for j in [self.next.take(), self.job.take()].into_iter().flatten() {
@@ -339,7 +366,7 @@ impl Axis {
         // The main motion is being stopped (superposition abort table row 4): a superposition
         // ends unless it is to resume after a motion stop, and then too if what it still has
         // to do would carry the stop past the limit; its velocity goes into the stop.
-        if let Some(sp) = self.superimposed {
+        if let Some(sp) = self.superposition.running {
             let to_come = sp.distance - sp.applied;
             if sp.option != SuperpositionAbortOption::ResumeAfterMotionStop {
                 self.abort_superposition(cx);

@@ -6,7 +6,6 @@
 //! what it makes up: VELOSYNC only the velocity, POSSYNC1 also positions lost to limiting once
 //! coupled, POSSYNC2 everything (coupling in motion, ratio changes, limiting).
 
-use super::coupling::{CouplingLaw, Master};
 use super::*;
 use crate::command::{GearInMultiMaster, MultiMasterSyncMode};
 
@@ -119,20 +118,6 @@ impl MultiGear {
 }
 
 impl Axis {
-    /// The masters this axis follows (Master1…Master4 of a multi-master coupling; the one
-    /// master of any other coupling first).
-    pub fn coupled_masters(&self) -> [Option<AxisSlot>; 4] {
-        match self.coupling.as_ref() {
-            Some(c) => [
-                Some(c.master),
-                c.more_masters[0],
-                c.more_masters[1],
-                c.more_masters[2],
-            ],
-            None => [self.master_slot(), None, None, None],
-        }
-    }
-
     /// The kernel hands over what it saw of every master before a submit or a step (in the
     /// order of [`Axis::coupled_masters`], or of a GearInMultiMaster's masters).
     pub fn offer_masters(&mut self, masters: [Option<MasterSample>; 4]) {
@@ -181,12 +166,8 @@ impl Axis {
         // Enable still TRUE on the same masters: new ratios.
         let order = self.multi_order(&g.masters);
         let same_masters = self.coupled_masters() == order.0;
-        if let Some(c) = self.coupling.as_mut().filter(|c| {
-            same_masters && c.dyn_command != 0 && matches!(c.law, CouplingLaw::Multi(_))
-        }) {
-            if let CouplingLaw::Multi(m) = &mut c.law {
-                m.retarget(permute(ratios, order.1), permute(rate, order.1));
-            }
+        if let Some(m) = self.enabled_multi_gear().filter(|_| same_masters) {
+            m.retarget(permute(ratios, order.1), permute(rate, order.1));
             self.hand_over_enabled_coupling(cx, id);
             return Ok(());
         }
@@ -231,10 +212,8 @@ impl Axis {
             last_ideal: None,
         };
         let primary_slot = order.0[0].expect("one master at least");
-        self.couple(cx, id, primary_slot, CouplingLaw::Multi(law), id);
-        if let Some(c) = self.coupling.as_mut() {
-            c.more_masters = [order.0[1], order.0[2], order.0[3]];
-        }
+        self.couple(cx, id, primary_slot, law, id);
+        self.couple_more_masters([order.0[1], order.0[2], order.0[3]]);
         Ok(())
     }
 
@@ -264,9 +243,8 @@ impl Axis {
         dt: f64,
     ) {
         // The law alone is copied (a coupling carries a cam set's size).
-        let mut law = match self.coupling.as_ref().map(|c| &c.law) {
-            Some(CouplingLaw::Multi(m)) => *m,
-            _ => return,
+        let Some(mut law) = self.multi_gear().copied() else {
+            return;
         };
         if !matches!(master, Master::Sample(_)) {
             return;
@@ -353,7 +331,7 @@ impl Axis {
                 MultiMasterSyncMode::Possync2 => v_synced && p_synced,
             };
         }
-        self.set_has_superposition = false;
+        self.superposition.main_motion_sampled();
         if job.id != 0 && job.out.in_gear != law.in_gear {
             let out = FbOutputs {
                 in_gear: law.in_gear,
@@ -361,8 +339,8 @@ impl Axis {
             };
             job.emit(cx, out);
         }
-        if let Some(c) = self.coupling.as_mut() {
-            c.law = CouplingLaw::Multi(law);
+        if let Some(m) = self.multi_gear_mut() {
+            *m = law;
         }
     }
 }

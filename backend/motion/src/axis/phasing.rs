@@ -19,6 +19,35 @@ pub(super) struct PhasingJob {
     halting: bool,
 }
 
+/// A slave's phase shift against its master and the phasing that moves it.
+#[derive(Debug)]
+pub(super) struct PhasingState {
+    /// The phase shift against the master (AbsPhasingPos) and its motion (§5.6).
+    shift: Kinematics,
+    /// Boxed: a planner is large, and the axis's hot fields stay close together without it.
+    planner: Box<Planner>,
+    /// A new phasing is planned here first and swapped in when it succeeds.
+    scratch: Box<Planner>,
+    job: Option<PhasingJob>,
+}
+
+impl PhasingState {
+    /// Built with the axis (the only allocation: the two planners).
+    pub(super) fn new(cycle_time: f64) -> Self {
+        PhasingState {
+            shift: Kinematics::default(),
+            planner: Box::new(Planner::new(cycle_time)),
+            scratch: Box::new(Planner::new(cycle_time)),
+            job: None,
+        }
+    }
+
+    /// The phase belongs to the coupling: a new one starts without a shift.
+    pub(super) fn clear_shift(&mut self) {
+        self.shift = Kinematics::default();
+    }
+}
+
 impl Axis {
     /// MC_PhasingAbsolute / MC_PhasingRelative / MC_HaltPhasing: admission (a slave coupled
     /// to `master` by a gear or a cam — not MC_GearInDyn, §5.6), the plan from where the
@@ -60,7 +89,7 @@ impl Axis {
         let acc = or(ph.acceleration, p.axis_acc);
         let dec = or(ph.deceleration, p.axis_dec);
         let jerk = or(ph.jerk, p.axis_jerk);
-        let from = self.phase;
+        let from = self.phasing.shift;
         let limits = Limits {
             velocity: ph.velocity.max(from.velocity.abs()).max(EPS_V),
             acceleration: acc,
@@ -69,8 +98,8 @@ impl Axis {
         };
         let (planned, target) = match ph.kind {
             PhasingKind::Halt => {
-                let r = self.phase_scratch.plan_velocity(from, 0.0, &limits);
-                (r, self.phase_scratch.end_state().position)
+                let r = self.phasing.scratch.plan_velocity(from, 0.0, &limits);
+                (r, self.phasing.scratch.end_state().position)
             }
             kind => {
                 let target = if kind == PhasingKind::Absolute {
@@ -83,7 +112,9 @@ impl Axis {
                     ..limits
                 };
                 (
-                    self.phase_scratch.plan_position(from, target, 0.0, &limits),
+                    self.phasing
+                        .scratch
+                        .plan_position(from, target, 0.0, &limits),
                     target,
                 )
             }
@@ -92,15 +123,15 @@ impl Axis {
         if planned.is_err() {
             return Err(ErrorId::PLANNING_FAILED);
         }
-        core::mem::swap(&mut self.phase_planner, &mut self.phase_scratch);
-        if let Some(mut old) = self.phasing.take() {
+        core::mem::swap(&mut self.phasing.planner, &mut self.phasing.scratch);
+        if let Some(mut old) = self.phasing.job.take() {
             old.cmd.end(cx, End::Aborted);
         }
         let cmd = Held::start_active(cx, id);
-        self.phasing = Some(PhasingJob {
+        self.phasing.job = Some(PhasingJob {
             cmd,
             target: if ph.kind == PhasingKind::Halt {
-                self.phase_planner.end_state().position
+                self.phasing.planner.end_state().position
             } else {
                 target
             },
@@ -115,18 +146,18 @@ impl Axis {
     /// (§5.6.1). Ends aborted when the coupling it shifts is gone.
     pub(super) fn step_phasing(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         if self.coupling.is_none() || self.mode != Mode::Enabled {
-            if self.phasing.is_some() || self.phase_planner.is_planned() {
+            if self.phasing.job.is_some() || self.phasing.planner.is_planned() {
                 self.end_phasing(cx, End::Aborted);
             }
             if self.coupling.is_none() {
-                self.phase = Kinematics::default();
+                self.phasing.shift = Kinematics::default();
             }
             return;
         }
-        let Some(k) = self.phase_planner.step(dt) else {
+        let Some(k) = self.phasing.planner.step(dt) else {
             return;
         };
-        let d = k.position - self.phase.position;
+        let d = k.position - self.phasing.shift.position;
         // A multi-master slave with advanced dynamics follows its law within its own limits:
         // the phase moves the law, and the slave catches up as it makes up any offset.
         let law_only = self
@@ -142,9 +173,9 @@ impl Axis {
             self.set.acceleration += k.acceleration;
             self.set.jerk += k.jerk;
         }
-        self.phase = k;
-        if self.phase_planner.finished() {
-            let ph = self.phasing.take();
+        self.phasing.shift = k;
+        if self.phasing.planner.finished() {
+            let ph = self.phasing.job.take();
             let at = match ph {
                 Some(p) if !p.halting => p.target,
                 _ => k.position,
@@ -157,35 +188,36 @@ impl Axis {
             if !law_only {
                 self.set.position += rest;
             }
-            self.phase = Kinematics {
+            self.phasing.shift = Kinematics {
                 position: at,
                 ..Kinematics::default()
             };
             if let Some(mut p) = ph {
                 p.cmd.end(cx, End::Done);
             }
-            self.phase_planner.clear();
+            self.phasing.planner.clear();
         }
     }
 
     /// Ends the running phasing command (`end`); the phase stays where it is.
     pub(super) fn end_phasing(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
-        if let Some(mut ph) = self.phasing.take() {
+        if let Some(mut ph) = self.phasing.job.take() {
             ph.cmd.end(cx, end);
         }
-        self.phase_planner.clear();
-        self.phase.velocity = 0.0;
-        self.phase.acceleration = 0.0;
-        self.phase.jerk = 0.0;
+        self.phasing.planner.clear();
+        self.phasing.shift.velocity = 0.0;
+        self.phasing.shift.acceleration = 0.0;
+        self.phasing.shift.jerk = 0.0;
     }
 
     /// The phasing part of the status (PhasingActive, AbsPhasingPos, CoveredPhaseShift).
     pub(super) fn phasing_status(&self) -> (bool, f64, f64) {
         (
-            self.phasing.is_some(),
-            self.phase.position,
+            self.phasing.job.is_some(),
+            self.phasing.shift.position,
             self.phasing
-                .map(|p| self.phase.position - p.start)
+                .job
+                .map(|p| self.phasing.shift.position - p.start)
                 .unwrap_or(0.0),
         )
     }

@@ -3,7 +3,6 @@
 //! axis. The following-error peak hold counts cycles only (see `Axis::step`).
 
 use super::*;
-use crate::cam::CamInfo;
 
 impl Axis {
     /// Starts a new following-error peak hold from the present following error.
@@ -84,8 +83,8 @@ impl Axis {
             Some(coupling::CouplingLaw::Multi(m)) => m.ratios(),
             _ => [s.gear_ratio, 0.0, 0.0, 0.0],
         };
-        s.compensating = self.superimposed.is_some();
-        s.superimposed_distance = self.superimposed.map(|x| x.applied).unwrap_or(0.0);
+        s.compensating = self.superposition.running.is_some();
+        s.superimposed_distance = self.superposition.running.map(|x| x.applied).unwrap_or(0.0);
         s.error_id = if self.mode == Mode::ErrorStop {
             self.error.0
         } else {
@@ -99,20 +98,8 @@ impl Axis {
         };
         s.set_position_offset = self.set_position_offset;
         s.active_command = job.map(|j| j.id).unwrap_or(0);
-        let (mut cam, queued, scaling) = self.cam_status();
-        if cam.cam_table_id != 0 {
-            cam.active = true;
-            self.cam_last = cam;
-        } else if self.cam_last.cam_table_id != 0 {
-            // Decoupled otherwise than by MC_CamOut: the last valid state stays readable.
-            cam = CamInfo {
-                active: false,
-                cam_data_queued: false,
-                cam_table_queued: false,
-                scaling_pending: false,
-                ..self.cam_last
-            };
-        }
+        let (cam, queued, scaling) = self.cam_status();
+        let cam = self.cam.kept_info(cam);
         let op_modes = crate::status::AxisOpModes {
             position_area_monitoring: p.axis_en_position_range_monitoring,
             target_position_monitoring: p.axis_en_target_position_monitoring,

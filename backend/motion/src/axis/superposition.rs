@@ -4,6 +4,23 @@
 
 use super::*;
 
+/// MC_MoveSuperImposed on this axis: the one running, and whether `set` carries it yet.
+#[derive(Debug, Default)]
+pub(super) struct SuperpositionState {
+    pub(super) running: Option<Superimposed>,
+    /// `set` includes what the superposition added (true between its step and the next
+    /// sample of the main motion).
+    in_set: bool,
+}
+
+impl SuperpositionState {
+    /// The main motion (or a master) wrote `set` anew: what the superposition added is no
+    /// longer in it.
+    pub(super) fn main_motion_sampled(&mut self) {
+        self.in_set = false;
+    }
+}
+
 /// A running MC_MoveSuperImposed: `distance` is laid over the main motion as a quintic
 /// (C² smooth) function of the main motion's travel `u` over `length` (spec §5.2.1, §6.13).
 #[derive(Clone, Copy, Debug)]
@@ -162,7 +179,7 @@ impl Axis {
             ..FbOutputs::default()
         };
         let cmd = Held::start(cx, id, out);
-        self.superimposed = Some(Superimposed {
+        self.superposition.running = Some(Superimposed {
             cmd,
             distance,
             length,
@@ -204,7 +221,7 @@ impl Axis {
     /// Ends a superposition that cannot go on within the soft limits: Done as far as it got,
     /// with Warning 0x4243 (as a superposition the parameters do not allow in full).
     pub(super) fn end_superposition_incomplete(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
-        if let Some(sp) = self.superimposed.as_mut() {
+        if let Some(sp) = self.superposition.running.as_mut() {
             warn_incomplete(cx, sp);
         }
         self.end_superposition(cx, End::Done);
@@ -213,7 +230,7 @@ impl Axis {
     /// Ends a superposition; what it applied stays. The velocity it was adding is handed to
     /// the main motion's planner, which takes it away smoothly.
     fn end_superposition(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
-        if let Some(mut sp) = self.superimposed.take() {
+        if let Some(mut sp) = self.superposition.running.take() {
             sp.cmd.end(cx, end);
             if sp.added != (0.0, 0.0)
                 && self.mode != Mode::Disabled
@@ -230,7 +247,11 @@ impl Axis {
     /// The state plans start from: the setpoint without what a running superposition adds
     /// (it keeps adding it on top of the new plan).
     pub(super) fn plan_origin(&self) -> Kinematics {
-        match self.superimposed.filter(|_| self.set_has_superposition) {
+        match self
+            .superposition
+            .running
+            .filter(|_| self.superposition.in_set)
+        {
             Some(sp) => Kinematics {
                 velocity: self.set.velocity - sp.added.0,
                 acceleration: self.set.acceleration - sp.added.1,
@@ -244,7 +265,7 @@ impl Axis {
     /// folded into the running plan (and target, and coupling), so the main motion carries it
     /// from now on and its target moves by the distance (spec §5.2.1).
     pub(super) fn step_superposition(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
-        let Some(mut sp) = self.superimposed else {
+        let Some(mut sp) = self.superposition.running else {
             return;
         };
         let base = self.set;
@@ -287,8 +308,8 @@ impl Axis {
             if let Some(c) = self.coupling.as_mut() {
                 c.law.shift_slave(sp.added.0 * dt);
             }
-            self.set_has_superposition = false;
-            self.superimposed = Some(sp);
+            self.superposition.in_set = false;
+            self.superposition.running = Some(sp);
             if abort {
                 self.abort_superposition(cx);
             } else {
@@ -358,13 +379,13 @@ impl Axis {
             let a_add = (v_add - sp.added.0) / dt;
             self.set.velocity += v_add;
             self.set.acceleration += a_add;
-            self.set_has_superposition = true;
+            self.superposition.in_set = true;
             sp.added = (v_add, a_add);
             sp.last_position = self.set.position;
-            self.superimposed = Some(sp);
+            self.superposition.running = Some(sp);
         } else {
             sp.cmd.end(cx, End::Done);
-            self.superimposed = None;
+            self.superposition.running = None;
         }
     }
 }
