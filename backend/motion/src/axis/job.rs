@@ -22,11 +22,22 @@ pub(super) struct Ctx<'a, E: EventSink> {
 impl<E: EventSink> Ctx<'_, E> {
     /// Pushes a change of `command`'s outputs.
     pub(super) fn report(&mut self, command: CommandId, outputs: FbOutputs) {
+        self.report_result(command, outputs, None);
+    }
+
+    /// Pushes a change of `command`'s outputs that carries its result (its Done).
+    pub(super) fn report_result(
+        &mut self,
+        command: CommandId,
+        outputs: FbOutputs,
+        result: Option<BlockResult>,
+    ) {
         self.events.push(CommandEvent {
             cycle: self.cycle,
             command,
             axis: self.slot,
             outputs,
+            result,
         });
     }
 }
@@ -250,6 +261,15 @@ impl Held {
 
     pub(super) fn end(&mut self, cx: &mut Ctx<'_, impl EventSink>, end: End) {
         self.emit(cx, ended(self.out, end));
+    }
+
+    /// Ends Done with `result` on the event that says so.
+    pub(super) fn done_with(&mut self, cx: &mut Ctx<'_, impl EventSink>, result: BlockResult) {
+        let out = ended(self.out, End::Done);
+        if out != self.out {
+            cx.report_result(self.id, out, Some(result));
+        }
+        self.out = out;
     }
 
     pub(super) fn emit(&mut self, cx: &mut Ctx<'_, impl EventSink>, out: FbOutputs) {

@@ -54,6 +54,31 @@ fn s4_3_a_probe_records_the_exact_position_of_the_mark() {
     assert!(out.done && !out.busy && !out.error && !out.command_aborted);
 }
 
+/// The recorded data travels on the event that ends the probe cycle Done (whoever tracks the
+/// command completes it from that event), and on no other event.
+#[test]
+fn s4_3_the_done_event_carries_the_recorded_data() {
+    let mut r = Rig::new(1);
+    r.plants[0].probe_mark = Some(42.123);
+    power(&mut r);
+    let p = r.ok(0, probe(LatchSource::Input1Rising, None, false));
+    r.ok(0, CommandKind::MoveAbsolute(mv(100.0, 50.0)));
+    r.until(3.0, |r| r.out(p).done);
+    let with: Vec<_> = r.events.iter().filter(|e| e.result.is_some()).collect();
+    assert_eq!(with.len(), 1, "one event carries a result");
+    assert_eq!(with[0].command, p);
+    assert!(with[0].outputs.done && !with[0].outputs.busy);
+    assert_eq!(
+        with[0].result,
+        Some(motion::BlockResult::Probe(motion::ProbeRecord {
+            recorded_position: 42.123,
+            absolute_position: 42.123,
+            modulo_position: 42.123,
+            counter: 1,
+        }))
+    );
+}
+
 /// §4.3.1 WindowOnly: an edge outside [First, Last] is discarded and the latch re-armed
 /// automatically; Done only for an in-window capture.
 #[test]

@@ -3,10 +3,10 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use motion::{AxisSlot, CommandEvent, CommandId, ErrorId, FbOutputs};
+use motion::{AxisSlot, BlockResult, CommandEvent, CommandId, ErrorId, FbOutputs};
 use serde::Serialize;
 
-use crate::model::Block;
+use crate::model::{Block, ProbeResult};
 use crate::model::{ClientInfo, CommandEventDto, CommandResource, CommandState};
 use crate::store::{self, AuditEntry};
 
@@ -34,8 +34,9 @@ pub struct CommandRecord {
     pub events: VecDeque<CommandEventDto>,
     /// The audit entry of its end, when it ended before its acceptance was recorded.
     pub final_audit: Option<AuditEntry>,
-    /// What a done MC_TouchProbe recorded (`MC_TouchProbeRecordedData`).
-    pub result: Option<motion::ProbeStatus>,
+    /// What the block ended Done with (MC_TouchProbe's `MC_TouchProbeRecordedData`), from its
+    /// Done event.
+    pub result: Option<BlockResult>,
 }
 
 impl CommandRecord {
@@ -60,7 +61,7 @@ impl CommandRecord {
             finished_at: self.finished_at.clone(),
             client: self.client.clone(),
             events: self.events.iter().copied().collect(),
-            result: self.result.map(|p| crate::model::ProbeResult {
+            result: self.result.map(|BlockResult::Probe(p)| ProbeResult {
                 recorded_position: p.recorded_position,
                 absolute_position: p.absolute_position,
                 modulo_position: p.modulo_position,
@@ -142,6 +143,9 @@ pub(super) fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option
     let r = store.map.get_mut(&ev.command)?;
     r.outputs = ev.outputs;
     r.last_cycle = ev.cycle;
+    if r.block.has_result && ev.result.is_some() {
+        r.result = ev.result;
+    }
     if r.events.len() == EVENTS_PER_COMMAND {
         r.events.pop_front();
     }

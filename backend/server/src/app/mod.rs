@@ -77,8 +77,6 @@ pub struct AppState {
     pub auth: Arc<crate::auth::Auth>,
     /// Who holds control of the machine.
     pub control: control::Control,
-    /// Done MC_TouchProbe commands (id, slot) whose recorded data is still to be read.
-    pub probe_results: Mutex<Vec<(u64, u16)>>,
     /// Passes of `drain` completed: a pass that begins after a snapshot was read has applied
     /// every command event of that snapshot's cycle (the cycle thread pushes them first).
     pub drains: AtomicU64,
@@ -119,7 +117,6 @@ impl AppState {
             info,
             auth,
             control: control::Control::new(control_lease),
-            probe_results: Mutex::new(Vec::new()),
         };
         (Arc::new(state), audit_rx)
     }

@@ -31,11 +31,6 @@ impl AppState {
                 let Some(n) = apply_event(&mut store, &ev) else {
                     continue;
                 };
-                if n.is_final && n.outputs.done {
-                    if let Some(r) = store.map.get(&n.command).filter(|r| r.block.has_result) {
-                        self.probe_results.lock().unwrap().push((r.id, r.slot));
-                    }
-                }
                 if n.is_final {
                     if let Some(r) = store.map.get_mut(&n.command) {
                         let entry = final_audit(&n, &r.client);
@@ -53,31 +48,6 @@ impl AppState {
         }
         for e in audits {
             self.audit(e);
-        }
-        // A done probe cycle's recorded position, from the axis status that records it (the
-        // snapshot of its cycle may be published after its event: tried until it is).
-        {
-            // (the statuses read first: the snapshot's lock is not taken under the store's)
-            let mut pending = self.probe_results.lock().unwrap();
-            let mut recorded = Vec::new();
-            pending.retain(|&(id, slot)| match self.status(slot).1.map(|st| st.probe) {
-                Some(probe) if probe.command < id => true,
-                Some(probe) if probe.command == id => {
-                    recorded.push((id, probe));
-                    false
-                }
-                // Recorded over by a later cycle, or the axis is gone.
-                _ => false,
-            });
-            drop(pending);
-            if !recorded.is_empty() {
-                let mut store = self.commands.lock().unwrap();
-                for (id, probe) in recorded {
-                    if let Some(r) = store.map.get_mut(&id) {
-                        r.result = Some(probe);
-                    }
-                }
-            }
         }
         {
             let mut scope = self.scope.lock().unwrap();
