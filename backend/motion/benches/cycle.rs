@@ -29,8 +29,10 @@ impl Machine {
     fn new(n: usize) -> Machine {
         let mut k = Kernel::new(0.001, n);
         for i in 0..n {
-            let mut p = AxisParameters::default();
-            p.axis_max_pos_lag_value = 1e6;
+            let p = AxisParameters {
+                axis_max_pos_lag_value: 1e6,
+                ..AxisParameters::default()
+            };
             k.insert_axis(
                 i as u16,
                 Axis::new(
@@ -190,9 +192,11 @@ fn powered_64(tune: impl Fn(&mut AxisParameters), cams: impl FnOnce(&mut Kernel)
     let n = 64;
     let mut k = Kernel::new(0.001, n);
     for i in 0..n {
-        let mut p = AxisParameters::default();
-        p.axis_max_pos_lag_value = 1e6;
-        p.axis_velo_max = 1e6;
+        let mut p = AxisParameters {
+            axis_max_pos_lag_value: 1e6,
+            axis_velo_max: 1e6,
+            ..AxisParameters::default()
+        };
         tune(&mut p);
         k.insert_axis(
             i as u16,

@@ -16,10 +16,10 @@ pub fn modulo_end_position(
     direction: Direction,
     from_standstill: bool,
 ) -> Result<f64, ErrorId> {
-    if !(period > 0.0) || !period.is_finite() {
+    if period <= 0.0 || !period.is_finite() {
         return Err(ErrorId::PARAMETER_NOT_CORRECT);
     }
-    if !(t >= 0.0) || !t.is_finite() {
+    if t < 0.0 || !t.is_finite() {
         return Err(ErrorId::PARAMETER_NOT_CORRECT);
     }
     let base_turn = (s / period).floor() * period;

@@ -421,7 +421,10 @@ impl std::error::Error for ParamIssue {}
 const INF: f64 = f64::INFINITY;
 const DWORD_MAX: f64 = u32::MAX as f64;
 
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one row of the parameter table, its columns in order (a const fn: no builder)"
+)]
 const fn entry(
     number: u16,
     name: &'static str,
@@ -451,7 +454,10 @@ const fn entry(
 }
 
 /// LREAL with an inclusive range.
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one row of the parameter table, its columns in order (a const fn: no builder)"
+)]
 const fn real(
     n: u16,
     name: &'static str,
@@ -544,7 +550,10 @@ const fn boolean(
     )
 }
 
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one row of the parameter table, its columns in order (a const fn: no builder)"
+)]
 const fn dword(
     n: u16,
     name: &'static str,

@@ -845,8 +845,8 @@ fn every_rest_to_rest_law_matches_its_closed_form_at_start_middle_and_end() {
         (
             BeschlTrapez,
             Box::new(move |z| match z {
-                z if z == 0.0 => [0.0, 0.0, 0.0, 8.0 * a_trap],
-                z if z == 1.0 => [1.0, 0.0, 0.0, 8.0 * a_trap],
+                0.0 => [0.0, 0.0, 0.0, 8.0 * a_trap],
+                1.0 => [1.0, 0.0, 0.0, 8.0 * a_trap],
                 _ => [0.5, 3.0 / 8.0 * a_trap, 0.0, -8.0 * a_trap],
             }),
             true,

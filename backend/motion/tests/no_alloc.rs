@@ -48,8 +48,10 @@ fn step_and_replanning_allocate_nothing() {
     const N: usize = 8;
     let mut k = Kernel::new(0.001, N);
     for i in 0..N {
-        let mut p = AxisParameters::default();
-        p.axis_max_pos_lag_value = 100.0;
+        let p = AxisParameters {
+            axis_max_pos_lag_value: 100.0,
+            ..AxisParameters::default()
+        };
         k.insert_axis(
             i as u16,
             Axis::new(

@@ -30,7 +30,10 @@ const VELOCITY_TOL: f64 = 1e-9; // absolute
 enum Defect {
     /// rsruckig returns "error in step 1" where upstream solves the problem (none left since
     /// the planner retries with tightened limits; kept for the next golden file).
-    #[allow(dead_code)]
+    #[allow(
+        dead_code,
+        reason = "no golden problem has it now; kept for the next golden file"
+    )]
     Rejects,
     /// rsruckig returns a valid (target reached, limits respected) but slower trajectory:
     /// not time-optimal.

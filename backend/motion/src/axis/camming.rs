@@ -1310,29 +1310,6 @@ impl Axis {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::crossed;
-
-    #[test]
-    fn crossings_are_found_between_two_cycles_in_either_direction() {
-        assert!(crossed(499.0, 500.0, 500.0, None));
-        assert!(
-            !crossed(500.0, 501.0, 500.0, None),
-            "from the position itself is not a crossing"
-        );
-        assert!(crossed(501.0, 499.0, 500.0, None));
-        assert!(!crossed(499.0, 499.5, 500.0, None));
-        // Periodic: any occurrence t + n·P.
-        assert!(crossed(710.0, 730.0, 0.0, Some(360.0)));
-        assert!(crossed(-10.0, 10.0, 0.0, Some(360.0)));
-        assert!(crossed(370.0, 350.0, 0.0, Some(360.0)));
-        assert!(!crossed(10.0, 350.0, 0.0, Some(360.0)));
-        assert!(crossed(10.0, 100.0, 90.0, Some(360.0)));
-        assert!(crossed(1000.0, 1200.0, 90.0, Some(360.0)));
-    }
-}
-
 /// A CamIn of the first cam (or a cam to add or exchange) from MC_CamIn_V2's scaling data.
 fn as_cam_in(op: &CamInV2) -> CamIn {
     let d = op.scaling;
@@ -1396,11 +1373,15 @@ impl Axis {
             // Not coupled: the first call couples (additive); nothing to exchange or remove.
             return match op.operation {
                 CamOperationMode::Default | CamOperationMode::Additive => {
+                    // (cam-position activation or AutoOffset) and (master relative or
+                    // AutoOffset), written out: AutoOffset always, a cam-position activation
+                    // only on a relative master.
+                    let auto_offset = d.master_scaling_mode == CamScalingMode::AutoOffset;
+                    let at_cam_pos =
+                        matches!(op.activation_mode, Act::AtMasterCamPos | Act::NextCycle);
                     if matches!(op.activation_mode, Act::DeleteQueuedData)
-                        || ((matches!(op.activation_mode, Act::AtMasterCamPos | Act::NextCycle)
-                            || d.master_scaling_mode == CamScalingMode::AutoOffset)
-                            && (d.master_relative
-                                || d.master_scaling_mode == CamScalingMode::AutoOffset))
+                        || auto_offset
+                        || (at_cam_pos && d.master_relative)
                     {
                         return Err(ErrorId::CAM_MODE_INVALID);
                     }
@@ -1683,5 +1664,28 @@ impl Axis {
         }
         self.cam.scaling_term = term;
         self.queue_cam_scaling(cx, id, scaling)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::crossed;
+
+    #[test]
+    fn crossings_are_found_between_two_cycles_in_either_direction() {
+        assert!(crossed(499.0, 500.0, 500.0, None));
+        assert!(
+            !crossed(500.0, 501.0, 500.0, None),
+            "from the position itself is not a crossing"
+        );
+        assert!(crossed(501.0, 499.0, 500.0, None));
+        assert!(!crossed(499.0, 499.5, 500.0, None));
+        // Periodic: any occurrence t + n·P.
+        assert!(crossed(710.0, 730.0, 0.0, Some(360.0)));
+        assert!(crossed(-10.0, 10.0, 0.0, Some(360.0)));
+        assert!(crossed(370.0, 350.0, 0.0, Some(360.0)));
+        assert!(!crossed(10.0, 350.0, 0.0, Some(360.0)));
+        assert!(crossed(10.0, 100.0, 90.0, Some(360.0)));
+        assert!(crossed(1000.0, 1200.0, 90.0, Some(360.0)));
     }
 }

@@ -24,6 +24,10 @@ pub(super) struct Coupling {
 }
 
 /// How the slave's setpoint follows the master's motion.
+#[allow(
+    clippy::large_enum_variant,
+    reason = "a Box would allocate on the cycle thread; an axis holds one coupling, inline"
+)]
 #[derive(Clone, Copy, Debug)]
 pub(super) enum CouplingLaw {
     /// MC_GearIn: a fixed ratio.

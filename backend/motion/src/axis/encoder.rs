@@ -41,7 +41,7 @@ impl Axis {
         relative: bool,
         write: (u16, f64),
     ) -> Result<(), ErrorId> {
-        if !(factor.is_finite() && factor >= 1e-12 && factor <= 1e12) {
+        if !(factor.is_finite() && (1e-12..=1e12).contains(&factor)) {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
         let k_new = factor / self.encoder.base;

@@ -1,13 +1,36 @@
 //! One PLCopen axis (spec §2–§5): built once off the cycle thread, then commanded through
 //! [`Axis::submit`] and stepped through [`Axis::step`] by the kernel.
 //!
-//! The axis is split along its seams, one concern a file (each says why it holds what it
-//! holds): `commands.rs` (submit: what acts at once, and the dispatch), `motion.rs` (from a
-//! move/halt/jog command to a job), `blending.rs` (the buffer and blending, §3.8),
-//! `planning.rs` (a job's plan), `cycle.rs` (step: the cycle order, the running job, the done
-//! criterion), `job.rs` (jobs and the FB output protocol, §3), `coupling.rs`, `homing.rs`,
-//! `superposition.rs`, `monitoring.rs` (one function group each), `status.rs` (the
-//! snapshot). This file holds the axis's data and what is derived from it: the PLCopen state.
+//! This file holds the PLCopen core of the axis — its mode and the PLCopen state derived from
+//! it, the status, the planner, the running and buffered job, MC_Power/MC_Stop/MC_Reset's
+//! held commands, limits, enables, overrides, the set and actual values and the coordinate
+//! offset. Every other capability keeps its state in a struct of its own, in the file that
+//! steps it, so that a capability's state and its behaviour are read in one place:
+//!
+//! | file | state (field of `Axis`) | behaviour |
+//! |---|---|---|
+//! | `commands.rs` | — | submit: what acts at once, the dispatch |
+//! | `motion.rs`, `blending.rs`, `planning.rs` | core (`job`, `next`, `planner`) | move/halt/jog to a job, the buffer and blending (§3.8), a job's plan |
+//! | `job.rs` | `Job`, `Held` (core) | jobs and the FB output protocol (§3) |
+//! | `cycle.rs` | core | step: the cycle order, the running job, the done criterion |
+//! | `master.rs` | `MasterSample`, `Master` (the kernel's input; `offered`) | what a slave sees of its master |
+//! | `coupling.rs` | `Coupling` (`coupling`) with its `CouplingLaw` | MC_GearIn/GearInDyn/GearOut, admission, following the master |
+//! | `camming.rs` | `CamSet` (the coupling's cam law), `CamState` (`cam`) | MC_CamIn(_V2)/CamOut/CamScaling/CamInfo, activations |
+//! | `multimaster.rs` | `MultiGear` (the coupling's multi-master law) | MC_GearInMultiMaster |
+//! | `phasing.rs` | `PhasingState` (`phasing`) | MC_Phasing* |
+//! | `superposition.rs` | `SuperpositionState` (`superposition`) | MC_MoveSuperImposed |
+//! | `homing.rs` | `HomeSeq` (in the homing job), the drive's `latch`, `prev_cam` (core: read every cycle) | MC_Home (§5.3) |
+//! | `probe.rs` | `Probe` (`probe`) | MC_TouchProbe, MC_AbortTrigger |
+//! | `correction.rs` | `Corrections` (`corrections`) | limiter, backlash, table compensation (§7.2) |
+//! | `encoder.rs` | `EncoderScaling` (`encoder`; `enc_k` core) | MC_SetEncoderScalingFactor, the encoder count |
+//! | `torque.rs` | `TorqueState` (`torque`) | MC_TorqueControl, the drive's operation mode |
+//! | `external.rs` | `ExtGen` (`ext`) | the external setpoint generator (§4.4) |
+//! | `monitoring.rs` | `OverrideFilterState` (`override_filter`) | MC_Power's enable, MC_OverrideFilter, errors, feed enables, soft limits, following error |
+//! | `status.rs` | — | the status snapshot |
+//!
+//! Type dependencies point one way: `coupling.rs` names the cam and multi-master laws,
+//! `camming.rs` and `multimaster.rs` reach the coupling only through the axis's methods
+//! (`cam_set`, `multi_gear`, `install_coupling`…); `scripts/check-layers.py` checks it.
 //!
 //! Invariants kept here:
 //! - the PLCopen state is derived from `mode` + the active job, so it cannot disagree with

@@ -60,7 +60,7 @@ impl Axis {
     }
 
     pub(super) fn check_velocity(&self, v: f64) -> Result<f64, ErrorId> {
-        if !(v > 0.0) || !v.is_finite() || v > self.p().axis_velo_max * (1.0 + 1e-12) {
+        if v <= 0.0 || !v.is_finite() || v > self.p().axis_velo_max * (1.0 + 1e-12) {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
         Ok(v)
@@ -179,7 +179,7 @@ impl Axis {
                     }
                     CommandKind::MoveContinuousAbsolute { end_velocity, .. }
                     | CommandKind::MoveContinuousRelative { end_velocity, .. } => {
-                        if !(end_velocity >= 0.0)
+                        if end_velocity < 0.0
                             || !end_velocity.is_finite()
                             || end_velocity > self.p().axis_velo_max
                         {
@@ -289,7 +289,7 @@ impl Axis {
                 self.check_feed_enable(dir)?;
                 match mode {
                     JogMode::Inching | JogMode::InchingModulo => {
-                        if !(position > 0.0) || !position.is_finite() {
+                        if position <= 0.0 || !position.is_finite() {
                             return Err(ErrorId::PARAMETER_NOT_CORRECT);
                         }
                         let s = self.set.position;

@@ -305,7 +305,10 @@ pub struct CamInfo {
 #[cfg(feature = "schema")]
 #[derive(Serialize, utoipa::ToSchema)]
 #[serde(rename_all = "snake_case")]
-#[allow(dead_code)]
+#[allow(
+    dead_code,
+    reason = "only its schema is used: the OpenAPI document's enum of the modes"
+)]
 pub enum OnlineActivationMode {
     Instantaneous,
     AtMasterCamPos,

@@ -245,6 +245,10 @@ impl Basis {
 }
 
 /// A segment's normalised shape `G(z)`, in slave units (`G(0) = 0`).
+#[allow(
+    clippy::large_enum_variant,
+    reason = "segments sit inline in a cam's table and are evaluated every cycle; a Box each would allocate and chase a pointer"
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
     /// `Σ c[i]·z^i`, degree ≤ 11.

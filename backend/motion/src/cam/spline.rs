@@ -128,8 +128,10 @@ fn dense(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
         }
         for r in col + 1..n {
             let f = a[r][col] / a[col][col];
-            for k in col..n {
-                a[r][k] -= f * a[col][k];
+            // Row r less f times the pivot row (col < r: the two rows borrowed apart).
+            let (above, below) = a.split_at_mut(r);
+            for (x, p) in below[0][col..n].iter_mut().zip(&above[col][col..n]) {
+                *x -= f * p;
             }
             b[r] -= f * b[col];
         }

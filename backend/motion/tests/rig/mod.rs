@@ -4,7 +4,10 @@
 //! from rest and left undisturbed its own dynamics: see [`FromRest`]; a positioning job never
 //! moves away from its target: see [`Course`]; the set position never leaves an enabled
 //! software limit while the axis is commanded: see `check_soft_limits`).
-#![allow(dead_code)]
+#![allow(
+    dead_code,
+    reason = "every test crate includes the rig and uses a part of it"
+)]
 
 use std::collections::{HashMap, HashSet};
 
@@ -273,21 +276,22 @@ pub struct Rig {
 }
 
 pub fn params() -> AxisParameters {
-    let mut p = AxisParameters::default();
-    p.axis_velo_max = 500.0;
-    p.axis_acc = 2000.0;
-    p.axis_dec = 1000.0;
-    p.axis_jerk = 20000.0;
-    p.axis_fast_dec = 5000.0;
-    p.axis_fast_acc = 5000.0;
-    p.axis_fast_jerk = 100000.0;
-    p.axis_maximum_acceleration = 5000.0;
-    p.axis_maximum_deceleration = 5000.0;
-    p.axis_target_position_window = 0.01;
-    p.axis_target_position_monitoring_time = 0.005;
-    p.axis_max_pos_lag_value = 1.0;
-    p.axis_max_pos_lag_filter_time = 0.01;
-    p
+    AxisParameters {
+        axis_velo_max: 500.0,
+        axis_acc: 2000.0,
+        axis_dec: 1000.0,
+        axis_jerk: 20000.0,
+        axis_fast_dec: 5000.0,
+        axis_fast_acc: 5000.0,
+        axis_fast_jerk: 100000.0,
+        axis_maximum_acceleration: 5000.0,
+        axis_maximum_deceleration: 5000.0,
+        axis_target_position_window: 0.01,
+        axis_target_position_monitoring_time: 0.005,
+        axis_max_pos_lag_value: 1.0,
+        axis_max_pos_lag_filter_time: 0.01,
+        ..AxisParameters::default()
+    }
 }
 
 impl Rig {
@@ -773,7 +777,7 @@ impl Rig {
             if let Some(prev) = self.outputs.get(&e.command) {
                 assert_ne!(*prev, o, "event without change: {e:?}");
                 assert!(
-                    !(prev.done && o.busy && !stop_locked && !prev.busy),
+                    !prev.done || !o.busy || stop_locked || prev.busy,
                     "done then busy again: {e:?}"
                 );
             }

@@ -61,7 +61,7 @@ fn s11a_18_zero_dynamics_use_axis_defaults_velocity_must_be_positive() {
     let amin = h.iter().map(|s| s.set_acceleration).fold(0.0, f64::min);
     // Defaults: acc 2000, dec 1000 (rig params).
     assert!(amax <= 2000.0 + 1e-6 && amax > 1900.0, "{amax}");
-    assert!(amin >= -1000.0 - 1e-6 && amin < -900.0, "{amin}");
+    assert!((-1000.0 - 1e-6..-900.0).contains(&amin), "{amin}");
 }
 
 #[test]
