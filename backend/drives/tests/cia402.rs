@@ -505,7 +505,7 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
     };
     let power = Command {
         id: 1,
-        axis: 0,
+        target: Target::Axis(0),
         kind: CommandKind::Power {
             enable: true,
             enable_positive: true,
@@ -523,7 +523,7 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
     assert_eq!(s.actual_position, -42.0);
     let mv = Command {
         id: 2,
-        axis: 0,
+        target: Target::Axis(0),
         kind: CommandKind::MoveAbsolute(Positioning {
             position: 10.0,
             velocity: 100.0,

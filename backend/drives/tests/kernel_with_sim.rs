@@ -48,8 +48,14 @@ impl Machine {
         self.next_id += 1;
         (
             id,
-            self.k
-                .submit(Command { id, axis: 0, kind }, &mut self.events),
+            self.k.submit(
+                Command {
+                    id,
+                    target: Target::Axis(0),
+                    kind,
+                },
+                &mut self.events,
+            ),
         )
     }
 

@@ -113,7 +113,7 @@ impl Machine {
         self.k.submit(
             Command {
                 id: self.next_id,
-                axis,
+                target: Target::Axis(axis),
                 kind,
             },
             &mut self.events,

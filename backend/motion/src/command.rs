@@ -632,11 +632,18 @@ pub struct PhasingMotion {
     pub jerk: f64,
 }
 
-/// A command addressed to one axis.
+/// What a command addresses. An axis today; a group of axes (its own blocks, PLCopen Part 4)
+/// is the next variant, so that everything keyed by a command's target stays as it is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Target {
+    Axis(AxisSlot),
+}
+
+/// A command addressed to its target.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Command {
     pub id: CommandId,
-    pub axis: AxisSlot,
+    pub target: Target,
     pub kind: CommandKind,
 }
 

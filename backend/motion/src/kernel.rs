@@ -6,7 +6,7 @@ use crate::axis::{Axis, Master, MasterSample};
 use std::sync::Arc;
 
 use crate::cam::{Cam, CamStore};
-use crate::command::{AxisSlot, Command, CommandKind, EventSink, Verdict};
+use crate::command::{AxisSlot, Command, CommandKind, EventSink, Target, Verdict};
 use crate::drive::{DriveFeedback, DriveSetpoint};
 use crate::error::ErrorId;
 use crate::params::AxisParameters;
@@ -275,7 +275,8 @@ impl Kernel {
     /// verdict is immediate; an accepted command changes the axis state at once and its
     /// outputs follow as events (the first one in this call).
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
-        let slot = cmd.axis as usize;
+        let Target::Axis(slot) = cmd.target;
+        let slot = slot as usize;
         if let CommandKind::GearInMultiMaster(g) = cmd.kind {
             let mut samples = [None; 4];
             for (i, m) in g.masters.iter().enumerate() {
@@ -489,7 +490,11 @@ mod tests {
         kind: CommandKind,
         e: &mut Vec<CommandEvent>,
     ) {
-        let cmd = Command { id, axis, kind };
+        let cmd = Command {
+            id,
+            target: Target::Axis(axis),
+            kind,
+        };
         assert_eq!(k.submit(cmd, e), Verdict::Accepted, "{kind:?}");
     }
 

@@ -38,7 +38,7 @@
 //!     enable_negative: true,
 //!     override_percent: 100.0, buffer_mode: BufferMode::Aborting,
 //! };
-//! let verdict = kernel.submit(Command { id: 1, axis: 0, kind: power }, &mut events);
+//! let verdict = kernel.submit(Command { id: 1, target: Target::Axis(0), kind: power }, &mut events);
 //! assert_eq!(verdict, Verdict::Accepted);
 //! while kernel.status(0).unwrap().state != AxisState::Standstill {
 //!     step(&mut kernel, &mut events);
@@ -51,7 +51,7 @@
 //!     buffer_mode: BufferMode::Aborting,
 //!     options: MoveOptions::default(),
 //! });
-//! kernel.submit(Command { id: 2, axis: 0, kind: to_100 }, &mut events);
+//! kernel.submit(Command { id: 2, target: Target::Axis(0), kind: to_100 }, &mut events);
 //! // Done once the axis has stood in the target window for its monitoring time.
 //! while !events.iter().any(|e| e.command == 2 && e.outputs.done) {
 //!     step(&mut kernel, &mut events);

@@ -73,7 +73,14 @@ fn step_and_replanning_allocate_nothing() {
         |k: &mut Kernel, events: &mut Vec<CommandEvent>, axis: u16, kind: CommandKind| {
             id += 1;
             assert_eq!(
-                k.submit(Command { id, axis, kind }, events),
+                k.submit(
+                    Command {
+                        id,
+                        target: Target::Axis(axis),
+                        kind,
+                    },
+                    events
+                ),
                 Verdict::Accepted,
                 "{kind:?}"
             );
@@ -171,7 +178,7 @@ fn step_and_replanning_allocate_nothing() {
         let kind = CommandKind::WriteParameter { number, value };
         let cmd = Command {
             id: 100_000,
-            axis: 6,
+            target: Target::Axis(6),
             kind,
         };
         assert_ne!(k.submit(cmd, &mut events), Verdict::Accepted, "{kind:?}");

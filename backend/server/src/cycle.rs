@@ -509,10 +509,8 @@ impl CycleThread {
                         Verdict::Rejected(e) => Err(e),
                     };
                     // Taken also after an acceptance, so that no stale hint stays behind.
-                    let hint = self
-                        .kernel
-                        .axis(cmd.axis)
-                        .and_then(|a| a.take_refusal_hint());
+                    let motion::Target::Axis(slot) = cmd.target;
+                    let hint = self.kernel.axis(slot).and_then(|a| a.take_refusal_hint());
                     Reply {
                         hint: hint.filter(|_| result.is_err()),
                         ticket: cmd.id,

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use drives::{DriveConfig, SimBus, SimFault};
 use motion::{
     Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint,
-    Positioning,
+    Positioning, Target,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
 use server::scope::{ScopeConfig, ScopeSignal};
@@ -117,7 +117,7 @@ fn a_cycle_allocates_nothing() {
                         shared
                             .push(Request::Command(Command {
                                 id,
-                                axis: slot,
+                                target: Target::Axis(slot),
                                 kind
                             }))
                             .is_ok()
@@ -139,7 +139,7 @@ fn a_cycle_allocates_nothing() {
                         .push_expiring(
                             Request::Command(Command {
                                 id,
-                                axis: 0,
+                                target: Target::Axis(0),
                                 kind: CommandKind::MoveAbsolute(p)
                             }),
                             std::time::Duration::from_secs(60)

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use drives::{DriveConfig, SimBus};
 use motion::{
-    Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint,
+    Axis, AxisConfig, AxisParameters, Command, CommandKind, DriveFeedback, DriveSetpoint, Target,
 };
 use server::cycle::{CycleThread, MAX_AXES, Request, Shared, Snapshot};
 
@@ -36,7 +36,7 @@ fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
     let power = |id: u64| {
         Request::Command(Command {
             id,
-            axis: 0,
+            target: Target::Axis(0),
             kind: CommandKind::Power {
                 enable: true,
                 enable_positive: true,

@@ -382,7 +382,14 @@ impl Rig {
             self.shifted[axis as usize] = true;
         }
         let before = self.k.status(axis);
-        let v = self.k.submit(Command { id, axis, kind }, &mut self.events);
+        let v = self.k.submit(
+            Command {
+                id,
+                target: Target::Axis(axis),
+                kind,
+            },
+            &mut self.events,
+        );
         if let Verdict::Rejected(_) = v {
             assert_eq!(self.events.len(), n, "a rejected command emitted events");
             assert_eq!(

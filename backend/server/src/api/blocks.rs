@@ -59,7 +59,7 @@ async fn command<B: Send + Sync + 'static>(
         let sub = Submission {
             block,
             to_kind,
-            axis: &target,
+            target: &target,
             body,
             raw,
             client: client.0,
@@ -169,7 +169,7 @@ macro_rules! catalogue {
                             let sub = Submission {
                                 block,
                                 to_kind: $to_kind,
-                                axis: target,
+                                target,
                                 body,
                                 raw,
                                 client,

@@ -308,7 +308,7 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     let mut subs: Vec<Sub> = Vec::new();
     let mut notices: Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>> = None;
     let (out_tx, mut out_rx) = mpsc::channel::<String>(64);
-    let jogs: Arc<Mutex<Vec<(u16, u64)>>> = Arc::default();
+    let jogs: Arc<Mutex<Vec<u64>>> = Arc::default();
     let in_flight = Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT));
     // Idle watch: a Ping after `ping_after` without anything from the client, then the socket
     // is closed if nothing arrives within `ping_after` (a dead peer or a frozen client).
@@ -426,8 +426,8 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
         }
     }
     // The socket is gone: release its jogs (a jog held on a socket stops when it closes).
-    let held: Vec<(u16, u64)> = std::mem::take(&mut *jogs.lock().unwrap());
-    for (_, id) in held {
+    let held: Vec<u64> = std::mem::take(&mut *jogs.lock().unwrap());
+    for id in held {
         if commands::get(&s, id).is_some_and(|c| !c.is_final) {
             let _ = commands::release(&s, id, &client).await;
         }
@@ -613,7 +613,7 @@ fn handle(
     notices: &mut Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>>,
     client: &ClientInfo,
     out_tx: &mpsc::Sender<String>,
-    jogs: &Arc<Mutex<Vec<(u16, u64)>>>,
+    jogs: &Arc<Mutex<Vec<u64>>>,
     in_flight: &Arc<tokio::sync::Semaphore>,
     text: &str,
 ) -> Option<String> {
@@ -867,14 +867,9 @@ fn handle(
                 let msg = match r {
                     Ok(v) => {
                         if block.keepalive {
-                            let slot = s.registry.read().unwrap().find(&axis).map(|e| e.slot);
-                            if let Some(slot) = slot {
-                                let mut held = jogs.lock().unwrap();
-                                held.retain(|(_, id)| {
-                                    commands::get(&s, *id).is_some_and(|c| !c.is_final)
-                                });
-                                held.push((slot, v.id));
-                            }
+                            let mut held = jogs.lock().unwrap();
+                            held.retain(|id| commands::get(&s, *id).is_some_and(|c| !c.is_final));
+                            held.push(v.id);
                         }
                         rpc_result(&id, serde_json::to_value(v).unwrap_or_default())
                     }

@@ -3,7 +3,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use motion::{AxisSlot, BlockResult, CommandEvent, CommandId, ErrorId, FbOutputs};
+use motion::{BlockResult, CommandEvent, CommandId, ErrorId, FbOutputs, Target};
 use serde::Serialize;
 
 use crate::model::{Block, ProbeResult};
@@ -18,11 +18,14 @@ pub struct CommandRecord {
     pub id: CommandId,
     pub axis_id: i64,
     pub axis_name: String,
-    pub slot: AxisSlot,
+    /// What it addresses (its axis; `axis_id`/`axis_name` are that axis as the API shows it).
+    pub target: Target,
     /// Its catalogue entry (name, milestone, flags).
     pub block: &'static Block,
     /// An MC_Stop: it holds its axis locked until released.
     pub locks_axis: bool,
+    /// An MC_Reset: what leaves error_stop (a wait for it does not end there).
+    pub resets_axis: bool,
     pub parameters: serde_json::Value,
     pub client: ClientInfo,
     pub submitted_at: String,

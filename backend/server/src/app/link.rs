@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use motion::{Axis, AxisConfig, AxisParameters, AxisSlot, Command, CommandKind};
+use motion::{Axis, AxisConfig, AxisParameters, AxisSlot, Command, CommandKind, Target};
 use tokio::sync::oneshot;
 
 use super::AppState;
@@ -112,8 +112,8 @@ impl AppState {
     }
 
     /// Sends a kernel command and waits for its verdict (not tracked as a command resource).
-    pub async fn kernel_command(&self, slot: AxisSlot, kind: CommandKind) -> AppResult<u64> {
-        let r = self.command_request(self.next_id(), slot, kind).await?;
+    pub async fn kernel_command(&self, target: Target, kind: CommandKind) -> AppResult<u64> {
+        let r = self.command_request(self.next_id(), target, kind).await?;
         r.result.map(|_| r.cycle).map_err(AppError::Rejected)
     }
 
@@ -121,14 +121,10 @@ impl AppState {
     pub(crate) async fn command_request(
         &self,
         id: u64,
-        slot: AxisSlot,
+        target: Target,
         kind: CommandKind,
     ) -> AppResult<Reply> {
-        let command = Command {
-            id,
-            axis: slot,
-            kind,
-        };
+        let command = Command { id, target, kind };
         self.request(id, Request::Command(command)).await
     }
 

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use axum::http::StatusCode;
-use motion::{AxisState, AxisStatus, CommandKind};
+use motion::{AxisState, AxisStatus, CommandKind, Target};
 
 use super::audit_entry;
 use crate::app::{AppState, AxisEntry};
@@ -316,7 +316,10 @@ pub async fn replace(
         for &(number, value) in &writes {
             let before = p.get(number).map(|v| v.as_f64()).unwrap_or(value);
             match s
-                .kernel_command(slot, CommandKind::WriteParameter { number, value })
+                .kernel_command(
+                    Target::Axis(slot),
+                    CommandKind::WriteParameter { number, value },
+                )
                 .await
             {
                 Ok(_) => {
@@ -337,7 +340,10 @@ pub async fn replace(
             // Nothing stored, so nothing left in force: the old values go back, last first.
             for (number, value) in done.into_iter().rev() {
                 let _ = s
-                    .kernel_command(slot, CommandKind::WriteParameter { number, value })
+                    .kernel_command(
+                        Target::Axis(slot),
+                        CommandKind::WriteParameter { number, value },
+                    )
                     .await;
             }
             return Err(match e {
@@ -549,10 +555,12 @@ pub async fn write_parameter(
         store::audit(&mut *tx, &audit).await?;
         // The kernel checks the value with the same table (it should agree with the checks
         // above): its refusal is the same 422 with the error number.
-        s.kernel_command(slot, kind).await.map_err(|e| match e {
-            AppError::Rejected(id) => invalid(id, id.text().into()),
-            e => e,
-        })?;
+        s.kernel_command(Target::Axis(slot), kind)
+            .await
+            .map_err(|e| match e {
+                AppError::Rejected(id) => invalid(id, id.text().into()),
+                e => e,
+            })?;
         if let Err(e) = tx.commit().await {
             // Not stored, so not acknowledged and not left active: the kernel gets the value
             // it had back, and API, kernel and database agree.
@@ -560,7 +568,7 @@ pub async fn write_parameter(
             let restored = match params::read(&before, info.number, &status) {
                 Ok(old) => s
                     .kernel_command(
-                        slot,
+                        Target::Axis(slot),
                         CommandKind::WriteParameter {
                             number: info.number,
                             value: old.as_f64(),
@@ -591,10 +599,12 @@ pub async fn write_parameter(
     } else {
         // The kernel checks the value with the same table (it should agree with the checks
         // above): its refusal is the same 422 with the error number.
-        s.kernel_command(slot, kind).await.map_err(|e| match e {
-            AppError::Rejected(id) => invalid(id, id.text().into()),
-            e => e,
-        })?;
+        s.kernel_command(Target::Axis(slot), kind)
+            .await
+            .map_err(|e| match e {
+                AppError::Rejected(id) => invalid(id, id.text().into()),
+                e => e,
+            })?;
         s.audit(audit);
     }
     let mut reg = s.registry_write();

@@ -6,7 +6,7 @@
 use std::collections::VecDeque;
 use std::time::Duration;
 
-use motion::{AxisSlot, CommandId, CommandKind, ErrorId, FbOutputs};
+use motion::{AxisSlot, CommandId, CommandKind, ErrorId, FbOutputs, Target};
 
 use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Registry};
 use crate::error::{AppError, AppResult};
@@ -18,12 +18,13 @@ use crate::store::{self, AuditEntry};
 /// How a catalogue entry turns its body into a kernel command.
 pub type ToKind<B> = fn(&B, &Registry, &AxisEntry) -> AppResult<CommandKind>;
 
-/// A function block as the catalogue hands it over: its name, its milestone and its body's
-/// conversion.
+/// A function block as the catalogue hands it over: its entry, its body's conversion and what
+/// it addresses.
 pub struct Submission<'a, B> {
     pub block: &'static Block,
     pub to_kind: ToKind<B>,
-    pub axis: &'a str,
+    /// Its target as the request names it (the route's `{axis}`: an axis id or name).
+    pub target: &'a str,
     pub body: B,
     /// The body as sent, kept with the command and in the audit log.
     pub raw: serde_json::Value,
@@ -42,15 +43,20 @@ pub async fn run<B>(
     let Submission {
         block,
         to_kind,
-        axis,
+        target,
         body,
         raw,
         client,
         idempotency_key,
     } = sub;
-    let id = submit(s, axis, block, (raw, idempotency_key), client, |reg, e| {
-        to_kind(&body, reg, e)
-    })
+    let id = submit(
+        s,
+        target,
+        block,
+        (raw, idempotency_key),
+        client,
+        |reg, e| to_kind(&body, reg, e),
+    )
     .await?;
     let view = match wait {
         Some(t) => wait_for(s, id, t).await.map(|mut v| {
@@ -143,9 +149,10 @@ async fn submit(
         id,
         axis_id,
         axis_name,
-        slot,
+        target: Target::Axis(slot),
         block,
         locks_axis: matches!(kind, CommandKind::Stop { .. }),
+        resets_axis: matches!(kind, CommandKind::Reset),
         parameters,
         client,
         submitted_at,
@@ -166,8 +173,10 @@ async fn submit(
         outcome: Some("submitted".into()),
         ..audit
     };
-    let (stored, reply) =
-        tokio::join!(store::audit(&s.db, &row), s.command_request(id, slot, kind));
+    let (stored, reply) = tokio::join!(
+        store::audit(&s.db, &row),
+        s.command_request(id, Target::Axis(slot), kind)
+    );
     let stored = match stored {
         Ok(()) => true,
         Err(e) => {
@@ -397,7 +406,7 @@ pub fn refusal_why(
                     .iter()
                     .rev()
                     .filter_map(|id| store.map.get(id))
-                    .find(|r| r.slot == slot && r.locks_axis && r.accepted)
+                    .find(|r| r.target == Target::Axis(slot) && r.locks_axis && r.accepted)
                     .map_or(st.active_command, |r| r.id)
             };
             if st.moving {
@@ -442,7 +451,7 @@ pub async fn ext_feed<B>(
         (e.slot, to_kind(body, &reg, e)?)
     };
     s.control.admit(client, &kind)?;
-    s.kernel_command(slot, kind).await
+    s.kernel_command(Target::Axis(slot), kind).await
 }
 
 /// An accepted command as it stands.
@@ -501,18 +510,19 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
     // Set when the axis was first seen in error_stop: the drain count to wait for.
     let mut error_stop_seen: Option<u64> = None;
     loop {
-        let (view, milestone, slot) = {
+        let (view, milestone, target, resets) = {
             let store = s.commands.lock().unwrap();
             let r = store.map.get(&id).filter(|r| r.accepted)?;
-            (r.view(), r.block.milestone, r.slot)
+            (r.view(), r.block.milestone, r.target, r.resets_axis)
         };
         if view.is_final || milestone.reached(&view.outputs) {
             return Some(view);
         }
+        let Target::Axis(slot) = target;
         let (cycle, st) = s.status(slot);
         // A reset is what leaves error_stop (its drive may take cycles to clear the fault).
         if cycle > view.accepted_cycle
-            && view.command != "reset"
+            && !resets
             && st.is_some_and(|st| st.state == motion::AxisState::ErrorStop)
         {
             // The snapshot is published before the pump applies that cycle's events: the
@@ -572,23 +582,23 @@ pub fn list(s: &AppState, f: ListFilter<'_>) -> AppResult<Vec<CommandResource>> 
         .collect())
 }
 
-/// The slot of an accepted command (404 for an unknown one).
-pub fn slot_of(s: &AppState, id: CommandId) -> AppResult<AxisSlot> {
+/// The target of an accepted command (404 for an unknown one).
+pub fn target_of(s: &AppState, id: CommandId) -> AppResult<Target> {
     let store = s.commands.lock().unwrap();
     store
         .map
         .get(&id)
         .filter(|r| r.accepted)
-        .map(|r| r.slot)
+        .map(|r| r.target)
         .ok_or_else(|| AppError::not_found("command", &id.to_string()))
 }
 
 /// Releases a command (the falling edge of Execute/Enable) and audits it; the cycle it took
 /// effect in.
 pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppResult<u64> {
-    let slot = slot_of(s, id)?;
+    let target = target_of(s, id)?;
     let result = s
-        .kernel_command(slot, CommandKind::Release { target: id })
+        .kernel_command(target, CommandKind::Release { target: id })
         .await;
     let outcome = match &result {
         Ok(_) => "accepted".to_owned(),
@@ -613,7 +623,7 @@ pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppRes
 
 /// Renews a jog's dead-man; the cycle it took effect in.
 pub async fn keepalive(s: &AppState, id: CommandId) -> AppResult<u64> {
-    let slot = slot_of(s, id)?;
-    s.kernel_command(slot, CommandKind::Keepalive { target: id })
+    let target = target_of(s, id)?;
+    s.kernel_command(target, CommandKind::Keepalive { target: id })
         .await
 }

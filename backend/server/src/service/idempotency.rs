@@ -108,7 +108,7 @@ pub async fn run_once<B>(
     let Some(key) = sub.idempotency_key.clone() else {
         return commands::run(s, sub, wait).await.map(|v| (v, false));
     };
-    let fingerprint = format!("{}\n{}\n{}", sub.block.name, sub.axis, sub.raw);
+    let fingerprint = format!("{}\n{}\n{}", sub.block.name, sub.target, sub.raw);
     let (principal, client_id) = (sub.client.principal.clone(), sub.client.id.clone());
     // Remembered per sender: principal and client id before the key (neither contains a newline).
     let scoped = format!(
@@ -160,7 +160,7 @@ pub async fn run_once<B>(
             .registry
             .read()
             .unwrap()
-            .find(sub.axis)
+            .find(sub.target)
             .map(|e| e.name.clone());
         let same = action == format!("command.{}", sub.block.name)
             && target == axis
