@@ -226,10 +226,12 @@ pub trait DriveBus: Send {
     /// Empties `slot`; returns the drive it held.
     fn detach(&mut self, slot: usize) -> Option<Drive>;
 
-    /// Injects a fault or disturbance into the drive of `slot` (simulated drives only).
-    fn inject(&mut self, slot: usize, fault: SimFault) -> Result<(), BusError> {
-        let _ = (slot, fault);
-        Err(BusError::Unsupported)
+    /// The bus's simulated drives, whose faults go through the simulated bus's own door
+    /// ([`SimBus::inject`]): the simulated bus itself, or the simulated axes another bus
+    /// carries besides its own drives; `None` for a bus without any. (A bus of real or
+    /// emulated drives has its own door, in its own crate.)
+    fn simulated(&mut self) -> Option<&mut SimBus> {
+        None
     }
 
     /// A bus with a clock of its own (EtherCAT distributed clocks): how far (ns) the last
@@ -256,6 +258,17 @@ pub struct SimBus {
 }
 
 impl SimBus {
+    /// Injects a fault or disturbance into the simulated drive of `slot`.
+    pub fn inject(&mut self, slot: usize, fault: SimFault) -> Result<(), BusError> {
+        match self.drives.get_mut(slot).and_then(|d| d.as_deref_mut()) {
+            Some(d) => {
+                d.inject(fault);
+                Ok(())
+            }
+            None => Err(BusError::NoDrive),
+        }
+    }
+
     pub fn new(slots: usize) -> SimBus {
         SimBus {
             drives: (0..slots).map(|_| None).collect(),
@@ -303,14 +316,8 @@ impl DriveBus for SimBus {
             .map(Drive::Simulated)
     }
 
-    fn inject(&mut self, slot: usize, fault: SimFault) -> Result<(), BusError> {
-        match self.drives.get_mut(slot).and_then(|d| d.as_deref_mut()) {
-            Some(d) => {
-                d.inject(fault);
-                Ok(())
-            }
-            None => Err(BusError::NoDrive),
-        }
+    fn simulated(&mut self) -> Option<&mut SimBus> {
+        Some(self)
     }
 }
 

@@ -14,7 +14,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use drives::cia402::{Cia402Drive, RxPdo, TxPdo};
-use drives::{BusError, Drive, DriveBus, SimBus, SimFault};
+use drives::{Drive, DriveBus, SimBus};
 use ethercrab::subdevice_group::{DcConfiguration, HasDc, Op};
 use ethercrab::{
     DcSync, MainDevice, MainDeviceConfig, PduStorage, RegisterAddress, RetryBehaviour,
@@ -23,7 +23,7 @@ use ethercrab::{
 use futures_lite::future::block_on;
 use motion::{DriveFeedback, DriveSetpoint};
 
-use crate::emu::{self, Segment};
+use crate::emu::Segment;
 use crate::txrx::{self, LinkState, Opener, RawWire, SegmentWire, Wire};
 
 /// SubDevices on one segment (a power of two, as ethercrab wants).
@@ -506,8 +506,6 @@ pub struct EthercatBus {
     /// Axes with simulated drives run beside the EtherCAT ones (a machine half commissioned).
     sim: SimBus,
     sim_feedback: Vec<DriveFeedback>,
-    /// The emulated segment, for fault injection into its drives.
-    segment: Option<Arc<Mutex<Segment>>>,
     /// The drive of each axis slot.
     slots: Vec<Option<Box<Cia402Drive>>>,
     /// Slot → SubDevice position, for the slots with a drive.
@@ -546,10 +544,6 @@ impl EthercatBus {
         let (tx, rx, pdu_loop) = storage
             .try_split()
             .map_err(|_| "PDU storage split twice".to_string())?;
-        let segment = match &link {
-            Link::Emulated(s) => Some(s.clone()),
-            Link::Interface(_) => None,
-        };
         // motiond's own TX/RX loop (never ethercrab's `tx_rx_task`: a late reply ends that).
         let (interface, wire, reopen): (String, Box<dyn Wire>, Opener) = match link {
             Link::Interface(iface) => {
@@ -626,7 +620,6 @@ impl EthercatBus {
             status,
             sim: SimBus::new(slots),
             sim_feedback: vec![DriveFeedback::default(); slots],
-            segment,
             slots: (0..slots).map(|_| None).collect(),
             layouts: vec![None; slots],
             faulted: false,
@@ -1167,37 +1160,9 @@ impl DriveBus for EthercatBus {
         }
     }
 
-    /// Simulated drives as on the simulated bus; a drive of the emulated segment takes a
-    /// drive fault (its 0x603F code), its probe input and its limit switches (0x60FD); a
-    /// real drive takes nothing.
-    fn inject(&mut self, slot: usize, fault: SimFault) -> Result<(), BusError> {
-        let Some(Some(d)) = self.slots.get(slot) else {
-            return self.sim.inject(slot, fault);
-        };
-        let Some(segment) = &self.segment else {
-            return Err(BusError::Unsupported);
-        };
-        let position = d.config().subdevice as usize;
-        let mut seg = segment.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(drive) = seg.app::<emu::drive::Cia402Emu>(position) else {
-            return Err(BusError::Unsupported);
-        };
-        match fault {
-            SimFault::DriveFault { code } => drive.inject_fault(code.min(0xFFFF) as u16),
-            SimFault::ProbeInput { active } => drive.set_probe_input(active),
-            SimFault::LimitSwitch { positive, active } => {
-                let bit = if positive { 0b010 } else { 0b001 };
-                let now = drive.od.u32(0x60FD, 0);
-                drive.set_digital_inputs(if active { now | bit } else { now & !bit });
-            }
-            SimFault::Clear => {
-                drive.set_probe_input(false);
-                drive.set_digital_inputs(0);
-            }
-            SimFault::Load { .. } | SimFault::ProbeMark { .. } => {
-                return Err(BusError::Unsupported);
-            }
-        }
-        Ok(())
+    /// The simulated axes this bus carries besides its EtherCAT drives (a drive of the
+    /// emulated segment takes its faults through the emulator's door, `emu::drive::Input`).
+    fn simulated(&mut self) -> Option<&mut SimBus> {
+        Some(&mut self.sim)
     }
 }

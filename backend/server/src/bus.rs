@@ -11,6 +11,7 @@ use ethercat::bus::{BusControl, BusOptions, BusStatus, EthercatBus, Link, SdoAcc
 use ethercat::emu::Segment;
 use ethercat::emu::drive::{self, Plant};
 use ethercat::emu::sii::Identity;
+use motion::ErrorId;
 use serde::Serialize;
 use utoipa::ToSchema;
 
@@ -53,6 +54,32 @@ pub struct BusHandle {
 }
 
 impl BusHandle {
+    /// A fault for the emulated CiA-402 drive at `position` of the emulated segment, through
+    /// the emulator's own door (`emu::drive::Input`): the drive's fault (its 0x603F code), its
+    /// probe input, its limit switches. The simulated load's disturbances (load, probe mark)
+    /// are the simulated drive's only; a real bus takes none.
+    pub fn inject_emulated(&self, position: u16, fault: drives::SimFault) -> Result<(), ErrorId> {
+        use drives::SimFault as F;
+        let input = match fault {
+            F::DriveFault { code } => drive::Input::Fault {
+                code: code.min(0xFFFF) as u16,
+            },
+            F::ProbeInput { active } => drive::Input::ProbeInput { active },
+            F::LimitSwitch { positive, active } => drive::Input::LimitSwitch { positive, active },
+            F::Clear => drive::Input::Clear,
+            F::Load { .. } | F::ProbeMark { .. } => return Err(ErrorId::COMMAND_NOT_PERMITTED),
+        };
+        let Some(segment) = &self.segment else {
+            return Err(ErrorId::COMMAND_NOT_PERMITTED);
+        };
+        let mut seg = segment.lock().unwrap_or_else(|e| e.into_inner());
+        let Some(d) = seg.app::<drive::Cia402Emu>(position as usize) else {
+            return Err(ErrorId::COMMAND_NOT_PERMITTED);
+        };
+        d.apply(input);
+        Ok(())
+    }
+
     pub fn simulated() -> BusHandle {
         BusHandle {
             kind: BusKind::Simulated,

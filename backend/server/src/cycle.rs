@@ -615,10 +615,15 @@ impl CycleThread {
                         }
                         (f, _) => f,
                     };
-                    let result = match self.bus.inject(slot as usize, fault) {
-                        Ok(()) => Ok(()),
-                        Err(BusError::NoDrive) => Err(ErrorId::AXIS_UNKNOWN),
-                        Err(BusError::Unsupported) => Err(ErrorId::COMMAND_NOT_PERMITTED),
+                    // The simulated drives' own door (an emulated drive's is the emulator's,
+                    // reached without the cycle thread: `BusHandle::inject_emulated`).
+                    let result = match self.bus.simulated().map(|b| b.inject(slot as usize, fault))
+                    {
+                        Some(Ok(())) => Ok(()),
+                        Some(Err(BusError::NoDrive)) => Err(ErrorId::AXIS_UNKNOWN),
+                        Some(Err(BusError::Unsupported)) | None => {
+                            Err(ErrorId::COMMAND_NOT_PERMITTED)
+                        }
                     };
                     Reply {
                         hint: None,

@@ -115,6 +115,24 @@ pub const MODE_CSP: i8 = 8;
 pub const MODE_CSV: i8 = 9;
 pub const MODE_CST: i8 = 10;
 
+/// An input to the emulated drive from outside its process data (the emulator's own fault
+/// door): a drive fault with its 0x603F code, the probe input, a limit switch (0x60FD bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    Fault {
+        code: u16,
+    },
+    ProbeInput {
+        active: bool,
+    },
+    LimitSwitch {
+        positive: bool,
+        active: bool,
+    },
+    /// Probe input and limit switches off (a fault is cleared by the drive's fault reset).
+    Clear,
+}
+
 impl Cia402Emu {
     pub fn new(id: &Identity, plant: Plant) -> Cia402Emu {
         let mut od = Od::default();
@@ -241,6 +259,24 @@ impl Cia402Emu {
     }
 
     /// A drive fault (overcurrent, encoder, …) with its 0x603F error code.
+    /// What a test or a demo does to the emulated drive from outside (the emulator's fault
+    /// door): its fault, its probe input, its limit switches.
+    pub fn apply(&mut self, input: Input) {
+        match input {
+            Input::Fault { code } => self.inject_fault(code),
+            Input::ProbeInput { active } => self.set_probe_input(active),
+            Input::LimitSwitch { positive, active } => {
+                let bit = if positive { 0b010 } else { 0b001 };
+                let now = self.od.u32(0x60FD, 0);
+                self.set_digital_inputs(if active { now | bit } else { now & !bit });
+            }
+            Input::Clear => {
+                self.set_probe_input(false);
+                self.set_digital_inputs(0);
+            }
+        }
+    }
+
     pub fn inject_fault(&mut self, error_code: u16) {
         self.pending_fault = Some(error_code);
     }

@@ -29,8 +29,28 @@ pub async fn inject_fault(
             return Err(AppError::field("force", "must be a finite number"));
         }
     }
-    let (slot, name) = s.axis_slot(axis)?;
-    let result = s.inject_fault(slot, fault).await;
+    let (slot, name, emulated) = {
+        let reg = s.registry.read().unwrap();
+        let e = reg
+            .find(axis)
+            .ok_or_else(|| AppError::not_found("axis", axis))?;
+        let emulated = match &e.config.drive {
+            drives::DriveConfig::Cia402(c) => Some(c.subdevice),
+            drives::DriveConfig::Simulated(_) => None,
+        };
+        (e.slot, e.name.clone(), emulated)
+    };
+    // Each bus's own door: a simulated drive's through the cycle thread, a CiA-402 drive's
+    // through the emulated segment.
+    let result = match emulated {
+        Some(position) => s
+            .info
+            .bus
+            .inject_emulated(position, fault)
+            .map(|()| 0)
+            .map_err(AppError::Rejected),
+        None => s.inject_fault(slot, fault).await,
+    };
     if let Err(e) = &result {
         if e.kernel_error().is_none() {
             // The cycle thread did not answer: nothing was injected, nothing to audit.
