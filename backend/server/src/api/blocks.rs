@@ -264,7 +264,6 @@ families!(
     probe,
     torque,
     corrections,
-    phasing,
 );
 
 /// The feed's OpenAPI operation.

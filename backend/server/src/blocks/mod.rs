@@ -22,7 +22,6 @@ pub mod coupling;
 pub mod homing;
 pub mod jog;
 pub mod moves;
-pub mod phasing;
 pub mod probe;
 pub mod superposition;
 pub mod torque;
