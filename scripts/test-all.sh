@@ -51,6 +51,13 @@ rm -f "$MOTIOND_SKIPPED_LOG"
 cargo test --workspace --all-targets 2>&1
 phase "Rust tests"
 
+# Who may depend on whom (docs/ARCHITECTURE.md): no import cycle, no upward import.
+python3 scripts/check-layers.py
+# Clippy (the workspace's [workspace.lints]): every warning is an error here.
+cargo clippy --version >/dev/null 2>&1 || rustup component add clippy
+cargo clippy --workspace --all-targets -- -D warnings 2>&1
+phase "layers and clippy"
+
 # --- Frontend (frontend/, tests/e2e/) ------------------------------------------------------
 # The UI's API types must match openapi/openapi.json, the UI must build, its logic tests
 # (Vitest) must pass, and the browser tests drive the real motiond binary with headless

@@ -1,5 +1,5 @@
 //! Starts the real `motiond` binary on a free port with its own database.
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test binary uses part of the fixtures")]
 
 use std::io::{BufRead, BufReader};
 use std::path::PathBuf;

@@ -19,9 +19,11 @@ struct Machine {
 impl Machine {
     fn new(config: SimDriveConfig) -> Machine {
         let mut k = Kernel::new(DT, 1);
-        let mut p = AxisParameters::default();
-        p.axis_target_position_window = 0.02;
-        p.axis_target_position_monitoring_time = 0.01;
+        let p = AxisParameters {
+            axis_target_position_window: 0.02,
+            axis_target_position_monitoring_time: 0.01,
+            ..Default::default()
+        };
         k.insert_axis(
             0,
             Axis::new(

@@ -107,9 +107,12 @@ pub struct Reply {
 }
 
 pub enum Garbage {
-    Axis(#[allow(dead_code)] Box<Axis>),
-    Drive(#[allow(dead_code)] Drive),
-    Cam(#[allow(dead_code)] Arc<motion::cam::Cam>),
+    Axis(#[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Box<Axis>),
+    Drive(#[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Drive),
+    Cam(
+        #[allow(dead_code, reason = "held only to be dropped off the cycle thread")]
+        Arc<motion::cam::Cam>,
+    ),
 }
 
 /// Status of every slot at the end of one cycle.

@@ -17,7 +17,10 @@ use crate::stats::Histogram;
 
 /// How the service answered a submitted command.
 #[derive(Clone, Copy, Debug, Hash, PartialEq, Eq, EncodeLabelValue)]
-#[allow(non_camel_case_types)]
+#[allow(
+    non_camel_case_types,
+    reason = "the variants are the label values as exported"
+)]
 pub enum Verdict {
     /// Taken by the kernel (202).
     accepted,

@@ -1,6 +1,6 @@
 //! Fixtures shared by the EtherCAT tests: emulated segments of CiA-402 servos on the segment's
 //! own clock.
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test binary uses part of the fixtures")]
 
 use std::sync::{Arc, Mutex};
 use std::time::Instant;

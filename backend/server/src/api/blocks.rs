@@ -130,7 +130,7 @@ macro_rules! catalogue {
             [$($flag:ident),*], $summary:literal;
     )+) => {
         /// The entries' positions in [`BLOCKS`].
-        #[allow(non_camel_case_types, clippy::enum_variant_names)]
+        #[allow(non_camel_case_types, clippy::enum_variant_names, reason = "named after the handlers (snake case)")]
         enum Entry { $($fn),+ }
 
         /// The family's blocks, in the order of the document.

@@ -98,7 +98,7 @@ macro_rules! problem_responses {
     ($($(#[doc = $doc:tt])* $name:ident($($attr:tt)*);)*) => {
         $(
             $(#[doc = $doc])*
-            #[allow(dead_code)]
+            #[allow(dead_code, reason = "a type for the OpenAPI document only, never built")]
             #[derive(ToResponse)]
             #[response(content_type = "application/problem+json", $($attr)*)]
             pub struct $name(Problem);
@@ -124,7 +124,7 @@ macro_rules! error_sets {
     ($($(#[doc = $doc:tt])* $set:ident { $($status:tt: $response:ident),+ $(,)? })*) => {
         $(
             $(#[doc = $doc])*
-            #[allow(dead_code)]
+            #[allow(dead_code, reason = "a type for the OpenAPI document only, never built")]
             #[derive(IntoResponses)]
             pub enum $set {
                 $(#[response(status = $status)] $response(#[ref_response] $response),)+

@@ -545,7 +545,13 @@ with `--allow-origin`, or with a `Sec-Fetch-Site` other than `same-origin` or `n
 `cross_origin_forbidden`; a POST, PUT, PATCH or DELETE must be sent as `Content-Type: application/json`, \
 also without a body, else 415 `unsupported_media_type`; a body must be a JSON object (422). Clients that send \
 no `Origin` (curl, an MES) only need the Content-Type.\n\nCommands are accepted with 202 and a command resource; `?wait=true` holds the response \
-until the command finishes. Authentication is not implemented yet: motiond only listens on loopback addresses.",
+until the command is final or reaches its milestone (the block's `x-motiond-block.milestone`), and its `wait` says \
+why when it ended otherwise.\n\nAuthentication is on once a user exists (`motiond user add --admin NAME`, then `POST /api/v1/users`): \
+every request then needs a browser session (`POST /api/v1/auth/login`, an HttpOnly cookie) or an API token \
+(`Authorization: Bearer`) with the role the operation names (`x-motiond-role`: viewer, operator, engineer, admin); without \
+users motiond listens on loopback addresses only, and a non-loopback `--listen` is served over TLS only \
+(`--tls-cert`/`--tls-key`, or a self-signed certificate). While a client holds the control lease, \
+motion from other clients is refused with 409 `control_held`; a stop, a halt and a power-off never are.",
         license(name = "MIT OR Apache-2.0")
     ),
     paths(

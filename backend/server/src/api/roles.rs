@@ -96,25 +96,22 @@ impl utoipa::Modify for RequestChecks {
                     responses.insert("403".into(), response(forbidden));
                     responses.insert("415".into(), response("UnsupportedMediaType"));
                 }
-                match role {
-                    Some(role) => {
-                        responses.insert("401".into(), response("Unauthenticated"));
-                        if !changes {
-                            responses.insert("403".into(), response("RoleInsufficient"));
-                        }
-                        op.security = Some(vec![
-                            SecurityRequirement::new("bearer", Vec::<String>::new()),
-                            SecurityRequirement::new("session", Vec::<String>::new()),
-                        ]);
-                        // A block names its role in `x-motiond-block` already (and utoipa
-                        // writes several extensions in no fixed order).
-                        let ext = op.extensions.get_or_insert_with(Default::default);
-                        if !ext.contains_key("x-motiond-block") {
-                            ext.insert("x-motiond-role".into(), serde_json::json!(role));
-                        }
+                // None: public, no credentials needed.
+                if let Some(role) = role {
+                    responses.insert("401".into(), response("Unauthenticated"));
+                    if !changes {
+                        responses.insert("403".into(), response("RoleInsufficient"));
                     }
-                    // Public: no credentials needed.
-                    None => {}
+                    op.security = Some(vec![
+                        SecurityRequirement::new("bearer", Vec::<String>::new()),
+                        SecurityRequirement::new("session", Vec::<String>::new()),
+                    ]);
+                    // A block names its role in `x-motiond-block` already (and utoipa
+                    // writes several extensions in no fixed order).
+                    let ext = op.extensions.get_or_insert_with(Default::default);
+                    if !ext.contains_key("x-motiond-block") {
+                        ext.insert("x-motiond-role".into(), serde_json::json!(role));
+                    }
                 }
             }
         }

@@ -606,7 +606,10 @@ fn batch_of(text: &str) -> Option<Result<Vec<Value>, String>> {
     })
 }
 
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one socket's whole state, borrowed apart"
+)]
 fn handle(
     s: &Arc<AppState>,
     subs: &mut Vec<Sub>,
@@ -650,7 +653,10 @@ fn handle(
     // A JSON-RPC notification (no id) is carried out but never answered.
     let notification = req.get("id").is_none();
     // (a closure, so that its early error returns are silenced for notifications too)
-    #[allow(clippy::redundant_closure_call)]
+    #[allow(
+        clippy::redundant_closure_call,
+        reason = "the closure scopes the early returns"
+    )]
     let need = match method.as_str() {
         "subscribe" | "unsubscribe" => Role::Viewer,
         "keepalive" | "release" | "ext-setpoint-gen-feed" => Role::Operator,

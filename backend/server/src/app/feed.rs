@@ -91,12 +91,9 @@ fn members(json: &str) -> Option<Vec<(u32, u32, u32)>> {
                 out.push((start as u32, value as u32, i as u32));
                 start = i + 1;
             }
-            b'}' if depth == 0 => {
-                // The object's end (it is the last byte).
-                if i > start {
-                    out.push((start as u32, value as u32, i as u32));
-                }
-            }
+            // The object's end (it is the last byte); nothing after an empty object's `{`.
+            b'}' if depth == 0 && i > start => out.push((start as u32, value as u32, i as u32)),
+            b'}' if depth == 0 => {}
             b'}' | b']' => depth = depth.checked_sub(1)?,
             _ => {}
         }

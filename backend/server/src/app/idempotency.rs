@@ -12,7 +12,8 @@ use crate::model::CommandResource;
 /// What a key's first request got.
 #[derive(Clone, Debug)]
 pub(crate) enum Answer {
-    Accepted(CommandResource),
+    /// Boxed: a command resource is large, a refusal small (both kept per key).
+    Accepted(Box<CommandResource>),
     /// Refused by the axis, with what was in the way then.
     Rejected(ErrorId, Option<String>),
 }
@@ -26,8 +27,11 @@ pub(crate) struct Remembered {
     pub(crate) answer: Option<Answer>,
 }
 
+/// The keys by name, and their names oldest first (to forget the oldest).
+pub(crate) type Memory = (HashMap<String, Remembered>, VecDeque<(Instant, String)>);
+
 /// The keys of recent commands.
 #[derive(Default)]
 pub struct Keys {
-    pub(crate) inner: Mutex<(HashMap<String, Remembered>, VecDeque<(Instant, String)>)>,
+    pub(crate) inner: Mutex<Memory>,
 }

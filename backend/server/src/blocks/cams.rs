@@ -39,7 +39,10 @@ pub(crate) use entries;
 /// document's view of `InterpolationType` without `4point`, which is no longer supported.
 #[derive(Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
-#[allow(dead_code)]
+#[allow(
+    dead_code,
+    reason = "the document's view of the kernel's enum, never built"
+)]
 pub enum CouplingInterpolation {
     Linear,
     Spline,
@@ -334,7 +337,10 @@ impl CamInBody {
 }
 
 /// A multi-cam operation (MC_CamIn_V2 and its convenience blocks).
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "MC_CamIn_V2's inputs, as the block has them"
+)]
 fn cam_in_v2(
     reg: &Registry,
     axis: &AxisEntry,

@@ -224,7 +224,10 @@ async fn replace_locked(
 /// the commit and out again if the commit fails. New data for an existing one goes to the kernel
 /// after the commit — checked first so that it will be taken: on a coupled table it is an
 /// online change that reaches the slaves by `replacing`'s rules, never with a jump.
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a cam table's parts as the two callers hold them"
+)]
 async fn store_and_register(
     s: &AppState,
     id: u32,
@@ -290,7 +293,10 @@ async fn store_and_register(
     ))
 }
 
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a cam table's parts as the two callers hold them"
+)]
 fn register(
     s: &AppState,
     id: u32,

@@ -126,7 +126,7 @@ pub async fn run_once<B>(
         Begin::New => {}
         Begin::Replay(Answer::Accepted(first)) => {
             // The command as it stands now (as it was answered, once it left the history).
-            return Ok((commands::get(s, first.id).unwrap_or(first), true));
+            return Ok((commands::get(s, first.id).unwrap_or(*first), true));
         }
         Begin::Replay(Answer::Rejected(id, why)) => {
             return Err(match why {
@@ -185,7 +185,7 @@ pub async fn run_once<B>(
     s.idempotency.finish(
         &scoped,
         match &r {
-            Ok(v) => Some(Answer::Accepted(v.clone())),
+            Ok(v) => Some(Answer::Accepted(Box::new(v.clone()))),
             Err(AppError::Rejected(id)) => Some(Answer::Rejected(*id, None)),
             Err(AppError::RejectedBecause { id, why }) => {
                 Some(Answer::Rejected(*id, Some(why.clone())))

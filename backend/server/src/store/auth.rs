@@ -176,7 +176,7 @@ pub async fn delete_expired_sessions(pool: &SqlitePool, now: &str) -> Result<(),
         .map(|_| ())
 }
 
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, reason = "one column each")]
 pub async fn insert_token<'e, E: sqlx::SqliteExecutor<'e>>(
     e: E,
     name: &str,
