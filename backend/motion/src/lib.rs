@@ -4,7 +4,7 @@
 //! process data. The same commands at the same cycles give bit-identical setpoints, so it is
 //! tested in virtual time.
 //!
-//! Interface (see `docs/ARCHITECTURE.md`): [`Kernel::submit`] takes a [`Command`] and gives a
+//! Interface: [`Kernel::submit`] takes a [`Command`] and gives a
 //! [`Verdict`] at once; [`Kernel::step`] advances one cycle from drive feedback to drive
 //! setpoints and reports changes of every command's FB outputs as [`CommandEvent`]s;
 //! [`Kernel::status`] gives a copyable [`AxisStatus`] per axis.

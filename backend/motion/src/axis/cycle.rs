@@ -1,6 +1,10 @@
-//! One cycle of an axis: [`Axis::step`] in the order of `docs/ARCHITECTURE.md` (feedback
-//! → power → feed enables → the job → superposition → soft limits → following error →
-//! unlock → status → setpoint); the running job's step (dead-man, a coupled slave, override
+//! One cycle of an axis: [`Axis::step`] in this order — read the feedback (actual = drive
+//! position + coordinate offset + the position correction sent last cycle) → power and drive
+//! readiness (notes 1, 2, 5) → feed enables → the job (planner sample, or the master through
+//! the coupling) → phasing → superposition laid on top → soft limits (endless motion, gear
+//! slaves) → following error (against the setpoint the drive is answering) → MC_Stop's unlock
+//! (note 6) → touch probe → position correction → status → setpoint (set − offset −
+//! correction); the running job's step (dead-man, a coupled slave, override
 //! re-plan, the planner sample, a blending hand-over, milestones and its end); the done
 //! criterion (§3.11). Kept in one place so that a cycle can be read top to bottom.
 

@@ -810,7 +810,7 @@ impl utoipa::Modify for ForeignExamples {
 /// `openapi-python-client` refuses (and with it every schema and operation that uses it). Here
 /// such a field becomes a plain `$ref`, and an object or array `default` beside a `$ref` is
 /// dropped and named in the description instead. The server's own types are written so that
-/// utoipa needs none of this (`model.rs`); `openapi_json_is_current` checks the whole document.
+/// utoipa needs none of this (`crate::model`, `crate::blocks`); `openapi_json_is_current` checks the whole document.
 struct PlainRefs;
 
 /// The component schemas [`PlainRefs`] rewrites.
