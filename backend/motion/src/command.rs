@@ -632,11 +632,17 @@ pub struct PhasingMotion {
     pub jerk: f64,
 }
 
-/// What a command addresses. An axis today; a group of axes (its own blocks, PLCopen Part 4)
-/// is the next variant, so that everything keyed by a command's target stays as it is.
+/// A group of axes (PLCopen Part 4, TwinCAT's TF5420 axis groups), by its number.
+pub type GroupId = u16;
+
+/// What a command addresses: an axis, or a group of axes with its own blocks (PLCopen Part 4).
+/// Everything keyed by a command — its record, control, idempotency, the audit, waiting — is
+/// keyed by this. No group exists yet: the kernel refuses a group's command with
+/// `GROUP_NOT_FOUND` (the groups issue gives groups their slots and blocks).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Target {
     Axis(AxisSlot),
+    Group(GroupId),
 }
 
 /// A command addressed to its target.

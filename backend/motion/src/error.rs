@@ -159,6 +159,9 @@ error_table! {
     EXT_SETPOINT_GEN_NOT_ENABLED = 0x70B8, "ext_setpoint_gen_not_enabled", "the external setpoint generator is not enabled";
     /// A motion command to an axis moved by the external setpoint generator without AxisAllowMotionCmdToExtSetAxis (#1066).
     EXT_SETPOINT_AXIS_COMMAND_NOT_ALLOWED = 0x70B9, "ext_setpoint_axis_command_not_allowed", "motion commands to an axis fed by the external setpoint generator are not allowed (#1066)";
+    /// A command addressed to an axis group that does not exist (TF5420's number for an invalid
+    /// object id of the command's target).
+    GROUP_NOT_FOUND = 0x8130, "group_not_found", "no such axis group";
 }
 
 impl fmt::Display for ErrorId {

@@ -275,7 +275,9 @@ impl Kernel {
     /// verdict is immediate; an accepted command changes the axis state at once and its
     /// outputs follow as events (the first one in this call).
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
-        let Target::Axis(slot) = cmd.target;
+        let Target::Axis(slot) = cmd.target else {
+            return Verdict::Rejected(ErrorId::GROUP_NOT_FOUND);
+        };
         let slot = slot as usize;
         if let CommandKind::GearInMultiMaster(g) = cmd.kind {
             let mut samples = [None; 4];
@@ -481,6 +483,24 @@ mod tests {
             })
             .collect();
         k.step(&fb, sp, events);
+    }
+
+    #[test]
+    fn a_command_for_a_group_is_refused_while_no_group_exists_and_changes_nothing() {
+        let mut k = kernel(1);
+        let mut e = Vec::new();
+        let before = k.status(0).unwrap();
+        let cmd = Command {
+            id: 1,
+            target: Target::Group(0),
+            kind: CommandKind::Reset,
+        };
+        assert_eq!(
+            k.submit(cmd, &mut e),
+            Verdict::Rejected(ErrorId::GROUP_NOT_FOUND)
+        );
+        assert!(e.is_empty(), "{e:?}");
+        assert_eq!(k.status(0).unwrap(), before);
     }
 
     fn accept(

@@ -512,8 +512,12 @@ impl CycleThread {
                         Verdict::Rejected(e) => Err(e),
                     };
                     // Taken also after an acceptance, so that no stale hint stays behind.
-                    let motion::Target::Axis(slot) = cmd.target;
-                    let hint = self.kernel.axis(slot).and_then(|a| a.take_refusal_hint());
+                    let hint = match cmd.target {
+                        motion::Target::Axis(slot) => {
+                            self.kernel.axis(slot).and_then(|a| a.take_refusal_hint())
+                        }
+                        motion::Target::Group(_) => None,
+                    };
                     Reply {
                         hint: hint.filter(|_| result.is_err()),
                         ticket: cmd.id,

@@ -518,8 +518,11 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
         if view.is_final || milestone.reached(&view.outputs) {
             return Some(view);
         }
-        let Target::Axis(slot) = target;
-        let (cycle, st) = s.status(slot);
+        let (cycle, st) = match target {
+            Target::Axis(slot) => s.status(slot),
+            // A group has no axis status: only its command's events end the wait.
+            Target::Group(_) => (0, None),
+        };
         // A reset is what leaves error_stop (its drive may take cycles to clear the fault).
         if cycle > view.accepted_cycle
             && !resets
