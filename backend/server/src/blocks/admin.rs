@@ -1,5 +1,6 @@
-//! MC_Power, MC_Reset, MC_SetPosition, MC_SetOverride, MC_OverrideFilter: the axis's enable, its
-//! error reset, its position and its overrides.
+//! MC_Power, MC_Reset, MC_SetPosition, MC_SetEncoderScalingFactor, MC_SetOverride,
+//! MC_OverrideFilter: the axis's enable, its error reset, its position and its scale, its
+//! overrides.
 
 use motion::{BufferMode, CommandKind};
 use serde::{Deserialize, Serialize};
@@ -19,6 +20,8 @@ macro_rules! entries {
                 "MC_Reset: clear an axis error";
             set_position: "set-position" at axes, SetPositionBody, SetPositionBody::to_kind, Operator, Done, [],
                 "MC_SetPosition";
+            set_encoder_scaling_factor: "set-encoder-scaling-factor" at axes, SetEncoderScalingFactorBody, SetEncoderScalingFactorBody::to_kind, Operator, Done, [],
+                "MC_SetEncoderScalingFactor: the encoder's units per increment; absolute (the position jumps, at standstill only) or relative (no jump, also in motion)";
             set_override: "set-override" at axes, SetOverrideBody, SetOverrideBody::to_kind, Operator, Done, [],
                 "MC_SetOverride: velocity factor at once; acceleration and jerk factors for the motion commands that follow";
             override_filter: "override-filter" at axes, OverrideFilterBody, OverrideFilterBody::to_kind, Operator, Done, [],
@@ -212,6 +215,45 @@ impl OverrideFilterBody {
             upper_threshold: self.upper_threshold,
             steps: self.steps,
             recovery_time: self.recovery_time,
+        })
+    }
+}
+
+/// `E_SetScalingFactorMode` (§6.11.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum EncoderScalingMode {
+    /// The position is the count × the new factor: it jumps (at standstill only; the set
+    /// position goes along, nothing moves).
+    #[default]
+    Absolute,
+    /// The offset takes up the change: no jump, also in motion (as long as the drive's
+    /// velocity steps by no more than the axis's acceleration in one cycle).
+    Relative,
+}
+
+/// MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment (#1040). The axis's
+/// drive is its encoder, so its setpoints are scaled alike and the position loop stays closed.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"scaling_factor": 0.001, "mode": "relative"}))]
+pub struct SetEncoderScalingFactorBody {
+    /// Units per encoder increment (> 0).
+    #[schema(minimum = 1e-12, maximum = 1e12)]
+    pub scaling_factor: f64,
+    #[serde(default)]
+    pub mode: EncoderScalingMode,
+}
+
+impl SetEncoderScalingFactorBody {
+    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
+        let mut c = Check::default();
+        if !(self.scaling_factor.is_finite() && (1e-12..=1e12).contains(&self.scaling_factor)) {
+            c.fail("scaling_factor", "must be a number from 1e-12 to 1e12");
+        }
+        c.done(CommandKind::SetEncoderScalingFactor {
+            factor: self.scaling_factor,
+            relative: self.mode == EncoderScalingMode::Relative,
         })
     }
 }

@@ -1,6 +1,6 @@
 //! The drive-side blocks: the external setpoint generator (MC_ExtSetPointGenEnable/Disable and its
 //! feed, MC_ExtSetPointGenFeed), MC_TorqueControl, MC_WriteDriveOperationMode,
-//! MC_SelectControlLoop, MC_SetEncoderScalingFactor.
+//! MC_SelectControlLoop.
 
 use motion::CommandKind;
 use serde::{Deserialize, Serialize};
@@ -24,8 +24,6 @@ macro_rules! entries {
                 "MC_WriteDriveOperationMode: the drive's position-based mode (configured, position, velocity), at rest; Done once the drive reports it";
             select_control_loop: "select-control-loop" at axes, SelectControlLoopBody, SelectControlLoopBody::to_kind, Operator, Done, [],
                 "MC_SelectControlLoop: an axis has the one control loop of its drive (index 0)";
-            set_encoder_scaling_factor: "set-encoder-scaling-factor" at axes, SetEncoderScalingFactorBody, SetEncoderScalingFactorBody::to_kind, Operator, Done, [],
-                "MC_SetEncoderScalingFactor: the encoder's units per increment; absolute (the position jumps, at standstill only) or relative (no jump, also in motion)";
         }
     };
 }
@@ -161,32 +159,6 @@ pub struct SelectControlLoopBody {
     pub select_type: SelectControlLoopType,
 }
 
-/// `E_SetScalingFactorMode` (§6.11.6).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum EncoderScalingMode {
-    /// The position is the count × the new factor: it jumps (at standstill only; the set
-    /// position goes along, nothing moves).
-    #[default]
-    Absolute,
-    /// The offset takes up the change: no jump, also in motion (as long as the drive's
-    /// velocity steps by no more than the axis's acceleration in one cycle).
-    Relative,
-}
-
-/// MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment (#1040). The axis's
-/// drive is its encoder, so its setpoints are scaled alike and the position loop stays closed.
-#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(example = json!({"scaling_factor": 0.001, "mode": "relative"}))]
-pub struct SetEncoderScalingFactorBody {
-    /// Units per encoder increment (> 0).
-    #[schema(minimum = 1e-12, maximum = 1e12)]
-    pub scaling_factor: f64,
-    #[serde(default)]
-    pub mode: EncoderScalingMode,
-}
-
 impl ExtSetPointGenEnableBody {
     pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
         let mut c = Check::default();
@@ -294,19 +266,6 @@ impl SelectControlLoopBody {
         }
         c.done(CommandKind::SelectControlLoop {
             index: self.encoder_index,
-        })
-    }
-}
-
-impl SetEncoderScalingFactorBody {
-    pub fn to_kind(&self, _: &Registry, _: &AxisEntry) -> AppResult<CommandKind> {
-        let mut c = Check::default();
-        if !(self.scaling_factor.is_finite() && (1e-12..=1e12).contains(&self.scaling_factor)) {
-            c.fail("scaling_factor", "must be a number from 1e-12 to 1e12");
-        }
-        c.done(CommandKind::SetEncoderScalingFactor {
-            factor: self.scaling_factor,
-            relative: self.mode == EncoderScalingMode::Relative,
         })
     }
 }
