@@ -59,4 +59,5 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28855, "ext_setpoint_stalled", "the external setpoint stream stalled"],
   [28856, "ext_setpoint_gen_not_enabled", "the external setpoint generator is not enabled"],
   [28857, "ext_setpoint_axis_command_not_allowed", "motion commands to an axis fed by the external setpoint generator are not allowed (#1066)"],
+  [33072, "group_not_found", "no such axis group"],
 ];
