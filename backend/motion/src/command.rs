@@ -715,19 +715,9 @@ pub struct CommandEvent {
 /// A block's result (Copy, no allocation: it travels on the event ring).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BlockResult {
-    /// MC_TouchProbe: `MC_TouchProbeRecordedData` of its probe cycle.
-    Probe(ProbeRecord),
-}
-
-/// The position a probe cycle recorded (`MC_TouchProbeRecordedData`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProbeRecord {
-    /// Absolute or modulo, as the probe cycle asked.
-    pub recorded_position: f64,
-    pub absolute_position: f64,
-    pub modulo_position: f64,
-    /// Edges recorded on the axis so far (this one included).
-    pub counter: u32,
+    /// MC_TouchProbe: `MC_TouchProbeRecordedData` of its probe cycle, as the axis's status
+    /// records it in the same cycle.
+    Probe(crate::status::ProbeStatus),
 }
 
 /// Where the kernel puts events; implemented by a Vec in tests and by a lock-free ring in

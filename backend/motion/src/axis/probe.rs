@@ -118,13 +118,7 @@ impl Axis {
             s.absolute_position = absolute;
             s.modulo_position = modulo;
             self.status.external_latch_valid = true;
-            let record = ProbeRecord {
-                recorded_position: s.recorded_position,
-                absolute_position: s.absolute_position,
-                modulo_position: s.modulo_position,
-                counter: s.counter,
-            };
-            p.held.done_with(cx, BlockResult::Probe(record));
+            p.held.done_with(cx, BlockResult::Probe(*s));
             return false;
         }
         p.sent = true;

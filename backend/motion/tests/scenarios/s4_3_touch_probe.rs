@@ -70,7 +70,9 @@ fn s4_3_the_done_event_carries_the_recorded_data() {
     assert!(with[0].outputs.done && !with[0].outputs.busy);
     assert_eq!(
         with[0].result,
-        Some(motion::BlockResult::Probe(motion::ProbeRecord {
+        Some(motion::BlockResult::Probe(motion::ProbeStatus {
+            armed: false,
+            command: p,
             recorded_position: 42.123,
             absolute_position: 42.123,
             modulo_position: 42.123,
