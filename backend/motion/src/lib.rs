@@ -70,6 +70,7 @@ pub mod functions;
 pub mod kernel;
 pub mod modulo;
 pub mod params;
+pub mod path;
 pub mod planner;
 pub mod status;
 
