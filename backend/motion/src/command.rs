@@ -439,6 +439,41 @@ pub enum CommandKind {
         master: AxisSlot,
         motion: PhasingMotion,
     },
+    /// MC_AddAxisToGroup (TF5420 §4.1): `axis` takes `role` in the target group.
+    AddAxisToGroup {
+        axis: AxisSlot,
+        role: crate::group::GroupRole,
+    },
+    /// MC_RemoveAxisFromGroup: the axis in `role` leaves (Done also when there is none).
+    RemoveAxisFromGroup {
+        role: crate::group::GroupRole,
+    },
+    /// MC_UngroupAllAxes.
+    UngroupAllAxes,
+    /// MC_GroupEnable.
+    GroupEnable,
+    /// MC_GroupDisable.
+    GroupDisable,
+    /// MC_GroupReset.
+    GroupReset,
+    /// MC_GroupSetOverride: `factor` is clamped to 0…1 (§4.1: clamped, never refused).
+    GroupSetOverride {
+        factor: f64,
+    },
+    /// MC_GroupHalt: stop on the path without a lock; flushes the queue.
+    GroupHalt {
+        deceleration: crate::group::PathValue,
+        jerk: crate::group::PathValue,
+    },
+    /// MC_GroupStop: stop on the path and lock the group until `Release`.
+    GroupStop {
+        deceleration: crate::group::PathValue,
+        jerk: crate::group::PathValue,
+    },
+    /// MC_ReleaseBlocker.
+    ReleaseBlocker {
+        blocker_id: u32,
+    },
     /// The falling edge of Execute/Enable of an earlier command (unlock a Stop, end a jog,
     /// switch off a Power).
     Release {
@@ -506,6 +541,16 @@ impl CommandKind {
                 PhasingKind::Relative => "phasing-relative",
                 PhasingKind::Halt => "halt-phasing",
             },
+            CommandKind::AddAxisToGroup { .. } => "add-axis",
+            CommandKind::RemoveAxisFromGroup { .. } => "remove-axis",
+            CommandKind::UngroupAllAxes => "ungroup-all",
+            CommandKind::GroupEnable => "enable",
+            CommandKind::GroupDisable => "disable",
+            CommandKind::GroupReset => "reset",
+            CommandKind::GroupSetOverride { .. } => "set-override",
+            CommandKind::GroupHalt { .. } => "halt",
+            CommandKind::GroupStop { .. } => "stop",
+            CommandKind::ReleaseBlocker { .. } => "release-blocker",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
         }
@@ -705,7 +750,8 @@ impl FbOutputs {
 pub struct CommandEvent {
     pub cycle: u64,
     pub command: CommandId,
-    pub axis: AxisSlot,
+    /// The axis or group whose command it is.
+    pub target: Target,
     pub outputs: FbOutputs,
     /// What the block ended Done with besides its outputs, on the event that ends it (so that
     /// whoever tracks the command needs nothing else to complete it).

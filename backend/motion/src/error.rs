@@ -162,6 +162,34 @@ error_table! {
     /// A command addressed to an axis group that does not exist (TF5420's number for an invalid
     /// object id of the command's target).
     GROUP_NOT_FOUND = 0x8130, "group_not_found", "no such axis group";
+    /// A group configuration is not usable: a role the convention does not have, an axis already in a group or a role already taken, fewer axes than the convention and Additional Axes Count need at MC_GroupEnable (TF5420 note 4).
+    GROUP_CONFIG_INVALID = 0x8120, "group_config_invalid", "the group's axes do not fit its configuration";
+    /// A path entry's TransitionMode is not supported or not allowed with its BufferMode (TF5420 §7.3), or its TransitionParameterCount is wrong.
+    TRANSITION_MODE_INVALID = 0x813B, "transition_mode_invalid", "transition mode not allowed here";
+    /// A path entry's BufferMode is not allowed (mcAborting after the first entry; Blocker and Dwell take only Buffered or Aborting; §7.3).
+    BUFFER_MODE_INVALID = 0x813C, "buffer_mode_invalid", "buffer mode not allowed here";
+    /// The command is not allowed in the group's current state (TF5420 §1.4), e.g. MC_AddAxisToGroup on an enabled group or MC_MovePath while it stops.
+    GROUP_STATE_INVALID = 0x813E, "group_state_invalid", "command not allowed in the current group state";
+    /// A path or halt/stop dynamics value is out of range: velocity ≤ 0, acceleration or deceleration < 1, jerk < 100, or not finite (TF5420 §2.4).
+    PATH_DYNAMICS_INVALID = 0x8140, "path_dynamics_invalid", "invalid value for one or more path dynamics parameters";
+    /// A path entry's position vector does not have one value per group axis (convention axes, then ADDAX1..n).
+    POSITION_COUNT_INVALID = 0x8141, "position_count_invalid", "the position vector does not match the group's axes";
+    /// A path has more entries than a MovePath takes, or the group's queue cannot hold it behind what is queued.
+    PATH_TOO_LONG = 0x8142, "path_too_long", "the path has too many entries";
+    /// A blocker id of 0 (blocker ids are > 0).
+    BLOCKER_ID_INVALID = 0x8143, "blocker_id_invalid", "blocker id must be greater than 0";
+    /// A dwell time below 0 or not finite.
+    DWELL_TIME_INVALID = 0x8144, "dwell_time_invalid", "dwell time must be 0 or more";
+    /// A single-axis motion command to an axis of an enabled group (TF5420 §1.5: only while the group is disabled).
+    AXIS_IN_GROUP = 0x8145, "axis_in_group", "the axis belongs to an enabled group: command the group";
+    /// Group error: a member axis is in ErrorStop (note 7).
+    GROUP_AXIS_ERROR = 0x8146, "group_axis_error", "an axis of the group is in error";
+    /// Group error: a member axis stopped following the path while the group moved it (MC_Stop on the axis, power off, its drive not ready).
+    GROUP_AXIS_LEFT = 0x8147, "group_axis_left", "an axis of the group stopped following the path";
+    /// A circle is not defined by its entry: border points collinear or a full circle; centre not equidistant, a half or a full circle; radius below half the chord or an end point out of the circle's plane; an arc out of the XY plane of a 2D group (TF5420 §8.2).
+    CIRCLE_INVALID = 0x8148, "circle_invalid", "the circular entry does not define an arc";
+    /// A path entry (or a point of its arc) lies beyond an enabled software limit of a member axis.
+    PATH_BEYOND_SOFT_LIMIT = 0x8149, "path_beyond_soft_limit", "the path leaves an axis's software limits";
 }
 
 impl fmt::Display for ErrorId {

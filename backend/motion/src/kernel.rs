@@ -9,6 +9,7 @@ use crate::cam::{Cam, CamStore};
 use crate::command::{AxisSlot, Command, CommandKind, EventSink, Target, Verdict};
 use crate::drive::{DriveFeedback, DriveSetpoint};
 use crate::error::ErrorId;
+use crate::group::{Group, GroupStatus, MAX_GROUPS, PathTable};
 use crate::params::AxisParameters;
 use crate::status::AxisStatus;
 
@@ -20,6 +21,9 @@ pub struct Kernel {
     axes: Vec<Option<Box<Axis>>>,
     order: StepOrder,
     cams: CamStore,
+    /// Coordinated-motion groups, stepped before the axes (they give their members' set
+    /// points).
+    groups: Vec<Option<Box<Group>>>,
 }
 
 /// The order the axes are stepped in: every master before its slaves, so that a slave follows
@@ -107,6 +111,7 @@ impl Kernel {
             axes: (0..max_axes).map(|_| None).collect(),
             order: StepOrder::new(max_axes),
             cams: CamStore::default(),
+            groups: (0..MAX_GROUPS).map(|_| None).collect(),
         }
     }
 
@@ -131,9 +136,19 @@ impl Kernel {
         slot: AxisSlot,
         mut axis: Box<Axis>,
     ) -> Result<Option<Box<Axis>>, Box<Axis>> {
+        // An axis put where a group member was takes its place in the group (disabled: the
+        // group is not enabled with a member that changes, see `insert_group`).
+        let member_of = self.groups.iter().flatten().find_map(|g| {
+            g.members()
+                .contains(&Some(slot))
+                .then(|| (g.status().enable_requested, g.id()))
+        });
         match self.axes.get_mut(slot as usize) {
             Some(s) => {
                 axis.place(slot);
+                if let Some((engaged, g)) = member_of {
+                    axis.set_group_link(Some(g), engaged);
+                }
                 self.order.stale = true;
                 Ok(s.replace(axis))
             }
@@ -271,12 +286,104 @@ impl Kernel {
         self.axis(slot).map(|a| a.parameters())
     }
 
-    /// Offers a command to its axis in the current cycle (before [`Kernel::step`]). The
-    /// verdict is immediate; an accepted command changes the axis state at once and its
+    /// Puts a ready-built group into a slot (0..MAX_GROUPS) and returns the one it replaces
+    /// (to be freed off the cycle thread). Refused — the group comes back — while the group
+    /// there is enabled: a configuration changes only on a disabled group. The new group
+    /// keeps the old one's members whose roles it still has.
+    pub fn insert_group(
+        &mut self,
+        id: crate::command::GroupId,
+        mut group: Box<Group>,
+    ) -> Result<Option<Box<Group>>, Box<Group>> {
+        let Some(slot) = self.groups.get_mut(id as usize) else {
+            return Err(group);
+        };
+        if slot
+            .as_ref()
+            .is_some_and(|g| g.status().enable_requested || g.in_error())
+        {
+            return Err(group);
+        }
+        group.place(id);
+        if let Some(old) = slot.as_deref() {
+            group.adopt_members(old, &mut self.axes);
+        }
+        Ok(slot.replace(group))
+    }
+
+    /// Takes a group out (to be freed off the cycle thread): its members leave it; a moving
+    /// group's members brake on their own ramps.
+    pub fn remove_group(
+        &mut self,
+        id: crate::command::GroupId,
+        events: &mut impl EventSink,
+    ) -> Option<Box<Group>> {
+        let mut g = self.groups.get_mut(id as usize).and_then(|g| g.take())?;
+        let cycle = self.cycle + 1;
+        let _ = g.submit(
+            0,
+            CommandKind::UngroupAllAxes,
+            &mut self.axes,
+            cycle,
+            events,
+        );
+        Some(g)
+    }
+
+    pub fn group(&self, id: crate::command::GroupId) -> Option<&Group> {
+        self.groups.get(id as usize).and_then(|g| g.as_deref())
+    }
+
+    pub fn group_status(&self, id: crate::command::GroupId) -> Option<GroupStatus> {
+        self.group(id).map(|g| *g.status())
+    }
+
+    /// MC_MovePath: the table (built and allocated off the cycle thread; the caller frees it
+    /// there) joins the group's queue, or is refused and changes nothing.
+    pub fn submit_path(
+        &mut self,
+        id: crate::command::CommandId,
+        group: crate::command::GroupId,
+        table: &PathTable,
+        events: &mut impl EventSink,
+    ) -> Verdict {
+        let cycle = self.cycle + 1;
+        match self
+            .groups
+            .get_mut(group as usize)
+            .and_then(|g| g.as_deref_mut())
+        {
+            Some(g) => match g.submit_path(id, table, &mut self.axes, cycle, events) {
+                Ok(()) => Verdict::Accepted,
+                Err(e) => Verdict::Rejected(e),
+            },
+            None => Verdict::Rejected(ErrorId::GROUP_NOT_FOUND),
+        }
+    }
+
+    /// Offers a command to its axis or group in the current cycle (before [`Kernel::step`]).
+    /// The verdict is immediate; an accepted command changes the state at once and its
     /// outputs follow as events (the first one in this call).
     pub fn submit(&mut self, cmd: Command, events: &mut impl EventSink) -> Verdict {
-        let Target::Axis(slot) = cmd.target else {
-            return Verdict::Rejected(ErrorId::GROUP_NOT_FOUND);
+        let slot = match cmd.target {
+            Target::Axis(slot) => slot,
+            Target::Group(g) => {
+                let cycle = self.cycle + 1;
+                if let CommandKind::AddAxisToGroup { axis, .. } = cmd.kind {
+                    // An axis in another group is refused by that group's link.
+                    if self.axis(axis).is_none() {
+                        return Verdict::Rejected(ErrorId::AXIS_UNKNOWN);
+                    }
+                }
+                return match self
+                    .groups
+                    .get_mut(g as usize)
+                    .and_then(|g| g.as_deref_mut())
+                {
+                    Some(group) => group.submit(cmd.id, cmd.kind, &mut self.axes, cycle, events),
+                    None => Verdict::Rejected(ErrorId::GROUP_NOT_FOUND),
+                };
+            }
         };
         let slot = slot as usize;
         if let CommandKind::GearInMultiMaster(g) = cmd.kind {
@@ -382,6 +489,9 @@ impl Kernel {
         let dt = self.cycle_time;
         if self.order.stale {
             self.order.compute(&self.axes);
+        }
+        for g in self.groups.iter_mut().flatten() {
+            g.step(&mut self.axes, cycle, events);
         }
         for k in 0..self.order.len {
             let i = self.order.slots[k] as usize;

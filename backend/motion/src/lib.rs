@@ -67,6 +67,7 @@ pub mod compensation;
 pub mod drive;
 pub mod error;
 pub mod functions;
+pub mod group;
 pub mod kernel;
 pub mod modulo;
 pub mod params;

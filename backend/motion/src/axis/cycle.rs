@@ -61,6 +61,7 @@ impl Axis {
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
         self.step_override_filter(dt);
+        self.step_group_reset(cx);
         self.step_drive_mode(cx, dt);
         // Power and drive readiness (notes 1, 2, 5).
         self.step_power(cx, dt, fb);
@@ -193,6 +194,11 @@ impl Axis {
         if job.kind == JobKind::External {
             self.job = Some(job);
             self.step_external(cx, dt);
+            return;
+        }
+        if job.kind == JobKind::Group {
+            self.job = Some(job);
+            self.step_group(cx, dt);
             return;
         }
 
@@ -394,7 +400,11 @@ impl Axis {
                     }
                 }
             }
-            JobKind::Home | JobKind::Gear | JobKind::Torque | JobKind::External => unreachable!(),
+            JobKind::Home
+            | JobKind::Gear
+            | JobKind::Torque
+            | JobKind::External
+            | JobKind::Group => unreachable!(),
         }
     }
 

@@ -35,7 +35,7 @@ impl<E: EventSink> Ctx<'_, E> {
         self.events.push(CommandEvent {
             cycle: self.cycle,
             command,
-            axis: self.slot,
+            target: crate::command::Target::Axis(self.slot),
             outputs,
             result,
         });
@@ -64,6 +64,8 @@ pub(super) enum JobKind {
     Torque,
     /// The external setpoint generator moves the axis (§4.4).
     External,
+    /// A coordinated-motion group moves the axis along its path (`group.rs`).
+    Group,
 }
 
 /// Where a job is in its life.

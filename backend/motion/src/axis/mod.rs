@@ -56,6 +56,7 @@ mod coupling;
 mod cycle;
 mod encoder;
 mod external;
+mod group;
 mod homing;
 mod job;
 mod master;
@@ -194,6 +195,8 @@ pub struct Axis {
     torque: torque::TorqueState,
     /// The external setpoint generator (§4.4).
     ext: external::ExtGen,
+    /// Membership of a coordinated-motion group (`group.rs`).
+    group: group::GroupLink,
     /// What the kernel saw of this axis's masters (`offer_masters`).
     offered: [Option<MasterSample>; 4],
 }
@@ -273,6 +276,7 @@ impl Axis {
             encoder: encoder::EncoderScaling::new(enc_base),
             torque: torque::TorqueState::default(),
             ext: external::ExtGen::default(),
+            group: group::GroupLink::default(),
             offered: [None; 4],
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
@@ -339,7 +343,7 @@ impl Axis {
                     | JobKind::Torque
                     | JobKind::External => AxisState::ContinuousMotion,
                     JobKind::Home => AxisState::Homing,
-                    JobKind::Gear => AxisState::SynchronizedMotion,
+                    JobKind::Gear | JobKind::Group => AxisState::SynchronizedMotion,
                 },
             },
         }

@@ -139,6 +139,13 @@ impl Axis {
         if let Some(mut sp) = self.superposition.running.take() {
             sp.cmd.end(cx, End::Error(e));
         }
+        // A member of a moving group keeps the group's job: the group sees the error in its
+        // next step and stops every member on the path (this one too, while its drive follows).
+        let group_job = if self.group_axis_following() {
+            self.job.take()
+        } else {
+            None
+        };
         for j in [self.next.take(), self.job.take()].into_iter().flatten() {
             let mut j = j;
             j.finish_error(cx, e);
@@ -148,6 +155,10 @@ impl Axis {
         }
         self.coupling = None;
         self.mode = Mode::ErrorStop;
+        if group_job.is_some() {
+            self.job = group_job;
+            return;
+        }
         let p = self.p();
         let (dec, jerk) = (
             p.axis_fast_dec.max(p.axis_dec),
@@ -302,7 +313,7 @@ impl Axis {
             // Checked against the samples themselves (`step_external`).
             return;
         }
-        if job.kind == JobKind::Gear {
+        if job.kind == JobKind::Gear || job.kind == JobKind::Group {
             // A slave follows its master and cannot brake for a limit of its own while
             // coupled. Crossing one (moving outwards beyond it) decouples it and stops it on
             // the fast-stop ramp in ErrorStop (TwinCAT raises an axis error for a slave

@@ -9,6 +9,7 @@ impl Axis {
     /// Checks shared by every motion command: state, lock, slave rule. Returns whether the
     /// axis is a slave that the command will decouple.
     pub(super) fn admit_motion(&self, buffer_mode: BufferMode) -> Result<(), ErrorId> {
+        self.admit_to_group()?;
         match self.state() {
             AxisState::Standstill | AxisState::DiscreteMotion | AxisState::ContinuousMotion => {
                 Ok(())

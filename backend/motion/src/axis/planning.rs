@@ -92,7 +92,7 @@ impl Axis {
                     },
                 )
             }
-            JobKind::Gear | JobKind::Torque | JobKind::External => return true,
+            JobKind::Gear | JobKind::Torque | JobKind::External | JobKind::Group => return true,
         };
         match res {
             Ok(_) => {

@@ -273,6 +273,12 @@ pub struct Rig {
     pub course_cycles: u64,
     /// Cycles checked against enabled software limits (all axes).
     pub soft_limit_cycles: u64,
+    /// Groups checked every cycle (see `check_groups`) and their last status.
+    pub groups: Vec<(GroupId, motion::group::GroupStatus)>,
+    /// Per MovePath: the highest path velocity its entries command.
+    pub path_velocity: HashMap<CommandId, f64>,
+    /// Cycles checked against a group's path invariants.
+    pub group_cycles: u64,
 }
 
 pub fn params() -> AxisParameters {
@@ -347,6 +353,9 @@ impl Rig {
             course: vec![None; n],
             course_cycles: 0,
             soft_limit_cycles: 0,
+            groups: Vec::new(),
+            path_velocity: HashMap::new(),
+            group_cycles: 0,
         }
     }
 
@@ -464,6 +473,7 @@ impl Rig {
         }
         self.check_events(n);
         self.check_axes();
+        self.check_groups();
     }
 
     pub fn run(&mut self, seconds: f64) {
@@ -793,6 +803,153 @@ impl Rig {
             if o.is_final() {
                 self.finals.insert(e.command);
             }
+        }
+    }
+
+    /// A group with `config` in slot `id`, with `members` (role, axis) added.
+    pub fn group(
+        &mut self,
+        id: GroupId,
+        config: motion::group::GroupConfig,
+        members: &[(motion::group::GroupRole, u16)],
+    ) {
+        assert!(
+            self.k
+                .insert_group(id, motion::group::Group::new(config, DT))
+                .is_ok()
+        );
+        for &(role, axis) in members {
+            self.gok(id, CommandKind::AddAxisToGroup { axis, role });
+        }
+        let st = self.gst(id);
+        self.groups.push((id, st));
+    }
+
+    pub fn gst(&self, id: GroupId) -> motion::group::GroupStatus {
+        self.k.group_status(id).expect("a group")
+    }
+
+    /// Submits a command to a group; a refusal must change nothing and report nothing.
+    pub fn gcmd(&mut self, id: GroupId, kind: CommandKind) -> (CommandId, Verdict) {
+        let cid = self.next_id;
+        self.next_id += 1;
+        let n = self.events.len();
+        let before = self.k.group_status(id);
+        let axes: Vec<_> = (0..self.prev.len())
+            .map(|i| self.k.status(i as u16))
+            .collect();
+        let v = self.k.submit(
+            Command {
+                id: cid,
+                target: Target::Group(id),
+                kind,
+            },
+            &mut self.events,
+        );
+        if let Verdict::Rejected(_) = v {
+            assert_eq!(self.events.len(), n, "a rejected command emitted events");
+            assert_eq!(
+                self.k.group_status(id),
+                before,
+                "a rejected command changed the group"
+            );
+            let after: Vec<_> = (0..self.prev.len())
+                .map(|i| self.k.status(i as u16))
+                .collect();
+            assert_eq!(axes, after, "a rejected group command changed an axis");
+        }
+        self.check_events_at(n, self.k.cycle() + 1);
+        if v == Verdict::Accepted {
+            self.kinds.insert(cid, kind);
+        }
+        (cid, v)
+    }
+
+    pub fn gok(&mut self, id: GroupId, kind: CommandKind) -> CommandId {
+        let (cid, v) = self.gcmd(id, kind);
+        assert_eq!(v, Verdict::Accepted, "{kind:?} rejected");
+        cid
+    }
+
+    pub fn grejected(&mut self, id: GroupId, kind: CommandKind) -> ErrorId {
+        match self.gcmd(id, kind).1 {
+            Verdict::Rejected(e) => e,
+            Verdict::Accepted => panic!("{kind:?} accepted"),
+        }
+    }
+
+    /// MC_MovePath with `entries`; a refusal must change nothing.
+    pub fn path(
+        &mut self,
+        id: GroupId,
+        entries: Vec<motion::group::PathEntry>,
+    ) -> (CommandId, Verdict) {
+        let cid = self.next_id;
+        self.next_id += 1;
+        let n = self.events.len();
+        let before = self.k.group_status(id);
+        let vmax = entries
+            .iter()
+            .filter_map(|e| match e {
+                motion::group::PathEntry::Linear { motion, .. }
+                | motion::group::PathEntry::Circular { motion, .. } => match motion.velocity {
+                    motion::group::PathValue::Value(v) => Some(v),
+                    _ => Some(f64::INFINITY),
+                },
+                _ => None,
+            })
+            .fold(0.0, f64::max);
+        let table = motion::group::PathTable { entries };
+        let v = self.k.submit_path(cid, id, &table, &mut self.events);
+        if let Verdict::Rejected(_) = v {
+            assert_eq!(self.events.len(), n, "a rejected MovePath emitted events");
+            assert_eq!(
+                self.k.group_status(id),
+                before,
+                "a rejected MovePath changed the group"
+            );
+        } else {
+            self.path_velocity.insert(cid, vmax);
+        }
+        self.check_events_at(n, self.k.cycle() + 1);
+        (cid, v)
+    }
+
+    pub fn path_ok(&mut self, id: GroupId, entries: Vec<motion::group::PathEntry>) -> CommandId {
+        let (cid, v) = self.path(id, entries);
+        assert_eq!(v, Verdict::Accepted, "MovePath rejected");
+        cid
+    }
+
+    /// Every cycle, every group: the path velocity is ≥ 0 and within what the running
+    /// MovePath commands; the path never runs backwards while anything is queued.
+    fn check_groups(&mut self) {
+        for k in 0..self.groups.len() {
+            let (id, prev) = self.groups[k];
+            let s = self.gst(id);
+            self.group_cycles += 1;
+            assert!(
+                s.path_velocity >= -1e-9,
+                "group {id}: path runs backwards: {s:?}"
+            );
+            if s.command != 0 {
+                if let Some(v) = self.path_velocity.get(&s.command) {
+                    assert!(
+                        s.path_velocity <= v * (1.0 + 1e-9) + 1e-9,
+                        "group {id}: path velocity {} above the commanded {v}",
+                        s.path_velocity
+                    );
+                }
+            }
+            if prev.queued_entries > 0 && s.queued_entries > 0 {
+                assert!(
+                    s.path_position >= prev.path_position - 1e-9,
+                    "group {id}: s went back {} -> {}",
+                    prev.path_position,
+                    s.path_position
+                );
+            }
+            self.groups[k].1 = s;
         }
     }
 

@@ -9,6 +9,7 @@
 mod rig;
 
 mod cam_couplings;
+mod groups_tf5420;
 mod rig_checks;
 mod s2_state_diagram;
 mod s3_10_slave_axes;

@@ -1,0 +1,1351 @@
+//! Coordinated-motion groups (TwinCAT TF5420 "CM group", spec `groups-tf5420.md`): several
+//! axes moved together along a path of lines, arcs and corner blends.
+//!
+//! A group is a kernel object stepped in the same cycle as its axes, before them. It keeps
+//! the group state machine (§1), the MovePath commands in flight and the path in motion
+//! (`motion.rs`); each cycle it gives every member axis its set point, which the axis takes
+//! as its setpoint source (as a cam slave takes its cam), so that every per-axis monitor
+//! stays where it is. What the manual leaves open is decided in docs/decisions.md (123–).
+//!
+//! States (§1.1): Disabled, NotReady, Standby, Moving, Stopping, ErrorStop — the last with
+//! the enable request telling GroupErrorEnabled from GroupErrorDisabled (§10 item 2).
+
+pub mod config;
+pub mod entry;
+mod motion;
+
+pub use config::*;
+pub use entry::*;
+
+use serde::{Deserialize, Serialize};
+
+use crate::axis::Axis;
+use crate::command::{AxisSlot, BufferMode, CommandEvent, CommandId, CommandKind, EventSink};
+use crate::command::{FbOutputs, Target, Verdict};
+use crate::error::ErrorId;
+use crate::path::{self, MAX_PATH_DIMS, PathPoint, Segment};
+use crate::planner::{Kinematics, Limits};
+use motion::{Exec, Item, ItemKind, PathRun, StepReport};
+
+/// `MC_GROUP_STATE` as motiond reports it.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GroupState {
+    #[default]
+    Disabled,
+    NotReady,
+    Standby,
+    Moving,
+    Stopping,
+    ErrorStop,
+}
+
+/// What a group reports every cycle (`NcToPlc` of the group, MC_GroupReadStatus,
+/// MC_GroupReadBlockerStatus, MC_GroupReadError).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GroupStatus {
+    pub state: GroupState,
+    /// `Flags.IsEnableRequested`.
+    pub enable_requested: bool,
+    /// `GroupErrorId` (0: none).
+    pub error_id: u32,
+    /// The member axis of each role ([X, Y, Z, C, ADDAX1..8]).
+    pub members: [Option<AxisSlot>; MAX_PATH_DIMS],
+    /// `GroupAxesCount`.
+    pub axes_count: u8,
+    /// `AllAxesStanding`: every member at v = 0 and a = 0.
+    pub all_axes_standing: bool,
+    /// Override asked for and in effect (`ActOverrideFactor`), 0…1.
+    pub override_factor: f64,
+    pub actual_override: f64,
+    /// `PathVelo` and the path acceleration (after override).
+    pub path_velocity: f64,
+    pub path_acceleration: f64,
+    /// Path length travelled since the group last stood idle.
+    pub path_position: f64,
+    /// The MovePath running and its entry (index in its table) and `InvokeId`.
+    pub command: CommandId,
+    pub entry_index: u32,
+    pub invoke_id: u32,
+    /// `IsInBlendingSegment`.
+    pub in_blending_segment: bool,
+    /// `RemainingCartesianDistanceActiveJob`, `RemainingTimeActiveJob`.
+    pub remaining_distance: f64,
+    pub remaining_time: f64,
+    /// MC_GroupReadBlockerStatus: `Blocked`, `BlockerId`.
+    pub blocked: bool,
+    pub blocker_id: u32,
+    /// Entries queued (running included).
+    pub queued_entries: u32,
+    /// The group's set point of every role (members' set positions).
+    pub position: PathPoint,
+}
+
+/// A MovePath in flight.
+#[derive(Clone, Copy, Debug)]
+struct PathCommand {
+    id: CommandId,
+    out: FbOutputs,
+}
+
+/// A halt or stop in progress.
+#[derive(Clone, Copy, Debug)]
+struct StopCommand {
+    id: CommandId,
+    out: FbOutputs,
+    /// MC_GroupStop (locks until released) rather than MC_GroupHalt.
+    locks: bool,
+    /// At standstill (the stop's Done has been reported).
+    standing: bool,
+    /// Execute went FALSE (`Release`).
+    released: bool,
+}
+
+/// MovePaths a group keeps in flight at most.
+const MAX_PATH_COMMANDS: usize = 64;
+
+/// One CM group.
+#[derive(Debug)]
+pub struct Group {
+    config: GroupConfig,
+    id: crate::command::GroupId,
+    cycle_time: f64,
+    members: [Option<AxisSlot>; MAX_PATH_DIMS],
+    enable_requested: bool,
+    state: GroupState,
+    error: ErrorId,
+    run: PathRun,
+    paths: [Option<PathCommand>; MAX_PATH_COMMANDS],
+    stop: Option<StopCommand>,
+    /// A MC_GroupReset asked while the error stop still moves: done at standstill.
+    pending_reset: Option<CommandId>,
+    /// Scratch for a MovePath's items before they are committed (capacity reserved).
+    scratch: Vec<Item>,
+    status: GroupStatus,
+}
+
+/// Per-member dynamics the path respects.
+#[derive(Clone, Copy, Debug)]
+struct AxisLimits {
+    velocity: f64,
+    acceleration: f64,
+    jerk: f64,
+    soft_min: Option<f64>,
+    soft_max: Option<f64>,
+}
+
+impl Group {
+    /// Built off the cycle thread (the queue's capacity is reserved here).
+    pub fn new(config: GroupConfig, cycle_time: f64) -> Box<Group> {
+        Box::new(Group {
+            config,
+            id: 0,
+            cycle_time,
+            members: [None; MAX_PATH_DIMS],
+            enable_requested: false,
+            state: GroupState::Disabled,
+            error: ErrorId(0),
+            run: PathRun::new(cycle_time, 2 * QUEUE_ENTRIES),
+            paths: [None; MAX_PATH_COMMANDS],
+            stop: None,
+            pending_reset: None,
+            scratch: Vec::with_capacity(2 * MAX_PATH_ENTRIES + 2),
+            status: GroupStatus {
+                override_factor: 1.0,
+                actual_override: 1.0,
+                ..GroupStatus::default()
+            },
+        })
+    }
+
+    pub fn config(&self) -> &GroupConfig {
+        &self.config
+    }
+
+    pub fn status(&self) -> &GroupStatus {
+        &self.status
+    }
+
+    pub fn state(&self) -> GroupState {
+        self.state
+    }
+
+    /// The member axes (by role dimension).
+    pub fn members(&self) -> &[Option<AxisSlot>; MAX_PATH_DIMS] {
+        &self.members
+    }
+
+    pub fn id(&self) -> crate::command::GroupId {
+        self.id
+    }
+
+    pub(crate) fn place(&mut self, id: crate::command::GroupId) {
+        self.id = id;
+    }
+
+    /// Takes over the members of the group this one replaces (a configuration change of a
+    /// disabled group keeps its axes where the new convention still has their roles).
+    pub(crate) fn adopt_members(&mut self, old: &Group, axes: &mut [Option<Box<Axis>>]) {
+        for role in GroupRole::ALL {
+            let d = role.dim();
+            if let Some(slot) = old.members[d] {
+                if self.config.has_role(role) {
+                    self.members[d] = Some(slot);
+                } else if let Some(a) = axes.get_mut(slot as usize).and_then(|a| a.as_deref_mut()) {
+                    a.set_group_link(None, false);
+                }
+            }
+        }
+    }
+
+    fn event(
+        &self,
+        events: &mut impl EventSink,
+        cycle: u64,
+        command: CommandId,
+        outputs: FbOutputs,
+    ) {
+        if command == 0 {
+            return;
+        }
+        events.push(CommandEvent {
+            cycle,
+            command,
+            target: Target::Group(self.id),
+            outputs,
+            result: None,
+        });
+    }
+
+    /// An Execute-type administrative block that is done in the cycle it is accepted.
+    fn done_at_once(&self, events: &mut impl EventSink, cycle: u64, id: CommandId) {
+        self.event(events, cycle, id, busy());
+        self.event(
+            events,
+            cycle,
+            id,
+            FbOutputs {
+                done: true,
+                ..FbOutputs::default()
+            },
+        );
+    }
+
+    /// The group's error reaction is running or over; new motion is refused until reset.
+    pub fn in_error(&self) -> bool {
+        self.state == GroupState::ErrorStop
+    }
+
+    /// Offers a command (not MovePath: [`Group::submit_path`]).
+    pub(crate) fn submit(
+        &mut self,
+        id: CommandId,
+        kind: CommandKind,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Verdict {
+        match self.try_submit(id, kind, axes, cycle, events) {
+            Ok(()) => {
+                self.update_status(axes);
+                Verdict::Accepted
+            }
+            Err(e) => Verdict::Rejected(e),
+        }
+    }
+
+    fn try_submit(
+        &mut self,
+        id: CommandId,
+        kind: CommandKind,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<(), ErrorId> {
+        let disabled_flavour = matches!(self.state, GroupState::Disabled)
+            || (self.state == GroupState::ErrorStop && !self.enable_requested);
+        match kind {
+            CommandKind::AddAxisToGroup { axis, role } => {
+                if !disabled_flavour {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                if !self.config.has_role(role) {
+                    return Err(ErrorId::GROUP_CONFIG_INVALID);
+                }
+                let d = role.dim();
+                let Some(a) = axes.get(axis as usize).and_then(|a| a.as_deref()) else {
+                    return Err(ErrorId::AXIS_UNKNOWN);
+                };
+                match a.group_link().0 {
+                    Some(g) if g == self.id && self.members[d] == Some(axis) => {}
+                    Some(_) => return Err(ErrorId::GROUP_CONFIG_INVALID),
+                    None => {}
+                }
+                if self.members[d].is_some_and(|s| s != axis) {
+                    return Err(ErrorId::GROUP_CONFIG_INVALID);
+                }
+                self.members[d] = Some(axis);
+                if let Some(a) = axes.get_mut(axis as usize).and_then(|a| a.as_deref_mut()) {
+                    a.set_group_link(Some(self.id), false);
+                }
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::RemoveAxisFromGroup { role } => {
+                if self.enable_requested {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                self.release_member(role.dim(), axes);
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::UngroupAllAxes => {
+                self.disable(axes, cycle, events);
+                for d in 0..MAX_PATH_DIMS {
+                    self.release_member(d, axes);
+                }
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::GroupEnable => {
+                if self.state == GroupState::ErrorStop {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                if self.state == GroupState::Disabled {
+                    let complete = self.config.roles().all(|r| self.members[r.dim()].is_some());
+                    if !complete {
+                        return Err(ErrorId::GROUP_CONFIG_INVALID);
+                    }
+                    self.enable_requested = true;
+                    self.state = GroupState::NotReady;
+                    self.for_members(axes, |a| {
+                        let g = a.group_link().0;
+                        a.set_group_link(g, true);
+                    });
+                    self.take_point(axes);
+                }
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::GroupDisable => {
+                self.disable(axes, cycle, events);
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::GroupReset => {
+                if self.state == GroupState::ErrorStop {
+                    if self.run.is_idle() {
+                        self.reset(axes);
+                    } else {
+                        // The error stop still moves: reset at standstill.
+                        if let Some(old) = self.pending_reset.replace(id) {
+                            self.event(events, cycle, old, aborted());
+                        }
+                        self.event(events, cycle, id, busy());
+                        return Ok(());
+                    }
+                }
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::GroupSetOverride { factor } => {
+                if !factor.is_finite() {
+                    return Err(ErrorId::PARAMETER_NOT_CORRECT);
+                }
+                self.run.k_target = factor.clamp(0.0, 1.0);
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::GroupHalt { deceleration, jerk }
+            | CommandKind::GroupStop { deceleration, jerk } => {
+                let locks = matches!(kind, CommandKind::GroupStop { .. });
+                let (dec, jerk) = self.stop_dynamics(deceleration, jerk)?;
+                self.start_stop(id, locks, dec, jerk, axes, cycle, events)?;
+            }
+            CommandKind::ReleaseBlocker { blocker_id } => {
+                if blocker_id == 0 {
+                    return Err(ErrorId::BLOCKER_ID_INVALID);
+                }
+                if !matches!(self.state, GroupState::Standby | GroupState::Moving) {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                // An unknown id is remembered nowhere: releasing a blocker that is not queued
+                // is Done and changes nothing (decision 127).
+                self.run.release_blocker(blocker_id);
+                self.done_at_once(events, cycle, id);
+            }
+            CommandKind::Release { target } => {
+                let Some(s) = self.stop.as_mut().filter(|s| s.id == target) else {
+                    // Releasing a command that no longer holds anything is harmless.
+                    return Ok(());
+                };
+                s.released = true;
+                self.try_unlock(cycle, events);
+            }
+            _ => return Err(ErrorId::INVALID_MODE),
+        }
+        Ok(())
+    }
+
+    fn for_members(&self, axes: &mut [Option<Box<Axis>>], mut f: impl FnMut(&mut Axis)) {
+        for slot in self.members.iter().flatten() {
+            if let Some(a) = axes.get_mut(*slot as usize).and_then(|a| a.as_deref_mut()) {
+                f(a);
+            }
+        }
+    }
+
+    fn release_member(&mut self, d: usize, axes: &mut [Option<Box<Axis>>]) {
+        if let Some(slot) = self.members[d].take() {
+            if let Some(a) = axes.get_mut(slot as usize).and_then(|a| a.as_deref_mut()) {
+                a.set_group_link(None, false);
+            }
+        }
+    }
+
+    /// MC_GroupDisable (and the first half of MC_UngroupAllAxes): from any state; a moving
+    /// group stops at once — each axis on its own fast-stop ramp, off the path (decision 126).
+    fn disable(&mut self, axes: &mut [Option<Box<Axis>>], cycle: u64, events: &mut impl EventSink) {
+        if !self.run.is_idle() || self.state == GroupState::Moving {
+            self.for_members(axes, |a| a.group_abandon());
+        }
+        self.abort_all(cycle, events);
+        if let Some(s) = self.stop.take() {
+            self.event(events, cycle, s.id, aborted());
+        }
+        if let Some(r) = self.pending_reset.take() {
+            self.event(events, cycle, r, aborted());
+        }
+        self.enable_requested = false;
+        self.for_members(axes, |a| {
+            let g = a.group_link().0;
+            a.set_group_link(g, false);
+        });
+        if self.state != GroupState::ErrorStop {
+            self.state = GroupState::Disabled;
+        }
+    }
+
+    /// The queue is flushed and every MovePath ends CommandAborted.
+    fn abort_all(&mut self, cycle: u64, events: &mut impl EventSink) {
+        for _ in self.run.flush() {}
+        self.end_all_paths(cycle, events, aborted());
+    }
+
+    /// Every MovePath in flight ends with `out` (CommandAborted or Error).
+    fn end_all_paths(&mut self, cycle: u64, events: &mut impl EventSink, out: FbOutputs) {
+        for p in self.paths.iter_mut() {
+            if let Some(c) = p.take() {
+                events.push(CommandEvent {
+                    cycle,
+                    command: c.id,
+                    target: Target::Group(self.id),
+                    outputs: out,
+                    result: None,
+                });
+            }
+        }
+    }
+
+    fn end_path(&mut self, id: CommandId, cycle: u64, events: &mut impl EventSink, out: FbOutputs) {
+        if let Some(slot) = self
+            .paths
+            .iter_mut()
+            .find(|p| p.is_some_and(|p| p.id == id))
+        {
+            *slot = None;
+            self.event(events, cycle, id, out);
+        }
+    }
+
+    /// MC_GroupReset in ErrorStop: the group's and the members' errors are cleared (§4.1).
+    fn reset(&mut self, axes: &mut [Option<Box<Axis>>]) {
+        self.error = ErrorId(0);
+        self.for_members(axes, |a| a.group_reset_axis());
+        self.state = if self.enable_requested {
+            GroupState::NotReady
+        } else {
+            GroupState::Disabled
+        };
+    }
+
+    /// Deceleration and jerk of a halt or stop: defaults and maxima from the configuration;
+    /// a value above the maximum is capped; `Ignore` on the jerk = no jerk limit.
+    fn stop_dynamics(&self, dec: PathValue, jerk: PathValue) -> Result<(f64, f64), ErrorId> {
+        let (d, m) = (self.config.default_dynamics, self.config.maximum_dynamics);
+        let dec = match dec {
+            PathValue::Default => d.deceleration,
+            PathValue::Maximum => m.deceleration,
+            PathValue::Value(x) if x.is_finite() && x >= 1.0 => x.min(m.deceleration),
+            _ => return Err(ErrorId::PATH_DYNAMICS_INVALID),
+        };
+        let jerk = match jerk {
+            PathValue::Default => d.jerk,
+            PathValue::Maximum => m.jerk,
+            PathValue::Ignore => 1e12,
+            PathValue::Value(x) if x.is_finite() && x >= 100.0 => x.min(m.jerk),
+            PathValue::Value(_) => return Err(ErrorId::PATH_DYNAMICS_INVALID),
+        };
+        Ok((dec, jerk))
+    }
+
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one call site; the cycle's context"
+    )]
+    fn start_stop(
+        &mut self,
+        id: CommandId,
+        locks: bool,
+        dec: f64,
+        jerk: f64,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<(), ErrorId> {
+        match self.state {
+            GroupState::Standby | GroupState::Moving => {}
+            GroupState::Stopping if locks => {}
+            GroupState::Stopping => return Err(ErrorId::GROUP_STATE_INVALID),
+            // A stop is never refused: where nothing moves it is done at once (decision 128).
+            _ if locks => {
+                self.done_at_once(events, cycle, id);
+                return Ok(());
+            }
+            _ => return Err(ErrorId::GROUP_STATE_INVALID),
+        }
+        if let Some(old) = self.stop.take() {
+            self.event(events, cycle, old.id, aborted());
+        }
+        // The queue is flushed: every MovePath is aborted; the stop runs over what is left.
+        self.end_all_paths(cycle, events, aborted());
+        self.run.brake(dec, jerk);
+        self.run.cut_at_stop(true, |_| {});
+        self.stop = Some(StopCommand {
+            id,
+            out: FbOutputs {
+                busy: true,
+                active: true,
+                ..FbOutputs::default()
+            },
+            locks,
+            standing: false,
+            released: false,
+        });
+        self.event(events, cycle, id, self.stop.expect("set").out);
+        if locks {
+            self.state = GroupState::Stopping;
+        }
+        if self.run.is_idle() {
+            self.stop_at_standstill(cycle, events);
+        }
+        self.update_status(axes);
+        Ok(())
+    }
+
+    fn stop_at_standstill(&mut self, cycle: u64, events: &mut impl EventSink) {
+        let Some(mut s) = self.stop else { return };
+        if s.standing {
+            return;
+        }
+        s.standing = true;
+        if s.locks {
+            // MC_GroupStop: Done at standstill, Busy and Active until Execute falls (§4.2).
+            s.out.done = true;
+            self.event(events, cycle, s.id, s.out);
+            self.stop = Some(s);
+            self.try_unlock(cycle, events);
+        } else {
+            self.stop = None;
+            self.event(
+                events,
+                cycle,
+                s.id,
+                FbOutputs {
+                    done: true,
+                    ..FbOutputs::default()
+                },
+            );
+        }
+    }
+
+    /// Stopping → Standby once the stop stands and is released (note 3).
+    fn try_unlock(&mut self, cycle: u64, events: &mut impl EventSink) {
+        let Some(s) = self.stop else { return };
+        if s.locks && s.standing && s.released {
+            self.stop = None;
+            self.event(
+                events,
+                cycle,
+                s.id,
+                FbOutputs {
+                    done: true,
+                    ..FbOutputs::default()
+                },
+            );
+            if self.state == GroupState::Stopping {
+                self.state = GroupState::Standby;
+            }
+        }
+    }
+
+    fn axis_limits(a: &Axis) -> AxisLimits {
+        let p = a.parameters();
+        AxisLimits {
+            velocity: p.axis_velo_max,
+            acceleration: p.axis_maximum_acceleration.min(p.axis_maximum_deceleration),
+            jerk: p.axis_jerk,
+            soft_min: p
+                .axis_en_min_soft_pos_limit
+                .then_some(p.axis_min_soft_pos_limit),
+            soft_max: p
+                .axis_en_max_soft_pos_limit
+                .then_some(p.axis_max_soft_pos_limit),
+        }
+    }
+
+    /// MC_MovePath: the table's entries join the queue as their first entry's BufferMode
+    /// says (§7.3). Everything is checked before anything changes.
+    pub(crate) fn submit_path(
+        &mut self,
+        id: CommandId,
+        table: &PathTable,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<(), ErrorId> {
+        if !matches!(self.state, GroupState::Standby | GroupState::Moving) {
+            return Err(ErrorId::GROUP_STATE_INVALID);
+        }
+        let axis_count = self.config.axis_count();
+        table.check(axis_count).map_err(|(_, _, e)| e)?;
+        if self.paths.iter().all(|p| p.is_some()) || self.run.free() < 2 * table.entries.len() + 2 {
+            return Err(ErrorId::PATH_TOO_LONG);
+        }
+        let mut limits = [None; MAX_PATH_DIMS];
+        for (d, m) in self.members.iter().enumerate() {
+            if let Some(a) = m
+                .and_then(|s| axes.get(s as usize))
+                .and_then(|a| a.as_deref())
+            {
+                limits[d] = Some(Self::axis_limits(a));
+            }
+        }
+        let first = table.entries[0].buffer_mode();
+        let aborting = first == BufferMode::Aborting && !self.run.is_idle();
+        // Where the new path starts, and the item it may blend from.
+        let (start, s0, blend_from) = if aborting {
+            // Velocity 0 at the transition (§7.3): the running path stops on itself first
+            // (an aborting CornerDistance blend from the virtual corner is decision 129).
+            let (dec, jerk) = self.front_dynamics();
+            let mut probe = self.run_probe_stop(dec, jerk);
+            probe.0 = probe.0.max(self.run.s.position);
+            (probe.1, probe.0, None)
+        } else {
+            let back = self.run.items.back().copied();
+            let blend_from = match (first, back) {
+                (BufferMode::BlendingPrevious, Some(b))
+                    if matches!(b.kind, ItemKind::Motion(_)) =>
+                {
+                    Some(b)
+                }
+                _ => None,
+            };
+            (self.run.end_point(), self.run.end_s(), blend_from)
+        };
+        let back_trim = self.build_items(id, table, start, s0, blend_from, &limits)?;
+        // Accepted: nothing below fails.
+        if aborting {
+            let (dec, jerk) = self.front_dynamics();
+            self.run.brake(dec, jerk);
+            self.run.cut_at_stop(true, |_| {});
+            self.end_all_paths(cycle, events, aborted());
+        }
+        if let Some(s) = self.stop.take() {
+            // A MovePath during a halt's ramp takes over (§4.2: CommandAborted).
+            self.event(events, cycle, s.id, aborted());
+        }
+        if let Some((seg, len, corner)) = back_trim {
+            if let Some(b) = self.run.items.back_mut() {
+                b.kind = ItemKind::Motion(seg);
+                b.len = len;
+                b.corner = corner;
+            }
+        }
+        let slot = self
+            .paths
+            .iter_mut()
+            .find(|p| p.is_none())
+            .expect("checked above");
+        *slot = Some(PathCommand { id, out: busy() });
+        self.event(events, cycle, id, busy());
+        let mut scratch = core::mem::take(&mut self.scratch);
+        self.run.append(scratch.drain(..));
+        self.scratch = scratch;
+        self.update_status(axes);
+        Ok(())
+    }
+
+    /// The deceleration and jerk the running item plans with (an aborting path's stop).
+    fn front_dynamics(&self) -> (f64, f64) {
+        self.run.front().map_or(
+            (
+                self.config.default_dynamics.deceleration,
+                self.config.default_dynamics.jerk,
+            ),
+            |i| (i.limits.deceleration, i.limits.jerk),
+        )
+    }
+
+    /// Where a stop with `dec`/`jerk` from the present state would end: (s, point). Planned
+    /// on a copy of the path's planner so that nothing changes.
+    fn run_probe_stop(&self, dec: f64, jerk: f64) -> (f64, PathPoint) {
+        let from = self.run.s;
+        let reach = crate::planner::stop_distance(from.velocity, from.acceleration, dec, jerk);
+        let s = (from.position + reach).min(self.run.end_s());
+        (s, self.point_at(s))
+    }
+
+    /// The queued path's point at global `s`.
+    fn point_at(&self, s: f64) -> PathPoint {
+        for it in self.run.items.iter() {
+            if let ItemKind::Motion(seg) = it.kind {
+                if s <= it.end_s() + 1e-12 {
+                    return seg.sample((s - it.s0).clamp(0.0, it.len)).position;
+                }
+            }
+        }
+        self.run.end_point()
+    }
+
+    /// Turns the table into items in `self.scratch`: geometry from `start`, dynamics within
+    /// the members' limits, blends, soft limits. Returns how the queue's last item is to be
+    /// trimmed for a blend into the first entry (applied only once everything passed).
+    #[allow(clippy::type_complexity, reason = "a private helper's tuple")]
+    fn build_items(
+        &mut self,
+        id: CommandId,
+        table: &PathTable,
+        start: PathPoint,
+        s0: f64,
+        blend_from: Option<Item>,
+        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+    ) -> Result<Option<(Segment, f64, f64)>, ErrorId> {
+        self.scratch.clear();
+        let roles: [Option<GroupRole>; MAX_PATH_DIMS] = {
+            let mut r = [None; MAX_PATH_DIMS];
+            for (i, role) in self.config.roles().enumerate() {
+                r[i] = Some(role);
+            }
+            r
+        };
+        let planar = self.config.convention.planar();
+        let mut at = start;
+        let mut s = s0;
+        let mut back_trim = None;
+        let mut prev: Option<Item> = blend_from;
+        let n = table.entries.len();
+        for (i, e) in table.entries.iter().enumerate() {
+            let last = i + 1 == n;
+            let invoke_id = e.invoke_id();
+            let base = Item {
+                kind: ItemKind::Dwell(0.0),
+                s0: s,
+                len: 0.0,
+                limits: Limits {
+                    velocity: 1.0,
+                    acceleration: 1.0,
+                    deceleration: 1.0,
+                    jerk: 100.0,
+                },
+                corner: 0.0,
+                through: 0.0,
+                v_end: 0.0,
+                command: id,
+                entry: i as u16,
+                invoke_id,
+                blend: false,
+                last,
+                stop_end: false,
+            };
+            let (seg, motion) = match *e {
+                PathEntry::Blocker { blocker_id, .. } => {
+                    self.scratch.push(Item {
+                        kind: ItemKind::Blocker {
+                            id: blocker_id,
+                            released: false,
+                        },
+                        ..base
+                    });
+                    prev = None;
+                    continue;
+                }
+                PathEntry::Dwell { time, .. } => {
+                    self.scratch.push(Item {
+                        kind: ItemKind::Dwell(time),
+                        ..base
+                    });
+                    prev = None;
+                    continue;
+                }
+                PathEntry::Linear {
+                    position, motion, ..
+                } => {
+                    let target = place(&roles, &position, at);
+                    let line =
+                        path::Line::new(at, target).map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
+                    (Segment::Line(line), motion)
+                }
+                PathEntry::Circular {
+                    mode,
+                    aux,
+                    end_point,
+                    path_choice,
+                    motion,
+                    ..
+                } => {
+                    let target = place(&roles, &end_point, at);
+                    let arc = path::Arc::new(mode, at, aux, target, path_choice, planar)
+                        .map_err(|_| ErrorId::CIRCLE_INVALID)?;
+                    (Segment::Arc(arc), motion)
+                }
+            };
+            let lim = self.entry_limits(&motion, &seg, limits);
+            check_soft_limits(&seg, limits)?;
+            let mut item = Item {
+                kind: ItemKind::Motion(seg),
+                len: seg.length(),
+                limits: lim,
+                ..base
+            };
+            // A blend into this entry from the one before (its transition parameters govern
+            // the corner at its start, §5.5).
+            if let (Some((r_in, r_out)), Some(p)) = (e.corner_distance(), prev) {
+                let ItemKind::Motion(pseg) = p.kind else {
+                    unreachable!("prev is a motion item")
+                };
+                let from_queue = i == 0;
+                if let Some((cut_prev, blend, cut_next)) =
+                    path::blend_corner(&pseg, &seg, r_in, r_out)
+                {
+                    let ok = !from_queue || self.blend_reachable(&p, cut_prev);
+                    if ok {
+                        let bseg = Segment::Blend(blend);
+                        let blim = self.blend_limits(&p.limits, &lim, &bseg, limits);
+                        check_soft_limits(&bseg, limits)?;
+                        let prev_seg = pseg.trimmed(0.0, cut_prev);
+                        let prev_corner = p.limits.velocity.min(blim.velocity);
+                        if from_queue {
+                            back_trim = Some((prev_seg, cut_prev, prev_corner));
+                            s = p.s0 + cut_prev;
+                        } else {
+                            let last_ix = self.scratch.len() - 1;
+                            let q = &mut self.scratch[last_ix];
+                            q.kind = ItemKind::Motion(prev_seg);
+                            q.len = cut_prev;
+                            q.corner = prev_corner;
+                            s = q.s0 + cut_prev;
+                        }
+                        let blen = bseg.length();
+                        self.scratch.push(Item {
+                            kind: ItemKind::Motion(bseg),
+                            s0: s,
+                            len: blen,
+                            limits: blim,
+                            corner: blim.velocity.min(lim.velocity),
+                            blend: true,
+                            last: false,
+                            ..base
+                        });
+                        s += blen;
+                        let rest = seg.trimmed(cut_next, seg.length());
+                        item.kind = ItemKind::Motion(rest);
+                        item.len = rest.length();
+                    }
+                } else if tangent_continuous(&pseg, &seg) {
+                    let corner = p
+                        .limits
+                        .velocity
+                        .min(lim.velocity)
+                        .min(curvature_jump_velocity(
+                            &pseg,
+                            &seg,
+                            limits,
+                            self.cycle_time,
+                        ));
+                    if from_queue {
+                        back_trim = Some((pseg, p.len, corner));
+                    } else {
+                        let last_ix = self.scratch.len() - 1;
+                        self.scratch[last_ix].corner = corner;
+                    }
+                }
+            }
+            // Motion, blocker, motion without a corner: passed in motion if the blocker is
+            // released before the path reaches it (§4.3).
+            let n_scratch = self.scratch.len();
+            if n_scratch >= 2 {
+                if let (ItemKind::Blocker { .. }, ItemKind::Motion(pseg)) = (
+                    self.scratch[n_scratch - 1].kind,
+                    self.scratch[n_scratch - 2].kind,
+                ) {
+                    if tangent_continuous(&pseg, &seg) {
+                        let jump = curvature_jump_velocity(&pseg, &seg, limits, self.cycle_time);
+                        let q = &mut self.scratch[n_scratch - 2];
+                        q.through = q.limits.velocity.min(lim.velocity).min(jump);
+                    }
+                }
+            }
+            item.s0 = s;
+            s += item.len;
+            at = seg.end();
+            self.scratch.push(item);
+            prev = Some(item);
+        }
+        Ok(back_trim)
+    }
+
+    /// A blend from the queue's last item can still be reached: the cut lies ahead of where
+    /// the path could stop if it braked now.
+    fn blend_reachable(&self, back: &Item, cut: f64) -> bool {
+        if self.run.is_idle() {
+            return true;
+        }
+        let front_is_back = self.run.items.len() == 1;
+        if !front_is_back {
+            return true;
+        }
+        let s = self.run.s;
+        let reach = crate::planner::stop_distance(
+            s.velocity,
+            s.acceleration,
+            back.limits.deceleration,
+            back.limits.jerk,
+        );
+        back.s0 + cut > s.position + reach + 1e-9
+    }
+
+    /// The entry's path dynamics, each lowered to what every member axis allows on `seg`
+    /// (decision 124): velocity by |dp_i/ds|, the centripetal part within half an axis's
+    /// acceleration, the tangential part within what is left.
+    fn entry_limits(
+        &self,
+        m: &EntryMotion,
+        seg: &Segment,
+        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+    ) -> Limits {
+        let (d, mx) = (self.config.default_dynamics, self.config.maximum_dynamics);
+        let pick = |v: PathValue, default: f64, max: f64| match v {
+            PathValue::Value(x) => x.min(max),
+            PathValue::Maximum => max,
+            PathValue::Default | PathValue::Ignore => default,
+        };
+        let commanded = Limits {
+            velocity: pick(m.velocity, d.velocity, mx.velocity),
+            acceleration: pick(m.acceleration, d.acceleration, mx.acceleration),
+            deceleration: pick(m.deceleration, d.deceleration, mx.deceleration),
+            jerk: pick(m.jerk, d.jerk, mx.jerk),
+        };
+        axis_bounded(commanded, seg, limits)
+    }
+
+    fn blend_limits(
+        &self,
+        a: &Limits,
+        b: &Limits,
+        seg: &Segment,
+        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+    ) -> Limits {
+        let commanded = Limits {
+            velocity: a.velocity.min(b.velocity),
+            acceleration: a.acceleration.min(b.acceleration),
+            deceleration: a.deceleration.min(b.deceleration),
+            jerk: a.jerk.min(b.jerk),
+        };
+        axis_bounded(commanded, seg, limits)
+    }
+
+    /// The members' set positions as the group's point (while nothing runs).
+    fn take_point(&mut self, axes: &[Option<Box<Axis>>]) {
+        let mut p = self.run.point;
+        for (d, m) in self.members.iter().enumerate() {
+            if let Some(a) = m
+                .and_then(|s| axes.get(s as usize))
+                .and_then(|a| a.as_deref())
+            {
+                p[d] = a.status().set_position;
+            }
+        }
+        self.run.take_point(p);
+    }
+
+    /// Enters ErrorStop: MovePaths end with the error; a moving path brakes on itself.
+    fn enter_error(&mut self, e: ErrorId, cycle: u64, events: &mut impl EventSink) {
+        if self.state == GroupState::ErrorStop {
+            return;
+        }
+        self.state = GroupState::ErrorStop;
+        self.error = e;
+        self.end_all_paths(cycle, events, failed(e));
+        if let Some(s) = self.stop.take() {
+            self.event(events, cycle, s.id, failed(e));
+        }
+        if !self.run.is_idle() {
+            let (dec, jerk) = self.front_dynamics();
+            if self.run.exec != Exec::Brake {
+                self.run.brake(dec, jerk);
+            }
+            self.run.cut_at_stop(true, |_| {});
+        }
+    }
+
+    /// One cycle, before the axes: the state machine, the path, the members' set points.
+    pub(crate) fn step(
+        &mut self,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let dt = self.cycle_time;
+        // What the members are.
+        let (mut any_error, mut all_ready, mut all_following) = (false, true, true);
+        let mut present = 0;
+        for slot in self.members.iter().flatten() {
+            match axes.get(*slot as usize).and_then(|a| a.as_deref()) {
+                Some(a) => {
+                    present += 1;
+                    // An axis MC_GroupReset is resetting counts from its next step on.
+                    any_error |= a.group_axis_error() && !a.group_reset_pending();
+                    all_ready &= a.group_axis_ready();
+                    all_following &= a.group_axis_following();
+                }
+                None => {
+                    any_error = true;
+                    all_ready = false;
+                    all_following = false;
+                }
+            }
+        }
+        let complete = present == self.config.axis_count();
+        match self.state {
+            GroupState::Disabled => self.take_point(axes),
+            GroupState::NotReady => {
+                if any_error {
+                    self.enter_error(ErrorId::GROUP_AXIS_ERROR, cycle, events);
+                } else if all_ready && complete {
+                    self.state = GroupState::Standby;
+                    self.take_point(axes);
+                } else {
+                    self.take_point(axes);
+                }
+            }
+            GroupState::Standby => {
+                if any_error {
+                    self.enter_error(ErrorId::GROUP_AXIS_ERROR, cycle, events);
+                } else if !all_ready || !complete {
+                    // T2b: an axis without its control loop makes the group NotReady.
+                    self.state = GroupState::NotReady;
+                    self.take_point(axes);
+                } else if !self.run.is_idle() {
+                    self.start_moving(axes, cycle, events);
+                } else if self.stop.is_none() {
+                    self.take_point(axes);
+                }
+            }
+            GroupState::Moving | GroupState::Stopping => {
+                if any_error {
+                    self.enter_error(ErrorId::GROUP_AXIS_ERROR, cycle, events);
+                } else if !all_following && !self.run.is_idle() {
+                    self.enter_error(ErrorId::GROUP_AXIS_LEFT, cycle, events);
+                }
+            }
+            GroupState::ErrorStop => {}
+        }
+        if self.run.is_idle() {
+            self.run.step(
+                dt,
+                self.config.override_ramp_time,
+                &mut StepReport::default(),
+            );
+        } else if matches!(
+            self.state,
+            GroupState::Moving | GroupState::Stopping | GroupState::ErrorStop
+        ) {
+            let mut report = StepReport::default();
+            self.run
+                .step(dt, self.config.override_ramp_time, &mut report);
+            // Members that still follow take the path's set point.
+            let (point, vel, acc) = (self.run.point, self.run.velocity, self.run.acceleration);
+            for (d, m) in self.members.iter().enumerate() {
+                if let Some(a) = m
+                    .and_then(|s| axes.get_mut(s as usize))
+                    .and_then(|a| a.as_deref_mut())
+                {
+                    a.group_follow(Kinematics {
+                        position: point[d],
+                        velocity: vel[d],
+                        acceleration: acc[d],
+                        jerk: 0.0,
+                    });
+                }
+            }
+            for c in &report.started[..report.started_len] {
+                if let Some(p) = self.paths.iter_mut().flatten().find(|p| p.id == *c) {
+                    if !p.out.active {
+                        p.out.active = true;
+                        let out = p.out;
+                        self.event(events, cycle, *c, out);
+                    }
+                }
+            }
+            for c in &report.done[..report.done_len] {
+                self.end_path(
+                    *c,
+                    cycle,
+                    events,
+                    FbOutputs {
+                        done: true,
+                        ..FbOutputs::default()
+                    },
+                );
+            }
+            if report.braked || self.run.is_idle() {
+                self.stop_at_standstill(cycle, events);
+            }
+            if self.run.is_idle() {
+                self.stand_still(axes, cycle, events);
+            }
+        }
+        self.update_status(axes);
+    }
+
+    /// Standby → Moving: every member takes the path as its setpoint source.
+    fn start_moving(
+        &mut self,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let mut all = true;
+        self.for_members(axes, |a| all &= a.group_start());
+        if all {
+            self.state = GroupState::Moving;
+        } else {
+            self.enter_error(ErrorId::GROUP_AXIS_LEFT, cycle, events);
+        }
+    }
+
+    /// The path stands with nothing left to run: the members are released to standstill.
+    fn stand_still(
+        &mut self,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        self.for_members(axes, |a| a.group_finish());
+        match self.state {
+            GroupState::Moving => self.state = GroupState::Standby,
+            GroupState::ErrorStop => {
+                if let Some(r) = self.pending_reset.take() {
+                    self.reset(axes);
+                    self.event(
+                        events,
+                        cycle,
+                        r,
+                        FbOutputs {
+                            done: true,
+                            ..FbOutputs::default()
+                        },
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn update_status(&mut self, axes: &[Option<Box<Axis>>]) {
+        let mut standing = true;
+        let mut position = self.run.point;
+        for (d, m) in self.members.iter().enumerate() {
+            if let Some(a) = m
+                .and_then(|s| axes.get(s as usize))
+                .and_then(|a| a.as_deref())
+            {
+                let st = a.status();
+                standing &= st.set_velocity == 0.0 && st.set_acceleration == 0.0;
+                position[d] = st.set_position;
+            }
+        }
+        let front = self.run.front().copied();
+        let (remaining_distance, remaining_time) = self.run.remaining();
+        let blocker = self.run.blocked();
+        self.status = GroupStatus {
+            state: self.state,
+            enable_requested: self.enable_requested,
+            error_id: self.error.0,
+            members: self.members,
+            axes_count: self.members.iter().flatten().count() as u8,
+            all_axes_standing: standing,
+            override_factor: self.run.k_target,
+            actual_override: self.run.k,
+            path_velocity: self.run.path_velocity(),
+            path_acceleration: self.run.path_acceleration(),
+            path_position: self.run.s.position,
+            command: front.map_or(0, |f| f.command),
+            entry_index: front.map_or(0, |f| f.entry as u32),
+            invoke_id: front.map_or(0, |f| f.invoke_id),
+            in_blending_segment: front.is_some_and(|f| f.blend) && !self.run.is_idle(),
+            remaining_distance,
+            remaining_time,
+            blocked: blocker.is_some(),
+            blocker_id: blocker.unwrap_or(0),
+            queued_entries: self.run.items.iter().filter(|i| !i.blend).count() as u32,
+            position,
+        };
+    }
+}
+
+/// The table's vector (convention axes, then ADDAX1..n) placed into a path point; roles the
+/// group does not have keep their value from `at`.
+fn place(roles: &[Option<GroupRole>; MAX_PATH_DIMS], v: &PathPoint, at: PathPoint) -> PathPoint {
+    let mut p = at;
+    for (i, r) in roles.iter().enumerate() {
+        if let Some(r) = r {
+            p[r.dim()] = v[i];
+        }
+    }
+    p
+}
+
+fn tangent_continuous(a: &Segment, b: &Segment) -> bool {
+    let ta = a.sample(a.length()).d1;
+    let tb = b.sample(0.0).d1;
+    let dot: f64 = ta.iter().zip(tb.iter()).map(|(x, y)| x * y).sum();
+    let na: f64 = ta.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let nb: f64 = tb.iter().map(|x| x * x).sum::<f64>().sqrt();
+    na > 0.0 && nb > 0.0 && dot / (na * nb) > 1.0 - 1e-9
+}
+
+/// max |d³p_i/ds³| over a segment: 0 on a line, 1/r² on an arc, sampled on a blend (with a
+/// margin: the blend's curvature changes smoothly, 64 intervals resolve it).
+fn third_derivative_max(seg: &Segment) -> PathPoint {
+    let mut out = [0.0; MAX_PATH_DIMS];
+    match seg {
+        Segment::Line(_) => {}
+        Segment::Arc(a) => {
+            let k = 1.0 / (a.radius() * a.radius());
+            out[..path::CARTESIAN_DIMS].iter_mut().for_each(|x| *x = k);
+        }
+        Segment::Blend(_) => {
+            const N: usize = 64;
+            let len = seg.length();
+            if len <= 0.0 {
+                return out;
+            }
+            let ds = len / N as f64;
+            let mut prev = seg.sample(0.0).d2;
+            for i in 1..=N {
+                let d2 = seg.sample(ds * i as f64).d2;
+                for d in 0..MAX_PATH_DIMS {
+                    out[d] = f64::max(out[d], 1.25 * (d2[d] - prev[d]).abs() / ds);
+                }
+                prev = d2;
+            }
+        }
+    }
+    out
+}
+
+/// Commanded path dynamics lowered to what every member axis allows on `seg`: the axis's
+/// velocity over |dp/ds|; its acceleration shared between the centripetal part (d²p/ds²·v²,
+/// at most half) and the tangential part; its jerk between the change of curvature
+/// (d³p/ds³·v³, at most half), the curvature with the tangential acceleration
+/// (3·d²p/ds²·v·a, a quarter) and the path jerk (a quarter) (decision 124).
+fn axis_bounded(
+    mut l: Limits,
+    seg: &Segment,
+    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+) -> Limits {
+    let b = seg.bounds();
+    let d3 = third_derivative_max(seg);
+    for (d, lim) in limits.iter().enumerate() {
+        let Some(lim) = lim else { continue };
+        if b.d1_max[d] > 0.0 {
+            l.velocity = l.velocity.min(lim.velocity / b.d1_max[d]);
+        }
+        if b.d2_max[d] > 0.0 {
+            l.velocity = l
+                .velocity
+                .min((0.5 * lim.acceleration / b.d2_max[d]).sqrt());
+        }
+        if d3[d] > 0.0 {
+            l.velocity = l.velocity.min((0.5 * lim.jerk / d3[d]).cbrt());
+        }
+    }
+    for (d, lim) in limits.iter().enumerate() {
+        let Some(lim) = lim else { continue };
+        if b.d1_max[d] > 0.0 {
+            let left = lim.acceleration - b.d2_max[d] * l.velocity * l.velocity;
+            let mut a = left.max(0.5 * lim.acceleration) / b.d1_max[d];
+            if b.d2_max[d] > 0.0 {
+                a = a.min(0.25 * lim.jerk / (3.0 * b.d2_max[d] * l.velocity));
+            }
+            l.acceleration = l.acceleration.min(a);
+            l.deceleration = l.deceleration.min(a);
+            l.jerk = l.jerk.min(0.25 * lim.jerk / b.d1_max[d]);
+        }
+    }
+    l
+}
+
+/// A corner without a blend where the tangent is continuous but the curvature jumps (a line
+/// into an arc): the axes' acceleration jumps by v²·Δ(d²p/ds²); keep that within one cycle of
+/// each axis's jerk (decision 124).
+fn curvature_jump_velocity(
+    a: &Segment,
+    b: &Segment,
+    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+    cycle_time: f64,
+) -> f64 {
+    let ka = a.sample(a.length()).d2;
+    let kb = b.sample(0.0).d2;
+    let mut v = f64::INFINITY;
+    for (d, lim) in limits.iter().enumerate() {
+        let Some(lim) = lim else { continue };
+        let jump = (ka[d] - kb[d]).abs();
+        if jump > 1e-12 {
+            v = v.min((lim.jerk * cycle_time / jump).sqrt());
+        }
+    }
+    v
+}
+
+fn check_soft_limits(
+    seg: &Segment,
+    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
+) -> Result<(), ErrorId> {
+    let b = seg.bounds();
+    for (d, lim) in limits.iter().enumerate() {
+        let Some(lim) = lim else { continue };
+        if lim.soft_min.is_some_and(|m| b.lo[d] < m) || lim.soft_max.is_some_and(|m| b.hi[d] > m) {
+            return Err(ErrorId::PATH_BEYOND_SOFT_LIMIT);
+        }
+    }
+    Ok(())
+}
+
+fn busy() -> FbOutputs {
+    FbOutputs {
+        busy: true,
+        ..FbOutputs::default()
+    }
+}
+
+fn aborted() -> FbOutputs {
+    FbOutputs {
+        command_aborted: true,
+        ..FbOutputs::default()
+    }
+}
+
+fn failed(e: ErrorId) -> FbOutputs {
+    FbOutputs {
+        error: true,
+        error_id: e.0,
+        ..FbOutputs::default()
+    }
+}
