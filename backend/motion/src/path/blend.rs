@@ -293,7 +293,8 @@ impl Blend {
         self.speed_of(&self.velocity(u)).0
     }
 
-    /// ds/du and d²s/du² from dp/du and (optionally) d²p/du².
+    /// ds/du from dp/du, and for an extra-dims blend the dim that sets it (whose d²p/du²
+    /// is then d²s/du² up to sign).
     fn speed_of(&self, p1: &PathPoint) -> (f64, usize) {
         if self.cartesian {
             (

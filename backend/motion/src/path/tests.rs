@@ -213,6 +213,35 @@ proptest! {
     }
 
     #[test]
+    fn random_lines_stay_on_the_straight_line_within_their_bounds(
+        from in vec3(),
+        to in vec3(),
+        extra_start in extras(),
+        extra_end in extras(),
+        seed in 1u64..u64::MAX,
+    ) {
+        let (start, end) = (point(from, &extra_start), point(to, &extra_end));
+        let line = Segment::Line(Line::new(start, end).unwrap());
+        let length = norm(&sub(&to, &from));
+        prop_assert!((line.length() - length).abs() <= 1e-12 * length);
+        let direction = unit(&sub(&to, &from));
+        let size = norm(&from).max(norm(&to)).max(1.0);
+        let bounds = line.bounds();
+        let mut random = Random(seed);
+        for _ in 0..200 {
+            let s = random.next() * line.length();
+            let q = line.sample(s);
+            // Distance from the programmed line, and how far along it the point is.
+            let rel = sub(&cartesian(&q.position), &from);
+            let across = norm(&sub(&rel, &scale(&direction, dot(&rel, &direction))));
+            prop_assert!(across <= 1e-9 * size, "{across} off the line");
+            prop_assert!((dot(&rel, &direction) - s).abs() <= 1e-9 * size);
+            assert_within(&bounds, &q)?;
+        }
+        prop_assert_eq!(line.sample(line.length()).position, end);
+    }
+
+    #[test]
     fn trimmed_lines_and_arcs_sample_as_the_original_shifted_by_s0(
         centre in vec3(),
         radius in 0.05..400.0f64,
