@@ -277,10 +277,22 @@ impl Blend {
         (p, p1, p2)
     }
 
+    /// dp/du in the dims that measure the path length (the others stay 0): the arc-length
+    /// integral evaluates it many times per sample.
     fn velocity(&self, u: f64) -> PathPoint {
         let c = &self.coeff;
         let mut p1 = [0.0; MAX_PATH_DIMS];
-        for (i, v) in p1.iter_mut().enumerate() {
+        let measuring = if self.cartesian {
+            0..CARTESIAN_DIMS
+        } else {
+            CARTESIAN_DIMS..MAX_PATH_DIMS
+        };
+        for (i, v) in p1
+            .iter_mut()
+            .enumerate()
+            .take(measuring.end)
+            .skip(measuring.start)
+        {
             *v = c[0][i]
                 + u * (2.0 * c[1][i]
                     + u * (3.0 * c[2][i] + u * (4.0 * c[3][i] + u * 5.0 * c[4][i])));
