@@ -527,6 +527,37 @@ mod tests {
     }
 
     #[test]
+    fn radius_mode_accepts_an_end_just_off_the_plane_and_still_ends_there() {
+        // 1e-5 off a radius-100 plane (tolerance 1e-4): accepted; the arc is built in the
+        // plane and the last point is still exactly the programmed end.
+        let e = p(100.0, 100.0, 1e-5);
+        let arc = Arc::new(
+            CircMode::Radius,
+            p(0.0, 0.0, 0.0),
+            [0.0, 0.0, 100.0],
+            e,
+            CircPathChoice::CounterClockwise,
+            false,
+        )
+        .unwrap();
+        assert_eq!(arc.sample(arc.length()).position, e);
+        assert!(max_radius_error(&arc) < 1e-9);
+        assert!((arc.angle() - PI / 2.0).abs() < 1e-9);
+        let far = p(100.0, 100.0, 1e-3);
+        assert_eq!(
+            Arc::new(
+                CircMode::Radius,
+                p(0.0, 0.0, 0.0),
+                [0.0, 0.0, 100.0],
+                far,
+                CircPathChoice::CounterClockwise,
+                false
+            ),
+            Err(GeometryError::RadiusEndOutOfPlane)
+        );
+    }
+
+    #[test]
     fn border_mode_runs_through_the_aux_point() {
         for aux in [[5.0, 5.0, 0.0], [5.0, -5.0, 0.0], [0.0, 10.0, 3.0]] {
             let arc = Arc::new(

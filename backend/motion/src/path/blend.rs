@@ -22,12 +22,15 @@ use super::{
 
 /// Intervals of the u ↔ s table.
 const TABLE_INTERVALS: usize = 64;
-/// Samples (in s) for the bounds. With the margins below they are true bounds; dense enough
-/// that the margins stay small.
-const BOUND_SAMPLES: usize = 1024;
+/// Samples (uniform in u) for the bounds, refined where d2 changes fast. With the margins
+/// of `compute_bounds` they are true bounds; dense enough that the margins stay small.
+const BOUND_SAMPLES: usize = 512;
 /// Newton steps on u. The table's linear guess is within (Δu)²; two steps reach rounding,
 /// the third is insurance at strongly curved places.
 const NEWTON_STEPS: usize = 3;
+/// How often the radii are halved when the quintic for them runs into a cusp; a corner
+/// that still fails turns back on itself (exact stop).
+const SHRINK_TRIES: usize = 4;
 /// Neighbours whose dp/ds agree to this at the corner need no blend.
 const TANGENT_CONTINUOUS: f64 = 1e-9;
 /// The blend's speed |dp/du| may not fall below this fraction of the chord anywhere: near a
@@ -83,7 +86,9 @@ pub struct Blend {
 /// Also None (exact stop) when either radius is zero or negative (no tolerance on that
 /// side), when one neighbour moves X, Y, Z at the corner and the other only C or additional
 /// axes (their path lengths are not the same quantity), and when the corner turns back on
-/// itself so sharply that no smooth blend exists.
+/// itself so sharply that no smooth blend exists. Where strongly curved neighbours make the
+/// quintic for the requested radii run into a cusp, both radii are halved (up to four
+/// times): the returned s0 and s1 say where the blend really starts and ends.
 pub fn blend_corner(
     prev: &Segment,
     next: &Segment,
@@ -111,6 +116,27 @@ pub fn blend_corner(
     if measured_in_xyz != is_cartesian(&leaving.d1) {
         return None;
     }
+    // Where the neighbours curve strongly (a tight arc cut far from the corner) the quintic
+    // may run into a cusp; the blend then ends sooner, as r_out allows ("blending may
+    // finish before r_out") and starts later likewise, rather than not at all.
+    let (mut r_in, mut r_out) = (r_in, r_out);
+    for _ in 0..SHRINK_TRIES {
+        if let Some(blend) = cut_and_blend(prev, next, r_in, r_out, measured_in_xyz) {
+            return Some(blend);
+        }
+        r_in /= 2.0;
+        r_out /= 2.0;
+    }
+    None
+}
+
+fn cut_and_blend(
+    prev: &Segment,
+    next: &Segment,
+    r_in: f64,
+    r_out: f64,
+    measured_in_xyz: bool,
+) -> Option<(f64, Blend, f64)> {
     let s0 = prev.length() - r_in;
     let s1 = r_out;
     let from = prev.sample(s0);
@@ -251,10 +277,22 @@ impl Blend {
         (p, p1, p2)
     }
 
+    /// dp/du in the dims that measure the path length (the others stay 0): the arc-length
+    /// integral evaluates it many times per sample.
     fn velocity(&self, u: f64) -> PathPoint {
         let c = &self.coeff;
         let mut p1 = [0.0; MAX_PATH_DIMS];
-        for (i, v) in p1.iter_mut().enumerate() {
+        let measuring = if self.cartesian {
+            0..CARTESIAN_DIMS
+        } else {
+            CARTESIAN_DIMS..MAX_PATH_DIMS
+        };
+        for (i, v) in p1
+            .iter_mut()
+            .enumerate()
+            .take(measuring.end)
+            .skip(measuring.start)
+        {
             *v = c[0][i]
                 + u * (2.0 * c[1][i]
                     + u * (3.0 * c[2][i] + u * (4.0 * c[3][i] + u * 5.0 * c[4][i])));
@@ -267,7 +305,8 @@ impl Blend {
         self.speed_of(&self.velocity(u)).0
     }
 
-    /// ds/du and d²s/du² from dp/du and (optionally) d²p/du².
+    /// ds/du from dp/du, and for an extra-dims blend the dim that sets it (whose d²p/du²
+    /// is then d²s/du² up to sign).
     fn speed_of(&self, p1: &PathPoint) -> (f64, usize) {
         if self.cartesian {
             (
@@ -328,7 +367,11 @@ impl Blend {
 
     /// Sample of the full (untrimmed) curve at its path length `s`.
     fn sample_curve(&self, s: f64) -> PathSample {
-        let u = self.parameter_at(s);
+        self.curve_at(self.parameter_at(s)).0
+    }
+
+    /// Position, dp/ds, d²p/ds² at parameter `u`, and ds/du there.
+    fn curve_at(&self, u: f64) -> (PathSample, f64) {
         let (p, p1, p2) = self.polynomial(u);
         let (speed, lead) = self.speed_of(&p1);
         // d²s/du²: the rate of change of the speed measure.
@@ -347,56 +390,145 @@ impl Blend {
             sample.d1[i] = p1[i] / speed;
             sample.d2[i] = (p2[i] - sample.d1[i] * acceleration) / (speed * speed);
         }
-        sample
+        (sample, speed)
     }
 
-    /// Dense samples plus margins that cover what can happen between them: a value with
-    /// derivative at most D moves at most D·Δs/2 away from the nearer sample; for d2 (whose
-    /// derivative is not at hand) the largest change between neighbours is the margin.
+    /// Dense samples in u plus margins that cover what can happen between them: a value
+    /// whose derivative is at most D moves at most D·Δs/2 away from the nearer sample (a
+    /// position, whose slope is 0 at an extreme, at most d2·Δs²/8). For d2, whose derivative
+    /// is not at hand, intervals where it changes by more than a thousandth of its range are
+    /// bisected until it does not, and the largest remaining change is the margin: a sharp
+    /// curvature peak near a short r_out is found, not stepped over.
     fn compute_bounds(&self) -> SegmentBounds {
-        let step = self.length / BOUND_SAMPLES as f64;
-        let mut lo = self.start;
-        let mut hi = self.start;
-        let mut d1_max = [0.0f64; MAX_PATH_DIMS];
-        let mut d2_max = [0.0f64; MAX_PATH_DIMS];
-        let mut d2_change = [0.0f64; MAX_PATH_DIMS];
-        let mut curvature_max = 0.0f64;
-        let mut curvature_change = 0.0f64;
-        let mut previous: Option<(PathSample, f64)> = None;
+        let u0 = self.parameter_at(self.window_start);
+        let u1 = self.parameter_at(self.window_start + self.length);
+        let du = (u1 - u0) / BOUND_SAMPLES as f64;
+        // First pass: the scale of d2 in each dim, which sets where to refine.
+        let mut scan = Scan::new(self.start);
         for k in 0..=BOUND_SAMPLES {
-            let sample = self.sample(step * k as f64);
-            let curvature = norm(&cartesian(&sample.d2));
-            for i in 0..MAX_PATH_DIMS {
-                lo[i] = lo[i].min(sample.position[i]);
-                hi[i] = hi[i].max(sample.position[i]);
-                d1_max[i] = d1_max[i].max(sample.d1[i].abs());
-                d2_max[i] = d2_max[i].max(sample.d2[i].abs());
-                if let Some((before, _)) = &previous {
-                    d2_change[i] = d2_change[i].max((sample.d2[i] - before.d2[i]).abs());
-                }
-            }
-            curvature_max = curvature_max.max(curvature);
-            if let Some((_, before)) = previous {
-                curvature_change = curvature_change.max((curvature - before).abs());
-            }
-            previous = Some((sample, curvature));
+            let (q, speed) = self.curve_at(u0 + du * k as f64);
+            scan.take(&q, speed);
         }
+        let mut refine = RefineLimits {
+            d2: [0.0; MAX_PATH_DIMS],
+            curvature: 1e-3 * scan.curvature_max + 1e-12,
+        };
+        let d2_scale = scan.d2_max.iter().fold(0.0f64, |m, x| m.max(*x));
+        for (limit, d2) in refine.d2.iter_mut().zip(scan.d2_max) {
+            *limit = 1e-3 * d2 + 1e-12 * d2_scale + 1e-300;
+        }
+        let speed_max = scan.speed_max;
+        let mut scan = Scan::new(self.start);
+        let mut left = self.curve_at(u0);
+        scan.take(&left.0, left.1);
+        for k in 0..BOUND_SAMPLES {
+            let (ua, ub) = (u0 + du * k as f64, u0 + du * (k + 1) as f64);
+            let right = self.curve_at(ub);
+            self.refine(ua, &left.0, ub, &right, REFINE_DEPTH, &refine, &mut scan);
+            left = right;
+        }
+        // Path length between neighbouring samples, with room for the speed to peak
+        // between the samples that measured it.
+        let step = scan.widest * speed_max.max(scan.speed_max) * 1.1;
         let mut bounds = SegmentBounds {
-            d1_max,
-            d2_max,
-            lo,
-            hi,
-            curvature_max: curvature_max + curvature_change + 1e-9 * curvature_max,
+            d1_max: [0.0; MAX_PATH_DIMS],
+            d2_max: [0.0; MAX_PATH_DIMS],
+            lo: [0.0; MAX_PATH_DIMS],
+            hi: [0.0; MAX_PATH_DIMS],
+            curvature_max: scan.curvature_max * (1.0 + 1e-9) + scan.curvature_change,
         };
         for i in 0..MAX_PATH_DIMS {
-            bounds.d2_max[i] = d2_max[i] + d2_change[i] + 1e-9 * d2_max[i];
-            bounds.d1_max[i] = d1_max[i] + bounds.d2_max[i] * step / 2.0 + 1e-9 * d1_max[i];
-            // An extreme between samples has slope 0 and lies within step/2 of one.
-            let drift = bounds.d2_max[i] * step * step / 8.0 + 1e-12 * (lo[i].abs() + hi[i].abs());
-            bounds.lo[i] = lo[i].min(self.end[i]) - drift;
-            bounds.hi[i] = hi[i].max(self.end[i]) + drift;
+            bounds.d2_max[i] = scan.d2_max[i] * (1.0 + 1e-9) + scan.d2_change[i];
+            bounds.d1_max[i] = scan.d1_max[i] * (1.0 + 1e-9) + bounds.d2_max[i] * step / 2.0;
+            let drift = bounds.d2_max[i] * step * step / 8.0
+                + 1e-12 * (scan.lo[i].abs() + scan.hi[i].abs());
+            bounds.lo[i] = scan.lo[i].min(self.start[i]).min(self.end[i]) - drift;
+            bounds.hi[i] = scan.hi[i].max(self.start[i]).max(self.end[i]) + drift;
         }
         bounds
+    }
+
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one bisection step: interval, its end samples, depth, limits and the accumulator"
+    )]
+    fn refine(
+        &self,
+        ua: f64,
+        a: &PathSample,
+        ub: f64,
+        b: &(PathSample, f64),
+        depth: u32,
+        limits: &RefineLimits,
+        scan: &mut Scan,
+    ) {
+        let (q, _) = b;
+        let too_coarse = (0..MAX_PATH_DIMS).any(|i| (q.d2[i] - a.d2[i]).abs() > limits.d2[i])
+            || (norm(&cartesian(&q.d2)) - norm(&cartesian(&a.d2))).abs() > limits.curvature;
+        if depth > 0 && too_coarse {
+            let um = (ua + ub) / 2.0;
+            let middle = self.curve_at(um);
+            self.refine(ua, a, um, &middle, depth - 1, limits, scan);
+            self.refine(um, &middle.0, ub, b, depth - 1, limits, scan);
+            return;
+        }
+        scan.widest = scan.widest.max(ub - ua);
+        for i in 0..MAX_PATH_DIMS {
+            scan.d2_change[i] = scan.d2_change[i].max((q.d2[i] - a.d2[i]).abs());
+        }
+        scan.curvature_change = scan
+            .curvature_change
+            .max((norm(&cartesian(&q.d2)) - norm(&cartesian(&a.d2))).abs());
+        scan.take(q, b.1);
+    }
+}
+
+/// Bisection depth of the bounds scan: up to 2⁸ pieces per sample interval.
+const REFINE_DEPTH: u32 = 8;
+
+struct RefineLimits {
+    d2: PathPoint,
+    curvature: f64,
+}
+
+/// What the bounds scan has seen so far.
+struct Scan {
+    lo: PathPoint,
+    hi: PathPoint,
+    d1_max: PathPoint,
+    d2_max: PathPoint,
+    d2_change: PathPoint,
+    curvature_max: f64,
+    curvature_change: f64,
+    speed_max: f64,
+    /// Widest interval in u between neighbouring samples.
+    widest: f64,
+}
+
+impl Scan {
+    fn new(start: PathPoint) -> Scan {
+        Scan {
+            lo: start,
+            hi: start,
+            d1_max: [0.0; MAX_PATH_DIMS],
+            d2_max: [0.0; MAX_PATH_DIMS],
+            d2_change: [0.0; MAX_PATH_DIMS],
+            curvature_max: 0.0,
+            curvature_change: 0.0,
+            speed_max: 0.0,
+            widest: 0.0,
+        }
+    }
+
+    fn take(&mut self, q: &PathSample, speed: f64) {
+        for i in 0..MAX_PATH_DIMS {
+            self.lo[i] = self.lo[i].min(q.position[i]);
+            self.hi[i] = self.hi[i].max(q.position[i]);
+            self.d1_max[i] = self.d1_max[i].max(q.d1[i].abs());
+            self.d2_max[i] = self.d2_max[i].max(q.d2[i].abs());
+        }
+        self.curvature_max = self.curvature_max.max(norm(&cartesian(&q.d2)));
+        self.speed_max = self.speed_max.max(speed);
     }
 }
 
