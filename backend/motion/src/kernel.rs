@@ -338,13 +338,30 @@ impl Kernel {
         self.group(id).map(|g| *g.status())
     }
 
-    /// MC_MovePath: the table (built and allocated off the cycle thread; the caller frees it
-    /// there) joins the group's queue, or is refused and changes nothing.
+    /// MC_MovePath: the table (allocated off the cycle thread; the caller frees it there)
+    /// joins the group's queue, or is refused and changes nothing. Its geometry is built
+    /// here, in the cycle: see [`Kernel::submit_prepared_path`] to build it off the thread.
     pub fn submit_path(
         &mut self,
         id: crate::command::CommandId,
         group: crate::command::GroupId,
         table: &PathTable,
+        events: &mut impl EventSink,
+    ) -> Verdict {
+        self.submit_prepared_path(id, group, table, None, events)
+    }
+
+    /// MC_MovePath with its items built off the cycle thread by
+    /// [`crate::group::prepare_path`] from the group's `queue_end` and
+    /// [`Kernel::path_context`]: taken as they are when the path still starts there in the
+    /// same context, built here otherwise (an aborting path while moving, a queue that
+    /// changed meanwhile, a parameter written since).
+    pub fn submit_prepared_path(
+        &mut self,
+        id: crate::command::CommandId,
+        group: crate::command::GroupId,
+        table: &PathTable,
+        prepared: Option<&crate::group::PreparedPath>,
         events: &mut impl EventSink,
     ) -> Verdict {
         let cycle = self.cycle + 1;
@@ -353,12 +370,20 @@ impl Kernel {
             .get_mut(group as usize)
             .and_then(|g| g.as_deref_mut())
         {
-            Some(g) => match g.submit_path(id, table, &mut self.axes, cycle, events) {
+            Some(g) => match g.submit_path(id, table, prepared, &mut self.axes, cycle, events) {
                 Ok(()) => Verdict::Accepted,
                 Err(e) => Verdict::Rejected(e),
             },
             None => Verdict::Rejected(ErrorId::GROUP_NOT_FOUND),
         }
+    }
+
+    /// What a MovePath for `group` is built against now (configuration, members' limits).
+    pub fn path_context(
+        &self,
+        group: crate::command::GroupId,
+    ) -> Option<crate::group::PathContext> {
+        self.group(group).map(|g| g.context(&self.axes))
     }
 
     /// Offers a command to its axis or group in the current cycle (before [`Kernel::step`]).

@@ -10,10 +10,12 @@
 //! States (§1.1): Disabled, NotReady, Standby, Moving, Stopping, ErrorStop — the last with
 //! the enable request telling GroupErrorEnabled from GroupErrorDisabled (§10 item 2).
 
+mod build;
 pub mod config;
 pub mod entry;
 mod motion;
 
+pub use build::{AxisLimits, PathContext, PreparedPath, prepare_path};
 pub use config::*;
 pub use entry::*;
 
@@ -80,6 +82,9 @@ pub struct GroupStatus {
     pub queued_entries: u32,
     /// The group's set point of every role (members' set positions).
     pub position: PathPoint,
+    /// Where a MovePath appended now would start: the end of what is queued (the set point
+    /// when nothing is). A path is prepared from it off the cycle thread.
+    pub queue_end: PathPoint,
 }
 
 /// A MovePath in flight.
@@ -122,17 +127,9 @@ pub struct Group {
     pending_reset: Option<CommandId>,
     /// Scratch for a MovePath's items before they are committed (capacity reserved).
     scratch: Vec<Item>,
+    /// MovePaths committed as prepared off the cycle thread (the rest were built in it).
+    prepared_taken: u64,
     status: GroupStatus,
-}
-
-/// Per-member dynamics the path respects.
-#[derive(Clone, Copy, Debug)]
-struct AxisLimits {
-    velocity: f64,
-    acceleration: f64,
-    jerk: f64,
-    soft_min: Option<f64>,
-    soft_max: Option<f64>,
 }
 
 impl Group {
@@ -151,6 +148,7 @@ impl Group {
             stop: None,
             pending_reset: None,
             scratch: Vec::with_capacity(2 * MAX_PATH_ENTRIES + 2),
+            prepared_taken: 0,
             status: GroupStatus {
                 override_factor: 1.0,
                 actual_override: 1.0,
@@ -169,6 +167,11 @@ impl Group {
 
     pub fn state(&self) -> GroupState {
         self.state
+    }
+
+    /// MovePaths whose items were taken as prepared off the cycle thread.
+    pub fn prepared_paths_taken(&self) -> u64 {
+        self.prepared_taken
     }
 
     /// The member axes (by role dimension).
@@ -583,27 +586,38 @@ impl Group {
         }
     }
 
-    fn axis_limits(a: &Axis) -> AxisLimits {
-        let p = a.parameters();
-        AxisLimits {
-            velocity: p.axis_velo_max,
-            acceleration: p.axis_maximum_acceleration.min(p.axis_maximum_deceleration),
-            jerk: p.axis_jerk,
-            soft_min: p
-                .axis_en_min_soft_pos_limit
-                .then_some(p.axis_min_soft_pos_limit),
-            soft_max: p
-                .axis_en_max_soft_pos_limit
-                .then_some(p.axis_max_soft_pos_limit),
+    /// What a MovePath is built against now (the members' limits as their parameters are).
+    pub(crate) fn context(&self, axes: &[Option<Box<Axis>>]) -> PathContext {
+        let mut limits = [None; MAX_PATH_DIMS];
+        for (d, m) in self.members.iter().enumerate() {
+            if let Some(a) = m
+                .and_then(|s| axes.get(s as usize))
+                .and_then(|a| a.as_deref())
+            {
+                limits[d] = Some(AxisLimits::of(a.parameters()));
+            }
+        }
+        PathContext {
+            config: self.config,
+            limits,
+            cycle_time: self.cycle_time,
         }
     }
 
     /// MC_MovePath: the table's entries join the queue as their first entry's BufferMode
-    /// says (§7.3). Everything is checked before anything changes.
+    /// says (§7.3). Everything is checked before anything changes. With `prepared` (built
+    /// off the cycle thread by [`prepare_path`]) the items are taken as they are when the
+    /// path starts where they were built from, in the same context; otherwise (an aborting
+    /// path while moving, or the group changed meanwhile) they are built here.
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the cycle's context, one call site"
+    )]
     pub(crate) fn submit_path(
         &mut self,
         id: CommandId,
         table: &PathTable,
+        prepared: Option<&PreparedPath>,
         axes: &mut [Option<Box<Axis>>],
         cycle: u64,
         events: &mut impl EventSink,
@@ -616,38 +630,50 @@ impl Group {
         if self.paths.iter().all(|p| p.is_some()) || self.run.free() < 2 * table.entries.len() + 2 {
             return Err(ErrorId::PATH_TOO_LONG);
         }
-        let mut limits = [None; MAX_PATH_DIMS];
-        for (d, m) in self.members.iter().enumerate() {
-            if let Some(a) = m
-                .and_then(|s| axes.get(s as usize))
-                .and_then(|a| a.as_deref())
-            {
-                limits[d] = Some(Self::axis_limits(a));
-            }
-        }
+        let ctx = self.context(axes);
         let first = table.entries[0].buffer_mode();
         let aborting = first == BufferMode::Aborting && !self.run.is_idle();
-        // Where the new path starts, and the item it may blend from.
-        let (start, s0, blend_from) = if aborting {
+        // Where the new path starts.
+        let (start, s0) = if aborting {
             // Velocity 0 at the transition (§7.3): the running path stops on itself first
             // (an aborting CornerDistance blend from the virtual corner is decision 129).
             let (dec, jerk) = self.front_dynamics();
-            let mut probe = self.run_probe_stop(dec, jerk);
-            probe.0 = probe.0.max(self.run.s.position);
-            (probe.1, probe.0, None)
+            let (s, point) = self.run_probe_stop(dec, jerk);
+            (point, s.max(self.run.s.position))
         } else {
-            let back = self.run.items.back().copied();
-            let blend_from = match (first, back) {
-                (BufferMode::BlendingPrevious, Some(b))
-                    if matches!(b.kind, ItemKind::Motion(_)) =>
-                {
-                    Some(b)
-                }
-                _ => None,
-            };
-            (self.run.end_point(), self.run.end_s(), blend_from)
+            (self.run.end_point(), self.run.end_s())
         };
-        let back_trim = self.build_items(id, table, start, s0, blend_from, &limits)?;
+        let mut scratch = core::mem::take(&mut self.scratch);
+        let built = match prepared {
+            Some(p) if !aborting && p.start == start && p.context == ctx => {
+                self.prepared_taken += 1;
+                scratch.clear();
+                scratch.extend(p.items.iter().map(|it| Item {
+                    command: id,
+                    s0: it.s0 + s0,
+                    ..*it
+                }));
+                Ok(())
+            }
+            _ => build::build(&ctx, id, table, start, s0, &mut scratch).map_err(|(_, e)| e),
+        };
+        // The blend from what is queued into the first entry.
+        let joined = built.and_then(|()| match (first, self.run.items.back().copied()) {
+            (BufferMode::BlendingPrevious, Some(back)) if !aborting => {
+                let radii = table.entries[0].corner_distance().unwrap_or((0.0, 0.0));
+                build::join(&ctx, &back, radii, &mut scratch, |cut| {
+                    self.blend_reachable(&back, cut)
+                })
+            }
+            _ => Ok(None),
+        });
+        let back_trim = match joined {
+            Ok(t) => t,
+            Err(e) => {
+                self.scratch = scratch;
+                return Err(e);
+            }
+        };
         // Accepted: nothing below fails.
         if aborting {
             let (dec, jerk) = self.front_dynamics();
@@ -673,7 +699,6 @@ impl Group {
             .expect("checked above");
         *slot = Some(PathCommand { id, out: busy() });
         self.event(events, cycle, id, busy());
-        let mut scratch = core::mem::take(&mut self.scratch);
         self.run.append(scratch.drain(..));
         self.scratch = scratch;
         self.update_status(axes);
@@ -712,193 +737,6 @@ impl Group {
         self.run.end_point()
     }
 
-    /// Turns the table into items in `self.scratch`: geometry from `start`, dynamics within
-    /// the members' limits, blends, soft limits. Returns how the queue's last item is to be
-    /// trimmed for a blend into the first entry (applied only once everything passed).
-    #[allow(clippy::type_complexity, reason = "a private helper's tuple")]
-    fn build_items(
-        &mut self,
-        id: CommandId,
-        table: &PathTable,
-        start: PathPoint,
-        s0: f64,
-        blend_from: Option<Item>,
-        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-    ) -> Result<Option<(Segment, f64, f64)>, ErrorId> {
-        self.scratch.clear();
-        let roles: [Option<GroupRole>; MAX_PATH_DIMS] = {
-            let mut r = [None; MAX_PATH_DIMS];
-            for (i, role) in self.config.roles().enumerate() {
-                r[i] = Some(role);
-            }
-            r
-        };
-        let planar = self.config.convention.planar();
-        let mut at = start;
-        let mut s = s0;
-        let mut back_trim = None;
-        let mut prev: Option<Item> = blend_from;
-        let n = table.entries.len();
-        for (i, e) in table.entries.iter().enumerate() {
-            let last = i + 1 == n;
-            let invoke_id = e.invoke_id();
-            let base = Item {
-                kind: ItemKind::Dwell(0.0),
-                s0: s,
-                len: 0.0,
-                limits: Limits {
-                    velocity: 1.0,
-                    acceleration: 1.0,
-                    deceleration: 1.0,
-                    jerk: 100.0,
-                },
-                corner: 0.0,
-                through: 0.0,
-                v_end: 0.0,
-                command: id,
-                entry: i as u16,
-                invoke_id,
-                blend: false,
-                last,
-                stop_end: false,
-            };
-            let (seg, motion) = match *e {
-                PathEntry::Blocker { blocker_id, .. } => {
-                    self.scratch.push(Item {
-                        kind: ItemKind::Blocker {
-                            id: blocker_id,
-                            released: false,
-                        },
-                        ..base
-                    });
-                    prev = None;
-                    continue;
-                }
-                PathEntry::Dwell { time, .. } => {
-                    self.scratch.push(Item {
-                        kind: ItemKind::Dwell(time),
-                        ..base
-                    });
-                    prev = None;
-                    continue;
-                }
-                PathEntry::Linear {
-                    position, motion, ..
-                } => {
-                    let target = place(&roles, &position, at);
-                    let line =
-                        path::Line::new(at, target).map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
-                    (Segment::Line(line), motion)
-                }
-                PathEntry::Circular {
-                    mode,
-                    aux,
-                    end_point,
-                    path_choice,
-                    motion,
-                    ..
-                } => {
-                    let target = place(&roles, &end_point, at);
-                    let arc = path::Arc::new(mode, at, aux, target, path_choice, planar)
-                        .map_err(|_| ErrorId::CIRCLE_INVALID)?;
-                    (Segment::Arc(arc), motion)
-                }
-            };
-            let lim = self.entry_limits(&motion, &seg, limits);
-            check_soft_limits(&seg, limits)?;
-            let mut item = Item {
-                kind: ItemKind::Motion(seg),
-                len: seg.length(),
-                limits: lim,
-                ..base
-            };
-            // A blend into this entry from the one before (its transition parameters govern
-            // the corner at its start, §5.5).
-            if let (Some((r_in, r_out)), Some(p)) = (e.corner_distance(), prev) {
-                let ItemKind::Motion(pseg) = p.kind else {
-                    unreachable!("prev is a motion item")
-                };
-                let from_queue = i == 0;
-                if let Some((cut_prev, blend, cut_next)) =
-                    path::blend_corner(&pseg, &seg, r_in, r_out)
-                {
-                    let ok = !from_queue || self.blend_reachable(&p, cut_prev);
-                    if ok {
-                        let bseg = Segment::Blend(blend);
-                        let blim = self.blend_limits(&p.limits, &lim, &bseg, limits);
-                        check_soft_limits(&bseg, limits)?;
-                        let prev_seg = pseg.trimmed(0.0, cut_prev);
-                        let prev_corner = p.limits.velocity.min(blim.velocity);
-                        if from_queue {
-                            back_trim = Some((prev_seg, cut_prev, prev_corner));
-                            s = p.s0 + cut_prev;
-                        } else {
-                            let last_ix = self.scratch.len() - 1;
-                            let q = &mut self.scratch[last_ix];
-                            q.kind = ItemKind::Motion(prev_seg);
-                            q.len = cut_prev;
-                            q.corner = prev_corner;
-                            s = q.s0 + cut_prev;
-                        }
-                        let blen = bseg.length();
-                        self.scratch.push(Item {
-                            kind: ItemKind::Motion(bseg),
-                            s0: s,
-                            len: blen,
-                            limits: blim,
-                            corner: blim.velocity.min(lim.velocity),
-                            blend: true,
-                            last: false,
-                            ..base
-                        });
-                        s += blen;
-                        let rest = seg.trimmed(cut_next, seg.length());
-                        item.kind = ItemKind::Motion(rest);
-                        item.len = rest.length();
-                    }
-                } else if tangent_continuous(&pseg, &seg) {
-                    let corner = p
-                        .limits
-                        .velocity
-                        .min(lim.velocity)
-                        .min(curvature_jump_velocity(
-                            &pseg,
-                            &seg,
-                            limits,
-                            self.cycle_time,
-                        ));
-                    if from_queue {
-                        back_trim = Some((pseg, p.len, corner));
-                    } else {
-                        let last_ix = self.scratch.len() - 1;
-                        self.scratch[last_ix].corner = corner;
-                    }
-                }
-            }
-            // Motion, blocker, motion without a corner: passed in motion if the blocker is
-            // released before the path reaches it (§4.3).
-            let n_scratch = self.scratch.len();
-            if n_scratch >= 2 {
-                if let (ItemKind::Blocker { .. }, ItemKind::Motion(pseg)) = (
-                    self.scratch[n_scratch - 1].kind,
-                    self.scratch[n_scratch - 2].kind,
-                ) {
-                    if tangent_continuous(&pseg, &seg) {
-                        let jump = curvature_jump_velocity(&pseg, &seg, limits, self.cycle_time);
-                        let q = &mut self.scratch[n_scratch - 2];
-                        q.through = q.limits.velocity.min(lim.velocity).min(jump);
-                    }
-                }
-            }
-            item.s0 = s;
-            s += item.len;
-            at = seg.end();
-            self.scratch.push(item);
-            prev = Some(item);
-        }
-        Ok(back_trim)
-    }
-
     /// A blend from the queue's last item can still be reached: the cut lies ahead of where
     /// the path could stop if it braked now.
     fn blend_reachable(&self, back: &Item, cut: f64) -> bool {
@@ -917,46 +755,6 @@ impl Group {
             back.limits.jerk,
         );
         back.s0 + cut > s.position + reach + 1e-9
-    }
-
-    /// The entry's path dynamics, each lowered to what every member axis allows on `seg`
-    /// (decision 124): velocity by |dp_i/ds|, the centripetal part within half an axis's
-    /// acceleration, the tangential part within what is left.
-    fn entry_limits(
-        &self,
-        m: &EntryMotion,
-        seg: &Segment,
-        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-    ) -> Limits {
-        let (d, mx) = (self.config.default_dynamics, self.config.maximum_dynamics);
-        let pick = |v: PathValue, default: f64, max: f64| match v {
-            PathValue::Value(x) => x.min(max),
-            PathValue::Maximum => max,
-            PathValue::Default | PathValue::Ignore => default,
-        };
-        let commanded = Limits {
-            velocity: pick(m.velocity, d.velocity, mx.velocity),
-            acceleration: pick(m.acceleration, d.acceleration, mx.acceleration),
-            deceleration: pick(m.deceleration, d.deceleration, mx.deceleration),
-            jerk: pick(m.jerk, d.jerk, mx.jerk),
-        };
-        axis_bounded(commanded, seg, limits)
-    }
-
-    fn blend_limits(
-        &self,
-        a: &Limits,
-        b: &Limits,
-        seg: &Segment,
-        limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-    ) -> Limits {
-        let commanded = Limits {
-            velocity: a.velocity.min(b.velocity),
-            acceleration: a.acceleration.min(b.acceleration),
-            deceleration: a.deceleration.min(b.deceleration),
-            jerk: a.jerk.min(b.jerk),
-        };
-        axis_bounded(commanded, seg, limits)
     }
 
     /// The members' set positions as the group's point (while nothing runs).
@@ -1195,137 +993,9 @@ impl Group {
             blocker_id: blocker.unwrap_or(0),
             queued_entries: self.run.items.iter().filter(|i| !i.blend).count() as u32,
             position,
+            queue_end: self.run.end_point(),
         };
     }
-}
-
-/// The table's vector (convention axes, then ADDAX1..n) placed into a path point; roles the
-/// group does not have keep their value from `at`.
-fn place(roles: &[Option<GroupRole>; MAX_PATH_DIMS], v: &PathPoint, at: PathPoint) -> PathPoint {
-    let mut p = at;
-    for (i, r) in roles.iter().enumerate() {
-        if let Some(r) = r {
-            p[r.dim()] = v[i];
-        }
-    }
-    p
-}
-
-fn tangent_continuous(a: &Segment, b: &Segment) -> bool {
-    let ta = a.sample(a.length()).d1;
-    let tb = b.sample(0.0).d1;
-    let dot: f64 = ta.iter().zip(tb.iter()).map(|(x, y)| x * y).sum();
-    let na: f64 = ta.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let nb: f64 = tb.iter().map(|x| x * x).sum::<f64>().sqrt();
-    na > 0.0 && nb > 0.0 && dot / (na * nb) > 1.0 - 1e-9
-}
-
-/// max |d³p_i/ds³| over a segment: 0 on a line, 1/r² on an arc, sampled on a blend (with a
-/// margin: the blend's curvature changes smoothly, 64 intervals resolve it).
-fn third_derivative_max(seg: &Segment) -> PathPoint {
-    let mut out = [0.0; MAX_PATH_DIMS];
-    match seg {
-        Segment::Line(_) => {}
-        Segment::Arc(a) => {
-            let k = 1.0 / (a.radius() * a.radius());
-            out[..path::CARTESIAN_DIMS].iter_mut().for_each(|x| *x = k);
-        }
-        Segment::Blend(_) => {
-            const N: usize = 64;
-            let len = seg.length();
-            if len <= 0.0 {
-                return out;
-            }
-            let ds = len / N as f64;
-            let mut prev = seg.sample(0.0).d2;
-            for i in 1..=N {
-                let d2 = seg.sample(ds * i as f64).d2;
-                for d in 0..MAX_PATH_DIMS {
-                    out[d] = f64::max(out[d], 1.25 * (d2[d] - prev[d]).abs() / ds);
-                }
-                prev = d2;
-            }
-        }
-    }
-    out
-}
-
-/// Commanded path dynamics lowered to what every member axis allows on `seg`: the axis's
-/// velocity over |dp/ds|; its acceleration shared between the centripetal part (d²p/ds²·v²,
-/// at most half) and the tangential part; its jerk between the change of curvature
-/// (d³p/ds³·v³, at most half), the curvature with the tangential acceleration
-/// (3·d²p/ds²·v·a, a quarter) and the path jerk (a quarter) (decision 124).
-fn axis_bounded(
-    mut l: Limits,
-    seg: &Segment,
-    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-) -> Limits {
-    let b = seg.bounds();
-    let d3 = third_derivative_max(seg);
-    for (d, lim) in limits.iter().enumerate() {
-        let Some(lim) = lim else { continue };
-        if b.d1_max[d] > 0.0 {
-            l.velocity = l.velocity.min(lim.velocity / b.d1_max[d]);
-        }
-        if b.d2_max[d] > 0.0 {
-            l.velocity = l
-                .velocity
-                .min((0.5 * lim.acceleration / b.d2_max[d]).sqrt());
-        }
-        if d3[d] > 0.0 {
-            l.velocity = l.velocity.min((0.5 * lim.jerk / d3[d]).cbrt());
-        }
-    }
-    for (d, lim) in limits.iter().enumerate() {
-        let Some(lim) = lim else { continue };
-        if b.d1_max[d] > 0.0 {
-            let left = lim.acceleration - b.d2_max[d] * l.velocity * l.velocity;
-            let mut a = left.max(0.5 * lim.acceleration) / b.d1_max[d];
-            if b.d2_max[d] > 0.0 {
-                a = a.min(0.25 * lim.jerk / (3.0 * b.d2_max[d] * l.velocity));
-            }
-            l.acceleration = l.acceleration.min(a);
-            l.deceleration = l.deceleration.min(a);
-            l.jerk = l.jerk.min(0.25 * lim.jerk / b.d1_max[d]);
-        }
-    }
-    l
-}
-
-/// A corner without a blend where the tangent is continuous but the curvature jumps (a line
-/// into an arc): the axes' acceleration jumps by v²·Δ(d²p/ds²); keep that within one cycle of
-/// each axis's jerk (decision 124).
-fn curvature_jump_velocity(
-    a: &Segment,
-    b: &Segment,
-    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-    cycle_time: f64,
-) -> f64 {
-    let ka = a.sample(a.length()).d2;
-    let kb = b.sample(0.0).d2;
-    let mut v = f64::INFINITY;
-    for (d, lim) in limits.iter().enumerate() {
-        let Some(lim) = lim else { continue };
-        let jump = (ka[d] - kb[d]).abs();
-        if jump > 1e-12 {
-            v = v.min((lim.jerk * cycle_time / jump).sqrt());
-        }
-    }
-    v
-}
-
-fn check_soft_limits(
-    seg: &Segment,
-    limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
-) -> Result<(), ErrorId> {
-    let b = seg.bounds();
-    for (d, lim) in limits.iter().enumerate() {
-        let Some(lim) = lim else { continue };
-        if lim.soft_min.is_some_and(|m| b.lo[d] < m) || lim.soft_max.is_some_and(|m| b.hi[d] > m) {
-            return Err(ErrorId::PATH_BEYOND_SOFT_LIMIT);
-        }
-    }
-    Ok(())
 }
 
 fn busy() -> FbOutputs {

@@ -991,3 +991,79 @@ fn s7_3_an_aborting_move_path_stops_the_running_one_on_its_path_and_starts_from_
     assert_eq!(r.history[0][turn - 1].set_velocity, 0.0);
     assert_eq!((at(&r, 0), at(&r, 1)), (0.0, 50.0));
 }
+
+#[test]
+fn s4_3_a_path_prepared_off_the_cycle_runs_exactly_as_one_built_in_it() {
+    let table = [
+        lin(&[100.0, 0.0], 200.0),
+        lin_blend(&[100.0, 100.0], 200.0, 10.0),
+        circ(
+            CircMode::Center,
+            [100.0, 50.0, 0.0],
+            &[50.0, 50.0],
+            CircPathChoice::CounterClockwise,
+            150.0,
+        ),
+        lin_blend(&[0.0, 0.0], 200.0, 20.0),
+    ];
+    let run = |prepare: bool| {
+        let mut r = rig_xy();
+        enable(&mut r);
+        let ctx = r.k.path_context(G).unwrap();
+        let first = PathTable {
+            entries: table[..2].to_vec(),
+        };
+        let second = PathTable {
+            entries: table[2..]
+                .iter()
+                .map(|e| match *e {
+                    PathEntry::Circular {
+                        mode,
+                        aux,
+                        end_point,
+                        count,
+                        path_choice,
+                        motion,
+                        invoke_id,
+                    } => PathEntry::Circular {
+                        motion: EntryMotion {
+                            buffer_mode: BufferMode::Buffered,
+                            ..motion
+                        },
+                        mode,
+                        aux,
+                        end_point,
+                        count,
+                        path_choice,
+                        invoke_id,
+                    },
+                    e => e,
+                })
+                .collect(),
+        };
+        let mut ids = Vec::new();
+        for (n, t) in [first, second].into_iter().enumerate() {
+            let start = r.gst(G).queue_end;
+            let prepared = motion::group::prepare_path(&ctx, &t, start).unwrap();
+            let v = if prepare {
+                r.k.submit_prepared_path(100 + n as u64, G, &t, Some(&prepared), &mut r.events)
+            } else {
+                r.k.submit_path(100 + n as u64, G, &t, &mut r.events)
+            };
+            assert_eq!(v, Verdict::Accepted);
+            ids.push(100 + n as u64);
+            r.run(0.2);
+        }
+        r.until(10.0, |r| {
+            r.events.iter().any(|e| e.command == 101 && e.outputs.done)
+        });
+        let taken = r.k.group(G).unwrap().prepared_paths_taken();
+        assert_eq!(taken, if prepare { 2 } else { 0 });
+        (r.history[0].clone(), r.history[1].clone())
+    };
+    let (a, b) = (run(false), run(true));
+    assert_eq!(a.0.len(), b.0.len());
+    for (x, y) in a.0.iter().zip(b.0.iter()).chain(a.1.iter().zip(b.1.iter())) {
+        assert_eq!(x.set_position, y.set_position);
+    }
+}
