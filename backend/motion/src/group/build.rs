@@ -75,7 +75,7 @@ pub fn prepare_path(
 ) -> Result<PreparedPath, (usize, &'static str, ErrorId)> {
     table.check(ctx.config.axis_count())?;
     let mut items = Vec::with_capacity(2 * table.entries.len());
-    build(ctx, 0, table, start, 0.0, &mut items).map_err(|(i, e)| (i, field_of(e), e))?;
+    build(ctx, 0, &table.entries, start, 0.0, &mut items).map_err(|(i, e)| (i, field_of(e), e))?;
     Ok(PreparedPath {
         start,
         context: *ctx,
@@ -97,7 +97,7 @@ fn field_of(e: ErrorId) -> &'static str {
 pub(super) fn build(
     ctx: &PathContext,
     id: CommandId,
-    table: &PathTable,
+    entries: &[PathEntry],
     start: PathPoint,
     s0: f64,
     out: &mut Vec<Item>,
@@ -115,8 +115,8 @@ pub(super) fn build(
     let mut at = start;
     let mut s = s0;
     let mut prev: Option<Item> = None;
-    let n = table.entries.len();
-    for (i, e) in table.entries.iter().enumerate() {
+    let n = entries.len();
+    for (i, e) in entries.iter().enumerate() {
         let last = i + 1 == n;
         let invoke_id = e.invoke_id();
         let base = Item {
@@ -137,7 +137,6 @@ pub(super) fn build(
             invoke_id,
             blend: false,
             last,
-            stop_end: false,
         };
         let (seg, motion) = match *e {
             PathEntry::Blocker { blocker_id, .. } => {
@@ -392,7 +391,7 @@ fn third_derivative_max(seg: &Segment) -> PathPoint {
             out[..path::CARTESIAN_DIMS].iter_mut().for_each(|x| *x = k);
         }
         Segment::Blend(_) => {
-            const N: usize = 64;
+            const N: usize = 1024;
             let len = seg.length();
             if len <= 0.0 {
                 return out;
@@ -402,7 +401,7 @@ fn third_derivative_max(seg: &Segment) -> PathPoint {
             for i in 1..=N {
                 let d2 = seg.sample(ds * i as f64).d2;
                 for d in 0..MAX_PATH_DIMS {
-                    out[d] = f64::max(out[d], 1.25 * (d2[d] - prev[d]).abs() / ds);
+                    out[d] = f64::max(out[d], 2.0 * (d2[d] - prev[d]).abs() / ds);
                 }
                 prev = d2;
             }

@@ -27,7 +27,7 @@ use crate::command::{FbOutputs, Target, Verdict};
 use crate::error::ErrorId;
 use crate::path::{self, MAX_PATH_DIMS, PathPoint, Segment};
 use crate::planner::{Kinematics, Limits};
-use motion::{Exec, Item, ItemKind, PathRun, StepReport};
+use motion::{Item, ItemKind, PathRun, StepReport};
 
 /// `MC_GROUP_STATE` as motiond reports it.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -129,6 +129,10 @@ pub struct Group {
     scratch: Vec<Item>,
     /// MovePaths committed as prepared off the cycle thread (the rest were built in it).
     prepared_taken: u64,
+    /// An aborting MovePath accepted while the group moved: its entries, built from where
+    /// the running path stops (capacity reserved).
+    pending: Option<CommandId>,
+    pending_entries: Vec<PathEntry>,
     status: GroupStatus,
 }
 
@@ -149,6 +153,8 @@ impl Group {
             pending_reset: None,
             scratch: Vec::with_capacity(2 * MAX_PATH_ENTRIES + 2),
             prepared_taken: 0,
+            pending: None,
+            pending_entries: Vec::with_capacity(MAX_PATH_ENTRIES),
             status: GroupStatus {
                 override_factor: 1.0,
                 actual_override: 1.0,
@@ -406,6 +412,7 @@ impl Group {
         if !self.run.is_idle() || self.state == GroupState::Moving {
             self.for_members(axes, |a| a.group_abandon());
         }
+        self.pending = None;
         self.abort_all(cycle, events);
         if let Some(s) = self.stop.take() {
             self.event(events, cycle, s.id, aborted());
@@ -516,8 +523,8 @@ impl Group {
         }
         // The queue is flushed: every MovePath is aborted; the stop runs over what is left.
         self.end_all_paths(cycle, events, aborted());
+        self.pending = None;
         self.run.brake(dec, jerk);
-        self.run.cut_at_stop(true, |_| {});
         self.stop = Some(StopCommand {
             id,
             out: FbOutputs {
@@ -535,6 +542,9 @@ impl Group {
         }
         if self.run.is_idle() {
             self.stop_at_standstill(cycle, events);
+            if self.state == GroupState::Moving {
+                self.stand_still(axes, cycle, events);
+            }
         }
         self.update_status(axes);
         Ok(())
@@ -632,20 +642,31 @@ impl Group {
         }
         let ctx = self.context(axes);
         let first = table.entries[0].buffer_mode();
-        let aborting = first == BufferMode::Aborting && !self.run.is_idle();
-        // Where the new path starts.
-        let (start, s0) = if aborting {
-            // Velocity 0 at the transition (§7.3): the running path stops on itself first
-            // (an aborting CornerDistance blend from the virtual corner is decision 129).
+        // A path during a stop's ramp starts where the stop ends, whatever its BufferMode.
+        let aborting =
+            (first == BufferMode::Aborting && !self.run.is_idle()) || self.run.is_braking();
+        if aborting {
+            // Velocity 0 at the transition (§7.3): the running path stops on itself first,
+            // and the new one is built from where it stands (an aborting CornerDistance
+            // blend from the virtual corner is decision 129).
             let (dec, jerk) = self.front_dynamics();
-            let (s, point) = self.run_probe_stop(dec, jerk);
-            (point, s.max(self.run.s.position))
-        } else {
-            (self.run.end_point(), self.run.end_s())
-        };
+            self.run.brake(dec, jerk);
+            self.end_all_paths(cycle, events, aborted());
+            if let Some(s) = self.stop.take() {
+                self.event(events, cycle, s.id, aborted());
+            }
+            self.pending_entries.clear();
+            self.pending_entries.extend_from_slice(&table.entries);
+            self.pending = Some(id);
+            self.paths[0] = Some(PathCommand { id, out: busy() });
+            self.event(events, cycle, id, busy());
+            self.update_status(axes);
+            return Ok(());
+        }
+        let (start, s0) = (self.run.end_point(), self.run.end_s());
         let mut scratch = core::mem::take(&mut self.scratch);
         let built = match prepared {
-            Some(p) if !aborting && p.start == start && p.context == ctx => {
+            Some(p) if p.start == start && p.context == ctx => {
                 self.prepared_taken += 1;
                 scratch.clear();
                 scratch.extend(p.items.iter().map(|it| Item {
@@ -655,11 +676,13 @@ impl Group {
                 }));
                 Ok(())
             }
-            _ => build::build(&ctx, id, table, start, s0, &mut scratch).map_err(|(_, e)| e),
+            _ => {
+                build::build(&ctx, id, &table.entries, start, s0, &mut scratch).map_err(|(_, e)| e)
+            }
         };
         // The blend from what is queued into the first entry.
         let joined = built.and_then(|()| match (first, self.run.items.back().copied()) {
-            (BufferMode::BlendingPrevious, Some(back)) if !aborting => {
+            (BufferMode::BlendingPrevious, Some(back)) => {
                 let radii = table.entries[0].corner_distance().unwrap_or((0.0, 0.0));
                 build::join(&ctx, &back, radii, &mut scratch, |cut| {
                     self.blend_reachable(&back, cut)
@@ -675,12 +698,6 @@ impl Group {
             }
         };
         // Accepted: nothing below fails.
-        if aborting {
-            let (dec, jerk) = self.front_dynamics();
-            self.run.brake(dec, jerk);
-            self.run.cut_at_stop(true, |_| {});
-            self.end_all_paths(cycle, events, aborted());
-        }
         if let Some(s) = self.stop.take() {
             // A MovePath during a halt's ramp takes over (§4.2: CommandAborted).
             self.event(events, cycle, s.id, aborted());
@@ -714,27 +731,6 @@ impl Group {
             ),
             |i| (i.limits.deceleration, i.limits.jerk),
         )
-    }
-
-    /// Where a stop with `dec`/`jerk` from the present state would end: (s, point). Planned
-    /// on a copy of the path's planner so that nothing changes.
-    fn run_probe_stop(&self, dec: f64, jerk: f64) -> (f64, PathPoint) {
-        let from = self.run.s;
-        let reach = crate::planner::stop_distance(from.velocity, from.acceleration, dec, jerk);
-        let s = (from.position + reach).min(self.run.end_s());
-        (s, self.point_at(s))
-    }
-
-    /// The queued path's point at global `s`.
-    fn point_at(&self, s: f64) -> PathPoint {
-        for it in self.run.items.iter() {
-            if let ItemKind::Motion(seg) = it.kind {
-                if s <= it.end_s() + 1e-12 {
-                    return seg.sample((s - it.s0).clamp(0.0, it.len)).position;
-                }
-            }
-        }
-        self.run.end_point()
     }
 
     /// A blend from the queue's last item can still be reached: the cut lies ahead of where
@@ -782,12 +778,10 @@ impl Group {
         if let Some(s) = self.stop.take() {
             self.event(events, cycle, s.id, failed(e));
         }
-        if !self.run.is_idle() {
+        self.pending = None;
+        if !self.run.is_idle() && !self.run.is_braking() {
             let (dec, jerk) = self.front_dynamics();
-            if self.run.exec != Exec::Brake {
-                self.run.brake(dec, jerk);
-            }
-            self.run.cut_at_stop(true, |_| {});
+            self.run.brake(dec, jerk);
         }
     }
 
@@ -903,12 +897,35 @@ impl Group {
             }
             if report.braked || self.run.is_idle() {
                 self.stop_at_standstill(cycle, events);
-            }
-            if self.run.is_idle() {
-                self.stand_still(axes, cycle, events);
+                if let Some(id) = self.pending.take() {
+                    self.build_pending(id, axes, cycle, events);
+                }
             }
         }
+        if self.run.is_idle() && matches!(self.state, GroupState::Moving | GroupState::ErrorStop) {
+            self.stand_still(axes, cycle, events);
+        }
         self.update_status(axes);
+    }
+
+    /// The aborting MovePath, from where the path stopped for it. Its geometry from there
+    /// is checked only now: a circle that is not defined from that point ends it with the
+    /// error (decision 129).
+    fn build_pending(
+        &mut self,
+        id: CommandId,
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        let ctx = self.context(axes);
+        let mut scratch = core::mem::take(&mut self.scratch);
+        let (start, s0) = (self.run.point, self.run.s.position);
+        match build::build(&ctx, id, &self.pending_entries, start, s0, &mut scratch) {
+            Ok(()) => self.run.append(scratch.drain(..)),
+            Err((_, e)) => self.end_path(id, cycle, events, failed(e)),
+        }
+        self.scratch = scratch;
     }
 
     /// Standby → Moving: every member takes the path as its setpoint source.

@@ -69,8 +69,6 @@ pub(super) struct Item {
     pub(super) blend: bool,
     /// The last item of its MovePath (its Done).
     pub(super) last: bool,
-    /// A stop ends exactly here (`cut_at_stop`): braking never passes it.
-    pub(super) stop_end: bool,
 }
 
 impl Item {
@@ -101,9 +99,6 @@ pub(super) enum Exec {
     Dwell { left: f64 },
     /// Standing at a blocker until it is released.
     Blocked { id: u32 },
-    /// A stop profile on `s` (halt, stop, error, aborting); at standstill the queue beyond
-    /// the stop point is dropped.
-    Brake,
 }
 
 /// What a cycle of the path reports to the group.
@@ -115,7 +110,7 @@ pub(super) struct StepReport {
     /// A MovePath whose first item started this cycle (Active).
     pub(super) started: [CommandId; 8],
     pub(super) started_len: usize,
-    /// The brake ended at standstill this cycle.
+    /// A stop ([`PathRun::brake`]) reached standstill this cycle.
     pub(super) braked: bool,
 }
 
@@ -157,6 +152,10 @@ pub(super) struct PathRun {
     pub(super) acceleration: PathPoint,
     /// The last command id whose item became active (Active reported).
     last_started: CommandId,
+    /// A stop in progress (halt, stop, error, an aborting MovePath): its deceleration and
+    /// jerk. The path is followed as planned, but each item is planned to stop as early as
+    /// its dynamics allow.
+    braking: Option<(f64, f64)>,
 }
 
 /// Velocity below which the path counts as standing.
@@ -177,6 +176,7 @@ impl PathRun {
             velocity: [0.0; MAX_PATH_DIMS],
             acceleration: [0.0; MAX_PATH_DIMS],
             last_started: 0,
+            braking: None,
         }
     }
 
@@ -306,20 +306,29 @@ impl PathRun {
     /// and than the acceleration left to the front item (dk/dt · v is a path acceleration),
     /// the rate itself changed no faster than the item's jerk allows (dk²/dt² · v).
     fn step_override(&mut self, dt: f64, ramp_time: f64) {
-        let diff = self.k_target - self.k;
+        // A stop never speeds up: while one runs the override may only fall.
+        let target = if self.braking.is_some() {
+            self.k_target.min(self.k)
+        } else {
+            self.k_target
+        };
+        let diff = target - self.k;
         if diff == 0.0 && self.k_rate == 0.0 {
             return;
         }
+        // dk/dt multiplies the plan's velocity v (s'' = k²·a + k'·v): both the rate and its
+        // change are bounded through v.
         let v = self.s.velocity.abs();
-        let (a_lim, j_lim) = self
-            .items
-            .front()
-            .map_or((f64::INFINITY, f64::INFINITY), |i| {
-                (
-                    i.limits.acceleration.min(i.limits.deceleration),
-                    i.limits.jerk,
-                )
-            });
+        let (a_lim, j_lim, v_lim) =
+            self.items
+                .front()
+                .map_or((f64::INFINITY, f64::INFINITY, 0.0), |i| {
+                    (
+                        i.limits.acceleration.min(i.limits.deceleration),
+                        i.limits.jerk,
+                        i.limits.velocity,
+                    )
+                });
         let mut r_max = if ramp_time > 0.0 {
             1.0 / ramp_time
         } else {
@@ -329,107 +338,70 @@ impl PathRun {
         if v > EPS_V {
             let used = self.k * self.k * self.s.acceleration.abs();
             r_max = r_max.min((a_lim - used).max(0.0) / v);
-            q = j_lim / v;
+            q = 0.5 * j_lim / v;
         }
-        let desired = diff.signum() * r_max.min((2.0 * q * diff.abs()).sqrt());
+        // The rate is kept low enough to be braked to 0 by the target at the rate change the
+        // item's highest velocity allows (v may grow meanwhile).
+        let v_up = v.max(v_lim);
+        let q_safe = if v_up > EPS_V { 0.5 * j_lim / v_up } else { q };
+        let desired = diff.signum() * r_max.min((2.0 * q_safe * diff.abs()).sqrt());
         let step = if q.is_finite() { q * dt } else { f64::INFINITY };
         self.k_rate += (desired - self.k_rate).clamp(-step, step);
         let next = self.k + self.k_rate * dt;
-        if (self.k_target - next) * diff <= 0.0 {
-            self.k = self.k_target;
+        if (target - next) * diff <= 0.0 {
+            self.k = target;
             self.k_rate = 0.0;
         } else {
             self.k = next.clamp(0.0, 1.0);
         }
     }
 
-    /// Starts a stop on the path with `dec`/`jerk` (path units). It never runs past the end
-    /// of what is queued: when the asked deceleration would, the stop ends exactly there
-    /// with the deceleration the look-ahead already planned for (decision 125).
+    /// Starts a stop on the path (halt, stop, error reaction, an aborting MovePath) with
+    /// `dec`/`jerk` (path units). The path stays on its geometry and every corner is passed
+    /// no faster than planned: each item is planned to stop as early as the lower of the
+    /// stop's and the item's own dynamics allow (the item's keep every member within its
+    /// limits), and where that would pass the item's end faster than the look-ahead planned,
+    /// with the item's own (decision 125). At standstill the rest of the queue is dropped.
+    /// What is queued belongs to no command from now on (the callers end them).
     pub(super) fn brake(&mut self, dec: f64, jerk: f64) {
-        if self.exec == Exec::Idle {
-            return;
+        for it in self.items.iter_mut() {
+            it.command = 0;
+            it.last = false;
         }
-        let from = self.s;
-        let end = self.end_s();
-        let limits = Limits {
-            velocity: from.velocity.abs().max(1e-6),
-            acceleration: dec,
-            deceleration: dec,
-            jerk,
-        };
-        let reach = crate::planner::stop_distance(from.velocity, from.acceleration, dec, jerk);
-        let ok = if from.position + reach <= end + 1e-12 {
-            self.planner.plan_velocity(from, 0.0, &limits).is_ok()
-        } else {
-            let (d, j) = self
-                .items
-                .iter()
-                .map(|i| (i.limits.deceleration, i.limits.jerk))
-                .fold((dec, jerk), |(a, b), (c, d)| (a.max(c), b.max(d)));
-            let lim = Limits {
-                acceleration: d,
-                deceleration: d,
-                jerk: j,
-                ..limits
-            };
-            self.planner.plan_position(from, end, 0.0, &lim).is_ok()
-        };
-        if !ok {
-            self.planner.plan_fallback_stop(from, dec, jerk);
+        self.last_started = 0;
+        match self.exec {
+            Exec::Idle => {}
+            Exec::Dwell { .. } | Exec::Blocked { .. } => {
+                // Standing already: the stop is here.
+                self.items.clear();
+                self.exec = Exec::Idle;
+                self.hold();
+            }
+            Exec::Follow { .. } if self.k == 0.0 && self.k_rate == 0.0 => {
+                // The override holds the path: it stands, and the stop is here.
+                self.items.clear();
+                self.exec = Exec::Idle;
+                self.hold();
+            }
+            Exec::Follow { .. } => {
+                self.braking = Some((dec, jerk));
+                self.exec = Exec::Follow { planned: false };
+            }
         }
-        self.exec = Exec::Brake;
+    }
+
+    /// A stop is running.
+    pub(super) fn is_braking(&self) -> bool {
+        self.braking.is_some()
     }
 
     /// Drops every item (and everything after `s`): the group stands where it is.
     pub(super) fn flush(&mut self) -> impl Iterator<Item = CommandId> + '_ {
         self.exec = Exec::Idle;
+        self.braking = None;
         self.s = Kinematics::default();
         self.last_started = 0;
         self.items.drain(..).map(|i| i.command)
-    }
-
-    /// After [`PathRun::brake`]: cuts the queue where the stop ends (the item there ends
-    /// at that point, later ones are dropped). With `orphan`, what is left no longer belongs
-    /// to a command (the stop owns it). Calls `dropped` for every command that loses items.
-    pub(super) fn cut_at_stop(&mut self, orphan: bool, mut dropped: impl FnMut(CommandId)) {
-        if self.exec != Exec::Brake {
-            return;
-        }
-        let stop = self.planner.end_state().position.max(self.s.position);
-        while let Some(last) = self.items.back().copied() {
-            if last.s0 >= stop - 1e-12 && self.items.len() > 1 {
-                self.items.pop_back();
-                dropped(last.command);
-            } else {
-                break;
-            }
-        }
-        if let Some(last) = self.items.back_mut() {
-            last.stop_end = true;
-            if let ItemKind::Motion(seg) = last.kind {
-                let local = (stop - last.s0).clamp(0.0, last.len);
-                if local < last.len - 1e-12 {
-                    last.kind = ItemKind::Motion(seg.trimmed(0.0, local));
-                    last.len = local;
-                    if last.last {
-                        dropped(last.command);
-                    }
-                    last.last = false;
-                }
-            }
-            last.corner = 0.0;
-        }
-        if orphan {
-            for it in self.items.iter_mut() {
-                if it.command != 0 {
-                    dropped(it.command);
-                }
-                it.command = 0;
-                it.last = false;
-            }
-        }
-        self.look_ahead();
     }
 
     /// One cycle. `dt` the cycle time; `ramp_time` the override ramp time.
@@ -462,38 +434,6 @@ impl PathRun {
                 }
                 self.hold();
             }
-            Exec::Brake => {
-                let k = self.planner.step(dt * self.k).unwrap_or(self.s);
-                self.s = Kinematics {
-                    // Never back along the path, never past its end.
-                    position: k.position.max(self.s.position).min(self.end_s()),
-                    ..k
-                };
-                self.advance_while_passed(report, false);
-                self.sample();
-                if self.planner.finished() {
-                    self.s.velocity = 0.0;
-                    self.s.acceleration = 0.0;
-                    // Exactly at the stop point the queue was cut at.
-                    if let Some(it) = self.items.front().copied().filter(|i| i.stop_end) {
-                        self.s.position = it.end_s();
-                        if let ItemKind::Motion(seg) = it.kind {
-                            self.point = seg.end();
-                        }
-                        self.items.pop_front();
-                        if it.last {
-                            report.push_done(it.command);
-                        }
-                    }
-                    self.hold();
-                    report.braked = true;
-                    self.exec = if self.items.is_empty() {
-                        Exec::Idle
-                    } else {
-                        Exec::Follow { planned: false }
-                    };
-                }
-            }
             Exec::Follow { .. } => self.follow(dt, report),
         }
     }
@@ -516,6 +456,41 @@ impl PathRun {
             from.velocity = from.velocity.min(it.limits.velocity.max(from.velocity));
         }
         let target = it.end_s();
+        if let Some((dec, jerk)) = self.braking {
+            let lim = Limits {
+                velocity: it.limits.velocity.max(from.velocity),
+                acceleration: it.limits.acceleration.min(dec),
+                deceleration: it.limits.deceleration.min(dec),
+                jerk: it.limits.jerk.min(jerk),
+            };
+            let reach = crate::planner::stop_distance(
+                from.velocity,
+                from.acceleration,
+                lim.deceleration,
+                lim.jerk,
+            );
+            let planned = if from.position + reach <= target {
+                // The stop ends within this item.
+                self.planner.plan_velocity(from, 0.0, &lim).map(|_| 0.0)
+            } else {
+                // Braking through the item; never faster at its end than planned before.
+                match self.planner.plan_position_towards(from, target, 0.0, &lim) {
+                    Ok(v) if v <= it.v_end + 1e-9 => Ok(v),
+                    _ => {
+                        let own = Limits {
+                            velocity: lim.velocity,
+                            ..it.limits
+                        };
+                        self.planner.plan_position_towards(from, target, 0.0, &own)
+                    }
+                }
+            };
+            if planned.is_err() {
+                self.planner
+                    .plan_fallback_stop(from, it.limits.deceleration, it.limits.jerk);
+            }
+            return;
+        }
         if target - from.position <= 1e-12 && it.v_end >= from.velocity - 1e-9 {
             // A zero-length item: passed at once.
             self.planner.clear();
@@ -555,6 +530,12 @@ impl PathRun {
         };
         self.advance_while_passed(report, true);
         self.sample();
+        if self.braking.is_some() && self.planner.finished() && self.s.velocity <= EPS_V {
+            // Standstill: the stop ends here; the rest of the queue is dropped.
+            self.items.clear();
+            self.braking = None;
+            report.braked = true;
+        }
         if self.items.is_empty() {
             self.exec = Exec::Idle;
             self.hold();
@@ -567,6 +548,14 @@ impl PathRun {
             let Some(it) = self.items.front().copied() else {
                 return false;
             };
+            if self.braking.is_some() && !matches!(it.kind, ItemKind::Motion(_)) {
+                // A stop that reaches a dwell or a blocker ends there.
+                self.items.clear();
+                self.braking = None;
+                self.exec = Exec::Idle;
+                report.braked = true;
+                return true;
+            }
             match it.kind {
                 ItemKind::Dwell(t) => {
                     if it.command != self.last_started {
@@ -616,14 +605,12 @@ impl PathRun {
     /// end until the next item is sampled.
     fn advance_while_passed(&mut self, report: &mut StepReport, following: bool) {
         while let Some(it) = self.items.front().copied() {
-            if it.stop_end && !following {
-                // A stop ends here: the brake's end pops it (`step`).
-                break;
-            }
             let ItemKind::Motion(seg) = it.kind else {
                 break;
             };
-            let finished = following && self.planner.finished();
+            // A stop that ends at standstill inside the item has not passed it.
+            let standing_stop = self.braking.is_some() && self.s.velocity <= EPS_V;
+            let finished = following && self.planner.finished() && !standing_stop;
             if self.s.position < it.end_s() - 1e-12 && !finished {
                 break;
             }
