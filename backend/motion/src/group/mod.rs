@@ -1008,7 +1008,7 @@ impl Group {
             remaining_time,
             blocked: blocker.is_some(),
             blocker_id: blocker.unwrap_or(0),
-            queued_entries: self.run.items.iter().filter(|i| !i.blend).count() as u32,
+            queued_entries: self.run.entries,
             position,
             queue_end: self.run.end_point(),
         };

@@ -152,6 +152,8 @@ pub(super) struct PathRun {
     pub(super) acceleration: PathPoint,
     /// The last command id whose item became active (Active reported).
     last_started: CommandId,
+    /// Entries queued (items that are not blends), kept as items come and go.
+    pub(super) entries: u32,
     /// A stop in progress (halt, stop, error, an aborting MovePath): its deceleration and
     /// jerk. The path is followed as planned, but each item is planned to stop as early as
     /// its dynamics allow.
@@ -177,7 +179,21 @@ impl PathRun {
             acceleration: [0.0; MAX_PATH_DIMS],
             last_started: 0,
             braking: None,
+            entries: 0,
         }
+    }
+
+    fn pop_item(&mut self) -> Option<Item> {
+        let it = self.items.pop_front();
+        if it.is_some_and(|i| !i.blend) {
+            self.entries -= 1;
+        }
+        it
+    }
+
+    fn clear_items(&mut self) {
+        self.items.clear();
+        self.entries = 0;
     }
 
     pub(super) fn free(&self) -> usize {
@@ -229,6 +245,9 @@ impl PathRun {
     pub(super) fn append(&mut self, new: impl Iterator<Item = Item>) {
         for it in new {
             debug_assert!(self.items.len() < self.capacity);
+            if !it.blend {
+                self.entries += 1;
+            }
             self.items.push_back(it);
         }
         self.look_ahead();
@@ -373,13 +392,13 @@ impl PathRun {
             Exec::Idle => {}
             Exec::Dwell { .. } | Exec::Blocked { .. } => {
                 // Standing already: the stop is here.
-                self.items.clear();
+                self.clear_items();
                 self.exec = Exec::Idle;
                 self.hold();
             }
             Exec::Follow { .. } if self.k == 0.0 && self.k_rate == 0.0 => {
                 // The override holds the path: it stands, and the stop is here.
-                self.items.clear();
+                self.clear_items();
                 self.exec = Exec::Idle;
                 self.hold();
             }
@@ -401,6 +420,7 @@ impl PathRun {
         self.braking = None;
         self.s = Kinematics::default();
         self.last_started = 0;
+        self.entries = 0;
         self.items.drain(..).map(|i| i.command)
     }
 
@@ -532,7 +552,7 @@ impl PathRun {
         self.sample();
         if self.braking.is_some() && self.planner.finished() && self.s.velocity <= EPS_V {
             // Standstill: the stop ends here; the rest of the queue is dropped.
-            self.items.clear();
+            self.clear_items();
             self.braking = None;
             report.braked = true;
         }
@@ -550,7 +570,7 @@ impl PathRun {
             };
             if self.braking.is_some() && !matches!(it.kind, ItemKind::Motion(_)) {
                 // A stop that reaches a dwell or a blocker ends there.
-                self.items.clear();
+                self.clear_items();
                 self.braking = None;
                 self.exec = Exec::Idle;
                 report.braked = true;
@@ -588,7 +608,7 @@ impl PathRun {
 
     /// Pops the front item as finished and goes on following.
     fn pass_front(&mut self, report: &mut StepReport) {
-        if let Some(it) = self.items.pop_front() {
+        if let Some(it) = self.pop_item() {
             if it.last {
                 report.push_done(it.command);
             }
@@ -618,7 +638,7 @@ impl PathRun {
                 // Never short of the item's end because of the solver's rounding.
                 self.s.position = self.s.position.max(it.end_s());
             }
-            self.items.pop_front();
+            self.pop_item();
             self.point = seg.end();
             if it.last {
                 report.push_done(it.command);
@@ -628,7 +648,7 @@ impl PathRun {
                 if !matches!(b.kind, ItemKind::Blocker { released: true, .. }) {
                     break;
                 }
-                self.items.pop_front();
+                self.pop_item();
                 if b.last {
                     report.push_done(b.command);
                 }
