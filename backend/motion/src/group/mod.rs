@@ -10,11 +10,13 @@
 //! States (§1.1): Disabled, NotReady, Standby, Moving, Stopping, ErrorStop — the last with
 //! the enable request telling GroupErrorEnabled from GroupErrorDisabled (§10 item 2).
 
+pub mod analysis;
 mod build;
 pub mod config;
 pub mod entry;
 mod motion;
 
+pub use analysis::{PathAnalysis, PlannedSample, analyse_path};
 pub use build::{AxisLimits, PathContext, PreparedPath, prepare_path};
 pub use config::*;
 pub use entry::*;
@@ -973,16 +975,17 @@ impl Group {
     }
 
     fn update_status(&mut self, axes: &[Option<Box<Axis>>]) {
+        // The set point the group gives its members this cycle (their own statuses show it
+        // after their step).
+        let position = self.run.point;
         let mut standing = true;
-        let mut position = self.run.point;
-        for (d, m) in self.members.iter().enumerate() {
+        for m in self.members.iter() {
             if let Some(a) = m
                 .and_then(|s| axes.get(s as usize))
                 .and_then(|a| a.as_deref())
             {
                 let st = a.status();
                 standing &= st.set_velocity == 0.0 && st.set_acceleration == 0.0;
-                position[d] = st.set_position;
             }
         }
         let front = self.run.front().copied();

@@ -1067,3 +1067,72 @@ fn s4_3_a_path_prepared_off_the_cycle_runs_exactly_as_one_built_in_it() {
         assert_eq!(x.set_position, y.set_position);
     }
 }
+
+#[test]
+fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
+    let ccw = CircPathChoice::CounterClockwise;
+    let table = PathTable {
+        entries: vec![
+            lin(&[200.0, 0.0, 0.0], 3000.0),
+            circ(
+                CircMode::Center,
+                [200.0, -100.0, 0.0],
+                &[300.0, -100.0, 0.0],
+                ccw,
+                1000.0,
+            ),
+            circ(
+                CircMode::Center,
+                [400.0, -100.0, 0.0],
+                &[400.0, -200.0, 0.0],
+                ccw,
+                1000.0,
+            ),
+            lin(&[600.0, -200.0, 100.0], 3000.0),
+        ],
+    };
+    let axes = [
+        (GroupRole::X, params()),
+        (GroupRole::Y, params()),
+        (GroupRole::Z, params()),
+    ];
+    let a = analyse_path(&xyz(), &axes, [0.0; MAX_PATH_DIMS], &table, DT, 60.0, 500).unwrap();
+    assert!(!a.truncated);
+    let expected =
+        200.0 + std::f64::consts::PI * 100.0 + (200.0f64.powi(2) + 100.0f64.powi(2)).sqrt();
+    assert!(
+        (a.length - expected).abs() < 1e-6,
+        "{} vs {expected}",
+        a.length
+    );
+    assert!(a.samples.len() <= 500 && a.samples.len() > 100);
+    let last = a.samples.last().unwrap();
+    assert_eq!(&last.position[..3], &[600.0, -200.0, 100.0]);
+    assert!((last.t - a.duration).abs() < 1e-12);
+    // Every member within its limits (the rig's parameters: 500 u/s, 5000 u/s²).
+    assert!(
+        a.max_velocity[..3]
+            .iter()
+            .all(|v| *v <= 500.0 * (1.0 + 1e-9))
+    );
+    assert!(
+        a.max_acceleration[..3]
+            .iter()
+            .all(|v| *v <= 5000.0 * (1.0 + 1e-9))
+    );
+    // A table the group refuses names its entry.
+    let bad = PathTable {
+        entries: vec![
+            lin(&[1.0, 1.0, 1.0], 100.0),
+            circ(
+                CircMode::Border,
+                [5.0, 5.0, 5.0],
+                &[1.0, 1.0, 1.0],
+                ccw,
+                100.0,
+            ),
+        ],
+    };
+    let e = analyse_path(&xyz(), &axes, [0.0; MAX_PATH_DIMS], &bad, DT, 60.0, 500).unwrap_err();
+    assert_eq!((e.0, e.2), (1, ErrorId::CIRCLE_INVALID));
+}
