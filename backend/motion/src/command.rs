@@ -470,6 +470,10 @@ pub enum CommandKind {
         deceleration: crate::group::PathValue,
         jerk: crate::group::PathValue,
     },
+    /// MC_SetCoordinateTransform: later MovePaths are read in this frame.
+    SetCoordinateTransform {
+        transform: crate::group::CoordTransform,
+    },
     /// MC_ReleaseBlocker.
     ReleaseBlocker {
         blocker_id: u32,
@@ -551,6 +555,7 @@ impl CommandKind {
             CommandKind::GroupHalt { .. } => "halt",
             CommandKind::GroupStop { .. } => "stop",
             CommandKind::ReleaseBlocker { .. } => "release-blocker",
+            CommandKind::SetCoordinateTransform { .. } => "set-coordinate-transform",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
         }

@@ -42,6 +42,8 @@ impl AxisLimits {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathContext {
     pub config: GroupConfig,
+    /// The coordinate frame in effect for the table's first entry.
+    pub frame: CoordTransform,
     /// Per role dimension: the member's limits (None: no member).
     pub limits: [Option<AxisLimits>; MAX_PATH_DIMS],
     pub cycle_time: f64,
@@ -53,6 +55,8 @@ pub struct PreparedPath {
     pub(super) start: PathPoint,
     pub(super) context: PathContext,
     pub(super) items: Vec<Item>,
+    /// The frame after the table (its last frame switch).
+    pub(super) frame: CoordTransform,
 }
 
 impl PreparedPath {
@@ -73,13 +77,15 @@ pub fn prepare_path(
     table: &PathTable,
     start: PathPoint,
 ) -> Result<PreparedPath, (usize, &'static str, ErrorId)> {
-    table.check(ctx.config.axis_count())?;
-    let mut items = Vec::with_capacity(2 * table.entries.len());
-    build(ctx, 0, &table.entries, start, 0.0, &mut items).map_err(|(i, e)| (i, field_of(e), e))?;
+    table.check(ctx.config.axis_count(), ctx.config.convention.planar())?;
+    let mut items = Vec::with_capacity(2 * table.entries.len() + 1);
+    let frame = build(ctx, 0, &table.entries, start, 0.0, &mut items)
+        .map_err(|(i, e)| (i, field_of(e), e))?;
     Ok(PreparedPath {
         start,
         context: *ctx,
         items,
+        frame,
     })
 }
 
@@ -101,8 +107,9 @@ pub(super) fn build(
     start: PathPoint,
     s0: f64,
     out: &mut Vec<Item>,
-) -> Result<(), (usize, ErrorId)> {
+) -> Result<CoordTransform, (usize, ErrorId)> {
     out.clear();
+    let mut frame = ctx.frame;
     let limits = &ctx.limits;
     let roles: [Option<GroupRole>; MAX_PATH_DIMS] = {
         let mut r = [None; MAX_PATH_DIMS];
@@ -115,9 +122,8 @@ pub(super) fn build(
     let mut at = start;
     let mut s = s0;
     let mut prev: Option<Item> = None;
-    let n = entries.len();
     for (i, e) in entries.iter().enumerate() {
-        let last = i + 1 == n;
+        let last = false;
         let invoke_id = e.invoke_id();
         let base = Item {
             kind: ItemKind::Dwell(0.0),
@@ -139,6 +145,10 @@ pub(super) fn build(
             last,
         };
         let (seg, motion) = match *e {
+            PathEntry::CoordinateTransform { transform } => {
+                frame = transform;
+                continue;
+            }
             PathEntry::Blocker { blocker_id, .. } => {
                 out.push(Item {
                     kind: ItemKind::Blocker {
@@ -161,7 +171,7 @@ pub(super) fn build(
             PathEntry::Linear {
                 position, motion, ..
             } => {
-                let target = place(&roles, &position, at);
+                let target = placed(&roles, &position, at, &frame, ctx.config.convention);
                 let line =
                     path::Line::new(at, target).map_err(|_| (i, ErrorId::PARAMETER_NOT_CORRECT))?;
                 (Segment::Line(line), motion)
@@ -174,7 +184,12 @@ pub(super) fn build(
                 motion,
                 ..
             } => {
-                let target = place(&roles, &end_point, at);
+                let target = placed(&roles, &end_point, at, &frame, ctx.config.convention);
+                // A point of the circle is a point; a radius-mode normal is a direction.
+                let aux = match mode {
+                    path::CircMode::Radius => frame.rotate(aux),
+                    _ => frame.apply(aux),
+                };
                 let arc = path::Arc::new(mode, at, aux, target, path_choice, planar)
                     .map_err(|_| (i, ErrorId::CIRCLE_INVALID))?;
                 (Segment::Arc(arc), motion)
@@ -254,7 +269,31 @@ pub(super) fn build(
         out.push(item);
         prev = Some(item);
     }
-    Ok(())
+    // The MovePath is Done when its last item is passed; a table of frame switches only is
+    // Done at once (a dwell of 0).
+    match out.last_mut() {
+        Some(l) => l.last = true,
+        None => out.push(Item {
+            kind: ItemKind::Dwell(0.0),
+            s0: s,
+            len: 0.0,
+            limits: Limits {
+                velocity: 1.0,
+                acceleration: 1.0,
+                deceleration: 1.0,
+                jerk: 100.0,
+            },
+            corner: 0.0,
+            through: 0.0,
+            v_end: 0.0,
+            command: id,
+            entry: 0,
+            invoke_id: 0,
+            blend: false,
+            last: true,
+        }),
+    }
+    Ok(frame)
 }
 
 /// The entry's path dynamics, each lowered to what every member axis allows on `seg`
@@ -357,6 +396,24 @@ pub(super) fn join(
         s += it.len;
     }
     Ok(trim)
+}
+
+/// The table's vector read in `frame`: its X, Y, Z (those the convention has) are
+/// transformed into machine coordinates, C and the ADDAX axes are not.
+fn placed(
+    roles: &[Option<GroupRole>; MAX_PATH_DIMS],
+    v: &PathPoint,
+    at: PathPoint,
+    frame: &CoordTransform,
+    convention: AxesConvention,
+) -> PathPoint {
+    let mut p = place(roles, v, at);
+    if !frame.is_identity() {
+        let spatial = if convention.planar() { 2 } else { 3 };
+        let m = frame.apply([p[0], p[1], if spatial == 3 { p[2] } else { 0.0 }]);
+        p[..spatial].copy_from_slice(&m[..spatial]);
+    }
+    p
 }
 
 /// The table's vector (convention axes, then ADDAX1..n) placed into a path point; roles the

@@ -59,6 +59,68 @@ pub struct EntryMotion {
     pub transition_parameter_count: u8,
 }
 
+/// A coordinate frame (MC_SetCoordinateTransform, its Preparation entry): positions
+/// programmed after it are read in this frame. DIN 9300 Z″Y′X: the frame is rotated by
+/// `rotation[2]` about Z, then `rotation[1]` about the new Y, then `rotation[0]` about the
+/// new X (degrees), and shifted by `translation`: p_machine = R·p_programmed + t.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CoordTransform {
+    pub translation: [f64; 3],
+    pub rotation: [f64; 3],
+}
+
+impl CoordTransform {
+    pub fn is_identity(&self) -> bool {
+        *self == CoordTransform::default()
+    }
+
+    /// The rotation matrix R = Rz(r3)·Ry(r2)·Rx(r1).
+    fn matrix(&self) -> [[f64; 3]; 3] {
+        let [a, b, c] = self.rotation.map(f64::to_radians);
+        let (sa, ca) = a.sin_cos();
+        let (sb, cb) = b.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        [
+            [cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
+            [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
+            [-sb, cb * sa, cb * ca],
+        ]
+    }
+
+    /// A direction (a radius-mode normal) into machine coordinates.
+    pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
+        if self.rotation == [0.0; 3] {
+            return v;
+        }
+        let m = self.matrix();
+        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    }
+
+    /// A point into machine coordinates.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = self.rotate(p);
+        [0, 1, 2].map(|i| r[i] + self.translation[i])
+    }
+
+    /// Finite, and for a planar (XY) group a frame of that plane: no rotation about X or Y,
+    /// no shift in Z. The failing field.
+    pub fn check(&self, planar: bool) -> Result<(), &'static str> {
+        if self.translation.iter().any(|x| !x.is_finite()) {
+            return Err("translation");
+        }
+        if self.rotation.iter().any(|x| !x.is_finite()) {
+            return Err("rotation");
+        }
+        if planar && (self.rotation[0] != 0.0 || self.rotation[1] != 0.0) {
+            return Err("rotation");
+        }
+        if planar && self.translation[2] != 0.0 {
+            return Err("translation");
+        }
+        Ok(())
+    }
+}
+
 /// One row of a path table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PathEntry {
@@ -93,6 +155,9 @@ pub enum PathEntry {
         buffer_mode: BufferMode,
         invoke_id: u32,
     },
+    /// MC_SetCoordinateTransformPreparation: the entries after it are read in `transform`
+    /// (it neither stops the path nor breaks a blend: the geometry is in machine coordinates).
+    CoordinateTransform { transform: CoordTransform },
 }
 
 impl PathEntry {
@@ -102,6 +167,7 @@ impl PathEntry {
             | PathEntry::Circular { invoke_id, .. }
             | PathEntry::Blocker { invoke_id, .. }
             | PathEntry::Dwell { invoke_id, .. } => invoke_id,
+            PathEntry::CoordinateTransform { .. } => 0,
         }
     }
 
@@ -113,6 +179,8 @@ impl PathEntry {
             PathEntry::Blocker { buffer_mode, .. } | PathEntry::Dwell { buffer_mode, .. } => {
                 buffer_mode
             }
+            // Joins as the entry after it does: a frame switch is not a job of its own.
+            PathEntry::CoordinateTransform { .. } => BufferMode::Buffered,
         }
     }
 
@@ -137,8 +205,16 @@ impl PathEntry {
     /// Checks what does not depend on where the path starts (§7.3, §11 items 10–13):
     /// `first` = the first entry of its table; `axes` = the group's axis count.
     /// The field that fails and the error.
-    pub fn check(&self, first: bool, axes: usize) -> Result<(), (&'static str, ErrorId)> {
+    pub fn check(
+        &self,
+        first: bool,
+        axes: usize,
+        planar: bool,
+    ) -> Result<(), (&'static str, ErrorId)> {
         match *self {
+            PathEntry::CoordinateTransform { transform } => transform
+                .check(planar)
+                .map_err(|f| (f, ErrorId::PARAMETER_NOT_CORRECT)),
             PathEntry::Linear {
                 count,
                 motion,
@@ -277,13 +353,39 @@ pub struct PathTable {
 
 impl PathTable {
     /// Every entry checked (the first one as the first); the entry index, field and error.
-    pub fn check(&self, axes: usize) -> Result<(), (usize, &'static str, ErrorId)> {
-        if self.entries.is_empty() || self.entries.len() > MAX_PATH_ENTRIES {
+    pub fn check(&self, axes: usize, planar: bool) -> Result<(), (usize, &'static str, ErrorId)> {
+        if self.entries.is_empty() {
+            return Err((0, "entries", ErrorId::PARAMETER_NOT_CORRECT));
+        }
+        if self.entries.len() > MAX_PATH_ENTRIES {
             return Err((0, "entries", ErrorId::PATH_TOO_LONG));
         }
+        // The first entry that is a job decides how the table joins (§7.3); frame switches
+        // before it do not count.
+        let first_job = self
+            .entries
+            .iter()
+            .position(|e| !matches!(e, PathEntry::CoordinateTransform { .. }))
+            .unwrap_or(0);
         for (i, e) in self.entries.iter().enumerate() {
-            e.check(i == 0, axes).map_err(|(f, id)| (i, f, id))?;
+            e.check(i == first_job, axes, planar)
+                .map_err(|(f, id)| (i, f, id))?;
         }
         Ok(())
+    }
+
+    /// The BufferMode the table joins the queue with: its first job's.
+    pub fn joins_with(&self) -> BufferMode {
+        self.entries
+            .iter()
+            .find(|e| !matches!(e, PathEntry::CoordinateTransform { .. }))
+            .map_or(BufferMode::Buffered, PathEntry::buffer_mode)
+    }
+
+    /// The first job (its corner radii decide a blend from the queue).
+    pub fn first_job(&self) -> Option<&PathEntry> {
+        self.entries
+            .iter()
+            .find(|e| !matches!(e, PathEntry::CoordinateTransform { .. }))
     }
 }

@@ -87,6 +87,8 @@ pub struct GroupStatus {
     /// Where a MovePath appended now would start: the end of what is queued (the set point
     /// when nothing is). A path is prepared from it off the cycle thread.
     pub queue_end: PathPoint,
+    /// The coordinate frame later MovePaths are read in.
+    pub frame: CoordTransform,
 }
 
 /// A MovePath in flight.
@@ -135,6 +137,10 @@ pub struct Group {
     /// the running path stops (capacity reserved).
     pending: Option<CommandId>,
     pending_entries: Vec<PathEntry>,
+    pending_frame: CoordTransform,
+    /// MC_SetCoordinateTransform: the frame later MovePaths are read in (cleared by a halt
+    /// or a stop, §4.2).
+    frame: CoordTransform,
     status: GroupStatus,
 }
 
@@ -157,6 +163,8 @@ impl Group {
             prepared_taken: 0,
             pending: None,
             pending_entries: Vec::with_capacity(MAX_PATH_ENTRIES),
+            pending_frame: CoordTransform::default(),
+            frame: CoordTransform::default(),
             status: GroupStatus {
                 override_factor: 1.0,
                 actual_override: 1.0,
@@ -367,6 +375,14 @@ impl Group {
                 let (dec, jerk) = self.stop_dynamics(deceleration, jerk)?;
                 self.start_stop(id, locks, dec, jerk, axes, cycle, events)?;
             }
+            CommandKind::SetCoordinateTransform { transform } => {
+                transform
+                    .check(self.config.convention.planar())
+                    .map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
+                // For the MovePaths that follow (those already accepted keep theirs).
+                self.frame = transform;
+                self.done_at_once(events, cycle, id);
+            }
             CommandKind::ReleaseBlocker { blocker_id } => {
                 if blocker_id == 0 {
                     return Err(ErrorId::BLOCKER_ID_INVALID);
@@ -526,6 +542,8 @@ impl Group {
         // The queue is flushed: every MovePath is aborted; the stop runs over what is left.
         self.end_all_paths(cycle, events, aborted());
         self.pending = None;
+        // MC_GroupHalt and MC_GroupStop clear the coordinate transformation (§4.2).
+        self.frame = CoordTransform::default();
         self.run.brake(dec, jerk);
         self.stop = Some(StopCommand {
             id,
@@ -611,6 +629,7 @@ impl Group {
         }
         PathContext {
             config: self.config,
+            frame: self.frame,
             limits,
             cycle_time: self.cycle_time,
         }
@@ -638,12 +657,14 @@ impl Group {
             return Err(ErrorId::GROUP_STATE_INVALID);
         }
         let axis_count = self.config.axis_count();
-        table.check(axis_count).map_err(|(_, _, e)| e)?;
+        table
+            .check(axis_count, self.config.convention.planar())
+            .map_err(|(_, _, e)| e)?;
         if self.paths.iter().all(|p| p.is_some()) || self.run.free() < 2 * table.entries.len() + 2 {
             return Err(ErrorId::PATH_TOO_LONG);
         }
         let ctx = self.context(axes);
-        let first = table.entries[0].buffer_mode();
+        let first = table.joins_with();
         // A path during a stop's ramp starts where the stop ends, whatever its BufferMode.
         let aborting =
             (first == BufferMode::Aborting && !self.run.is_idle()) || self.run.is_braking();
@@ -659,6 +680,7 @@ impl Group {
             }
             self.pending_entries.clear();
             self.pending_entries.extend_from_slice(&table.entries);
+            self.pending_frame = self.frame;
             self.pending = Some(id);
             self.paths[0] = Some(PathCommand { id, out: busy() });
             self.event(events, cycle, id, busy());
@@ -676,23 +698,27 @@ impl Group {
                     s0: it.s0 + s0,
                     ..*it
                 }));
-                Ok(())
+                Ok(p.frame)
             }
             _ => {
                 build::build(&ctx, id, &table.entries, start, s0, &mut scratch).map_err(|(_, e)| e)
             }
         };
         // The blend from what is queued into the first entry.
-        let joined = built.and_then(|()| match (first, self.run.items.back().copied()) {
+        let joined = built.and_then(|frame| match (first, self.run.items.back().copied()) {
             (BufferMode::BlendingPrevious, Some(back)) => {
-                let radii = table.entries[0].corner_distance().unwrap_or((0.0, 0.0));
+                let radii = table
+                    .first_job()
+                    .and_then(PathEntry::corner_distance)
+                    .unwrap_or((0.0, 0.0));
                 build::join(&ctx, &back, radii, &mut scratch, |cut| {
                     self.blend_reachable(&back, cut)
                 })
+                .map(|t| (t, frame))
             }
-            _ => Ok(None),
+            _ => Ok((None, frame)),
         });
-        let back_trim = match joined {
+        let (back_trim, frame_after) = match joined {
             Ok(t) => t,
             Err(e) => {
                 self.scratch = scratch;
@@ -700,6 +726,7 @@ impl Group {
             }
         };
         // Accepted: nothing below fails.
+        self.frame = frame_after;
         if let Some(s) = self.stop.take() {
             // A MovePath during a halt's ramp takes over (§4.2: CommandAborted).
             self.event(events, cycle, s.id, aborted());
@@ -920,11 +947,17 @@ impl Group {
         cycle: u64,
         events: &mut impl EventSink,
     ) {
-        let ctx = self.context(axes);
+        let ctx = PathContext {
+            frame: self.pending_frame,
+            ..self.context(axes)
+        };
         let mut scratch = core::mem::take(&mut self.scratch);
         let (start, s0) = (self.run.point, self.run.s.position);
         match build::build(&ctx, id, &self.pending_entries, start, s0, &mut scratch) {
-            Ok(()) => self.run.append(scratch.drain(..)),
+            Ok(frame) => {
+                self.frame = frame;
+                self.run.append(scratch.drain(..));
+            }
             Err((_, e)) => self.end_path(id, cycle, events, failed(e)),
         }
         self.scratch = scratch;
@@ -1014,6 +1047,7 @@ impl Group {
             queued_entries: self.run.entries,
             position,
             queue_end: self.run.end_point(),
+            frame: self.frame,
         };
     }
 }

@@ -93,6 +93,7 @@ fn with_invoke(mut e: PathEntry, id: u32) -> PathEntry {
         | PathEntry::Circular { invoke_id, .. }
         | PathEntry::Blocker { invoke_id, .. }
         | PathEntry::Dwell { invoke_id, .. } => *invoke_id = id,
+        PathEntry::CoordinateTransform { .. } => {}
     }
     e
 }
@@ -1135,4 +1136,64 @@ fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
     };
     let e = analyse_path(&xyz(), &axes, [0.0; MAX_PATH_DIMS], &bad, DT, 60.0, 500).unwrap_err();
     assert_eq!((e.0, e.2), (1, ErrorId::CIRCLE_INVALID));
+}
+
+#[test]
+fn s4_1_set_coordinate_transform_reads_later_paths_in_the_frame_and_a_halt_clears_it() {
+    let mut r = rig_xy();
+    enable(&mut r);
+    let frame = CoordTransform {
+        translation: [100.0, 50.0, 0.0],
+        rotation: [0.0, 0.0, 90.0],
+    };
+    r.gok(G, CommandKind::SetCoordinateTransform { transform: frame });
+    assert_eq!(r.gst(G).frame, frame);
+    // (10, 0) in the frame rotated by 90° about Z and shifted: (100, 60) in the machine.
+    let p = r.path_ok(G, vec![lin(&[10.0, 0.0], 200.0)]);
+    run_done(&mut r, p, 5.0);
+    assert!((at(&r, 0) - 100.0).abs() < 1e-12 && (at(&r, 1) - 60.0).abs() < 1e-12);
+    // A frame of another plane is refused by an XY group.
+    let tilted = CoordTransform {
+        rotation: [10.0, 0.0, 0.0],
+        ..CoordTransform::default()
+    };
+    let e = r.grejected(G, CommandKind::SetCoordinateTransform { transform: tilted });
+    assert_eq!(e, ErrorId::PARAMETER_NOT_CORRECT);
+    // A halt clears it (§4.2): later paths are in machine coordinates again.
+    let h = r.gok(G, halt());
+    r.until(0.1, |r| r.out(h).done);
+    assert!(r.gst(G).frame.is_identity());
+    let p = r.path_ok(G, vec![lin(&[10.0, 0.0], 200.0)]);
+    run_done(&mut r, p, 5.0);
+    assert_eq!((at(&r, 0), at(&r, 1)), (10.0, 0.0));
+}
+
+#[test]
+fn s4_1_a_frame_switch_inside_a_table_applies_to_the_entries_after_it_without_stopping() {
+    let mut r = rig_xy();
+    enable(&mut r);
+    let shifted = CoordTransform {
+        translation: [0.0, 100.0, 0.0],
+        rotation: [0.0; 3],
+    };
+    let p = r.path_ok(
+        G,
+        vec![
+            lin(&[100.0, 0.0], 200.0),
+            PathEntry::CoordinateTransform { transform: shifted },
+            // (100, 0) in the shifted frame: (100, 100), blended into.
+            lin_blend(&[100.0, 0.0], 200.0, 10.0),
+        ],
+    );
+    run_done(&mut r, p, 5.0);
+    assert_eq!((at(&r, 0), at(&r, 1)), (100.0, 100.0));
+    let min_v = r.history[0]
+        .iter()
+        .zip(r.history[1].iter())
+        .filter(|(x, y)| x.set_position > 95.0 && y.set_position > 0.0 && y.set_position < 5.0)
+        .map(|(x, y)| x.set_velocity.hypot(y.set_velocity))
+        .fold(f64::INFINITY, f64::min);
+    assert!(min_v > 10.0, "stopped at the frame switch: {min_v}");
+    // The frame stays in effect after the table.
+    assert_eq!(r.gst(G).frame, shifted);
 }
