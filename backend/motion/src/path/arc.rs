@@ -142,6 +142,7 @@ impl Arc {
             bounds: SegmentBounds {
                 d1_max: [0.0; MAX_PATH_DIMS],
                 d2_max: [0.0; MAX_PATH_DIMS],
+                d3_max: [0.0; MAX_PATH_DIMS],
                 lo: [0.0; MAX_PATH_DIMS],
                 hi: [0.0; MAX_PATH_DIMS],
                 curvature_max: 1.0 / radius,
@@ -279,6 +280,9 @@ impl Arc {
             bounds.d1_max[i] = lo.abs().max(hi.abs())
                 + ((self.end_fix[i] - self.start_fix[i]) / length).abs()
                 + ulps;
+            // d³p/ds³ = −(dp/ds of the circle)/r²: the end correction is linear in s and
+            // has none.
+            bounds.d3_max[i] = (lo.abs().max(hi.abs()) + ulps) / (self.radius * self.radius);
             let (lo, hi) = sinusoid_range(u, v, self.sweep);
             bounds.d2_max[i] = (lo.abs().max(hi.abs()) + ulps) / self.radius;
         }
@@ -287,6 +291,7 @@ impl Arc {
             bounds.hi[i] = self.start[i].max(self.end[i]);
             bounds.d1_max[i] = (self.end[i] - self.start[i]).abs() / length;
             bounds.d2_max[i] = 0.0;
+            bounds.d3_max[i] = 0.0;
         }
         bounds.curvature_max = (1.0 + 8.0 * f64::EPSILON) / self.radius;
         bounds

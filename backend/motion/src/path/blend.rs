@@ -10,9 +10,19 @@
 //! The Hermite tangent scale is the chord between the cut points: the curve then takes
 //! about the chord's length in u, so u is nearly proportional to arc length and the curve
 //! stays inside the corner instead of overshooting it (for two lines every Bézier control
-//! point lies within max(r_in, r_out) of the corner). The path runs by arc length, so a
-//! fixed table u ↔ s (64 intervals, 5-point Gauss–Legendre in each) is built once, and
-//! sampling refines u by Newton steps on the exact integral.
+//! point lies within max(r_in, r_out) of the corner).
+//!
+//! Arc length: a table of s at u = k/32 (5-point Gauss–Legendre per interval) is built once.
+//! Sampling guesses u(s) by the cubic Hermite through the neighbouring table nodes with the
+//! slopes du/ds = 1/|dp/du| there (error O(Δu⁴)), and one Newton step on the exact integral
+//! squares that error away.
+//!
+//! Bounds are true bounds, not sampled estimates: the window is cut into pieces in u; on
+//! each piece the polynomial's derivatives are enclosed by their Taylor expansions about the
+//! piece's middle, and interval arithmetic carries those through the chain rule to
+//! d²p/ds² and d³p/ds³ (see [`Blend::enclose`]). d³p/ds³ is bounded by that enclosure
+//! directly; the lower derivatives and the positions by their exact values at the piece's
+//! ends plus what the enclosure of their derivative allows in between, which is tighter.
 
 use super::vector::{cartesian, norm, sub};
 use super::{
@@ -20,14 +30,21 @@ use super::{
     extra_travel, trim_window,
 };
 
-/// Intervals of the u ↔ s table.
-const TABLE_INTERVALS: usize = 64;
-/// Samples (uniform in u) for the bounds, refined where d2 changes fast. With the margins
-/// of `compute_bounds` they are true bounds; dense enough that the margins stay small.
-const BOUND_SAMPLES: usize = 512;
-/// Newton steps on u. The table's linear guess is within (Δu)²; two steps reach rounding,
-/// the third is insurance at strongly curved places.
-const NEWTON_STEPS: usize = 3;
+/// Most intervals of the u ↔ s table. It starts with [`TABLE_START`] equal intervals in u and
+/// halves each until 5-point Gauss–Legendre on it agrees with the sum over its halves to
+/// [`TABLE_TOLERANCE`] of its length: the speed of a quintic is smooth, except that near a
+/// sharp turn it dips towards 0 and its square root then needs short intervals.
+const TABLE_CAPACITY: usize = 48;
+const TABLE_START: usize = 8;
+/// Nodes are multiples of 1/TABLE_UNIT in u (exact in a u16).
+const TABLE_UNIT: f64 = 32768.0;
+const TABLE_TOLERANCE: f64 = 1e-13;
+/// Most Newton steps on u per sample (see [`Blend::parameter_at`]).
+const NEWTON_STEPS: usize = 4;
+/// Pieces in u of the bounds computation; a piece whose enclosure is loose (the speed's
+/// lower bound far below its values at the ends) is halved up to [`BOUND_DEPTH`] times.
+const BOUND_PIECES: usize = 32;
+const BOUND_DEPTH: u32 = 6;
 /// How often the radii are halved when the quintic for them runs into a cusp; a corner
 /// that still fails turns back on itself (exact stop).
 const SHRINK_TRIES: usize = 4;
@@ -37,9 +54,12 @@ const TANGENT_CONTINUOUS: f64 = 1e-9;
 /// full reversal the Hermite curve runs into a cusp where arc length cannot parametrise it
 /// (and curvature would be unbounded), so such corners get no blend (exact stop).
 const MIN_SPEED_RATIO: f64 = 0.02;
+/// Relative slack on every bound: covers the rounding of the samples and of the interval
+/// arithmetic (which rounds to nearest, not outwards).
+const BOUND_SLACK: f64 = 1e-9;
 
 /// 5-point Gauss–Legendre on [-1, 1]: exact for polynomials of degree 9, and the speed of a
-/// quintic is smooth, so 64 intervals give the arc length to rounding.
+/// quintic is smooth, so 32 intervals give the arc length to rounding.
 const GAUSS_NODES: [f64; 5] = [
     0.0,
     -0.538_469_310_105_683_1,
@@ -66,8 +86,10 @@ pub struct Blend {
     /// Path length measured in X, Y, Z; false for a corner of C / additional axes only,
     /// measured as the largest extra-dim rate (the length rule of lines and arcs).
     cartesian: bool,
-    /// s at u = k / TABLE_INTERVALS.
-    table: [f64; TABLE_INTERVALS + 1],
+    /// The table's nodes u_k · TABLE_UNIT and s at them; `intervals` of them are used.
+    nodes: [u16; TABLE_CAPACITY + 1],
+    table: [f64; TABLE_CAPACITY + 1],
+    intervals: usize,
     /// Where this (possibly trimmed) piece starts on the full curve's s.
     window_start: f64,
     length: f64,
@@ -159,6 +181,17 @@ fn is_cartesian(d1: &PathPoint) -> bool {
     d1[..CARTESIAN_DIMS].iter().map(|x| x * x).sum::<f64>() > 0.25
 }
 
+fn empty_bounds() -> SegmentBounds {
+    SegmentBounds {
+        d1_max: [0.0; MAX_PATH_DIMS],
+        d2_max: [0.0; MAX_PATH_DIMS],
+        d3_max: [0.0; MAX_PATH_DIMS],
+        lo: [0.0; MAX_PATH_DIMS],
+        hi: [0.0; MAX_PATH_DIMS],
+        curvature_max: 0.0,
+    }
+}
+
 impl Blend {
     /// The quintic Hermite from `from` to `to`, dp/du = T·dp/ds and d²p/du² = T²·d²p/ds² at
     /// both ends (so that dp/ds and d²p/ds² match after re-parametrising by arc length, as
@@ -189,36 +222,31 @@ impl Blend {
             origin: from.position,
             coeff,
             cartesian,
-            table: [0.0; TABLE_INTERVALS + 1],
+            nodes: [0; TABLE_CAPACITY + 1],
+            table: [0.0; TABLE_CAPACITY + 1],
+            intervals: 0,
             window_start: 0.0,
             length: 0.0,
             start: from.position,
             end: to.position,
-            bounds: SegmentBounds {
-                d1_max: [0.0; MAX_PATH_DIMS],
-                d2_max: [0.0; MAX_PATH_DIMS],
-                lo: [0.0; MAX_PATH_DIMS],
-                hi: [0.0; MAX_PATH_DIMS],
-                curvature_max: 0.0,
-            },
+            bounds: empty_bounds(),
         };
-        let h = 1.0 / TABLE_INTERVALS as f64;
-        let mut slowest = f64::INFINITY;
-        for k in 0..TABLE_INTERVALS {
-            let u = k as f64 * h;
-            blend.table[k + 1] = blend.table[k] + blend.arc_length(u, u + h);
-            for j in 0..8 {
-                slowest = slowest.min(blend.speed(u + h * j as f64 / 8.0));
-            }
+        let step = (TABLE_UNIT as usize / TABLE_START) as u16;
+        for k in 0..TABLE_START {
+            blend.tabulate(k as u16 * step, (k as u16 + 1) * step)?;
         }
-        slowest = slowest.min(blend.speed(1.0));
-        // Written so that a NaN speed also refuses the blend.
-        let fast_enough = slowest >= MIN_SPEED_RATIO * t;
-        if !fast_enough || !blend.table[TABLE_INTERVALS].is_finite() {
+        blend.length = blend.table[blend.intervals];
+        if !blend.length.is_finite() {
             return None;
         }
-        blend.length = blend.table[TABLE_INTERVALS];
-        blend.bounds = blend.compute_bounds();
+        let min_speed = MIN_SPEED_RATIO * t;
+        let (bounds, slowest) = blend.compute_bounds(0.0, 1.0, min_speed)?;
+        // Written so that a NaN speed also refuses the blend.
+        let fast_enough = slowest >= min_speed;
+        if !fast_enough {
+            return None;
+        }
+        blend.bounds = bounds;
         Some(blend)
     }
 
@@ -240,7 +268,7 @@ impl Blend {
 
     pub fn sample(&self, s: f64) -> PathSample {
         let s = clamp_s(s, self.length);
-        let mut sample = self.sample_curve(self.window_start + s);
+        let mut sample = self.curve_at(self.parameter_at(self.window_start + s)).0;
         // The ends exactly as cut, so that the neighbours join bit-identically.
         if s >= self.length {
             sample.position = self.end;
@@ -257,7 +285,15 @@ impl Blend {
         piece.end = self.sample(b).position;
         piece.window_start = self.window_start + a;
         piece.length = b - a;
-        piece.bounds = piece.compute_bounds();
+        let (u0, u1) = (
+            self.parameter_at(piece.window_start),
+            self.parameter_at(piece.window_start + piece.length),
+        );
+        // The parent's bounds hold for any part of it; a part's own are tighter.
+        piece.bounds = match piece.compute_bounds(u0, u1, 0.0) {
+            Some((bounds, _)) => bounds,
+            None => self.bounds,
+        };
         piece
     }
 
@@ -277,32 +313,27 @@ impl Blend {
         (p, p1, p2)
     }
 
-    /// dp/du in the dims that measure the path length (the others stay 0): the arc-length
-    /// integral evaluates it many times per sample.
-    fn velocity(&self, u: f64) -> PathPoint {
-        let c = &self.coeff;
-        let mut p1 = [0.0; MAX_PATH_DIMS];
-        let measuring = if self.cartesian {
-            0..CARTESIAN_DIMS
-        } else {
-            CARTESIAN_DIMS..MAX_PATH_DIMS
-        };
-        for (i, v) in p1
-            .iter_mut()
-            .enumerate()
-            .take(measuring.end)
-            .skip(measuring.start)
-        {
-            *v = c[0][i]
-                + u * (2.0 * c[1][i]
-                    + u * (3.0 * c[2][i] + u * (4.0 * c[3][i] + u * 5.0 * c[4][i])));
-        }
-        p1
+    /// Whether dim `i` measures the path length (|dp_i/ds| ≤ 1 there).
+    fn measures(&self, i: usize) -> bool {
+        (i < CARTESIAN_DIMS) == self.cartesian
     }
 
-    /// ds/du.
+    /// ds/du: |dp/du| over X, Y, Z, or the largest extra-dim rate.
     fn speed(&self, u: f64) -> f64 {
-        self.speed_of(&self.velocity(u)).0
+        let c = &self.coeff;
+        let rate = |i: usize| {
+            c[0][i]
+                + u * (2.0 * c[1][i]
+                    + u * (3.0 * c[2][i] + u * (4.0 * c[3][i] + u * 5.0 * c[4][i])))
+        };
+        if self.cartesian {
+            let (x, y, z) = (rate(0), rate(1), rate(2));
+            (x * x + y * y + z * z).sqrt()
+        } else {
+            (CARTESIAN_DIMS..MAX_PATH_DIMS)
+                .map(|i| rate(i).abs())
+                .fold(0.0, f64::max)
+        }
     }
 
     /// ds/du from dp/du, and for an extra-dims blend the dim that sets it (whose d²p/du²
@@ -340,34 +371,66 @@ impl Blend {
             * half
     }
 
-    /// The u at which the full curve has run path length `s`.
+    /// Appends [a, b] (in table units) to the table, halved as often as needed; None when
+    /// the table is full (a corner so sharp that the speed nearly vanishes).
+    fn tabulate(&mut self, a: u16, b: u16) -> Option<()> {
+        let (ua, ub) = (f64::from(a) / TABLE_UNIT, f64::from(b) / TABLE_UNIT);
+        let whole = self.arc_length(ua, ub);
+        let m = a + (b - a) / 2;
+        if b - a > 1 {
+            let um = f64::from(m) / TABLE_UNIT;
+            let halves = self.arc_length(ua, um) + self.arc_length(um, ub);
+            // Written so that NaN bisects down to the capacity and fails there.
+            if !((whole - halves).abs() <= TABLE_TOLERANCE * whole) {
+                self.tabulate(a, m)?;
+                return self.tabulate(m, b);
+            }
+        }
+        if self.intervals == TABLE_CAPACITY {
+            return None;
+        }
+        self.table[self.intervals + 1] = self.table[self.intervals] + whole;
+        self.intervals += 1;
+        self.nodes[self.intervals] = b;
+        Some(())
+    }
+
+    /// The u at which the full curve has run path length `s`: the cubic Hermite guess from
+    /// the table (s and du/ds at the interval's ends), then one Newton step on the exact
+    /// integral.
     fn parameter_at(&self, s: f64) -> f64 {
-        let total = self.table[TABLE_INTERVALS];
+        let n = self.intervals;
+        let total = self.table[n];
         if s <= 0.0 {
             return 0.0;
         }
         if s >= total {
             return 1.0;
         }
-        let k = self
-            .table
-            .partition_point(|&x| x <= s)
-            .clamp(1, TABLE_INTERVALS)
-            - 1;
-        let h = 1.0 / TABLE_INTERVALS as f64;
-        let (u_lo, u_hi) = (k as f64 * h, (k + 1) as f64 * h);
+        let k = self.table[..=n].partition_point(|&x| x <= s).clamp(1, n) - 1;
+        let u_lo = f64::from(self.nodes[k]) / TABLE_UNIT;
+        let u_hi = f64::from(self.nodes[k + 1]) / TABLE_UNIT;
+        let h = u_hi - u_lo;
         let (s_lo, s_hi) = (self.table[k], self.table[k + 1]);
-        let mut u = u_lo + (s - s_lo) / (s_hi - s_lo) * h;
+        let ds = s_hi - s_lo;
+        let t = (s - s_lo) / ds;
+        // Slopes of u(t) on [0, 1] in units of h: (ds/h)/σ at both ends.
+        let (m0, m1) = (ds / (h * self.speed(u_lo)), ds / (h * self.speed(u_hi)));
+        let guess = t * t * (3.0 - 2.0 * t) + t * (1.0 - t) * ((1.0 - t) * m0 - t * m1);
+        let mut u = (u_lo + h * guess).clamp(u_lo, u_hi);
+        // Newton converges quadratically: after a step of δ the error is about
+        // (σ'/2σ)·δ², so a step below 1e-7 of the interval leaves rounding. One step is the
+        // rule; where the speed changes fast the guess is worse and another follows.
         for _ in 0..NEWTON_STEPS {
             let error = s_lo + self.arc_length(u_lo, u) - s;
-            u = (u - error / self.speed(u)).clamp(u_lo, u_hi);
+            let next = (u - error / self.speed(u)).clamp(u_lo, u_hi);
+            let step = (next - u).abs();
+            u = next;
+            if !(step > 1e-7 * h) {
+                break;
+            }
         }
         u
-    }
-
-    /// Sample of the full (untrimmed) curve at its path length `s`.
-    fn sample_curve(&self, s: f64) -> PathSample {
-        self.curve_at(self.parameter_at(s)).0
     }
 
     /// Position, dp/ds, d²p/ds² at parameter `u`, and ds/du there.
@@ -385,150 +448,423 @@ impl Blend {
             d1: [0.0; MAX_PATH_DIMS],
             d2: [0.0; MAX_PATH_DIMS],
         };
+        let inverse = 1.0 / speed;
         for i in 0..MAX_PATH_DIMS {
             sample.position[i] = self.origin[i] + p[i];
-            sample.d1[i] = p1[i] / speed;
-            sample.d2[i] = (p2[i] - sample.d1[i] * acceleration) / (speed * speed);
+            sample.d1[i] = p1[i] * inverse;
+            sample.d2[i] = (p2[i] - sample.d1[i] * acceleration) * inverse * inverse;
         }
         (sample, speed)
     }
 
-    /// Dense samples in u plus margins that cover what can happen between them: a value
-    /// whose derivative is at most D moves at most D·Δs/2 away from the nearer sample (a
-    /// position, whose slope is 0 at an extreme, at most d2·Δs²/8). For d2, whose derivative
-    /// is not at hand, intervals where it changes by more than a thousandth of its range are
-    /// bisected until it does not, and the largest remaining change is the margin: a sharp
-    /// curvature peak near a short r_out is found, not stepped over.
-    fn compute_bounds(&self) -> SegmentBounds {
-        let u0 = self.parameter_at(self.window_start);
-        let u1 = self.parameter_at(self.window_start + self.length);
-        let du = (u1 - u0) / BOUND_SAMPLES as f64;
-        // First pass: the scale of d2 in each dim, which sets where to refine.
-        let mut scan = Scan::new(self.start);
-        for k in 0..=BOUND_SAMPLES {
-            let (q, speed) = self.curve_at(u0 + du * k as f64);
-            scan.take(&q, speed);
-        }
-        let mut refine = RefineLimits {
-            d2: [0.0; MAX_PATH_DIMS],
-            curvature: 1e-3 * scan.curvature_max + 1e-12,
+    /// True bounds over u in [u0, u1] (the window of this piece), and a lower bound of the
+    /// speed ds/du that is at least `min_speed` if the speed stays above it (pieces where the
+    /// enclosure cannot tell are halved). None when the speed cannot be shown to stay
+    /// positive (a cusp: arc length cannot parametrise the curve there).
+    ///
+    /// On a piece [a, b] of width w in u, with the enclosure of [`Blend::enclose`]:
+    /// - d³p_i/ds³: the enclosure itself.
+    /// - d²p_i/ds²: its values at a and b plus w/2 · max|d/du d²p_i/ds²| = w/2 · max|σ·d³p_i|
+    ///   (σ = ds/du): a function cannot get further from both ends than its slope allows.
+    ///   Where the leading dim of an extra-dims blend may change inside the piece d² jumps
+    ///   there, and only the direct enclosure of d² counts.
+    /// - dp_i/ds: likewise with max|σ·d²p_i|.
+    /// - positions: an interior extreme has slope 0, so it is at most w²/8 · max|d²p_i/du²|
+    ///   beyond the nearer end.
+    /// - curvature |d²p_xyz/ds²|: the ends plus w/2 · σ·|d³p_xyz| (or its enclosure).
+    fn compute_bounds(&self, u0: f64, u1: f64, min_speed: f64) -> Option<(SegmentBounds, f64)> {
+        let mut acc = Accumulator {
+            bounds: empty_bounds(),
+            slowest: f64::INFINITY,
+            min_speed,
         };
-        let d2_scale = scan.d2_max.iter().fold(0.0f64, |m, x| m.max(*x));
-        for (limit, d2) in refine.d2.iter_mut().zip(scan.d2_max) {
-            *limit = 1e-3 * d2 + 1e-12 * d2_scale + 1e-300;
-        }
-        let speed_max = scan.speed_max;
-        let mut scan = Scan::new(self.start);
+        acc.bounds.lo = self.start;
+        acc.bounds.hi = self.start;
         let mut left = self.curve_at(u0);
-        scan.take(&left.0, left.1);
-        for k in 0..BOUND_SAMPLES {
-            let (ua, ub) = (u0 + du * k as f64, u0 + du * (k + 1) as f64);
-            let right = self.curve_at(ub);
-            self.refine(ua, &left.0, ub, &right, REFINE_DEPTH, &refine, &mut scan);
+        acc.take(&left);
+        let du = (u1 - u0) / BOUND_PIECES as f64;
+        for k in 0..BOUND_PIECES {
+            let b = if k + 1 == BOUND_PIECES {
+                u1
+            } else {
+                u0 + du * (k + 1) as f64
+            };
+            let a = u0 + du * k as f64;
+            let right = self.curve_at(b);
+            self.bound_piece(a, &left, b, &right, BOUND_DEPTH, &mut acc)?;
             left = right;
         }
-        // Path length between neighbouring samples, with room for the speed to peak
-        // between the samples that measured it.
-        let step = scan.widest * speed_max.max(scan.speed_max) * 1.1;
-        let mut bounds = SegmentBounds {
-            d1_max: [0.0; MAX_PATH_DIMS],
-            d2_max: [0.0; MAX_PATH_DIMS],
-            lo: [0.0; MAX_PATH_DIMS],
-            hi: [0.0; MAX_PATH_DIMS],
-            curvature_max: scan.curvature_max * (1.0 + 1e-9) + scan.curvature_change,
-        };
+        let mut bounds = acc.bounds;
+        let grow = 1.0 + BOUND_SLACK;
+        let d2_scale = bounds.d2_max.iter().fold(0.0f64, |m, x| m.max(*x));
+        let d3_scale = bounds.d3_max.iter().fold(0.0f64, |m, x| m.max(*x));
         for i in 0..MAX_PATH_DIMS {
-            bounds.d2_max[i] = scan.d2_max[i] * (1.0 + 1e-9) + scan.d2_change[i];
-            bounds.d1_max[i] = scan.d1_max[i] * (1.0 + 1e-9) + bounds.d2_max[i] * step / 2.0;
-            let drift = bounds.d2_max[i] * step * step / 8.0
-                + 1e-12 * (scan.lo[i].abs() + scan.hi[i].abs());
-            bounds.lo[i] = scan.lo[i].min(self.start[i]).min(self.end[i]) - drift;
-            bounds.hi[i] = scan.hi[i].max(self.start[i]).max(self.end[i]) + drift;
+            bounds.d1_max[i] = bounds.d1_max[i] * grow + 1e-15;
+            bounds.d2_max[i] = bounds.d2_max[i] * grow + 1e-12 * d2_scale;
+            bounds.d3_max[i] = bounds.d3_max[i] * grow + 1e-12 * d3_scale;
+            bounds.lo[i] = bounds.lo[i].min(self.start[i]).min(self.end[i]);
+            bounds.hi[i] = bounds.hi[i].max(self.start[i]).max(self.end[i]);
+            let slack = 1e-12 * (bounds.lo[i].abs() + bounds.hi[i].abs());
+            bounds.lo[i] -= slack;
+            bounds.hi[i] += slack;
         }
-        bounds
+        bounds.curvature_max *= grow;
+        Some((bounds, acc.slowest))
     }
 
-    #[allow(
-        clippy::too_many_arguments,
-        reason = "one bisection step: interval, its end samples, depth, limits and the accumulator"
-    )]
-    fn refine(
+    fn bound_piece(
         &self,
-        ua: f64,
-        a: &PathSample,
-        ub: f64,
-        b: &(PathSample, f64),
+        a: f64,
+        left: &(PathSample, f64),
+        b: f64,
+        right: &(PathSample, f64),
         depth: u32,
-        limits: &RefineLimits,
-        scan: &mut Scan,
-    ) {
-        let (q, _) = b;
-        let too_coarse = (0..MAX_PATH_DIMS).any(|i| (q.d2[i] - a.d2[i]).abs() > limits.d2[i])
-            || (norm(&cartesian(&q.d2)) - norm(&cartesian(&a.d2))).abs() > limits.curvature;
-        if depth > 0 && too_coarse {
-            let um = (ua + ub) / 2.0;
-            let middle = self.curve_at(um);
-            self.refine(ua, a, um, &middle, depth - 1, limits, scan);
-            self.refine(um, &middle.0, ub, b, depth - 1, limits, scan);
-            return;
+        acc: &mut Accumulator,
+    ) -> Option<()> {
+        let e = self.enclose(a, b);
+        let slow_end = left.1.min(right.1);
+        let loose = !(e.speed.lo > 0.5 * slow_end)
+            || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed);
+        if depth > 0 && loose {
+            let m = (a + b) / 2.0;
+            let middle = self.curve_at(m);
+            self.bound_piece(a, left, m, &middle, depth - 1, acc)?;
+            self.bound_piece(m, &middle, b, right, depth - 1, acc)?;
+            return Some(());
         }
-        scan.widest = scan.widest.max(ub - ua);
+        if !(e.speed.lo > 0.0) {
+            return None;
+        }
+        if e.speed.lo < acc.min_speed {
+            acc.slowest = acc.slowest.min(e.speed.lo);
+        }
+        acc.take(right);
+        let half = (b - a) / 2.0;
+        let ends = |f: fn(&PathSample) -> &PathPoint, i: usize| {
+            f(&left.0)[i].abs().max(f(&right.0)[i].abs())
+        };
+        let bounds = &mut acc.bounds;
+        let mut d3_xyz = 0.0;
         for i in 0..MAX_PATH_DIMS {
-            scan.d2_change[i] = scan.d2_change[i].max((q.d2[i] - a.d2[i]).abs());
+            let d3 = e.d3[i].magnitude();
+            bounds.d3_max[i] = bounds.d3_max[i].max(d3);
+            if i < CARTESIAN_DIMS {
+                d3_xyz += d3 * d3;
+            }
+            let mut d2 = e.d2[i].magnitude();
+            if e.single_lead {
+                d2 = d2.min(ends(|q| &q.d2, i) + half * e.speed.mul(e.d3[i]).magnitude());
+            }
+            bounds.d2_max[i] = bounds.d2_max[i].max(d2);
+            let d1 = ends(|q| &q.d1, i) + half * e.speed.mul(e.d2[i]).magnitude();
+            let d1 = if self.measures(i) { d1.min(1.0) } else { d1 };
+            bounds.d1_max[i] = bounds.d1_max[i].max(d1);
+            let drift = half * half / 2.0 * e.p2[i].magnitude();
+            bounds.lo[i] = bounds.lo[i].min(left.0.position[i].min(right.0.position[i]) - drift);
+            bounds.hi[i] = bounds.hi[i].max(left.0.position[i].max(right.0.position[i]) + drift);
         }
-        scan.curvature_change = scan
-            .curvature_change
-            .max((norm(&cartesian(&q.d2)) - norm(&cartesian(&a.d2))).abs());
-        scan.take(q, b.1);
+        let direct = (0..CARTESIAN_DIMS)
+            .map(|i| e.d2[i].magnitude().powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let curvature_ends = norm(&cartesian(&left.0.d2)).max(norm(&cartesian(&right.0.d2)));
+        let curvature = direct.min(curvature_ends + half * e.speed.hi * d3_xyz.sqrt());
+        bounds.curvature_max = bounds.curvature_max.max(curvature);
+        Some(())
+    }
+
+    /// Enclosures over u in [a, b] of σ = ds/du, d²p/du² and (chain rule, σ₁ = dσ/du,
+    /// σ₂ = d²σ/du², d1 = p'/σ):
+    ///
+    /// - d²p/ds² = (p'' − d1·σ₁) / σ²
+    /// - d³p/ds³ = (p''' − 3σ₁σ·d²p/ds² − d1·σ₂) / σ³
+    ///
+    /// (differentiate d² = p''/σ² − p'σ₁/σ³ once more in u and divide by σ). In X, Y, Z,
+    /// σ² = |p'|², σσ₁ = p'·p'' =: g and σ₂ = (g' − σ₁²)/σ with g' = |p''|² + p'·p'''.
+    /// For extra dims σ = |p'_L| of the leading dim L, σ₁ = ±p''_L, σ₂ = ±p'''_L, taken over
+    /// every dim that may lead inside the piece.
+    ///
+    /// The derivatives of p are enclosed by their Taylor polynomials about the middle of the
+    /// piece (exact for the polynomial; even powers of the offset are ≥ 0).
+    fn enclose(&self, a: f64, b: f64) -> Enclosure {
+        let middle = (a + b) / 2.0;
+        let r = (b - a) / 2.0;
+        let mut p1 = [Iv::ZERO; MAX_PATH_DIMS];
+        let mut p2 = [Iv::ZERO; MAX_PATH_DIMS];
+        let mut p3 = [Iv::ZERO; MAX_PATH_DIMS];
+        for i in 0..MAX_PATH_DIMS {
+            // Taylor shift of p(u) − origin to u = middle + x: t[k] = p⁽ᵏ⁾(middle)/k!.
+            let mut t = [
+                0.0,
+                self.coeff[0][i],
+                self.coeff[1][i],
+                self.coeff[2][i],
+                self.coeff[3][i],
+                self.coeff[4][i],
+            ];
+            if t.iter().all(|&x| x == 0.0) {
+                continue;
+            }
+            for j in 0..5 {
+                for m in (j..5).rev() {
+                    t[m] += middle * t[m + 1];
+                }
+            }
+            p1[i] = taylor_range(&[t[1], 2.0 * t[2], 3.0 * t[3], 4.0 * t[4], 5.0 * t[5]], r);
+            p2[i] = taylor_range(&[2.0 * t[2], 6.0 * t[3], 12.0 * t[4], 20.0 * t[5]], r);
+            p3[i] = taylor_range(&[6.0 * t[3], 24.0 * t[4], 60.0 * t[5]], r);
+        }
+        let (speed, s1, s2, single_lead) = if self.cartesian {
+            let mut square = Iv::ZERO;
+            let mut g = Iv::ZERO;
+            let mut g1 = Iv::ZERO;
+            for i in 0..CARTESIAN_DIMS {
+                square = square.add(p1[i].square());
+                g = g.add(p1[i].mul(p2[i]));
+                g1 = g1.add(p2[i].square()).add(p1[i].mul(p3[i]));
+            }
+            let speed = square.sqrt();
+            let s1 = g.div(speed);
+            let s2 = g1.sub(s1.square()).div(speed);
+            (speed, s1, s2, true)
+        } else {
+            let mut speed = Iv::ZERO;
+            for v in &p1[CARTESIAN_DIMS..] {
+                speed = Iv {
+                    lo: speed.lo.max(v.mignitude()),
+                    hi: speed.hi.max(v.magnitude()),
+                };
+            }
+            let mut s1: Option<Iv> = None;
+            let mut s2: Option<Iv> = None;
+            let mut leads = 0;
+            for i in CARTESIAN_DIMS..MAX_PATH_DIMS {
+                if p1[i].magnitude() >= speed.lo {
+                    leads += 1;
+                    let (d1, d2) = if p1[i].lo > 0.0 {
+                        (p2[i], p3[i])
+                    } else if p1[i].hi < 0.0 {
+                        (p2[i].neg(), p3[i].neg())
+                    } else {
+                        (p2[i].symmetric(), p3[i].symmetric())
+                    };
+                    s1 = Some(s1.map_or(d1, |x| x.hull(d1)));
+                    s2 = Some(s2.map_or(d2, |x| x.hull(d2)));
+                }
+            }
+            (
+                speed,
+                s1.unwrap_or(Iv::ZERO),
+                s2.unwrap_or(Iv::ZERO),
+                leads <= 1,
+            )
+        };
+        let mut e = Enclosure {
+            speed,
+            single_lead,
+            p2,
+            d2: [Iv::ZERO; MAX_PATH_DIMS],
+            d3: [Iv::ZERO; MAX_PATH_DIMS],
+        };
+        if !(speed.lo > 0.0) {
+            return e;
+        }
+        let inverse = Iv {
+            lo: 1.0 / speed.hi,
+            hi: 1.0 / speed.lo,
+        };
+        let inverse2 = inverse.square();
+        let inverse3 = inverse2.mul(inverse);
+        let s1_speed_3 = s1.mul(speed).scale(3.0);
+        for i in 0..MAX_PATH_DIMS {
+            if p1[i] == Iv::ZERO && p2[i] == Iv::ZERO && p3[i] == Iv::ZERO {
+                continue;
+            }
+            let mut d1 = p1[i].mul(inverse);
+            if self.measures(i) {
+                d1 = d1.clip(1.0);
+            }
+            let d2 = p2[i].sub(d1.mul(s1)).mul(inverse2);
+            e.d2[i] = d2;
+            e.d3[i] = p3[i].sub(s1_speed_3.mul(d2)).sub(d1.mul(s2)).mul(inverse3);
+        }
+        e
     }
 }
 
-/// Bisection depth of the bounds scan: up to 2⁸ pieces per sample interval.
-const REFINE_DEPTH: u32 = 8;
-
-struct RefineLimits {
-    d2: PathPoint,
-    curvature: f64,
+/// Range of Σ c_k·x^k over |x| ≤ r: odd powers symmetric, even powers on one side of 0.
+fn taylor_range(c: &[f64], r: f64) -> Iv {
+    let mut range = Iv { lo: c[0], hi: c[0] };
+    let mut power = 1.0;
+    for (k, &ck) in c.iter().enumerate().skip(1) {
+        power *= r;
+        let term = ck * power;
+        if k % 2 == 1 {
+            range.lo -= term.abs();
+            range.hi += term.abs();
+        } else if term > 0.0 {
+            range.hi += term;
+        } else {
+            range.lo += term;
+        }
+    }
+    range
 }
 
-/// What the bounds scan has seen so far.
-struct Scan {
-    lo: PathPoint,
-    hi: PathPoint,
-    d1_max: PathPoint,
-    d2_max: PathPoint,
-    d2_change: PathPoint,
-    curvature_max: f64,
-    curvature_change: f64,
-    speed_max: f64,
-    /// Widest interval in u between neighbouring samples.
-    widest: f64,
+/// What [`Blend::enclose`] finds on one piece.
+struct Enclosure {
+    speed: Iv,
+    /// Only one dim can set the speed on the piece (always so in X, Y, Z).
+    single_lead: bool,
+    /// d²p/du².
+    p2: [Iv; MAX_PATH_DIMS],
+    /// d²p/ds², d³p/ds³.
+    d2: [Iv; MAX_PATH_DIMS],
+    d3: [Iv; MAX_PATH_DIMS],
 }
 
-impl Scan {
-    fn new(start: PathPoint) -> Scan {
-        Scan {
-            lo: start,
-            hi: start,
-            d1_max: [0.0; MAX_PATH_DIMS],
-            d2_max: [0.0; MAX_PATH_DIMS],
-            d2_change: [0.0; MAX_PATH_DIMS],
-            curvature_max: 0.0,
-            curvature_change: 0.0,
-            speed_max: 0.0,
-            widest: 0.0,
+/// The bounds found so far, and the lowest speed (see [`Blend::compute_bounds`]).
+struct Accumulator {
+    bounds: SegmentBounds,
+    slowest: f64,
+    min_speed: f64,
+}
+
+impl Accumulator {
+    /// An exact sample at the end of a piece.
+    fn take(&mut self, (q, speed): &(PathSample, f64)) {
+        let b = &mut self.bounds;
+        for i in 0..MAX_PATH_DIMS {
+            b.lo[i] = b.lo[i].min(q.position[i]);
+            b.hi[i] = b.hi[i].max(q.position[i]);
+            b.d1_max[i] = b.d1_max[i].max(q.d1[i].abs());
+            b.d2_max[i] = b.d2_max[i].max(q.d2[i].abs());
+        }
+        b.curvature_max = b.curvature_max.max(norm(&cartesian(&q.d2)));
+        // Written so that a NaN speed counts as slow.
+        if !(*speed >= self.slowest) {
+            self.slowest = *speed;
+        }
+    }
+}
+
+/// A closed interval [lo, hi] (rounded to nearest: the callers add a relative slack).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Iv {
+    lo: f64,
+    hi: f64,
+}
+
+impl Iv {
+    const ZERO: Iv = Iv { lo: 0.0, hi: 0.0 };
+
+    fn add(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
         }
     }
 
-    fn take(&mut self, q: &PathSample, speed: f64) {
-        for i in 0..MAX_PATH_DIMS {
-            self.lo[i] = self.lo[i].min(q.position[i]);
-            self.hi[i] = self.hi[i].max(q.position[i]);
-            self.d1_max[i] = self.d1_max[i].max(q.d1[i].abs());
-            self.d2_max[i] = self.d2_max[i].max(q.d2[i].abs());
+    fn sub(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo - o.hi,
+            hi: self.hi - o.lo,
         }
-        self.curvature_max = self.curvature_max.max(norm(&cartesian(&q.d2)));
-        self.speed_max = self.speed_max.max(speed);
+    }
+
+    fn neg(self) -> Iv {
+        Iv {
+            lo: -self.hi,
+            hi: -self.lo,
+        }
+    }
+
+    fn scale(self, k: f64) -> Iv {
+        debug_assert!(k >= 0.0);
+        Iv {
+            lo: self.lo * k,
+            hi: self.hi * k,
+        }
+    }
+
+    fn mul(self, o: Iv) -> Iv {
+        let p = [
+            self.lo * o.lo,
+            self.lo * o.hi,
+            self.hi * o.lo,
+            self.hi * o.hi,
+        ];
+        Iv {
+            lo: p.iter().copied().fold(f64::INFINITY, f64::min),
+            hi: p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+
+    /// By an interval of positive numbers.
+    fn div(self, o: Iv) -> Iv {
+        self.mul(Iv {
+            lo: 1.0 / o.hi,
+            hi: 1.0 / o.lo,
+        })
+    }
+
+    fn square(self) -> Iv {
+        let (a, b) = (self.lo * self.lo, self.hi * self.hi);
+        if self.lo <= 0.0 && self.hi >= 0.0 {
+            Iv {
+                lo: 0.0,
+                hi: a.max(b),
+            }
+        } else {
+            Iv {
+                lo: a.min(b),
+                hi: a.max(b),
+            }
+        }
+    }
+
+    fn sqrt(self) -> Iv {
+        Iv {
+            lo: self.lo.max(0.0).sqrt(),
+            hi: self.hi.max(0.0).sqrt(),
+        }
+    }
+
+    fn hull(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
+    }
+
+    /// [−m, m] with m the magnitude.
+    fn symmetric(self) -> Iv {
+        let m = self.magnitude();
+        Iv { lo: -m, hi: m }
+    }
+
+    /// Intersected with [−k, k] (a unit tangent's component).
+    fn clip(self, k: f64) -> Iv {
+        Iv {
+            lo: self.lo.max(-k).min(k),
+            hi: self.hi.min(k).max(-k),
+        }
+    }
+
+    /// Largest |x|.
+    fn magnitude(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+
+    /// Smallest |x|.
+    fn mignitude(self) -> f64 {
+        if self.lo > 0.0 {
+            self.lo
+        } else if self.hi < 0.0 {
+            -self.hi
+        } else {
+            0.0
+        }
     }
 }
 
@@ -670,5 +1006,75 @@ mod tests {
             assert!(max_diff(&a.position, &b.position) < 1e-12);
             assert!(max_diff(&a.d1, &b.d1) < 1e-12);
         }
+    }
+}
+
+#[cfg(test)]
+mod diagnostics {
+    use super::*;
+    use crate::path::Line;
+
+    fn xs(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Reference arc length by 2000 GL5 pieces.
+    fn reference_s(b: &Blend, u: f64) -> f64 {
+        let n = 2000;
+        (0..n)
+            .map(|k| b.arc_length(u * k as f64 / n as f64, u * (k + 1) as f64 / n as f64))
+            .sum()
+    }
+
+    #[test]
+    #[ignore = "diagnostic"]
+    fn arc_length_error_survey() {
+        let mut st = 88172645463325252u64;
+        let mut worst = (0.0, 0.0, 0.0);
+        let mut most = 0;
+        for _ in 0..3000 {
+            let mut d = [0.0; 3];
+            let mut e = [0.0; 3];
+            for j in 0..3 {
+                d[j] = xs(&mut st) * 2.0 - 1.0;
+                e[j] = xs(&mut st) * 2.0 - 1.0;
+            }
+            let mut a = [0.0; MAX_PATH_DIMS];
+            let mut k = [0.0; MAX_PATH_DIMS];
+            let mut c = [0.0; MAX_PATH_DIMS];
+            for j in 0..3 {
+                a[j] = -50.0 * d[j];
+                c[j] = 50.0 * e[j];
+            }
+            k[3] = 1.0;
+            c[3] = 3.0;
+            let prev = Segment::Line(Line::new(a, k).unwrap());
+            let next = Segment::Line(Line::new(k, c).unwrap());
+            let r = (1.0 + 20.0 * xs(&mut st), 1.0 + 20.0 * xs(&mut st));
+            let Some((_, b, _)) = blend_corner(&prev, &next, r.0, r.1) else {
+                continue;
+            };
+            // table error and the inverse's error
+            let total_ref = reference_s(&b, 1.0);
+            let table_err = (b.length - total_ref).abs() / total_ref;
+            most = most.max(b.intervals);
+            let mut inv_err: f64 = 0.0;
+            for j in 1..50 {
+                let s = b.length() * j as f64 / 50.0;
+                let u = b.parameter_at(s);
+                inv_err = inv_err.max((reference_s(&b, u) - s).abs() / b.length());
+            }
+            if table_err + inv_err > worst.0 + worst.1 {
+                worst = (table_err, inv_err, b.bounds.curvature_max * b.length());
+            }
+        }
+        println!("most intervals {most}");
+        println!(
+            "worst table {:e} inverse {:e} (curv·len {})",
+            worst.0, worst.1, worst.2
+        );
     }
 }

@@ -28,6 +28,7 @@ impl Line {
         let mut bounds = SegmentBounds {
             d1_max: [0.0; MAX_PATH_DIMS],
             d2_max: [0.0; MAX_PATH_DIMS],
+            d3_max: [0.0; MAX_PATH_DIMS],
             lo: [0.0; MAX_PATH_DIMS],
             hi: [0.0; MAX_PATH_DIMS],
             curvature_max: 0.0,

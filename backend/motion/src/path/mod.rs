@@ -193,6 +193,9 @@ pub struct SegmentBounds {
     pub d1_max: PathPoint,
     /// Largest |d²p_i/ds²| over the segment.
     pub d2_max: PathPoint,
+    /// Largest |d³p_i/ds³| over the segment: 0 on a line, at most 1/r² on an arc. An axis's
+    /// jerk at path velocity v contains d³p_i/ds³·v³.
+    pub d3_max: PathPoint,
     /// Axis-wise lowest position reached.
     pub lo: PathPoint,
     /// Axis-wise highest position reached.
