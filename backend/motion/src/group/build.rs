@@ -209,11 +209,13 @@ pub(super) fn build(
             let ItemKind::Motion(pseg) = p.kind else {
                 unreachable!("prev is a motion item")
             };
-            if let Some((cut_prev, blend, cut_next)) = path::blend_corner(&pseg, &seg, r_in, r_out)
-            {
+            let blended = path::blend_corner(&pseg, &seg, r_in, r_out).and_then(|b| {
+                let bseg = Segment::Blend(b.1);
+                let blim = blend_limits(&p.limits, &lim, &bseg, limits);
+                worth_blending(&blim, &p.limits, &lim).then_some((b, bseg, blim))
+            });
+            if let Some(((cut_prev, _, cut_next), bseg, blim)) = blended {
                 {
-                    let bseg = Segment::Blend(blend);
-                    let blim = blend_limits(&p.limits, &lim, &bseg, limits);
                     check_soft_limits(&bseg, limits).map_err(|e| (i, e))?;
                     let prev_seg = pseg.trimmed(0.0, cut_prev);
                     let prev_corner = p.limits.velocity.min(blim.velocity);
@@ -354,10 +356,13 @@ pub(super) fn join(
     let limits = &ctx.limits;
     let mut trim = None;
     let mut s = back.end_s();
-    if let Some((cut_prev, blend, cut_next)) = path::blend_corner(&pseg, &seg, radii.0, radii.1) {
+    let blended = path::blend_corner(&pseg, &seg, radii.0, radii.1).and_then(|b| {
+        let bseg = Segment::Blend(b.1);
+        let blim = blend_limits(&back.limits, &first.limits, &bseg, limits);
+        worth_blending(&blim, &back.limits, &first.limits).then_some((b, bseg, blim))
+    });
+    if let Some(((cut_prev, _, cut_next), bseg, blim)) = blended {
         if reachable(cut_prev) {
-            let bseg = Segment::Blend(blend);
-            let blim = blend_limits(&back.limits, &first.limits, &bseg, limits);
             check_soft_limits(&bseg, limits)?;
             trim = Some((
                 pseg.trimmed(0.0, cut_prev),
@@ -437,34 +442,11 @@ fn tangent_continuous(a: &Segment, b: &Segment) -> bool {
     na > 0.0 && nb > 0.0 && dot / (na * nb) > 1.0 - 1e-9
 }
 
-/// max |d³p_i/ds³| over a segment: 0 on a line, 1/r² on an arc, sampled on a blend (with a
-/// margin: the blend's curvature changes smoothly, 64 intervals resolve it).
-fn third_derivative_max(seg: &Segment) -> PathPoint {
-    let mut out = [0.0; MAX_PATH_DIMS];
-    match seg {
-        Segment::Line(_) => {}
-        Segment::Arc(a) => {
-            let k = 1.0 / (a.radius() * a.radius());
-            out[..path::CARTESIAN_DIMS].iter_mut().for_each(|x| *x = k);
-        }
-        Segment::Blend(_) => {
-            const N: usize = 1024;
-            let len = seg.length();
-            if len <= 0.0 {
-                return out;
-            }
-            let ds = len / N as f64;
-            let mut prev = seg.sample(0.0).d2;
-            for i in 1..=N {
-                let d2 = seg.sample(ds * i as f64).d2;
-                for d in 0..MAX_PATH_DIMS {
-                    out[d] = f64::max(out[d], 2.0 * (d2[d] - prev[d]).abs() / ds);
-                }
-                prev = d2;
-            }
-        }
-    }
-    out
+/// A blend is made only where it is faster than stopping at the corner: a near-reversal's
+/// blend curls so tightly that the members' jerk holds it to a crawl; below a twentieth of
+/// its neighbours' velocity the corner is an exact stop instead (decision 124).
+fn worth_blending(blend: &Limits, prev: &Limits, next: &Limits) -> bool {
+    blend.velocity >= 0.05 * prev.velocity.min(next.velocity)
 }
 
 /// Commanded path dynamics lowered to what every member axis allows on `seg`: the axis's
@@ -478,7 +460,7 @@ fn axis_bounded(
     limits: &[Option<AxisLimits>; MAX_PATH_DIMS],
 ) -> Limits {
     let b = seg.bounds();
-    let d3 = third_derivative_max(seg);
+    let d3 = b.d3_max;
     for (d, lim) in limits.iter().enumerate() {
         let Some(lim) = lim else { continue };
         if b.d1_max[d] > 0.0 {
