@@ -16,7 +16,9 @@ struct Machine {
     sp: Vec<DriveSetpoint>,
     events: Vec<CommandEvent>,
     next_id: u64,
-    groups: Vec<(GroupId, usize)>,
+    /// Per group: its slot, its loop and the loop prepared off the cycle (it starts and
+    /// ends at the origin, so one preparation serves every lap).
+    groups: Vec<(GroupId, PathTable, PreparedPath)>,
 }
 
 fn motion_of(first: bool, v: f64) -> EntryMotion {
@@ -150,19 +152,23 @@ impl Machine {
             Verdict::Accepted
         );
         self.run(5);
-        self.groups.push((g, members.len()));
+        let table = blended_loop(50, members.len());
+        let ctx = self.k.path_context(g).unwrap();
+        let prepared = prepare_path(&ctx, &table, [0.0; MAX_PATH_DIMS]).unwrap();
+        self.groups.push((g, table, prepared));
         self.feed();
     }
 
-    /// Keeps every group's queue filled with its loop.
+    /// Keeps every group's queue filled with its loop, committed as prepared (preparing is
+    /// off the cycle thread and measured on its own).
     fn feed(&mut self) {
-        for i in 0..self.groups.len() {
-            let (g, axes) = self.groups[i];
-            if self.k.group_status(g).unwrap().queued_entries < 60 {
+        for (g, table, prepared) in &self.groups {
+            if self.k.group_status(*g).unwrap().queued_entries < 60 {
                 self.next_id += 1;
+                let id = self.next_id;
                 let v =
                     self.k
-                        .submit_path(self.next_id, g, &blended_loop(50, axes), &mut self.events);
+                        .submit_prepared_path(id, *g, table, Some(prepared), &mut self.events);
                 assert_eq!(v, Verdict::Accepted);
             }
         }
