@@ -44,7 +44,11 @@ const NEWTON_STEPS: usize = 4;
 /// Pieces in u of the bounds computation; a piece whose enclosure is loose (the speed's
 /// lower bound far below its values at the ends) is halved up to [`BOUND_DEPTH`] times.
 const BOUND_PIECES: usize = 32;
-const BOUND_DEPTH: u32 = 6;
+const BOUND_DEPTH: u32 = 8;
+/// A piece is also halved while its enclosure of d³p/ds³ exceeds this multiple of the
+/// largest value seen at points: interval arithmetic overestimates in proportion to the
+/// piece's width, and d³ sets the group's velocity through its cube root.
+const D3_LOOSE: f64 = 1.1;
 /// How often the radii are halved when the quintic for them runs into a cusp; a corner
 /// that still fails turns back on itself (exact stop).
 const SHRINK_TRIES: usize = 4;
@@ -477,12 +481,19 @@ impl Blend {
             bounds: empty_bounds(),
             slowest: f64::INFINITY,
             min_speed,
+            d3_seen: [0.0; MAX_PATH_DIMS],
+            d3_scale: 0.0,
         };
         acc.bounds.lo = self.start;
         acc.bounds.hi = self.start;
         let mut left = self.curve_at(u0);
         acc.take(&left);
         let du = (u1 - u0) / BOUND_PIECES as f64;
+        // d³ at the pieces' ends (an enclosure of width 0 is the value): what the enclosure
+        // of a piece is compared with to decide whether to halve it.
+        for k in 0..=BOUND_PIECES {
+            acc.see_d3(&self.enclose(u0 + du * k as f64, u0 + du * k as f64));
+        }
         for k in 0..BOUND_PIECES {
             let b = if k + 1 == BOUND_PIECES {
                 u1
@@ -524,10 +535,13 @@ impl Blend {
         let e = self.enclose(a, b);
         let slow_end = left.1.min(right.1);
         let loose = !(e.speed.lo > 0.5 * slow_end)
-            || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed);
+            || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed)
+            || (0..MAX_PATH_DIMS)
+                .any(|i| e.d3[i].magnitude() > D3_LOOSE * acc.d3_seen[i] + 1e-9 * acc.d3_scale);
         if depth > 0 && loose {
             let m = (a + b) / 2.0;
             let middle = self.curve_at(m);
+            acc.see_d3(&self.enclose(m, m));
             self.bound_piece(a, left, m, &middle, depth - 1, acc)?;
             self.bound_piece(m, &middle, b, right, depth - 1, acc)?;
             return Some(());
@@ -728,9 +742,19 @@ struct Accumulator {
     bounds: SegmentBounds,
     slowest: f64,
     min_speed: f64,
+    /// Largest |d³p_i/ds³| at points so far, and the largest of them.
+    d3_seen: PathPoint,
+    d3_scale: f64,
 }
 
 impl Accumulator {
+    fn see_d3(&mut self, point: &Enclosure) {
+        for (seen, d3) in self.d3_seen.iter_mut().zip(&point.d3) {
+            *seen = seen.max(d3.magnitude());
+            self.d3_scale = self.d3_scale.max(*seen);
+        }
+    }
+
     /// An exact sample at the end of a piece.
     fn take(&mut self, (q, speed): &(PathSample, f64)) {
         let b = &mut self.bounds;
