@@ -43,7 +43,7 @@ const TABLE_TOLERANCE: f64 = 1e-13;
 const NEWTON_STEPS: usize = 4;
 /// Pieces in u of the bounds computation; a piece whose enclosure is loose (the speed's
 /// lower bound far below its values at the ends) is halved up to [`BOUND_DEPTH`] times.
-const BOUND_PIECES: usize = 32;
+const BOUND_PIECES: usize = 16;
 const BOUND_DEPTH: u32 = 8;
 /// A piece is also halved while its enclosure of d³p/ds³ exceeds this multiple of the
 /// largest value seen at points: interval arithmetic overestimates in proportion to the
@@ -385,7 +385,8 @@ impl Blend {
             let um = f64::from(m) / TABLE_UNIT;
             let halves = self.arc_length(ua, um) + self.arc_length(um, ub);
             // Written so that NaN bisects down to the capacity and fails there.
-            if !((whole - halves).abs() <= TABLE_TOLERANCE * whole) {
+            let agree = (whole - halves).abs() <= TABLE_TOLERANCE * whole;
+            if !agree {
                 self.tabulate(a, m)?;
                 return self.tabulate(m, b);
             }
@@ -434,7 +435,8 @@ impl Blend {
             let next = (u - error / self.speed(u)).clamp(u_lo, u_hi);
             let step = (next - u).abs();
             u = next;
-            if !(curving * step * step > 1e-10 * h) {
+            let more = curving * step * step > 1e-10 * h;
+            if !more {
                 break;
             }
         }
@@ -538,7 +540,8 @@ impl Blend {
     ) -> Option<()> {
         let e = self.enclose(a, b);
         let slow_end = left.1.min(right.1);
-        let loose = !(e.speed.lo > 0.5 * slow_end)
+        let tight_speed = e.speed.lo > 0.5 * slow_end;
+        let loose = !tight_speed
             || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed)
             || (0..MAX_PATH_DIMS)
                 .any(|i| e.d3[i].magnitude() > D3_LOOSE * acc.d3_seen[i] + 1e-9 * acc.d3_scale);
@@ -550,7 +553,8 @@ impl Blend {
             self.bound_piece(m, &middle, b, right, depth - 1, acc)?;
             return Some(());
         }
-        if !(e.speed.lo > 0.0) {
+        let moving = e.speed.lo > 0.0;
+        if !moving {
             return None;
         }
         if e.speed.lo < acc.min_speed {
@@ -577,7 +581,13 @@ impl Blend {
             let d1 = ends(|q| &q.d1, i) + half * e.speed.mul(e.d2[i]).magnitude();
             let d1 = if self.measures(i) { d1.min(1.0) } else { d1 };
             bounds.d1_max[i] = bounds.d1_max[i].max(d1);
-            let drift = half * half / 2.0 * e.p2[i].magnitude();
+            // Monotone on the piece (dp_i/du of one sign): the ends are the extremes.
+            let monotone = e.p1[i].lo > 0.0 || e.p1[i].hi < 0.0;
+            let drift = if monotone {
+                0.0
+            } else {
+                half * half / 2.0 * e.p2[i].magnitude()
+            };
             bounds.lo[i] = bounds.lo[i].min(left.0.position[i].min(right.0.position[i]) - drift);
             bounds.hi[i] = bounds.hi[i].max(left.0.position[i].max(right.0.position[i]) + drift);
         }
@@ -680,11 +690,13 @@ impl Blend {
         let mut e = Enclosure {
             speed,
             single_lead,
+            p1,
             p2,
             d2: [Iv::ZERO; MAX_PATH_DIMS],
             d3: [Iv::ZERO; MAX_PATH_DIMS],
         };
-        if !(speed.lo > 0.0) {
+        let moving = speed.lo > 0.0;
+        if !moving {
             return e;
         }
         let inverse = Iv {
@@ -734,7 +746,8 @@ struct Enclosure {
     speed: Iv,
     /// Only one dim can set the speed on the piece (always so in X, Y, Z).
     single_lead: bool,
-    /// d²p/du².
+    /// dp/du, d²p/du².
+    p1: [Iv; MAX_PATH_DIMS],
     p2: [Iv; MAX_PATH_DIMS],
     /// d²p/ds², d³p/ds³.
     d2: [Iv; MAX_PATH_DIMS],
@@ -770,7 +783,8 @@ impl Accumulator {
         }
         b.curvature_max = b.curvature_max.max(norm(&cartesian(&q.d2)));
         // Written so that a NaN speed counts as slow.
-        if !(*speed >= self.slowest) {
+        let not_slower = *speed >= self.slowest;
+        if !not_slower {
             self.slowest = *speed;
         }
     }
