@@ -35,7 +35,7 @@ use super::{
 /// [`TABLE_TOLERANCE`] of its length: the speed of a quintic is smooth, except that near a
 /// sharp turn it dips towards 0 and its square root then needs short intervals.
 const TABLE_CAPACITY: usize = 48;
-const TABLE_START: usize = 8;
+const TABLE_START: usize = 16;
 /// Nodes are multiples of 1/TABLE_UNIT in u (exact in a u16).
 const TABLE_UNIT: f64 = 32768.0;
 const TABLE_TOLERANCE: f64 = 1e-13;
@@ -43,8 +43,12 @@ const TABLE_TOLERANCE: f64 = 1e-13;
 const NEWTON_STEPS: usize = 4;
 /// Pieces in u of the bounds computation; a piece whose enclosure is loose (the speed's
 /// lower bound far below its values at the ends) is halved up to [`BOUND_DEPTH`] times.
-const BOUND_PIECES: usize = 32;
-const BOUND_DEPTH: u32 = 6;
+const BOUND_PIECES: usize = 16;
+const BOUND_DEPTH: u32 = 8;
+/// A piece is also halved while its enclosure of d³p/ds³ exceeds this multiple of the
+/// largest value seen at points: interval arithmetic overestimates in proportion to the
+/// piece's width, and d³ sets the group's velocity through its cube root.
+const D3_LOOSE: f64 = 1.1;
 /// How often the radii are halved when the quintic for them runs into a cusp; a corner
 /// that still fails turns back on itself (exact stop).
 const SHRINK_TRIES: usize = 4;
@@ -381,7 +385,8 @@ impl Blend {
             let um = f64::from(m) / TABLE_UNIT;
             let halves = self.arc_length(ua, um) + self.arc_length(um, ub);
             // Written so that NaN bisects down to the capacity and fails there.
-            if !((whole - halves).abs() <= TABLE_TOLERANCE * whole) {
+            let agree = (whole - halves).abs() <= TABLE_TOLERANCE * whole;
+            if !agree {
                 self.tabulate(a, m)?;
                 return self.tabulate(m, b);
             }
@@ -415,18 +420,23 @@ impl Blend {
         let ds = s_hi - s_lo;
         let t = (s - s_lo) / ds;
         // Slopes of u(t) on [0, 1] in units of h: (ds/h)/σ at both ends.
-        let (m0, m1) = (ds / (h * self.speed(u_lo)), ds / (h * self.speed(u_hi)));
+        let (speed_lo, speed_hi) = (self.speed(u_lo), self.speed(u_hi));
+        let (m0, m1) = (ds / (h * speed_lo), ds / (h * speed_hi));
+        // |σ'|/2σ on the interval, over-estimated tenfold (the table's intervals are short
+        // enough to resolve σ): after a Newton step δ the error left is about that · δ².
+        let curving = 10.0 * (speed_hi - speed_lo).abs() / (h * speed_lo.min(speed_hi));
         let guess = t * t * (3.0 - 2.0 * t) + t * (1.0 - t) * ((1.0 - t) * m0 - t * m1);
         let mut u = (u_lo + h * guess).clamp(u_lo, u_hi);
         // Newton converges quadratically: after a step of δ the error is about
-        // (σ'/2σ)·δ², so a step below 1e-7 of the interval leaves rounding. One step is the
-        // rule; where the speed changes fast the guess is worse and another follows.
+        // (σ'/2σ)·δ². One step is the rule; where the speed changes fast the guess is worse
+        // and another follows.
         for _ in 0..NEWTON_STEPS {
             let error = s_lo + self.arc_length(u_lo, u) - s;
             let next = (u - error / self.speed(u)).clamp(u_lo, u_hi);
             let step = (next - u).abs();
             u = next;
-            if !(step > 1e-7 * h) {
+            let more = curving * step * step > 1e-10 * h;
+            if !more {
                 break;
             }
         }
@@ -477,12 +487,19 @@ impl Blend {
             bounds: empty_bounds(),
             slowest: f64::INFINITY,
             min_speed,
+            d3_seen: [0.0; MAX_PATH_DIMS],
+            d3_scale: 0.0,
         };
         acc.bounds.lo = self.start;
         acc.bounds.hi = self.start;
         let mut left = self.curve_at(u0);
         acc.take(&left);
         let du = (u1 - u0) / BOUND_PIECES as f64;
+        // d³ at the pieces' ends (an enclosure of width 0 is the value): what the enclosure
+        // of a piece is compared with to decide whether to halve it.
+        for k in 0..=BOUND_PIECES {
+            acc.see_d3(&self.enclose(u0 + du * k as f64, u0 + du * k as f64));
+        }
         for k in 0..BOUND_PIECES {
             let b = if k + 1 == BOUND_PIECES {
                 u1
@@ -523,16 +540,21 @@ impl Blend {
     ) -> Option<()> {
         let e = self.enclose(a, b);
         let slow_end = left.1.min(right.1);
-        let loose = !(e.speed.lo > 0.5 * slow_end)
-            || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed);
+        let tight_speed = e.speed.lo > 0.5 * slow_end;
+        let loose = !tight_speed
+            || (e.speed.lo < acc.min_speed && slow_end >= acc.min_speed)
+            || (0..MAX_PATH_DIMS)
+                .any(|i| e.d3[i].magnitude() > D3_LOOSE * acc.d3_seen[i] + 1e-9 * acc.d3_scale);
         if depth > 0 && loose {
             let m = (a + b) / 2.0;
             let middle = self.curve_at(m);
+            acc.see_d3(&self.enclose(m, m));
             self.bound_piece(a, left, m, &middle, depth - 1, acc)?;
             self.bound_piece(m, &middle, b, right, depth - 1, acc)?;
             return Some(());
         }
-        if !(e.speed.lo > 0.0) {
+        let moving = e.speed.lo > 0.0;
+        if !moving {
             return None;
         }
         if e.speed.lo < acc.min_speed {
@@ -559,7 +581,13 @@ impl Blend {
             let d1 = ends(|q| &q.d1, i) + half * e.speed.mul(e.d2[i]).magnitude();
             let d1 = if self.measures(i) { d1.min(1.0) } else { d1 };
             bounds.d1_max[i] = bounds.d1_max[i].max(d1);
-            let drift = half * half / 2.0 * e.p2[i].magnitude();
+            // Monotone on the piece (dp_i/du of one sign): the ends are the extremes.
+            let monotone = e.p1[i].lo > 0.0 || e.p1[i].hi < 0.0;
+            let drift = if monotone {
+                0.0
+            } else {
+                half * half / 2.0 * e.p2[i].magnitude()
+            };
             bounds.lo[i] = bounds.lo[i].min(left.0.position[i].min(right.0.position[i]) - drift);
             bounds.hi[i] = bounds.hi[i].max(left.0.position[i].max(right.0.position[i]) + drift);
         }
@@ -662,11 +690,13 @@ impl Blend {
         let mut e = Enclosure {
             speed,
             single_lead,
+            p1,
             p2,
             d2: [Iv::ZERO; MAX_PATH_DIMS],
             d3: [Iv::ZERO; MAX_PATH_DIMS],
         };
-        if !(speed.lo > 0.0) {
+        let moving = speed.lo > 0.0;
+        if !moving {
             return e;
         }
         let inverse = Iv {
@@ -716,7 +746,8 @@ struct Enclosure {
     speed: Iv,
     /// Only one dim can set the speed on the piece (always so in X, Y, Z).
     single_lead: bool,
-    /// d²p/du².
+    /// dp/du, d²p/du².
+    p1: [Iv; MAX_PATH_DIMS],
     p2: [Iv; MAX_PATH_DIMS],
     /// d²p/ds², d³p/ds³.
     d2: [Iv; MAX_PATH_DIMS],
@@ -728,9 +759,19 @@ struct Accumulator {
     bounds: SegmentBounds,
     slowest: f64,
     min_speed: f64,
+    /// Largest |d³p_i/ds³| at points so far, and the largest of them.
+    d3_seen: PathPoint,
+    d3_scale: f64,
 }
 
 impl Accumulator {
+    fn see_d3(&mut self, point: &Enclosure) {
+        for (seen, d3) in self.d3_seen.iter_mut().zip(&point.d3) {
+            *seen = seen.max(d3.magnitude());
+            self.d3_scale = self.d3_scale.max(*seen);
+        }
+    }
+
     /// An exact sample at the end of a piece.
     fn take(&mut self, (q, speed): &(PathSample, f64)) {
         let b = &mut self.bounds;
@@ -742,7 +783,8 @@ impl Accumulator {
         }
         b.curvature_max = b.curvature_max.max(norm(&cartesian(&q.d2)));
         // Written so that a NaN speed counts as slow.
-        if !(*speed >= self.slowest) {
+        let not_slower = *speed >= self.slowest;
+        if !not_slower {
             self.slowest = *speed;
         }
     }
@@ -1075,6 +1117,57 @@ mod diagnostics {
         println!(
             "worst table {:e} inverse {:e} (curv·len {})",
             worst.0, worst.1, worst.2
+        );
+    }
+}
+
+#[cfg(test)]
+mod timing {
+    use super::*;
+    use crate::path::Line;
+    use std::time::Instant;
+
+    #[test]
+    #[ignore = "timing, run in release"]
+    fn blend_timing() {
+        let mut a = [0.0; MAX_PATH_DIMS];
+        let mut k = a;
+        k[0] = 100.0;
+        k[3] = 10.0;
+        let mut c = k;
+        c[1] = 100.0;
+        c[3] = 20.0;
+        a[3] = 0.0;
+        let prev = Segment::Line(Line::new(a, k).unwrap());
+        let next = Segment::Line(Line::new(k, c).unwrap());
+        let mut best = f64::INFINITY;
+        for _ in 0..20 {
+            let t = Instant::now();
+            for _ in 0..200 {
+                std::hint::black_box(blend_corner(std::hint::black_box(&prev), &next, 5.0, 5.0));
+            }
+            best = best.min(t.elapsed().as_secs_f64() / 200.0);
+        }
+        let (_, b, _) = blend_corner(&prev, &next, 5.0, 5.0).unwrap();
+        let mut best_s = f64::INFINITY;
+        for _ in 0..20 {
+            let t = Instant::now();
+            let mut s = 0.0;
+            for _ in 0..20000 {
+                s += 0.618_033_988_749_894_9 * b.length();
+                if s > b.length() {
+                    s -= b.length();
+                }
+                std::hint::black_box(std::hint::black_box(&b).sample(s));
+            }
+            best_s = best_s.min(t.elapsed().as_secs_f64() / 20000.0);
+        }
+        println!(
+            "blend_corner {:.2} µs, sample {:.1} ns, intervals {}, size of Segment {}",
+            best * 1e6,
+            best_s * 1e9,
+            b.intervals,
+            std::mem::size_of::<Segment>()
         );
     }
 }

@@ -157,6 +157,32 @@ fn assert_within(bounds: &SegmentBounds, q: &PathSample) -> Result<(), TestCaseE
     Ok(())
 }
 
+/// d³p/ds³ against `bounds.d3_max` by the mean value theorem: the change of d²p/ds² over
+/// [s, s + h] divided by h is d³p/ds³ somewhere in between. The allowance is the rounding
+/// of d2 divided by h. Returns the largest ratio of difference quotient to bound seen.
+fn assert_d3_within(
+    segment: &Segment,
+    bounds: &SegmentBounds,
+    s: f64,
+    h: f64,
+) -> Result<f64, TestCaseError> {
+    let (a, b) = (segment.sample(s), segment.sample(s + h));
+    let d2_scale = bounds.d2_max.iter().fold(1.0f64, |m, x| m.max(*x));
+    let mut ratio: f64 = 0.0;
+    for i in 0..MAX_PATH_DIMS {
+        let quotient = (b.d2[i] - a.d2[i]).abs() / h;
+        prop_assert!(
+            quotient <= bounds.d3_max[i] + 1e-10 * d2_scale / h,
+            "d3 dim {i}: {quotient} > {} at s = {s}",
+            bounds.d3_max[i]
+        );
+        if bounds.d3_max[i] > 0.0 {
+            ratio = ratio.max(quotient / bounds.d3_max[i]);
+        }
+    }
+    Ok(ratio)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
 
@@ -209,6 +235,17 @@ proptest! {
                 prop_assert_eq!(q.position[2], centre[2]);
             }
             assert_within(&bounds, &q)?;
+            let h = segment.length() * 1e-4;
+            assert_d3_within(&segment, &bounds, s.min(segment.length() - h), h)?;
+        }
+        // The exact bound: 1/r² in every Cartesian dim whose tangent component reaches 1.
+        for i in 0..CARTESIAN_DIMS {
+            prop_assert!(bounds.d3_max[i] <= (1.0 + 1e-9) / (radius * radius));
+            prop_assert!(
+                (bounds.d3_max[i] * radius * radius - bounds.d1_max[i]).abs() < 1e-6
+                    || bounds.d1_max[i] > 1.0,
+                "d3 of dim {i} is not the tangent's share over r²"
+            );
         }
     }
 
@@ -238,6 +275,7 @@ proptest! {
             prop_assert!((dot(&rel, &direction) - s).abs() <= 1e-9 * size);
             assert_within(&bounds, &q)?;
         }
+        prop_assert_eq!(bounds.d3_max, [0.0; MAX_PATH_DIMS]);
         prop_assert_eq!(line.sample(line.length()).position, end);
     }
 
@@ -458,6 +496,12 @@ fn check_corner(c: &Corner, r: (f64, f64), planar: bool, seed: u64) -> Result<()
         }
         assert_within(&bounds, &q)?;
     }
+    // d³p/ds³ within its bound everywhere, including where the curvature peaks.
+    let h = b.length() * 1e-4;
+    for k in 0..400 {
+        let s = (b.length() - h) * k as f64 / 399.0;
+        assert_d3_within(&b, &bounds, s, h)?;
+    }
     // Finite differences agree with the arc-length parametrisation.
     let h = b.length() * 1e-5;
     for k in 0..20 {
@@ -518,6 +562,48 @@ proptest! {
         for _ in 0..10_000 {
             assert_within(&bounds, &blend.sample(random.next() * blend.length()))?;
         }
+        let segment = Segment::Blend(blend);
+        let h = blend.length() * 1e-5;
+        for _ in 0..2_000 {
+            assert_d3_within(&segment, &bounds, random.next() * (blend.length() - h), h)?;
+        }
+    }
+}
+
+/// The d³ bound of a blend at a near-reversal with very different radii (the shape that
+/// makes the curvature peak sharply near the short side): finite differences of d2 stay
+/// within it, and it is not wildly pessimistic.
+#[test]
+fn d3_bound_holds_and_is_tight_at_a_166_degree_turn_with_asymmetric_radii() {
+    for (r_in, r_out) in [(28.0, 1.26), (1.26, 28.0), (5.0, 5.0)] {
+        let turn = 166f64.to_radians();
+        let mut a = [0.0; MAX_PATH_DIMS];
+        let corner = [100.0, 0.0, 0.0];
+        a[0] = 0.0;
+        let mut k = [0.0; MAX_PATH_DIMS];
+        k[..3].copy_from_slice(&corner);
+        let mut c = k;
+        c[0] += 60.0 * turn.cos();
+        c[1] += 60.0 * turn.sin();
+        c[3] = 45.0;
+        let prev = Segment::Line(Line::new(a, k).unwrap());
+        let next = Segment::Line(Line::new(k, c).unwrap());
+        let (_, blend, _) = blend_corner(&prev, &next, r_in, r_out).unwrap();
+        let b = Segment::Blend(blend);
+        let bounds = b.bounds();
+        let h = b.length() * 1e-5;
+        let mut tightest: f64 = 0.0;
+        for j in 0..20_000 {
+            let s = (b.length() - h) * j as f64 / 19_999.0;
+            tightest = tightest.max(assert_d3_within(&b, &bounds, s, h).unwrap());
+        }
+        // The largest difference quotient reaches most of the bound: the group's
+        // velocity limit cbrt(jerk / d3) loses little.
+        assert!(
+            tightest > 0.5,
+            "({r_in}, {r_out}): d3 bound {tightest} tight"
+        );
+        println!("({r_in}, {r_out}): sampled/bound {tightest}");
     }
 }
 
