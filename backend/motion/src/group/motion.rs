@@ -477,11 +477,19 @@ impl PathRun {
         }
         let target = it.end_s();
         if let Some((dec, jerk)) = self.braking {
+            // Braking into an item whose jerk cannot take the deceleration back to 0 before
+            // the velocity reaches 0 would end the stop with a step in acceleration (or run
+            // backwards): use at least the jerk that can (as the axis planner does, decision 125).
+            let unwind = if from.acceleration < 0.0 && from.velocity > EPS_V {
+                1.05 * from.acceleration * from.acceleration / (2.0 * from.velocity)
+            } else {
+                0.0
+            };
             let lim = Limits {
                 velocity: it.limits.velocity.max(from.velocity),
                 acceleration: it.limits.acceleration.min(dec),
-                deceleration: it.limits.deceleration.min(dec),
-                jerk: it.limits.jerk.min(jerk),
+                deceleration: it.limits.deceleration.min(dec).max(-from.acceleration),
+                jerk: it.limits.jerk.min(jerk).max(unwind),
             };
             let reach = crate::planner::stop_distance(
                 from.velocity,
