@@ -287,6 +287,25 @@ fn take_axis(params: &mut Map<String, Value>) -> Option<String> {
     }
 }
 
+/// The `group` of a group block's params (an id or a name), taken out of them.
+fn take_group(params: &mut Map<String, Value>) -> Option<String> {
+    match params.remove("group") {
+        Some(Value::String(g)) => Some(g),
+        Some(Value::Number(n)) => Some(n.to_string()),
+        _ => None,
+    }
+}
+
+/// A block method addresses a group when its params name one (`group`), else an axis: the
+/// same name (`halt`, `stop`, `reset`, `set-override`) is a block of both.
+fn target_kind(params: &Map<String, Value>) -> blocks::At {
+    if params.contains_key("group") {
+        blocks::At::Groups
+    } else {
+        blocks::At::Axes
+    }
+}
+
 fn api_error(id: &Value, e: AppError) -> String {
     let code = match e.status().as_u16() {
         422 | 400 => -32602,
@@ -660,7 +679,7 @@ fn handle(
     let need = match method.as_str() {
         "subscribe" | "unsubscribe" => Role::Viewer,
         "keepalive" | "release" | "ext-setpoint-gen-feed" => Role::Operator,
-        name => blocks::find(name).map_or(Role::Viewer, |b| b.role),
+        name => blocks::find(target_kind(&params), name).map_or(Role::Viewer, |b| b.role),
     };
     if let Err(e) = may(s, client, need) {
         return Some(api_error(&id, e)).filter(|_| !notification);
@@ -826,7 +845,8 @@ fn handle(
             })
         }
         name => {
-            let Some(block) = blocks::find(name) else {
+            let at = target_kind(&params);
+            let Some(block) = blocks::find(at, name) else {
                 return Some(rpc_error(
                     &id,
                     -32601,
@@ -834,7 +854,11 @@ fn handle(
                     None,
                 ));
             };
-            let Some(axis) = take_axis(&mut params) else {
+            let target = match at {
+                blocks::At::Axes => take_axis(&mut params),
+                blocks::At::Groups => take_group(&mut params),
+            };
+            let Some(axis) = target else {
                 return Some(rpc_error(&id, -32602, "axis is required", None));
             };
             // The REST query's rules (`?wait=true&timeout_ms=N`), from the params.
@@ -867,7 +891,7 @@ fn handle(
             let jogs = jogs.clone();
             tokio::spawn(async move {
                 let raw = Value::Object(params);
-                let r = blocks::dispatch(&s, block.name, &axis, raw, client, wait)
+                let r = blocks::dispatch(&s, (at, block.name), &axis, raw, client, wait)
                     .await
                     .expect("a block of the catalogue");
                 let msg = match r {

@@ -380,6 +380,16 @@ pub async fn delete(s: &AppState, axis: &str, client: &ClientInfo) -> AppResult<
             e.persistent.clone(),
         )
     };
+    // A group's configured member stays (the group would lose a role it needs to enable).
+    if let Some(g) = s.registry.read().unwrap().group_of_axis(id) {
+        return Err(AppError::conflict(
+            "axis_in_group",
+            format!(
+                "axis {name} is a member of group {}: change the group (PUT /api/v1/groups/{}) first",
+                g.name, g.name
+            ),
+        ));
+    }
     let mut tx = s.db.begin().await?;
     store::axes::delete_axis(&mut tx, id).await?;
     store::audit(
@@ -636,9 +646,11 @@ pub fn export(s: &AppState) -> ConfigDocument {
         max_errors_in_row: bus.ethercat.as_ref().map(|(st, _)| st.max_errors_in_row),
     });
     let reg = s.registry.read().unwrap();
+    let groups = Some(super::groups::export(s));
     ConfigDocument {
         version: 1,
         cam_tables,
+        groups,
         bus,
         axes: reg
             .axes
