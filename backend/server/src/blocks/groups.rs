@@ -249,116 +249,102 @@ impl TransitionModeDto {
     }
 }
 
-/// MC_MoveLinearAbsolutePreparation.
+/// One row of the path table, by `type`: `linear` (MC_MoveLinearAbsolutePreparation),
+/// `circular` (MC_MoveCircularAbsolutePreparation), `blocker` (MC_BlockerPreparation: the path
+/// holds there until MC_ReleaseBlocker), `dwell` (MC_DwellTimePreparation).
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct LinearEntry {
-    /// The target in the group's axis order (the convention's axes, then addax1..n): as many
-    /// values as the group has axes.
-    #[schema(min_items = 1, max_items = 12)]
-    pub position: Vec<f64>,
-    /// Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory).
-    pub velocity: PathValueDto,
-    /// ≥ 1, `"default"` (default) or `"maximum"`.
-    #[serde(default)]
-    pub acceleration: PathValueDto,
-    /// ≥ 1, `"default"` (default) or `"maximum"`.
-    #[serde(default)]
-    pub deceleration: PathValueDto,
-    /// ≥ 100, `"default"` (default) or `"maximum"`.
-    #[serde(default)]
-    pub jerk: PathValueDto,
-    /// How the entry joins the one before (TF5420 §7.3); default `aborting` as the manual's
-    /// (legal only on the first entry of a path: later entries need `buffered` or
-    /// `blending_previous`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_mode: Option<BufferMode>,
-    /// Blending at the start of this entry (default `none`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub transition_mode: Option<TransitionModeDto>,
-    /// TransitionParameter[1..]: 1 for corner_distance, 2 for corner_distance_advanced.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    #[schema(max_items = 2)]
-    pub transition_parameters: Vec<f64>,
-    /// Echoed in the group status while the entry runs.
-    #[serde(default)]
-    #[schema(default = 0)]
-    pub invoke_id: u32,
-}
-
-/// MC_MoveCircularAbsolutePreparation.
-#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct CircularEntry {
-    /// What `aux_point` is: a point on the arc (`border`), its centre (`center`), or the normal
-    /// of its plane whose length is the radius (`radius`).
-    pub circ_mode: CircMode,
-    /// X, Y, Z of the auxiliary point.
-    #[schema(min_items = 3, max_items = 3)]
-    pub aux_point: Vec<f64>,
-    /// The end in the group's axis order (as many values as the group has axes).
-    #[schema(min_items = 1, max_items = 12)]
-    pub end_point: Vec<f64>,
-    /// Which arc (ignored for `border`; default `counter_clockwise`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub path_choice: Option<CircPathChoice>,
-    /// Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory).
-    pub velocity: PathValueDto,
-    #[serde(default)]
-    pub acceleration: PathValueDto,
-    #[serde(default)]
-    pub deceleration: PathValueDto,
-    #[serde(default)]
-    pub jerk: PathValueDto,
-    /// As for a linear entry (default `aborting`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_mode: Option<BufferMode>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub transition_mode: Option<TransitionModeDto>,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    #[schema(max_items = 2)]
-    pub transition_parameters: Vec<f64>,
-    #[serde(default)]
-    #[schema(default = 0)]
-    pub invoke_id: u32,
-}
-
-/// MC_BlockerPreparation: the path holds here until MC_ReleaseBlocker(`blocker_id`).
-#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct BlockerEntry {
-    /// > 0.
-    pub blocker_id: u32,
-    /// `buffered` (default) or, as the first entry, `aborting`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_mode: Option<BufferMode>,
-    #[serde(default)]
-    #[schema(default = 0)]
-    pub invoke_id: u32,
-}
-
-/// MC_DwellTimePreparation: the path stands still for `time`.
-#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct DwellEntry {
-    /// Seconds, ≥ 0 (0 still forces an exact stop).
-    pub time: f64,
-    /// `buffered` (default) or, as the first entry, `aborting`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub buffer_mode: Option<BufferMode>,
-    #[serde(default)]
-    #[schema(default = 0)]
-    pub invoke_id: u32,
-}
-
-/// One row of the path table, by `type`.
-#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum PathEntryDto {
-    Linear(LinearEntry),
-    Circular(CircularEntry),
-    Blocker(BlockerEntry),
-    Dwell(DwellEntry),
+    /// MC_MoveLinearAbsolutePreparation.
+    Linear {
+        /// The target in the group's axis order (the convention's axes, then addax1..n): as many
+        /// values as the group has axes.
+        #[schema(min_items = 1, max_items = 12)]
+        position: Vec<f64>,
+        /// Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory).
+        velocity: PathValueDto,
+        /// ≥ 1, `"default"` (default) or `"maximum"`.
+        #[serde(default)]
+        acceleration: PathValueDto,
+        /// ≥ 1, `"default"` (default) or `"maximum"`.
+        #[serde(default)]
+        deceleration: PathValueDto,
+        /// ≥ 100, `"default"` (default) or `"maximum"`.
+        #[serde(default)]
+        jerk: PathValueDto,
+        /// How the entry joins the one before (TF5420 §7.3); default `aborting` as the manual's
+        /// (legal only on the first entry of a path: later entries need `buffered` or
+        /// `blending_previous`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        buffer_mode: Option<BufferMode>,
+        /// Blending at the start of this entry (default `none`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        transition_mode: Option<TransitionModeDto>,
+        /// TransitionParameter[1..]: 1 for corner_distance, 2 for corner_distance_advanced.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        #[schema(max_items = 2)]
+        transition_parameters: Vec<f64>,
+        /// Echoed in the group status while the entry runs.
+        #[serde(default)]
+        #[schema(default = 0)]
+        invoke_id: u32,
+    },
+    /// MC_MoveCircularAbsolutePreparation.
+    Circular {
+        /// What `aux_point` is: a point on the arc (`border`), its centre (`center`), or the normal
+        /// of its plane whose length is the radius (`radius`).
+        circ_mode: CircMode,
+        /// X, Y, Z of the auxiliary point.
+        #[schema(min_items = 3, max_items = 3)]
+        aux_point: Vec<f64>,
+        /// The end in the group's axis order (as many values as the group has axes).
+        #[schema(min_items = 1, max_items = 12)]
+        end_point: Vec<f64>,
+        /// Which arc (ignored for `border`; default `counter_clockwise`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        path_choice: Option<CircPathChoice>,
+        /// Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory).
+        velocity: PathValueDto,
+        #[serde(default)]
+        acceleration: PathValueDto,
+        #[serde(default)]
+        deceleration: PathValueDto,
+        #[serde(default)]
+        jerk: PathValueDto,
+        /// As for a linear entry (default `aborting`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        buffer_mode: Option<BufferMode>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        transition_mode: Option<TransitionModeDto>,
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        #[schema(max_items = 2)]
+        transition_parameters: Vec<f64>,
+        #[serde(default)]
+        #[schema(default = 0)]
+        invoke_id: u32,
+    },
+    /// MC_BlockerPreparation.
+    Blocker {
+        /// > 0.
+        blocker_id: u32,
+        /// `buffered` (default) or, as the first entry, `aborting`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        buffer_mode: Option<BufferMode>,
+        #[serde(default)]
+        #[schema(default = 0)]
+        invoke_id: u32,
+    },
+    /// MC_DwellTimePreparation: the path stands still for `time`.
+    Dwell {
+        /// Seconds, ≥ 0 (0 still forces an exact stop).
+        time: f64,
+        /// `buffered` (default) or, as the first entry, `aborting`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        buffer_mode: Option<BufferMode>,
+        #[serde(default)]
+        #[schema(default = 0)]
+        invoke_id: u32,
+    },
 }
 
 /// MC_MovePath with its table.
@@ -401,15 +387,10 @@ fn point(v: &[f64]) -> Option<(PathPoint, u8)> {
     Some((p, v.len() as u8))
 }
 
-#[allow(
-    clippy::too_many_arguments,
-    reason = "the motion inputs of a Preparation block as its body holds them"
-)]
+/// The motion inputs of a linear or circular entry (`[velocity, acceleration, deceleration,
+/// jerk]` and the buffer and transition inputs) with the manual's defaults.
 fn motion(
-    velocity: PathValueDto,
-    acceleration: PathValueDto,
-    deceleration: PathValueDto,
-    jerk: PathValueDto,
+    [velocity, acceleration, deceleration, jerk]: [PathValueDto; 4],
     buffer_mode: Option<BufferMode>,
     transition_mode: Option<TransitionModeDto>,
     params: &[f64],
@@ -450,58 +431,82 @@ impl MovePathBody {
                 )
             };
             entries.push(match e {
-                PathEntryDto::Linear(l) => {
-                    let (position, count_) = point(&l.position).ok_or_else(|| count("position"))?;
+                PathEntryDto::Linear {
+                    position,
+                    velocity,
+                    acceleration,
+                    deceleration,
+                    jerk,
+                    buffer_mode,
+                    transition_mode,
+                    transition_parameters,
+                    invoke_id,
+                } => {
+                    let (position, count_) = point(position).ok_or_else(|| count("position"))?;
                     PathEntry::Linear {
                         position,
                         count: count_,
                         motion: motion(
-                            l.velocity,
-                            l.acceleration,
-                            l.deceleration,
-                            l.jerk,
-                            l.buffer_mode,
-                            l.transition_mode,
-                            &l.transition_parameters,
+                            [*velocity, *acceleration, *deceleration, *jerk],
+                            *buffer_mode,
+                            *transition_mode,
+                            transition_parameters,
                         )
                         .ok_or_else(too_many_params)?,
-                        invoke_id: l.invoke_id,
+                        invoke_id: *invoke_id,
                     }
                 }
-                PathEntryDto::Circular(c) => {
-                    let (end_point, count_) =
-                        point(&c.end_point).ok_or_else(|| count("end_point"))?;
-                    let aux: [f64; 3] = c.aux_point.as_slice().try_into().map_err(|_| {
+                PathEntryDto::Circular {
+                    circ_mode,
+                    aux_point,
+                    end_point,
+                    path_choice,
+                    velocity,
+                    acceleration,
+                    deceleration,
+                    jerk,
+                    buffer_mode,
+                    transition_mode,
+                    transition_parameters,
+                    invoke_id,
+                } => {
+                    let (end_point, count_) = point(end_point).ok_or_else(|| count("end_point"))?;
+                    let aux: [f64; 3] = aux_point.as_slice().try_into().map_err(|_| {
                         AppError::field(&field("aux_point"), "X, Y and Z: three numbers")
                     })?;
                     PathEntry::Circular {
-                        mode: c.circ_mode,
+                        mode: *circ_mode,
                         aux,
                         end_point,
                         count: count_,
-                        path_choice: c.path_choice.unwrap_or_default(),
+                        path_choice: path_choice.unwrap_or_default(),
                         motion: motion(
-                            c.velocity,
-                            c.acceleration,
-                            c.deceleration,
-                            c.jerk,
-                            c.buffer_mode,
-                            c.transition_mode,
-                            &c.transition_parameters,
+                            [*velocity, *acceleration, *deceleration, *jerk],
+                            *buffer_mode,
+                            *transition_mode,
+                            transition_parameters,
                         )
                         .ok_or_else(too_many_params)?,
-                        invoke_id: c.invoke_id,
+                        invoke_id: *invoke_id,
                     }
                 }
-                PathEntryDto::Blocker(b) => PathEntry::Blocker {
-                    blocker_id: b.blocker_id,
-                    buffer_mode: b.buffer_mode.unwrap_or(BufferMode::Buffered),
-                    invoke_id: b.invoke_id,
+                PathEntryDto::Blocker {
+                    blocker_id,
+                    buffer_mode,
+                    invoke_id,
+                } => PathEntry::Blocker {
+                    blocker_id: *blocker_id,
+                    buffer_mode: buffer_mode.unwrap_or(BufferMode::Buffered),
+                    invoke_id: *invoke_id,
                 },
-                PathEntryDto::Dwell(d) => PathEntry::Dwell {
-                    time: d.time,
-                    buffer_mode: d.buffer_mode.unwrap_or(BufferMode::Buffered),
-                    invoke_id: d.invoke_id,
+                PathEntryDto::Dwell {
+                    time,
+                    buffer_mode,
+                    invoke_id,
+                } => PathEntry::Dwell {
+                    time: *time,
+                    buffer_mode: buffer_mode.unwrap_or(BufferMode::Buffered),
+                    invoke_id: *invoke_id,
                 },
             });
         }
