@@ -127,12 +127,6 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
         "{}",
         r.text
     );
-    // The spindle is spin's: an axis of a configured group is not deleted.
-    assert_problem(
-        &delete(&s, "/api/v1/axes/spindle").await,
-        409,
-        "axis_in_group",
-    );
     // 16 group slots: the 17th is refused.
     for i in 3..=16 {
         let r = post(&s, "/api/v1/groups", json!({"name": format!("g{i}")})).await;
@@ -165,6 +159,12 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
     );
     assert_problem(
         &delete(&s, "/api/v1/groups/xy").await,
+        409,
+        "group_state_invalid",
+    );
+    // Nor does an axis leave an enabled group by being deleted.
+    assert_problem(
+        &delete(&s, "/api/v1/axes/y").await,
         409,
         "group_state_invalid",
     );
@@ -332,9 +332,41 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
             .len(),
         2
     );
+    // A deleted axis leaves its (disabled) group's configuration and membership.
+    assert_eq!(delete(&s, "/api/v1/axes/spindle").await.status, 204);
+    let spin = get(&s, "/api/v1/groups/spin").await.json;
+    assert_eq!(spin["axes"], json!([]), "{spin}");
+    assert_eq!(spin["status"]["members"], json!({}), "{spin}");
     // And it is in the configuration document.
     let doc = get(&s, "/api/v1/config").await;
     assert_eq!(doc.json["groups"][0]["name"], "xy", "{}", doc.text);
+    // An import replaces the groups with the document's, members checked against its axes.
+    let mut bad = doc.json.clone();
+    bad["groups"][0]["axes"][0]["axis"] = json!("nope");
+    let r = put(&s, "/api/v1/config", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "groups[0].axes[0].axis",
+        "{}",
+        r.text
+    );
+    let mut one = doc.json.clone();
+    one["groups"].as_array_mut().unwrap().truncate(1);
+    let r = put(&s, "/api/v1/config", one).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let all = get(&s, "/api/v1/groups").await.json;
+    assert_eq!(all.as_array().unwrap().len(), 1, "{all}");
+    assert_eq!(
+        all[0]["status"]["members"],
+        json!({"x": "x", "y": "y"}),
+        "{all}"
+    );
+    enable_xy(&s).await;
+    assert_problem(
+        &put(&s, "/api/v1/config", doc.json.clone()).await,
+        409,
+        "group_state_invalid",
+    );
     s.stop();
     let _ = std::fs::remove_dir_all(dir);
 }

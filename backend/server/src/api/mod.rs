@@ -672,6 +672,10 @@ impl utoipa::Modify for ForeignExamples {
             ),
             ("MoveOptions", to_value(motion::MoveOptions::default())),
             (
+                "PathDynamics",
+                to_value(motion::group::GroupConfig::default().default_dynamics),
+            ),
+            (
                 "HomingOptions",
                 to_value(motion::HomingOptions {
                     search_velocity: Some(20.0),

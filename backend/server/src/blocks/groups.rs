@@ -122,6 +122,7 @@ pub enum SpecialValue {
 /// (and `"ignore"` for the jerk of a halt or stop).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(untagged)]
+#[schema(example = json!(200.0))]
 pub enum PathValueDto {
     Number(f64),
     Special(SpecialValue),
@@ -254,6 +255,7 @@ impl TransitionModeDto {
 /// holds there until MC_ReleaseBlocker), `dwell` (MC_DwellTimePreparation).
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+#[schema(example = json!({"type": "linear", "position": [100.0, 0.0], "velocity": 200.0}))]
 pub enum PathEntryDto {
     /// MC_MoveLinearAbsolutePreparation.
     Linear {

@@ -94,6 +94,17 @@ pub struct GroupMemberResource {
 
 /// A group: its configuration and, while it is in the cycle, its live status.
 #[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"id": 1, "name": "xy", "convention": "xy", "additional_axes": 0,
+    "axes": [{"role": "x", "axis": "x", "axis_id": 1}, {"role": "y", "axis": "y", "axis_id": 2}],
+    "default_dynamics": {"velocity": 100.0, "acceleration": 1000.0, "deceleration": 1000.0, "jerk": 10000.0},
+    "maximum_dynamics": {"velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0, "jerk": 25000.0},
+    "override_ramp_time": 0.1, "updated_at": "2026-11-27T19:00:25.160Z",
+    "status": {"cycle": 1200, "state": "disabled", "enable_requested": false, "error_id": 0,
+        "members": {"x": "x", "y": "y"}, "axes_count": 2, "all_axes_standing": true, "override_factor": 1.0,
+        "actual_override": 1.0, "path_velocity": 0.0, "path_acceleration": 0.0, "path_position": 0.0,
+        "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
+        "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
+        "position": {"x": 0.0, "y": 0.0}}}))]
 pub struct GroupResource {
     pub id: i64,
     pub name: String,

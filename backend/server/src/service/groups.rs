@@ -582,3 +582,236 @@ pub async fn create_demo(s: &AppState) -> AppResult<()> {
     };
     create(s, body, &client).await.map(drop)
 }
+
+/// The groups of an import, validated against the imported axes (`axes`: id and name) before
+/// anything is changed; errors name `groups[i].…`. `None` (no `groups` in the document): the
+/// stored groups stay, and their members must be among the imported axes.
+pub fn prepare_import(
+    s: &AppState,
+    groups: Option<&[GroupBody]>,
+    axes: &[(i64, String)],
+) -> Result<Option<Vec<GroupEntry>>, Vec<FieldError>> {
+    let mut errs = Vec::new();
+    let Some(groups) = groups else {
+        let reg = s.registry.read().unwrap();
+        for g in reg.groups.values() {
+            for (role, a) in &g.members {
+                if !axes.iter().any(|(id, _)| id == a) {
+                    errs.push(FieldError {
+                        field: "groups".into(),
+                        message: format!(
+                            "the stored group {} has axis {a} as {}, which the document does not have: \
+                             give the groups too",
+                            g.name,
+                            role_name(*role)
+                        ),
+                    });
+                }
+            }
+        }
+        return if errs.is_empty() { Ok(None) } else { Err(errs) };
+    };
+    if groups.len() > MAX_GROUPS {
+        errs.push(FieldError {
+            field: "groups".into(),
+            message: format!("at most {MAX_GROUPS} groups"),
+        });
+    }
+    let now = store::now_rfc3339();
+    let mut entries: Vec<GroupEntry> = Vec::new();
+    for (i, g) in groups.iter().enumerate() {
+        let prefix = format!("groups[{i}].");
+        let mut fail = |f: &str, m: String| {
+            errs.push(FieldError {
+                field: format!("{prefix}{f}"),
+                message: m,
+            })
+        };
+        if !valid_name(&g.name) {
+            fail("name", "must start with a letter or '_' and contain only letters, digits, '_' or '-' (at most 64)".into());
+        }
+        if groups[..i].iter().any(|o| o.name == g.name) {
+            fail("name", "duplicate name".into());
+        }
+        match g.id {
+            None => fail("id", "required in a configuration document".into()),
+            Some(id) if !(1..=MAX_GROUPS as i64).contains(&id) => {
+                fail("id", format!("a group id is 1..{MAX_GROUPS}"))
+            }
+            Some(id) if groups[..i].iter().any(|o| o.id == Some(id)) => {
+                fail("id", "duplicate id".into())
+            }
+            _ => {}
+        }
+        if let Err((field, id)) = g.config().validate() {
+            fail(field, format!("{} ({})", id.text(), id.code()));
+            continue;
+        }
+        let members = resolve_members(
+            g,
+            &prefix,
+            |k| {
+                axes.iter()
+                    .find(|(id, name)| id.to_string() == k || name == k)
+                    .cloned()
+            },
+            |a| {
+                entries
+                    .iter()
+                    .find(|e| e.members.iter().any(|(_, m)| *m == a))
+                    .map(|e| e.name.clone())
+            },
+            &mut errs,
+        );
+        let id = g.id.unwrap_or(1).clamp(1, MAX_GROUPS as i64);
+        entries.push(GroupEntry {
+            id,
+            name: g.name.clone(),
+            slot: (id - 1) as motion::group::GroupId,
+            config: g.config(),
+            members,
+            updated_at: now.clone(),
+        });
+    }
+    if errs.is_empty() {
+        Ok(Some(entries))
+    } else {
+        Err(errs)
+    }
+}
+
+/// 409 `group_state_invalid` while a group is enabled or in error (an import replaces the
+/// axes under every group).
+pub fn refuse_unless_all_disabled(s: &AppState) -> AppResult<()> {
+    let groups: Vec<GroupEntry> = s
+        .registry
+        .read()
+        .unwrap()
+        .groups
+        .values()
+        .cloned()
+        .collect();
+    groups.iter().try_for_each(|g| refuse_unless_disabled(s, g))
+}
+
+/// Replaces the stored groups within an import's transaction.
+pub async fn store_import(
+    tx: &mut sqlx::SqliteConnection,
+    entries: &[GroupEntry],
+) -> Result<(), sqlx::Error> {
+    store::groups::delete_all_groups(tx).await?;
+    for e in entries {
+        store::groups::upsert_group(
+            tx,
+            e.id,
+            &e.name,
+            &stored_json(&e.config, &e.members),
+            &e.updated_at,
+        )
+        .await?;
+    }
+    Ok(())
+}
+
+/// After an import has committed: the groups (the new ones, or the stored ones kept) put in
+/// force again with the imported axes, the others taken out of the kernel. A group the cycle
+/// thread does not take is reported; it is in force after the next start.
+pub async fn install_import(s: &AppState, new: Option<Vec<GroupEntry>>) {
+    let old: Vec<GroupEntry> = s
+        .registry
+        .read()
+        .unwrap()
+        .groups
+        .values()
+        .cloned()
+        .collect();
+    let entries = new.unwrap_or_else(|| old.clone());
+    for g in &old {
+        if !entries.iter().any(|e| e.slot == g.slot) {
+            if let Err(e) = s.uninstall_group(g.slot, false).await {
+                tracing::error!("group {} not taken out after the import: {e}", g.name);
+            }
+        }
+    }
+    for g in &entries {
+        if let Err(e) = put_in_force(s, g.slot, g.config, &g.members).await {
+            tracing::error!(
+                "group {} imported but not in force until the next start: {e}",
+                g.name
+            );
+        }
+    }
+    s.registry_write().groups = entries.into_iter().map(|e| (e.id, e)).collect();
+}
+
+/// Before axis `axis_id` (in kernel slot `slot`) is deleted: it leaves every group it is in —
+/// the kernel's membership (MC_RemoveAxisFromGroup, so that no later axis in that slot finds
+/// itself in the group) and the stored configuration (in `tx`, the axis's deletion). Refused
+/// with 409 `group_state_invalid` while such a group is enabled or in error. The changed
+/// groups, to be registered once `tx` has committed.
+pub async fn axis_leaves(
+    s: &AppState,
+    tx: &mut sqlx::SqliteConnection,
+    axis_id: i64,
+    slot: motion::AxisSlot,
+) -> AppResult<Vec<GroupEntry>> {
+    let groups: Vec<GroupEntry> = s
+        .registry
+        .read()
+        .unwrap()
+        .groups
+        .values()
+        .cloned()
+        .collect();
+    let mut changed = Vec::new();
+    for g in groups {
+        let live: Vec<GroupRole> = s
+            .group_status(g.slot)
+            .1
+            .map(|st| {
+                GroupRole::ALL
+                    .iter()
+                    .zip(st.members.iter())
+                    .filter(|(_, m)| **m == Some(slot))
+                    .map(|(r, _)| *r)
+                    .collect()
+            })
+            .unwrap_or_default();
+        let configured = g.members.iter().any(|(_, a)| *a == axis_id);
+        if live.is_empty() && !configured {
+            continue;
+        }
+        refuse_unless_disabled(s, &g)?;
+        for role in live {
+            s.kernel_command(
+                Target::Group(g.slot),
+                CommandKind::RemoveAxisFromGroup { role },
+            )
+            .await
+            .map_err(|e| state_conflict(e, &g.name))?;
+        }
+        if configured {
+            let mut e = g.clone();
+            e.members.retain(|(_, a)| *a != axis_id);
+            e.updated_at = store::now_rfc3339();
+            store::groups::upsert_group(
+                tx,
+                e.id,
+                &e.name,
+                &stored_json(&e.config, &e.members),
+                &e.updated_at,
+            )
+            .await?;
+            changed.push(e);
+        }
+    }
+    Ok(changed)
+}
+
+/// Registers groups changed by [`axis_leaves`] after their transaction committed.
+pub fn register(s: &AppState, changed: Vec<GroupEntry>) {
+    let mut reg = s.registry_write();
+    for e in changed {
+        reg.groups.insert(e.id, e);
+    }
+}
