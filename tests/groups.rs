@@ -246,6 +246,18 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
     }
     let r = post(&s, "/api/v1/groups/xy/move-path", json!({"entries": [{"type": "linear", "position": [1.0, 2.0], "velocity": 100.0, "speed": 1}]})).await;
     assert_problem(&r, 422, "validation_failed");
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path",
+        json!({"entries": [{"type": "linear", "position": [1e13, 2.0], "velocity": 100.0}]}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "entries[0].position[0]",
+        "{}",
+        r.text
+    );
     // Three points on a line are no arc: the kernel's verdict, with its code.
     let r = post(
         &s,
@@ -399,6 +411,38 @@ async fn a_blocker_is_released_and_a_stop_held_over_the_websocket() {
     let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
         .await
         .expect("websocket connects");
+
+    // The group's status as a subscription: the full object first.
+    let r = call(
+        &mut ws,
+        9,
+        "subscribe",
+        json!({"topic": "groups/xy/status", "rate_hz": 50}),
+    )
+    .await;
+    assert_eq!(r["result"]["topic"], "groups/xy/status", "{r}");
+    loop {
+        let msg = tokio::time::timeout(Duration::from_secs(20), ws.next())
+            .await
+            .expect("an update")
+            .unwrap()
+            .unwrap();
+        let Message::Text(t) = msg else { continue };
+        let v: Value = serde_json::from_str(&t).unwrap();
+        if v["method"] == "update" && v["params"]["topic"] == "groups/xy/status" {
+            assert_eq!(v["params"]["full"], true, "{v}");
+            assert_eq!(v["params"]["data"]["state"], "standby", "{v}");
+            break;
+        }
+    }
+    let r = call(
+        &mut ws,
+        10,
+        "unsubscribe",
+        json!({"topic": "groups/xy/status"}),
+    )
+    .await;
+    assert_eq!(r["result"], true, "{r}");
 
     // A path that holds at blocker 7 between two lines.
     let r = call(&mut ws, 1, "move-path", json!({"group": "xy", "entries": [

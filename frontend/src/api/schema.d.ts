@@ -1934,7 +1934,7 @@ export interface paths {
         };
         /**
          * Websocket: JSON-RPC 2.0 subscriptions and commands
-         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). A request without an id is a notification: carried out, never answered. A client may send a JSON-RPC 2.0 batch (an array of requests): each is started in order (a command does not wait for the one before it to end) and the batch is answered with one array of the responses, once every one of them is in (nothing for a batch of notifications; an empty array is an invalid request). The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. A message over 256 KiB closes the socket with code 1009 (message too big).
+         * @description Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, `move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`), a group's blocks (`enable`, `move-path`, `release-blocker` …) with `group` instead of `axis`; `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does not keep a jog going, so a frozen client stops it too. A jog sent over the socket is also released when the socket closes. At most 32 requests per socket may await their responses; more are refused (`too_many_in_flight`). A request without an id is a notification: carried out, never answered. A client may send a JSON-RPC 2.0 batch (an array of requests): each is started in order (a command does not wait for the one before it to end) and the batch is answered with one array of the responses, once every one of them is in (nothing for a batch of notifications; an empty array is an invalid request). The server sends one message per tick (5 ms grid): when several notifications are due together (the updates of several subscriptions), they come as one JSON-RPC 2.0 batch, a JSON array of the notifications. Every message is described by the AsyncAPI 3 document at `/asyncapi.json`. The server pings a socket it has heard nothing from for 30 s (`--ws-ping-s`) and closes it (code 4408) when nothing arrives within as long again. A message over 256 KiB closes the socket with code 1009 (message too big).
          */
         get: operations["upgrade"];
         put?: never;
@@ -5100,7 +5100,70 @@ export interface components {
         GroupRemoveAxisBody: {
             role: components["schemas"]["GroupRole"];
         };
-        /** @description A group: its configuration and, while it is in the cycle, its live status. */
+        /**
+         * @description A group: its configuration and, while it is in the cycle, its live status.
+         * @example {
+         *       "additional_axes": 0,
+         *       "axes": [
+         *         {
+         *           "axis": "x",
+         *           "axis_id": 1,
+         *           "role": "x"
+         *         },
+         *         {
+         *           "axis": "y",
+         *           "axis_id": 2,
+         *           "role": "y"
+         *         }
+         *       ],
+         *       "convention": "xy",
+         *       "default_dynamics": {
+         *         "acceleration": 1000,
+         *         "deceleration": 1000,
+         *         "jerk": 10000,
+         *         "velocity": 100
+         *       },
+         *       "id": 1,
+         *       "maximum_dynamics": {
+         *         "acceleration": 2500,
+         *         "deceleration": 2500,
+         *         "jerk": 25000,
+         *         "velocity": 500
+         *       },
+         *       "name": "xy",
+         *       "override_ramp_time": 0.1,
+         *       "status": {
+         *         "actual_override": 1,
+         *         "all_axes_standing": true,
+         *         "axes_count": 2,
+         *         "blocked": false,
+         *         "blocker_id": 0,
+         *         "cycle": 1200,
+         *         "enable_requested": false,
+         *         "entry_index": 0,
+         *         "error_id": 0,
+         *         "in_blending_segment": false,
+         *         "invoke_id": 0,
+         *         "members": {
+         *           "x": "x",
+         *           "y": "y"
+         *         },
+         *         "override_factor": 1,
+         *         "path_acceleration": 0,
+         *         "path_position": 0,
+         *         "path_velocity": 0,
+         *         "position": {
+         *           "x": 0,
+         *           "y": 0
+         *         },
+         *         "queued_entries": 0,
+         *         "remaining_distance": 0,
+         *         "remaining_time": 0,
+         *         "state": "disabled"
+         *       },
+         *       "updated_at": "2026-11-27T19:00:25.160Z"
+         *     }
+         */
         GroupResource: {
             /** Format: int64 */
             id: number;
@@ -6354,7 +6417,15 @@ export interface components {
             /** @description 8–1024 characters. */
             new_password: string;
         };
-        /** @description Path dynamics of a group (path units: mm, mm/s … along the Cartesian path). */
+        /**
+         * @description Path dynamics of a group (path units: mm, mm/s … along the Cartesian path).
+         * @example {
+         *       "acceleration": 1000,
+         *       "deceleration": 1000,
+         *       "jerk": 10000,
+         *       "velocity": 100
+         *     }
+         */
         PathDynamics: {
             /** Format: double */
             velocity: number;
@@ -6378,6 +6449,14 @@ export interface components {
          * @description One row of the path table, by `type`: `linear` (MC_MoveLinearAbsolutePreparation),
          *     `circular` (MC_MoveCircularAbsolutePreparation), `blocker` (MC_BlockerPreparation: the path
          *     holds there until MC_ReleaseBlocker), `dwell` (MC_DwellTimePreparation).
+         * @example {
+         *       "position": [
+         *         100,
+         *         0
+         *       ],
+         *       "type": "linear",
+         *       "velocity": 200
+         *     }
          */
         PathEntryDto: {
             /**
@@ -6463,6 +6542,7 @@ export interface components {
         /**
          * @description A path dynamics input: a number (path units/s, /s², /s³), or `"default"`, `"maximum"`
          *     (and `"ignore"` for the jerk of a halt or stop).
+         * @example 200
          */
         PathValueDto: number | components["schemas"]["SpecialValue"];
         /**

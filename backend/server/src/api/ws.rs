@@ -72,7 +72,8 @@ use crate::app::feed::TICK;
 #[derive(Debug, Serialize, ToSchema)]
 #[schema(example = json!({"topic": "axes/x/status", "rate_hz": 25.0}))]
 pub struct SubscribeParams {
-    /// `axes/{axis}/status` (axis id or name), `commands` or `system`.
+    /// `axes/{axis}/status` (axis id or name), `groups/{group}/status` (group id or name),
+    /// `commands` or `system`.
     pub topic: String,
     /// Updates per second, 0.1–100 (more is capped); default 10. Not used by `commands`
     /// (every change is sent).
@@ -176,7 +177,8 @@ pub struct RpcError {
     description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
 (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and \
 ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, \
-`move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); \
+`move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`), a group's blocks \
+(`enable`, `move-path`, `release-blocker` …) with `group` instead of `axis`; \
 `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, \
 then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is \
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
@@ -248,6 +250,11 @@ enum Topic {
     },
     Commands,
     System,
+    /// A group's status (`groups/{group}/status`), followed by the group id. Made per
+    /// subscriber from the snapshot, as the system topic (16 groups at most, few watchers).
+    Group {
+        id: i64,
+    },
 }
 
 struct Sub {
@@ -549,6 +556,32 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, 
                     write_update(out.next(), &sub.key_json, p.cycle, p.full, &data);
                 }
             }
+            Topic::Group { id } => {
+                // A deleted group (or one not in the cycle) sends nothing.
+                let Ok(st) = crate::service::groups::status(s, &id.to_string()) else {
+                    continue;
+                };
+                let Ok(Value::Object(map)) = serde_json::to_value(&st) else {
+                    continue;
+                };
+                let data = match &sub.last {
+                    None => map.clone(),
+                    Some(last) => crate::app::feed::delta(last, &map),
+                };
+                let full = sub.last.is_none();
+                sub.last = Some(Arc::new(map));
+                if full || !data.is_empty() {
+                    out.push(&notify(
+                        "update",
+                        UpdateParams {
+                            topic: sub.key.clone(),
+                            cycle: st.cycle,
+                            full,
+                            data,
+                        },
+                    ));
+                }
+            }
             Topic::System => {
                 let sys = super::system::system_resource(s);
                 let Ok(Value::Object(map)) = serde_json::to_value(&sys) else {
@@ -725,11 +758,22 @@ fn handle(
                         return Some(rpc_error(&id, -32602, &format!("no axis '{axis}'"), None));
                     }
                 }
+            } else if let Some(group) = key
+                .strip_prefix("groups/")
+                .and_then(|r| r.strip_suffix("/status"))
+            {
+                let reg = s.registry.read().unwrap();
+                match reg.find_group(group) {
+                    Some(g) => Topic::Group { id: g.id },
+                    None => {
+                        return Some(rpc_error(&id, -32602, &format!("no group '{group}'"), None));
+                    }
+                }
             } else {
                 return Some(rpc_error(
                     &id,
                     -32602,
-                    "unknown topic (axes/{axis}/status, commands, system)",
+                    "unknown topic (axes/{axis}/status, groups/{group}/status, commands, system)",
                     None,
                 ));
             };

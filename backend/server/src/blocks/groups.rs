@@ -512,6 +512,48 @@ impl MovePathBody {
                 },
             });
         }
+        // Beyond ±1e12 an f64 position has no useful resolution and lengths could overflow to
+        // infinity inside the planner: refused here, as for an axis's positions.
+        let mut c = Check::default();
+        for (i, e) in self.entries.iter().enumerate() {
+            let field = |name: &str, j: usize| format!("entries[{i}].{name}[{j}]");
+            let vectors: [(&str, &[f64]); 4] = match e {
+                PathEntryDto::Linear {
+                    position,
+                    transition_parameters,
+                    ..
+                } => [
+                    ("position", position),
+                    ("transition_parameters", transition_parameters),
+                    ("", &[]),
+                    ("", &[]),
+                ],
+                PathEntryDto::Circular {
+                    aux_point,
+                    end_point,
+                    transition_parameters,
+                    ..
+                } => [
+                    ("aux_point", aux_point),
+                    ("end_point", end_point),
+                    ("transition_parameters", transition_parameters),
+                    ("", &[]),
+                ],
+                PathEntryDto::Dwell { time, .. } => {
+                    if *time > crate::model::MAX_MAGNITUDE {
+                        c.fail(&format!("entries[{i}].time"), "at most 1e12 s");
+                    }
+                    [("", &[]), ("", &[]), ("", &[]), ("", &[])]
+                }
+                PathEntryDto::Blocker { .. } => [("", &[]), ("", &[]), ("", &[]), ("", &[])],
+            };
+            for (name, v) in vectors {
+                for (j, x) in v.iter().enumerate() {
+                    c.finite(&field(name, j), *x);
+                }
+            }
+        }
+        c.done(())?;
         let table = PathTable { entries };
         table
             .check(axes)
