@@ -561,51 +561,39 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, 
                 let Ok(st) = crate::service::groups::status(s, &id.to_string()) else {
                     continue;
                 };
-                let Ok(Value::Object(map)) = serde_json::to_value(&st) else {
-                    continue;
-                };
-                let data = match &sub.last {
-                    None => map.clone(),
-                    Some(last) => crate::app::feed::delta(last, &map),
-                };
-                let full = sub.last.is_none();
-                sub.last = Some(Arc::new(map));
-                if full || !data.is_empty() {
-                    out.push(&notify(
-                        "update",
-                        UpdateParams {
-                            topic: sub.key.clone(),
-                            cycle: st.cycle,
-                            full,
-                            data,
-                        },
-                    ));
-                }
+                object_update(sub, st.cycle, &st, out);
             }
             Topic::System => {
                 let sys = super::system::system_resource(s);
-                let Ok(Value::Object(map)) = serde_json::to_value(&sys) else {
-                    continue;
-                };
-                let data = match &sub.last {
-                    None => map.clone(),
-                    Some(last) => crate::app::feed::delta(last, &map),
-                };
-                let full = sub.last.is_none();
-                sub.last = Some(Arc::new(map));
-                if full || !data.is_empty() {
-                    out.push(&notify(
-                        "update",
-                        UpdateParams {
-                            topic: sub.key.clone(),
-                            cycle: sys.cycle,
-                            full,
-                            data,
-                        },
-                    ));
-                }
+                object_update(sub, sys.cycle, &sys, out);
             }
         }
+    }
+}
+
+/// An object topic's update (system, a group): made for this subscriber from the object and
+/// the one it was last sent — the whole object first, then the changed fields, nothing when
+/// none changed.
+fn object_update(sub: &mut Sub, cycle: u64, object: &impl Serialize, out: &mut Batch) {
+    let Ok(Value::Object(map)) = serde_json::to_value(object) else {
+        return;
+    };
+    let data = match &sub.last {
+        None => map.clone(),
+        Some(last) => crate::app::feed::delta(last, &map),
+    };
+    let full = sub.last.is_none();
+    sub.last = Some(Arc::new(map));
+    if full || !data.is_empty() {
+        out.push(&notify(
+            "update",
+            UpdateParams {
+                topic: sub.key.clone(),
+                cycle,
+                full,
+                data,
+            },
+        ));
     }
 }
 

@@ -25,6 +25,17 @@ struct Stored {
     members: Vec<(GroupRole, i64)>,
 }
 
+/// Every configured group (a copy: the registry is not held across awaits).
+fn all(s: &AppState) -> Vec<GroupEntry> {
+    s.registry
+        .read()
+        .unwrap()
+        .groups
+        .values()
+        .cloned()
+        .collect()
+}
+
 fn entry(s: &AppState, key: &str) -> AppResult<GroupEntry> {
     s.registry
         .read()
@@ -109,14 +120,7 @@ fn resource(s: &AppState, e: &GroupEntry) -> GroupResource {
 }
 
 pub fn list(s: &AppState) -> Vec<GroupResource> {
-    let entries: Vec<GroupEntry> = s
-        .registry
-        .read()
-        .unwrap()
-        .groups
-        .values()
-        .cloned()
-        .collect();
+    let entries = all(s);
     entries.iter().map(|e| resource(s, e)).collect()
 }
 
@@ -353,45 +357,54 @@ pub async fn create(
                 })?,
         }
     };
-    let config = body.config();
-    let slot = (id - 1) as motion::group::GroupId;
-    let now = store::now_rfc3339();
-    let mut tx = s.db.begin().await?;
-    store::groups::upsert_group(
-        &mut tx,
-        id,
-        &body.name,
-        &stored_json(&config, &members),
-        &now,
-    )
-    .await?;
-    store::audit(
-        &mut *tx,
-        &audit_entry(
-            client,
-            "group.create",
-            &body.name,
-            serde_json::to_string(&body).unwrap_or_default(),
-        ),
-    )
-    .await?;
-    if let Err(e) = put_in_force(s, slot, config, &members).await {
-        let _ = s.uninstall_group(slot, false).await;
-        return Err(e);
-    }
-    if let Err(e) = tx.commit().await {
-        let _ = s.uninstall_group(slot, false).await;
-        return Err(e.into());
-    }
     let e = GroupEntry {
         id,
-        name: body.name,
-        slot,
-        config,
+        name: body.name.clone(),
+        slot: (id - 1) as motion::group::GroupId,
+        config: body.config(),
         members,
-        updated_at: now,
+        updated_at: store::now_rfc3339(),
     };
-    s.registry_write().groups.insert(id, e.clone());
+    store_and_register(s, e, &body, client, None).await
+}
+
+/// Stores a group with its audit row and puts it in force before the commit; if either fails,
+/// the kernel gets back what it had (`replacing`: the old group; `None`: nothing in the slot).
+async fn store_and_register(
+    s: &AppState,
+    e: GroupEntry,
+    body: &GroupBody,
+    client: &ClientInfo,
+    replacing: Option<&GroupEntry>,
+) -> AppResult<GroupResource> {
+    let restore = || async {
+        match replacing {
+            Some(old) => drop(put_in_force(s, old.slot, old.config, &old.members).await),
+            None => drop(s.uninstall_group(e.slot, false).await),
+        }
+    };
+    let mut tx = s.db.begin().await?;
+    let stored = stored_json(&e.config, &e.members);
+    store::groups::upsert_group(&mut tx, e.id, &e.name, &stored, &e.updated_at).await?;
+    let action = if replacing.is_some() {
+        "group.replace"
+    } else {
+        "group.create"
+    };
+    let detail = serde_json::to_string(body).unwrap_or_default();
+    store::audit(&mut *tx, &audit_entry(client, action, &e.name, detail)).await?;
+    if let Err(err) = put_in_force(s, e.slot, e.config, &e.members).await {
+        // Refused because the group there is enabled: nothing was swapped.
+        if err.kernel_error() != Some(ErrorId::GROUP_STATE_INVALID) || replacing.is_none() {
+            restore().await;
+        }
+        return Err(state_conflict(err, &e.name));
+    }
+    if let Err(err) = tx.commit().await {
+        restore().await;
+        return Err(err.into());
+    }
+    s.registry_write().groups.insert(e.id, e.clone());
     Ok(resource(s, &e))
 }
 
@@ -413,48 +426,15 @@ pub async fn replace(
     let members = check(s, &body, Some(old.id))?;
     name_taken(s, &body.name, Some(old.id))?;
     refuse_unless_disabled(s, &old)?;
-    let config = body.config();
-    let now = store::now_rfc3339();
-    let mut tx = s.db.begin().await?;
-    store::groups::upsert_group(
-        &mut tx,
-        old.id,
-        &body.name,
-        &stored_json(&config, &members),
-        &now,
-    )
-    .await?;
-    store::audit(
-        &mut *tx,
-        &audit_entry(
-            client,
-            "group.replace",
-            &body.name,
-            serde_json::to_string(&body).unwrap_or_default(),
-        ),
-    )
-    .await?;
-    let restore = || put_in_force(s, old.slot, old.config, &old.members);
-    if let Err(e) = put_in_force(s, old.slot, config, &members).await {
-        if e.kernel_error() != Some(ErrorId::GROUP_STATE_INVALID) {
-            let _ = restore().await;
-        }
-        return Err(state_conflict(e, &old.name));
-    }
-    if let Err(e) = tx.commit().await {
-        let _ = restore().await;
-        return Err(e.into());
-    }
     let e = GroupEntry {
         id: old.id,
-        name: body.name,
+        name: body.name.clone(),
         slot: old.slot,
-        config,
+        config: body.config(),
         members,
-        updated_at: now,
+        updated_at: store::now_rfc3339(),
     };
-    s.registry_write().groups.insert(old.id, e.clone());
-    Ok(resource(s, &e))
+    store_and_register(s, e, &body, client, Some(&old)).await
 }
 
 /// 409 `group_state_invalid` while the group is enabled or in error (as the snapshot shows it;
@@ -683,14 +663,7 @@ pub fn prepare_import(
 /// 409 `group_state_invalid` while a group is enabled or in error (an import replaces the
 /// axes under every group).
 pub fn refuse_unless_all_disabled(s: &AppState) -> AppResult<()> {
-    let groups: Vec<GroupEntry> = s
-        .registry
-        .read()
-        .unwrap()
-        .groups
-        .values()
-        .cloned()
-        .collect();
+    let groups = all(s);
     groups.iter().try_for_each(|g| refuse_unless_disabled(s, g))
 }
 
@@ -717,14 +690,7 @@ pub async fn store_import(
 /// force again with the imported axes, the others taken out of the kernel. A group the cycle
 /// thread does not take is reported; it is in force after the next start.
 pub async fn install_import(s: &AppState, new: Option<Vec<GroupEntry>>) {
-    let old: Vec<GroupEntry> = s
-        .registry
-        .read()
-        .unwrap()
-        .groups
-        .values()
-        .cloned()
-        .collect();
+    let old = all(s);
     let entries = new.unwrap_or_else(|| old.clone());
     for g in &old {
         if !entries.iter().any(|e| e.slot == g.slot) {
@@ -755,14 +721,7 @@ pub async fn axis_leaves(
     axis_id: i64,
     slot: motion::AxisSlot,
 ) -> AppResult<Vec<GroupEntry>> {
-    let groups: Vec<GroupEntry> = s
-        .registry
-        .read()
-        .unwrap()
-        .groups
-        .values()
-        .cloned()
-        .collect();
+    let groups = all(s);
     let mut changed = Vec::new();
     for g in groups {
         let live: Vec<GroupRole> = s
