@@ -9,9 +9,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
 
 use crossbeam_queue::ArrayQueue;
+use motion::group::{Group, GroupId, GroupStatus, MAX_GROUPS, PathTable};
 use motion::{
-    Axis, AxisSlot, AxisStatus, Command, CommandEvent, DriveFeedback, DriveSetpoint, ErrorId,
-    EventSink, Kernel, Verdict,
+    Axis, AxisSlot, AxisStatus, Command, CommandEvent, CommandId, DriveFeedback, DriveSetpoint,
+    ErrorId, EventSink, Kernel, Verdict,
 };
 
 use drives::{BusError, Drive, DriveBus, SimFault};
@@ -86,6 +87,27 @@ pub enum Request {
         ticket: u64,
         id: u32,
     },
+    /// Put a built group into its slot (refused while the group there is enabled or in
+    /// error: a configuration changes only on a disabled group).
+    InsertGroup {
+        ticket: u64,
+        id: GroupId,
+        group: Box<Group>,
+    },
+    /// Take a group out; with `require_disabled`, only while it is disabled (not enabled, not
+    /// in error).
+    RemoveGroup {
+        ticket: u64,
+        id: GroupId,
+        require_disabled: bool,
+    },
+    /// MC_MovePath: a table built and checked off the thread; it comes back as garbage after
+    /// the verdict (the group copies what it accepts into its own queue).
+    MovePath {
+        command: CommandId,
+        group: GroupId,
+        table: Box<PathTable>,
+    },
     /// What the scope samples from the cycle this is drained in (see `scope.rs`).
     ScopeConfig {
         ticket: u64,
@@ -113,6 +135,10 @@ pub enum Garbage {
         #[allow(dead_code, reason = "held only to be dropped off the cycle thread")]
         Arc<motion::cam::Cam>,
     ),
+    Group(#[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Box<Group>),
+    Path(
+        #[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Box<PathTable>,
+    ),
 }
 
 /// Status of every slot at the end of one cycle.
@@ -120,6 +146,8 @@ pub enum Garbage {
 pub struct Snapshot {
     pub cycle: u64,
     pub axes: [Option<AxisStatus>; MAX_AXES],
+    /// The groups' status (TF5420 `NcToPlc` of each group), by group slot.
+    pub groups: [Option<GroupStatus>; MAX_GROUPS],
 }
 
 impl Default for Snapshot {
@@ -127,6 +155,7 @@ impl Default for Snapshot {
         Snapshot {
             cycle: 0,
             axes: [None; MAX_AXES],
+            groups: [None; MAX_GROUPS],
         }
     }
 }
@@ -404,6 +433,8 @@ pub struct CycleThread {
     /// The snapshot's slots that have ever held an axis are `..published` (only they are
     /// written each cycle: a slot emptied later is cleared in every buffer of the triple).
     published: usize,
+    /// The same for the group slots.
+    groups_published: usize,
 }
 
 impl CycleThread {
@@ -422,6 +453,7 @@ impl CycleThread {
             snapshot,
             scope: ScopeConfig::default(),
             published: 0,
+            groups_published: 0,
         }
     }
 
@@ -498,6 +530,12 @@ impl CycleThread {
                         }
                         Request::InsertCam { cam, .. } | Request::ChangeCam { cam, .. } => {
                             let _ = shared.garbage.push(Garbage::Cam(cam));
+                        }
+                        Request::InsertGroup { group, .. } => {
+                            let _ = shared.garbage.push(Garbage::Group(group));
+                        }
+                        Request::MovePath { table, .. } => {
+                            let _ = shared.garbage.push(Garbage::Path(table));
                         }
                         _ => {}
                     }
@@ -717,6 +755,68 @@ impl CycleThread {
                         result: Ok(()),
                     }
                 }
+                Request::InsertGroup { ticket, id, group } => {
+                    let result = match self.kernel.insert_group(id, group) {
+                        Ok(old) => {
+                            self.groups_published = self.groups_published.max(id as usize + 1);
+                            if let Some(old) = old {
+                                self.discard(Garbage::Group(old));
+                            }
+                            Ok(())
+                        }
+                        Err(group) => {
+                            self.discard(Garbage::Group(group));
+                            Err(ErrorId::GROUP_STATE_INVALID)
+                        }
+                    };
+                    Reply {
+                        hint: None,
+                        ticket,
+                        cycle,
+                        result,
+                    }
+                }
+                Request::RemoveGroup {
+                    ticket,
+                    id,
+                    require_disabled,
+                } => {
+                    let enabled = self.kernel.group(id).is_some_and(|g| {
+                        g.status().enable_requested
+                            || g.state() == motion::group::GroupState::ErrorStop
+                    });
+                    let result = if require_disabled && enabled {
+                        Err(ErrorId::GROUP_STATE_INVALID)
+                    } else {
+                        if let Some(old) = self.kernel.remove_group(id, &mut sink) {
+                            self.discard(Garbage::Group(old));
+                        }
+                        Ok(())
+                    };
+                    Reply {
+                        hint: None,
+                        ticket,
+                        cycle,
+                        result,
+                    }
+                }
+                Request::MovePath {
+                    command,
+                    group,
+                    table,
+                } => {
+                    let result = match self.kernel.submit_path(command, group, &table, &mut sink) {
+                        Verdict::Accepted => Ok(()),
+                        Verdict::Rejected(e) => Err(e),
+                    };
+                    self.discard(Garbage::Path(table));
+                    Reply {
+                        hint: None,
+                        ticket: command,
+                        cycle,
+                        result,
+                    }
+                }
                 Request::ScopeConfig { ticket, config } => {
                     self.scope = config;
                     Reply {
@@ -755,6 +855,13 @@ impl CycleThread {
             match (self.kernel.axis(i as AxisSlot), s.as_mut()) {
                 (Some(a), Some(dst)) => *dst = *a.status(),
                 (Some(a), None) => *s = Some(*a.status()),
+                (None, _) => *s = None,
+            }
+        }
+        for (i, s) in snap.groups[..self.groups_published].iter_mut().enumerate() {
+            match (self.kernel.group(i as GroupId), s.as_mut()) {
+                (Some(g), Some(dst)) => *dst = *g.status(),
+                (Some(g), None) => *s = Some(*g.status()),
                 (None, _) => *s = None,
             }
         }

@@ -69,6 +69,12 @@ pub enum AppError {
         errors: Vec<FieldError>,
         id: ErrorId,
     },
+    /// 422 with the error's own code (`transition_mode_invalid` …): a value the kernel's rules
+    /// refuse before anything is submitted (a path entry), the field at fault named.
+    InvalidCoded {
+        errors: Vec<FieldError>,
+        id: ErrorId,
+    },
     /// 409: the axis refused the command (its PLCopen ErrorID is the code).
     Rejected(ErrorId),
     /// 409: the axis refused the command, with what was in the way (the axis state, its error,
@@ -198,6 +204,7 @@ impl AppError {
             AppError::Rejected(id)
             | AppError::RejectedBecause { id, .. }
             | AppError::InvalidNumbered { id, .. }
+            | AppError::InvalidCoded { id, .. }
             | AppError::Kernel { id, .. }
             | AppError::Refused { id, .. } => Some(*id),
             _ => None,
@@ -208,7 +215,7 @@ impl AppError {
         use AppError::*;
         match self {
             NotFound { .. } => StatusCode::NOT_FOUND,
-            Invalid(_) | InvalidNumbered { .. } | Refused { .. } => {
+            Invalid(_) | InvalidNumbered { .. } | InvalidCoded { .. } | Refused { .. } => {
                 StatusCode::UNPROCESSABLE_ENTITY
             }
             Rejected(_) | RejectedBecause { .. } | Conflict { .. } => StatusCode::CONFLICT,
@@ -231,6 +238,7 @@ impl AppError {
             Invalid(_) | InvalidNumbered { .. } | Refused { .. } => {
                 ("validation_failed".into(), "Invalid request")
             }
+            InvalidCoded { id, .. } => (id.code().into(), "Invalid request"),
             Rejected(id) | RejectedBecause { id, .. } => {
                 (id.code().into(), "Command rejected by the axis")
             }
@@ -250,7 +258,9 @@ impl AppError {
             Http { code, title, .. } => (code.clone(), title),
         };
         let errors = match self {
-            Invalid(errors) | InvalidNumbered { errors, .. } => errors.clone(),
+            Invalid(errors) | InvalidNumbered { errors, .. } | InvalidCoded { errors, .. } => {
+                errors.clone()
+            }
             Refused { field, message, .. } => vec![FieldError {
                 field: field.to_string(),
                 message: message.clone(),
@@ -275,7 +285,7 @@ impl fmt::Display for AppError {
         use AppError::*;
         match self {
             NotFound { what, key } => write!(f, "no {what} '{key}'"),
-            Invalid(errors) | InvalidNumbered { errors, .. } => {
+            Invalid(errors) | InvalidNumbered { errors, .. } | InvalidCoded { errors, .. } => {
                 for (i, e) in errors.iter().enumerate() {
                     if i > 0 {
                         f.write_str("; ")?;

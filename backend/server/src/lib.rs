@@ -400,6 +400,10 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
     if cams > 0 {
         tracing::info!("{cams} cam tables loaded");
     }
+    let groups = service::groups::load(&state).await?;
+    if groups > 0 {
+        tracing::info!("{groups} axis groups loaded (disabled)");
+    }
 
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
@@ -755,8 +759,12 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
                     .await
                     .map_err(|e| format!("cannot create demo axis {name}: {}", e))?;
             }
+            service::groups::create_demo(state)
+                .await
+                .map_err(|e| format!("cannot create the demo group xy: {e}"))?;
             tracing::info!(
-                "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°)"
+                "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°), \
+                 and the group xy of x and y (disabled)"
             );
             return Ok(());
         }

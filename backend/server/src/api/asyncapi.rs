@@ -125,7 +125,11 @@ fn error() -> Value {
 }
 
 /// A command method's params: its REST body's schema with `axis`, `wait` and `timeout_ms`.
-fn command_params(body: &str, schemas: &Map<String, Value>) -> Value {
+fn command_params(body: &str, at: super::blocks::At, schemas: &Map<String, Value>) -> Value {
+    let (target, what) = match at {
+        super::blocks::At::Axes => ("axis", "Axis id or name."),
+        super::blocks::At::Groups => ("group", "Group id or name."),
+    };
     let mut p = schemas
         .get(body)
         .cloned()
@@ -138,8 +142,8 @@ fn command_params(body: &str, schemas: &Map<String, Value>) -> Value {
         .expect("a body is an object");
     let mut all = Map::new();
     all.insert(
-        "axis".into(),
-        json!({"type": ["string", "integer"], "description": "Axis id or name.", "example": "x"}),
+        target.into(),
+        json!({"type": ["string", "integer"], "description": what, "example": if target == "axis" { "x" } else { "xy" }}),
     );
     all.insert(
         "wait".into(),
@@ -152,9 +156,9 @@ fn command_params(body: &str, schemas: &Map<String, Value>) -> Value {
     all.extend(std::mem::take(props));
     *props = all;
     let required = p["required"].as_array().cloned().unwrap_or_default();
-    p["required"] = Value::Array([json!("axis")].into_iter().chain(required).collect());
+    p["required"] = Value::Array([json!(target)].into_iter().chain(required).collect());
     if let Some(d) = p.get("description").and_then(Value::as_str) {
-        p["description"] = json!(format!("{d} (the REST body {body} with the axis)"));
+        p["description"] = json!(format!("{d} (the REST body {body} with the {target})"));
     }
     p.as_object_mut().unwrap().remove("example");
     p
@@ -192,7 +196,21 @@ impl Builder {
         summary: &str,
         description: &str,
     ) {
-        let key = camel(method);
+        self.rpc_as(&camel(method), method, params, result, summary, description);
+    }
+
+    /// A method under its own message key (a group's block shares its method name with an
+    /// axis's block: `halt` with `group` in its params).
+    fn rpc_as(
+        &mut self,
+        key: &str,
+        method: &str,
+        params: Value,
+        result: Value,
+        summary: &str,
+        description: &str,
+    ) {
+        let key = key.to_owned();
         let reply = format!("{key}Result");
         self.message(&key, request(method, params, summary));
         self.message(&reply, response(method, result));
@@ -245,7 +263,8 @@ pub fn document() -> Value {
         "Subscribe to a topic",
         "`axes/{axis}/status` (updates at `rate_hz` from the latest cycle: the full `LiveStatus` first, then only \
          the changed fields; the subscription follows its axis by id and ends with `subscription_ended` when the \
-         axis is removed), `system` (the `SystemResource`, likewise) or `commands` (every `command_event`). \
+         axis is removed), `groups/{group}/status` (the `GroupStatusDto`, likewise; nothing is sent while the group \
+         does not exist), `system` (the `SystemResource`, likewise) or `commands` (every `command_event`). \
          Subscribing again to a topic replaces the subscription (and starts with a full object).",
     );
     d.rpc(
@@ -270,9 +289,14 @@ pub fn document() -> Value {
         "Unlocks an MC_Stop, ends a jog, a power or a gear-in-dyn (as `DELETE /api/v1/commands/{id}`).",
     );
     for block in super::blocks::BLOCKS {
-        d.rpc(
+        let key = match block.at {
+            super::blocks::At::Axes => camel(block.name),
+            super::blocks::At::Groups => camel(&format!("group-{}", block.name)),
+        };
+        d.rpc_as(
+            &key,
             block.name,
-            command_params(block.body, &schemas),
+            command_params(block.body, block.at, &schemas),
             schema_ref("CommandResource"),
             &format!("The command `POST {}`", block.path),
             "Validated, submitted and answered as over REST: the result is the command resource (final, or at its \

@@ -23,8 +23,11 @@ use crate::app::AppState;
 use crate::blocks::torque::{ExtSetPointFeedBody, FeedResult};
 use crate::error::AppError;
 use crate::error::AppResult;
-use crate::model::{Block, ClientInfo, CommandResource, EmptyBody, Milestone};
-use crate::service::commands::{self, Submission};
+use crate::model::{Block, ClientInfo, CommandResource, EmptyBody, GroupOrder, Milestone};
+use crate::service::commands::{self, Convert, Submission};
+
+/// What a block addresses: an axis or a group.
+pub use crate::model::At;
 use crate::service::idempotency;
 
 /// What a client must be allowed to do to send a block (shown in the OpenAPI document as
@@ -47,7 +50,7 @@ fn accepted(view: CommandResource) -> Response {
 async fn command<B: Send + Sync + 'static>(
     s: Arc<AppState>,
     block: &'static Block,
-    to_kind: commands::ToKind<B>,
+    to_kind: Convert<B>,
     target: String,
     (client, headers, q): (Client, axum::http::HeaderMap, WaitQuery),
     (body, raw): (B, Value),
@@ -91,9 +94,27 @@ async fn command<B: Send + Sync + 'static>(
 macro_rules! catalogue {
     // The route prefix of each kind of target: under /api/v1, and as a REST path.
     (@route axes, $name:literal) => { concat!("/axes/{axis}/", $name) };
+    (@route groups, $name:literal) => { concat!("/groups/{group}/", $name) };
+    // The body's conversion with its target's kind.
+    (@convert axes, $to_kind:expr) => { Convert::Axis($to_kind) };
+    (@convert groups, $to_kind:expr) => { Convert::Group($to_kind) };
+    (@block groups, $name:literal, $body:ident, $role:ident, $milestone:ident, [$($flag:ident),*], $summary:literal) => {
+        Block {
+            name: $name,
+            at: At::Groups,
+            path: concat!("/api/v1/groups/{group}/", $name),
+            body: stringify!($body),
+            role: Role::$role,
+            milestone: Milestone::$milestone,
+            summary: $summary,
+            $($flag: true,)*
+            ..Block::PLAIN
+        }
+    };
     (@block axes, $name:literal, $body:ident, $role:ident, $milestone:ident, [$($flag:ident),*], $summary:literal) => {
         Block {
             name: $name,
+            at: At::Axes,
             path: concat!("/api/v1/axes/{axis}/", $name),
             body: stringify!($body),
             role: Role::$role,
@@ -122,7 +143,29 @@ macro_rules! catalogue {
             JsonBody(body, raw): JsonBody<$body>,
         ) -> AppResult<Response> {
             let block = &BLOCKS[Entry::$fn as usize];
-            command(s, block, $to_kind, axis, (client, headers, q), (body, raw)).await
+            command(s, block, Convert::Axis($to_kind), axis, (client, headers, q), (body, raw)).await
+        }
+    };
+    (@handler groups, $fn:ident, $name:literal, $body:ident, $to_kind:expr, $role:ident, $milestone:ident, $summary:literal) => {
+        #[utoipa::path(post, path = concat!("/api/v1/groups/{group}/", $name), tag = "groups", summary = $summary,
+            params(("group" = String, Path, description = "group id (1..16) or name", example = "xy"), WaitQuery,
+                ("Idempotency-Key" = Option<String>, Header, min_length = 1, max_length = 255, pattern = "^[!-~]+$", description = "1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).", example = "mes-order-4711-step-3")),
+            request_body = $body,
+            responses(
+                (status = 202, description = "Accepted: the command resource (final or at its milestone when waited for)",
+                    body = CommandResource, headers(("Location" = String, description = "/api/v1/commands/{id}"))),
+                crate::api::errors::GroupCommandErrors),
+            extensions(("x-motiond-block" = json!({"role": Role::$role, "milestone": Milestone::$milestone}))))]
+        pub async fn $fn(
+            State(s): State<Arc<AppState>>,
+            Path(group): Path<String>,
+            client: Client,
+            headers: axum::http::HeaderMap,
+            Q(q): Q<WaitQuery>,
+            JsonBody(body, raw): JsonBody<$body>,
+        ) -> AppResult<Response> {
+            let block = &BLOCKS[Entry::$fn as usize];
+            command(s, block, Convert::Group($to_kind), group, (client, headers, q), (body, raw)).await
         }
     };
     ($(
@@ -168,7 +211,7 @@ macro_rules! catalogue {
                         Ok((body, raw)) => {
                             let sub = Submission {
                                 block,
-                                to_kind: $to_kind,
+                                to_kind: catalogue!(@convert $prefix, $to_kind),
                                 target,
                                 body,
                                 raw,
@@ -237,14 +280,14 @@ macro_rules! families {
         /// that is not a block.
         pub async fn dispatch(
             s: &AppState,
-            method: &str,
+            (at, method): (At, &str),
             target: &str,
             raw: Value,
             client: ClientInfo,
             wait: Option<Duration>,
         ) -> Option<AppResult<CommandResource>> {
             $(
-                if $family::BLOCKS.iter().any(|b| b.name == method) {
+                if $family::BLOCKS.iter().any(|b| b.name == method && b.at == at) {
                     return $family::dispatch(s, method, target, raw, client, wait).await;
                 }
             )+
@@ -264,6 +307,7 @@ families!(
     probe,
     torque,
     corrections,
+    groups,
 );
 
 /// The feed's OpenAPI operation.
@@ -295,9 +339,9 @@ pub async fn ext_setpoint_gen_feed(
     Ok(Json(FeedResult { cycle }))
 }
 
-/// The catalogue entry of a block (websocket method) name.
-pub fn find(name: &str) -> Option<&'static Block> {
-    BLOCKS.iter().find(|b| b.name == name)
+/// The catalogue entry of a block (websocket method) name for a kind of target.
+pub fn find(at: At, name: &str) -> Option<&'static Block> {
+    BLOCKS.iter().find(|b| b.name == name && b.at == at)
 }
 
 #[cfg(test)]
@@ -307,9 +351,13 @@ mod tests {
     #[test]
     fn every_entry_is_unique_and_routed_under_its_name() {
         for (i, b) in BLOCKS.iter().enumerate() {
-            assert_eq!(b.path, format!("/api/v1/axes/{{axis}}/{}", b.name));
+            let prefix = match b.at {
+                At::Axes => "/api/v1/axes/{axis}/",
+                At::Groups => "/api/v1/groups/{group}/",
+            };
+            assert_eq!(b.path, format!("{prefix}{}", b.name));
             assert!(
-                BLOCKS[..i].iter().all(|o| o.name != b.name),
+                BLOCKS[..i].iter().all(|o| o.name != b.name || o.at != b.at),
                 "{} twice",
                 b.name
             );

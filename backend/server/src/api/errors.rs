@@ -200,6 +200,9 @@ problem_responses! {
     /// No such command (never accepted, or no longer among the last 2000).
     CommandNotFound(example = json!(p(AppError::not_found("command", "12345"))));
 
+    /// No such axis group.
+    GroupNotFound(example = json!(p(AppError::not_found("group", "gantry"))));
+
     /// No such cam table.
     CamTableNotFound(example = json!(p(AppError::not_found("cam_table", "knife"))));
 
@@ -235,6 +238,32 @@ problem_responses! {
             value = json!(p(AppError::rejected(ErrorId::EXT_SETPOINT_INVALID))))),
         ("control_held" = (summary = "Another client holds control of the machine",
             value = json!(control_held())))));
+
+    /// Rejected by the group (wrong group state, a path the group cannot run …) or by the
+    /// kernel's check of a path (`circle_invalid`, `path_beyond_soft_limit` …); `error_id` and
+    /// `code` name it. No command is kept.
+    GroupCommandRejected(examples(
+        ("group_state_invalid" = (summary = "A path for a disabled group",
+            value = json!(p(AppError::rejected(ErrorId::GROUP_STATE_INVALID))))),
+        ("path_beyond_soft_limit" = (summary = "The path leaves an axis's software limits",
+            value = json!(p(AppError::rejected(ErrorId::PATH_BEYOND_SOFT_LIMIT))))),
+        ("control_held" = (summary = "Another client holds control of the machine (stop, halt and disabling always pass)",
+            value = json!(control_held())))));
+
+    /// The name or the id is taken, all 16 group slots are used, or the group is enabled or in
+    /// error (`group_state_invalid`: disable it first).
+    GroupConflict(examples(
+        ("group_name_taken" = (value = json!(p(AppError::conflict("group_name_taken", "a group named 'xy' exists"))))),
+        ("group_id_taken" = (value = json!(p(AppError::conflict("group_id_taken",
+            "group 1 exists: PUT /api/v1/groups/1 replaces it"))))),
+        ("no_free_group_slot" = (value = json!(p(AppError::conflict("no_free_group_slot",
+            "all 16 group slots are used (delete a group first)"))))),
+        ("group_state_invalid" = (value = json!(p(AppError::RejectedBecause { id: ErrorId::GROUP_STATE_INVALID,
+            why: "group xy is enabled or in error: disable it first (POST /api/v1/groups/xy/disable)".into() }))))));
+
+    /// The group is enabled or in error (`group_state_invalid`: disable it first).
+    GroupNotDisabled(example = json!(p(AppError::RejectedBecause { id: ErrorId::GROUP_STATE_INVALID,
+        why: "group xy is enabled or in error: disable it first (POST /api/v1/groups/xy/disable)".into() })));
 
     /// The axis is not (and was not) coupled through a cam.
     CamNotCoupled(example = json!(p(AppError::rejected(ErrorId::CAM_NOT_COUPLED))));
@@ -356,6 +385,31 @@ problem_responses! {
     CommandInvalid(examples(
         ("body" = (summary = "An invalid field", value = json!(p(AppError::field("velocity", "must be > 0"))))),
         ("query" = (summary = "An invalid query", value = json!(p(AppError::field("timeout_ms", "at most 600000")))))));
+
+    /// Invalid fields of a group (`errors[].field`); `error_id` 0x8140 path_dynamics_invalid
+    /// or 0x8120 group_config_invalid when the kernel's rules refuse a value.
+    GroupInvalid(examples(
+        ("path_dynamics_invalid" = (summary = "A default above the maximum",
+            value = json!(p(AppError::InvalidNumbered { errors: vec![crate::error::FieldError {
+                field: "default_dynamics.velocity".into(), message: ErrorId::PATH_DYNAMICS_INVALID.text().into() }],
+                id: ErrorId::PATH_DYNAMICS_INVALID })))),
+        ("role" = (summary = "A role the convention does not have",
+            value = json!(p(AppError::field("axes[2].role",
+                "not a role of this group: x, y (the convention's axes, then addax1..0)")))))));
+
+    /// An invalid field of a group block (`errors[].field`), or a path entry the TF5420 rules
+    /// refuse: then `code` is the rule's (`transition_mode_invalid`, `buffer_mode_invalid`,
+    /// `position_count_invalid`, `path_dynamics_invalid`, `blocker_id_invalid` …) and `error_id`
+    /// its number, the field `entries[i].…`.
+    GroupCommandInvalid(examples(
+        ("body" = (summary = "An invalid field", value = json!(p(AppError::field("factor", "must be a number"))))),
+        ("transition_mode_invalid" = (summary = "A corner blend with buffered (TF5420 §7.3)",
+            value = json!(p(AppError::InvalidCoded { errors: vec![crate::error::FieldError {
+                field: "entries[1].transition_mode".into(),
+                message: "transition_mode_invalid (0x813B): transition mode not allowed here".into() }],
+                id: ErrorId::TRANSITION_MODE_INVALID })))),
+        ("circle_invalid" = (summary = "Three points on a line",
+            value = json!(p(AppError::kernel(axum::http::StatusCode::UNPROCESSABLE_ENTITY, "Invalid request", ErrorId::CIRCLE_INVALID)))))));
 
     /// An invalid or unknown query parameter.
     QueryInvalid(example = json!(p(AppError::field("query",
@@ -506,6 +560,30 @@ error_sets! {
     CommandErrors {
         400: MalformedJson, 404: AxisNotFound, 409: CommandRejected, 413: PayloadTooLarge,
         422: CommandInvalid, 503: CommandUnavailable,
+    }
+    /// `POST /groups/{group}/<block>`.
+    GroupCommandErrors {
+        400: MalformedJson, 404: GroupNotFound, 409: GroupCommandRejected, 413: PayloadTooLarge,
+        422: GroupCommandInvalid, 503: CommandUnavailable,
+    }
+    /// `GET /groups/{group}`, its reads.
+    GroupReadErrors { 404: GroupNotFound }
+    /// `GET /groups/{group}/status`.
+    GroupStatusErrors { 404: GroupNotFound, 503: CycleUnavailable }
+    /// `POST /groups`.
+    GroupCreateErrors {
+        400: MalformedJson, 409: GroupConflict, 413: PayloadTooLarge, 422: GroupInvalid,
+        503: WriteUnavailable,
+    }
+    /// `PUT /groups/{group}`.
+    GroupReplaceErrors {
+        400: MalformedJson, 404: GroupNotFound, 409: GroupConflict, 413: PayloadTooLarge,
+        422: GroupInvalid, 503: WriteUnavailable,
+    }
+    /// `DELETE /groups/{group}`.
+    GroupDeleteErrors {
+        400: MalformedJson, 404: GroupNotFound, 409: GroupNotDisabled, 413: PayloadTooLarge,
+        422: EmptyBodyInvalid, 503: WriteUnavailable,
     }
     /// `GET /commands`.
     CommandListErrors { 404: AxisNotFound, 422: QueryInvalid }

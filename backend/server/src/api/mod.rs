@@ -10,6 +10,7 @@ pub mod cams;
 pub mod commands;
 pub mod errors;
 pub mod functions;
+pub mod groups;
 pub mod guard;
 pub mod reads;
 pub mod roles;
@@ -236,6 +237,22 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .delete(axes::delete_axis),
         )
         .route("/axes/{axis}/status", get(axes::axis_status))
+        .route(
+            "/groups",
+            get(groups::list_groups).post(groups::create_group),
+        )
+        .route(
+            "/groups/{group}",
+            get(groups::get_group)
+                .put(groups::replace_group)
+                .delete(groups::delete_group),
+        )
+        .route("/groups/{group}/status", get(groups::group_status))
+        .route("/groups/{group}/read-error", get(groups::read_error))
+        .route(
+            "/groups/{group}/read-blocker-status",
+            get(groups::read_blocker_status),
+        )
         .route("/axes/{axis}/cam-info", get(cams::cam_info))
         .route(
             "/axes/{axis}/status/following-error-peak/reset",
@@ -564,6 +581,8 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
         functions::calc_dynamics_by_ramp_time_fb,
         reads::convert_inc_pos_to_pos, reads::convert_pos_to_inc_pos, reads::read_axis_components,
         reads::read_drive_operation_mode,
+        groups::list_groups, groups::create_group, groups::get_group, groups::replace_group, groups::delete_group,
+        groups::group_status, groups::read_error, groups::read_blocker_status,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
@@ -579,6 +598,7 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
         (name = "bus", description = "The drive bus: EtherCAT SubDevices, their state and SDOs (or the simulated bus)"),
         (name = "parameters", description = "MC_AxisParameter read/write (MC_ReadParameter, MC_WriteParameter[Persistent])"),
         (name = "commands", description = "One endpoint per function block; command resources"),
+        (name = "groups", description = "Axis groups (TwinCAT TF5420 CM group): configurations, live status, and their blocks (path motion)"),
         (name = "cams", description = "Cam tables (TwinCAT NC Camming): position tables and motion functions, and their analysis"),
         (name = "simulation", description = "Fault injection into the simulated drives"),
         (name = "scope", description = "Recordings of axis signals at the cycle rate, optionally triggered"),
@@ -651,6 +671,10 @@ impl utoipa::Modify for ForeignExamples {
                 }),
             ),
             ("MoveOptions", to_value(motion::MoveOptions::default())),
+            (
+                "PathDynamics",
+                to_value(motion::group::GroupConfig::default().default_dynamics),
+            ),
             (
                 "HomingOptions",
                 to_value(motion::HomingOptions {

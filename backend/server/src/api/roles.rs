@@ -30,9 +30,16 @@ pub fn required(method: &Method, path: &str) -> Option<Role> {
         // The external setpoint generator's samples, fed like a jog's keepalives.
         "/axes/{axis}/ext-setpoint-gen-feed" => Operator,
         _ if p.starts_with("/scope/") => Operator,
+        _ if p.starts_with("/groups/{group}/") => match p
+            .strip_prefix("/groups/{group}/")
+            .and_then(|n| super::blocks::find(super::blocks::At::Groups, n))
+        {
+            Some(block) => block.role,
+            None => Engineer,
+        },
         _ => match p
             .strip_prefix("/axes/{axis}/")
-            .and_then(super::blocks::find)
+            .and_then(|n| super::blocks::find(super::blocks::At::Axes, n))
         {
             Some(block) => block.role,
             // Axes, parameters, cam tables, configuration, fault injection.
@@ -137,6 +144,12 @@ mod tests {
             Some(Operator)
         );
         assert_eq!(r(Method::POST, "/api/v1/axes/{axis}/stop"), Some(Operator));
+        assert_eq!(
+            r(Method::POST, "/api/v1/groups/{group}/move-path"),
+            Some(Operator)
+        );
+        assert_eq!(r(Method::POST, "/api/v1/groups"), Some(Engineer));
+        assert_eq!(r(Method::PUT, "/api/v1/groups/{group}"), Some(Engineer));
         assert_eq!(
             r(Method::POST, "/api/v1/axes/{axis}/simulation/fault"),
             Some(Engineer)

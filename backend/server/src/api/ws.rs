@@ -72,7 +72,8 @@ use crate::app::feed::TICK;
 #[derive(Debug, Serialize, ToSchema)]
 #[schema(example = json!({"topic": "axes/x/status", "rate_hz": 25.0}))]
 pub struct SubscribeParams {
-    /// `axes/{axis}/status` (axis id or name), `commands` or `system`.
+    /// `axes/{axis}/status` (axis id or name), `groups/{group}/status` (group id or name),
+    /// `commands` or `system`.
     pub topic: String,
     /// Updates per second, 0.1–100 (more is capped); default 10. Not used by `commands`
     /// (every change is sent).
@@ -176,7 +177,8 @@ pub struct RpcError {
     description = "Requests: `subscribe` {topic, rate_hz} with topic `axes/{axis}/status`, `commands` or `system` \
 (0.1–100 Hz, more is capped; default 10) — an axis topic follows its axis (by id) when an import moves it and \
 ends with a `subscription_ended` {topic, reason} notification when the axis is removed; `unsubscribe` {topic}; every command endpoint by its name (`power`, \
-`move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`); \
+`move-absolute`, `jog` …) with params = the REST body plus `axis` (and optional `wait`, `timeout_ms`), a group's blocks \
+(`enable`, `move-path`, `release-blocker` …) with `group` instead of `axis`; \
 `keepalive` / `release` {command}. Notifications: `update` {topic, cycle, full, data} — first the full object, \
 then only changed fields; `command_event` {cycle, command, axis, name, state, final, outputs}. A jog's dead-man is \
 the client's to renew whatever the transport (`keepalive` within its `deadman_timeout`): an open socket alone does \
@@ -248,6 +250,11 @@ enum Topic {
     },
     Commands,
     System,
+    /// A group's status (`groups/{group}/status`), followed by the group id. Made per
+    /// subscriber from the snapshot, as the system topic (16 groups at most, few watchers).
+    Group {
+        id: i64,
+    },
 }
 
 struct Sub {
@@ -284,6 +291,25 @@ fn take_axis(params: &mut Map<String, Value>) -> Option<String> {
         Some(Value::String(a)) => Some(a),
         Some(Value::Number(n)) => Some(n.to_string()),
         _ => None,
+    }
+}
+
+/// The `group` of a group block's params (an id or a name), taken out of them.
+fn take_group(params: &mut Map<String, Value>) -> Option<String> {
+    match params.remove("group") {
+        Some(Value::String(g)) => Some(g),
+        Some(Value::Number(n)) => Some(n.to_string()),
+        _ => None,
+    }
+}
+
+/// A block method addresses a group when its params name one (`group`), else an axis: the
+/// same name (`halt`, `stop`, `reset`, `set-override`) is a block of both.
+fn target_kind(params: &Map<String, Value>) -> blocks::At {
+    if params.contains_key("group") {
+        blocks::At::Groups
+    } else {
+        blocks::At::Axes
     }
 }
 
@@ -530,30 +556,44 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, 
                     write_update(out.next(), &sub.key_json, p.cycle, p.full, &data);
                 }
             }
-            Topic::System => {
-                let sys = super::system::system_resource(s);
-                let Ok(Value::Object(map)) = serde_json::to_value(&sys) else {
+            Topic::Group { id } => {
+                // A deleted group (or one not in the cycle) sends nothing.
+                let Ok(st) = crate::service::groups::status(s, &id.to_string()) else {
                     continue;
                 };
-                let data = match &sub.last {
-                    None => map.clone(),
-                    Some(last) => crate::app::feed::delta(last, &map),
-                };
-                let full = sub.last.is_none();
-                sub.last = Some(Arc::new(map));
-                if full || !data.is_empty() {
-                    out.push(&notify(
-                        "update",
-                        UpdateParams {
-                            topic: sub.key.clone(),
-                            cycle: sys.cycle,
-                            full,
-                            data,
-                        },
-                    ));
-                }
+                object_update(sub, st.cycle, &st, out);
+            }
+            Topic::System => {
+                let sys = super::system::system_resource(s);
+                object_update(sub, sys.cycle, &sys, out);
             }
         }
+    }
+}
+
+/// An object topic's update (system, a group): made for this subscriber from the object and
+/// the one it was last sent — the whole object first, then the changed fields, nothing when
+/// none changed.
+fn object_update(sub: &mut Sub, cycle: u64, object: &impl Serialize, out: &mut Batch) {
+    let Ok(Value::Object(map)) = serde_json::to_value(object) else {
+        return;
+    };
+    let data = match &sub.last {
+        None => map.clone(),
+        Some(last) => crate::app::feed::delta(last, &map),
+    };
+    let full = sub.last.is_none();
+    sub.last = Some(Arc::new(map));
+    if full || !data.is_empty() {
+        out.push(&notify(
+            "update",
+            UpdateParams {
+                topic: sub.key.clone(),
+                cycle,
+                full,
+                data,
+            },
+        ));
     }
 }
 
@@ -660,7 +700,7 @@ fn handle(
     let need = match method.as_str() {
         "subscribe" | "unsubscribe" => Role::Viewer,
         "keepalive" | "release" | "ext-setpoint-gen-feed" => Role::Operator,
-        name => blocks::find(name).map_or(Role::Viewer, |b| b.role),
+        name => blocks::find(target_kind(&params), name).map_or(Role::Viewer, |b| b.role),
     };
     if let Err(e) = may(s, client, need) {
         return Some(api_error(&id, e)).filter(|_| !notification);
@@ -706,11 +746,22 @@ fn handle(
                         return Some(rpc_error(&id, -32602, &format!("no axis '{axis}'"), None));
                     }
                 }
+            } else if let Some(group) = key
+                .strip_prefix("groups/")
+                .and_then(|r| r.strip_suffix("/status"))
+            {
+                let reg = s.registry.read().unwrap();
+                match reg.find_group(group) {
+                    Some(g) => Topic::Group { id: g.id },
+                    None => {
+                        return Some(rpc_error(&id, -32602, &format!("no group '{group}'"), None));
+                    }
+                }
             } else {
                 return Some(rpc_error(
                     &id,
                     -32602,
-                    "unknown topic (axes/{axis}/status, commands, system)",
+                    "unknown topic (axes/{axis}/status, groups/{group}/status, commands, system)",
                     None,
                 ));
             };
@@ -826,7 +877,8 @@ fn handle(
             })
         }
         name => {
-            let Some(block) = blocks::find(name) else {
+            let at = target_kind(&params);
+            let Some(block) = blocks::find(at, name) else {
                 return Some(rpc_error(
                     &id,
                     -32601,
@@ -834,7 +886,11 @@ fn handle(
                     None,
                 ));
             };
-            let Some(axis) = take_axis(&mut params) else {
+            let target = match at {
+                blocks::At::Axes => take_axis(&mut params),
+                blocks::At::Groups => take_group(&mut params),
+            };
+            let Some(axis) = target else {
                 return Some(rpc_error(&id, -32602, "axis is required", None));
             };
             // The REST query's rules (`?wait=true&timeout_ms=N`), from the params.
@@ -867,7 +923,7 @@ fn handle(
             let jogs = jogs.clone();
             tokio::spawn(async move {
                 let raw = Value::Object(params);
-                let r = blocks::dispatch(&s, block.name, &axis, raw, client, wait)
+                let r = blocks::dispatch(&s, (at, block.name), &axis, raw, client, wait)
                     .await
                     .expect("a block of the catalogue");
                 let msg = match r {

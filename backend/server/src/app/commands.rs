@@ -20,6 +20,8 @@ pub struct CommandRecord {
     pub axis_name: String,
     /// What it addresses (its axis; `axis_id`/`axis_name` are that axis as the API shows it).
     pub target: Target,
+    /// A group's command: the group's id and name (`axis_id` 0, `axis_name` empty).
+    pub group: Option<(i64, String)>,
     /// Its catalogue entry (name, milestone, flags).
     pub block: &'static Block,
     /// An MC_Stop: it holds its axis locked until released.
@@ -52,6 +54,8 @@ impl CommandRecord {
             id: self.id,
             axis: self.axis_name.clone(),
             axis_id: self.axis_id,
+            group: self.group.as_ref().map(|g| g.1.clone()),
+            group_id: self.group.as_ref().map(|g| g.0),
             command: self.block.name,
             parameters: self.parameters.clone(),
             state: CommandState::of(o),
@@ -112,6 +116,9 @@ impl CommandStore {
 pub struct CommandNotice {
     pub command: CommandId,
     pub axis: String,
+    /// The group a group's command addresses (`axis` is empty then).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
     pub name: &'static str,
     pub cycle: u64,
     pub state: CommandState,
@@ -128,7 +135,7 @@ pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry 
         client_id: client.id.clone(),
         principal: client.principal.clone(),
         action: "command.final".into(),
-        target: Some(n.axis.clone()),
+        target: Some(n.group.clone().unwrap_or_else(|| n.axis.clone())),
         command_id: Some(n.command),
         detail: serde_json::to_string(n).unwrap_or_default(),
         outcome: Some(match n.state {
@@ -162,6 +169,7 @@ pub(super) fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option
     Some(CommandNotice {
         command: r.id,
         axis: r.axis_name.clone(),
+        group: r.group.as_ref().map(|g| g.1.clone()),
         name: r.block.name,
         cycle: ev.cycle,
         state: CommandState::of(&ev.outputs),

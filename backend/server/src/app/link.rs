@@ -128,6 +128,53 @@ impl AppState {
         self.request(id, Request::Command(command)).await
     }
 
+    /// Sends MC_MovePath `id` with its table (built and checked off the cycle thread) and
+    /// waits for the cycle thread's reply, whatever its verdict.
+    pub(crate) async fn path_request(
+        &self,
+        id: u64,
+        group: motion::group::GroupId,
+        table: Box<motion::group::PathTable>,
+    ) -> AppResult<Reply> {
+        self.request(
+            id,
+            Request::MovePath {
+                command: id,
+                group,
+                table,
+            },
+        )
+        .await
+    }
+
+    /// Hands a ready group to the cycle thread; 409 `group_state_invalid` while the group in
+    /// that slot is enabled or in error.
+    pub async fn install_group(
+        &self,
+        id: motion::group::GroupId,
+        group: Box<motion::group::Group>,
+    ) -> AppResult<()> {
+        self.ticketed(|ticket| Request::InsertGroup { ticket, id, group })
+            .await
+            .map(drop)
+    }
+
+    /// Takes a group out of the cycle thread (with `require_disabled`: 409
+    /// `group_state_invalid` while it is enabled or in error).
+    pub async fn uninstall_group(
+        &self,
+        id: motion::group::GroupId,
+        require_disabled: bool,
+    ) -> AppResult<()> {
+        self.ticketed(|ticket| Request::RemoveGroup {
+            ticket,
+            id,
+            require_disabled,
+        })
+        .await
+        .map(drop)
+    }
+
     /// Hands a ready axis to the cycle thread.
     pub async fn install_axis(
         &self,

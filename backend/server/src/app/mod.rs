@@ -13,7 +13,7 @@ mod registry;
 
 pub use commands::{CommandNotice, CommandRecord, CommandStore, HISTORY};
 pub use pump::{audit_writer, pump};
-pub use registry::{AxisEntry, CamEntry, Registry};
+pub use registry::{AxisEntry, CamEntry, GroupEntry, Registry};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
@@ -148,6 +148,16 @@ impl AppState {
         let mut out = self.snapshot.lock().unwrap();
         let s = out.read();
         (s.cycle, s.axes.get(slot as usize).copied().flatten())
+    }
+
+    /// The latest published snapshot: its cycle and the status of one group slot.
+    pub fn group_status(
+        &self,
+        slot: motion::group::GroupId,
+    ) -> (u64, Option<motion::group::GroupStatus>) {
+        let mut out = self.snapshot.lock().unwrap();
+        let s = out.read();
+        (s.cycle, s.groups.get(slot as usize).copied().flatten())
     }
 
     /// The slot and name of an axis given by id or name (404 when there is none).

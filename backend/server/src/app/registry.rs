@@ -24,6 +24,22 @@ pub struct Registry {
     pub axes: BTreeMap<i64, AxisEntry>,
     /// Cam tables by id (MC_CAM_ID).
     pub cams: BTreeMap<u32, CamEntry>,
+    /// Axis groups by id (1..16; the kernel's group slot is id − 1).
+    pub groups: BTreeMap<i64, GroupEntry>,
+}
+
+/// A configured axis group (TF5420 CM group).
+#[derive(Clone, Debug)]
+pub struct GroupEntry {
+    pub id: i64,
+    pub name: String,
+    /// The kernel's group slot (`id − 1`).
+    pub slot: motion::group::GroupId,
+    pub config: motion::group::GroupConfig,
+    /// The configured members: role and axis id, added with MC_AddAxisToGroup whenever the
+    /// group is put into the kernel.
+    pub members: Vec<(motion::group::GroupRole, i64)>,
+    pub updated_at: String,
 }
 
 /// A stored cam table: its definition and the cam built from it (shared with couplings).
@@ -60,6 +76,19 @@ impl Registry {
             Ok(id) => self.cams.get(&id),
             Err(_) => self.cams.values().find(|c| c.name == key),
         }
+    }
+    /// A group by id (all digits) or by name.
+    pub fn find_group(&self, key: &str) -> Option<&GroupEntry> {
+        match key.parse::<i64>() {
+            Ok(id) => self.groups.get(&id),
+            Err(_) => self.groups.values().find(|g| g.name == key),
+        }
+    }
+    /// The group that has `axis` (an axis id) among its configured members.
+    pub fn group_of_axis(&self, axis: i64) -> Option<&GroupEntry> {
+        self.groups
+            .values()
+            .find(|g| g.members.iter().any(|(_, a)| *a == axis))
     }
     pub fn by_slot(&self, slot: AxisSlot) -> Option<&AxisEntry> {
         self.axes.values().find(|a| a.slot == slot)

@@ -6,7 +6,10 @@
 //!
 //! An entry (`entries!`, handed to `crate::api::blocks`, which makes each one's REST handler,
 //! route, OpenAPI operation and websocket method): `fn: "name" at prefix, Body, conversion,
-//! Role, Milestone, [flags], "summary";` — `at axes`: the route prefix `/api/v1/axes/{axis}/`;
+//! Role, Milestone, [flags], "summary";` — `at axes`: the route prefix `/api/v1/axes/{axis}/`,
+//! the body converted with the axis (`fn(&Body, &Registry, &AxisEntry) -> CommandKind`);
+//! `at groups`: `/api/v1/groups/{group}/`, converted with the group (`… &GroupEntry) ->
+//! GroupOrder`, a command or a path table);
 //! the flags are `model::Block`'s (`has_result`, `keepalive`, `lease_free`).
 //!
 //! Bodies: fields follow the FB inputs; 0 dynamics = axis default. Bodies whose every field may
@@ -19,6 +22,7 @@ pub mod admin;
 pub mod cams;
 pub mod corrections;
 pub mod coupling;
+pub mod groups;
 pub mod homing;
 pub mod jog;
 pub mod moves;

@@ -109,8 +109,14 @@ impl ClientInfo {
 }))]
 pub struct CommandResource {
     pub id: u64,
+    /// The axis it addresses (empty, 0 for a group's command: see `group`).
     pub axis: String,
     pub axis_id: i64,
+    /// The axis group it addresses (a group's block).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub group_id: Option<i64>,
     /// kebab-case command name (the REST endpoint).
     pub command: &'static str,
     /// The request body as given.
@@ -209,6 +215,8 @@ pub struct WaitOutcome {
 pub struct Block {
     /// The endpoint's last segment and the websocket method.
     pub name: &'static str,
+    /// What it addresses (an axis or a group): the same name may be a block of each.
+    pub at: At,
     /// The REST path: the entry's route prefix (`/api/v1/axes/{axis}/`: the block addresses an
     /// axis) and its name.
     pub path: &'static str,
@@ -228,10 +236,21 @@ pub struct Block {
     pub lease_free: bool,
 }
 
+/// The kind of target a block addresses (the catalogue entry's route prefix).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum At {
+    /// `/api/v1/axes/{axis}/…`; the websocket method's `axis`.
+    Axes,
+    /// `/api/v1/groups/{group}/…`; the websocket method's `group`.
+    Groups,
+}
+
 impl Block {
     /// An entry without flags (the catalogue sets the ones an entry names).
     pub const PLAIN: Block = Block {
         name: "",
+        at: At::Axes,
         path: "",
         body: "",
         role: Role::Operator,

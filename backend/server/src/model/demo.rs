@@ -84,3 +84,31 @@ pub fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
         ));
     }
 }
+
+/// The demo machine's group `xy`: axes `x` (role x) and `y` (role y) in the XY convention,
+/// disabled, with the default dynamics (within what both axes can do: 500 mm/s, 2500 mm/s²).
+pub fn group() -> super::GroupBody {
+    let member = |role, axis: &str| super::GroupMemberBody {
+        role,
+        axis: axis.into(),
+    };
+    let config = motion::group::GroupConfig::default();
+    super::GroupBody {
+        id: None,
+        name: "xy".into(),
+        convention: motion::group::AxesConvention::Xy,
+        additional_axes: 0,
+        axes: vec![
+            member(motion::group::GroupRole::X, "x"),
+            member(motion::group::GroupRole::Y, "y"),
+        ],
+        default_dynamics: config.default_dynamics,
+        maximum_dynamics: motion::group::PathDynamics {
+            velocity: 500.0,
+            acceleration: 2500.0,
+            deceleration: 2500.0,
+            jerk: 25_000.0,
+        },
+        override_ramp_time: config.override_ramp_time,
+    }
+}

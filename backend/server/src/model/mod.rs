@@ -3,8 +3,10 @@
 
 pub mod command;
 pub mod demo;
+pub mod group;
 
 pub use command::*;
+pub use group::*;
 
 use std::collections::BTreeMap;
 
@@ -329,6 +331,12 @@ pub struct ConfigDocument {
     /// tables as they are; with it (also `[]`) they are replaced.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cam_tables: Option<Vec<CamTableBody>>,
+    /// The axis groups with their ids. An import without this field leaves the stored groups
+    /// as they are (their members must then be among the imported axes); with it (also `[]`)
+    /// they are replaced.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_items = 16)]
+    pub groups: Option<Vec<GroupBody>>,
     /// The drive bus the machine runs on (`--bus`, `--interface`, `--bus-max-errors` at start).
     /// Exported as it runs; an import that names another bus kind is refused (start motiond
     /// with that bus first), the interface and error limit are information only.

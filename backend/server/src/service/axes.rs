@@ -381,6 +381,8 @@ pub async fn delete(s: &AppState, axis: &str, client: &ClientInfo) -> AppResult<
         )
     };
     let mut tx = s.db.begin().await?;
+    // The axis leaves its group (only while the group is disabled), in the same transaction.
+    let groups = super::groups::axis_leaves(s, &mut tx, id, slot).await?;
     store::axes::delete_axis(&mut tx, id).await?;
     store::audit(
         &mut *tx,
@@ -397,6 +399,7 @@ pub async fn delete(s: &AppState, axis: &str, client: &ClientInfo) -> AppResult<
         return Err(e.into());
     }
     s.registry_write().axes.remove(&id);
+    super::groups::register(s, groups);
     Ok(())
 }
 
@@ -636,9 +639,11 @@ pub fn export(s: &AppState) -> ConfigDocument {
         max_errors_in_row: bus.ethercat.as_ref().map(|(st, _)| st.max_errors_in_row),
     });
     let reg = s.registry.read().unwrap();
+    let groups = Some(super::groups::export(s));
     ConfigDocument {
         version: 1,
         cam_tables,
+        groups,
         bus,
         axes: reg
             .axes
@@ -715,6 +720,18 @@ pub async fn import(
             }
         },
     };
+    let doc_axes: Vec<(i64, String)> = doc
+        .axes
+        .iter()
+        .map(|a| (a.id, a.config.name.clone()))
+        .collect();
+    let groups = match super::groups::prepare_import(s, doc.groups.as_deref(), &doc_axes) {
+        Ok(g) => g,
+        Err(e) => {
+            errs.extend(e);
+            None
+        }
+    };
     let mut built = Vec::new();
     for (i, a) in doc.axes.iter().enumerate() {
         if a.id <= 0 {
@@ -789,6 +806,8 @@ pub async fn import(
             })
             .collect()
     };
+    // The axes under every group are replaced: no group may be enabled.
+    super::groups::refuse_unless_all_disabled(s)?;
     for (_, slot, name, _, _) in &old {
         if s.status(*slot)
             .1
@@ -810,6 +829,9 @@ pub async fn import(
     }
     if let Some(entries) = &cams {
         super::cams::store_import(&mut tx, entries).await?;
+    }
+    if let Some(entries) = &groups {
+        super::groups::store_import(&mut tx, entries).await?;
     }
     store::audit(
         &mut *tx,
@@ -905,5 +927,6 @@ pub async fn import(
             reg.cams = cams.into_iter().map(|e| (e.id, e)).collect();
         }
     }
+    super::groups::install_import(s, groups).await;
     Ok(export(s))
 }

@@ -8,22 +8,38 @@ use std::time::Duration;
 
 use motion::{AxisSlot, CommandId, CommandKind, ErrorId, FbOutputs, Target};
 
-use crate::app::{AppState, AxisEntry, CommandRecord, HISTORY, Registry};
+use crate::app::{AppState, AxisEntry, CommandRecord, GroupEntry, HISTORY, Registry};
 use crate::error::{AppError, AppResult};
 use crate::metrics::Verdict;
 use crate::model::*;
 use crate::store::{self, AuditEntry};
 
-/// Validates, submits and (optionally) waits: shared by all command endpoints and the websocket.
-/// How a catalogue entry turns its body into a kernel command.
+/// How a catalogue entry `at axes` turns its body into a kernel command.
 pub type ToKind<B> = fn(&B, &Registry, &AxisEntry) -> AppResult<CommandKind>;
+/// How a catalogue entry `at groups` turns its body into a kernel command or a path table.
+pub type ToOrder<B> = fn(&B, &Registry, &GroupEntry) -> AppResult<GroupOrder>;
+
+/// A block's conversion with what it addresses.
+pub enum Convert<B> {
+    Axis(ToKind<B>),
+    Group(ToOrder<B>),
+}
+
+/// What a checked block addresses and what it is.
+struct Resolved {
+    target: Target,
+    /// The axis (id, name) as the command resource shows it; (0, "") for a group's block.
+    axis: (i64, String),
+    group: Option<(i64, String)>,
+    order: GroupOrder,
+}
 
 /// A function block as the catalogue hands it over: its entry, its body's conversion and what
 /// it addresses.
 pub struct Submission<'a, B> {
     pub block: &'static Block,
-    pub to_kind: ToKind<B>,
-    /// Its target as the request names it (the route's `{axis}`: an axis id or name).
+    pub to_kind: Convert<B>,
+    /// Its target as the request names it (the route's `{axis}` or `{group}`: an id or name).
     pub target: &'a str,
     pub body: B,
     /// The body as sent, kept with the command and in the audit log.
@@ -55,7 +71,30 @@ pub async fn run<B>(
         block,
         (raw, idempotency_key),
         client,
-        |reg, e| to_kind(&body, reg, e),
+        |reg| match to_kind {
+            Convert::Axis(f) => {
+                let e = reg
+                    .find(target)
+                    .ok_or_else(|| AppError::not_found("axis", target))?;
+                Ok(Resolved {
+                    target: Target::Axis(e.slot),
+                    axis: (e.id, e.name.clone()),
+                    group: None,
+                    order: GroupOrder::Command(f(&body, reg, e)?),
+                })
+            }
+            Convert::Group(f) => {
+                let g = reg
+                    .find_group(target)
+                    .ok_or_else(|| AppError::not_found("group", target))?;
+                Ok(Resolved {
+                    target: Target::Group(g.slot),
+                    axis: (0, String::new()),
+                    group: Some((g.id, g.name.clone())),
+                    order: f(&body, reg, g)?,
+                })
+            }
+        },
     )
     .await?;
     let view = match wait {
@@ -90,36 +129,37 @@ pub fn wait_duration(wait: Option<bool>, timeout_ms: Option<u64>) -> AppResult<O
 /// audited and forgotten.
 async fn submit(
     s: &AppState,
-    axis_key: &str,
+    target_key: &str,
     block: &'static Block,
     (parameters, key): (serde_json::Value, Option<String>),
     client: ClientInfo,
-    build: impl FnOnce(&Registry, &AxisEntry) -> AppResult<CommandKind>,
+    build: impl FnOnce(&Registry) -> AppResult<Resolved>,
 ) -> AppResult<CommandId> {
     let name = block.name;
-    let (slot, axis_id, axis_name, kind) = {
+    let Resolved {
+        target,
+        axis: (axis_id, axis_name),
+        group,
+        order,
+    } = {
         let reg = s.registry.read().unwrap();
-        let invalid = |e| {
-            s.metrics.command(name, Verdict::invalid);
-            e
-        };
-        let e = reg
-            .find(axis_key)
-            .ok_or_else(|| invalid(AppError::not_found("axis", axis_key)))?;
-        (
-            e.slot,
-            e.id,
-            e.name.clone(),
-            build(&reg, e).map_err(invalid)?,
-        )
+        build(&reg).inspect_err(|_| s.metrics.command(name, Verdict::invalid))?
     };
-    if let Some(e) = drive_lacks(s, axis_key, &kind) {
-        s.metrics.command(name, Verdict::rejected);
-        return Err(e);
+    if let (Target::Axis(_), GroupOrder::Command(kind)) = (target, &order) {
+        if let Some(e) = drive_lacks(s, target_key, kind) {
+            s.metrics.command(name, Verdict::rejected);
+            return Err(e);
+        }
     }
+    let stops =
+        matches!(&order, GroupOrder::Command(k) if crate::service::control::stops_motion(k));
     // One holder commands motion at a time (stop, halt and disabling always pass).
     if !block.lease_free {
-        s.control.admit(&client, &kind).inspect_err(|_| {
+        let admitted = match &order {
+            GroupOrder::Command(kind) => s.control.admit(&client, kind),
+            GroupOrder::Path(_) => s.control.admit_motion(&client),
+        };
+        admitted.inspect_err(|_| {
             s.metrics.command(name, Verdict::rejected);
         })?;
     }
@@ -127,7 +167,7 @@ async fn submit(
     if let Err(e) = s.reserve_id(id).await {
         // A stop is never refused (docs/decisions.md 116): its id comes from memory, unique in
         // this run (after a crash it may be handed out again — its audit row is lost anyway).
-        if !crate::service::control::stops_motion(&kind) {
+        if !stops {
             return Err(e);
         }
         tracing::error!("command {id} ({name}) acts although its id could not be reserved: {e}");
@@ -139,7 +179,11 @@ async fn submit(
         client_id: client.id.clone(),
         principal: client.principal.clone(),
         action: format!("command.{name}"),
-        target: Some(axis_name.clone()),
+        target: Some(
+            group
+                .as_ref()
+                .map_or_else(|| axis_name.clone(), |g| g.1.clone()),
+        ),
         command_id: Some(id),
         detail: parameters.to_string(),
         outcome: None,
@@ -149,10 +193,17 @@ async fn submit(
         id,
         axis_id,
         axis_name,
-        target: Target::Axis(slot),
+        target,
+        group: group.clone(),
         block,
-        locks_axis: matches!(kind, CommandKind::Stop { .. }),
-        resets_axis: matches!(kind, CommandKind::Reset),
+        locks_axis: matches!(
+            order,
+            GroupOrder::Command(CommandKind::Stop { .. } | CommandKind::GroupStop { .. })
+        ),
+        resets_axis: matches!(
+            order,
+            GroupOrder::Command(CommandKind::Reset | CommandKind::GroupReset)
+        ),
         parameters,
         client,
         submitted_at,
@@ -173,10 +224,23 @@ async fn submit(
         outcome: Some("submitted".into()),
         ..audit
     };
-    let (stored, reply) = tokio::join!(
-        store::audit(&s.db, &row),
-        s.command_request(id, Target::Axis(slot), kind)
-    );
+    let scaling = match &order {
+        GroupOrder::Command(CommandKind::SetEncoderScalingFactor { factor, .. }) => Some(*factor),
+        _ => None,
+    };
+    let request = async {
+        match order {
+            GroupOrder::Command(kind) => s.command_request(id, target, kind).await,
+            GroupOrder::Path(table) => match target {
+                Target::Group(g) => s.path_request(id, g, table).await,
+                Target::Axis(_) => Err(AppError::unavailable(
+                    "internal",
+                    "a path table addresses a group",
+                )),
+            },
+        }
+    };
+    let (stored, reply) = tokio::join!(store::audit(&s.db, &row), request);
     let stored = match stored {
         Ok(()) => true,
         Err(e) => {
@@ -218,7 +282,7 @@ async fn submit(
             // Accepted only now, so that the end row (queued by the pump once the command
             // counts as accepted and is final) comes after the outcome.
             outcome("accepted".into());
-            if let CommandKind::SetEncoderScalingFactor { factor, .. } = kind {
+            if let Some(factor) = scaling {
                 // The kernel recorded the factor in #1040; so does the server's mirror.
                 if let Some(e) = s.registry_write().axes.get_mut(&axis_id) {
                     let _ = e.params.write(1040, factor);
@@ -240,11 +304,66 @@ async fn submit(
         Err(e) => {
             s.commands.lock().unwrap().remove(id);
             outcome(format!("rejected:{}", e.code()));
-            Err(match refusal_why(s, slot, e, reply.hint) {
-                Some(why) => AppError::RejectedBecause { id: e, why },
-                None => AppError::rejected(e),
+            Err(match target {
+                Target::Axis(slot) => match refusal_why(s, slot, e, reply.hint) {
+                    Some(why) => AppError::RejectedBecause { id: e, why },
+                    None => AppError::rejected(e),
+                },
+                Target::Group(g) => group_refusal(s, g, e),
             })
         }
+    }
+}
+
+/// A group's refusal as the API answers it: a path the group cannot run by its own values
+/// (an arc that is no arc, a table the rules refuse) is a 422 with the rule's code; a state
+/// that does not allow the block a 409 saying the state; anything else a 409 with its code.
+fn group_refusal(s: &AppState, g: motion::group::GroupId, e: ErrorId) -> AppError {
+    const VALUES: [ErrorId; 9] = [
+        ErrorId::CIRCLE_INVALID,
+        ErrorId::TRANSITION_MODE_INVALID,
+        ErrorId::BUFFER_MODE_INVALID,
+        ErrorId::POSITION_COUNT_INVALID,
+        ErrorId::PATH_DYNAMICS_INVALID,
+        ErrorId::PATH_TOO_LONG,
+        ErrorId::BLOCKER_ID_INVALID,
+        ErrorId::DWELL_TIME_INVALID,
+        ErrorId::GROUP_CONFIG_INVALID,
+    ];
+    if VALUES.contains(&e) {
+        return AppError::kernel(
+            axum::http::StatusCode::UNPROCESSABLE_ENTITY,
+            "Invalid request",
+            e,
+        );
+    }
+    let st = s.group_status(g).1;
+    match st {
+        Some(st) if e == ErrorId::GROUP_STATE_INVALID => {
+            let state = serde_json::to_value(st.state)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_owned))
+                .unwrap_or_default();
+            let why = match st.state {
+                motion::group::GroupState::ErrorStop => format!(
+                    "the group is in error_stop with 0x{:04X} {}: reset it (POST …/reset)",
+                    st.error_id,
+                    ErrorId(st.error_id).code()
+                ),
+                motion::group::GroupState::Disabled => {
+                    "the group is disabled: enable it first (POST …/enable)".into()
+                }
+                motion::group::GroupState::NotReady => {
+                    "the group is not_ready: power its axes (POST /api/v1/axes/{axis}/power)".into()
+                }
+                motion::group::GroupState::Stopping => {
+                    "the group is stopping and locked by MC_GroupStop: release the stop (DELETE /api/v1/commands/{id}) once it stands".into()
+                }
+                _ => format!("the group is in {state}"),
+            };
+            AppError::RejectedBecause { id: e, why }
+        }
+        _ => AppError::rejected(e),
     }
 }
 
@@ -473,6 +592,17 @@ pub fn find(s: &AppState, id: CommandId) -> AppResult<CommandResource> {
 /// How a wait ended: at the milestone, or why not (the axis's state and error as they are).
 fn wait_outcome(s: &AppState, v: &CommandResource, milestone: Milestone) -> WaitOutcome {
     let reached = v.is_final || milestone.reached(&v.outputs);
+    if v.group.is_some() {
+        // A group's command: its own events end the wait (the group's state is in its status).
+        return WaitOutcome {
+            milestone,
+            reached,
+            reason: (!reached).then_some("timeout"),
+            axis_state: Default::default(),
+            axis_error_id: 0,
+            axis_error_code: None,
+        };
+    }
     let st = s
         .registry
         .read()

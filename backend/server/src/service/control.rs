@@ -117,6 +117,10 @@ pub fn stops_motion(kind: &CommandKind) -> bool {
         kind,
         CommandKind::Stop { .. }
             | CommandKind::Halt { .. }
+            | CommandKind::GroupStop { .. }
+            | CommandKind::GroupHalt { .. }
+            | CommandKind::GroupDisable
+            | CommandKind::UngroupAllAxes
             | CommandKind::Power { enable: false, .. }
             // Switching the external generator off stops what it moves.
             | CommandKind::ExtSetPointGenDisable
@@ -245,6 +249,15 @@ impl Control {
             return Ok(());
         }
         if stops_motion(kind) {
+            return Ok(());
+        }
+        self.admit_motion(client)
+    }
+
+    /// Whether `client` may command motion now (a path for a group): refused while another
+    /// client holds control.
+    pub fn admit_motion(&self, client: &ClientInfo) -> AppResult<()> {
+        if !self.enabled {
             return Ok(());
         }
         let h = self.live();

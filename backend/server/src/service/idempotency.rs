@@ -108,7 +108,8 @@ pub async fn run_once<B>(
     let Some(key) = sub.idempotency_key.clone() else {
         return commands::run(s, sub, wait).await.map(|v| (v, false));
     };
-    let fingerprint = format!("{}\n{}\n{}", sub.block.name, sub.target, sub.raw);
+    // The block's path, not its name: an axis's and a group's block may share a name.
+    let fingerprint = format!("{}\n{}\n{}", sub.block.path, sub.target, sub.raw);
     let (principal, client_id) = (sub.client.principal.clone(), sub.client.id.clone());
     // Remembered per sender: principal and client id before the key (neither contains a newline).
     let scoped = format!(

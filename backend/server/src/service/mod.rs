@@ -6,6 +6,7 @@ pub mod axes;
 pub mod cams;
 pub mod commands;
 pub mod control;
+pub mod groups;
 pub mod idempotency;
 pub mod metrics;
 pub mod reads;

@@ -1,6 +1,6 @@
 //! SQLite store (DESIGN §5): WAL, synchronous=FULL, one writer connection. All SQL lives in
 //! this module, one submodule per table group ([`axes`]: axes and their persistent
-//! parameters; [`cams`]: cam tables; [`audit`]: the audit log); the service decides what goes into a transaction.
+//! parameters; [`cams`]: cam tables; [`groups`]: axis groups; [`audit`]: the audit log); the service decides what goes into a transaction.
 //!
 //! The database is opened with `locking_mode=EXCLUSIVE`, so a second motiond on the same
 //! file fails at start-up with "database is locked" instead of two processes writing.
@@ -9,6 +9,7 @@ pub mod audit;
 pub mod auth;
 pub mod axes;
 pub mod cams;
+pub mod groups;
 pub mod scope_setups;
 
 pub use audit::{

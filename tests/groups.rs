@@ -1,0 +1,506 @@
+//! Axis groups (TwinCAT TF5420 CM group) over HTTP and the websocket against the real binary:
+//! the demo group `xy`, a path with a line, an arc and a blended corner run with `?wait=true`,
+//! invalid entries refused field by field and changing nothing, a blocker released over the
+//! websocket, a stop held until released, the configuration kept across a kill -9.
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+use futures_util::{SinkExt, StreamExt};
+use serde_json::{Value, json};
+use tokio_tungstenite::tungstenite::Message;
+
+/// The README tour's path: a line, a quarter arc (centre mode) and two corners blended with a
+/// 5 mm tolerance sphere; it ends at (0, 150).
+fn tour_path() -> Value {
+    json!({"entries": [
+        {"type": "linear", "position": [100.0, 0.0], "velocity": 200.0},
+        {"type": "circular", "circ_mode": "center", "aux_point": [100.0, 50.0, 0.0], "end_point": [150.0, 50.0],
+            "velocity": 200.0, "buffer_mode": "buffered"},
+        {"type": "linear", "position": [150.0, 150.0], "velocity": 200.0, "buffer_mode": "blending_previous",
+            "transition_mode": "corner_distance", "transition_parameters": [5.0]},
+        {"type": "linear", "position": [0.0, 150.0], "velocity": 200.0, "buffer_mode": "blending_previous",
+            "transition_mode": "corner_distance", "transition_parameters": [5.0], "invoke_id": 4}
+    ]})
+}
+
+async fn group_status(s: &Server) -> Value {
+    let r = get(s, "/api/v1/groups/xy/status").await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    r.json
+}
+
+/// Polls the group's status until `f` holds (or panics after 20 s): the status is what the
+/// cycle thread published, there is no event to wait on for a state.
+async fn until_group(s: &Server, what: &str, f: impl Fn(&Value) -> bool) -> Value {
+    let deadline = std::time::Instant::now() + Duration::from_secs(20);
+    loop {
+        let st = group_status(s).await;
+        if f(&st) {
+            return st;
+        }
+        assert!(std::time::Instant::now() < deadline, "{what}: {st}");
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+}
+
+async fn enable_xy(s: &Server) {
+    power_on(s, "x").await;
+    power_on(s, "y").await;
+    let r = post(s, "/api/v1/groups/xy/enable?wait=true", json!({})).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(r.json["group"], "xy");
+    until_group(s, "standby", |st| st["state"] == "standby").await;
+}
+
+fn near(v: &Value, want: f64) -> bool {
+    (v.as_f64().unwrap_or(f64::NAN) - want).abs() < 1e-6
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_across_a_kill() {
+    let dir = temp_dir();
+    let db = dir.join("g.db");
+    let db = db.to_str().unwrap();
+    let s = Server::start_with(db, &[]);
+
+    // The demo machine's group: disabled, x and y in their roles.
+    let g = get(&s, "/api/v1/groups/xy").await;
+    assert_eq!(g.status, 200, "{}", g.text);
+    assert_eq!(g.json["id"], 1);
+    assert_eq!(
+        g.json["axes"],
+        json!([{"role": "x", "axis": "x", "axis_id": 1}, {"role": "y", "axis": "y", "axis_id": 2}])
+    );
+    assert_eq!(g.json["status"]["state"], "disabled");
+    assert_eq!(
+        get(&s, "/api/v1/groups/1").await.json["name"],
+        "xy",
+        "by id or name"
+    );
+
+    // A group of its own, validated field by field.
+    let r = post(
+        &s,
+        "/api/v1/groups",
+        json!({"name": "spin", "axes": [{"role": "x", "axis": "x"}]}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "axes[0].axis",
+        "x is xy's: {}",
+        r.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/groups",
+        json!({"name": "spin", "axes": [{"role": "z", "axis": "spindle"}]}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(r.json["errors"][0]["field"], "axes[0].role", "{}", r.text);
+    let r = post(&s, "/api/v1/groups", json!({"name": "spin",
+        "default_dynamics": {"velocity": 2000.0, "acceleration": 1000.0, "deceleration": 1000.0, "jerk": 10000.0}})).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "default_dynamics.velocity",
+        "{}",
+        r.text
+    );
+    assert_eq!(r.json["error_id"], 0x8140, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/groups",
+        json!({"name": "spin", "convention": "xyzc", "additional_axes": 1,
+        "axes": [{"role": "addax1", "axis": "spindle"}]}),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.location.as_deref(), Some("/api/v1/groups/2"));
+    assert_eq!(
+        r.json["status"]["members"],
+        json!({"addax1": "spindle"}),
+        "{}",
+        r.text
+    );
+    // 16 group slots: the 17th is refused.
+    for i in 3..=16 {
+        let r = post(&s, "/api/v1/groups", json!({"name": format!("g{i}")})).await;
+        assert_eq!(r.status, 201, "{}", r.text);
+    }
+    assert_problem(
+        &post(&s, "/api/v1/groups", json!({"name": "g17"})).await,
+        409,
+        "no_free_group_slot",
+    );
+    for i in 3..=16 {
+        assert_eq!(
+            delete(&s, &format!("/api/v1/groups/g{i}")).await.status,
+            204
+        );
+    }
+
+    enable_xy(&s).await;
+
+    // Configuration changes only on a disabled group.
+    let g = get(&s, "/api/v1/groups/xy").await.json;
+    let mut body =
+        json!({"name": "xy", "axes": [{"role": "x", "axis": "x"}, {"role": "y", "axis": "y"}]});
+    body["default_dynamics"] = g["default_dynamics"].clone();
+    body["maximum_dynamics"] = g["maximum_dynamics"].clone();
+    assert_problem(
+        &put(&s, "/api/v1/groups/xy", body.clone()).await,
+        409,
+        "group_state_invalid",
+    );
+    assert_problem(
+        &delete(&s, "/api/v1/groups/xy").await,
+        409,
+        "group_state_invalid",
+    );
+    // Nor does an axis leave an enabled group by being deleted.
+    assert_problem(
+        &delete(&s, "/api/v1/axes/y").await,
+        409,
+        "group_state_invalid",
+    );
+    // A member of an enabled group takes no single-axis motion (TF5420 §1.5).
+    let r = post(
+        &s,
+        "/api/v1/axes/x/move-absolute",
+        json!({"position": 10.0, "velocity": 10.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_in_group");
+    assert_eq!(r.json["error_id"], 0x8145);
+
+    // Invalid entries: each a 422 naming the entry's field and the rule, and nothing changes.
+    let commands_before = get(&s, "/api/v1/commands?limit=2000")
+        .await
+        .json
+        .as_array()
+        .unwrap()
+        .len();
+    let line = |p: [f64; 2]| json!({"type": "linear", "position": p, "velocity": 100.0});
+    let mut blended = line([20.0, 20.0]);
+    blended["buffer_mode"] = json!("buffered");
+    blended["transition_mode"] = json!("corner_distance");
+    blended["transition_parameters"] = json!([2.0]);
+    let mut second_aborting = line([20.0, 20.0]);
+    second_aborting["buffer_mode"] = json!("aborting");
+    let cases = [
+        (
+            json!([{"type": "linear", "position": [1.0, 2.0, 3.0], "velocity": 100.0}]),
+            "entries[0].position",
+            "position_count_invalid",
+        ),
+        (
+            json!([{"type": "linear", "position": [1.0, 2.0], "velocity": 0.0}]),
+            "entries[0].velocity",
+            "path_dynamics_invalid",
+        ),
+        (
+            json!([{"type": "linear", "position": [1.0, 2.0], "velocity": "default"}]),
+            "entries[0].velocity",
+            "path_dynamics_invalid",
+        ),
+        (
+            json!([line([10.0, 0.0]), second_aborting]),
+            "entries[1].buffer_mode",
+            "buffer_mode_invalid",
+        ),
+        (
+            json!([line([10.0, 0.0]), blended]),
+            "entries[1].transition_mode",
+            "transition_mode_invalid",
+        ),
+        (
+            json!([{"type": "blocker", "blocker_id": 0}]),
+            "entries[0].blocker_id",
+            "blocker_id_invalid",
+        ),
+        (
+            json!([{"type": "dwell", "time": -1.0}]),
+            "entries[0].time",
+            "dwell_time_invalid",
+        ),
+        (
+            json!([{"type": "linear", "position": [1.0, 2.0], "velocity": 100.0, "transition_mode": "start_velocity"}]),
+            "entries[0].transition_mode",
+            "transition_mode_invalid",
+        ),
+    ];
+    for (entries, field, code) in cases {
+        let r = post(
+            &s,
+            "/api/v1/groups/xy/move-path",
+            json!({"entries": entries}),
+        )
+        .await;
+        assert_problem(&r, 422, code);
+        assert_eq!(r.json["errors"][0]["field"], field, "{}", r.text);
+    }
+    let r = post(&s, "/api/v1/groups/xy/move-path", json!({"entries": [{"type": "linear", "position": [1.0, 2.0], "velocity": 100.0, "speed": 1}]})).await;
+    assert_problem(&r, 422, "validation_failed");
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path",
+        json!({"entries": [{"type": "linear", "position": [1e13, 2.0], "velocity": 100.0}]}),
+    )
+    .await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "entries[0].position[0]",
+        "{}",
+        r.text
+    );
+    // Three points on a line are no arc: the kernel's verdict, with its code.
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path",
+        json!({"entries": [{"type": "circular", "circ_mode": "border",
+        "aux_point": [5.0, 0.0, 0.0], "end_point": [10.0, 0.0], "velocity": 100.0}]}),
+    )
+    .await;
+    assert_problem(&r, 422, "circle_invalid");
+    let st = group_status(&s).await;
+    assert_eq!(st["state"], "standby", "{st}");
+    assert_eq!(st["queued_entries"], 0, "{st}");
+    assert_eq!(st["position"], json!({"x": 0.0, "y": 0.0}), "{st}");
+    let commands_after = get(&s, "/api/v1/commands?limit=2000")
+        .await
+        .json
+        .as_array()
+        .unwrap()
+        .len();
+    assert_eq!(
+        commands_before, commands_after,
+        "no command resource for a refused request"
+    );
+
+    // The tour's path, waited for: done, and the axes stand at its end.
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path?wait=true&timeout_ms=30000",
+        tour_path(),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    assert_eq!(r.json["wait"]["reached"], true, "{}", r.text);
+    assert!(r.json["outputs"]["done"] == true && r.json["outputs"]["error"] == false);
+    let x = status(&s, "x").await;
+    let y = status(&s, "y").await;
+    assert!(near(&x["status"]["set_position"], 0.0), "{x}");
+    assert!(near(&y["status"]["set_position"], 150.0), "{y}");
+    let st = until_group(&s, "standby after the path", |st| st["state"] == "standby").await;
+    assert!(near(&st["position"]["y"], 150.0), "{st}");
+
+    // Halt with ?wait=true at standstill is done at once; disabled again, a PUT takes.
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/halt?wait=true",
+        json!({"deceleration": "maximum", "jerk": "ignore"}),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let r = post(&s, "/api/v1/groups/xy/disable?wait=true", json!({})).await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    until_group(&s, "disabled", |st| st["state"] == "disabled").await;
+    body["override_ramp_time"] = json!(0.25);
+    let r = put(&s, "/api/v1/groups/xy", body).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+
+    // kill -9: the configuration is in the database.
+    s.stop();
+    let s = Server::start_with(db, &[]);
+    let g = get(&s, "/api/v1/groups/xy").await;
+    assert_eq!(g.status, 200, "{}", g.text);
+    assert_eq!(g.json["override_ramp_time"], 0.25, "{}", g.text);
+    assert_eq!(g.json["status"]["state"], "disabled", "{}", g.text);
+    assert_eq!(
+        g.json["status"]["members"],
+        json!({"x": "x", "y": "y"}),
+        "{}",
+        g.text
+    );
+    let spin = get(&s, "/api/v1/groups/spin").await;
+    assert_eq!(
+        spin.json["axes"],
+        json!([{"role": "addax1", "axis": "spindle", "axis_id": 3}]),
+        "{}",
+        spin.text
+    );
+    assert_eq!(
+        get(&s, "/api/v1/groups")
+            .await
+            .json
+            .as_array()
+            .unwrap()
+            .len(),
+        2
+    );
+    // A deleted axis leaves its (disabled) group's configuration and membership.
+    assert_eq!(delete(&s, "/api/v1/axes/spindle").await.status, 204);
+    let spin = get(&s, "/api/v1/groups/spin").await.json;
+    assert_eq!(spin["axes"], json!([]), "{spin}");
+    assert_eq!(spin["status"]["members"], json!({}), "{spin}");
+    // And it is in the configuration document.
+    let doc = get(&s, "/api/v1/config").await;
+    assert_eq!(doc.json["groups"][0]["name"], "xy", "{}", doc.text);
+    // An import replaces the groups with the document's, members checked against its axes.
+    let mut bad = doc.json.clone();
+    bad["groups"][0]["axes"][0]["axis"] = json!("nope");
+    let r = put(&s, "/api/v1/config", bad).await;
+    assert_problem(&r, 422, "validation_failed");
+    assert_eq!(
+        r.json["errors"][0]["field"], "groups[0].axes[0].axis",
+        "{}",
+        r.text
+    );
+    let mut one = doc.json.clone();
+    one["groups"].as_array_mut().unwrap().truncate(1);
+    let r = put(&s, "/api/v1/config", one).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let all = get(&s, "/api/v1/groups").await.json;
+    assert_eq!(all.as_array().unwrap().len(), 1, "{all}");
+    assert_eq!(
+        all[0]["status"]["members"],
+        json!({"x": "x", "y": "y"}),
+        "{all}"
+    );
+    enable_xy(&s).await;
+    assert_problem(
+        &put(&s, "/api/v1/config", doc.json.clone()).await,
+        409,
+        "group_state_invalid",
+    );
+    s.stop();
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+type Stream =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+async fn call(ws: &mut Stream, id: u64, method: &str, params: Value) -> Value {
+    let m = json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params});
+    ws.send(Message::Text(m.to_string().into())).await.unwrap();
+    loop {
+        let msg = tokio::time::timeout(Duration::from_secs(20), ws.next())
+            .await
+            .expect("an answer within 20 s")
+            .expect("the socket stays open")
+            .unwrap();
+        if let Message::Text(t) = msg {
+            let v: Value = serde_json::from_str(&t).unwrap();
+            if v["id"] == id {
+                return v;
+            }
+        }
+    }
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_blocker_is_released_and_a_stop_held_over_the_websocket() {
+    let s = Server::start();
+    enable_xy(&s).await;
+    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
+        .await
+        .expect("websocket connects");
+
+    // The group's status as a subscription: the full object first.
+    let r = call(
+        &mut ws,
+        9,
+        "subscribe",
+        json!({"topic": "groups/xy/status", "rate_hz": 50}),
+    )
+    .await;
+    assert_eq!(r["result"]["topic"], "groups/xy/status", "{r}");
+    loop {
+        let msg = tokio::time::timeout(Duration::from_secs(20), ws.next())
+            .await
+            .expect("an update")
+            .unwrap()
+            .unwrap();
+        let Message::Text(t) = msg else { continue };
+        let v: Value = serde_json::from_str(&t).unwrap();
+        if v["method"] == "update" && v["params"]["topic"] == "groups/xy/status" {
+            assert_eq!(v["params"]["full"], true, "{v}");
+            assert_eq!(v["params"]["data"]["state"], "standby", "{v}");
+            break;
+        }
+    }
+    let r = call(
+        &mut ws,
+        10,
+        "unsubscribe",
+        json!({"topic": "groups/xy/status"}),
+    )
+    .await;
+    assert_eq!(r["result"], true, "{r}");
+
+    // A path that holds at blocker 7 between two lines.
+    let r = call(&mut ws, 1, "move-path", json!({"group": "xy", "entries": [
+        {"type": "linear", "position": [50.0, 0.0], "velocity": 200.0},
+        {"type": "blocker", "blocker_id": 7},
+        {"type": "linear", "position": [50.0, 50.0], "velocity": 200.0, "buffer_mode": "buffered"}
+    ]})).await;
+    let path = r["result"]["id"].as_u64().unwrap_or_else(|| panic!("{r}"));
+    assert_eq!(r["result"]["group"], "xy", "{r}");
+    let st = until_group(&s, "held at blocker 7", |st| st["blocked"] == true).await;
+    assert_eq!(st["blocker_id"], 7, "{st}");
+    assert_eq!(st["state"], "moving", "a held path is moving (TF5420 §4.3)");
+    assert!(
+        near(&st["position"]["x"], 50.0) && near(&st["position"]["y"], 0.0),
+        "{st}"
+    );
+    let b = get(&s, "/api/v1/groups/xy/read-blocker-status").await;
+    assert_eq!(b.json["blocked"], true, "{}", b.text);
+    assert_eq!(b.json["blocker_id"], 7, "{}", b.text);
+    // The same names as the axis's blocks: `group` in the params says whose.
+    let r = call(
+        &mut ws,
+        2,
+        "release-blocker",
+        json!({"group": "xy", "blocker_id": 7, "wait": true}),
+    )
+    .await;
+    assert_eq!(r["result"]["state"], "done", "{r}");
+    let done = until_final(&s, path, 20).await;
+    assert_eq!(done["state"], "done", "{done}");
+    assert!(near(&status(&s, "y").await["status"]["set_position"], 50.0));
+
+    // MC_GroupStop: done at standstill, the group locked in stopping until released.
+    let r = call(&mut ws, 3, "stop", json!({"group": "xy", "wait": true})).await;
+    let stop = r["result"]["id"].as_u64().unwrap_or_else(|| panic!("{r}"));
+    assert_eq!(r["result"]["outputs"]["done"], true, "{r}");
+    assert_eq!(r["result"]["outputs"]["busy"], true, "held: {r}");
+    assert_eq!(group_status(&s).await["state"], "stopping");
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path",
+        json!({"entries": [
+        {"type": "linear", "position": [0.0, 0.0], "velocity": 100.0}]}),
+    )
+    .await;
+    assert_problem(&r, 409, "group_state_invalid");
+    let r = call(&mut ws, 4, "release", json!({"command": stop})).await;
+    assert!(r["result"]["cycle"].is_u64(), "{r}");
+    until_group(&s, "standby after the release", |st| {
+        st["state"] == "standby"
+    })
+    .await;
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path?wait=true",
+        json!({"entries": [
+        {"type": "linear", "position": [0.0, 0.0], "velocity": 100.0}]}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+}
