@@ -1028,11 +1028,12 @@ async fn openapi_json_is_current() {
         "/api/v1/groups/{group}/read-error",
         "/api/v1/groups/{group}/read-blocker-status",
         "/api/v1/groups/{group}/move-path",
+        "/api/v1/groups/{group}/set-coordinate-transform",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    // 93 before the groups: 5 resource paths and 11 blocks.
-    assert_eq!(paths.len(), 109, "{:?}", paths.keys().collect::<Vec<_>>());
+    // 93 before the groups: 5 resource paths and 12 blocks.
+    assert_eq!(paths.len(), 110, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

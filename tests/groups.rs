@@ -299,6 +299,41 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
     assert!(near(&y["status"]["set_position"], 150.0), "{y}");
     let st = until_group(&s, "standby after the path", |st| st["state"] == "standby").await;
     assert!(near(&st["position"]["y"], 150.0), "{st}");
+    // Its entries were built off the cycle thread and taken as built (decision 133).
+    assert_eq!(st["prepared_paths"], 1, "{st}");
+
+    // A frame for later paths: (10, 0) in a frame turned by 90° about Z and shifted by
+    // (20, 30) is (20, 40).
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/set-coordinate-transform?wait=true",
+        json!({"translation": [20.0, 30.0, 0.0], "rotation": [0.0, 0.0, 90.0]}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/set-coordinate-transform",
+        json!({"translation": [0.0, 0.0, 0.0], "rotation": [10.0, 0.0, 0.0]}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "an XY group turns only about Z: {}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path?wait=true&timeout_ms=30000",
+        json!({"entries": [{"type": "linear", "position": [10.0, 0.0], "velocity": 200.0}]}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let st = until_group(&s, "standby after the framed path", |st| {
+        st["state"] == "standby"
+    })
+    .await;
+    assert!(
+        near(&st["position"]["x"], 20.0) && near(&st["position"]["y"], 40.0),
+        "{st}"
+    );
+    assert_eq!(st["frame"]["rotation"], json!([0.0, 0.0, 90.0]), "{st}");
 
     // Halt with ?wait=true at standstill is done at once; disabled again, a PUT takes.
     let r = post(

@@ -6,6 +6,127 @@
 
 use serde::{Deserialize, Serialize};
 
+// The group's plain interface types live here with the rest of the command interface (the
+// group module builds on the commands, not the other way round).
+
+/// `IDENT_IN_GROUP_REF` of a CM group: MCS_X/Y/Z, MCS_C1, ADDAX1..8.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GroupRole {
+    X,
+    Y,
+    Z,
+    C,
+    Addax1,
+    Addax2,
+    Addax3,
+    Addax4,
+    Addax5,
+    Addax6,
+    Addax7,
+    Addax8,
+}
+
+impl GroupRole {
+    pub const ALL: [GroupRole; crate::path::MAX_PATH_DIMS] = [
+        GroupRole::X,
+        GroupRole::Y,
+        GroupRole::Z,
+        GroupRole::C,
+        GroupRole::Addax1,
+        GroupRole::Addax2,
+        GroupRole::Addax3,
+        GroupRole::Addax4,
+        GroupRole::Addax5,
+        GroupRole::Addax6,
+        GroupRole::Addax7,
+        GroupRole::Addax8,
+    ];
+
+    /// Index in a path point ([X, Y, Z, C, ADDAX1..8]).
+    pub fn dim(self) -> usize {
+        GroupRole::ALL
+            .iter()
+            .position(|r| *r == self)
+            .expect("every role is listed")
+    }
+}
+
+/// An `MC_LREAL` dynamics input: a number, or one of the special values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PathValue {
+    Value(f64),
+    /// `MC_DEFAULT`: the group's default dynamics.
+    Default,
+    /// `MC_MAXIMUM`: the group's maximum dynamics.
+    Maximum,
+    /// `MC_IGNORE` (jerk of a halt or stop only): no jerk limit.
+    Ignore,
+}
+
+/// A coordinate frame (MC_SetCoordinateTransform, its Preparation entry): positions
+/// programmed after it are read in this frame. DIN 9300 Z″Y′X: the frame is rotated by
+/// `rotation[2]` about Z, then `rotation[1]` about the new Y, then `rotation[0]` about the
+/// new X (degrees), and shifted by `translation`: p_machine = R·p_programmed + t.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CoordTransform {
+    pub translation: [f64; 3],
+    pub rotation: [f64; 3],
+}
+
+impl CoordTransform {
+    pub fn is_identity(&self) -> bool {
+        *self == CoordTransform::default()
+    }
+
+    /// The rotation matrix R = Rz(r3)·Ry(r2)·Rx(r1).
+    fn matrix(&self) -> [[f64; 3]; 3] {
+        let [a, b, c] = self.rotation.map(f64::to_radians);
+        let (sa, ca) = a.sin_cos();
+        let (sb, cb) = b.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        [
+            [cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
+            [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
+            [-sb, cb * sa, cb * ca],
+        ]
+    }
+
+    /// A direction (a radius-mode normal) into machine coordinates.
+    pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
+        if self.rotation == [0.0; 3] {
+            return v;
+        }
+        let m = self.matrix();
+        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    }
+
+    /// A point into machine coordinates.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = self.rotate(p);
+        [0, 1, 2].map(|i| r[i] + self.translation[i])
+    }
+
+    /// Finite, and for a planar (XY) group a frame of that plane: no rotation about X or Y,
+    /// no shift in Z. The failing field.
+    pub fn check(&self, planar: bool) -> Result<(), &'static str> {
+        if self.translation.iter().any(|x| !x.is_finite()) {
+            return Err("translation");
+        }
+        if self.rotation.iter().any(|x| !x.is_finite()) {
+            return Err("rotation");
+        }
+        if planar && (self.rotation[0] != 0.0 || self.rotation[1] != 0.0) {
+            return Err("rotation");
+        }
+        if planar && self.translation[2] != 0.0 {
+            return Err("translation");
+        }
+        Ok(())
+    }
+}
+
 /// Identifies one command for its whole life (assigned by the caller, unique).
 pub type CommandId = u64;
 
@@ -442,11 +563,11 @@ pub enum CommandKind {
     /// MC_AddAxisToGroup (TF5420 §4.1): `axis` takes `role` in the target group.
     AddAxisToGroup {
         axis: AxisSlot,
-        role: crate::group::GroupRole,
+        role: GroupRole,
     },
     /// MC_RemoveAxisFromGroup: the axis in `role` leaves (Done also when there is none).
     RemoveAxisFromGroup {
-        role: crate::group::GroupRole,
+        role: GroupRole,
     },
     /// MC_UngroupAllAxes.
     UngroupAllAxes,
@@ -462,17 +583,17 @@ pub enum CommandKind {
     },
     /// MC_GroupHalt: stop on the path without a lock; flushes the queue.
     GroupHalt {
-        deceleration: crate::group::PathValue,
-        jerk: crate::group::PathValue,
+        deceleration: PathValue,
+        jerk: PathValue,
     },
     /// MC_GroupStop: stop on the path and lock the group until `Release`.
     GroupStop {
-        deceleration: crate::group::PathValue,
-        jerk: crate::group::PathValue,
+        deceleration: PathValue,
+        jerk: PathValue,
     },
     /// MC_SetCoordinateTransform: later MovePaths are read in this frame.
     SetCoordinateTransform {
-        transform: crate::group::CoordTransform,
+        transform: CoordTransform,
     },
     /// MC_ReleaseBlocker.
     ReleaseBlocker {

@@ -160,6 +160,10 @@ impl Kernel {
     /// it lose their master at the next step.
     pub fn remove_axis(&mut self, slot: AxisSlot) -> Option<Box<Axis>> {
         self.order.stale = true;
+        // It leaves its group: an axis put into the slot later is not a member by accident.
+        for g in self.groups.iter_mut().flatten() {
+            g.forget_member(slot);
+        }
         self.axes.get_mut(slot as usize).and_then(|s| s.take())
     }
 

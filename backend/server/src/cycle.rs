@@ -107,6 +107,9 @@ pub enum Request {
         command: CommandId,
         group: GroupId,
         table: Box<PathTable>,
+        /// Its items built off the thread (`motion::group::prepare_path`), taken when the
+        /// group still joins them where they were built from; built here otherwise.
+        prepared: Option<Box<motion::group::PreparedPath>>,
     },
     /// What the scope samples from the cycle this is drained in (see `scope.rs`).
     ScopeConfig {
@@ -138,6 +141,10 @@ pub enum Garbage {
     Group(#[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Box<Group>),
     Path(
         #[allow(dead_code, reason = "held only to be dropped off the cycle thread")] Box<PathTable>,
+    ),
+    Prepared(
+        #[allow(dead_code, reason = "held only to be dropped off the cycle thread")]
+        Box<motion::group::PreparedPath>,
     ),
 }
 
@@ -534,8 +541,13 @@ impl CycleThread {
                         Request::InsertGroup { group, .. } => {
                             let _ = shared.garbage.push(Garbage::Group(group));
                         }
-                        Request::MovePath { table, .. } => {
+                        Request::MovePath {
+                            table, prepared, ..
+                        } => {
                             let _ = shared.garbage.push(Garbage::Path(table));
+                            if let Some(p) = prepared {
+                                let _ = shared.garbage.push(Garbage::Prepared(p));
+                            }
                         }
                         _ => {}
                     }
@@ -804,12 +816,23 @@ impl CycleThread {
                     command,
                     group,
                     table,
+                    prepared,
                 } => {
-                    let result = match self.kernel.submit_path(command, group, &table, &mut sink) {
+                    let verdict = self.kernel.submit_prepared_path(
+                        command,
+                        group,
+                        &table,
+                        prepared.as_deref(),
+                        &mut sink,
+                    );
+                    let result = match verdict {
                         Verdict::Accepted => Ok(()),
                         Verdict::Rejected(e) => Err(e),
                     };
                     self.discard(Garbage::Path(table));
+                    if let Some(p) = prepared {
+                        self.discard(Garbage::Prepared(p));
+                    }
                     Reply {
                         hint: None,
                         ticket: command,

@@ -1591,7 +1591,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_MovePath: run a path of linear, circular, blocker and dwell entries */
+        /** MC_MovePath: run a path of linear, circular, blocker, dwell and coordinate-transform entries */
         post: operations["group_move_path"];
         delete?: never;
         options?: never;
@@ -1678,6 +1678,23 @@ export interface paths {
         put?: never;
         /** MC_GroupReset: clear the errors of the group and its axes */
         post: operations["group_reset"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/set-coordinate-transform": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it) */
+        post: operations["group_set_coordinate_transform"];
         delete?: never;
         options?: never;
         head?: never;
@@ -4863,6 +4880,26 @@ export interface components {
             message: string;
         };
         /**
+         * @description A coordinate frame: a shift and DIN 9300 Z″Y′X rotations in degrees.
+         * @example {
+         *       "rotation": [
+         *         0,
+         *         0,
+         *         90
+         *       ],
+         *       "translation": [
+         *         100,
+         *         50,
+         *         0
+         *       ]
+         *     }
+         */
+        FrameDto: {
+            translation: number[];
+            /** @description [about X, about Y, about Z] in degrees. */
+            rotation: number[];
+        };
+        /**
          * @description MC_GearIn.
          * @example {
          *       "master": "x",
@@ -5142,6 +5179,18 @@ export interface components {
          *         "enable_requested": false,
          *         "entry_index": 0,
          *         "error_id": 0,
+         *         "frame": {
+         *           "rotation": [
+         *             0,
+         *             0,
+         *             0
+         *           ],
+         *           "translation": [
+         *             0,
+         *             0,
+         *             0
+         *           ]
+         *         },
          *         "in_blending_segment": false,
          *         "invoke_id": 0,
          *         "members": {
@@ -5156,6 +5205,7 @@ export interface components {
          *           "x": 0,
          *           "y": 0
          *         },
+         *         "prepared_paths": 0,
          *         "queued_entries": 0,
          *         "remaining_distance": 0,
          *         "remaining_time": 0,
@@ -5215,6 +5265,18 @@ export interface components {
          *       "enable_requested": true,
          *       "entry_index": 0,
          *       "error_id": 0,
+         *       "frame": {
+         *         "rotation": [
+         *           0,
+         *           0,
+         *           0
+         *         ],
+         *         "translation": [
+         *           0,
+         *           0,
+         *           0
+         *         ]
+         *       },
          *       "in_blending_segment": false,
          *       "invoke_id": 0,
          *       "members": {
@@ -5229,6 +5291,7 @@ export interface components {
          *         "x": 0,
          *         "y": 0
          *       },
+         *       "prepared_paths": 0,
          *       "queued_entries": 0,
          *       "remaining_distance": 0,
          *       "remaining_time": 0,
@@ -5313,6 +5376,17 @@ export interface components {
             position: {
                 [key: string]: number;
             };
+            /**
+             * @description The coordinate frame later MovePaths are read in (MC_SetCoordinateTransform or a
+             *     table's frame entry; a halt or stop clears it).
+             */
+            frame: components["schemas"]["FrameDto"];
+            /**
+             * Format: int64
+             * @description MovePaths whose entries were built off the cycle thread and taken as built (the
+             *     others were built in the cycle: an aborting path while moving, a queue that changed).
+             */
+            prepared_paths: number;
         };
         /**
          * @description MC_GroupHalt, MC_GroupStop.
@@ -6538,6 +6612,13 @@ export interface components {
             invoke_id: number;
             /** @enum {string} */
             type: "dwell";
+        } | {
+            /** @description Shift of the frame's origin, X, Y, Z. */
+            translation: number[];
+            /** @description Rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z]. */
+            rotation: number[];
+            /** @enum {string} */
+            type: "coordinate_transform";
         };
         /**
          * @description A path dynamics input: a number (path units/s, /s², /s³), or `"default"`, `"maximum"`
@@ -7357,6 +7438,27 @@ export interface components {
             role?: null | components["schemas"]["Role"];
             /** @description When the session ends (null for tokens and when not authenticated). */
             expires_at?: string | null;
+        };
+        /**
+         * @description MC_SetCoordinateTransform: later MovePaths are read in this frame.
+         * @example {
+         *       "rotation": [
+         *         0,
+         *         0,
+         *         90
+         *       ],
+         *       "translation": [
+         *         100,
+         *         50,
+         *         0
+         *       ]
+         *     }
+         */
+        SetCoordinateTransformBody: {
+            /** @description Shift of the frame's origin, X, Y, Z. */
+            translation: number[];
+            /** @description Rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z]. */
+            rotation: number[];
         };
         /**
          * @description MC_SetEncoderScalingFactor (§4.5.9): the encoder's units per increment (#1040). The axis's
@@ -14673,6 +14775,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_set_coordinate_transform: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["SetCoordinateTransformBody"];
             };
         };
         responses: {

@@ -6,10 +6,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::ErrorId;
-use crate::path::MAX_PATH_DIMS;
 
 /// Index of a group slot in the kernel (0-based).
-pub use crate::command::GroupId;
+pub use crate::command::{GroupId, GroupRole};
 
 /// Groups a kernel holds at most (fixed so that the cycle never allocates).
 pub const MAX_GROUPS: usize = 16;
@@ -41,50 +40,6 @@ impl AxesConvention {
     /// The path lies in the XY plane (arcs too).
     pub fn planar(self) -> bool {
         self == AxesConvention::Xy
-    }
-}
-
-/// `IDENT_IN_GROUP_REF` of a CM group: MCS_X/Y/Z, MCS_C1, ADDAX1..8.
-#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum GroupRole {
-    X,
-    Y,
-    Z,
-    C,
-    Addax1,
-    Addax2,
-    Addax3,
-    Addax4,
-    Addax5,
-    Addax6,
-    Addax7,
-    Addax8,
-}
-
-impl GroupRole {
-    pub const ALL: [GroupRole; MAX_PATH_DIMS] = [
-        GroupRole::X,
-        GroupRole::Y,
-        GroupRole::Z,
-        GroupRole::C,
-        GroupRole::Addax1,
-        GroupRole::Addax2,
-        GroupRole::Addax3,
-        GroupRole::Addax4,
-        GroupRole::Addax5,
-        GroupRole::Addax6,
-        GroupRole::Addax7,
-        GroupRole::Addax8,
-    ];
-
-    /// Index in a path point ([X, Y, Z, C, ADDAX1..8]).
-    pub fn dim(self) -> usize {
-        GroupRole::ALL
-            .iter()
-            .position(|r| *r == self)
-            .expect("every role is listed")
     }
 }
 

@@ -5,6 +5,7 @@
 //! where the group is (or will be) at that moment.
 
 use crate::command::BufferMode;
+pub use crate::command::{CoordTransform, PathValue};
 use crate::error::ErrorId;
 use crate::path::{CircMode, CircPathChoice, PathPoint};
 
@@ -14,18 +15,6 @@ use crate::path::{CircMode, CircPathChoice, PathPoint};
 pub const MAX_PATH_ENTRIES: usize = 256;
 /// Entries a group keeps queued at most (running and buffered MovePaths together).
 pub const QUEUE_ENTRIES: usize = 512;
-
-/// An `MC_LREAL` dynamics input: a number, or one of the special values.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PathValue {
-    Value(f64),
-    /// `MC_DEFAULT`: the group's default dynamics.
-    Default,
-    /// `MC_MAXIMUM`: the group's maximum dynamics.
-    Maximum,
-    /// `MC_IGNORE` (jerk of a halt or stop only): no jerk limit.
-    Ignore,
-}
 
 /// `MC_TRANSITION_MODE`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -57,68 +46,6 @@ pub struct EntryMotion {
     /// TransitionParameter[1..count].
     pub transition_parameters: [f64; 2],
     pub transition_parameter_count: u8,
-}
-
-/// A coordinate frame (MC_SetCoordinateTransform, its Preparation entry): positions
-/// programmed after it are read in this frame. DIN 9300 Z″Y′X: the frame is rotated by
-/// `rotation[2]` about Z, then `rotation[1]` about the new Y, then `rotation[0]` about the
-/// new X (degrees), and shifted by `translation`: p_machine = R·p_programmed + t.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CoordTransform {
-    pub translation: [f64; 3],
-    pub rotation: [f64; 3],
-}
-
-impl CoordTransform {
-    pub fn is_identity(&self) -> bool {
-        *self == CoordTransform::default()
-    }
-
-    /// The rotation matrix R = Rz(r3)·Ry(r2)·Rx(r1).
-    fn matrix(&self) -> [[f64; 3]; 3] {
-        let [a, b, c] = self.rotation.map(f64::to_radians);
-        let (sa, ca) = a.sin_cos();
-        let (sb, cb) = b.sin_cos();
-        let (sc, cc) = c.sin_cos();
-        [
-            [cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
-            [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
-            [-sb, cb * sa, cb * ca],
-        ]
-    }
-
-    /// A direction (a radius-mode normal) into machine coordinates.
-    pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
-        if self.rotation == [0.0; 3] {
-            return v;
-        }
-        let m = self.matrix();
-        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-    }
-
-    /// A point into machine coordinates.
-    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
-        let r = self.rotate(p);
-        [0, 1, 2].map(|i| r[i] + self.translation[i])
-    }
-
-    /// Finite, and for a planar (XY) group a frame of that plane: no rotation about X or Y,
-    /// no shift in Z. The failing field.
-    pub fn check(&self, planar: bool) -> Result<(), &'static str> {
-        if self.translation.iter().any(|x| !x.is_finite()) {
-            return Err("translation");
-        }
-        if self.rotation.iter().any(|x| !x.is_finite()) {
-            return Err("rotation");
-        }
-        if planar && (self.rotation[0] != 0.0 || self.rotation[1] != 0.0) {
-            return Err("rotation");
-        }
-        if planar && self.translation[2] != 0.0 {
-            return Err("translation");
-        }
-        Ok(())
-    }
 }
 
 /// One row of a path table.

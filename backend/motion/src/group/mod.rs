@@ -89,6 +89,8 @@ pub struct GroupStatus {
     pub queue_end: PathPoint,
     /// The coordinate frame later MovePaths are read in.
     pub frame: CoordTransform,
+    /// MovePaths committed as prepared off the cycle thread (the others were built in it).
+    pub prepared_paths: u64,
 }
 
 /// A MovePath in flight.
@@ -197,6 +199,16 @@ impl Group {
 
     pub fn id(&self) -> crate::command::GroupId {
         self.id
+    }
+
+    /// The axis in `slot` is gone: it is no member any more (a moving group stops with
+    /// 0x8147 in its next step, an enabled one is NotReady).
+    pub(crate) fn forget_member(&mut self, slot: AxisSlot) {
+        for m in self.members.iter_mut() {
+            if *m == Some(slot) {
+                *m = None;
+            }
+        }
     }
 
     pub(crate) fn place(&mut self, id: crate::command::GroupId) {
@@ -870,7 +882,7 @@ impl Group {
             GroupState::Moving | GroupState::Stopping => {
                 if any_error {
                     self.enter_error(ErrorId::GROUP_AXIS_ERROR, cycle, events);
-                } else if !all_following && !self.run.is_idle() {
+                } else if (!all_following || !complete) && !self.run.is_idle() {
                     self.enter_error(ErrorId::GROUP_AXIS_LEFT, cycle, events);
                 }
             }
@@ -1048,6 +1060,7 @@ impl Group {
             position,
             queue_end: self.run.end_point(),
             frame: self.frame,
+            prepared_paths: self.prepared_taken,
         };
     }
 }

@@ -715,10 +715,11 @@ impl PathRun {
         match (self.exec, self.items.front()) {
             (Exec::Follow { .. }, Some(it)) => {
                 let d = (it.end_s() - self.s.position).max(0.0);
+                // At the override in effect; with the path held (0) as at 100 %.
                 let t = if self.k > 0.0 {
                     self.planner.remaining_time() / self.k
                 } else {
-                    f64::INFINITY
+                    self.planner.remaining_time()
                 };
                 (d, t)
             }

@@ -135,6 +135,7 @@ impl AppState {
         id: u64,
         group: motion::group::GroupId,
         table: Box<motion::group::PathTable>,
+        prepared: Option<Box<motion::group::PreparedPath>>,
     ) -> AppResult<Reply> {
         self.request(
             id,
@@ -142,6 +143,7 @@ impl AppState {
                 command: id,
                 group,
                 table,
+                prepared,
             },
         )
         .await

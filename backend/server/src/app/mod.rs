@@ -42,6 +42,12 @@ pub struct SystemInfo {
     pub bus: crate::bus::BusHandle,
 }
 
+/// A prepared MovePath, or why the table does not build (entry index, field, error).
+pub type PreparedOrWhy = (
+    Option<Box<motion::group::PreparedPath>>,
+    Option<(usize, &'static str, motion::ErrorId)>,
+);
+
 /// A status as a JSON object, shared by every websocket subscriber of that cycle.
 pub type StatusJson = Arc<serde_json::Map<String, serde_json::Value>>;
 
@@ -158,6 +164,42 @@ impl AppState {
         let mut out = self.snapshot.lock().unwrap();
         let s = out.read();
         (s.cycle, s.groups.get(slot as usize).copied().flatten())
+    }
+
+    /// A MovePath's items built here, off the cycle thread, from the group's queue end in the
+    /// latest snapshot, its configuration and the members' parameters as mirrored. The
+    /// cycle thread takes them only if that is still what the group joins (else it builds
+    /// them itself), so a stale snapshot costs time, never a wrong path. A table that does
+    /// not build gives the failing entry, for the refusal to name it.
+    pub fn prepare_path(
+        &self,
+        slot: motion::group::GroupId,
+        table: &motion::group::PathTable,
+    ) -> PreparedOrWhy {
+        let (_, Some(st)) = self.group_status(slot) else {
+            return (None, None);
+        };
+        let reg = self.registry.read().unwrap();
+        let Some(entry) = reg.groups.values().find(|e| e.slot == slot) else {
+            return (None, None);
+        };
+        let mut limits = [None; motion::path::MAX_PATH_DIMS];
+        for (d, m) in st.members.iter().enumerate() {
+            if let Some(a) = m.and_then(|m| reg.axes.values().find(|a| a.slot == m)) {
+                limits[d] = Some(motion::group::AxisLimits::of(&a.params));
+            }
+        }
+        let ctx = motion::group::PathContext {
+            config: entry.config,
+            frame: st.frame,
+            limits,
+            cycle_time: self.info.cycle_time_s,
+        };
+        drop(reg);
+        match motion::group::prepare_path(&ctx, table, st.queue_end) {
+            Ok(p) => (Some(Box::new(p)), None),
+            Err(why) => (None, Some(why)),
+        }
     }
 
     /// The slot and name of an axis given by id or name (404 when there is none).

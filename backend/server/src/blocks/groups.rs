@@ -43,7 +43,9 @@ macro_rules! entries {
             group_release_blocker: "release-blocker" at groups, ReleaseBlockerBody, ReleaseBlockerBody::to_order, Operator, Done, [],
                 "MC_ReleaseBlocker: let the path go on past a blocker";
             group_move_path: "move-path" at groups, MovePathBody, MovePathBody::to_order, Operator, Done, [],
-                "MC_MovePath: run a path of linear, circular, blocker and dwell entries";
+                "MC_MovePath: run a path of linear, circular, blocker, dwell and coordinate-transform entries";
+            group_set_coordinate_transform: "set-coordinate-transform" at groups, SetCoordinateTransformBody, SetCoordinateTransformBody::to_order, Operator, Done, [],
+                "MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it)";
         }
     };
 }
@@ -347,6 +349,67 @@ pub enum PathEntryDto {
         #[schema(default = 0)]
         invoke_id: u32,
     },
+    /// MC_SetCoordinateTransformPreparation: the entries after it are read in this frame.
+    CoordinateTransform {
+        /// Shift of the frame's origin, X, Y, Z.
+        #[schema(min_items = 3, max_items = 3)]
+        translation: Vec<f64>,
+        /// Rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z].
+        #[schema(min_items = 3, max_items = 3)]
+        rotation: Vec<f64>,
+    },
+}
+
+/// Three numbers as a kernel vector (`None`: not three).
+fn xyz(v: &[f64]) -> Option<[f64; 3]> {
+    v.try_into().ok()
+}
+
+/// MC_SetCoordinateTransform: later MovePaths are read in this frame.
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"translation": [100.0, 50.0, 0.0], "rotation": [0.0, 0.0, 90.0]}))]
+pub struct SetCoordinateTransformBody {
+    /// Shift of the frame's origin, X, Y, Z.
+    #[schema(min_items = 3, max_items = 3)]
+    pub translation: Vec<f64>,
+    /// Rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z].
+    #[schema(min_items = 3, max_items = 3)]
+    pub rotation: Vec<f64>,
+}
+
+impl SetCoordinateTransformBody {
+    pub fn to_order(&self, _: &Registry, group: &GroupEntry) -> AppResult<GroupOrder> {
+        let mut c = Check::default();
+        for (name, v) in [
+            ("translation", &self.translation),
+            ("rotation", &self.rotation),
+        ] {
+            if v.len() != 3 {
+                c.fail(name, "X, Y and Z: three numbers");
+            }
+            for (j, x) in v.iter().enumerate() {
+                c.finite(&format!("{name}[{j}]"), *x);
+            }
+        }
+        c.done(())?;
+        let transform = motion::group::CoordTransform {
+            translation: xyz(&self.translation).unwrap_or_default(),
+            rotation: xyz(&self.rotation).unwrap_or_default(),
+        };
+        // An XY group's frames stay in its plane (decision 135).
+        transform
+            .check(group.config.convention.planar())
+            .map_err(|f| {
+                AppError::field(
+                    f,
+                    "an XY group's frame turns only about Z and does not shift in Z",
+                )
+            })?;
+        Ok(GroupOrder::Command(CommandKind::SetCoordinateTransform {
+            transform,
+        }))
+    }
 }
 
 /// MC_MovePath with its table.
@@ -418,7 +481,7 @@ fn motion(
 impl MovePathBody {
     /// The kernel's table, checked entry by entry with the kernel's rules for this group's
     /// axis count.
-    pub fn to_table(&self, axes: usize) -> AppResult<PathTable> {
+    pub fn to_table(&self, axes: usize, planar: bool) -> AppResult<PathTable> {
         if self.entries.is_empty() || self.entries.len() > MAX_PATH_ENTRIES {
             return Err(coded("entries".into(), motion::ErrorId::PATH_TOO_LONG));
         }
@@ -510,6 +573,22 @@ impl MovePathBody {
                     buffer_mode: buffer_mode.unwrap_or(BufferMode::Buffered),
                     invoke_id: *invoke_id,
                 },
+                PathEntryDto::CoordinateTransform {
+                    translation,
+                    rotation,
+                } => {
+                    let three = |name: &str, v: &[f64]| {
+                        xyz(v).ok_or_else(|| {
+                            AppError::field(&field(name), "X, Y and Z: three numbers")
+                        })
+                    };
+                    PathEntry::CoordinateTransform {
+                        transform: motion::group::CoordTransform {
+                            translation: three("translation", translation)?,
+                            rotation: three("rotation", rotation)?,
+                        },
+                    }
+                }
             });
         }
         // Beyond ±1e12 an f64 position has no useful resolution and lengths could overflow to
@@ -546,6 +625,15 @@ impl MovePathBody {
                     [("", &[]), ("", &[]), ("", &[]), ("", &[])]
                 }
                 PathEntryDto::Blocker { .. } => [("", &[]), ("", &[]), ("", &[]), ("", &[])],
+                PathEntryDto::CoordinateTransform {
+                    translation,
+                    rotation,
+                } => [
+                    ("translation", translation),
+                    ("rotation", rotation),
+                    ("", &[]),
+                    ("", &[]),
+                ],
             };
             for (name, v) in vectors {
                 for (j, x) in v.iter().enumerate() {
@@ -556,13 +644,13 @@ impl MovePathBody {
         c.done(())?;
         let table = PathTable { entries };
         table
-            .check(axes)
+            .check(axes, planar)
             .map_err(|(i, f, id)| coded(format!("entries[{i}].{f}"), id))?;
         Ok(table)
     }
 
     pub fn to_order(&self, _: &Registry, group: &GroupEntry) -> AppResult<GroupOrder> {
-        let table = self.to_table(group.config.axis_count())?;
+        let table = self.to_table(group.config.axis_count(), group.config.convention.planar())?;
         Ok(GroupOrder::Path(Box::new(table)))
     }
 }

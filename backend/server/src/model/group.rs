@@ -104,7 +104,8 @@ pub struct GroupMemberResource {
         "actual_override": 1.0, "path_velocity": 0.0, "path_acceleration": 0.0, "path_position": 0.0,
         "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
         "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
-        "position": {"x": 0.0, "y": 0.0}}}))]
+        "position": {"x": 0.0, "y": 0.0},
+        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0}}))]
 pub struct GroupResource {
     pub id: i64,
     pub name: String,
@@ -127,7 +128,8 @@ pub struct GroupResource {
     "actual_override": 1.0, "path_velocity": 0.0, "path_acceleration": 0.0, "path_position": 0.0,
     "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
     "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
-    "position": {"x": 0.0, "y": 0.0}}))]
+    "position": {"x": 0.0, "y": 0.0},
+        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0}))]
 pub struct GroupStatusDto {
     pub cycle: u64,
     /// MC_GROUP_STATE (error_stop with `enable_requested` false is GroupErrorDisabled).
@@ -171,6 +173,21 @@ pub struct GroupStatusDto {
     pub queued_entries: u32,
     /// The group's set point of each role of its configuration.
     pub position: BTreeMap<String, f64>,
+    /// The coordinate frame later MovePaths are read in (MC_SetCoordinateTransform or a
+    /// table's frame entry; a halt or stop clears it).
+    pub frame: FrameDto,
+    /// MovePaths whose entries were built off the cycle thread and taken as built (the
+    /// others were built in the cycle: an aborting path while moving, a queue that changed).
+    pub prepared_paths: u64,
+}
+
+/// A coordinate frame: a shift and DIN 9300 Z″Y′X rotations in degrees.
+#[derive(Clone, Copy, Debug, Default, Serialize, ToSchema)]
+#[schema(example = json!({"translation": [100.0, 50.0, 0.0], "rotation": [0.0, 0.0, 90.0]}))]
+pub struct FrameDto {
+    pub translation: [f64; 3],
+    /// [about X, about Y, about Z] in degrees.
+    pub rotation: [f64; 3],
 }
 
 /// A role as JSON names it (`x`, `addax1` …).

@@ -228,11 +228,17 @@ async fn submit(
         GroupOrder::Command(CommandKind::SetEncoderScalingFactor { factor, .. }) => Some(*factor),
         _ => None,
     };
+    // A path is built here, off the cycle thread; what does not build names its entry.
+    let mut path_why = None;
     let request = async {
         match order {
             GroupOrder::Command(kind) => s.command_request(id, target, kind).await,
             GroupOrder::Path(table) => match target {
-                Target::Group(g) => s.path_request(id, g, table).await,
+                Target::Group(g) => {
+                    let (prepared, why) = s.prepare_path(g, &table);
+                    path_why = why;
+                    s.path_request(id, g, table, prepared).await
+                }
                 Target::Axis(_) => Err(AppError::unavailable(
                     "internal",
                     "a path table addresses a group",
@@ -309,7 +315,7 @@ async fn submit(
                     Some(why) => AppError::RejectedBecause { id: e, why },
                     None => AppError::rejected(e),
                 },
-                Target::Group(g) => group_refusal(s, g, e),
+                Target::Group(g) => group_refusal(s, g, e, path_why),
             })
         }
     }
@@ -318,8 +324,25 @@ async fn submit(
 /// A group's refusal as the API answers it: a path the group cannot run by its own values
 /// (an arc that is no arc, a table the rules refuse) is a 422 with the rule's code; a state
 /// that does not allow the block a 409 saying the state; anything else a 409 with its code.
-fn group_refusal(s: &AppState, g: motion::group::GroupId, e: ErrorId) -> AppError {
-    const VALUES: [ErrorId; 9] = [
+fn group_refusal(
+    s: &AppState,
+    g: motion::group::GroupId,
+    e: ErrorId,
+    path_why: Option<(usize, &'static str, ErrorId)>,
+) -> AppError {
+    // The same refusal as the path's preparation found: at the entry and field it names.
+    if let Some((i, field, _)) = path_why.filter(|w| w.2 == e) {
+        if e != ErrorId::PATH_BEYOND_SOFT_LIMIT {
+            return AppError::InvalidCoded {
+                errors: vec![crate::error::FieldError {
+                    message: format!("{} (0x{:04X}): {}", e.code(), e.0, e.text()),
+                    field: format!("entries[{i}].{field}"),
+                }],
+                id: e,
+            };
+        }
+    }
+    const VALUES: [ErrorId; 10] = [
         ErrorId::CIRCLE_INVALID,
         ErrorId::TRANSITION_MODE_INVALID,
         ErrorId::BUFFER_MODE_INVALID,
@@ -329,6 +352,7 @@ fn group_refusal(s: &AppState, g: motion::group::GroupId, e: ErrorId) -> AppErro
         ErrorId::BLOCKER_ID_INVALID,
         ErrorId::DWELL_TIME_INVALID,
         ErrorId::GROUP_CONFIG_INVALID,
+        ErrorId::PARAMETER_NOT_CORRECT,
     ];
     if VALUES.contains(&e) {
         return AppError::kernel(

@@ -87,6 +87,11 @@ pub fn status_dto(
             .roles()
             .map(|r| (role_name(r), st.position[r.dim()]))
             .collect(),
+        frame: crate::model::FrameDto {
+            translation: st.frame.translation,
+            rotation: st.frame.rotation,
+        },
+        prepared_paths: st.prepared_paths,
     }
 }
 
