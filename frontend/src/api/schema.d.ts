@@ -1471,6 +1471,287 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/groups": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** List the axis groups with their live status */
+        get: operations["list_groups"];
+        put?: never;
+        /**
+         * Create an axis group (TF5420 CM group): convention, additional axes, dynamics, and its axes
+         * @description Validated field by field (`errors[].field`; `error_id` 0x8120 group_config_invalid or 0x8140 path_dynamics_invalid for the kernel's rules). The group takes the kernel slot id − 1 (16 at most), disabled, and gets its configured axes (MC_AddAxisToGroup).
+         */
+        post: operations["create_group"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** One axis group: configuration and live status */
+        get: operations["get_group"];
+        /**
+         * Replace an axis group's configuration (only while it is disabled)
+         * @description 409 group_state_invalid while the group is enabled or in error (disable it first).
+         */
+        put: operations["replace_group"];
+        post?: never;
+        /** Delete an axis group (only while it is disabled) */
+        delete: operations["delete_group"];
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/add-axis": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_AddAxisToGroup: an axis takes a role (only while the group is disabled) */
+        post: operations["group_add_axis"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/disable": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupDisable: disabled at once (a moving group stops abruptly: halt or stop first) */
+        post: operations["group_disable"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/enable": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupEnable: with all its axes, the group goes to standby (not_ready until every axis is powered) */
+        post: operations["group_enable"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/halt": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupHalt: stop on the path without a lock; flushes the queued entries */
+        post: operations["group_halt"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/move-path": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_MovePath: run a path of linear, circular, blocker and dwell entries */
+        post: operations["group_move_path"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/read-blocker-status": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_GroupReadBlockerStatus: whether a blocker holds the path, and which */
+        get: operations["read_blocker_status"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/read-error": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_GroupReadError: the group's error (GroupErrorId) */
+        get: operations["read_error"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/release-blocker": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_ReleaseBlocker: let the path go on past a blocker */
+        post: operations["group_release_blocker"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/remove-axis": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_RemoveAxisFromGroup: the axis of a role leaves (Done also when there is none) */
+        post: operations["group_remove_axis"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/reset": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupReset: clear the errors of the group and its axes */
+        post: operations["group_reset"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/set-override": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupSetOverride: the path velocity factor, clamped to 0…1, ramped over the override ramp time */
+        post: operations["group_set_override"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/status": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** MC_GroupReadStatus: the group's live status (NcToPlc) */
+        get: operations["group_status"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/stop": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_GroupStop: stop on the path and lock the group until released (DELETE /commands/{id}) */
+        post: operations["group_stop"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/ungroup-all": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_UngroupAllAxes: every axis leaves and the group is disabled */
+        post: operations["group_ungroup_all"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/scope/recordings": {
         parameters: {
             query?: never;
@@ -1744,6 +2025,11 @@ export interface components {
             /** @description `committed`, `accepted`, `rejected:<code>`, `done`, `aborted`, `error:<code>`, `applied` … */
             outcome?: string | null;
         };
+        /**
+         * @description `MC_AXES_CONVENTION`: which Cartesian axes form the path.
+         * @enum {string}
+         */
+        AxesConvention: "xy" | "xyz" | "xyzc";
         /**
          * @description MC_ReadAxisComponents (§4.2.3, ST_AxisComponents): the encoder, controller and drive of
          *     an axis. motiond gives each axis one of each, numbered with the axis id.
@@ -2464,6 +2750,20 @@ export interface components {
              */
             ramp: number;
             disable_mode?: components["schemas"]["DisableMode"];
+        };
+        /** @description MC_BlockerPreparation: the path holds here until MC_ReleaseBlocker(`blocker_id`). */
+        BlockerEntry: {
+            /**
+             * Format: int32
+             * @description > 0.
+             */
+            blocker_id: number;
+            buffer_mode?: null | components["schemas"]["BufferMode"];
+            /**
+             * Format: int32
+             * @default 0
+             */
+            invoke_id?: number;
         };
         /** @enum {string} */
         BufferMode: "aborting" | "buffered" | "blending_low" | "blending_previous" | "blending_next" | "blending_high";
@@ -3549,6 +3849,44 @@ export interface components {
          */
         Cia402Mode: "csp" | "csv" | "cst";
         /**
+         * @description MC_CIRC_MODE: what the AuxPoint of a circular segment means. (Invalid is not a value
+         *     here: a request without a valid mode is refused before it reaches the geometry.)
+         * @enum {string}
+         */
+        CircMode: "border" | "center" | "radius";
+        /**
+         * @description MC_CIRC_PATHCHOICE: which of the arcs from start to end is meant (Center and Radius
+         *     modes; Border ignores it). See the module documentation for the exact rule.
+         * @enum {string}
+         */
+        CircPathChoice: "clockwise" | "counter_clockwise" | "short_segment" | "long_segment";
+        /** @description MC_MoveCircularAbsolutePreparation. */
+        CircularEntry: {
+            /**
+             * @description What `aux_point` is: a point on the arc (`border`), its centre (`center`), or the normal
+             *     of its plane whose length is the radius (`radius`).
+             */
+            circ_mode: components["schemas"]["CircMode"];
+            /** @description X, Y, Z of the auxiliary point. */
+            aux_point: number[];
+            /** @description The end in the group's axis order (as many values as the group has axes). */
+            end_point: number[];
+            path_choice?: null | components["schemas"]["CircPathChoice"];
+            /** @description Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory). */
+            velocity: components["schemas"]["PathValueDto"];
+            acceleration?: components["schemas"]["PathValueDto"];
+            deceleration?: components["schemas"]["PathValueDto"];
+            jerk?: components["schemas"]["PathValueDto"];
+            buffer_mode?: null | components["schemas"]["BufferMode"];
+            transition_mode?: null | components["schemas"]["TransitionModeDto"];
+            transition_parameters?: number[];
+            /**
+             * Format: int32
+             * @default 0
+             */
+            invoke_id?: number;
+        };
+        /**
          * @description Where a command came from.
          * @example {
          *       "addr": "127.0.0.1:50312",
@@ -3658,9 +3996,14 @@ export interface components {
         CommandResource: {
             /** Format: int64 */
             id: number;
+            /** @description The axis it addresses (empty, 0 for a group's command: see `group`). */
             axis: string;
             /** Format: int64 */
             axis_id: number;
+            /** @description The axis group it addresses (a group's block). */
+            group?: string | null;
+            /** Format: int64 */
+            group_id?: number | null;
             /** @description kebab-case command name (the REST endpoint). */
             command: string;
             /** @description The request body as given. */
@@ -4043,6 +4386,12 @@ export interface components {
              *     tables as they are; with it (also `[]`) they are replaced.
              */
             cam_tables?: components["schemas"]["CamTableBody"][] | null;
+            /**
+             * @description The axis groups with their ids. An import without this field leaves the stored groups
+             *     as they are (their members must then be among the imported axes); with it (also `[]`)
+             *     they are replaced.
+             */
+            groups?: components["schemas"]["GroupBody"][] | null;
             bus?: null | components["schemas"]["BusSettings"];
         };
         /**
@@ -4392,6 +4741,20 @@ export interface components {
             /** Format: int64 */
             cycle: number;
         };
+        /** @description MC_DwellTimePreparation: the path stands still for `time`. */
+        DwellEntry: {
+            /**
+             * Format: double
+             * @description Seconds, ≥ 0 (0 still forces an exact stop).
+             */
+            time: number;
+            buffer_mode?: null | components["schemas"]["BufferMode"];
+            /**
+             * Format: int32
+             * @default 0
+             */
+            invoke_id?: number;
+        };
         /**
          * @description MC_Reset, MC_GearOut, MC_AbortSuperposition (no inputs; an empty body is read as `{}`).
          * @example {}
@@ -4637,6 +5000,325 @@ export interface components {
             sync_mode?: components["schemas"]["MultiMasterSyncMode"];
         };
         /**
+         * @description MC_AddAxisToGroup.
+         * @example {
+         *       "axis": "x",
+         *       "role": "x"
+         *     }
+         */
+        GroupAddAxisBody: {
+            /** @description `IdentInGroup`: a role of the group's convention or addax1..n. */
+            role: components["schemas"]["GroupRole"];
+            /** @description The axis: its id (all digits) or its name. */
+            axis: string;
+        };
+        /**
+         * @description MC_GroupReadBlockerStatus.
+         * @example {
+         *       "blocked": true,
+         *       "blocker_id": 7,
+         *       "cycle": 1200,
+         *       "group": "xy",
+         *       "valid": true
+         *     }
+         */
+        GroupBlockerRead: {
+            group: string;
+            /** Format: int64 */
+            cycle: number;
+            /** @description `Valid` (a CM group in the cycle). */
+            valid: boolean;
+            /** @description `Blocked`: a blocker holds the path. */
+            blocked: boolean;
+            /**
+             * Format: int32
+             * @description `BlockerId` (0: none).
+             */
+            blocker_id: number;
+        };
+        /**
+         * @description A group's configuration (`POST /groups`, `PUT /groups/{group}`; the configuration
+         *     document's `groups[]`). Every field but `name` has a default.
+         * @example {
+         *       "axes": [
+         *         {
+         *           "axis": "x",
+         *           "role": "x"
+         *         },
+         *         {
+         *           "axis": "y",
+         *           "role": "y"
+         *         }
+         *       ],
+         *       "convention": "xy",
+         *       "name": "xy"
+         *     }
+         */
+        GroupBody: {
+            /**
+             * Format: int64
+             * @description 1..16 (`POST`: the lowest free one when left out; `PUT`: the group's own). The kernel's
+             *     group slot is id − 1.
+             */
+            id?: number | null;
+            /** @description Unique name: a letter or `_`, then letters, digits, `_` or `-` (at most 64). */
+            name: string;
+            /** @description Spatial Axes Convention (default `xy`). */
+            convention?: components["schemas"]["AxesConvention"];
+            /**
+             * Format: int32
+             * @description Additional Axes Count, 0..8 (ADDAX1..n; default 0).
+             * @default 0
+             */
+            additional_axes: number;
+            /**
+             * @description The axes added (MC_AddAxisToGroup) whenever the group is put in force (created,
+             *     replaced, motiond started): each role of the convention and ADDAX1..n at most once,
+             *     each axis in at most one group. Default none.
+             */
+            axes?: components["schemas"]["GroupMemberBody"][];
+            /** @description What `"default"` means in a path entry, halt or stop (default v 100, a/d 1000, j 10000). */
+            default_dynamics?: components["schemas"]["PathDynamics"];
+            /**
+             * @description What `"maximum"` means, and the cap of every commanded path value (default v 1000,
+             *     a/d 10000, j 1e6).
+             */
+            maximum_dynamics?: components["schemas"]["PathDynamics"];
+            /**
+             * Format: double
+             * @description Time Override Ramp Time (s), 0..10 (default 0.1).
+             * @default 0.1
+             */
+            override_ramp_time: number;
+        };
+        /**
+         * @description MC_GroupReadError.
+         * @example {
+         *       "cycle": 1200,
+         *       "error": false,
+         *       "error_id": 0,
+         *       "group": "xy",
+         *       "valid": true
+         *     }
+         */
+        GroupErrorRead: {
+            group: string;
+            /** Format: int64 */
+            cycle: number;
+            /** @description `Valid`: the outputs are valid (the group is in the cycle). */
+            valid: boolean;
+            /** @description Whether the group has an error (`GroupErrorId` ≠ 0). */
+            error: boolean;
+            /**
+             * Format: int32
+             * @description `GroupErrorId`.
+             */
+            error_id: number;
+            error_code?: string | null;
+        };
+        /**
+         * @description One member of a group's configuration: the axis that takes a role (`IDENT_IN_GROUP_REF`).
+         * @example {
+         *       "axis": "x",
+         *       "role": "x"
+         *     }
+         */
+        GroupMemberBody: {
+            role: components["schemas"]["GroupRole"];
+            /**
+             * @description The axis: its id (all digits) or its name.
+             * @example x
+             */
+            axis: string;
+        };
+        /**
+         * @description A configured member as the API shows it.
+         * @example {
+         *       "axis": "x",
+         *       "axis_id": 1,
+         *       "role": "x"
+         *     }
+         */
+        GroupMemberResource: {
+            role: components["schemas"]["GroupRole"];
+            axis: string;
+            /** Format: int64 */
+            axis_id: number;
+        };
+        /**
+         * @description MC_RemoveAxisFromGroup.
+         * @example {
+         *       "role": "y"
+         *     }
+         */
+        GroupRemoveAxisBody: {
+            role: components["schemas"]["GroupRole"];
+        };
+        /** @description A group: its configuration and, while it is in the cycle, its live status. */
+        GroupResource: {
+            /** Format: int64 */
+            id: number;
+            name: string;
+            convention: components["schemas"]["AxesConvention"];
+            /** Format: int32 */
+            additional_axes: number;
+            axes: components["schemas"]["GroupMemberResource"][];
+            default_dynamics: components["schemas"]["PathDynamics"];
+            maximum_dynamics: components["schemas"]["PathDynamics"];
+            /** Format: double */
+            override_ramp_time: number;
+            updated_at: string;
+            status?: null | components["schemas"]["GroupStatusDto"];
+        };
+        /**
+         * @description `IDENT_IN_GROUP_REF` of a CM group: MCS_X/Y/Z, MCS_C1, ADDAX1..8.
+         * @enum {string}
+         */
+        GroupRole: "x" | "y" | "z" | "c" | "addax1" | "addax2" | "addax3" | "addax4" | "addax5" | "addax6" | "addax7" | "addax8";
+        /**
+         * @description MC_GroupSetOverride.
+         * @example {
+         *       "factor": 0.5
+         *     }
+         */
+        GroupSetOverrideBody: {
+            /**
+             * Format: double
+             * @description `VelFactor`: 0 (0 %) … 1 (100 %); a value outside is clamped, never refused.
+             */
+            factor: number;
+        };
+        /**
+         * @description `MC_GROUP_STATE` as motiond reports it.
+         * @enum {string}
+         */
+        GroupState: "disabled" | "not_ready" | "standby" | "moving" | "stopping" | "error_stop";
+        /**
+         * @description A group's live status (TF5420 `NcToPlc`, MC_GroupReadStatus, MC_GroupReadError,
+         *     MC_GroupReadBlockerStatus), as of `cycle`.
+         * @example {
+         *       "actual_override": 1,
+         *       "all_axes_standing": true,
+         *       "axes_count": 2,
+         *       "blocked": false,
+         *       "blocker_id": 0,
+         *       "cycle": 1200,
+         *       "enable_requested": true,
+         *       "entry_index": 0,
+         *       "error_id": 0,
+         *       "in_blending_segment": false,
+         *       "invoke_id": 0,
+         *       "members": {
+         *         "x": "x",
+         *         "y": "y"
+         *       },
+         *       "override_factor": 1,
+         *       "path_acceleration": 0,
+         *       "path_position": 0,
+         *       "path_velocity": 0,
+         *       "position": {
+         *         "x": 0,
+         *         "y": 0
+         *       },
+         *       "queued_entries": 0,
+         *       "remaining_distance": 0,
+         *       "remaining_time": 0,
+         *       "state": "standby"
+         *     }
+         */
+        GroupStatusDto: {
+            /** Format: int64 */
+            cycle: number;
+            /** @description MC_GROUP_STATE (error_stop with `enable_requested` false is GroupErrorDisabled). */
+            state: components["schemas"]["GroupState"];
+            /** @description `Flags.IsEnableRequested`. */
+            enable_requested: boolean;
+            /**
+             * Format: int32
+             * @description `GroupErrorId` (0: none).
+             */
+            error_id: number;
+            error_code?: string | null;
+            /** @description The member axis of each role (its name), as the group has them now. */
+            members: {
+                [key: string]: string;
+            };
+            /**
+             * Format: int32
+             * @description `GroupAxesCount`.
+             */
+            axes_count: number;
+            /** @description `AllAxesStanding`: every member at v = 0 and a = 0. */
+            all_axes_standing: boolean;
+            /**
+             * Format: double
+             * @description Override asked for (MC_GroupSetOverride's VelFactor, clamped) and in effect
+             *     (`ActOverrideFactor`), 0..1.
+             */
+            override_factor: number;
+            /** Format: double */
+            actual_override: number;
+            /**
+             * Format: double
+             * @description `PathVelo` (path units/s) and the path acceleration.
+             */
+            path_velocity: number;
+            /** Format: double */
+            path_acceleration: number;
+            /**
+             * Format: double
+             * @description Path length travelled since the group last stood idle.
+             */
+            path_position: number;
+            /**
+             * Format: int64
+             * @description The MovePath command running (absent: none).
+             */
+            command?: number | null;
+            /**
+             * Format: int32
+             * @description Its entry (index in its table) and that entry's `InvokeId`.
+             */
+            entry_index: number;
+            /** Format: int32 */
+            invoke_id: number;
+            /** @description `IsInBlendingSegment`. */
+            in_blending_segment: boolean;
+            /**
+             * Format: double
+             * @description `RemainingCartesianDistanceActiveJob` and `RemainingTimeActiveJob` (s).
+             */
+            remaining_distance: number;
+            /** Format: double */
+            remaining_time: number;
+            /** @description MC_GroupReadBlockerStatus: `Blocked` and `BlockerId`. */
+            blocked: boolean;
+            /** Format: int32 */
+            blocker_id: number;
+            /**
+             * Format: int32
+             * @description Entries queued (the running one included).
+             */
+            queued_entries: number;
+            /** @description The group's set point of each role of its configuration. */
+            position: {
+                [key: string]: number;
+            };
+        };
+        /**
+         * @description MC_GroupHalt, MC_GroupStop.
+         * @example {
+         *       "deceleration": 2000,
+         *       "jerk": "default"
+         *     }
+         */
+        GroupStopBody: {
+            /** @description ≥ 1, `"default"` (default) or `"maximum"`. */
+            deceleration?: components["schemas"]["PathValueDto"];
+            /** @description ≥ 100, `"default"` (default), `"maximum"` or `"ignore"` (no jerk limit). */
+            jerk?: components["schemas"]["PathValueDto"];
+        };
+        /**
          * @description MC_Halt.
          * @example {
          *       "deceleration": 1000
@@ -4839,6 +5521,32 @@ export interface components {
              * @default false
              */
             fault_on_hit: boolean;
+        };
+        /** @description MC_MoveLinearAbsolutePreparation. */
+        LinearEntry: {
+            /**
+             * @description The target in the group's axis order (the convention's axes, then addax1..n): as many
+             *     values as the group has axes.
+             */
+            position: number[];
+            /** @description Maximum path velocity of the segment: > 0 or `"maximum"` (mandatory). */
+            velocity: components["schemas"]["PathValueDto"];
+            /** @description ≥ 1, `"default"` (default) or `"maximum"`. */
+            acceleration?: components["schemas"]["PathValueDto"];
+            /** @description ≥ 1, `"default"` (default) or `"maximum"`. */
+            deceleration?: components["schemas"]["PathValueDto"];
+            /** @description ≥ 100, `"default"` (default) or `"maximum"`. */
+            jerk?: components["schemas"]["PathValueDto"];
+            buffer_mode?: null | components["schemas"]["BufferMode"];
+            transition_mode?: null | components["schemas"]["TransitionModeDto"];
+            /** @description TransitionParameter[1..]: 1 for corner_distance, 2 for corner_distance_advanced. */
+            transition_parameters?: number[];
+            /**
+             * Format: int32
+             * @description Echoed in the group status while the entry runs.
+             * @default 0
+             */
+            invoke_id?: number;
         };
         /**
          * @description The live status of an axis: the kernel's status plus what only the server can name.
@@ -5308,6 +6016,67 @@ export interface components {
             enable_stop_position_monitoring?: boolean;
         };
         /**
+         * @description MC_MovePath with its table.
+         * @example {
+         *       "entries": [
+         *         {
+         *           "position": [
+         *             100,
+         *             0
+         *           ],
+         *           "type": "linear",
+         *           "velocity": 200
+         *         },
+         *         {
+         *           "aux_point": [
+         *             100,
+         *             50,
+         *             0
+         *           ],
+         *           "buffer_mode": "buffered",
+         *           "circ_mode": "center",
+         *           "end_point": [
+         *             150,
+         *             50
+         *           ],
+         *           "path_choice": "counter_clockwise",
+         *           "type": "circular",
+         *           "velocity": 200
+         *         },
+         *         {
+         *           "buffer_mode": "blending_previous",
+         *           "position": [
+         *             150,
+         *             150
+         *           ],
+         *           "transition_mode": "corner_distance",
+         *           "transition_parameters": [
+         *             5
+         *           ],
+         *           "type": "linear",
+         *           "velocity": 200
+         *         },
+         *         {
+         *           "buffer_mode": "blending_previous",
+         *           "position": [
+         *             0,
+         *             150
+         *           ],
+         *           "transition_mode": "corner_distance",
+         *           "transition_parameters": [
+         *             5
+         *           ],
+         *           "type": "linear",
+         *           "velocity": 200
+         *         }
+         *       ]
+         *     }
+         */
+        MovePathBody: {
+            /** @description 1 to 256 entries (TwinCAT's table holds 30; decision 123). */
+            entries: components["schemas"]["PathEntryDto"][];
+        };
+        /**
          * @description MC_MoveRelative / MC_MoveAdditive: a distance (PLCopen's `Distance`), from the set position
          *     (relative) or added to the running target (additive).
          * @example {
@@ -5665,6 +6434,45 @@ export interface components {
             /** @description 8–1024 characters. */
             new_password: string;
         };
+        /** @description Path dynamics of a group (path units: mm, mm/s … along the Cartesian path). */
+        PathDynamics: {
+            /** Format: double */
+            velocity: number;
+            /**
+             * Format: double
+             * @description ≥ 1 (TF5420 §2.4).
+             */
+            acceleration: number;
+            /**
+             * Format: double
+             * @description ≥ 1.
+             */
+            deceleration: number;
+            /**
+             * Format: double
+             * @description ≥ 100.
+             */
+            jerk: number;
+        };
+        /** @description One row of the path table, by `type`. */
+        PathEntryDto: (components["schemas"]["LinearEntry"] & {
+            /** @enum {string} */
+            type: "linear";
+        }) | (components["schemas"]["CircularEntry"] & {
+            /** @enum {string} */
+            type: "circular";
+        }) | (components["schemas"]["BlockerEntry"] & {
+            /** @enum {string} */
+            type: "blocker";
+        }) | (components["schemas"]["DwellEntry"] & {
+            /** @enum {string} */
+            type: "dwell";
+        });
+        /**
+         * @description A path dynamics input: a number (path units/s, /s², /s³), or `"default"`, `"maximum"`
+         *     (and `"ignore"` for the jerk of a halt or stop).
+         */
+        PathValueDto: number | components["schemas"]["SpecialValue"];
         /**
          * @description When the following-error peak hold counts from.
          * @example {
@@ -6133,6 +6941,19 @@ export interface components {
             al_status_code?: string | null;
             /** @description The AL status code with its ETG.1000 meaning, or the SDO error. */
             reason: string;
+        };
+        /**
+         * @description MC_ReleaseBlocker.
+         * @example {
+         *       "blocker_id": 7
+         *     }
+         */
+        ReleaseBlockerBody: {
+            /**
+             * Format: int32
+             * @description The blocker's id (> 0).
+             */
+            blocker_id: number;
         };
         /**
          * @description What a client must be allowed to do. Ordered: each role may do what the ones before it may.
@@ -6604,6 +7425,11 @@ export interface components {
              */
             max: number;
         };
+        /**
+         * @description `MC_DEFAULT`, `MC_MAXIMUM`, `MC_IGNORE` (TF5420 §2.4, §5.16).
+         * @enum {string}
+         */
+        SpecialValue: "default" | "maximum" | "ignore";
         /**
          * @description `MC_StartMode`: absolute or relative, for master and slave (spec §1.6). Relative places the
          *     origin of the cam's coordinates (raw 0) at the axis's position when the cam takes effect.
@@ -7282,6 +8108,12 @@ export interface components {
              */
             modulo_positions?: boolean;
         };
+        /**
+         * @description `MC_TRANSITION_MODE` (only `none`, `corner_distance` and `corner_distance_advanced` are
+         *     supported by the CM group; the others are refused with transition_mode_invalid).
+         * @enum {string}
+         */
+        TransitionModeDto: "none" | "corner_distance" | "corner_distance_advanced" | "start_velocity" | "constant_velocity" | "max_corner_deviation";
         /**
          * @description Direction of a trigger crossing.
          * @enum {string}
@@ -7992,6 +8824,94 @@ export interface components {
                  *       "status": 422,
                  *       "title": "Invalid request",
                  *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description An invalid field of a group block (`errors[].field`), or a path entry the TF5420 rules
+         *     refuse: then `code` is the rule's (`transition_mode_invalid`, `buffer_mode_invalid`,
+         *     `position_count_invalid`, `path_dynamics_invalid`, `blocker_id_invalid` …) and `error_id`
+         *     its number, the field `entries[i].…`.
+         */
+        GroupCommandInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Rejected by the group (wrong group state, a path the group cannot run …) or by the
+         *     kernel's check of a path (`circle_invalid`, `path_beyond_soft_limit` …); `error_id` and
+         *     `code` name it. No command is kept.
+         */
+        GroupCommandRejected: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The name or the id is taken, all 16 group slots are used, or the group is enabled or in
+         *     error (`group_state_invalid`: disable it first).
+         */
+        GroupConflict: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description Invalid fields of a group (`errors[].field`); `error_id` 0x8140 path_dynamics_invalid
+         *     or 0x8120 group_config_invalid when the kernel's rules refuse a value.
+         */
+        GroupInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description The group is enabled or in error (`group_state_invalid`: disable it first). */
+        GroupNotDisabled: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "group_state_invalid",
+                 *       "detail": "command not allowed in the current group state: group xy is enabled or in error: disable it first (POST /api/v1/groups/xy/disable)",
+                 *       "error_id": 33086,
+                 *       "status": 409,
+                 *       "title": "Command rejected by the axis",
+                 *       "type": "urn:motiond:problem:group_state_invalid"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such axis group. */
+        GroupNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "group_not_found",
+                 *       "detail": "no group 'gantry'",
+                 *       "status": 404,
+                 *       "title": "Not found",
+                 *       "type": "urn:motiond:problem:group_not_found"
                  *     }
                  */
                 "application/problem+json": components["schemas"]["Problem"];
@@ -12998,6 +13918,924 @@ export interface operations {
             403: components["responses"]["RoleInsufficient"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["FunctionInputInvalid"];
+        };
+    };
+    list_groups: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description All groups, by id */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupResource"][];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    create_group: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GroupBody"];
+            };
+        };
+        responses: {
+            /** @description Created */
+            201: {
+                headers: {
+                    /** @description /api/v1/groups/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            409: components["responses"]["GroupConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    get_group: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The group */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupResource"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["GroupNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    replace_group: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GroupBody"];
+            };
+        };
+        responses: {
+            /** @description Replaced */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    delete_group: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        /** @description `{}` or an empty body, sent as `application/json` (the operation takes no parameters; anything else is a 422). */
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Deleted */
+            204: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content?: never;
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupNotDisabled"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
+            503: components["responses"]["WriteUnavailable"];
+        };
+    };
+    group_add_axis: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GroupAddAxisBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_disable: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_enable: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_halt: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["GroupStopBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_move_path: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["MovePathBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    read_blocker_status: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description As of the latest cycle */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupBlockerRead"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["GroupNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    read_error: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description As of the latest cycle */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupErrorRead"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["GroupNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    group_release_blocker: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["ReleaseBlockerBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_remove_axis: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GroupRemoveAxisBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_reset: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_set_override: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["GroupSetOverrideBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_status: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description As of the latest cycle */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["GroupStatusDto"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            404: components["responses"]["GroupNotFound"];
+            421: components["responses"]["MisdirectedRequest"];
+            503: components["responses"]["CycleUnavailable"];
+        };
+    };
+    group_stop: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["GroupStopBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_ungroup_all: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["EmptyBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     list_recordings: {
