@@ -138,6 +138,19 @@ export function drawView(ctx: CanvasRenderingContext2D, w: number, h: number, d:
   ctx.beginPath();
   ctx.rect(m.l, m.t, pw, ph);
   ctx.clip();
+  // live trace: wide and translucent under the programmed path, so both stay visible
+  if (d.trace.length > 1) {
+    ctx.save();
+    ctx.globalAlpha = 0.5;
+    ctx.strokeStyle = VIEW_COLORS.trace;
+    ctx.lineWidth = 5;
+    ctx.lineJoin = 'round';
+    ctx.lineCap = 'round';
+    ctx.beginPath();
+    d.trace.forEach((q, i) => (i ? ctx.lineTo(X(q[plane.h]), Y(q[plane.v])) : ctx.moveTo(X(q[plane.h]), Y(q[plane.v]))));
+    ctx.stroke();
+    ctx.restore();
+  }
   ctx.globalAlpha = d.dim ? 0.45 : 1;
   const p = d.preview;
   if (p) {
@@ -186,15 +199,6 @@ export function drawView(ctx: CanvasRenderingContext2D, w: number, h: number, d:
       const [a, b] = key.split(',').map(Number);
       ctx.fillText(texts.join(', '), a + 5, b - 3);
     }
-  }
-  // live trace
-  if (d.trace.length > 1) {
-    ctx.globalAlpha = 1;
-    ctx.strokeStyle = VIEW_COLORS.trace;
-    ctx.lineWidth = 2;
-    ctx.beginPath();
-    d.trace.forEach((q, i) => (i ? ctx.lineTo(X(q[plane.h]), Y(q[plane.v])) : ctx.moveTo(X(q[plane.h]), Y(q[plane.v]))));
-    ctx.stroke();
   }
   if (d.now && Number.isFinite(d.now[plane.h]) && Number.isFinite(d.now[plane.v])) {
     ctx.globalAlpha = 1;

@@ -64,12 +64,12 @@ function groupLamp(s: GroupStatus | null | undefined): string {
   }
 }
 
-function GroupLamp({ status }: { status: GroupStatus | null | undefined }) {
+function GroupLamp({ status, label = true }: { status: GroupStatus | null | undefined; label?: boolean }) {
   const text = status ? GROUP_STATE_LABEL[status.state] : 'unknown';
   return (
     <span class="lamp-wrap" data-group-state={status?.state ?? 'unknown'} title={text}>
       <span class={`lamp ${groupLamp(status)}`} />
-      <span class="lamp-label">{text}</span>
+      {label && <span class="lamp-label">{text}</span>}
     </span>
   );
 }
@@ -452,9 +452,9 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
     <>
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="group-grid">
-        <Panel title={<>Group {group.name}</>} class="group-online" actions={<span class={`live-ind ${stale ? 'live-stale' : ''}`} data-live={stale ? 'stale' : s ? 'live' : 'waiting'}><span class="live-dot" />{stale ? 'stale' : 'live'}</span>}>
+        <Panel title={<>Group {group.name}</>} class="group-online" actions={<span class={`live-ind live-${stale ? 'stale' : status ? 'live' : 'off'}`} data-live={stale ? 'stale' : status ? 'live' : 'off'} title="the group's status, read every 50 ms"><span class="live-dot" />{stale ? 'stale' : status ? 'live' : 'waiting'}</span>}>
           <div class="group-state-row">
-            <GroupLamp status={s} />
+            <GroupLamp status={s} label={false} />
             <b class="group-state" data-testid="group-state">{s ? stateText(s) : '—'}</b>
             <span class="muted small">{group.convention.toUpperCase()} · {group.axes.map((m) => `${m.role}=${m.axis}`).join(' ')}</span>
           </div>
