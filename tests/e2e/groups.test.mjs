@@ -149,4 +149,43 @@ describe('groups page', () => {
     assert.equal((await rest(stack.api, 'GET', '/groups/second')).status, 404);
     await page.close();
   });
+  test('a blocker holds the path until released from the page; Stop ends a run on the path and is released at standstill', async () => {
+    const page = await openPage(browser, `${stack.url}/#/groups/xy`);
+    await page.waitForSelector('.group-online [data-group-state]');
+    if ((await groupStatus()).state === 'disabled') await page.click('button[name="group-enable"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 50);
+    await fill(page, 'entries[0].position[1]', 20);
+    await page.click('button[name="add-blocker"]');
+    await fill(page, 'entries[1].blocker_id', 7);
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[2].position[0]', 80);
+    await fill(page, 'entries[2].position[1]', 20);
+    await page.click('button[name="run-path"]');
+    await page.waitForSelector('[data-blocked="1"]');
+    assert.equal(await page.textContent('[data-testid="blocker-id"]'), '7');
+    assert.equal((await groupStatus()).state, 'moving');
+    await page.click('button[name="release-blocker"]');
+    await page.waitForSelector('.main tr[data-command="move-path"][data-state="done"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    assert.equal((await groupStatus()).position.x, 80);
+
+    // A long line at 50 mm/s, stopped on its way: Stopping, then back to standby (the UI's release).
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 600);
+    await fill(page, 'entries[0].position[1]', 20);
+    await fill(page, 'entries[0].velocity', 50);
+    await page.click('button[name="run-path"]');
+    await page.waitForSelector('.group-online [data-group-state="moving"]');
+    await page.click('button[name="group-stop"]');
+    await page.waitForSelector('.main tr[data-command="stop"][data-state="done"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    const s = await groupStatus();
+    assert.ok(s.position.x > 80 && s.position.x < 600, `stopped on the way: ${s.position.x}`);
+    assert.equal(s.position.y, 20);
+    await page.close();
+  });
 });
