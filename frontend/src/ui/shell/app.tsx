@@ -172,7 +172,7 @@ export function App() {
       );
   }
   const nav = (r: Route, label: string, active: boolean) => (
-    <a href={href(r)} class={`nav-link ${active ? 'active' : ''}`}>
+    <a href={href(r)} class={`nav-link nav-${r.page} ${active ? 'active' : ''}`}>
       {label}
     </a>
   );
