@@ -11,6 +11,8 @@ export type Route =
   | { page: 'scope' }
   | { page: 'cams' }
   | { page: 'cam'; table: string }
+  | { page: 'groups' }
+  | { page: 'group'; group: string }
   | { page: 'users' }
   | { page: 'system' }
   | { page: 'not-found'; path: string };
@@ -22,6 +24,8 @@ export function parseRoute(hash: string): Route {
   if (parts[0] === 'scope' && parts.length === 1) return { page: 'scope' };
   if (parts[0] === 'cams' && parts.length === 1) return { page: 'cams' };
   if (parts[0] === 'cams' && parts.length === 2) return { page: 'cam', table: parts[1] };
+  if (parts[0] === 'groups' && parts.length === 1) return { page: 'groups' };
+  if (parts[0] === 'groups' && parts.length === 2) return { page: 'group', group: parts[1] };
   if (parts[0] === 'new-axis' && parts.length === 1) return { page: 'new-axis' };
   if (parts[0] === 'users' && parts.length === 1) return { page: 'users' };
   if (parts[0] === 'system' && parts.length === 1) return { page: 'system' };
@@ -42,6 +46,10 @@ export function href(r: Route): string {
       return '#/cams';
     case 'cam':
       return `#/cams/${encodeURIComponent(r.table)}`;
+    case 'groups':
+      return '#/groups';
+    case 'group':
+      return `#/groups/${encodeURIComponent(r.group)}`;
     case 'new-axis':
       return '#/new-axis';
     case 'users':

@@ -14,6 +14,7 @@ import { TrendBuffer } from './live/trend';
 import { releaseWhenDone } from './axis/stop';
 import { LiveTrace } from './scope/live';
 import { clientId } from './auth/client-id';
+import { postGroupBlock, type GroupBlockBody, type GroupBlockName } from './groups/api';
 
 export interface LiveStatus {
   status: AxisLiveStatus | null;
@@ -192,7 +193,8 @@ function entryOf(r: CommandResource): LogEntry {
   return {
     key: `c${r.id}`,
     id: r.id,
-    axis: r.axis,
+    // A group's command addresses no axis: the log names its group.
+    axis: r.group ?? r.axis,
     command: r.command,
     parameters: r.parameters,
     state: r.state,
@@ -253,7 +255,7 @@ function onCommandEvent(ev: CommandEvent): void {
   upsert({
     key: `c${ev.command}`,
     id: ev.command,
-    axis: ev.axis,
+    axis: ev.group ?? ev.axis,
     command: ev.name,
     parameters: known?.parameters ?? null,
     state: ev.state,
@@ -336,6 +338,55 @@ export async function findHeldStop(axis: string): Promise<number | null> {
   for (const state of ['active', 'done'] as const) {
     const list = await api.GET('/api/v1/commands', { params: { query: { axis, state, limit: 500 } } });
     const stop = list.find((c) => c.command === 'stop' && !c.final);
+    if (stop) return stop.id;
+  }
+  return null;
+}
+
+// ---- axis groups ---------------------------------------------------------------------------
+
+/** Runs group block `name` on `group` over REST (body checked by tsc), logging it as `command` does. */
+export async function groupCommand<N extends GroupBlockName>(group: string, name: N, body: GroupBlockBody<N>): Promise<CommandResource> {
+  try {
+    const r = await postGroupBlock(group, name, body);
+    logCommand(r);
+    return r;
+  } catch (e) {
+    logRejected(group, name, body, e);
+    throw e;
+  }
+}
+
+/**
+ * MC_GroupStop from the Groups page as the axis page's Stop: sent, then released once the group
+ * stands (the stop `done`: axis/stop.ts), so the group is back in standby for the next path.
+ */
+export async function groupStopAndRelease(group: string, body: GroupBlockBody<'stop'>): Promise<{ stop: CommandResource; followed: Promise<'released' | 'ended'> }> {
+  const stop = await groupCommand(group, 'stop', body);
+  const followed = releaseWhenDone(stop.id, {
+    read: (id) => api.GET('/api/v1/commands/{id}', { params: { path: { id } } }),
+    watch: (id, on) => {
+      const check = () => {
+        const e = commandLog.get().find((x) => x.id === id);
+        if (e) on(e);
+      };
+      check();
+      return commandLog.subscribe(check);
+    },
+    release: (id) => releaseCommand(id, group),
+  });
+  return { stop, followed };
+}
+
+/**
+ * The MC_GroupStop of this group that still holds its lock, asked of the server when needed (it
+ * may be another client's). `GET /commands` has no group filter: the newest active / done
+ * commands are searched for a stop of this group.
+ */
+export async function findHeldGroupStop(group: string, groupId: number): Promise<number | null> {
+  for (const state of ['active', 'done'] as const) {
+    const list = await api.GET('/api/v1/commands', { params: { query: { state, limit: 2000 } } });
+    const stop = list.find((c) => c.command === 'stop' && !c.final && (c.group === group || c.group_id === groupId));
     if (stop) return stop.id;
   }
   return null;

@@ -31,6 +31,16 @@ try {
   await page.goto(stack.url + '/#/axes/y/config');
   await page.waitForSelector('select[name="drive.plant.kind"]');
   await shot(page, `dev-config-${w}`);
+  // the Groups page while a path runs (the demo group xy: a line, a quarter arc, a blended line)
+  await rest(stack.api, 'POST', '/axes/y/power', {});
+  await until(async () => (await rest(stack.api, 'GET', '/axes/x/status')).body.status.state === 'standstill', { what: 'x at rest' });
+  await rest(stack.api, 'POST', '/groups/xy/enable', {});
+  await until(async () => (await rest(stack.api, 'GET', '/groups/xy/status')).body.state === 'standby', { what: 'group xy in standby' });
+  await page.goto(stack.url + '/#/groups/xy');
+  await page.waitForSelector('.group-online [data-group-state="standby"]');
+  await page.click('button[name="run-path"]');
+  await page.waitForSelector('.main tr[data-command="move-path"][data-state="done"]', { timeout: 30000 });
+  await shot(page, `dev-groups-${w}`);
   await page.goto(stack.url + '/#/scope');
   await page.waitForSelector('[data-channel="0"]');
   await shot(page, `dev-scope-${w}`);

@@ -45,7 +45,10 @@ export type PlantModel = S['PlantModel'];
 export interface CommandEvent {
   cycle: number;
   command: number;
+  /** Empty for a group's command (see `group`). */
   axis: string;
+  /** The group a group's command addresses. */
+  group?: string;
   name: string;
   state: CommandState;
   final: boolean;
@@ -75,3 +78,19 @@ export type CamDiscontinuity = S['Discontinuity'];
 export type OnlineChange = S['OnlineChange'];
 export type OnlineActivationMode = S['OnlineActivationMode'];
 export type TableType = S['TableType'];
+/** Axis groups (TF5420 CM group): the configuration resource, its body, the live status. */
+export type GroupResource = S['GroupResource'];
+export type GroupBody = S['GroupBody'];
+export type GroupStatus = S['GroupStatusDto'];
+export type GroupState = S['GroupState'];
+export type GroupRole = S['GroupRole'];
+export type AxesConvention = S['AxesConvention'];
+export type PathDynamics = S['PathDynamics'];
+/** MC_MovePath's body and one entry of its table (`type`: linear, circular, blocker, dwell). */
+export type MovePathBody = S['MovePathBody'];
+export type PathEntry = S['PathEntryDto'];
+export type PathValue = S['PathValueDto'];
+export type BufferMode = S['BufferMode'];
+export type TransitionMode = S['TransitionModeDto'];
+export type CircMode = S['CircMode'];
+export type CircPathChoice = S['CircPathChoice'];

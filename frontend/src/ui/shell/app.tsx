@@ -9,6 +9,7 @@ import { AxisPage } from '../axis/axis-page';
 import { AxisConfigPage } from '../config/axis-config';
 import { ScopePage } from '../scope/scope';
 import { CamListPage, CamPage } from '../cams/cams';
+import { GroupsPage } from '../groups/groups';
 import type { ConnState } from '../../live/client';
 import { ageText } from '../../live/liveness';
 import { useLiveness } from '../shared/liveness';
@@ -149,6 +150,12 @@ export function App() {
     case 'cam':
       page = <CamPage key={route.table} table={route.table} />;
       break;
+    case 'groups':
+      page = <GroupsPage group={null} />;
+      break;
+    case 'group':
+      page = <GroupsPage key={route.group} group={route.group} />;
+      break;
     case 'users':
       page = <UsersPage />;
       break;
@@ -165,7 +172,7 @@ export function App() {
       );
   }
   const nav = (r: Route, label: string, active: boolean) => (
-    <a href={href(r)} class={`nav-link ${active ? 'active' : ''}`}>
+    <a href={href(r)} class={`nav-link nav-${r.page} ${active ? 'active' : ''}`}>
       {label}
     </a>
   );
@@ -191,6 +198,7 @@ export function App() {
           {nav({ page: 'overview' }, 'Overview', route.page === 'overview')}
           {nav({ page: 'scope' }, 'Scope', route.page === 'scope')}
           {nav({ page: 'cams' }, 'Cams', route.page === 'cams' || route.page === 'cam')}
+          {nav({ page: 'groups' }, 'Groups', route.page === 'groups' || route.page === 'group')}
           {nav({ page: 'new-axis' }, 'New axis', route.page === 'new-axis')}
           {nav({ page: 'system' }, 'System', route.page === 'system')}
           {admin && nav({ page: 'users' }, 'Users', route.page === 'users')}

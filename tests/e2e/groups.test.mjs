@@ -1,0 +1,191 @@
+// The Groups page in headless Debian Chromium against the real motiond with its demo machine
+// (axes x and y, group `xy`): a path of a line, an arc and a blended line entered as rows, run,
+// followed to its end; the server's 422 shown at the row and field it names, and at a field of
+// the group form; the page fits the window at every size. Everything waits on the page's DOM or
+// the server's state, never on a fixed time.
+import { after, before, describe, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { clippedText, launch, openPage, overflowing, picture, powerOn, rest, startStack, until } from './lib.mjs';
+
+const stack = await startStack({ noDemo: false });
+let browser;
+
+before(async () => {
+  browser = await launch({ width: 1600, height: 1000 });
+});
+
+after(async () => {
+  await browser?.close();
+  await stack.stop();
+});
+
+const groupStatus = async () => (await rest(stack.api, 'GET', '/groups/xy/status')).body;
+
+/** Fills the text input named `name` (a JSON path) with `value`. */
+async function fill(page, name, value) {
+  await page.fill(`input[name="${name}"]`, String(value));
+}
+
+async function select(page, name, value) {
+  await page.selectOption(`select[name="${name}"]`, value);
+}
+
+describe('groups page', () => {
+  test('the demo group xy is listed; enabled from the page; a line, an arc and a blended line run to their end', async () => {
+    await powerOn(stack.api, ['x', 'y']);
+    const page = await openPage(browser, `${stack.url}/#/groups`);
+    await page.click('.nav-link:text("Groups")');
+    await page.waitForSelector('tr[data-group="xy"]');
+    await page.click('tr[data-group="xy"] a');
+    await page.waitForSelector('[data-testid="group-state"]');
+    await page.waitForSelector('.group-online [data-group-state="disabled"]');
+
+    await page.click('button[name="group-enable"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+
+    // The table: cleared, then three rows entered.
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 100);
+    await fill(page, 'entries[0].position[1]', 0);
+    await fill(page, 'entries[0].velocity', 200);
+    await fill(page, 'entries[0].invoke_id', 10);
+    await page.click('button[name="add-circular"]');
+    // a new row after the first: buffered / none, the velocity of the row before
+    assert.equal(await page.inputValue('select[name="entries[1].buffer_mode"]'), 'buffered');
+    assert.equal(await page.inputValue('select[name="entries[1].transition_mode"]'), 'none');
+    assert.equal(await page.inputValue('input[name="entries[1].velocity"]'), '200');
+    await select(page, 'entries[1].circ_mode', 'center');
+    await fill(page, 'entries[1].aux_point[0]', 100);
+    await fill(page, 'entries[1].aux_point[1]', 50);
+    await fill(page, 'entries[1].end_point[0]', 150);
+    await fill(page, 'entries[1].end_point[1]', 50);
+    await select(page, 'entries[1].path_choice', 'counter_clockwise');
+    await fill(page, 'entries[1].invoke_id', 20);
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[2].position[0]', 150);
+    await fill(page, 'entries[2].position[1]', 150);
+    await select(page, 'entries[2].buffer_mode', 'blending_previous');
+    await select(page, 'entries[2].transition_mode', 'corner_distance');
+    await fill(page, 'entries[2].transition_parameters[0]', 5);
+    await fill(page, 'entries[2].invoke_id', 30);
+    // The preview: three segments, 100 + a quarter arc of radius 50 + 100.
+    const want = 100 + (Math.PI * 50) / 2 + 100;
+    await page.waitForSelector('.path-canvas[data-plane="xy"][data-segments="3"]');
+    const lengthText = await page.textContent('[data-testid="preview-length"]');
+    assert.match(lengthText, new RegExp(`programmed length ${want.toFixed(2)}`), lengthText);
+
+    // At half speed (MC_GroupSetOverride from the slider's button), so the run is seen on its way.
+    await page.click('button[name="group-override-50"]');
+    await until(async () => (await groupStatus()).actual_override === 0.5, { what: 'override 50 % in effect' });
+    await page.click('button[name="run-path"]');
+    // On its way through the arc or the blended line: the entry and its invoke id shown, the picture taken.
+    await page.waitForFunction(() => / \/ (20|30)$/.test(document.querySelector('[data-readout="entry"] .dro-value')?.textContent ?? ''));
+    await picture(page, 'groups');
+    // Followed to its end: the move-path command done in the group's command log, the group in standby.
+    await page.waitForSelector('.main tr[data-command="move-path"][data-state="done"]', { timeout: 30000 });
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    await page.waitForFunction(() => document.querySelector('[data-readout="pos-x"] .dro-value')?.textContent === '150.000' && document.querySelector('[data-readout="pos-y"] .dro-value')?.textContent === '150.000');
+    const s = await groupStatus();
+    assert.equal(s.state, 'standby');
+    assert.ok(Math.abs(s.position.x - 150) < 1e-6 && Math.abs(s.position.y - 150) < 1e-6, JSON.stringify(s.position));
+    // the live trace was drawn from the statuses read while it ran
+    const traced = Number(await page.getAttribute('.path-canvas[data-plane="xy"]', 'data-trace'));
+    assert.ok(traced > 5, `trace points: ${traced}`);
+    await page.click('button[name="group-override-100"]');
+
+    // The page fits the window at every size, nothing cut off.
+    for (const [width, height] of [
+      [1600, 1000],
+      [1280, 800],
+      [1024, 768],
+      [390, 844],
+    ]) {
+      await page.setViewportSize({ width, height });
+      await page.waitForFunction((w) => document.documentElement.clientWidth === w, width);
+      const o = await overflowing(page);
+      assert.ok(o.doc <= 0 && o.main <= 0, `groups at ${width}×${height} scrolls sideways: ${JSON.stringify(o)}`);
+      assert.deepEqual(o.wide, [], `groups at ${width}×${height}: elements beyond the window's right edge`);
+      assert.deepEqual(await clippedText(page), [], `groups at ${width}×${height}: text cut off`);
+    }
+    await page.setViewportSize({ width: 1600, height: 1000 });
+    await page.close();
+  });
+
+  test("a bad velocity is refused by the server and shown at its row and field; a taken axis at the form's role", async () => {
+    const page = await openPage(browser, `${stack.url}/#/groups/xy`);
+    await page.waitForSelector('.group-online [data-group-state]');
+    if ((await groupStatus()).state === 'disabled') {
+      await page.click('button[name="group-enable"]');
+    }
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    const before = (await groupStatus()).position;
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 200);
+    await fill(page, 'entries[0].position[1]', 100);
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[1].position[0]', 250);
+    await fill(page, 'entries[1].velocity', -5);
+    await page.click('button[name="run-path"]');
+    const input = 'tr[data-row="1"] input[name="entries[1].velocity"][aria-invalid="true"]';
+    await page.waitForSelector(input);
+    const msg = await page.textContent('tr[data-row="1"] td:has(input[name="entries[1].velocity"]) .field-error');
+    assert.match(msg, /path_dynamics_invalid|velocity|dynamics/i, msg);
+    // only that row is marked, and nothing moved
+    assert.equal(await page.locator('tr.path-row.row-error').count(), 1);
+    assert.deepEqual((await groupStatus()).position, before);
+    assert.equal((await groupStatus()).state, 'standby');
+
+    // The group form: a new group that takes axis x (already in xy) → 422 at that role's select.
+    await page.click('button[name="new-group"]');
+    await page.fill('.group-form input[name="name"] >> nth=0', 'second');
+    await page.selectOption('.group-form select[data-role="x"] >> nth=0', 'x');
+    await page.selectOption('.group-form select[data-role="y"] >> nth=0', '');
+    await page.click('button[name="save-group"] >> nth=0');
+    const field = '.group-form >> nth=0 >> label.field.has-error[data-field="axes[0].axis"]';
+    await page.waitForSelector(field);
+    assert.match(await page.textContent(`${field} .field-error`), /belongs to group xy/);
+    assert.equal((await rest(stack.api, 'GET', '/groups/second')).status, 404);
+    await page.close();
+  });
+  test('a blocker holds the path until released from the page; Stop ends a run on the path and is released at standstill', async () => {
+    const page = await openPage(browser, `${stack.url}/#/groups/xy`);
+    await page.waitForSelector('.group-online [data-group-state]');
+    if ((await groupStatus()).state === 'disabled') await page.click('button[name="group-enable"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 50);
+    await fill(page, 'entries[0].position[1]', 20);
+    await page.click('button[name="add-blocker"]');
+    await fill(page, 'entries[1].blocker_id', 7);
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[2].position[0]', 80);
+    await fill(page, 'entries[2].position[1]', 20);
+    await page.click('button[name="run-path"]');
+    await page.waitForSelector('[data-blocked="1"]');
+    assert.equal(await page.textContent('[data-testid="blocker-id"]'), '7');
+    assert.equal((await groupStatus()).state, 'moving');
+    await page.click('button[name="release-blocker"]');
+    await page.waitForSelector('.main tr[data-command="move-path"][data-state="done"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    assert.equal((await groupStatus()).position.x, 80);
+
+    // A long line at 50 mm/s, stopped on its way: Stopping, then back to standby (the UI's release).
+    await page.click('button[name="clear-rows"]');
+    await page.click('button[name="add-linear"]');
+    await fill(page, 'entries[0].position[0]', 600);
+    await fill(page, 'entries[0].position[1]', 20);
+    await fill(page, 'entries[0].velocity', 50);
+    await page.click('button[name="run-path"]');
+    await page.waitForSelector('.group-online [data-group-state="moving"]');
+    await page.click('button[name="group-stop"]');
+    await page.waitForSelector('.main tr[data-command="stop"][data-state="done"]');
+    await page.waitForSelector('.group-online [data-group-state="standby"]');
+    const s = await groupStatus();
+    assert.ok(s.position.x > 80 && s.position.x < 600, `stopped on the way: ${s.position.x}`);
+    assert.equal(s.position.y, 20);
+    await page.close();
+  });
+});
