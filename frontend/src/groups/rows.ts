@@ -12,7 +12,9 @@
 import type { AxesConvention, BufferMode, CircMode, CircPathChoice, GroupRole, MovePathBody, PathEntry, PathValue, TransitionMode } from '../api/types';
 import type { PathChoiceName, PreviewEntry, Vec3 } from './geometry';
 
-export type EntryType = PathEntry['type'];
+/** The entry types the editor has rows for (a frame switch, `coordinate_transform`, is not
+ * edited here yet: MC_SetCoordinateTransform is the group's own block). */
+export type EntryType = Exclude<PathEntry['type'], 'coordinate_transform'>;
 export const ENTRY_TYPES: EntryType[] = ['linear', 'circular', 'blocker', 'dwell'];
 export const CIRC_MODES: CircMode[] = ['border', 'center', 'radius'];
 export const PATH_CHOICES: CircPathChoice[] = ['counter_clockwise', 'clockwise', 'short_segment', 'long_segment'];
@@ -206,6 +208,9 @@ const text = (v: number | string | undefined | null) => (v === undefined || v ==
 /** A row of a JSON entry (a path loaded back, a table pasted): absent fields as the server reads them. */
 export function entryToRow(e: PathEntry, axes: number): PathRow {
   const r = newRow(axes);
+  if (e.type === 'coordinate_transform') {
+    throw new Error('a coordinate_transform entry has no row in the editor');
+  }
   r.type = e.type;
   r.velocity = '';
   switch (e.type) {
