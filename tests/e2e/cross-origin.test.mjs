@@ -134,7 +134,7 @@ async function assertUntouched(what) {
   const velo = (await rest(stack.api, 'GET', '/axes/y/parameters/AxisVeloMax')).body;
   assert.equal(velo.value, 500, `${what}: parameter written`);
   const audit = (await rest(stack.api, 'GET', '/audit?limit=1000')).body;
-  const foreign = audit.filter((row) => !(row.action === 'axis.create' && row.client_id === 'demo'));
+  const foreign = audit.filter((row) => !((row.action === 'axis.create' || row.action === 'group.create') && row.client_id === 'demo'));
   assert.deepEqual(foreign, [], `${what}: audited`);
 }
 
