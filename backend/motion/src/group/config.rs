@@ -68,16 +68,18 @@ impl PathDynamics {
         let ok = |x: f64, min: f64, strict: bool| {
             x.is_finite() && if strict { x > min } else { x >= min }
         };
-        if !ok(self.velocity, 0.0, true) {
+        // The upper bounds are the schema's: beyond them no machine moves and the planner's
+        // arithmetic loses its resolution.
+        if !ok(self.velocity, 0.0, true) || self.velocity > 1e9 {
             return Err("velocity");
         }
-        if !ok(self.acceleration, 1.0, false) {
+        if !ok(self.acceleration, 1.0, false) || self.acceleration > 1e12 {
             return Err("acceleration");
         }
-        if !ok(self.deceleration, 1.0, false) {
+        if !ok(self.deceleration, 1.0, false) || self.deceleration > 1e12 {
             return Err("deceleration");
         }
-        if !ok(self.jerk, 100.0, false) {
+        if !ok(self.jerk, 100.0, false) || self.jerk > 1e15 {
             return Err("jerk");
         }
         Ok(())
