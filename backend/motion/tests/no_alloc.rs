@@ -299,3 +299,156 @@ fn evaluating_a_cam_allocates_nothing() {
     assert!(sum.is_finite());
     assert_eq!(allocations() - before, 0, "cam evaluation allocated");
 }
+
+/// A group running blended paths — committing a prepared path, following lines, arcs and
+/// blends, an override change, a halt on the path and a path built in the cycle after it —
+/// allocates nothing in the cycle (the tables and the prepared paths are built before).
+#[test]
+fn a_group_on_a_blended_path_allocates_nothing() {
+    use motion::group::*;
+    use motion::path::{CircMode, CircPathChoice, MAX_PATH_DIMS};
+    const N: usize = 3;
+    let mut k = Kernel::new(0.001, N);
+    for i in 0..N {
+        let config = AxisConfig {
+            modulo: false,
+            parameters: AxisParameters {
+                axis_max_pos_lag_value: 100.0,
+                ..AxisParameters::default()
+            },
+            compensation_table: None,
+        };
+        k.insert_axis(i as u16, Axis::new(config, 0.001)).unwrap();
+    }
+    let config = GroupConfig {
+        convention: AxesConvention::Xyz,
+        ..GroupConfig::default()
+    };
+    k.insert_group(0, Group::new(config, 0.001)).unwrap();
+    let mut events: Vec<CommandEvent> = Vec::with_capacity(1 << 16);
+    let mut id = 0;
+    let mut cmd = |k: &mut Kernel, target: Target, kind: CommandKind, e: &mut Vec<CommandEvent>| {
+        id += 1;
+        k.submit(Command { id, target, kind }, e)
+    };
+    for a in 0..N as u16 {
+        let power = CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
+        };
+        cmd(&mut k, Target::Axis(a), power, &mut events);
+        let role = [GroupRole::X, GroupRole::Y, GroupRole::Z][a as usize];
+        cmd(
+            &mut k,
+            Target::Group(0),
+            CommandKind::AddAxisToGroup { axis: a, role },
+            &mut events,
+        );
+    }
+    cmd(
+        &mut k,
+        Target::Group(0),
+        CommandKind::GroupEnable,
+        &mut events,
+    );
+    let mut sp = vec![DriveSetpoint::default(); N];
+    let mut fb = vec![DriveFeedback::default(); N];
+    for _ in 0..20 {
+        exchange(&sp, &mut fb);
+        k.step(&fb, &mut sp, &mut events);
+    }
+    assert_eq!(k.group_status(0).unwrap().state, GroupState::Standby);
+    let motion_of = |first: bool| EntryMotion {
+        velocity: PathValue::Value(300.0),
+        acceleration: PathValue::Default,
+        deceleration: PathValue::Default,
+        jerk: PathValue::Default,
+        buffer_mode: if first {
+            BufferMode::Buffered
+        } else {
+            BufferMode::BlendingPrevious
+        },
+        transition_mode: if first {
+            TransitionMode::None
+        } else {
+            TransitionMode::CornerDistance
+        },
+        transition_parameters: [5.0, 0.0],
+        transition_parameter_count: if first { 0 } else { 1 },
+    };
+    let p = |x: f64, y: f64, z: f64| {
+        let mut v = [0.0; MAX_PATH_DIMS];
+        v[..3].copy_from_slice(&[x, y, z]);
+        v
+    };
+    let table = PathTable {
+        entries: vec![
+            PathEntry::Linear {
+                position: p(100.0, 0.0, 0.0),
+                count: 3,
+                motion: motion_of(true),
+                invoke_id: 1,
+            },
+            PathEntry::Circular {
+                mode: CircMode::Center,
+                aux: [100.0, 50.0, 0.0],
+                end_point: p(150.0, 50.0, 0.0),
+                count: 3,
+                path_choice: CircPathChoice::CounterClockwise,
+                motion: motion_of(false),
+                invoke_id: 2,
+            },
+            PathEntry::Linear {
+                position: p(150.0, 150.0, 20.0),
+                count: 3,
+                motion: motion_of(false),
+                invoke_id: 3,
+            },
+            PathEntry::Linear {
+                position: p(0.0, 0.0, 0.0),
+                count: 3,
+                motion: motion_of(false),
+                invoke_id: 4,
+            },
+        ],
+    };
+    let ctx = k.path_context(0).unwrap();
+    let prepared = prepare_path(&ctx, &table, k.group_status(0).unwrap().queue_end).unwrap();
+    let before = allocations();
+    let verdict = k.submit_prepared_path(1000, 0, &table, Some(&prepared), &mut events);
+    assert_eq!(verdict, Verdict::Accepted);
+    for c in 0..3000 {
+        if c == 500 {
+            cmd(
+                &mut k,
+                Target::Group(0),
+                CommandKind::GroupSetOverride { factor: 0.5 },
+                &mut events,
+            );
+        }
+        if c == 1500 {
+            let halt = CommandKind::GroupHalt {
+                deceleration: PathValue::Default,
+                jerk: PathValue::Default,
+            };
+            cmd(&mut k, Target::Group(0), halt, &mut events);
+            // A path during the halt's ramp: built in the cycle from where the halt stops.
+            assert_eq!(
+                k.submit_path(1001, 0, &table, &mut events),
+                Verdict::Accepted
+            );
+        }
+        exchange(&sp, &mut fb);
+        k.step(&fb, &mut sp, &mut events);
+    }
+    assert_eq!(allocations() - before, 0, "the group's cycles allocated");
+    assert!(k.group(0).unwrap().prepared_paths_taken() == 1);
+    assert!(
+        events
+            .iter()
+            .any(|e| e.command == 1000 && e.outputs.command_aborted)
+    );
+}

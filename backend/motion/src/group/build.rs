@@ -123,27 +123,7 @@ pub(super) fn build(
     let mut s = s0;
     let mut prev: Option<Item> = None;
     for (i, e) in entries.iter().enumerate() {
-        let last = false;
-        let invoke_id = e.invoke_id();
-        let base = Item {
-            kind: ItemKind::Dwell(0.0),
-            s0: s,
-            len: 0.0,
-            limits: Limits {
-                velocity: 1.0,
-                acceleration: 1.0,
-                deceleration: 1.0,
-                jerk: 100.0,
-            },
-            corner: 0.0,
-            through: 0.0,
-            v_end: 0.0,
-            command: id,
-            entry: i as u16,
-            invoke_id,
-            blend: false,
-            last,
-        };
+        let base = standing_item(id, s, i as u16, e.invoke_id());
         let (seg, motion) = match *e {
             PathEntry::CoordinateTransform { transform } => {
                 frame = transform;
@@ -276,26 +256,34 @@ pub(super) fn build(
     match out.last_mut() {
         Some(l) => l.last = true,
         None => out.push(Item {
-            kind: ItemKind::Dwell(0.0),
-            s0: s,
-            len: 0.0,
-            limits: Limits {
-                velocity: 1.0,
-                acceleration: 1.0,
-                deceleration: 1.0,
-                jerk: 100.0,
-            },
-            corner: 0.0,
-            through: 0.0,
-            v_end: 0.0,
-            command: id,
-            entry: 0,
-            invoke_id: 0,
-            blend: false,
             last: true,
+            ..standing_item(id, s, 0, 0)
         }),
     }
     Ok(frame)
+}
+
+/// An item that stands (a dwell of 0) at `s`: the base every entry's item is made from.
+fn standing_item(command: CommandId, s: f64, entry: u16, invoke_id: u32) -> Item {
+    Item {
+        kind: ItemKind::Dwell(0.0),
+        s0: s,
+        len: 0.0,
+        limits: Limits {
+            velocity: 1.0,
+            acceleration: 1.0,
+            deceleration: 1.0,
+            jerk: 100.0,
+        },
+        corner: 0.0,
+        through: 0.0,
+        v_end: 0.0,
+        command,
+        entry,
+        invoke_id,
+        blend: false,
+        last: false,
+    }
 }
 
 /// The entry's path dynamics, each lowered to what every member axis allows on `seg`
