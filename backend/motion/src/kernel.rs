@@ -398,12 +398,6 @@ impl Kernel {
             Target::Axis(slot) => slot,
             Target::Group(g) => {
                 let cycle = self.cycle + 1;
-                if let CommandKind::AddAxisToGroup { axis, .. } = cmd.kind {
-                    // An axis in another group is refused by that group's link.
-                    if self.axis(axis).is_none() {
-                        return Verdict::Rejected(ErrorId::AXIS_UNKNOWN);
-                    }
-                }
                 return match self
                     .groups
                     .get_mut(g as usize)

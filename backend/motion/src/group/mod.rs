@@ -462,7 +462,7 @@ impl Group {
 
     /// The queue is flushed and every MovePath ends CommandAborted.
     fn abort_all(&mut self, cycle: u64, events: &mut impl EventSink) {
-        for _ in self.run.flush() {}
+        self.run.flush();
         self.end_all_paths(cycle, events, aborted());
     }
 

@@ -101,17 +101,30 @@ pub(super) enum Exec {
     Blocked { id: u32 },
 }
 
-/// What a cycle of the path reports to the group.
-#[derive(Clone, Copy, Debug, Default)]
+/// What a cycle of the path reports to the group. Room for every MovePath a group keeps in
+/// flight: short entries can finish many in one cycle, and none may lose its Done.
+#[derive(Clone, Copy, Debug)]
 pub(super) struct StepReport {
     /// Items finished this cycle: the MovePaths whose last item it was are Done.
-    pub(super) done: [CommandId; 8],
+    pub(super) done: [CommandId; super::MAX_PATH_COMMANDS],
     pub(super) done_len: usize,
     /// A MovePath whose first item started this cycle (Active).
-    pub(super) started: [CommandId; 8],
+    pub(super) started: [CommandId; super::MAX_PATH_COMMANDS],
     pub(super) started_len: usize,
     /// A stop ([`PathRun::brake`]) reached standstill this cycle.
     pub(super) braked: bool,
+}
+
+impl Default for StepReport {
+    fn default() -> Self {
+        StepReport {
+            done: [0; super::MAX_PATH_COMMANDS],
+            done_len: 0,
+            started: [0; super::MAX_PATH_COMMANDS],
+            started_len: 0,
+            braked: false,
+        }
+    }
 }
 
 impl StepReport {
@@ -414,14 +427,13 @@ impl PathRun {
         self.braking.is_some()
     }
 
-    /// Drops every item (and everything after `s`): the group stands where it is.
-    pub(super) fn flush(&mut self) -> impl Iterator<Item = CommandId> + '_ {
+    /// Drops every item: the group stands where it is.
+    pub(super) fn flush(&mut self) {
         self.exec = Exec::Idle;
         self.braking = None;
         self.s = Kinematics::default();
         self.last_started = 0;
-        self.entries = 0;
-        self.items.drain(..).map(|i| i.command)
+        self.clear_items();
     }
 
     /// One cycle. `dt` the cycle time; `ramp_time` the override ramp time.
@@ -556,7 +568,7 @@ impl PathRun {
             velocity: k.velocity.max(0.0),
             ..k
         };
-        self.advance_while_passed(report, true);
+        self.advance_while_passed(report);
         self.sample();
         if self.braking.is_some() && self.planner.finished() && self.s.velocity <= EPS_V {
             // Standstill: the stop ends here; the rest of the queue is dropped.
@@ -628,17 +640,17 @@ impl PathRun {
         };
     }
 
-    /// Pops every motion item `s` has passed (or whose plan has ended); when following,
-    /// plans the next one from the present state. The point of a passed item is its exact
-    /// end until the next item is sampled.
-    fn advance_while_passed(&mut self, report: &mut StepReport, following: bool) {
+    /// Pops every motion item `s` has passed (or whose plan has ended) and plans the next one
+    /// from the present state. The point of a passed item is its exact end until the next
+    /// item is sampled.
+    fn advance_while_passed(&mut self, report: &mut StepReport) {
         while let Some(it) = self.items.front().copied() {
             let ItemKind::Motion(seg) = it.kind else {
                 break;
             };
             // A stop that ends at standstill inside the item has not passed it.
             let standing_stop = self.braking.is_some() && self.s.velocity <= EPS_V;
-            let finished = following && self.planner.finished() && !standing_stop;
+            let finished = self.planner.finished() && !standing_stop;
             if self.s.position < it.end_s() - 1e-12 && !finished {
                 break;
             }
@@ -668,14 +680,12 @@ impl PathRun {
                 self.last_started = next.command;
                 report.push_started(next.command);
             }
-            if following {
-                if next.waits() {
-                    self.s.velocity = 0.0;
-                    self.s.acceleration = 0.0;
-                    break;
-                }
-                self.plan_front();
+            if next.waits() {
+                self.s.velocity = 0.0;
+                self.s.acceleration = 0.0;
+                break;
             }
+            self.plan_front();
         }
     }
 

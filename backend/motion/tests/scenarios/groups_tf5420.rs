@@ -1197,3 +1197,18 @@ fn s4_1_a_frame_switch_inside_a_table_applies_to_the_entries_after_it_without_st
     // The frame stays in effect after the table.
     assert_eq!(r.gst(G).frame, shifted);
 }
+
+#[test]
+fn s4_3_move_paths_that_end_in_one_cycle_are_all_done() {
+    // Twelve MovePaths of one entry that moves nothing (the group stands there): all pass in
+    // the same cycle, and every one reports its Done.
+    let mut r = rig_xy();
+    enable(&mut r);
+    let ids: Vec<_> = (0..12)
+        .map(|_| r.path_ok(G, vec![lin(&[0.0, 0.0], 100.0)]))
+        .collect();
+    r.run(0.01);
+    for id in ids {
+        assert!(r.out(id).done, "MovePath {id} not done: {:?}", r.out(id));
+    }
+}
