@@ -539,3 +539,77 @@ async fn a_blocker_is_released_and_a_stop_held_over_the_websocket() {
     .await;
     assert_eq!(r.json["state"], "done", "{}", r.text);
 }
+
+/// MC_TrackConveyorBelt over HTTP: the spindle serves as the conveyor (an ordinary axis in
+/// move-velocity). `?wait=true` answers at InSync with the command still active (it has no
+/// Done); refusals change nothing; a static frame detaches, Done once the tracking stands.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_group_tracks_a_conveyor_until_a_frame_detaches_it() {
+    let s = Server::start();
+    enable_xy(&s).await;
+    power_on(&s, "spindle").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/spindle/move-velocity?wait=true&timeout_ms=5000",
+        json!({"velocity": 20.0}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["in_velocity"], true, "{}", r.text);
+    let body = |conveyor: &str, velocity: f64| {
+        json!({"conveyor": conveyor, "translation": [0.0, 50.0, 0.0],
+            "initial_object_position": [10.0], "master_ref_position": 0.0,
+            "velocity": velocity, "acceleration": 500.0, "deceleration": 500.0, "jerk": 5000.0})
+    };
+    // Refused, changing nothing: a member as conveyor, a velocity not above the conveyor's,
+    // an object outside an XY group's plane.
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/track-conveyor-belt",
+        body("x", 100.0),
+    )
+    .await;
+    assert_problem(&r, 409, "conveyor_invalid");
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/track-conveyor-belt",
+        body("spindle", 15.0),
+    )
+    .await;
+    assert_problem(&r, 409, "tracking_dynamics_invalid");
+    let mut bad = body("spindle", 100.0);
+    bad["initial_object_position"] = json!([10.0, 0.0, 5.0]);
+    let r = post(&s, "/api/v1/groups/xy/track-conveyor-belt", bad).await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert!(r.text.contains("initial_object_position[2]"), "{}", r.text);
+    assert_eq!(group_status(&s).await["state"], "standby");
+
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/track-conveyor-belt?wait=true&timeout_ms=10000",
+        body("spindle", 100.0),
+    )
+    .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    assert_eq!(r.json["outputs"]["busy"], true, "no Done: {}", r.text);
+    let track = r.json["id"].as_u64().unwrap();
+    let st = group_status(&s).await;
+    assert_eq!(st["state"], "moving", "{st}");
+    assert_eq!(st["tracking"]["conveyor"], "spindle", "{st}");
+    assert_eq!(st["tracking"]["command"], track, "{st}");
+    // The frame of later paths is the object's.
+    assert_eq!(st["frame"]["translation"][1], 50.0, "{st}");
+
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/set-coordinate-transform?wait=true&timeout_ms=10000",
+        json!({"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let r = get(&s, &format!("/api/v1/commands/{track}")).await;
+    assert_eq!(r.json["state"], "aborted", "{}", r.text);
+    let st = until_group(&s, "standby after detaching", |st| st["state"] == "standby").await;
+    assert!(st.get("tracking").is_none(), "{st}");
+    assert_eq!(st["tracking_velocity"], 0.0, "{st}");
+}

@@ -127,6 +127,45 @@ impl CoordTransform {
     }
 }
 
+/// `mcTrackingBehavior…` (TF5420 §2.5): how MC_TrackConveyorBelt holds the synchronism once
+/// it has been reached.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TrackingBehavior {
+    /// `mcTrackingBehaviorDynLimited`: the group follows within the tracking's acceleration,
+    /// deceleration and jerk; InSync falls when a conveyor jolt is more than they can follow
+    /// and rises again when the group has caught up.
+    #[default]
+    DynLimited,
+    /// `mcTrackingBehaviorStayInSync`: once in sync the group follows the conveyor whatever
+    /// it does (no dynamic limit); InSync stays TRUE while the command is active.
+    StayInSync,
+}
+
+/// MC_TrackConveyorBelt's inputs (TF5420 §4.1): the conveyor frame (`transform`, its X the
+/// conveying direction), the object detected on it and the conveyor position latched at
+/// that moment, the synchronisation dynamics (not capped by the axes' maxima) and the
+/// tracking object's behaviour and tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConveyorTracking {
+    /// The conveyor axis (the master).
+    pub conveyor: AxisSlot,
+    pub transform: CoordTransform,
+    /// `InitialObjectPos`: the object in the conveyor frame when it was detected.
+    pub initial_object_position: [f64; 3],
+    /// `MasterRefPos`: the conveyor's position latched when the object was detected.
+    pub master_ref_position: f64,
+    pub velocity: PathValue,
+    pub acceleration: PathValue,
+    pub deceleration: PathValue,
+    pub jerk: PathValue,
+    pub behavior: TrackingBehavior,
+    /// Synchronization Tolerance Distance: within it (and able to stay within it) the group
+    /// is InSync.
+    pub sync_tolerance: f64,
+}
+
 /// Identifies one command for its whole life (assigned by the caller, unique).
 pub type CommandId = u64;
 
@@ -595,6 +634,9 @@ pub enum CommandKind {
     SetCoordinateTransform {
         transform: CoordTransform,
     },
+    /// MC_TrackConveyorBelt: the group follows a conveyor; the MovePaths after it are read
+    /// relative to the detected object.
+    TrackConveyorBelt(ConveyorTracking),
     /// MC_ReleaseBlocker.
     ReleaseBlocker {
         blocker_id: u32,
@@ -677,6 +719,7 @@ impl CommandKind {
             CommandKind::GroupStop { .. } => "stop",
             CommandKind::ReleaseBlocker { .. } => "release-blocker",
             CommandKind::SetCoordinateTransform { .. } => "set-coordinate-transform",
+            CommandKind::TrackConveyorBelt(_) => "track-conveyor-belt",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
         }

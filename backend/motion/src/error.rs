@@ -190,6 +190,10 @@ error_table! {
     CIRCLE_INVALID = 0x8148, "circle_invalid", "the circular entry does not define an arc";
     /// A path entry (or a point of its arc) lies beyond an enabled software limit of a member axis.
     PATH_BEYOND_SOFT_LIMIT = 0x8149, "path_beyond_soft_limit", "the path leaves an axis's software limits";
+    /// MC_TrackConveyorBelt: the synchronisation velocity is not above the conveyor's velocity, or a tracking dynamics input is out of range (TF5420 §11).
+    TRACKING_DYNAMICS_INVALID = 0x814A, "tracking_dynamics_invalid", "the tracking velocity must exceed the conveyor's, and its dynamics be valid";
+    /// MC_TrackConveyorBelt: the conveyor axis does not exist or is an axis of the group itself.
+    CONVEYOR_INVALID = 0x814B, "conveyor_invalid", "the conveyor must be an existing axis outside the group";
 }
 
 impl fmt::Display for ErrorId {

@@ -303,13 +303,12 @@ fn evaluating_a_cam_allocates_nothing() {
 /// A group running blended paths — committing a prepared path, following lines, arcs and
 /// blends, an override change, a halt on the path and a path built in the cycle after it —
 /// allocates nothing in the cycle (the tables and the prepared paths are built before).
-#[test]
-fn a_group_on_a_blended_path_allocates_nothing() {
+/// A kernel of `n` axes (a generous lag limit: the exchange below is ideal anyway) and group 0
+/// of `convention`, not yet populated.
+fn group_kernel(n: usize, convention: motion::group::AxesConvention) -> Kernel {
     use motion::group::*;
-    use motion::path::{CircMode, CircPathChoice, MAX_PATH_DIMS};
-    const N: usize = 3;
-    let mut k = Kernel::new(0.001, N);
-    for i in 0..N {
+    let mut k = Kernel::new(0.001, n);
+    for i in 0..n {
         let config = AxisConfig {
             modulo: false,
             parameters: AxisParameters {
@@ -321,10 +320,19 @@ fn a_group_on_a_blended_path_allocates_nothing() {
         k.insert_axis(i as u16, Axis::new(config, 0.001)).unwrap();
     }
     let config = GroupConfig {
-        convention: AxesConvention::Xyz,
+        convention,
         ..GroupConfig::default()
     };
     k.insert_group(0, Group::new(config, 0.001)).unwrap();
+    k
+}
+
+#[test]
+fn a_group_on_a_blended_path_allocates_nothing() {
+    use motion::group::*;
+    use motion::path::{CircMode, CircPathChoice, MAX_PATH_DIMS};
+    const N: usize = 3;
+    let mut k = group_kernel(N, AxesConvention::Xyz);
     let mut events: Vec<CommandEvent> = Vec::with_capacity(1 << 16);
     let mut id = 0;
     let mut cmd = |k: &mut Kernel, target: Target, kind: CommandKind, e: &mut Vec<CommandEvent>| {
@@ -451,4 +459,108 @@ fn a_group_on_a_blended_path_allocates_nothing() {
             .iter()
             .any(|e| e.command == 1000 && e.outputs.command_aborted)
     );
+}
+
+/// MC_TrackConveyorBelt in the cycle: the chase, InSync, a conveyor that speeds up (a plan
+/// per cycle), a second tracking across the first (one brakes while the other chases), a
+/// frame that detaches and a halt — no allocation.
+#[test]
+fn a_group_tracking_conveyors_allocates_nothing() {
+    use motion::group::*;
+    const N: usize = 4;
+    let mut k = group_kernel(N, AxesConvention::Xy);
+    let mut events: Vec<CommandEvent> = Vec::with_capacity(1 << 16);
+    let mut id = 0;
+    let mut cmd = |k: &mut Kernel, target: Target, kind: CommandKind, e: &mut Vec<CommandEvent>| {
+        id += 1;
+        k.submit(Command { id, target, kind }, e)
+    };
+    for a in 0..N as u16 {
+        let power = CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
+        };
+        cmd(&mut k, Target::Axis(a), power, &mut events);
+    }
+    for (a, role) in [(0, GroupRole::X), (1, GroupRole::Y)] {
+        let add = CommandKind::AddAxisToGroup { axis: a, role };
+        cmd(&mut k, Target::Group(0), add, &mut events);
+    }
+    cmd(
+        &mut k,
+        Target::Group(0),
+        CommandKind::GroupEnable,
+        &mut events,
+    );
+    let belt = |v: f64| CommandKind::MoveVelocity {
+        velocity: v,
+        dynamics: Dynamics::default(),
+        direction: Direction::Positive,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    };
+    cmd(&mut k, Target::Axis(2), belt(50.0), &mut events);
+    cmd(&mut k, Target::Axis(3), belt(30.0), &mut events);
+    let mut sp = vec![DriveSetpoint::default(); N];
+    let mut fb = vec![DriveFeedback::default(); N];
+    for _ in 0..1000 {
+        exchange(&sp, &mut fb);
+        k.step(&fb, &mut sp, &mut events);
+    }
+    let track = |conveyor: u16, turn: f64| {
+        CommandKind::TrackConveyorBelt(ConveyorTracking {
+            conveyor,
+            transform: CoordTransform {
+                translation: [0.0, 100.0, 0.0],
+                rotation: [0.0, 0.0, turn],
+            },
+            initial_object_position: [30.0, 0.0, 0.0],
+            master_ref_position: 0.0,
+            velocity: PathValue::Value(200.0),
+            acceleration: PathValue::Value(1000.0),
+            deceleration: PathValue::Value(1000.0),
+            jerk: PathValue::Value(10000.0),
+            behavior: TrackingBehavior::DynLimited,
+            sync_tolerance: 0.01,
+        })
+    };
+    let before = allocations();
+    assert_eq!(
+        cmd(&mut k, Target::Group(0), track(2, 0.0), &mut events),
+        Verdict::Accepted
+    );
+    for c in 0..4000 {
+        match c {
+            800 => {
+                cmd(&mut k, Target::Axis(2), belt(80.0), &mut events);
+            }
+            1600 => {
+                let v = cmd(&mut k, Target::Group(0), track(3, 90.0), &mut events);
+                assert_eq!(v, Verdict::Accepted);
+            }
+            2400 => {
+                let frame = CommandKind::SetCoordinateTransform {
+                    transform: CoordTransform::default(),
+                };
+                cmd(&mut k, Target::Group(0), frame, &mut events);
+                cmd(&mut k, Target::Group(0), track(2, 0.0), &mut events);
+            }
+            3200 => {
+                let halt = CommandKind::GroupHalt {
+                    deceleration: PathValue::Default,
+                    jerk: PathValue::Default,
+                };
+                cmd(&mut k, Target::Group(0), halt, &mut events);
+            }
+            _ => {}
+        }
+        exchange(&sp, &mut fb);
+        k.step(&fb, &mut sp, &mut events);
+    }
+    assert_eq!(allocations() - before, 0, "the tracking's cycles allocated");
+    assert!(events.iter().any(|e| e.outputs.in_sync), "it synchronised");
+    assert_eq!(k.group_status(0).unwrap().state, GroupState::Standby);
 }

@@ -248,15 +248,27 @@ impl Shared {
     }
 
     /// Queues a request that never expires (nobody waits for it, or a test steps the cycle).
+    #[allow(
+        clippy::result_large_err,
+        reason = "a full queue hands the request back as it was; boxing it would allocate per command"
+    )]
     pub fn push(&self, request: Request) -> Result<(), Request> {
         self.enqueue(request, 0)
     }
 
     /// Queues a request that is dropped undone unless the cycle thread takes it within `ttl`.
+    #[allow(
+        clippy::result_large_err,
+        reason = "a full queue hands the request back as it was; boxing it would allocate per command"
+    )]
     pub fn push_expiring(&self, request: Request, ttl: std::time::Duration) -> Result<(), Request> {
         self.enqueue(request, now_ns() + ttl.as_nanos() as u64)
     }
 
+    #[allow(
+        clippy::result_large_err,
+        reason = "a full queue hands the request back as it was; boxing it would allocate per command"
+    )]
     fn enqueue(&self, request: Request, expires_ns: u64) -> Result<(), Request> {
         self.requests
             .push(Queued {

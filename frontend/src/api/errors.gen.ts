@@ -74,4 +74,6 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [33095, "group_axis_left", "an axis of the group stopped following the path"],
   [33096, "circle_invalid", "the circular entry does not define an arc"],
   [33097, "path_beyond_soft_limit", "the path leaves an axis's software limits"],
+  [33098, "tracking_dynamics_invalid", "the tracking velocity must exceed the conveyor's, and its dynamics be valid"],
+  [33099, "conveyor_invalid", "the conveyor must be an existing axis outside the group"],
 ];

@@ -1693,7 +1693,7 @@ export interface paths {
         };
         get?: never;
         put?: never;
-        /** MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it) */
+        /** MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it; it detaches from a tracked conveyor: active while the tracking brakes to rest) */
         post: operations["group_set_coordinate_transform"];
         delete?: never;
         options?: never;
@@ -1746,6 +1746,23 @@ export interface paths {
         put?: never;
         /** MC_GroupStop: stop on the path and lock the group until released (DELETE /commands/{id}) */
         post: operations["group_stop"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/groups/{group}/track-conveyor-belt": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** MC_TrackConveyorBelt: follow a conveyor axis; later MovePaths are read relative to the detected object (no Done: in_sync, until another frame, tracking, halt or stop) */
+        post: operations["group_track_conveyor_belt"];
         delete?: never;
         options?: never;
         head?: never;
@@ -5209,7 +5226,8 @@ export interface components {
          *         "queued_entries": 0,
          *         "remaining_distance": 0,
          *         "remaining_time": 0,
-         *         "state": "disabled"
+         *         "state": "disabled",
+         *         "tracking_velocity": 0
          *       },
          *       "updated_at": "2026-11-27T19:00:25.160Z"
          *     }
@@ -5295,7 +5313,8 @@ export interface components {
          *       "queued_entries": 0,
          *       "remaining_distance": 0,
          *       "remaining_time": 0,
-         *       "state": "standby"
+         *       "state": "standby",
+         *       "tracking_velocity": 0
          *     }
          */
         GroupStatusDto: {
@@ -5387,6 +5406,12 @@ export interface components {
              *     others were built in the cycle: an aborting path while moving, a queue that changed).
              */
             prepared_paths: number;
+            tracking?: null | components["schemas"]["TrackingStatusDto"];
+            /**
+             * Format: double
+             * @description The set point's velocity along conveyors (a tracking still braking to rest included).
+             */
+            tracking_velocity: number;
         };
         /**
          * @description MC_GroupHalt, MC_GroupStop.
@@ -8281,6 +8306,110 @@ export interface components {
              *     the window repeats every period and wraps when first > last.
              */
             modulo_positions?: boolean;
+        };
+        /**
+         * @description MC_TrackConveyorBelt: the conveyor frame (its X the conveying direction), the object
+         *     detected on it with the conveyor position latched at that moment, and the
+         *     synchronisation's dynamics (not capped by the axes' maxima, TF5420 §4.1).
+         * @example {
+         *       "acceleration": 1000,
+         *       "conveyor": "belt",
+         *       "deceleration": 1000,
+         *       "initial_object_position": [
+         *         30,
+         *         0
+         *       ],
+         *       "jerk": 10000,
+         *       "master_ref_position": 1250,
+         *       "rotation": [
+         *         0,
+         *         0,
+         *         0
+         *       ],
+         *       "sync_tolerance": 0.01,
+         *       "tracking_behavior": "dyn_limited",
+         *       "translation": [
+         *         0,
+         *         100,
+         *         0
+         *       ],
+         *       "velocity": 200
+         *     }
+         */
+        TrackConveyorBeltBody: {
+            /**
+             * @description The conveyor axis (the master): its id (all digits) or its name; not an axis of the
+             *     group.
+             */
+            conveyor: string;
+            /** @description The conveyor frame's origin in machine coordinates, X, Y, Z (default 0). */
+            translation?: number[];
+            /** @description Its rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z] (default 0). */
+            rotation?: number[];
+            /**
+             * @description `InitialObjectPos`: where the object was detected, in the conveyor frame (1 to 3
+             *     numbers: X along the belt, then Y, Z; missing ones are 0).
+             */
+            initial_object_position: number[];
+            /**
+             * Format: double
+             * @description `MasterRefPos`: the conveyor's position latched when the object was detected.
+             */
+            master_ref_position: number;
+            /**
+             * @description Synchronisation velocity (> the conveyor's velocity), acceleration (≥ 1),
+             *     deceleration (≥ 1), jerk (≥ 100): numbers, `"default"` (the group's default
+             *     dynamics) or `"maximum"`.
+             */
+            velocity?: components["schemas"]["PathValueDto"];
+            acceleration?: components["schemas"]["PathValueDto"];
+            deceleration?: components["schemas"]["PathValueDto"];
+            jerk?: components["schemas"]["PathValueDto"];
+            /** @description `dyn_limited` (default): InSync may fall when the conveyor jolts; `stay_in_sync`. */
+            tracking_behavior?: components["schemas"]["TrackingBehavior"];
+            /**
+             * Format: double
+             * @description Synchronization Tolerance Distance (> 0, default 0.01 path units).
+             */
+            sync_tolerance?: number;
+        };
+        /**
+         * @description `mcTrackingBehavior…` (TF5420 §2.5): how MC_TrackConveyorBelt holds the synchronism once
+         *     it has been reached.
+         * @enum {string}
+         */
+        TrackingBehavior: "dyn_limited" | "stay_in_sync";
+        /**
+         * @description The conveyor tracking of a group (MC_TrackConveyorBelt's outputs, `NcToPlc`).
+         * @example {
+         *       "command": 57,
+         *       "conveyor": "belt",
+         *       "conveyor_error": false,
+         *       "in_sync": true,
+         *       "remaining_distance_to_sync": 0,
+         *       "remaining_time_to_sync": 0
+         *     }
+         */
+        TrackingStatusDto: {
+            /** @description The conveyor axis's name. */
+            conveyor: string;
+            /**
+             * Format: int64
+             * @description The MC_TrackConveyorBelt command.
+             */
+            command: number;
+            /** @description `InSync`. */
+            in_sync: boolean;
+            /** @description The conveyor is in error or gone: the path goes on, the client decides (TF5420 §4.1). */
+            conveyor_error: boolean;
+            /**
+             * Format: double
+             * @description `RemainingCartesianTimeToSync` (despite its name a distance) and
+             *     `RemainingTimeToSync` (s).
+             */
+            remaining_distance_to_sync: number;
+            /** Format: double */
+            remaining_time_to_sync: number;
         };
         /**
          * @description `MC_TRANSITION_MODE` (only `none`, `corner_distance` and `corner_distance_advanced` are
@@ -14986,6 +15115,66 @@ export interface operations {
         requestBody?: {
             content: {
                 "application/json": components["schemas"]["GroupStopBody"];
+            };
+        };
+        responses: {
+            /** @description Accepted: the command resource (final or at its milestone when waited for) */
+            202: {
+                headers: {
+                    /** @description /api/v1/commands/{id} */
+                    Location?: string;
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["GroupNotFound"];
+            409: components["responses"]["GroupCommandRejected"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["GroupCommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    group_track_conveyor_belt: {
+        parameters: {
+            query?: {
+                /**
+                 * @description Hold the response until the command is final or reaches its milestone
+                 *     (in_velocity, in_gear, in_end_velocity, done of a Stop, status of a Power). Default:
+                 *     true when `timeout_ms` is given, else false.
+                 */
+                wait?: boolean;
+                /**
+                 * @description Longest wait in ms (default 10000, at most 600000); then the command is returned as it
+                 *     stands. Given alone it means `wait=true`; with `wait=false` it is not used.
+                 */
+                timeout_ms?: number;
+            };
+            header?: {
+                /**
+                 * @description 1–255 visible ASCII characters: a retry with the key of a command sent within 24 h gets that command's answer and nothing is done again (as for an axis's block).
+                 * @example mes-order-4711-step-3
+                 */
+                "Idempotency-Key"?: string | null;
+            };
+            path: {
+                /**
+                 * @description group id (1..16) or name
+                 * @example xy
+                 */
+                group: string;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["TrackConveyorBeltBody"];
             };
         };
         responses: {

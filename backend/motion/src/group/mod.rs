@@ -15,6 +15,7 @@ mod build;
 pub mod config;
 pub mod entry;
 mod motion;
+mod tracking;
 
 pub use analysis::{PathAnalysis, PlannedSample, analyse_path};
 pub use build::{AxisLimits, PathContext, PreparedPath, prepare_path};
@@ -28,8 +29,9 @@ use crate::command::{AxisSlot, BufferMode, CommandEvent, CommandId, CommandKind,
 use crate::command::{FbOutputs, Target, Verdict};
 use crate::error::ErrorId;
 use crate::path::{self, MAX_PATH_DIMS, PathPoint, Segment};
-use crate::planner::{Kinematics, Limits};
+use crate::planner::{Kinematics, Limits, Planner};
 use motion::{Item, ItemKind, PathRun, StepReport};
+use tracking::{Leaving, MAX_LEAVING, Tracking};
 
 /// `MC_GROUP_STATE` as motiond reports it.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
@@ -91,6 +93,18 @@ pub struct GroupStatus {
     pub frame: CoordTransform,
     /// MovePaths committed as prepared off the cycle thread (the others were built in it).
     pub prepared_paths: u64,
+    /// MC_TrackConveyorBelt: the conveyor followed and the command following it.
+    pub conveyor: Option<AxisSlot>,
+    pub tracking_command: CommandId,
+    /// `InSync` of the tracking.
+    pub in_sync: bool,
+    /// The conveyor is in error or gone (the path goes on: the caller reacts, §4.1).
+    pub conveyor_error: bool,
+    /// `RemainingCartesianTimeToSync` (a distance) and `RemainingTimeToSync` (s).
+    pub remaining_distance_to_sync: f64,
+    pub remaining_time_to_sync: f64,
+    /// The set point's motion along the conveyor (trackings still braking included).
+    pub tracking_velocity: f64,
 }
 
 /// A MovePath in flight.
@@ -143,6 +157,18 @@ pub struct Group {
     /// MC_SetCoordinateTransform: the frame later MovePaths are read in (cleared by a halt
     /// or a stop, §4.2).
     frame: CoordTransform,
+    /// MC_TrackConveyorBelt: the tracking active, those braking to rest since they ended,
+    /// the planners for them (made off the cycle thread), and what the displacements of
+    /// those that ended left between the path's coordinates and the machine's (X, Y, Z;
+    /// zero again once the group rests).
+    track: Option<Tracking>,
+    leaving: [Option<Leaving>; MAX_LEAVING],
+    spare: Vec<Planner>,
+    shift: [f64; 3],
+    /// This cycle's conveyor offset of the set point (position, velocity, acceleration).
+    offset: [[f64; 3]; 3],
+    /// A MC_SetCoordinateTransform that detached a tracking: Done once it stands.
+    frame_command: Option<CommandId>,
     status: GroupStatus,
 }
 
@@ -167,6 +193,14 @@ impl Group {
             pending_entries: Vec::with_capacity(MAX_PATH_ENTRIES),
             pending_frame: CoordTransform::default(),
             frame: CoordTransform::default(),
+            track: None,
+            leaving: Default::default(),
+            spare: (0..=MAX_LEAVING)
+                .map(|_| Planner::new(cycle_time))
+                .collect(),
+            shift: [0.0; 3],
+            offset: [[0.0; 3]; 3],
+            frame_command: None,
             status: GroupStatus {
                 override_factor: 1.0,
                 actual_override: 1.0,
@@ -391,9 +425,67 @@ impl Group {
                 transform
                     .check(self.config.convention.planar())
                     .map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
+                if !matches!(self.state, GroupState::Standby | GroupState::Moving)
+                    && self.track.is_some()
+                {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
                 // For the MovePaths that follow (those already accepted keep theirs).
                 self.frame = transform;
-                self.done_at_once(events, cycle, id);
+                if self.track.is_some() {
+                    // A static frame detaches from the conveyor: Active while the tracking
+                    // brakes to rest, Done when it stands (§4.1, decision 147).
+                    self.detach(None, aborted(), cycle, events);
+                    if let Some(old) = self.frame_command.replace(id) {
+                        self.event(events, cycle, old, aborted());
+                    }
+                    self.event(
+                        events,
+                        cycle,
+                        id,
+                        FbOutputs {
+                            busy: true,
+                            active: true,
+                            ..FbOutputs::default()
+                        },
+                    );
+                } else {
+                    self.done_at_once(events, cycle, id);
+                }
+            }
+            CommandKind::TrackConveyorBelt(t) => {
+                if !matches!(self.state, GroupState::Standby | GroupState::Moving) {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                // Room for this tracking to brake to rest one day, and for the one it
+                // replaces to do so now.
+                let free = self.leaving.iter().filter(|l| l.is_none()).count();
+                let needed = 1 + usize::from(self.track.is_some());
+                if free < needed {
+                    return Err(ErrorId::GROUP_STATE_INVALID);
+                }
+                let checked = Tracking::check(&t, &self.config, &self.members, axes)?;
+                let planner = self.spare.pop().ok_or(ErrorId::GROUP_STATE_INVALID)?;
+                let mut new = Tracking::new(id, &t, checked, planner);
+                // Accepted. A second tracking switches over directly (§4.1).
+                if let Some(old) = self.track.take() {
+                    self.event(events, cycle, old.id, aborted());
+                    match new.take_over(&old) {
+                        Some(folded) => {
+                            for (i, s) in self.shift.iter_mut().enumerate() {
+                                *s += old.dir[i] * folded;
+                            }
+                            self.spare.push(old.planner);
+                        }
+                        None => {
+                            let (dec, jerk) = old.braking();
+                            self.park(old.leave(dec, jerk));
+                        }
+                    }
+                }
+                self.frame = new.object_frame(&t);
+                self.event(events, cycle, id, new.out);
+                self.track = Some(new);
             }
             CommandKind::ReleaseBlocker { blocker_id } => {
                 if blocker_id == 0 {
@@ -420,6 +512,163 @@ impl Group {
         Ok(())
     }
 
+    /// The frame moves: a conveyor is tracked, or a tracking that ended still brakes.
+    fn frame_moves(&self) -> bool {
+        self.track.is_some() || self.leaving.iter().any(Option::is_some)
+    }
+
+    /// `frame` as the path's coordinates read it (the displacements of trackings that
+    /// ended lie between them and the machine's).
+    fn build_frame(&self, frame: CoordTransform) -> CoordTransform {
+        let mut f = frame;
+        for (t, s) in f.translation.iter_mut().zip(self.shift) {
+            *t -= s;
+        }
+        f
+    }
+
+    /// The active tracking ends with `out` and brakes to rest (with `braking`, else its own
+    /// deceleration and jerk).
+    fn detach(
+        &mut self,
+        braking: Option<(f64, f64)>,
+        out: FbOutputs,
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) {
+        if let Some(t) = self.track.take() {
+            self.event(events, cycle, t.id, out);
+            let (dec, jerk) = braking.unwrap_or(t.braking());
+            self.park(t.leave(dec, jerk));
+        }
+    }
+
+    fn park(&mut self, l: Leaving) {
+        // Room was checked when the tracking was accepted.
+        if let Some(slot) = self.leaving.iter_mut().find(|s| s.is_none()) {
+            *slot = Some(l);
+        }
+    }
+
+    /// Trackings are gone at once (the group is disabled): the members stop on their own.
+    fn drop_trackings(&mut self, cycle: u64, events: &mut impl EventSink) {
+        if let Some(t) = self.track.take() {
+            self.event(events, cycle, t.id, aborted());
+            self.spare.push(t.planner);
+        }
+        for slot in self.leaving.iter_mut() {
+            if let Some(l) = slot.take() {
+                self.spare.push(l.planner);
+            }
+        }
+        if let Some(c) = self.frame_command.take() {
+            self.event(events, cycle, c, aborted());
+        }
+    }
+
+    /// One cycle of the conveyor tracking and of those braking to rest: the offset of the
+    /// members' set points (X, Y, Z), and the look-ahead that stops the group before the
+    /// tracking carries a member beyond an enabled software limit.
+    fn step_frame(&mut self, axes: &[Option<Box<Axis>>], cycle: u64, events: &mut impl EventSink) {
+        let dt = self.cycle_time;
+        let mut off = [self.shift, [0.0; 3], [0.0; 3]];
+        let add = |off: &mut [[f64; 3]; 3], dir: [f64; 3], k: Kinematics| {
+            for i in 0..3 {
+                off[0][i] += dir[i] * k.position;
+                off[1][i] += dir[i] * k.velocity;
+                off[2][i] += dir[i] * k.acceleration;
+            }
+        };
+        let mut report = None;
+        let mut failed_with = None;
+        if let Some(t) = self.track.as_mut() {
+            let first = !t.out.active;
+            t.out.active = true;
+            match t.step(axes, dt) {
+                Ok(changed) => {
+                    if first || changed {
+                        report = Some((t.id, t.out));
+                    }
+                }
+                Err(e) => failed_with = Some(e),
+            }
+            add(&mut off, t.dir, t.d);
+        }
+        if let Some((id, out)) = report {
+            self.event(events, cycle, id, out);
+        }
+        if let Some(e) = failed_with {
+            self.detach(None, failed(e), cycle, events);
+        }
+        for slot in self.leaving.iter_mut() {
+            let Some(l) = slot.as_mut() else { continue };
+            let at_rest = l.step(dt);
+            add(&mut off, l.dir, l.d);
+            if at_rest {
+                for i in 0..3 {
+                    self.shift[i] += l.dir[i] * l.d.position;
+                }
+                if let Some(l) = slot.take() {
+                    self.spare.push(l.planner);
+                }
+            }
+        }
+        if self.leaving.iter().all(Option::is_none) {
+            if let Some(c) = self.frame_command.take() {
+                self.event(
+                    events,
+                    cycle,
+                    c,
+                    FbOutputs {
+                        done: true,
+                        ..FbOutputs::default()
+                    },
+                );
+            }
+        }
+        self.offset = off;
+        if self.state != GroupState::ErrorStop && self.tracking_beyond_limit(axes) {
+            self.enter_error(ErrorId::PATH_BEYOND_SOFT_LIMIT, cycle, events);
+        }
+    }
+
+    /// A tracked member could no longer stop short of an enabled software limit it heads
+    /// for, braking both the path and the tracking (decision 148).
+    fn tracking_beyond_limit(&self, axes: &[Option<Box<Axis>>]) -> bool {
+        let Some(t) = self.track.as_ref() else {
+            return false;
+        };
+        let (tdec, tjerk) = t.braking();
+        let (pdec, pjerk) = self.front_dynamics();
+        let dt = self.cycle_time;
+        for d in 0..3 {
+            let Some(a) = self.members[d]
+                .and_then(|s| axes.get(s as usize))
+                .and_then(|a| a.as_deref())
+            else {
+                continue;
+            };
+            let p = a.parameters();
+            let pos = self.run.point[d] + self.offset[0][d];
+            let v_track = t.dir[d] * t.d.velocity;
+            let v = self.run.velocity[d] + self.offset[1][d];
+            let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {
+                p.axis_max_soft_pos_limit
+            } else if v < 0.0 && p.axis_en_min_soft_pos_limit {
+                p.axis_min_soft_pos_limit
+            } else {
+                continue;
+            };
+            let reach = crate::planner::stop_distance(v_track.abs(), 0.0, tdec, tjerk)
+                + crate::planner::stop_distance(self.run.velocity[d].abs(), 0.0, pdec, pjerk)
+                + 2.0 * v.abs() * dt;
+            if (limit - pos) * v.signum() <= reach {
+                return true;
+            }
+        }
+        false
+    }
+
     fn for_members(&self, axes: &mut [Option<Box<Axis>>], mut f: impl FnMut(&mut Axis)) {
         for slot in self.members.iter().flatten() {
             if let Some(a) = axes.get_mut(*slot as usize).and_then(|a| a.as_deref_mut()) {
@@ -444,6 +693,7 @@ impl Group {
         }
         self.pending = None;
         self.abort_all(cycle, events);
+        self.drop_trackings(cycle, events);
         if let Some(s) = self.stop.take() {
             self.event(events, cycle, s.id, aborted());
         }
@@ -554,8 +804,10 @@ impl Group {
         // The queue is flushed: every MovePath is aborted; the stop runs over what is left.
         self.end_all_paths(cycle, events, aborted());
         self.pending = None;
-        // MC_GroupHalt and MC_GroupStop clear the coordinate transformation (§4.2).
+        // MC_GroupHalt and MC_GroupStop clear the coordinate transformation (§4.2); a
+        // tracked conveyor is left with the stop's deceleration.
         self.frame = CoordTransform::default();
+        self.detach(Some((dec, jerk)), aborted(), cycle, events);
         self.run.brake(dec, jerk);
         self.stop = Some(StopCommand {
             id,
@@ -572,7 +824,7 @@ impl Group {
         if locks {
             self.state = GroupState::Stopping;
         }
-        if self.run.is_idle() {
+        if self.run.is_idle() && !self.frame_moves() {
             self.stop_at_standstill(cycle, events);
             if self.state == GroupState::Moving {
                 self.stand_still(axes, cycle, events);
@@ -641,7 +893,7 @@ impl Group {
         }
         PathContext {
             config: self.config,
-            frame: self.frame,
+            frame: self.build_frame(self.frame),
             limits,
             cycle_time: self.cycle_time,
         }
@@ -674,6 +926,15 @@ impl Group {
             .map_err(|(_, _, e)| e)?;
         if self.paths.iter().all(|p| p.is_some()) || self.run.free() < 2 * table.entries.len() + 2 {
             return Err(ErrorId::PATH_TOO_LONG);
+        }
+        let frame_entry = table
+            .entries
+            .iter()
+            .any(|e| matches!(e, PathEntry::CoordinateTransform { .. }));
+        if frame_entry && (self.frame_moves() || self.shift != [0.0; 3]) {
+            // A frame entry would detach from the conveyor in the middle of a path:
+            // detach first with MC_SetCoordinateTransform (decision 147).
+            return Err(ErrorId::GROUP_STATE_INVALID);
         }
         let ctx = self.context(axes);
         let first = table.joins_with();
@@ -737,8 +998,11 @@ impl Group {
                 return Err(e);
             }
         };
-        // Accepted: nothing below fails.
-        self.frame = frame_after;
+        // Accepted: nothing below fails. (With a shift there is no frame entry: the frame
+        // stays.)
+        if self.shift == [0.0; 3] {
+            self.frame = frame_after;
+        }
         if let Some(s) = self.stop.take() {
             // A MovePath during a halt's ramp takes over (§4.2: CommandAborted).
             self.event(events, cycle, s.id, aborted());
@@ -796,6 +1060,9 @@ impl Group {
 
     /// The members' set positions as the group's point (while nothing runs).
     fn take_point(&mut self, axes: &[Option<Box<Axis>>]) {
+        // The members' set points are the machine's: nothing lies between any more.
+        self.shift = [0.0; 3];
+        self.offset = [[0.0; 3]; 3];
         let mut p = self.run.point;
         for (d, m) in self.members.iter().enumerate() {
             if let Some(a) = m
@@ -820,6 +1087,8 @@ impl Group {
             self.event(events, cycle, s.id, failed(e));
         }
         self.pending = None;
+        // A tracked conveyor is left with the tracking's own deceleration.
+        self.detach(None, failed(e), cycle, events);
         if !self.run.is_idle() && !self.run.is_braking() {
             let (dec, jerk) = self.front_dynamics();
             self.run.brake(dec, jerk);
@@ -873,7 +1142,7 @@ impl Group {
                     // T2b: an axis without its control loop makes the group NotReady.
                     self.state = GroupState::NotReady;
                     self.take_point(axes);
-                } else if !self.run.is_idle() {
+                } else if !self.run.is_idle() || self.frame_moves() {
                     self.start_moving(axes, cycle, events);
                 } else if self.stop.is_none() {
                     self.take_point(axes);
@@ -882,13 +1151,15 @@ impl Group {
             GroupState::Moving | GroupState::Stopping => {
                 if any_error {
                     self.enter_error(ErrorId::GROUP_AXIS_ERROR, cycle, events);
-                } else if (!all_following || !complete) && !self.run.is_idle() {
+                } else if (!all_following || !complete)
+                    && (!self.run.is_idle() || self.frame_moves())
+                {
                     self.enter_error(ErrorId::GROUP_AXIS_LEFT, cycle, events);
                 }
             }
             GroupState::ErrorStop => {}
         }
-        if self.run.is_idle() {
+        if self.run.is_idle() && !self.frame_moves() {
             self.run.step(
                 dt,
                 self.config.override_ramp_time,
@@ -901,17 +1172,21 @@ impl Group {
             let mut report = StepReport::default();
             self.run
                 .step(dt, self.config.override_ramp_time, &mut report);
-            // Members that still follow take the path's set point.
+            if self.frame_moves() || self.shift != [0.0; 3] {
+                self.step_frame(axes, cycle, events);
+            }
+            // Members that still follow take the path's set point (moved with the conveyor).
             let (point, vel, acc) = (self.run.point, self.run.velocity, self.run.acceleration);
             for (d, m) in self.members.iter().enumerate() {
                 if let Some(a) = m
                     .and_then(|s| axes.get_mut(s as usize))
                     .and_then(|a| a.as_deref_mut())
                 {
+                    let o = |i: usize| if d < 3 { self.offset[i][d] } else { 0.0 };
                     a.group_follow(Kinematics {
-                        position: point[d],
-                        velocity: vel[d],
-                        acceleration: acc[d],
+                        position: point[d] + o(0),
+                        velocity: vel[d] + o(1),
+                        acceleration: acc[d] + o(2),
                         jerk: 0.0,
                     });
                 }
@@ -937,13 +1212,18 @@ impl Group {
                 );
             }
             if report.braked || self.run.is_idle() {
-                self.stop_at_standstill(cycle, events);
+                if !self.frame_moves() {
+                    self.stop_at_standstill(cycle, events);
+                }
                 if let Some(id) = self.pending.take() {
                     self.build_pending(id, axes, cycle, events);
                 }
             }
         }
-        if self.run.is_idle() && matches!(self.state, GroupState::Moving | GroupState::ErrorStop) {
+        if self.run.is_idle()
+            && !self.frame_moves()
+            && matches!(self.state, GroupState::Moving | GroupState::ErrorStop)
+        {
             self.stand_still(axes, cycle, events);
         }
         self.update_status(axes);
@@ -960,14 +1240,16 @@ impl Group {
         events: &mut impl EventSink,
     ) {
         let ctx = PathContext {
-            frame: self.pending_frame,
+            frame: self.build_frame(self.pending_frame),
             ..self.context(axes)
         };
         let mut scratch = core::mem::take(&mut self.scratch);
         let (start, s0) = (self.run.point, self.run.s.position);
         match build::build(&ctx, id, &self.pending_entries, start, s0, &mut scratch) {
             Ok(frame) => {
-                self.frame = frame;
+                if self.shift == [0.0; 3] {
+                    self.frame = frame;
+                }
                 self.run.append(scratch.drain(..));
             }
             Err((_, e)) => self.end_path(id, cycle, events, failed(e)),
@@ -1022,7 +1304,10 @@ impl Group {
     fn update_status(&mut self, axes: &[Option<Box<Axis>>]) {
         // The set point the group gives its members this cycle (their own statuses show it
         // after their step).
-        let position = self.run.point;
+        let mut position = self.run.point;
+        for (p, o) in position.iter_mut().zip(self.offset[0]) {
+            *p += o;
+        }
         let mut standing = true;
         for m in self.members.iter() {
             if let Some(a) = m
@@ -1061,6 +1346,16 @@ impl Group {
             queue_end: self.run.end_point(),
             frame: self.frame,
             prepared_paths: self.prepared_taken,
+            conveyor: self.track.as_ref().map(|t| t.conveyor),
+            tracking_command: self.track.as_ref().map_or(0, |t| t.id),
+            in_sync: self.track.as_ref().is_some_and(|t| t.out.in_sync),
+            conveyor_error: self.track.as_ref().is_some_and(|t| t.conveyor_error),
+            remaining_distance_to_sync: self.track.as_ref().map_or(0.0, |t| t.distance_to_sync),
+            remaining_time_to_sync: self.track.as_ref().map_or(0.0, |t| t.time_to_sync),
+            tracking_velocity: {
+                let v = self.offset[1];
+                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+            },
         };
     }
 }

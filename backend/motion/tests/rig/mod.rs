@@ -770,8 +770,11 @@ impl Rig {
             );
             // A coupling FB ends with InSync instead of Done (Tc2_MC2_Camming §2.0).
             assert!(a >= 1 || o.in_sync, "no output set: {e:?}");
+            // MC_TrackConveyorBelt's InSync is the exception: it has no Done and is InSync
+            // while Busy and Active (TF5420 §4.1).
+            let tracking = matches!(e.target, Target::Group(_)) && !o.done;
             assert!(
-                !(o.in_sync && (o.busy || o.active || o.done)),
+                !(o.in_sync && (o.busy || o.active || o.done)) || tracking,
                 "InSync is a completion output: {e:?}"
             );
             assert!(

@@ -1212,3 +1212,265 @@ fn s4_3_move_paths_that_end_in_one_cycle_are_all_done() {
         assert!(r.out(id).done, "MovePath {id} not done: {:?}", r.out(id));
     }
 }
+
+// ---- MC_TrackConveyorBelt (§4.1, §2.5, §11 item 16) ----
+
+/// An XY group of axes 0 and 1 and conveyors 2 (and 3) outside it, all powered, the group
+/// enabled; the conveyors run at `speeds` in +X of the conveyor frame.
+fn rig_conveyor(speeds: &[f64]) -> Rig {
+    let mut r = Rig::new(2 + speeds.len());
+    for a in 0..(2 + speeds.len()) as u16 {
+        r.power_on(a);
+    }
+    r.group(G, xy(), &[(GroupRole::X, 0), (GroupRole::Y, 1)]);
+    enable(&mut r);
+    for (i, v) in speeds.iter().enumerate() {
+        r.ok(2 + i as u16, velocity(*v, Direction::Positive));
+    }
+    // The conveyors at their speed.
+    r.until(1.0, |r| {
+        (0..speeds.len()).all(|i| r.out(i as u64 + 1).busy)
+            && r.st(2).set_acceleration == 0.0
+            && r.st(2).set_velocity > 0.0
+    });
+    r
+}
+
+/// A belt along machine X at Y = 100: the object detected at 30 mm, 20 mm of conveyor
+/// travel ago.
+fn track(r: &Rig, conveyor: u16, behavior: TrackingBehavior) -> ConveyorTracking {
+    ConveyorTracking {
+        conveyor,
+        transform: CoordTransform {
+            translation: [0.0, 100.0, 0.0],
+            rotation: [0.0; 3],
+        },
+        initial_object_position: [30.0, 0.0, 0.0],
+        master_ref_position: at(r, conveyor) - 20.0,
+        velocity: PathValue::Value(200.0),
+        acceleration: PathValue::Value(1000.0),
+        deceleration: PathValue::Value(1000.0),
+        jerk: PathValue::Value(10000.0),
+        behavior,
+        sync_tolerance: 0.01,
+    }
+}
+
+#[test]
+fn s4_1_track_conveyor_belt_syncs_without_done_and_a_path_then_reaches_the_object_on_the_belt() {
+    let mut r = rig_conveyor(&[50.0]);
+    let t = track(&r, 2, TrackingBehavior::DynLimited);
+    let (mrp, c0) = (t.master_ref_position, at(&r, 2));
+    let id = r.gok(G, CommandKind::TrackConveyorBelt(t));
+    assert!(r.out(id).busy && !r.out(id).active);
+    r.step();
+    assert!(r.out(id).active, "Active when the sync motion starts");
+    assert_eq!(
+        r.gst(G).state,
+        GroupState::Moving,
+        "tracking is Moving (§10)"
+    );
+    assert_eq!(r.gst(G).conveyor, Some(2));
+    // It catches up with the conveyor's travel since the start and is then InSync.
+    let n = r.until(3.0, |r| r.out(id).in_sync);
+    assert!(n > 10, "not at once: the group starts from rest");
+    let lag = (at(&r, 0) - (at(&r, 2) - c0)).abs();
+    assert!(lag <= 0.01, "within the tolerance: {lag}");
+    // Then exactly with the conveyor.
+    r.until(1.0, |r| (r.st(0).set_velocity - 50.0).abs() < 1e-9);
+    assert!((at(&r, 0) - (at(&r, 2) - c0)).abs() < 1e-9);
+    // The frame of later paths: the object in the moving frame.
+    assert_eq!(r.gst(G).frame.translation, [30.0 + c0 - mrp, 100.0, 0.0]);
+    // A path to the object: InSync and Done together mean it is reached (§4.1).
+    let p = r.path_ok(G, vec![lin(&[0.0, 0.0], 300.0)]);
+    run_done(&mut r, p, 5.0);
+    assert!(r.out(id).in_sync && !r.out(id).done && r.out(id).busy);
+    for _ in 0..200 {
+        r.step();
+        // The object: detected at 30, carried by the conveyor's travel since the latch.
+        let object_x = 30.0 + at(&r, 2) - mrp;
+        assert!(
+            (at(&r, 0) - object_x).abs() < 1e-6,
+            "{} vs {object_x}",
+            at(&r, 0)
+        );
+        assert!((at(&r, 1) - 100.0).abs() < 1e-9);
+        assert!((r.st(0).set_velocity - 50.0).abs() < 1e-6);
+    }
+    assert!(!r.out(id).done, "no Done: it runs until replaced");
+}
+
+#[test]
+fn s4_1_a_second_tracking_takes_over_directly_and_a_frame_detaches_with_active_until_at_rest() {
+    let mut r = rig_conveyor(&[50.0, 80.0]);
+    let a = r.gok(
+        G,
+        CommandKind::TrackConveyorBelt(track(&r, 2, TrackingBehavior::DynLimited)),
+    );
+    r.until(3.0, |r| r.out(a).in_sync);
+    let b = r.gok(
+        G,
+        CommandKind::TrackConveyorBelt(track(&r, 3, TrackingBehavior::DynLimited)),
+    );
+    assert!(r.out(a).command_aborted && r.out(b).busy);
+    // The same direction: the velocity carries on (the rig checks every cycle that no
+    // member jumps) and the group catches up with the faster belt.
+    r.until(3.0, |r| r.out(b).in_sync);
+    r.until(1.0, |r| (r.st(0).set_velocity - 80.0).abs() < 1e-9);
+    // A static frame detaches: Active while the tracking brakes, Done at rest.
+    let f = r.gok(
+        G,
+        CommandKind::SetCoordinateTransform {
+            transform: CoordTransform::default(),
+        },
+    );
+    assert!(r.out(b).command_aborted);
+    assert!(r.out(f).busy && r.out(f).active && !r.out(f).done);
+    r.until(2.0, |r| r.out(f).done);
+    assert_eq!(r.st(0).set_velocity, 0.0);
+    r.until(0.1, |r| r.gst(G).state == GroupState::Standby);
+    assert_eq!(r.gst(G).conveyor, None);
+    // Where it stopped is where the machine is: a later path is in machine coordinates.
+    let p = r.path_ok(G, vec![lin(&[10.0, 20.0], 200.0)]);
+    run_done(&mut r, p, 5.0);
+    assert_eq!((at(&r, 0), at(&r, 1)), (10.0, 20.0));
+}
+
+#[test]
+fn s4_2_a_halt_while_tracking_ends_it_brakes_the_group_and_clears_the_frame() {
+    let mut r = rig_conveyor(&[50.0]);
+    let t = r.gok(
+        G,
+        CommandKind::TrackConveyorBelt(track(&r, 2, TrackingBehavior::DynLimited)),
+    );
+    r.until(3.0, |r| r.out(t).in_sync);
+    let p = r.path_ok(G, vec![lin(&[0.0, 0.0], 100.0), lin(&[50.0, 50.0], 100.0)]);
+    r.run(0.3);
+    let h = r.gok(G, halt());
+    assert!(r.out(t).command_aborted && r.out(p).command_aborted);
+    assert!(!r.out(h).done);
+    r.until(2.0, |r| r.out(h).done);
+    assert_eq!((r.st(0).set_velocity, r.st(1).set_velocity), (0.0, 0.0));
+    assert!(r.gst(G).frame.is_identity());
+    r.until(0.1, |r| r.gst(G).state == GroupState::Standby);
+}
+
+#[test]
+fn s11_16_track_conveyor_belt_refuses_a_slow_velocity_a_member_as_conveyor_and_a_disabled_group() {
+    let mut r = rig_conveyor(&[50.0]);
+    let before = r.gst(G);
+    let mut t = track(&r, 2, TrackingBehavior::DynLimited);
+    t.velocity = PathValue::Value(50.0);
+    let e = r.grejected(G, CommandKind::TrackConveyorBelt(t));
+    assert_eq!(
+        e,
+        ErrorId::TRACKING_DYNAMICS_INVALID,
+        "not above the conveyor"
+    );
+    let mut t = track(&r, 0, TrackingBehavior::DynLimited);
+    t.conveyor = 0;
+    assert_eq!(
+        r.grejected(G, CommandKind::TrackConveyorBelt(t)),
+        ErrorId::CONVEYOR_INVALID
+    );
+    t.conveyor = 9;
+    assert_eq!(
+        r.grejected(G, CommandKind::TrackConveyorBelt(t)),
+        ErrorId::CONVEYOR_INVALID
+    );
+    let mut t = track(&r, 2, TrackingBehavior::DynLimited);
+    t.sync_tolerance = 0.0;
+    assert_eq!(
+        r.grejected(G, CommandKind::TrackConveyorBelt(t)),
+        ErrorId::PARAMETER_NOT_CORRECT
+    );
+    assert_eq!(r.gst(G), before, "a refusal changes nothing");
+    r.gok(G, CommandKind::GroupDisable);
+    let t = track(&r, 2, TrackingBehavior::DynLimited);
+    assert_eq!(
+        r.grejected(G, CommandKind::TrackConveyorBelt(t)),
+        ErrorId::GROUP_STATE_INVALID
+    );
+}
+
+#[test]
+fn s2_5_dyn_limited_drops_in_sync_on_a_conveyor_jolt_and_stay_in_sync_holds_it() {
+    for behavior in [TrackingBehavior::DynLimited, TrackingBehavior::StayInSync] {
+        let mut r = rig_conveyor(&[50.0]);
+        let mut t = track(&r, 2, behavior);
+        // A weak tracking: the conveyor speeds up harder than it may.
+        t.acceleration = PathValue::Value(200.0);
+        t.deceleration = PathValue::Value(200.0);
+        t.velocity = PathValue::Value(400.0);
+        let id = r.gok(G, CommandKind::TrackConveyorBelt(t));
+        r.until(5.0, |r| r.out(id).in_sync);
+        r.ok(2, velocity(150.0, Direction::Positive));
+        let mut dropped = false;
+        for _ in 0..3000 {
+            r.step();
+            dropped |= !r.out(id).in_sync;
+            if behavior == TrackingBehavior::DynLimited && dropped && r.out(id).in_sync {
+                break;
+            }
+            if behavior == TrackingBehavior::DynLimited {
+                // Within the tracking's own dynamics.
+                assert!(r.st(0).set_acceleration.abs() <= 200.0 * (1.0 + 1e-6) + 1e-6);
+            }
+        }
+        match behavior {
+            TrackingBehavior::DynLimited => {
+                assert!(dropped, "InSync fell while the group caught up");
+                assert!(r.out(id).in_sync, "and rose again");
+            }
+            TrackingBehavior::StayInSync => {
+                assert!(!dropped, "InSync stays TRUE while active");
+                assert!((r.st(0).set_velocity - 150.0).abs() < 1e-6);
+            }
+        }
+    }
+}
+
+#[test]
+fn s1_5_an_axis_error_while_tracking_fails_it_and_the_group_brakes_to_error_stop() {
+    let mut r = rig_conveyor(&[50.0]);
+    let t = r.gok(
+        G,
+        CommandKind::TrackConveyorBelt(track(&r, 2, TrackingBehavior::DynLimited)),
+    );
+    r.until(3.0, |r| r.out(t).in_sync);
+    r.plants[1].fault = true;
+    r.until(0.1, |r| r.gst(G).state == GroupState::ErrorStop);
+    assert!(r.out(t).error && r.out(t).error_id == ErrorId::GROUP_AXIS_ERROR.0);
+    assert_eq!(r.gst(G).state, GroupState::ErrorStop);
+    r.until(2.0, |r| r.st(0).set_velocity == 0.0);
+}
+
+#[test]
+fn s2_4_tracking_never_carries_a_member_beyond_its_software_limit() {
+    let mut p = vec![
+        (false, params_with_soft_limits(-1000.0, 300.0)),
+        (false, params()),
+    ];
+    p.push((false, params()));
+    let mut r = Rig::with(p);
+    for a in 0..3 {
+        r.power_on(a);
+    }
+    r.group(G, xy(), &[(GroupRole::X, 0), (GroupRole::Y, 1)]);
+    enable(&mut r);
+    r.ok(2, velocity(100.0, Direction::Positive));
+    r.until(1.0, |r| r.st(2).set_velocity == 100.0);
+    let t = r.gok(
+        G,
+        CommandKind::TrackConveyorBelt(track(&r, 2, TrackingBehavior::DynLimited)),
+    );
+    r.until(10.0, |r| r.gst(G).state == GroupState::ErrorStop);
+    assert_eq!(r.gst(G).error_id, ErrorId::PATH_BEYOND_SOFT_LIMIT.0);
+    assert!(r.out(t).error);
+    r.until(2.0, |r| r.st(0).set_velocity == 0.0);
+    assert!(
+        at(&r, 0) <= 300.0,
+        "stopped short of the limit: {}",
+        at(&r, 0)
+    );
+}

@@ -9,7 +9,7 @@ use motion::group::{
     EntryMotion, GroupRole, MAX_PATH_ENTRIES, PathEntry, PathTable, PathValue, TransitionMode,
 };
 use motion::path::{CircMode, CircPathChoice, MAX_PATH_DIMS, PathPoint};
-use motion::{BufferMode, CommandKind};
+use motion::{BufferMode, CommandKind, ConveyorTracking, TrackingBehavior};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
@@ -45,7 +45,9 @@ macro_rules! entries {
             group_move_path: "move-path" at groups, MovePathBody, MovePathBody::to_order, Operator, Done, [],
                 "MC_MovePath: run a path of linear, circular, blocker, dwell and coordinate-transform entries";
             group_set_coordinate_transform: "set-coordinate-transform" at groups, SetCoordinateTransformBody, SetCoordinateTransformBody::to_order, Operator, Done, [],
-                "MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it)";
+                "MC_SetCoordinateTransform: later MovePaths are read in this frame (a halt or stop clears it; it detaches from a tracked conveyor: active while the tracking brakes to rest)";
+            group_track_conveyor_belt: "track-conveyor-belt" at groups, TrackConveyorBeltBody, TrackConveyorBeltBody::to_order, Operator, InSync, [],
+                "MC_TrackConveyorBelt: follow a conveyor axis; later MovePaths are read relative to the detected object (no Done: in_sync, until another frame, tracking, halt or stop)";
         }
     };
 }
@@ -360,6 +362,18 @@ pub enum PathEntryDto {
     },
 }
 
+/// A frame's shift and rotations: three finite numbers each.
+fn check_frame(c: &mut Check, translation: &[f64], rotation: &[f64]) {
+    for (name, v) in [("translation", translation), ("rotation", rotation)] {
+        if v.len() != 3 {
+            c.fail(name, "X, Y and Z: three numbers");
+        }
+        for (j, x) in v.iter().enumerate() {
+            c.finite(&format!("{name}[{j}]"), *x);
+        }
+    }
+}
+
 /// Three numbers as a kernel vector (`None`: not three).
 fn xyz(v: &[f64]) -> Option<[f64; 3]> {
     v.try_into().ok()
@@ -381,17 +395,7 @@ pub struct SetCoordinateTransformBody {
 impl SetCoordinateTransformBody {
     pub fn to_order(&self, _: &Registry, group: &GroupEntry) -> AppResult<GroupOrder> {
         let mut c = Check::default();
-        for (name, v) in [
-            ("translation", &self.translation),
-            ("rotation", &self.rotation),
-        ] {
-            if v.len() != 3 {
-                c.fail(name, "X, Y and Z: three numbers");
-            }
-            for (j, x) in v.iter().enumerate() {
-                c.finite(&format!("{name}[{j}]"), *x);
-            }
-        }
+        check_frame(&mut c, &self.translation, &self.rotation);
         c.done(())?;
         let transform = motion::group::CoordTransform {
             translation: xyz(&self.translation).unwrap_or_default(),
@@ -409,6 +413,134 @@ impl SetCoordinateTransformBody {
         Ok(GroupOrder::Command(CommandKind::SetCoordinateTransform {
             transform,
         }))
+    }
+}
+
+/// MC_TrackConveyorBelt: the conveyor frame (its X the conveying direction), the object
+/// detected on it with the conveyor position latched at that moment, and the
+/// synchronisation's dynamics (not capped by the axes' maxima, TF5420 §4.1).
+#[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"conveyor": "belt", "translation": [0.0, 100.0, 0.0], "rotation": [0.0, 0.0, 0.0],
+    "initial_object_position": [30.0, 0.0], "master_ref_position": 1250.0, "velocity": 200.0,
+    "acceleration": 1000.0, "deceleration": 1000.0, "jerk": 10000.0,
+    "tracking_behavior": "dyn_limited", "sync_tolerance": 0.01}))]
+pub struct TrackConveyorBeltBody {
+    /// The conveyor axis (the master): its id (all digits) or its name; not an axis of the
+    /// group.
+    #[schema(min_length = 1, max_length = 64)]
+    pub conveyor: String,
+    /// The conveyor frame's origin in machine coordinates, X, Y, Z (default 0).
+    #[serde(default = "zero3")]
+    #[schema(min_items = 3, max_items = 3)]
+    pub translation: Vec<f64>,
+    /// Its rotations in degrees, DIN 9300 Z″Y′X: [about X, about Y, about Z] (default 0).
+    #[serde(default = "zero3")]
+    #[schema(min_items = 3, max_items = 3)]
+    pub rotation: Vec<f64>,
+    /// `InitialObjectPos`: where the object was detected, in the conveyor frame (1 to 3
+    /// numbers: X along the belt, then Y, Z; missing ones are 0).
+    #[schema(min_items = 1, max_items = 3)]
+    pub initial_object_position: Vec<f64>,
+    /// `MasterRefPos`: the conveyor's position latched when the object was detected.
+    pub master_ref_position: f64,
+    /// Synchronisation velocity (> the conveyor's velocity), acceleration (≥ 1),
+    /// deceleration (≥ 1), jerk (≥ 100): numbers, `"default"` (the group's default
+    /// dynamics) or `"maximum"`.
+    #[serde(default)]
+    pub velocity: PathValueDto,
+    #[serde(default)]
+    pub acceleration: PathValueDto,
+    #[serde(default)]
+    pub deceleration: PathValueDto,
+    #[serde(default)]
+    pub jerk: PathValueDto,
+    /// `dyn_limited` (default): InSync may fall when the conveyor jolts; `stay_in_sync`.
+    #[serde(default)]
+    pub tracking_behavior: TrackingBehavior,
+    /// Synchronization Tolerance Distance (> 0, default 0.01 path units).
+    #[serde(default = "default_sync_tolerance")]
+    #[schema(exclusive_minimum = 0.0)]
+    pub sync_tolerance: f64,
+}
+
+fn zero3() -> Vec<f64> {
+    vec![0.0; 3]
+}
+
+fn default_sync_tolerance() -> f64 {
+    0.01
+}
+
+impl TrackConveyorBeltBody {
+    pub fn to_order(&self, reg: &Registry, group: &GroupEntry) -> AppResult<GroupOrder> {
+        let mut c = Check::default();
+        let conveyor = reg.find(&self.conveyor);
+        if conveyor.is_none() {
+            c.fail("conveyor", &format!("no axis '{}'", self.conveyor));
+        }
+        check_frame(&mut c, &self.translation, &self.rotation);
+        if self.initial_object_position.is_empty() || self.initial_object_position.len() > 3 {
+            c.fail("initial_object_position", "1 to 3 numbers: X, Y, Z");
+        }
+        for (j, x) in self.initial_object_position.iter().enumerate() {
+            c.finite(&format!("initial_object_position[{j}]"), *x);
+        }
+        c.finite("master_ref_position", self.master_ref_position);
+        for (name, v, min) in [
+            ("velocity", self.velocity, f64::MIN_POSITIVE),
+            ("acceleration", self.acceleration, 1.0),
+            ("deceleration", self.deceleration, 1.0),
+            ("jerk", self.jerk, 100.0),
+        ] {
+            match v {
+                PathValueDto::Number(x) if !(x.is_finite() && x >= min) => c.fail(
+                    name,
+                    &format!("must be ≥ {min}, \"default\" or \"maximum\""),
+                ),
+                PathValueDto::Special(SpecialValue::Ignore) => {
+                    c.fail(name, "must be a number, \"default\" or \"maximum\"")
+                }
+                _ => {}
+            }
+        }
+        if !(self.sync_tolerance.is_finite() && self.sync_tolerance > 0.0) {
+            c.fail("sync_tolerance", "must be > 0");
+        }
+        c.done(())?;
+        let mut object = [0.0; 3];
+        object[..self.initial_object_position.len()].copy_from_slice(&self.initial_object_position);
+        let transform = motion::group::CoordTransform {
+            translation: xyz(&self.translation).unwrap_or_default(),
+            rotation: xyz(&self.rotation).unwrap_or_default(),
+        };
+        let planar = group.config.convention.planar();
+        transform.check(planar).map_err(|f| {
+            AppError::field(
+                f,
+                "an XY group's conveyor lies in its plane: it turns only about Z and does not shift in Z",
+            )
+        })?;
+        if planar && object[2] != 0.0 {
+            return Err(AppError::field(
+                "initial_object_position[2]",
+                "an XY group's object lies in its plane (Z = 0)",
+            ));
+        }
+        Ok(GroupOrder::Command(CommandKind::TrackConveyorBelt(
+            ConveyorTracking {
+                conveyor: conveyor.map(|a| a.slot).unwrap_or_default(),
+                transform,
+                initial_object_position: object,
+                master_ref_position: self.master_ref_position,
+                velocity: self.velocity.kernel(),
+                acceleration: self.acceleration.kernel(),
+                deceleration: self.deceleration.kernel(),
+                jerk: self.jerk.kernel(),
+                behavior: self.tracking_behavior,
+                sync_tolerance: self.sync_tolerance,
+            },
+        )))
     }
 }
 

@@ -105,7 +105,8 @@ pub struct GroupMemberResource {
         "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
         "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
         "position": {"x": 0.0, "y": 0.0},
-        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0}}))]
+        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0,
+        "tracking_velocity": 0.0}}))]
 pub struct GroupResource {
     pub id: i64,
     pub name: String,
@@ -129,7 +130,8 @@ pub struct GroupResource {
     "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
     "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
     "position": {"x": 0.0, "y": 0.0},
-        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0}))]
+        "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0,
+        "tracking_velocity": 0.0}))]
 pub struct GroupStatusDto {
     pub cycle: u64,
     /// MC_GROUP_STATE (error_stop with `enable_requested` false is GroupErrorDisabled).
@@ -179,6 +181,30 @@ pub struct GroupStatusDto {
     /// MovePaths whose entries were built off the cycle thread and taken as built (the
     /// others were built in the cycle: an aborting path while moving, a queue that changed).
     pub prepared_paths: u64,
+    /// MC_TrackConveyorBelt: the conveyor the group follows (absent: none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tracking: Option<TrackingStatusDto>,
+    /// The set point's velocity along conveyors (a tracking still braking to rest included).
+    pub tracking_velocity: f64,
+}
+
+/// The conveyor tracking of a group (MC_TrackConveyorBelt's outputs, `NcToPlc`).
+#[derive(Clone, Debug, Default, Serialize, ToSchema)]
+#[schema(example = json!({"conveyor": "belt", "command": 57, "in_sync": true, "conveyor_error": false,
+    "remaining_distance_to_sync": 0.0, "remaining_time_to_sync": 0.0}))]
+pub struct TrackingStatusDto {
+    /// The conveyor axis's name.
+    pub conveyor: String,
+    /// The MC_TrackConveyorBelt command.
+    pub command: u64,
+    /// `InSync`.
+    pub in_sync: bool,
+    /// The conveyor is in error or gone: the path goes on, the client decides (TF5420 §4.1).
+    pub conveyor_error: bool,
+    /// `RemainingCartesianTimeToSync` (despite its name a distance) and
+    /// `RemainingTimeToSync` (s).
+    pub remaining_distance_to_sync: f64,
+    pub remaining_time_to_sync: f64,
 }
 
 /// A coordinate frame: a shift and DIN 9300 Z″Y′X rotations in degrees.

@@ -92,6 +92,18 @@ pub fn status_dto(
             rotation: st.frame.rotation,
         },
         prepared_paths: st.prepared_paths,
+        tracking: st.conveyor.map(|slot| crate::model::TrackingStatusDto {
+            conveyor: reg
+                .by_slot(slot)
+                .map(|a| a.name.clone())
+                .unwrap_or_default(),
+            command: st.tracking_command,
+            in_sync: st.in_sync,
+            conveyor_error: st.conveyor_error,
+            remaining_distance_to_sync: st.remaining_distance_to_sync,
+            remaining_time_to_sync: st.remaining_time_to_sync,
+        }),
+        tracking_velocity: st.tracking_velocity,
     }
 }
 
