@@ -477,3 +477,100 @@ async fn scope_setups_are_saved_by_name_and_survive_a_restart() {
     );
     s.stop();
 }
+
+/// A group's signals (TF5420 §9: path velocity, path position, entry index) beside an axis's:
+/// a recording triggered by the group's path velocity holds the path from rest to rest, its
+/// velocity within the commanded one, the entry index counting through the table; a group
+/// signal on an axis (and the other way round) is a 422 naming the field.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_group_s_path_signals_are_recorded_beside_its_axes() {
+    let s = Server::start();
+    power_on(&s, "x").await;
+    power_on(&s, "y").await;
+    let r = post(&s, "/api/v1/groups/xy/enable?wait=true", json!({})).await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let r = post(
+        &s,
+        RECORDINGS,
+        json!({"channels": [{"axis": "x", "signal": "path_velocity"}], "duration_s": 0.5}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert_eq!(
+        r.json["errors"][0]["field"], "channels[0].signal",
+        "{}",
+        r.text
+    );
+    let r = post(
+        &s,
+        RECORDINGS,
+        json!({"channels": [{"group": "xy", "signal": "set_position"}], "duration_s": 0.5}),
+    )
+    .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    let r = post(
+        &s,
+        RECORDINGS,
+        json!({"channels": [{"group": "nope", "signal": "path_velocity"}], "duration_s": 0.5}),
+    )
+    .await;
+    assert_eq!(
+        r.json["errors"][0]["field"], "channels[0].group",
+        "{}",
+        r.text
+    );
+
+    let r = post(
+        &s,
+        RECORDINGS,
+        json!({"channels": [{"group": "xy", "signal": "path_velocity"},
+                            {"group": "xy", "signal": "path_position"},
+                            {"group": "xy", "signal": "entry_index"},
+                            {"axis": "y", "signal": "set_position"}],
+               "duration_s": 2.0,
+               "trigger": {"channel": 0, "level": 0.001, "edge": "rising", "pre_trigger_s": 0.01}}),
+    )
+    .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert_eq!(r.json["channels"][0]["group"], "xy", "{}", r.text);
+    assert_eq!(r.json["channels"][0]["unit"], "mm/s", "{}", r.text);
+    assert!(r.json["channels"][0].get("axis").is_none(), "{}", r.text);
+    let id = r.json["id"].as_u64().unwrap();
+    let r = post(
+        &s,
+        "/api/v1/groups/xy/move-path?wait=true",
+        json!({"entries": [
+            {"type": "linear", "position": [50.0, 0.0], "velocity": 200.0},
+            {"type": "linear", "position": [50.0, 50.0], "velocity": 200.0, "buffer_mode": "buffered"}]}),
+    )
+    .await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
+    let rec = until_final(&s, id).await;
+    assert_eq!(rec["state"], "done", "{rec}");
+    let v = floats(&rec["data"][0]);
+    let pos = floats(&rec["data"][1]);
+    let entry = floats(&rec["data"][2]);
+    let y = floats(&rec["data"][3]);
+    assert!(v.iter().all(|v| *v >= 0.0 && *v <= 200.0 + 1e-9), "{v:?}");
+    assert!(v.iter().any(|v| *v > 100.0), "it ran");
+    // 100 mm of path from rest to rest within the recording, never backwards (the path
+    // position starts again at 0 once the group stands idle), the second entry after the
+    // first.
+    let end = pos.iter().cloned().fold(0.0, f64::max);
+    assert!((end - 100.0).abs() < 1e-6, "{end}");
+    let last = pos.iter().rposition(|p| *p == end).unwrap();
+    assert!(
+        pos[..=last].windows(2).all(|w| w[1] >= w[0] - 1e-9),
+        "never backwards: {pos:?}"
+    );
+    assert!(entry.contains(&0.0) && entry.contains(&1.0), "{entry:?}");
+    assert!((y.last().unwrap() - 50.0).abs() < 1e-6);
+    // The CSV names the group's columns.
+    let csv = get(&s, &format!("{RECORDINGS}/{id}?format=csv")).await;
+    assert!(
+        csv.text
+            .starts_with("t,xy.path_velocity,xy.path_position,xy.entry_index,y.set_position"),
+        "{}",
+        csv.text
+    );
+}

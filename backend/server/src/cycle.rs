@@ -901,7 +901,7 @@ impl CycleThread {
             }
         }
         if self.scope.is_active() {
-            let frame = ScopeFrame::sample(cycle, &self.scope, &snap.axes);
+            let frame = ScopeFrame::sample(cycle, &self.scope, &snap.axes, &snap.groups);
             if shared.scope_frames.push(frame).is_err() {
                 shared.stats.scope_frames_dropped.fetch_add(1, Relaxed);
             }

@@ -3733,7 +3733,8 @@ export interface components {
             rows: number[][];
         };
         /**
-         * @description One signal of one axis.
+         * @description One signal of one axis, or of one group (`group` instead of `axis`, with `path_position`,
+         *     `path_velocity`, `path_acceleration` or `entry_index`).
          * @example {
          *       "axis": "x",
          *       "signal": "set_position"
@@ -3744,7 +3745,12 @@ export interface components {
              * @description Axis id or name.
              * @example x
              */
-            axis: string;
+            axis?: string | null;
+            /**
+             * @description Group id or name (for a group's signal).
+             * @example xy
+             */
+            group?: string | null;
             signal: components["schemas"]["ScopeSignal"];
         };
         /**
@@ -7149,12 +7155,19 @@ export interface components {
          */
         ScopeChannel: {
             /**
-             * @description The axis's name (also when it was given by id).
+             * @description The axis's name (also when it was given by id); absent for a group's signal.
              * @example x
              */
-            axis: string;
+            axis?: string | null;
             /** Format: int64 */
-            axis_id: number;
+            axis_id?: number | null;
+            /**
+             * @description The group's name for a group's signal (`path_position`, `path_velocity`,
+             *     `path_acceleration`, `entry_index`).
+             */
+            group?: string | null;
+            /** Format: int64 */
+            group_id?: number | null;
             signal: components["schemas"]["ScopeSignal"];
             /**
              * @description Unit of the values (axis unit, unit/s, unit/s²).
@@ -7335,10 +7348,11 @@ export interface components {
             view: Record<string, never>;
         };
         /**
-         * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step).
+         * @description What the scope can sample of an axis (the axis's status after the cycle's kernel step), and
+         *     of a group (its status after the step: path position, velocity, acceleration, the entry).
          * @enum {string}
          */
-        ScopeSignal: "set_position" | "actual_position" | "set_velocity" | "actual_velocity" | "set_acceleration" | "actual_acceleration" | "following_error";
+        ScopeSignal: "set_position" | "actual_position" | "set_velocity" | "actual_velocity" | "set_acceleration" | "actual_acceleration" | "following_error" | "path_position" | "path_velocity" | "path_acceleration" | "entry_index";
         /**
          * @description A trigger on one of the recording's channels.
          * @example {

@@ -17,9 +17,17 @@ export const SIGNAL_LABEL: Record<Signal, string> = {
   set_acceleration: 'set acceleration',
   actual_acceleration: 'actual acceleration',
   following_error: 'following error',
+  path_position: 'path position',
+  path_velocity: 'path velocity',
+  path_acceleration: 'path acceleration',
+  entry_index: 'entry index',
 };
 
-export const SIGNALS = Object.keys(SIGNAL_LABEL) as Signal[];
+/** A group's signals (a channel with `group` instead of `axis`). */
+export const GROUP_SIGNALS: Signal[] = ['path_position', 'path_velocity', 'path_acceleration', 'entry_index'];
+
+/** An axis's signals (what the form offers). */
+export const SIGNALS = (Object.keys(SIGNAL_LABEL) as Signal[]).filter((s) => !GROUP_SIGNALS.includes(s));
 
 export const MAX_CHANNELS = 8;
 
@@ -29,7 +37,9 @@ export type TriggerSpec = S['TriggerRequest'];
 export type RecordingState = S['RecordingState'];
 
 export interface ChannelSpec {
-  axis: string;
+  /** The axis — or, for a group's signal, the group. */
+  axis?: string | null;
+  group?: string | null;
   signal: Signal;
   /** The signal's unit (the server names it in a recording). */
   unit?: string;
@@ -61,6 +71,8 @@ export function preTriggerSamples(trigger: TriggerSpec | null | undefined, cycle
 
 export interface FormChannel {
   axis: string;
+  /** A group's signal (from a setup stored over the API): kept as it is. */
+  group?: string;
   signal: Signal;
 }
 
@@ -73,11 +85,12 @@ export interface ScopeForm {
 /** Builds the request body from the form; errors by field path (as the server names them). */
 export function buildRequest(f: ScopeForm): { request: RecordingRequest | null; errors: Record<string, string> } {
   const errors: Record<string, string> = {};
-  const channels = f.channels.filter((c) => c.axis);
+  const channels = f.channels.filter((c) => c.axis || c.group);
   if (channels.length === 0) errors.channels = 'pick at least one signal';
   if (channels.length > MAX_CHANNELS) errors.channels = `at most ${MAX_CHANNELS} channels`;
   channels.forEach((c, i) => {
-    if (!SIGNALS.includes(c.signal)) errors[`channels[${i}].signal`] = 'unknown signal';
+    const known = c.group ? GROUP_SIGNALS : SIGNALS;
+    if (!known.includes(c.signal)) errors[`channels[${i}].signal`] = 'unknown signal';
   });
   if (!(Number.isFinite(f.duration_s) && f.duration_s > 0)) errors.duration_s = 'must be > 0';
   let trigger: TriggerSpec | null = null;
@@ -93,13 +106,17 @@ export function buildRequest(f: ScopeForm): { request: RecordingRequest | null; 
   }
   if (Object.keys(errors).length) return { request: null, errors };
   return {
-    request: { channels: channels.map((c) => ({ axis: c.axis, signal: c.signal })), duration_s: f.duration_s, trigger },
+    request: {
+      channels: channels.map((c) => (c.group ? { group: c.group, signal: c.signal } : { axis: c.axis, signal: c.signal })),
+      duration_s: f.duration_s,
+      trigger,
+    },
     errors,
   };
 }
 
 export function channelLabel(c: ChannelSpec): string {
-  return `${c.axis}.${c.signal}`;
+  return `${c.axis ?? c.group ?? ''}.${c.signal}`;
 }
 
 /** The unit of a signal given the axis's position unit. */

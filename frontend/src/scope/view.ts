@@ -110,10 +110,14 @@ export function toSetup(request: RecordingRequest, v: ScopeView): ScopeSetup {
 /** A saved setup as the form and view of the page. */
 export function fromSetup(s: ScopeSetup): { form: ScopeForm; view: ScopeView } {
   const r = s.recording;
-  const channels = (r.channels ?? []).slice(0, MAX_CHANNELS).map((c) => ({
-    axis: c.axis,
-    signal: (SIGNALS.includes(c.signal as Signal) ? c.signal : 'actual_position') as Signal,
-  }));
+  const channels = (r.channels ?? []).slice(0, MAX_CHANNELS).map((c) =>
+    c.group
+      ? { axis: '', group: c.group, signal: c.signal as Signal }
+      : {
+          axis: c.axis ?? '',
+          signal: (SIGNALS.includes(c.signal as Signal) ? c.signal : 'actual_position') as Signal,
+        },
+  );
   const t = r.trigger ?? null;
   const form: ScopeForm = {
     channels,

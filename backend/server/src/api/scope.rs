@@ -159,7 +159,8 @@ fn to_csv(r: &ScopeRecording) -> String {
     let mut out = String::with_capacity(16 * (r.channels.len() + 1) * (t.len() + 1));
     out.push('t');
     for c in &r.channels {
-        let _ = write!(out, ",{}.{}", c.axis, c.signal.name());
+        let source = c.axis.as_deref().or(c.group.as_deref()).unwrap_or_default();
+        let _ = write!(out, ",{source}.{}", c.signal.name());
     }
     out.push('\n');
     for (i, t) in t.iter().enumerate() {

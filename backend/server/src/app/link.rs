@@ -173,8 +173,9 @@ impl AppState {
             id,
             require_disabled,
         })
-        .await
-        .map(drop)
+        .await?;
+        self.scope.lock().unwrap().group_removed(id as AxisSlot);
+        Ok(())
     }
 
     /// Hands a ready axis to the cycle thread.

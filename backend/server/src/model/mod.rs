@@ -632,14 +632,20 @@ impl AxisKey {
     }
 }
 
-/// One signal of one axis.
+/// One signal of one axis, or of one group (`group` instead of `axis`, with `path_position`,
+/// `path_velocity`, `path_acceleration` or `entry_index`).
 #[derive(Clone, Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[schema(example = json!({"axis": "x", "signal": "set_position"}))]
 pub struct ChannelRequest {
     /// Axis id or name.
-    #[schema(value_type = String, example = "x")]
-    pub axis: AxisKey,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<String>, example = "x")]
+    pub axis: Option<AxisKey>,
+    /// Group id or name (for a group's signal).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<String>, example = "xy")]
+    pub group: Option<AxisKey>,
     #[schema(value_type = ScopeSignal)]
     pub signal: String,
 }

@@ -2,13 +2,15 @@
 //! which ones go into which index of the frame, and the frame itself (`Copy`, fixed width: the
 //! cycle thread writes one per cycle into the ring without allocating).
 
+use motion::group::GroupStatus;
 use motion::{AxisSlot, AxisStatus};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::SCOPE_CHANNELS;
 
-/// What the scope can sample of an axis (the axis's status after the cycle's kernel step).
+/// What the scope can sample of an axis (the axis's status after the cycle's kernel step), and
+/// of a group (its status after the step: path position, velocity, acceleration, the entry).
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, ToSchema,
 )]
@@ -21,10 +23,17 @@ pub enum ScopeSignal {
     SetAcceleration,
     ActualAcceleration,
     FollowingError,
+    /// A group's path length travelled since it last stood idle.
+    PathPosition,
+    /// A group's path velocity (`PathVelo`, after override).
+    PathVelocity,
+    PathAcceleration,
+    /// The index of the running entry in its table.
+    EntryIndex,
 }
 
 impl ScopeSignal {
-    pub const ALL: [ScopeSignal; 7] = [
+    pub const ALL: [ScopeSignal; 11] = [
         ScopeSignal::SetPosition,
         ScopeSignal::ActualPosition,
         ScopeSignal::SetVelocity,
@@ -32,7 +41,22 @@ impl ScopeSignal {
         ScopeSignal::SetAcceleration,
         ScopeSignal::ActualAcceleration,
         ScopeSignal::FollowingError,
+        ScopeSignal::PathPosition,
+        ScopeSignal::PathVelocity,
+        ScopeSignal::PathAcceleration,
+        ScopeSignal::EntryIndex,
     ];
+
+    /// A signal of a group (else of an axis).
+    pub fn of_group(self) -> bool {
+        matches!(
+            self,
+            ScopeSignal::PathPosition
+                | ScopeSignal::PathVelocity
+                | ScopeSignal::PathAcceleration
+                | ScopeSignal::EntryIndex
+        )
+    }
 
     pub fn name(self) -> &'static str {
         match self {
@@ -43,6 +67,10 @@ impl ScopeSignal {
             ScopeSignal::SetAcceleration => "set_acceleration",
             ScopeSignal::ActualAcceleration => "actual_acceleration",
             ScopeSignal::FollowingError => "following_error",
+            ScopeSignal::PathPosition => "path_position",
+            ScopeSignal::PathVelocity => "path_velocity",
+            ScopeSignal::PathAcceleration => "path_acceleration",
+            ScopeSignal::EntryIndex => "entry_index",
         }
     }
 
@@ -60,14 +88,31 @@ impl ScopeSignal {
             ScopeSignal::SetAcceleration => s.set_acceleration,
             ScopeSignal::ActualAcceleration => s.actual_acceleration,
             ScopeSignal::FollowingError => s.following_error,
+            _ => f64::NAN,
+        }
+    }
+
+    #[inline]
+    pub fn sample_group(self, s: &GroupStatus) -> f64 {
+        match self {
+            ScopeSignal::PathPosition => s.path_position,
+            ScopeSignal::PathVelocity => s.path_velocity,
+            ScopeSignal::PathAcceleration => s.path_acceleration,
+            ScopeSignal::EntryIndex => f64::from(s.entry_index),
+            _ => f64::NAN,
         }
     }
 
     /// The unit of the signal for an axis whose positions are in `unit`.
     pub fn unit(self, unit: &str) -> String {
         match self {
-            ScopeSignal::SetVelocity | ScopeSignal::ActualVelocity => format!("{unit}/s"),
-            ScopeSignal::SetAcceleration | ScopeSignal::ActualAcceleration => format!("{unit}/s²"),
+            ScopeSignal::SetVelocity | ScopeSignal::ActualVelocity | ScopeSignal::PathVelocity => {
+                format!("{unit}/s")
+            }
+            ScopeSignal::SetAcceleration
+            | ScopeSignal::ActualAcceleration
+            | ScopeSignal::PathAcceleration => format!("{unit}/s²"),
+            ScopeSignal::EntryIndex => String::new(),
             _ => unit.to_string(),
         }
     }
@@ -97,13 +142,27 @@ pub struct ScopeFrame {
 impl ScopeFrame {
     /// Samples `config` from the statuses of one cycle (no allocation: runs on the cycle thread).
     #[inline]
-    pub fn sample(cycle: u64, config: &ScopeConfig, axes: &[Option<AxisStatus>]) -> ScopeFrame {
+    pub fn sample(
+        cycle: u64,
+        config: &ScopeConfig,
+        axes: &[Option<AxisStatus>],
+        groups: &[Option<GroupStatus>],
+    ) -> ScopeFrame {
         let mut values = [f64::NAN; SCOPE_CHANNELS];
         for (v, c) in values.iter_mut().zip(&config.channels) {
-            if let Some((slot, signal)) = c {
-                if let Some(Some(s)) = axes.get(*slot as usize) {
-                    *v = signal.sample(s);
+            match c {
+                // A group signal's slot is the group's.
+                Some((slot, signal)) if signal.of_group() => {
+                    if let Some(Some(s)) = groups.get(*slot as usize) {
+                        *v = signal.sample_group(s);
+                    }
                 }
+                Some((slot, signal)) => {
+                    if let Some(Some(s)) = axes.get(*slot as usize) {
+                        *v = signal.sample(s);
+                    }
+                }
+                None => {}
             }
         }
         ScopeFrame {

@@ -272,19 +272,32 @@ impl Recordings {
     /// An axis left its slot: the active recordings of it fail (the slot may get another
     /// axis). Returns true when the layout changed.
     pub fn axis_removed(&mut self, slot: AxisSlot) -> bool {
+        self.removed(slot, false)
+    }
+
+    /// A group left its slot: likewise for the recordings of its signals.
+    pub fn group_removed(&mut self, slot: AxisSlot) -> bool {
+        self.removed(slot, true)
+    }
+
+    fn removed(&mut self, slot: AxisSlot, group: bool) -> bool {
         let layout = self.layout;
         let mut ended = Vec::new();
         for r in self.recordings.values_mut() {
             if !r.state.is_active() {
                 continue;
             }
-            let hit = r
-                .index
-                .iter()
-                .zip(&r.channels)
-                .find(|(i, _)| layout[**i].is_some_and(|(s, _, _)| s == slot));
+            let hit = r.index.iter().zip(&r.channels).find(|(i, _)| {
+                layout[**i].is_some_and(|(s, g, _)| s == slot && g.of_group() == group)
+            });
             if let Some((_, c)) = hit {
-                let reason = format!("axis '{}' was removed during the recording", c.axis);
+                let reason = match (&c.axis, &c.group) {
+                    (Some(a), _) => format!("axis '{a}' was removed during the recording"),
+                    (None, g) => format!(
+                        "group '{}' was removed during the recording",
+                        g.as_deref().unwrap_or_default()
+                    ),
+                };
                 r.fail(reason);
                 ended.push(r.id);
             }
@@ -354,8 +367,10 @@ mod tests {
         (
             0,
             ScopeChannel {
-                axis: "x".into(),
-                axis_id: 1,
+                axis: Some("x".into()),
+                axis_id: Some(1),
+                group: None,
+                group_id: None,
                 signal,
                 unit: "mm".into(),
             },
@@ -383,7 +398,7 @@ mod tests {
             set_velocity: -(cycle as f64),
             ..Default::default()
         });
-        ScopeFrame::sample(cycle, config, &axes)
+        ScopeFrame::sample(cycle, config, &axes, &[])
     }
 
     #[test]

@@ -78,10 +78,18 @@ impl RecordingState {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[schema(example = json!({"axis": "x", "axis_id": 1, "signal": "set_velocity", "unit": "mm/s"}))]
 pub struct ScopeChannel {
-    /// The axis's name (also when it was given by id).
+    /// The axis's name (also when it was given by id); absent for a group's signal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(example = "x")]
-    pub axis: String,
-    pub axis_id: i64,
+    pub axis: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_id: Option<i64>,
+    /// The group's name for a group's signal (`path_position`, `path_velocity`,
+    /// `path_acceleration`, `entry_index`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub group_id: Option<i64>,
     pub signal: ScopeSignal,
     /// Unit of the values (axis unit, unit/s, unit/s²).
     #[schema(example = "mm")]

@@ -35,21 +35,71 @@ pub fn recording(s: &AppState, body: RecordingRequest) -> AppResult<NewRecording
                     ),
                 );
             }
-            let key = c.axis.key();
-            let axis = reg.find(&key);
-            if axis.is_none() {
-                fail(format!("channels[{i}].axis"), format!("no axis '{key}'"));
-            }
-            if let (Some(a), Some(signal)) = (axis, signal) {
-                channels.push((
-                    a.slot,
-                    ScopeChannel {
-                        axis: a.name.clone(),
-                        axis_id: a.id,
-                        signal,
-                        unit: signal.unit(&a.config.unit),
-                    },
-                ));
+            match (&c.axis, &c.group) {
+                (Some(key), None) => {
+                    let key = key.key();
+                    let axis = reg.find(&key);
+                    if axis.is_none() {
+                        fail(format!("channels[{i}].axis"), format!("no axis '{key}'"));
+                    }
+                    if signal.is_some_and(ScopeSignal::of_group) {
+                        fail(
+                            format!("channels[{i}].signal"),
+                            "a group's signal: give `group` instead of `axis`".into(),
+                        );
+                    }
+                    if let (Some(a), Some(signal)) = (axis, signal) {
+                        channels.push((
+                            a.slot,
+                            ScopeChannel {
+                                axis: Some(a.name.clone()),
+                                axis_id: Some(a.id),
+                                group: None,
+                                group_id: None,
+                                signal,
+                                unit: signal.unit(&a.config.unit),
+                            },
+                        ));
+                    }
+                }
+                (None, Some(key)) => {
+                    let key = key.key();
+                    let group = reg.find_group(&key);
+                    if group.is_none() {
+                        fail(format!("channels[{i}].group"), format!("no group '{key}'"));
+                    }
+                    if signal.is_some_and(|s| !s.of_group()) {
+                        fail(
+                            format!("channels[{i}].signal"),
+                            "a group has path_position, path_velocity, path_acceleration and \
+                             entry_index"
+                                .into(),
+                        );
+                    }
+                    if let (Some(g), Some(signal)) = (group, signal) {
+                        // The path's unit: its first member's.
+                        let unit = g
+                            .members
+                            .first()
+                            .and_then(|(_, id)| reg.find(&id.to_string()))
+                            .map_or_else(String::new, |a| a.config.unit.clone());
+                        channels.push((
+                            g.slot as motion::AxisSlot,
+                            ScopeChannel {
+                                axis: None,
+                                axis_id: None,
+                                group: Some(g.name.clone()),
+                                group_id: Some(g.id),
+                                signal,
+                                unit: signal.unit(&unit),
+                            },
+                        ));
+                    }
+                }
+                _ => fail(
+                    format!("channels[{i}]"),
+                    "either `axis` or `group`, not both".into(),
+                ),
             }
         }
     }

@@ -74,7 +74,7 @@ export function ScopePage() {
   const session = useStore(scope.state);
   const roll = useStore(rolling.state);
   const online = useOnline();
-  const unitOf = (axis: string) => list.find((a) => a.config.name === axis)?.config.unit ?? '';
+  const unitOf = (axis: string | null | undefined) => list.find((a) => a.config.name === axis)?.config.unit ?? '';
   const [available, setAvailable] = useState<boolean | null>(null);
   const defaultChannels = (): ScopeForm['channels'] =>
     list.length
@@ -173,10 +173,10 @@ export function ScopePage() {
   const t = useMemo(() => (rec && rec.data ? timeAxis(rec) : null), [rec]);
   const problems = useMemo(() => (rec && rec.data ? checkRecording(rec) : []), [rec]);
 
-  const seriesOf = (c: { axis: string; signal: string; unit?: string }, i: number, values: (number | null)[], extra: Partial<ChartSeries> = {}) => {
+  const seriesOf = (c: { axis?: string | null; group?: string | null; signal: string; unit?: string }, i: number, values: (number | null)[], extra: Partial<ChartSeries> = {}) => {
     const unit = c.unit ?? signalUnit(c.signal as Signal, unitOf(c.axis));
     return {
-      label: channelLabel(c as { axis: string; signal: Signal }),
+      label: channelLabel({ ...c, signal: c.signal as Signal }),
       unit,
       scale: scaleKey(c.signal as Signal, unitOf(c.axis)),
       values,
