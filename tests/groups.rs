@@ -612,4 +612,28 @@ async fn a_group_tracks_a_conveyor_until_a_frame_detaches_it() {
     let st = until_group(&s, "standby after detaching", |st| st["state"] == "standby").await;
     assert!(st.get("tracking").is_none(), "{st}");
     assert_eq!(st["tracking_velocity"], 0.0, "{st}");
+
+    // The group's commands, by group: each names its group and no axis.
+    let r = get(&s, "/api/v1/commands?group=xy").await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let list = r.json.as_array().unwrap();
+    assert!(list.iter().any(|c| c["id"] == track), "{}", r.text);
+    assert!(
+        list.iter()
+            .all(|c| c["group"] == "xy" && c.get("axis").is_none()),
+        "{}",
+        r.text
+    );
+    let r = get(&s, "/api/v1/commands?axis=spindle").await;
+    assert!(
+        r.json
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|c| c["axis"] == "spindle" && c.get("group").is_none()),
+        "{}",
+        r.text
+    );
+    let r = get(&s, "/api/v1/commands?group=gantry").await;
+    assert_problem(&r, 404, "group_not_found");
 }

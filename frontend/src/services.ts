@@ -194,7 +194,7 @@ function entryOf(r: CommandResource): LogEntry {
     key: `c${r.id}`,
     id: r.id,
     // A group's command addresses no axis: the log names its group.
-    axis: r.group ?? r.axis,
+    axis: r.group ?? r.axis ?? '',
     command: r.command,
     parameters: r.parameters,
     state: r.state,

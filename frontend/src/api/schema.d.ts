@@ -3996,10 +3996,10 @@ export interface components {
         CommandResource: {
             /** Format: int64 */
             id: number;
-            /** @description The axis it addresses (empty, 0 for a group's command: see `group`). */
-            axis: string;
+            /** @description The axis it addresses (absent for a group's command: see `group`). */
+            axis?: string | null;
             /** Format: int64 */
-            axis_id: number;
+            axis_id?: number | null;
             /** @description The axis group it addresses (a group's block). */
             group?: string | null;
             /** Format: int64 */
@@ -8680,6 +8680,15 @@ export interface components {
                  *       "type": "urn:motiond:problem:axis_not_found"
                  *     }
                  */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /** @description No such axis or axis group (`?axis=`, `?group=`). */
+        AxisOrGroupNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
                 "application/problem+json": components["schemas"]["Problem"];
             };
         };
@@ -13946,6 +13955,8 @@ export interface operations {
             query?: {
                 /** @description Only commands of this axis (id or name). */
                 axis?: string;
+                /** @description Only commands of this axis group (id or name). */
+                group?: string;
                 /** @description Only commands in this state. */
                 state?: components["schemas"]["CommandState"];
                 /** @description At most this many (default 100, at most 2000), newest first. */
@@ -13968,7 +13979,7 @@ export interface operations {
             };
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["RoleInsufficient"];
-            404: components["responses"]["AxisNotFound"];
+            404: components["responses"]["AxisOrGroupNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["QueryInvalid"];
         };

@@ -37,6 +37,8 @@ pub async fn get_command(
 pub struct ListQuery {
     /// Only commands of this axis (id or name).
     pub axis: Option<String>,
+    /// Only commands of this axis group (id or name).
+    pub group: Option<String>,
     /// Only commands in this state.
     pub state: Option<CommandState>,
     /// At most this many (default 100, at most 2000), newest first.
@@ -59,6 +61,7 @@ pub async fn list_commands(
     }
     let filter = ListFilter {
         axis: q.axis.as_deref(),
+        group: q.group.as_deref(),
         state: q.state,
         limit: q.limit.map(|l| l as usize),
     };

@@ -203,6 +203,11 @@ problem_responses! {
     /// No such axis group.
     GroupNotFound(example = json!(p(AppError::not_found("group", "gantry"))));
 
+    /// No such axis or axis group (`?axis=`, `?group=`).
+    AxisOrGroupNotFound(examples(
+        ("axis_not_found" = (value = json!(axis_not_found()))),
+        ("group_not_found" = (value = json!(p(AppError::not_found("group", "gantry")))))));
+
     /// No such cam table.
     CamTableNotFound(example = json!(p(AppError::not_found("cam_table", "knife"))));
 
@@ -586,7 +591,7 @@ error_sets! {
         422: EmptyBodyInvalid, 503: WriteUnavailable,
     }
     /// `GET /commands`.
-    CommandListErrors { 404: AxisNotFound, 422: QueryInvalid }
+    CommandListErrors { 404: AxisOrGroupNotFound, 422: QueryInvalid }
     /// `GET /commands/{id}`.
     CommandReadErrors { 404: CommandNotFound }
     /// `DELETE /commands/{id}`, `POST /commands/{id}/keepalive`.

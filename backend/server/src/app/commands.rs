@@ -52,8 +52,8 @@ impl CommandRecord {
         let o = &self.outputs;
         CommandResource {
             id: self.id,
-            axis: self.axis_name.clone(),
-            axis_id: self.axis_id,
+            axis: self.group.is_none().then(|| self.axis_name.clone()),
+            axis_id: self.group.is_none().then_some(self.axis_id),
             group: self.group.as_ref().map(|g| g.1.clone()),
             group_id: self.group.as_ref().map(|g| g.0),
             command: self.block.name,

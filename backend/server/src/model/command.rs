@@ -109,9 +109,11 @@ impl ClientInfo {
 }))]
 pub struct CommandResource {
     pub id: u64,
-    /// The axis it addresses (empty, 0 for a group's command: see `group`).
-    pub axis: String,
-    pub axis_id: i64,
+    /// The axis it addresses (absent for a group's command: see `group`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_id: Option<i64>,
     /// The axis group it addresses (a group's block).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub group: Option<String>,

@@ -631,7 +631,7 @@ fn wait_outcome(s: &AppState, v: &CommandResource, milestone: Milestone) -> Wait
         .registry
         .read()
         .unwrap()
-        .find(&v.axis_id.to_string())
+        .find(&v.axis_id.unwrap_or_default().to_string())
         .map(|e| e.slot)
         .and_then(|slot| s.status(slot).1)
         .unwrap_or_default();
@@ -707,6 +707,7 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
 /// `GET /commands` filters.
 pub struct ListFilter<'a> {
     pub axis: Option<&'a str>,
+    pub group: Option<&'a str>,
     pub state: Option<CommandState>,
     pub limit: Option<usize>,
 }
@@ -724,6 +725,17 @@ pub fn list(s: &AppState, f: ListFilter<'_>) -> AppResult<Vec<CommandResource>> 
         ),
         None => None,
     };
+    let group_id = match f.group {
+        Some(g) => Some(
+            s.registry
+                .read()
+                .unwrap()
+                .find_group(g)
+                .map(|e| e.id)
+                .ok_or_else(|| AppError::not_found("group", g))?,
+        ),
+        None => None,
+    };
     let limit = f.limit.unwrap_or(100).min(HISTORY);
     let store = s.commands.lock().unwrap();
     Ok(store
@@ -732,7 +744,8 @@ pub fn list(s: &AppState, f: ListFilter<'_>) -> AppResult<Vec<CommandResource>> 
         .rev()
         .filter_map(|id| store.map.get(id))
         .filter(|r| r.accepted)
-        .filter(|r| axis_id.is_none_or(|a| r.axis_id == a))
+        .filter(|r| axis_id.is_none_or(|a| r.group.is_none() && r.axis_id == a))
+        .filter(|r| group_id.is_none_or(|g| r.group.as_ref().is_some_and(|(id, _)| *id == g)))
         .map(|r| r.view())
         .filter(|v| f.state.is_none_or(|st| v.state == st))
         .take(limit)
