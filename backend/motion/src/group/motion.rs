@@ -171,6 +171,7 @@ pub(super) struct PathRun {
     /// jerk. The path is followed as planned, but each item is planned to stop as early as
     /// its dynamics allow.
     braking: Option<(f64, f64)>,
+    cycle_time: f64,
 }
 
 /// Velocity below which the path counts as standing.
@@ -193,6 +194,7 @@ impl PathRun {
             last_started: 0,
             braking: None,
             entries: 0,
+            cycle_time,
         }
     }
 
@@ -297,7 +299,12 @@ impl PathRun {
                     if waits {
                         v = 0.0;
                     } else {
-                        v = v.min(brake_reach(len, next_v_end, lim.deceleration, lim.jerk));
+                        // The cycle that passes an item's end travels on into the next
+                        // one: up to a cycle's travel of it is gone before it is planned, so
+                        // it must stop within what is left.
+                        let reach = brake_reach(len, next_v_end, lim.deceleration, lim.jerk);
+                        let left = (len - reach * self.cycle_time).max(0.0);
+                        v = v.min(brake_reach(left, next_v_end, lim.deceleration, lim.jerk));
                     }
                 }
             }
@@ -338,12 +345,11 @@ impl PathRun {
     /// and than the acceleration left to the front item (dk/dt · v is a path acceleration),
     /// the rate itself changed no faster than the item's jerk allows (dk²/dt² · v).
     fn step_override(&mut self, dt: f64, ramp_time: f64) {
-        // A stop never speeds up: while one runs the override may only fall.
-        let target = if self.braking.is_some() {
-            self.k_target.min(self.k)
-        } else {
-            self.k_target
-        };
+        // A stop runs in real time with its own deceleration (`brake`): the override waits.
+        if self.braking.is_some() {
+            return;
+        }
+        let target = self.k_target;
         let diff = target - self.k;
         if diff == 0.0 && self.k_rate == 0.0 {
             return;
@@ -416,10 +422,29 @@ impl PathRun {
                 self.hold();
             }
             Exec::Follow { .. } => {
+                // A stop brakes with its own deceleration in real time, not stretched by a
+                // low override: the time scaling is folded into the path's state (the
+                // velocity and acceleration stay what they are) and is 1 while the stop
+                // runs; at standstill the override asked for is in effect again (decision 151).
+                if self.k != 1.0 || self.k_rate != 0.0 {
+                    let k = self.k;
+                    self.s.acceleration =
+                        k * k * self.s.acceleration + self.k_rate * self.s.velocity;
+                    self.s.velocity *= k;
+                    self.k = 1.0;
+                    self.k_rate = 0.0;
+                }
                 self.braking = Some((dec, jerk));
                 self.exec = Exec::Follow { planned: false };
             }
         }
+    }
+
+    /// The stop is at standstill: the override asked for applies to what comes next.
+    fn end_brake(&mut self) {
+        self.braking = None;
+        self.k = self.k_target;
+        self.k_rate = 0.0;
     }
 
     /// A stop is running.
@@ -430,7 +455,7 @@ impl PathRun {
     /// Drops every item: the group stands where it is.
     pub(super) fn flush(&mut self) {
         self.exec = Exec::Idle;
-        self.braking = None;
+        self.end_brake();
         self.s = Kinematics::default();
         self.last_started = 0;
         self.clear_items();
@@ -573,7 +598,7 @@ impl PathRun {
         if self.braking.is_some() && self.planner.finished() && self.s.velocity <= EPS_V {
             // Standstill: the stop ends here; the rest of the queue is dropped.
             self.clear_items();
-            self.braking = None;
+            self.end_brake();
             report.braked = true;
         }
         if self.items.is_empty() {
@@ -591,7 +616,7 @@ impl PathRun {
             if self.braking.is_some() && !matches!(it.kind, ItemKind::Motion(_)) {
                 // A stop that reaches a dwell or a blocker ends there.
                 self.clear_items();
-                self.braking = None;
+                self.end_brake();
                 self.exec = Exec::Idle;
                 report.braked = true;
                 return true;

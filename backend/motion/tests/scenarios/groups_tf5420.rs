@@ -1474,3 +1474,32 @@ fn s2_4_tracking_never_carries_a_member_beyond_its_software_limit() {
         at(&r, 0)
     );
 }
+
+#[test]
+fn s4_2_a_halt_at_a_low_override_brakes_in_real_time_with_its_own_deceleration() {
+    let mut r = rig_xy();
+    enable(&mut r);
+    r.gok(G, CommandKind::GroupSetOverride { factor: 0.1 });
+    let p = r.path_ok(G, vec![lin(&[800.0, 0.0], 200.0)]);
+    r.until(3.0, |r| (r.gst(G).path_velocity - 20.0).abs() < 1e-6);
+    let h = r.gok(
+        G,
+        CommandKind::GroupHalt {
+            deceleration: PathValue::Value(1000.0),
+            jerk: PathValue::Value(100_000.0),
+        },
+    );
+    assert!(r.out(p).command_aborted);
+    // From 20 mm/s at 1000 mm/s², the item's jerk of 5000 mm/s³ (a stop brakes with the
+    // lower of its own and the item's dynamics): about 0.13 s — not the seconds it would
+    // take were the stop stretched by the override's time scaling (1000 · 0.1² mm/s²).
+    let n = r.until(0.5, |r| r.out(h).done);
+    assert!(n <= 150, "{n} cycles");
+    assert_eq!(r.gst(G).path_velocity, 0.0);
+    // The override asked for applies to the next path.
+    assert_eq!(r.gst(G).actual_override, 0.1);
+    let p = r.path_ok(G, vec![lin(&[0.0, 0.0], 200.0)]);
+    r.run(0.5);
+    assert!(r.gst(G).path_velocity <= 20.0 + 1e-9);
+    run_done(&mut r, p, 60.0);
+}
