@@ -161,6 +161,8 @@ pub fn analyse_path(
     let mut all = Vec::with_capacity(2 * keep + 1);
     let mut every = 1usize;
     let mut last = None;
+    // The entry reached: the status's index goes back to 0 once the path is done.
+    let mut entry = 0;
     let mut max_velocity = [0.0; MAX_PATH_DIMS];
     let mut max_acceleration = [0.0; MAX_PATH_DIMS];
     let mut done = false;
@@ -185,12 +187,13 @@ pub fn analyse_path(
                 max_acceleration[d] = f64::max(max_acceleration[d], a.set_acceleration.abs());
             }
         }
+        entry = u32::max(entry, s.entry_index);
         let sample = PlannedSample {
             t: c as f64 * cycle_time,
             path_position: s.path_position,
             path_velocity: s.path_velocity,
             path_acceleration: s.path_acceleration,
-            entry: s.entry_index,
+            entry,
             in_blend: s.in_blending_segment,
             position: s.position,
             velocity,

@@ -1119,6 +1119,10 @@ fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
     assert!(a.samples.len() <= 500 && a.samples.len() > 100);
     let last = a.samples.last().unwrap();
     assert_eq!(&last.position[..3], &[600.0, -200.0, 100.0]);
+    assert_eq!(
+        last.entry, 3,
+        "the last entry at the end (the status's index is 0 again)"
+    );
     assert!((last.t - a.duration).abs() < 1e-12);
     // Every member within its limits (the rig's parameters: 500 u/s, 5000 u/s²).
     assert!(
