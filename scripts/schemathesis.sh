@@ -203,7 +203,9 @@ parameters = { "path.id" = { dictionary = "decoy_tokens", probability = 1.0 } }
 # master that is the slave itself, a move-modulo on a linear axis, a recording longer than
 # 600 000 cycles, an X-Client-Id needed to take control while authentication is off, a group
 # role the convention lacks, a default above the group's maximum, an arc that is no arc, a
-# frame out of an XY group's plane, a conveyor that is a member or slower than the tracking, "ignore" or a value below 1 for a halt's deceleration …
+# frame out of an XY group's plane, a conveyor that is a member or slower than the tracking,
+# "ignore" or a value below 1 for a halt's deceleration, a path analysed for a group that is
+# not there …
 [[operations]]
 include-operation-id = ["create_axis", "replace_axis", "import_config", "write_parameter",
     "create_cam_table", "replace_cam_table", "write_points", "write_point", "values",
@@ -214,7 +216,8 @@ include-operation-id = ["create_axis", "replace_axis", "import_config", "write_p
     "phasing_relative", "halt_phasing", "position_correction_limiter", "override_filter",
     "torque_control", "convert_pos_to_inc_pos", "ext_setpoint_gen_feed", "gear_in_multi_master",
     "create_group", "replace_group", "group_add_axis", "group_halt", "group_stop",
-    "group_move_path", "group_set_coordinate_transform", "group_track_conveyor_belt"]
+    "group_move_path", "group_set_coordinate_transform", "group_track_conveyor_belt",
+    "analyse_path"]
 checks.positive_data_acceptance.expected-statuses = ["2XX", "3XX", 401, 403, 404, 409, 422, 429, "5XX"]
 
 [[operations]]

@@ -637,3 +637,229 @@ async fn a_group_tracks_a_conveyor_until_a_frame_detaches_it() {
     let r = get(&s, "/api/v1/commands?group=gantry").await;
     assert_problem(&r, 404, "group_not_found");
 }
+
+/// The §8.3 example's arcs N20 and N30 (both counter-clockwise, as the manual's prose has
+/// them), from N10's end (200, 0): two quarter arcs of radius 100 in the XY plane.
+fn worked_arcs(n20: &str) -> Value {
+    json!([
+        {"type": "circular", "circ_mode": "center", "aux_point": [200.0, -100.0, 0.0], "end_point": [300.0, -100.0],
+            "path_choice": n20, "velocity": 1000.0, "invoke_id": 20},
+        {"type": "circular", "circ_mode": "center", "aux_point": [400.0, -100.0, 0.0], "end_point": [400.0, -200.0],
+            "path_choice": "counter_clockwise", "velocity": 1000.0, "buffer_mode": "buffered", "invoke_id": 30}
+    ])
+}
+
+#[tokio::test(flavor = "multi_thread")]
+async fn a_path_is_analysed_by_the_groups_planner_without_storing_or_moving_anything() {
+    let s = Server::start();
+    enable_xy(&s).await;
+    let before = group_status(&s).await;
+    let commands_before = get(&s, "/api/v1/commands?limit=2000").await.json;
+
+    // §8.3: two quarter arcs of π·100/2 ≈ 157.08 each.
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "start": {"x": 200.0, "y": 0.0}, "entries": worked_arcs("counter_clockwise")}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let a = &r.json;
+    let quarter = std::f64::consts::PI * 100.0 / 2.0;
+    assert!(
+        (a["length"].as_f64().unwrap() - 2.0 * quarter).abs() < 1e-6,
+        "{}",
+        a["length"]
+    );
+    assert_eq!(a["truncated"], false);
+    assert_eq!(a["group"], "xy");
+    assert_eq!(a["start"], json!({"x": 200.0, "y": 0.0}));
+    let t = a["t"].as_array().unwrap();
+    assert!(t.len() > 100 && t.len() <= 2000, "{}", t.len());
+    for column in [
+        "path_position",
+        "path_velocity",
+        "path_acceleration",
+        "entry",
+        "in_blend",
+    ] {
+        assert_eq!(a[column].as_array().unwrap().len(), t.len(), "{column}");
+    }
+    assert!(near(t.last().unwrap(), a["duration"].as_f64().unwrap()));
+    assert_eq!(a["entry"][0], 0);
+    assert_eq!(a["entry"][t.len() - 1], 1, "the last entry at the end");
+    let axes = a["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 2);
+    assert_eq!(
+        (&axes[0]["role"], &axes[0]["axis"]),
+        (&json!("x"), &json!("x"))
+    );
+    assert_eq!(
+        (&axes[1]["role"], &axes[1]["axis"]),
+        (&json!("y"), &json!("y"))
+    );
+    assert!(near(
+        axes[0]["position"].as_array().unwrap().last().unwrap(),
+        400.0
+    ));
+    assert!(near(
+        axes[1]["position"].as_array().unwrap().last().unwrap(),
+        -200.0
+    ));
+    // Halfway along N20 (45°): x = 200 + 100·sin 45°, y = −100 + 100·cos 45°, turning clockwise
+    // seen from +Z (the manual's normal is −Z).
+    let i = a["path_position"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|p| p.as_f64().unwrap() >= quarter / 2.0)
+        .unwrap();
+    let (x, y) = (
+        axes[0]["position"][i].as_f64().unwrap(),
+        axes[1]["position"][i].as_f64().unwrap(),
+    );
+    let h = 100.0 * std::f64::consts::FRAC_1_SQRT_2;
+    assert!(
+        (x - 200.0 - h).abs() < 2.0 && (y + 100.0 - h).abs() < 2.0,
+        "({x}, {y})"
+    );
+    // Every axis within its limits (the demo's 500 mm/s, 2500 mm/s²).
+    for ax in axes {
+        assert!(
+            ax["max_velocity"].as_f64().unwrap() <= 500.0 * (1.0 + 1e-9),
+            "{ax}"
+        );
+        assert!(
+            ax["max_acceleration"].as_f64().unwrap() <= 2500.0 * (1.0 + 1e-9),
+            "{ax}"
+        );
+        assert_eq!(ax["velocity"].as_array().unwrap().len(), t.len());
+    }
+    // Clockwise on N20 (the manual's code line) is the long way round: 270° + 90°.
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "start": {"x": 200.0, "y": 0.0}, "entries": worked_arcs("clockwise"), "max_samples": 50}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert!((r.json["length"].as_f64().unwrap() - 4.0 * quarter).abs() < 1e-6);
+    assert!(r.json["t"].as_array().unwrap().len() <= 50);
+
+    // The tour from where the group stands (0, 0): its corners blended, a little shorter than
+    // programmed; a run longer than asked for is truncated.
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "1", "entries": tour_path()["entries"]}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["start"], json!({"x": 0.0, "y": 0.0}));
+    let programmed = 100.0 + std::f64::consts::PI * 50.0 / 2.0 + 100.0 + 150.0;
+    let length = r.json["length"].as_f64().unwrap();
+    assert!(
+        length < programmed - 0.1 && length > programmed - 10.0,
+        "{length}"
+    );
+    assert!(
+        r.json["in_blend"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|b| b == true)
+    );
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "entries": tour_path()["entries"], "max_seconds": 0.5}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["truncated"], true);
+    let d = r.json["duration"].as_f64().unwrap();
+    assert!((0.5..0.51).contains(&d), "{d}");
+
+    // Refusals name the entry and field with the rule's code, as move-path's do.
+    let mut bad = worked_arcs("counter_clockwise");
+    // (N20 ends at (300, −100): three points on a line are no arc)
+    bad[1] = json!({"type": "circular", "circ_mode": "border", "aux_point": [350.0, -100.0, 0.0],
+        "end_point": [400.0, -100.0], "velocity": 100.0, "buffer_mode": "buffered"});
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "start": {"x": 200.0, "y": 0.0}, "entries": bad}),
+    )
+    .await;
+    assert_problem(&r, 422, "circle_invalid");
+    assert_eq!(
+        r.json["errors"][0]["field"], "entries[1].aux_point",
+        "{}",
+        r.text
+    );
+    let mut bad = worked_arcs("counter_clockwise");
+    bad[1]["buffer_mode"] = json!("aborting");
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "entries": bad}),
+    )
+    .await;
+    assert_problem(&r, 422, "buffer_mode_invalid");
+    assert_eq!(
+        r.json["errors"][0]["field"], "entries[1].buffer_mode",
+        "{}",
+        r.text
+    );
+    // x's soft limits are 0…1000: a path to x = −50 is refused at its entry (a preview names
+    // the row where move-path answers 409).
+    let line = |x: f64| json!({"type": "linear", "position": [x, 0.0], "velocity": 100.0, "buffer_mode": "buffered"});
+    let r = post(
+        &s,
+        "/api/v1/path-analysis",
+        json!({"group": "xy", "entries": [line(50.0), line(-50.0)]}),
+    )
+    .await;
+    assert_problem(&r, 422, "path_beyond_soft_limit");
+    assert_eq!(
+        r.json["errors"][0]["field"], "entries[1].position",
+        "{}",
+        r.text
+    );
+    for (body, field) in [
+        (json!({"group": "gantry", "entries": [line(1.0)]}), "group"),
+        (
+            json!({"group": "xy", "start": {"z": 1.0}, "entries": [line(1.0)]}),
+            "start.z",
+        ),
+        (
+            json!({"group": "xy", "entries": [line(1.0)], "max_samples": 1}),
+            "max_samples",
+        ),
+        (
+            json!({"group": "xy", "entries": [line(1.0)], "max_seconds": 0.0}),
+            "max_seconds",
+        ),
+        (json!({"group": "xy", "entries": []}), "entries"),
+    ] {
+        let r = post(&s, "/api/v1/path-analysis", body).await;
+        assert_eq!(r.status, 422, "{}", r.text);
+        assert_eq!(r.json["errors"][0]["field"], field, "{}", r.text);
+    }
+
+    // Nothing stored, nothing moved: the group's status and the command list as they were.
+    let after = group_status(&s).await;
+    for k in [
+        "state",
+        "position",
+        "queued_entries",
+        "path_position",
+        "command",
+    ] {
+        assert_eq!(after[k], before[k], "{k}");
+    }
+    assert_eq!(
+        get(&s, "/api/v1/commands?limit=2000").await.json,
+        commands_before
+    );
+}

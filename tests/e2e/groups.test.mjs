@@ -1,6 +1,8 @@
 // The Groups page in headless Debian Chromium against the real motiond with its demo machine
-// (axes x and y, group `xy`): a path of a line, an arc and a blended line entered as rows, run,
-// followed to its end; the server's 422 shown at the row and field it names, and at a field of
+// (axes x and y, group `xy`): a path of a line, an arc and a blended line entered as rows,
+// planned by the server as it is entered (its length and duration, the charts of its dynamics),
+// run, its live trace drawn over the plan while it runs, followed to its end; the server's 422 —
+// of the plan while editing, of the run — shown at the row and field it names, and at a field of
 // the group form; the page fits the window at every size. Everything waits on the page's DOM or
 // the server's state, never on a fixed time.
 import { after, before, describe, test } from 'node:test';
@@ -74,6 +76,29 @@ describe('groups page', () => {
     await page.waitForSelector('.path-canvas[data-plane="xy"][data-segments="3"]');
     const lengthText = await page.textContent('[data-testid="preview-length"]');
     assert.match(lengthText, new RegExp(`programmed length ${want.toFixed(2)}`), lengthText);
+    // The server's plan of these rows from where the group stands: the same length and duration
+    // as POST /path-analysis gives, its trace drawn, its dynamics charted.
+    const entries = [
+      { type: 'linear', position: [100, 0], velocity: 200, invoke_id: 10 },
+      { type: 'circular', circ_mode: 'center', aux_point: [100, 50, 0], end_point: [150, 50], path_choice: 'counter_clockwise', velocity: 200, buffer_mode: 'buffered', invoke_id: 20 },
+      { type: 'linear', position: [150, 150], velocity: 200, buffer_mode: 'blending_previous', transition_mode: 'corner_distance', transition_parameters: [5], invoke_id: 30 },
+    ];
+    const planned = await rest(stack.api, 'POST', '/path-analysis', { group: 'xy', entries, start: { x: 0, y: 0 } });
+    assert.equal(planned.status, 200, JSON.stringify(planned.body));
+    const summary = '[data-testid="plan-summary"][data-state="ok"]';
+    await page.waitForFunction(
+      ([sel, length]) => Number(document.querySelector(sel)?.getAttribute('data-length')) === length,
+      [summary, planned.body.length],
+    );
+    assert.equal(Number(await page.getAttribute(summary, 'data-duration')), planned.body.duration);
+    assert.match(await page.textContent(summary), new RegExp(`planned length ${planned.body.length.toFixed(2)}, duration ${planned.body.duration.toFixed(3)} s`));
+    assert.ok(Math.abs(planned.body.length - want) < 1, `${planned.body.length} vs ${want}`);
+    await page.waitForSelector('.path-canvas[data-plane="xy"][data-plan]:not([data-plan="0"])');
+    assert.equal(Number(await page.getAttribute('.path-canvas[data-plane="xy"]', 'data-plan')), planned.body.t.length + 1);
+    const chart = '[data-testid="plan-chart"]';
+    assert.equal(Number(await page.getAttribute(chart, 'data-samples')), planned.body.t.length);
+    assert.equal(await page.getAttribute(chart, 'data-series'), 'path velocity,x velocity,y velocity,x acceleration,y acceleration');
+    assert.equal(await page.locator(`${chart} .plan-pane canvas`).count(), 3);
 
     // At half speed (MC_GroupSetOverride from the slider's button), so the run is seen on its way.
     await page.click('button[name="group-override-50"]');
@@ -81,7 +106,13 @@ describe('groups page', () => {
     await page.click('button[name="run-path"]');
     // On its way through the arc or the blended line: the entry and its invoke id shown, the picture taken.
     await page.waitForFunction(() => / \/ (20|30)$/.test(document.querySelector('[data-readout="entry"] .dro-value')?.textContent ?? ''));
+    // The live trace over the plan, from the group's websocket topic, while it runs: on the
+    // canvas and as the live path velocity in the charts.
+    await page.waitForFunction(() => Number(document.querySelector('.path-canvas[data-plane="xy"]')?.getAttribute('data-trace')) > 3 && Number(document.querySelector('[data-testid="plan-chart"]')?.getAttribute('data-live')) > 3);
+    assert.equal((await groupStatus()).state, 'moving');
+    await page.evaluate(() => document.querySelector('.group-grid')?.scrollIntoView());
     await picture(page, 'groups');
+    await page.evaluate(() => window.scrollTo(0, 0));
     // Followed to its end: the move-path command done in the group's command log, the group in standby.
     await page.waitForSelector('.main tr[data-command="move-path"][data-state="done"]', { timeout: 30000 });
     await page.waitForSelector('.group-online [data-group-state="standby"]');
@@ -124,11 +155,31 @@ describe('groups page', () => {
     await page.click('button[name="add-linear"]');
     await fill(page, 'entries[0].position[0]', 200);
     await fill(page, 'entries[0].position[1]', 100);
+    // An arc through three points on a line, planned while it is entered: the planner's
+    // refusal (circle_invalid) at its row, nothing planned.
+    await page.click('button[name="add-circular"]');
+    await select(page, 'entries[1].circ_mode', 'border');
+    await fill(page, 'entries[1].aux_point[0]', 300);
+    await fill(page, 'entries[1].aux_point[1]', 100);
+    await fill(page, 'entries[1].end_point[0]', 400);
+    await fill(page, 'entries[1].end_point[1]', 100);
+    await page.waitForSelector('tr[data-row="1"].row-error');
+    assert.match(await page.textContent('tr[data-row="1"]'), /circle_invalid/);
+    await page.waitForSelector('[data-testid="plan-summary"][data-state="refused"]');
+    assert.equal(await page.locator('tr.path-row.row-error').count(), 1);
+    await page.click('button[name="row-remove-1"]');
+    await page.waitForSelector('[data-testid="plan-summary"][data-state="ok"]');
+    assert.equal(await page.locator('tr.path-row.row-error').count(), 0);
+
     await page.click('button[name="add-linear"]');
     await fill(page, 'entries[1].position[0]', 250);
     await fill(page, 'entries[1].velocity', -5);
-    await page.click('button[name="run-path"]');
+    // marked by the plan as it is entered, and by the run's refusal
     const input = 'tr[data-row="1"] input[name="entries[1].velocity"][aria-invalid="true"]';
+    await page.waitForSelector(input);
+    await page.waitForSelector('[data-testid="plan-summary"][data-state="refused"]');
+    await page.click('button[name="run-path"]');
+    await page.waitForSelector('[data-testid="path-error"]');
     await page.waitForSelector(input);
     const msg = await page.textContent('tr[data-row="1"] td:has(input[name="entries[1].velocity"]) .field-error');
     assert.match(msg, /path_dynamics_invalid|velocity|dynamics/i, msg);

@@ -1786,6 +1786,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/path-analysis": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Plan a path for a group without running it: the planned trace, path velocity, each axis's velocity and acceleration
+         * @description What the path editor draws while a table is edited; the server's planner is the one source of the path. The table is checked as `move-path`'s body (the same errors at the same fields, `entries[i].…` with the rule's code) and then run in virtual time on a kernel of its own: the group's configuration and coordinate frame, ideal drives with its members' parameters, override 100 %, every blocker released as it is reached. A table the group would refuse (an arc that is no arc, a path beyond a soft limit) is a 422 naming the entry. Nothing is stored, nothing moves, the group is not asked (any state will do).
+         */
+        post: operations["analyse_path"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/scope/recordings": {
         parameters: {
             query?: never;
@@ -6523,6 +6543,214 @@ export interface components {
             new_password: string;
         };
         /**
+         * @description `POST /path-analysis`: a path table as for MC_MovePath, analysed for a group without
+         *     running it (the path editor's preview).
+         * @example {
+         *       "entries": [
+         *         {
+         *           "position": [
+         *             100,
+         *             0
+         *           ],
+         *           "type": "linear",
+         *           "velocity": 200
+         *         },
+         *         {
+         *           "aux_point": [
+         *             100,
+         *             50,
+         *             0
+         *           ],
+         *           "buffer_mode": "buffered",
+         *           "circ_mode": "center",
+         *           "end_point": [
+         *             150,
+         *             50
+         *           ],
+         *           "path_choice": "counter_clockwise",
+         *           "type": "circular",
+         *           "velocity": 200
+         *         },
+         *         {
+         *           "buffer_mode": "blending_previous",
+         *           "position": [
+         *             150,
+         *             150
+         *           ],
+         *           "transition_mode": "corner_distance",
+         *           "transition_parameters": [
+         *             5
+         *           ],
+         *           "type": "linear",
+         *           "velocity": 200
+         *         }
+         *       ],
+         *       "group": "xy",
+         *       "max_samples": 2000,
+         *       "start": {
+         *         "x": 0,
+         *         "y": 0
+         *       }
+         *     }
+         */
+        PathAnalysisBody: {
+            /**
+             * @description The group: its id (1..16) or its name. Its configuration, its members' parameters and
+             *     its coordinate frame are the analysis's.
+             * @example xy
+             */
+            group: string;
+            /**
+             * @description The table, as `move-path`'s body has it (checked the same way, the same errors at the
+             *     same fields).
+             */
+            entries: components["schemas"]["PathEntryDto"][];
+            /**
+             * @description Where the path starts, per role of the group (machine coordinates); a role left out
+             *     starts where its axis's set point is now.
+             */
+            start?: {
+                [key: string]: number;
+            } | null;
+            /**
+             * Format: int32
+             * @description At most this many samples, evenly spread over the run, the last at its end (default
+             *     2000).
+             */
+            max_samples?: number | null;
+            /**
+             * Format: double
+             * @description The run analysed at most this long (s, default 60); a longer path is `truncated`.
+             */
+            max_seconds?: number | null;
+        };
+        /**
+         * @description What a path table will do, planned by the group's own planner in virtual time (ideal
+         *     drives, override 100 %, blockers released as they are reached): sample columns of equal
+         *     length, and what the run comes to. Nothing was stored or moved.
+         * @example {
+         *       "axes": [
+         *         {
+         *           "acceleration": [
+         *             200,
+         *             0,
+         *             0
+         *           ],
+         *           "axis": "x",
+         *           "max_acceleration": 2000,
+         *           "max_velocity": 200,
+         *           "position": [
+         *             0.0001,
+         *             140,
+         *             150
+         *           ],
+         *           "role": "x",
+         *           "velocity": [
+         *             0.2,
+         *             80,
+         *             0
+         *           ]
+         *         },
+         *         {
+         *           "acceleration": [
+         *             0,
+         *             0,
+         *             0
+         *           ],
+         *           "axis": "y",
+         *           "max_acceleration": 2000,
+         *           "max_velocity": 200,
+         *           "position": [
+         *             0,
+         *             20,
+         *             150
+         *           ],
+         *           "role": "y",
+         *           "velocity": [
+         *             0,
+         *             180,
+         *             0
+         *           ]
+         *         }
+         *       ],
+         *       "cycle_time": 0.001,
+         *       "duration": 1.62,
+         *       "entry": [
+         *         0,
+         *         1,
+         *         2
+         *       ],
+         *       "group": "xy",
+         *       "in_blend": [
+         *         false,
+         *         false,
+         *         false
+         *       ],
+         *       "length": 278.54,
+         *       "path_acceleration": [
+         *         200,
+         *         0,
+         *         0
+         *       ],
+         *       "path_position": [
+         *         0.0001,
+         *         150,
+         *         278.54
+         *       ],
+         *       "path_velocity": [
+         *         0.2,
+         *         200,
+         *         0
+         *       ],
+         *       "start": {
+         *         "x": 0,
+         *         "y": 0
+         *       },
+         *       "t": [
+         *         0.001,
+         *         0.81,
+         *         1.62
+         *       ],
+         *       "truncated": false
+         *     }
+         */
+        PathAnalysisResource: {
+            /** @description The group's name. */
+            group: string;
+            /**
+             * Format: double
+             * @description The cycle the run was planned in (s).
+             */
+            cycle_time: number;
+            /** @description Where the run started, per role. */
+            start: {
+                [key: string]: number;
+            };
+            /**
+             * Format: double
+             * @description Time until the last entry is done (s; the time analysed when `truncated`).
+             */
+            duration: number;
+            /**
+             * Format: double
+             * @description The path length travelled.
+             */
+            length: number;
+            /** @description The path did not end within `max_seconds`. */
+            truncated: boolean;
+            /** @description Time of each sample since the start (s). */
+            t: number[];
+            /** @description Path position, velocity and acceleration at each sample. */
+            path_position: number[];
+            path_velocity: number[];
+            path_acceleration: number[];
+            /** @description The entry running (index in `entries`) and whether a corner blend runs. */
+            entry: number[];
+            in_blend: boolean[];
+            /** @description The members in the group's axis order. */
+            axes: components["schemas"]["PlannedAxisDto"][];
+        };
+        /**
          * @description Path dynamics of a group (path units: mm, mm/s … along the Cartesian path).
          * @example {
          *       "acceleration": 1000,
@@ -6704,6 +6932,47 @@ export interface components {
             deceleration?: number;
             /** Format: double */
             jerk?: number;
+        };
+        /**
+         * @description One member of an analysed path: its axis's set values over the run.
+         * @example {
+         *       "acceleration": [
+         *         0,
+         *         4000,
+         *         0
+         *       ],
+         *       "axis": "x",
+         *       "max_acceleration": 5000,
+         *       "max_velocity": 200,
+         *       "position": [
+         *         0,
+         *         0.5,
+         *         100
+         *       ],
+         *       "role": "x",
+         *       "velocity": [
+         *         0,
+         *         40,
+         *         0
+         *       ]
+         *     }
+         */
+        PlannedAxisDto: {
+            role: components["schemas"]["GroupRole"];
+            /** @description The axis of the role (its name). */
+            axis: string;
+            /** @description Set position, velocity and acceleration at each sample's `t`. */
+            position: number[];
+            velocity: number[];
+            acceleration: number[];
+            /**
+             * Format: double
+             * @description The largest |velocity| and |acceleration| over the whole run (every cycle, not only the
+             *     samples).
+             */
+            max_velocity: number;
+            /** Format: double */
+            max_acceleration: number;
         };
         /**
          * @description Closed-loop response of the load to the position reference.
@@ -9366,6 +9635,20 @@ export interface components {
          *     force; should even that fail, the detail says so).
          */
         ParameterWriteUnavailable: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description An invalid field of the analysis's body (`errors[].field`: `group` naming no group,
+         *     `start.{role}`, `max_samples` …), or a path entry the group would refuse: then `code` is
+         *     the rule's (`circle_invalid`, `transition_mode_invalid`, `path_beyond_soft_limit` …) and
+         *     `error_id` its number, the field `entries[i].…`, as for `move-path`.
+         */
+        PathAnalysisInvalid: {
             headers: {
                 [name: string]: unknown;
             };
@@ -15284,6 +15567,37 @@ export interface operations {
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["GroupCommandInvalid"];
             503: components["responses"]["CommandUnavailable"];
+        };
+    };
+    analyse_path: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["PathAnalysisBody"];
+            };
+        };
+        responses: {
+            /** @description The planned run: sample columns and what it comes to */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["PathAnalysisResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["PathAnalysisInvalid"];
         };
     };
     list_recordings: {

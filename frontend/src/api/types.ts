@@ -94,3 +94,7 @@ export type BufferMode = S['BufferMode'];
 export type TransitionMode = S['TransitionModeDto'];
 export type CircMode = S['CircMode'];
 export type CircPathChoice = S['CircPathChoice'];
+/** `POST /path-analysis`: a path table planned for a group without running it, and the plan. */
+export type PathAnalysisBody = S['PathAnalysisBody'];
+export type PathAnalysisResource = S['PathAnalysisResource'];
+export type PlannedAxis = S['PlannedAxisDto'];

@@ -6,8 +6,8 @@ import { ApiError } from '../api/problem';
 import { sig } from '../format';
 
 /** What the latest answered request says about the table as edited. */
-export type Analysis =
-  | { kind: 'ok'; seq: number; result: CamAnalysisResource }
+export type Analysis<R = CamAnalysisResource> =
+  | { kind: 'ok'; seq: number; result: R }
   /** The server's validation refused it (422): messages by field (`points[1].point_type`). */
   | { kind: 'invalid'; seq: number; fields: Record<string, string>; text: string }
   /** No answer (server gone, another refusal). */
@@ -23,11 +23,12 @@ export interface LiveAnalysisOptions {
 /**
  * Debounces edits into requests and drops stale answers: each request has a sequence number,
  * and an answer is passed on only if no later request was sent meanwhile. `pending` is true
- * from an edit until the answer to it (or to a later one) is in.
+ * from an edit until the answer to it (or to a later one) is in. The body and answer are a cam
+ * table's by default (the path editor's are a path table's: groups/plan.ts).
  */
-export class LiveAnalysis {
+export class LiveAnalysis<B = CamTableBody, R = CamAnalysisResource> {
   private seq = 0;
-  private body: CamTableBody | null = null;
+  private body: B | null = null;
   private timer: ReturnType<typeof setTimeout> | null = null;
   private firstWait = 0;
   private waiting = false;
@@ -36,8 +37,8 @@ export class LiveAnalysis {
   private readonly maxWait: number;
 
   constructor(
-    private readonly send: (body: CamTableBody) => Promise<CamAnalysisResource>,
-    private readonly onAnalysis: (a: Analysis) => void,
+    private readonly send: (body: B) => Promise<R>,
+    private readonly onAnalysis: (a: Analysis<R>) => void,
     private readonly onPending: (pending: boolean) => void = () => {},
     opts: LiveAnalysisOptions = {},
     private readonly now: () => number = () => Date.now(),
@@ -51,7 +52,7 @@ export class LiveAnalysis {
   }
 
   /** The table changed: analyse it once the edits pause (or maxWait has passed). */
-  schedule(body: CamTableBody): void {
+  schedule(body: B): void {
     this.body = body;
     const t = this.now();
     if (!this.waiting) this.firstWait = t;
@@ -71,7 +72,7 @@ export class LiveAnalysis {
     const seq = ++this.seq;
     this.inFlight = seq;
     this.setWaiting(false);
-    let a: Analysis;
+    let a: Analysis<R>;
     try {
       a = { kind: 'ok', seq, result: await this.send(body) };
     } catch (e) {
@@ -87,6 +88,18 @@ export class LiveAnalysis {
   }
 
   private disposed = false;
+
+  /** Drops the scheduled body and any answer still to come (nothing to analyse now). */
+  cancel(): void {
+    const before = this.pending;
+    if (this.timer !== null) clearTimeout(this.timer);
+    this.timer = null;
+    this.body = null;
+    this.seq++;
+    this.inFlight = 0;
+    this.waiting = false;
+    if (this.pending !== before) this.onPending(this.pending);
+  }
 
   dispose(): void {
     this.disposed = true;

@@ -44,6 +44,18 @@ export interface CamChartCallbacks {
 
 let charts = 0;
 
+/** The width of a stacked pane in `el`, and whether `el` is narrow (a phone's width). */
+export const paneWidth = (el: HTMLElement) => Math.max(200, el.clientWidth || 600);
+export const narrowPanes = (el: HTMLElement) => (el.clientWidth || 600) < 560;
+
+/** Keeps stacked panes as wide as `el`, each `height(i)` high (null without ResizeObserver). */
+export function followWidth(el: HTMLElement, panes: () => uPlot[], height: (i: number) => number): ResizeObserver | null {
+  if (typeof ResizeObserver === 'undefined') return null;
+  const ro = new ResizeObserver(() => panes().forEach((u, i) => u.setSize({ width: paneWidth(el), height: height(i) })));
+  ro.observe(el);
+  return ro;
+}
+
 export class CamChart {
   private panes: uPlot[] = [];
   private readout: HTMLElement;
@@ -101,18 +113,15 @@ export class CamChart {
     el.dataset.series = NAMES.join(',');
     el.dataset.samples = '0';
     this.handleBox = this.panes[0].over;
-    if (typeof ResizeObserver !== 'undefined') {
-      this.ro = new ResizeObserver(() => this.panes.forEach((u, i) => u.setSize({ width: this.width(), height: this.height(i) })));
-      this.ro.observe(el);
-    }
+    this.ro = followWidth(el, () => this.panes, (i) => this.height(i));
   }
 
   private width(): number {
-    return Math.max(200, this.el.clientWidth || 600);
+    return paneWidth(this.el);
   }
 
   private height(i: number): number {
-    const small = (this.el.clientWidth || 600) < 560;
+    const small = narrowPanes(this.el);
     return i === 0 ? (small ? 200 : 250) : small ? 96 : 120;
   }
 

@@ -1,9 +1,12 @@
-// The live XY (XZ) view of a group's path on a canvas: the preview (programmed points, lines,
-// sampled arcs, corner tolerance circles) and the live trace of the members' set positions, on
-// one scale for both axes (a circle stays round, which uPlot's independent scales would not
-// keep), with a grid of round numbers. Drawing only: the data come from geometry.ts and the
-// trace buffer below. No UI framework, no global state.
+// The live XY (XZ, YZ) view of a group's path on a canvas: the path as the server plans it
+// (plan.ts: the sampled trace, corner blends in their own colour), the programmed geometry
+// faintly beneath it (points, lines, arcs, corner tolerance circles: geometry.ts), and the live
+// trace of the group's set positions drawn over the plan while it runs, on one scale for both
+// axes (a circle stays round, which uPlot's independent scales would not keep), with a grid of
+// round numbers. Drawing only: the data come from geometry.ts, plan.ts and the trace buffer
+// below. No UI framework, no global state.
 import type { Preview } from './geometry';
+import { tracePieces, type PlannedTrace } from './plan';
 
 /** Which plane: the path-point dims on the horizontal and the vertical axis. */
 export interface Plane {
@@ -15,6 +18,7 @@ export interface Plane {
 }
 export const XY: Plane = { name: 'xy', h: 0, v: 1, hLabel: 'X', vLabel: 'Y' };
 export const XZ: Plane = { name: 'xz', h: 0, v: 2, hLabel: 'X', vLabel: 'Z' };
+export const YZ: Plane = { name: 'yz', h: 1, v: 2, hLabel: 'Y', vLabel: 'Z' };
 
 /** A bounded buffer of path points (the live trace), cleared when a new run starts. */
 export class TraceBuffer {
@@ -36,6 +40,8 @@ export class TraceBuffer {
 
 export interface ViewData {
   preview: Preview | null;
+  /** The server's plan of the rows (null: none yet, or refused). */
+  plan?: PlannedTrace | null;
   trace: readonly number[][];
   /** The group's position now (path point), drawn as a dot. */
   now: number[] | null;
@@ -47,7 +53,7 @@ export interface ViewData {
   dim?: boolean;
 }
 
-export const VIEW_COLORS = { path: '#1363c6', active: '#2b8a3e', arc: '#1363c6', point: '#1b2a3a', corner: '#ae3ec9', trace: '#e8590c', now: '#d9480f', grid: '#e3e8ee', axis: '#8a96a3', error: '#c92a2a' };
+export const VIEW_COLORS = { path: '#1363c6', active: '#2b8a3e', arc: '#1363c6', point: '#1b2a3a', corner: '#ae3ec9', blend: '#ae3ec9', programmed: '#9aa5b1', trace: '#e8590c', now: '#d9480f', grid: '#e3e8ee', axis: '#8a96a3', error: '#c92a2a' };
 
 /** A round step (1, 2, 5 × 10ⁿ) that gives about `n` grid lines over `span`. */
 export function niceStep(span: number, n: number): number {
@@ -75,6 +81,7 @@ export function bounds(d: ViewData, plane: Plane): [number, number, number, numb
     for (const s of d.preview.segments) for (const p of s.points) see(p);
     for (const c of d.preview.corners) see(c.at, Math.max(Number.isFinite(c.rIn) ? c.rIn : 0, Number.isFinite(c.rOut) ? c.rOut : 0));
   }
+  for (const p of d.plan?.points ?? []) see(p);
   for (const p of d.trace) see(p);
   if (d.now) see(d.now);
   if (!Number.isFinite(x0)) return [-10, -10, 10, 10];
@@ -138,25 +145,23 @@ export function drawView(ctx: CanvasRenderingContext2D, w: number, h: number, d:
   ctx.beginPath();
   ctx.rect(m.l, m.t, pw, ph);
   ctx.clip();
-  // live trace: wide and translucent under the programmed path, so both stay visible
-  if (d.trace.length > 1) {
-    ctx.save();
-    ctx.globalAlpha = 0.5;
-    ctx.strokeStyle = VIEW_COLORS.trace;
-    ctx.lineWidth = 5;
-    ctx.lineJoin = 'round';
-    ctx.lineCap = 'round';
-    ctx.beginPath();
-    d.trace.forEach((q, i) => (i ? ctx.lineTo(X(q[plane.h]), Y(q[plane.v])) : ctx.moveTo(X(q[plane.h]), Y(q[plane.v]))));
-    ctx.stroke();
-    ctx.restore();
-  }
   ctx.globalAlpha = d.dim ? 0.45 : 1;
   const p = d.preview;
+  const plan = d.plan ?? null;
+  const line = (pts: readonly number[][], from = 0, to = pts.length - 1) => {
+    ctx.beginPath();
+    for (let i = from; i <= to; i++) {
+      const q = pts[i];
+      if (i === from) ctx.moveTo(X(q[plane.h]), Y(q[plane.v]));
+      else ctx.lineTo(X(q[plane.h]), Y(q[plane.v]));
+    }
+    ctx.stroke();
+  };
   if (p) {
     // corner tolerance circles
     ctx.setLineDash([4, 3]);
     ctx.strokeStyle = VIEW_COLORS.corner;
+    ctx.lineWidth = 1;
     for (const c of p.corners) {
       for (const r of c.rIn === c.rOut ? [c.rIn] : [c.rIn, c.rOut]) {
         if (!(r > 0)) continue;
@@ -166,19 +171,38 @@ export function drawView(ctx: CanvasRenderingContext2D, w: number, h: number, d:
       }
     }
     ctx.setLineDash([]);
-    // segments
+    // programmed segments: the path itself when there is no plan, faint beneath the plan
     for (const s of p.segments) {
-      ctx.strokeStyle = s.entry === d.activeEntry ? VIEW_COLORS.active : VIEW_COLORS.path;
-      ctx.lineWidth = s.entry === d.selectedEntry || s.entry === d.activeEntry ? 3 : 1.75;
-      ctx.beginPath();
-      s.points.forEach((q, i) => (i ? ctx.lineTo(X(q[plane.h]), Y(q[plane.v])) : ctx.moveTo(X(q[plane.h]), Y(q[plane.v]))));
-      ctx.stroke();
+      if (plan) {
+        ctx.strokeStyle = VIEW_COLORS.programmed;
+        ctx.lineWidth = 1;
+        ctx.setLineDash([3, 3]);
+      } else {
+        ctx.strokeStyle = s.entry === d.activeEntry ? VIEW_COLORS.active : VIEW_COLORS.path;
+        ctx.lineWidth = s.entry === d.selectedEntry || s.entry === d.activeEntry ? 3 : 1.75;
+      }
+      line(s.points);
+      ctx.setLineDash([]);
       if (s.centre) {
-        ctx.fillStyle = VIEW_COLORS.path;
+        ctx.fillStyle = plan ? VIEW_COLORS.programmed : VIEW_COLORS.path;
         const [a, b] = [X(s.centre[plane.h] ?? 0), Y(s.centre[plane.v] ?? 0)];
         ctx.fillRect(a - 1.5, b - 1.5, 3, 3);
       }
     }
+  }
+  if (plan && plan.points.length > 1) {
+    // the server's plan: pieces of one entry and blend state, blends in their own colour, the
+    // running or selected entry emphasised
+    ctx.lineJoin = 'round';
+    ctx.lineCap = 'round';
+    for (const piece of tracePieces(plan)) {
+      const e = piece.entry;
+      ctx.strokeStyle = piece.blend ? VIEW_COLORS.blend : e === d.activeEntry ? VIEW_COLORS.active : VIEW_COLORS.path;
+      ctx.lineWidth = piece.blend || e === d.selectedEntry || e === d.activeEntry ? 3.5 : 2.25;
+      line(plan.points, piece.from, piece.to);
+    }
+  }
+  if (p) {
     // programmed points with their row number
     ctx.lineWidth = 1;
     ctx.font = '11px system-ui, sans-serif';
@@ -199,6 +223,17 @@ export function drawView(ctx: CanvasRenderingContext2D, w: number, h: number, d:
       const [a, b] = key.split(',').map(Number);
       ctx.fillText(texts.join(', '), a + 5, b - 3);
     }
+  }
+  // the live trace, over the plan
+  if (d.trace.length > 1) {
+    ctx.save();
+    ctx.globalAlpha = 0.9;
+    ctx.strokeStyle = VIEW_COLORS.trace;
+    ctx.lineWidth = 2;
+    ctx.lineJoin = 'round';
+    ctx.lineCap = 'round';
+    line(d.trace);
+    ctx.restore();
   }
   if (d.now && Number.isFinite(d.now[plane.h]) && Number.isFinite(d.now[plane.v])) {
     ctx.globalAlpha = 1;

@@ -31,7 +31,8 @@ pub struct PlannedSample {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PathAnalysis {
     pub samples: Vec<PlannedSample>,
-    /// Time until the last entry is done (s), and the path length.
+    /// Time until the last entry is done (s; when truncated, the time analysed), and the path
+    /// length.
     pub duration: f64,
     pub length: f64,
     /// Per role dimension: the largest |velocity| and |acceleration| of the member.
@@ -41,14 +42,17 @@ pub struct PathAnalysis {
     pub truncated: bool,
 }
 
-/// Runs `table` from `start` for a group with `config` whose members have `axes` (role,
-/// parameters), for at most `max_seconds`, keeping at most `max_samples` samples (evenly
-/// decimated; the last one is always kept). The failing entry's index, field and error when
-/// the group would refuse the path.
+/// Runs `table` from `start` (machine coordinates) for a group with `config` whose members have
+/// `axes` (role, parameters) and whose entries are read in `frame` (MC_SetCoordinateTransform),
+/// for at most `max_seconds`, keeping at most `max_samples` samples (evenly decimated; the last
+/// one is always kept; memory stays within twice that however long the path runs). The failing
+/// entry's index, field and error when the group would refuse the path.
+#[allow(clippy::too_many_arguments)] // the preview's whole situation, each given once by its caller
 pub fn analyse_path(
     config: &GroupConfig,
     axes: &[(GroupRole, AxisParameters)],
     start: PathPoint,
+    frame: CoordTransform,
     table: &PathTable,
     cycle_time: f64,
     max_seconds: f64,
@@ -131,6 +135,12 @@ pub fn analyse_path(
     {
         return Err((0, "group", ErrorId::GROUP_CONFIG_INVALID));
     }
+    if !frame.is_identity() {
+        let set = CommandKind::SetCoordinateTransform { transform: frame };
+        if let Verdict::Rejected(e) = submit(&mut kernel, Target::Group(0), set, &mut events) {
+            return Err((0, "frame", e));
+        }
+    }
     let ctx = kernel.path_context(0).expect("inserted above");
     // Refusals name their entry as a prepared path does.
     let prepared = prepare_path(
@@ -145,7 +155,14 @@ pub fn analyse_path(
         Verdict::Rejected(e) => return Err((0, "entries", e)),
     }
     let cycles = (max_seconds / cycle_time).ceil() as usize;
-    let mut all = Vec::new();
+    let keep = max_samples.max(2);
+    // Every `every`-th cycle is kept; when twice `keep` are, every other one goes and the
+    // stride doubles, so a long path costs no more memory than a short one.
+    let mut all = Vec::with_capacity(2 * keep + 1);
+    let mut every = 1usize;
+    let mut last = None;
+    // The entry reached: the status's index goes back to 0 once the path is done.
+    let mut entry = 0;
     let mut max_velocity = [0.0; MAX_PATH_DIMS];
     let mut max_acceleration = [0.0; MAX_PATH_DIMS];
     let mut done = false;
@@ -170,17 +187,26 @@ pub fn analyse_path(
                 max_acceleration[d] = f64::max(max_acceleration[d], a.set_acceleration.abs());
             }
         }
-        all.push(PlannedSample {
+        entry = u32::max(entry, s.entry_index);
+        let sample = PlannedSample {
             t: c as f64 * cycle_time,
             path_position: s.path_position,
             path_velocity: s.path_velocity,
             path_acceleration: s.path_acceleration,
-            entry: s.entry_index,
+            entry,
             in_blend: s.in_blending_segment,
             position: s.position,
             velocity,
             acceleration,
-        });
+        };
+        last = Some(sample);
+        if (c - 1) % every == 0 {
+            all.push(sample);
+            if all.len() >= 2 * keep {
+                all = all.into_iter().step_by(2).collect();
+                every *= 2;
+            }
+        }
         done = events
             .iter()
             .any(|e| e.command == path_id && (e.outputs.done || e.outputs.error));
@@ -190,19 +216,22 @@ pub fn analyse_path(
             break;
         }
     }
-    let length = all.last().map_or(0.0, |s| s.path_position);
-    let keep = max_samples.max(2);
-    let samples = if all.len() <= keep {
+    let length = last.map_or(0.0, |s| s.path_position);
+    if !done {
+        // Truncated: the time analysed.
+        duration = last.map_or(0.0, |s| s.t);
+    }
+    let mut samples = if all.len() < keep {
         all
     } else {
         let every = all.len().div_ceil(keep - 1);
-        let last = *all.last().expect("not empty");
-        let mut v: Vec<_> = all.into_iter().step_by(every).collect();
-        if v.last() != Some(&last) {
-            v.push(last);
-        }
-        v
+        all.into_iter().step_by(every).collect()
     };
+    if let Some(last) = last {
+        if samples.last() != Some(&last) {
+            samples.push(last);
+        }
+    }
     Ok(PathAnalysis {
         samples,
         duration,

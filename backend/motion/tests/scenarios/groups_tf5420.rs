@@ -1097,7 +1097,17 @@ fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
         (GroupRole::Y, params()),
         (GroupRole::Z, params()),
     ];
-    let a = analyse_path(&xyz(), &axes, [0.0; MAX_PATH_DIMS], &table, DT, 60.0, 500).unwrap();
+    let a = analyse_path(
+        &xyz(),
+        &axes,
+        [0.0; MAX_PATH_DIMS],
+        CoordTransform::default(),
+        &table,
+        DT,
+        60.0,
+        500,
+    )
+    .unwrap();
     assert!(!a.truncated);
     let expected =
         200.0 + std::f64::consts::PI * 100.0 + (200.0f64.powi(2) + 100.0f64.powi(2)).sqrt();
@@ -1109,6 +1119,10 @@ fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
     assert!(a.samples.len() <= 500 && a.samples.len() > 100);
     let last = a.samples.last().unwrap();
     assert_eq!(&last.position[..3], &[600.0, -200.0, 100.0]);
+    assert_eq!(
+        last.entry, 3,
+        "the last entry at the end (the status's index is 0 again)"
+    );
     assert!((last.t - a.duration).abs() < 1e-12);
     // Every member within its limits (the rig's parameters: 500 u/s, 5000 u/s²).
     assert!(
@@ -1134,8 +1148,49 @@ fn path_analysis_runs_the_worked_example_in_virtual_time_without_a_group() {
             ),
         ],
     };
-    let e = analyse_path(&xyz(), &axes, [0.0; MAX_PATH_DIMS], &bad, DT, 60.0, 500).unwrap_err();
+    let e = analyse_path(
+        &xyz(),
+        &axes,
+        [0.0; MAX_PATH_DIMS],
+        CoordTransform::default(),
+        &bad,
+        DT,
+        60.0,
+        500,
+    )
+    .unwrap_err();
     assert_eq!((e.0, e.2), (1, ErrorId::CIRCLE_INVALID));
+    // Read in the group's frame: (10, 0, 0) shifted by (100, 50, 0) ends at (110, 50, 0); a
+    // long run at a small sample budget keeps no more than asked (the first and last kept).
+    let frame = CoordTransform {
+        translation: [100.0, 50.0, 0.0],
+        rotation: [0.0; 3],
+    };
+    let slow = PathTable {
+        entries: vec![lin(&[10.0, 0.0, 0.0], 2.0)],
+    };
+    let a = analyse_path(
+        &xyz(),
+        &axes,
+        [0.0; MAX_PATH_DIMS],
+        frame,
+        &slow,
+        DT,
+        600.0,
+        7,
+    )
+    .unwrap();
+    assert!(!a.truncated);
+    assert!(
+        a.samples.len() <= 7 && a.samples.len() >= 4,
+        "{}",
+        a.samples.len()
+    );
+    let last = a.samples.last().unwrap();
+    assert_eq!(&last.position[..3], &[110.0, 50.0, 0.0]);
+    assert!((last.t - a.duration).abs() < 1e-12);
+    assert!((a.samples[0].t - DT).abs() < 1e-12);
+    assert!((a.length - (110.0f64.powi(2) + 50.0f64.powi(2)).sqrt()).abs() < 1e-6);
 }
 
 #[test]

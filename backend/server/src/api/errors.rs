@@ -416,6 +416,23 @@ problem_responses! {
         ("circle_invalid" = (summary = "Three points on a line",
             value = json!(p(AppError::kernel(axum::http::StatusCode::UNPROCESSABLE_ENTITY, "Invalid request", ErrorId::CIRCLE_INVALID)))))));
 
+    /// An invalid field of the analysis's body (`errors[].field`: `group` naming no group,
+    /// `start.{role}`, `max_samples` …), or a path entry the group would refuse: then `code` is
+    /// the rule's (`circle_invalid`, `transition_mode_invalid`, `path_beyond_soft_limit` …) and
+    /// `error_id` its number, the field `entries[i].…`, as for `move-path`.
+    PathAnalysisInvalid(examples(
+        ("body" = (summary = "A group that is not there", value = json!(p(AppError::field("group", "no group 'gantry'"))))),
+        ("transition_mode_invalid" = (summary = "A corner blend with buffered (TF5420 §7.3)",
+            value = json!(p(AppError::InvalidCoded { errors: vec![crate::error::FieldError {
+                field: "entries[1].transition_mode".into(),
+                message: "transition_mode_invalid (0x813B): transition mode not allowed here".into() }],
+                id: ErrorId::TRANSITION_MODE_INVALID })))),
+        ("circle_invalid" = (summary = "Three points on a line: the entry named",
+            value = json!(p(AppError::InvalidCoded { errors: vec![crate::error::FieldError {
+                field: "entries[1].aux_point".into(),
+                message: format!("circle_invalid (0x{:04X}): {}", ErrorId::CIRCLE_INVALID.0, ErrorId::CIRCLE_INVALID.text()) }],
+                id: ErrorId::CIRCLE_INVALID }))))));
+
     /// An invalid or unknown query parameter.
     QueryInvalid(example = json!(p(AppError::field("query",
         "Failed to deserialize query string: state: unknown variant `running`, expected one of \
@@ -661,6 +678,8 @@ error_sets! {
     }
     /// `POST /bus/reset`.
     BusResetErrors { 409: BusNotEthercat, 503: BusResetFailed }
+    /// `POST /path-analysis`.
+    PathAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: PathAnalysisInvalid }
     /// `POST /cam-analysis`.
     CamAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: CamTableInvalid }
     /// `PUT /cam-tables/{table}`, its points.

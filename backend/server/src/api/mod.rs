@@ -301,6 +301,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
                 .delete(cams::delete_cam_table)
                 .layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
         )
+        .route("/path-analysis", post(groups::analyse_path))
         .route(
             "/cam-analysis",
             post(cams::analyse).layer(DefaultBodyLimit::max(cams::CAM_BODY_LIMIT)),
@@ -582,7 +583,7 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
         reads::convert_inc_pos_to_pos, reads::convert_pos_to_inc_pos, reads::read_axis_components,
         reads::read_drive_operation_mode,
         groups::list_groups, groups::create_group, groups::get_group, groups::replace_group, groups::delete_group,
-        groups::group_status, groups::read_error, groups::read_blocker_status,
+        groups::group_status, groups::read_error, groups::read_blocker_status, groups::analyse_path,
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,

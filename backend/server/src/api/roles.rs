@@ -22,7 +22,7 @@ pub fn required(method: &Method, path: &str) -> Option<Role> {
         _ if p.starts_with("/users") || p.starts_with("/tokens") => Admin,
         "/audit" => Engineer,
         // A computation that stores nothing: whoever may read the tables may analyse one.
-        "/cam-analysis" => Viewer,
+        "/cam-analysis" | "/path-analysis" => Viewer,
         _ if read => Viewer,
         "/control" => Operator,
         "/commands/{id}" | "/commands/{id}/keepalive" => Operator,

@@ -260,3 +260,61 @@ pub enum GroupOrder {
     Command(motion::CommandKind),
     Path(Box<motion::group::PathTable>),
 }
+
+/// One member of an analysed path: its axis's set values over the run.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"role": "x", "axis": "x", "position": [0.0, 0.5, 100.0],
+    "velocity": [0.0, 40.0, 0.0], "acceleration": [0.0, 4000.0, 0.0],
+    "max_velocity": 200.0, "max_acceleration": 5000.0}))]
+pub struct PlannedAxisDto {
+    pub role: GroupRole,
+    /// The axis of the role (its name).
+    pub axis: String,
+    /// Set position, velocity and acceleration at each sample's `t`.
+    pub position: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    /// The largest |velocity| and |acceleration| over the whole run (every cycle, not only the
+    /// samples).
+    pub max_velocity: f64,
+    pub max_acceleration: f64,
+}
+
+/// What a path table will do, planned by the group's own planner in virtual time (ideal
+/// drives, override 100 %, blockers released as they are reached): sample columns of equal
+/// length, and what the run comes to. Nothing was stored or moved.
+#[derive(Clone, Debug, Serialize, ToSchema)]
+#[schema(example = json!({"group": "xy", "cycle_time": 0.001, "start": {"x": 0.0, "y": 0.0},
+    "duration": 1.62, "length": 278.54, "truncated": false,
+    "t": [0.001, 0.81, 1.62], "path_position": [0.0001, 150.0, 278.54],
+    "path_velocity": [0.2, 200.0, 0.0], "path_acceleration": [200.0, 0.0, 0.0],
+    "entry": [0, 1, 2], "in_blend": [false, false, false],
+    "axes": [{"role": "x", "axis": "x", "position": [0.0001, 140.0, 150.0], "velocity": [0.2, 80.0, 0.0],
+        "acceleration": [200.0, 0.0, 0.0], "max_velocity": 200.0, "max_acceleration": 2000.0},
+      {"role": "y", "axis": "y", "position": [0.0, 20.0, 150.0], "velocity": [0.0, 180.0, 0.0],
+        "acceleration": [0.0, 0.0, 0.0], "max_velocity": 200.0, "max_acceleration": 2000.0}]}))]
+pub struct PathAnalysisResource {
+    /// The group's name.
+    pub group: String,
+    /// The cycle the run was planned in (s).
+    pub cycle_time: f64,
+    /// Where the run started, per role.
+    pub start: BTreeMap<String, f64>,
+    /// Time until the last entry is done (s; the time analysed when `truncated`).
+    pub duration: f64,
+    /// The path length travelled.
+    pub length: f64,
+    /// The path did not end within `max_seconds`.
+    pub truncated: bool,
+    /// Time of each sample since the start (s).
+    pub t: Vec<f64>,
+    /// Path position, velocity and acceleration at each sample.
+    pub path_position: Vec<f64>,
+    pub path_velocity: Vec<f64>,
+    pub path_acceleration: Vec<f64>,
+    /// The entry running (index in `entries`) and whether a corner blend runs.
+    pub entry: Vec<u32>,
+    pub in_blend: Vec<bool>,
+    /// The members in the group's axis order.
+    pub axes: Vec<PlannedAxisDto>,
+}

@@ -791,3 +791,157 @@ pub fn register(s: &AppState, changed: Vec<GroupEntry>) {
         reg.groups.insert(e.id, e);
     }
 }
+
+/// The samples a path analysis keeps by default, and at most.
+pub const ANALYSIS_SAMPLES: usize = 2000;
+pub const MAX_ANALYSIS_SAMPLES: usize = 20_000;
+/// The run a path analysis plans by default, and at most (s).
+pub const ANALYSIS_SECONDS: f64 = 60.0;
+pub const MAX_ANALYSIS_SECONDS: f64 = 600.0;
+
+/// The configuration of a group named in a body (422 at `field` when there is none).
+pub fn config_of(s: &AppState, key: &str, field: &str) -> AppResult<GroupConfig> {
+    s.registry
+        .read()
+        .unwrap()
+        .find_group(key)
+        .map(|e| e.config)
+        .ok_or_else(|| AppError::field(field, &format!("no group '{key}'")))
+}
+
+/// A path table's run planned for a group without running it (`POST /path-analysis`): the
+/// group's configuration and frame, its configured members' parameters as mirrored, from
+/// `start` (per role; a role left out from its axis's set point now), in virtual time on a
+/// private kernel off the async runtime. Nothing is stored, nothing reaches the cycle thread.
+/// A table the group would refuse is a 422 naming the entry and field, with the rule's code.
+pub async fn analyse_path(
+    s: &AppState,
+    key: &str,
+    table: motion::group::PathTable,
+    start: Option<std::collections::BTreeMap<String, f64>>,
+    max_samples: usize,
+    max_seconds: f64,
+) -> AppResult<crate::model::PathAnalysisResource> {
+    let e = s
+        .registry
+        .read()
+        .unwrap()
+        .find_group(key)
+        .cloned()
+        .ok_or_else(|| AppError::field("group", &format!("no group '{key}'")))?;
+    let roles: Vec<GroupRole> = e.config.roles().collect();
+    let mut errors = Vec::new();
+    for (name, v) in start.iter().flatten() {
+        let field = format!("start.{name}");
+        if !roles.iter().any(|r| role_name(*r) == *name) {
+            let names: Vec<String> = roles.iter().map(|r| role_name(*r)).collect();
+            errors.push(FieldError {
+                field,
+                message: format!("not a role of this group: {}", names.join(", ")),
+            });
+        } else if !(v.is_finite() && v.abs() <= crate::model::MAX_MAGNITUDE) {
+            errors.push(FieldError {
+                field,
+                message: "must be a number from -1e12 to 1e12".into(),
+            });
+        }
+    }
+    if !errors.is_empty() {
+        return Err(AppError::Invalid(errors));
+    }
+    let (_, st) = s.group_status(e.slot);
+    let frame = st.map(|st| st.frame).unwrap_or_default();
+    let mut axes = Vec::with_capacity(roles.len());
+    let mut names = Vec::with_capacity(roles.len());
+    let mut at = [0.0; motion::path::MAX_PATH_DIMS];
+    {
+        let reg = s.registry.read().unwrap();
+        for r in &roles {
+            let member = e.members.iter().find(|(role, _)| role == r);
+            let Some(a) = member.and_then(|(_, id)| reg.axes.get(id)) else {
+                return Err(AppError::field(
+                    "group",
+                    &format!(
+                        "group {} has no axis for role {}: a path needs every role's axis",
+                        e.name,
+                        role_name(*r)
+                    ),
+                ));
+            };
+            axes.push((*r, a.params.clone()));
+            names.push(a.name.clone());
+            // Where the group's set point is now (the axis's when the group is not in the cycle).
+            at[r.dim()] = match st {
+                Some(st) => st.position[r.dim()],
+                None => s.status(a.slot).1.map_or(0.0, |a| a.set_position),
+            };
+        }
+    }
+    for (name, v) in start.iter().flatten() {
+        if let Some(r) = roles.iter().find(|r| role_name(**r) == *name) {
+            at[r.dim()] = *v;
+        }
+    }
+    let config = e.config;
+    let cycle_time = s.info.cycle_time_s;
+    let analysis = tokio::task::spawn_blocking(move || {
+        motion::group::analyse_path(
+            &config,
+            &axes,
+            at,
+            frame,
+            &table,
+            cycle_time,
+            max_seconds,
+            max_samples,
+        )
+    })
+    .await
+    .map_err(|e| AppError::unavailable("internal", format!("the analysis failed: {e}")))?;
+    let a = analysis.map_err(|(i, field, id)| {
+        let field = match field {
+            "group" | "frame" | "entries" => field.to_string(),
+            f => format!("entries[{i}].{f}"),
+        };
+        AppError::InvalidCoded {
+            errors: vec![FieldError {
+                message: format!("{} (0x{:04X}): {}", id.code(), id.0, id.text()),
+                field,
+            }],
+            id,
+        }
+    })?;
+    let column = |f: &dyn Fn(&motion::group::PlannedSample) -> f64| -> Vec<f64> {
+        a.samples.iter().map(f).collect()
+    };
+    Ok(crate::model::PathAnalysisResource {
+        group: e.name.clone(),
+        cycle_time,
+        start: roles.iter().map(|r| (role_name(*r), at[r.dim()])).collect(),
+        duration: a.duration,
+        length: a.length,
+        truncated: a.truncated,
+        t: column(&|p| p.t),
+        path_position: column(&|p| p.path_position),
+        path_velocity: column(&|p| p.path_velocity),
+        path_acceleration: column(&|p| p.path_acceleration),
+        entry: a.samples.iter().map(|p| p.entry).collect(),
+        in_blend: a.samples.iter().map(|p| p.in_blend).collect(),
+        axes: roles
+            .iter()
+            .zip(names)
+            .map(|(r, axis)| {
+                let d = r.dim();
+                crate::model::PlannedAxisDto {
+                    role: *r,
+                    axis,
+                    position: column(&|p| p.position[d]),
+                    velocity: column(&|p| p.velocity[d]),
+                    acceleration: column(&|p| p.acceleration[d]),
+                    max_velocity: a.max_velocity[d],
+                    max_acceleration: a.max_acceleration[d],
+                }
+            })
+            .collect(),
+    })
+}

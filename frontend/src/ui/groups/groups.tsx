@@ -2,14 +2,20 @@
 // group (and to edit or delete a disabled one), and for the selected group its online panel
 // (state with the error's text, enable / disable / reset, override, halt, stop with its release,
 // blocker and release), the path editor whose rows are MC_MovePath's entries (run with
-// `move-path`; the server's 422 lands at the row and field it names) and the XY (XZ) view: the
-// preview of the rows computed here (groups/geometry.ts) and the live trace of the group's set
-// positions from its status, read every 50 ms while the page is visible (the websocket has no
-// group topic).
+// `move-path`; the server's 422 lands at the row and field it names), the XY (XZ, YZ) view and
+// the charts of the plan: every edit of the rows is planned by the server (`POST
+// /path-analysis`, debounced; its refusals land at their row and field too) and drawn — the
+// planned trace with its blends over the programmed geometry (groups/geometry.ts), the path
+// velocity and every axis's velocity and acceleration over time — and while the path runs, the
+// live trace and path velocity over the plan, from the group's websocket topic
+// `groups/{group}/status`.
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { api } from '../../api/client';
 import { errorInfo } from '../../api/errors';
-import type { GroupResource, GroupRole, GroupState, GroupStatus } from '../../api/types';
+import type { GroupResource, GroupRole, GroupState, GroupStatus, PathAnalysisBody, PathAnalysisResource } from '../../api/types';
+import { LiveAnalysis } from '../../cams/analysis';
+import { PlanChart } from '../../groups/chart';
+import { LiveRun, analysisBody, planText, plannedTrace } from '../../groups/plan';
 import { bodyOf, CONVENTIONS, draftOf, draftRoles, DYNAMICS, memberError, memberField, newDraft, type GroupDraft } from '../../groups/config';
 import { PATH_DIMS, preview, type Preview } from '../../groups/geometry';
 import {
@@ -31,9 +37,9 @@ import {
   type EntryType,
   type PathRow,
 } from '../../groups/rows';
-import { TraceBuffer, XY, XZ, drawView, type Plane, type ViewData } from '../../groups/view';
+import { TraceBuffer, XY, XZ, YZ, drawView, type Plane, type ViewData } from '../../groups/view';
 import { navigate } from '../../router';
-import { axes, findHeldGroupStop, groupCommand, groupStopAndRelease, releaseCommand } from '../../services';
+import { axes, findHeldGroupStop, groupCommand, groupStopAndRelease, live, releaseCommand, system } from '../../services';
 import { useStore } from '../../store';
 import { num } from '../../format';
 import { ActionButton, ErrorBanner, Field, NumberInput, Panel, errorText, fieldsOf, useOnline } from '../shared/common';
@@ -80,37 +86,28 @@ function stateText(s: GroupStatus): string {
   return GROUP_STATE_LABEL[s.state];
 }
 
-/** A group's status read every `ms` while the page is visible (the next read after the last answer). */
-function useGroupStatus(group: string, ms: number, on?: (s: GroupStatus) => void): { status: GroupStatus | null; stale: boolean } {
+/** The live status updates of a group per second (the websocket's topic; at most 100). */
+const GROUP_RATE_HZ = 50;
+
+/**
+ * A group's status from its websocket topic `groups/{group}/status` (kept across reconnections;
+ * stale while the socket is down); `on` sees every update.
+ */
+function useGroupStatus(group: string, on?: (s: GroupStatus) => void): { status: GroupStatus | null; stale: boolean } {
   const [status, setStatus] = useState<GroupStatus | null>(null);
   const [stale, setStale] = useState(false);
   const onRef = useRef(on);
   onRef.current = on;
-  useEffect(() => {
-    let over = false;
-    let timer: ReturnType<typeof setTimeout> | null = null;
-    const read = async () => {
-      timer = null;
-      if (over) return;
-      if (document.visibilityState === 'visible') {
-        try {
-          const s = await api.GET('/api/v1/groups/{group}/status', { params: { path: { group } } });
-          if (over) return;
-          setStatus(s);
-          setStale(false);
-          onRef.current?.(s);
-        } catch {
-          if (!over) setStale(true);
-        }
-      }
-      if (!over) timer = setTimeout(read, ms);
-    };
-    void read();
-    return () => {
-      over = true;
-      if (timer) clearTimeout(timer);
-    };
-  }, [group, ms]);
+  useEffect(
+    () =>
+      live.subscribe<GroupStatus>(`groups/${group}/status`, GROUP_RATE_HZ, (v, isStale) => {
+        setStale(isStale);
+        if (!v) return;
+        setStatus(v);
+        if (!isStale) onRef.current?.(v);
+      }),
+    [group],
+  );
   return { status, stale };
 }
 
@@ -358,10 +355,20 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
   const roles = useMemo(() => groupRoles(group.convention, group.additional_axes), [group.convention, group.additional_axes]);
   const dims = useMemo(() => roles.map(roleDim), [roles]);
   const online = useOnline();
+  const axisList = useStore(axes);
+  // The unit of the charts: the members' (when they all have one unit).
+  const units = new Set(group.axes.map((m) => axisList.find((a) => a.config.name === m.axis)?.config.unit ?? ''));
+  const axisUnit = units.size === 1 ? [...units][0] : '';
   const [error, setError] = useState<string | null>(null);
   const trace = useRef(new TraceBuffer());
-  const { status, stale } = useGroupStatus(group.name, 50, (s) => {
-    if (s.state === 'moving' || s.state === 'stopping') trace.current.push(pointOf(s.position));
+  const liveRun = useRef(new LiveRun());
+  const [, setLiveTick] = useState(0);
+  const { status, stale } = useGroupStatus(group.name, (s) => {
+    if (s.state === 'moving' || s.state === 'stopping') {
+      trace.current.push(pointOf(s.position));
+      liveRun.current.push(s.cycle, s.path_velocity);
+      setLiveTick((n) => n + 1);
+    }
   });
   const s = status ?? group.status ?? null;
 
@@ -410,8 +417,12 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
   const setRows = (r: PathRow[]) => {
     savedRows.set(group.id, r);
     setRowsState(r);
-    // Edited rows are a new path: it would start where the group is now.
-    if (!moving) setRunStart(null);
+    // Edited rows are a new path: it would start where the group is now (the last run's traces go).
+    if (!moving) {
+      setRunStart(null);
+      trace.current.clear();
+      liveRun.current.clear();
+    }
   };
   const [pathFields, setPathFields] = useState<Record<string, string>>({});
   const [pathError, setPathError] = useState<string | null>(null);
@@ -429,9 +440,11 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
     setPathFields({});
     try {
       const start = pointOf(s?.position);
+      const cycle = s?.cycle ?? 0;
       const r = await groupCommand(group.name, 'move-path', movePathBody(rows));
       trace.current.clear();
       trace.current.push(start);
+      liveRun.current.begin(cycle, plan?.cycle_time ?? system.get()?.cycle_time ?? 0.001);
       setRunStart(start);
       setRunCommand(r.id);
     } catch (e) {
@@ -444,7 +457,50 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
   const start = runStart ?? pointOf(s?.position);
   const pv: Preview = useMemo(() => preview(rows.map(previewEntry), start, dims, group.convention === 'xy'), [rows, start.join(','), dims, group.convention]);
   const activeEntry = moving && s?.command === runCommand ? (s?.entry_index ?? -1) : -1;
-  const view: ViewData = { preview: pv, trace: trace.current.points, now: s ? pointOf(s.position) : null, activeEntry, selectedEntry: selectedRow, dim: stale };
+
+  // ---- the server's plan of the rows (from where the path starts), redone on every edit
+  const [plan, setPlan] = useState<PathAnalysisResource | null>(null);
+  const [planFields, setPlanFields] = useState<Record<string, string>>({});
+  const [planError, setPlanError] = useState<string | null>(null);
+  const [planPending, setPlanPending] = useState(false);
+  const analysis = useMemo(
+    () =>
+      new LiveAnalysis<PathAnalysisBody, PathAnalysisResource>(
+        (body) => api.POST('/api/v1/path-analysis', { body }),
+        (a) => {
+          if (a.kind === 'ok') {
+            setPlan(a.result);
+            setPlanFields({});
+            setPlanError(null);
+          } else {
+            setPlan(null);
+            setPlanFields(a.kind === 'invalid' ? a.fields : {});
+            setPlanError(a.text);
+          }
+        },
+        setPlanPending,
+        { delay: 300, maxWait: 900 },
+      ),
+    [group.name],
+  );
+  useEffect(() => () => analysis.dispose(), [analysis]);
+  // While the group moves the start stays where it is (a run's plan is not redone each update).
+  const haveStart = runStart !== null || s !== null;
+  const startKey = haveStart && !(moving && runStart === null) ? roles.map((r) => start[roleDim(r)].toFixed(6)).join(',') : 'none';
+  useEffect(() => {
+    if (rows.length === 0) {
+      analysis.cancel();
+      setPlan(null);
+      setPlanFields({});
+      setPlanError(null);
+      setPlanPending(false);
+      return;
+    }
+    analysis.schedule(analysisBody(group.name, rows, roles, startKey === 'none' ? null : start));
+  }, [rows, startKey, analysis]);
+  const planned = useMemo(() => (plan ? plannedTrace(plan) : null), [plan]);
+  const view: ViewData = { preview: pv, plan: planned, trace: trace.current.points, now: s ? pointOf(s.position) : null, activeEntry, selectedEntry: selectedRow, dim: stale || planPending };
+  const rowFields = { ...planFields, ...pathFields };
 
   const errorId = s?.error_id ?? 0;
   const err = errorId ? errorInfo(errorId) : null;
@@ -452,7 +508,7 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
     <>
       <ErrorBanner error={error} onClose={() => setError(null)} />
       <div class="group-grid">
-        <Panel title={<>Group {group.name}</>} class="group-online" actions={<span class={`live-ind live-${stale ? 'stale' : status ? 'live' : 'off'}`} data-live={stale ? 'stale' : status ? 'live' : 'off'} title="the group's status, read every 50 ms"><span class="live-dot" />{stale ? 'stale' : status ? 'live' : 'waiting'}</span>}>
+        <Panel title={<>Group {group.name}</>} class="group-online" actions={<span class={`live-ind live-${stale ? 'stale' : status ? 'live' : 'off'}`} data-live={stale ? 'stale' : status ? 'live' : 'off'} title={`the group's status over the websocket (groups/${group.name}/status, ${GROUP_RATE_HZ} Hz)`}><span class="live-dot" />{stale ? 'stale' : status ? 'live' : 'waiting'}</span>}>
           <div class="group-state-row">
             <GroupLamp status={s} label={false} />
             <b class="group-state" data-testid="group-state">{s ? stateText(s) : '—'}</b>
@@ -511,17 +567,41 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
             ))}
           </div>
         </Panel>
-        <Panel title="Path view" class="group-view" actions={<span class="muted small">preview from the rows · <span style="color:#e8590c">live trace</span></span>}>
-          <div class="view-planes">
+        <Panel
+          title="Path view"
+          class="group-view"
+          actions={
+            <span class="view-legend small">
+              <span class="key key-plan">planned</span>
+              <span class="key key-blend">blend</span>
+              <span class="key key-programmed">programmed</span>
+              <span class="key key-trace">live trace</span>
+            </span>
+          }
+        >
+          <div class={`view-planes ${group.convention !== 'xy' ? 'view-planes-3d' : ''}`}>
             <PathCanvas data={view} plane={XY} />
             {group.convention !== 'xy' && <PathCanvas data={view} plane={XZ} />}
+            {group.convention !== 'xy' && <PathCanvas data={view} plane={YZ} />}
           </div>
+          <p class="small view-note" data-testid="plan-summary" data-state={planPending ? 'pending' : plan ? 'ok' : planError ? 'refused' : 'none'} data-length={plan?.length ?? ''} data-duration={plan?.duration ?? ''}>
+            {plan ? (
+              <>
+                <b>{planText(plan)}</b> <span class="muted">(at 100 % override, blockers released at once)</span>
+              </>
+            ) : planError ? <span class="text-error">not planned: {planError}</span> : <span class="muted">{rows.length ? 'planning…' : 'no rows to plan'}</span>}
+            {planPending && plan && <span class="muted"> · planning the edit…</span>}
+          </p>
           <p class="muted small view-note" data-testid="preview-length">
             {pv.segments.length} segments, programmed length {num(pv.length, 2)}
             {pv.errors.length > 0 && <span class="text-error"> · row {pv.errors.map((e) => `${e.entry + 1}: ${e.text}`).join('; ')}</span>}
           </p>
         </Panel>
       </div>
+
+      <Panel title="Planned dynamics" class="plan-panel" actions={<span class="muted small">the server's plan of the rows over time · blends shaded · each row's start marked</span>}>
+        <PlanCharts plan={plan} roles={roles} unit={axisUnit} live={liveRun.current} />
+      </Panel>
 
       <Panel
         title="Path (MC_MovePath)"
@@ -558,7 +638,7 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
             {pathError}
           </p>
         )}
-        {pathFields.entries && <p class="field-error">{pathFields.entries}</p>}
+        {(pathFields.entries ?? planFields.entries) && <p class="field-error">{pathFields.entries ?? planFields.entries}</p>}
         <div class="table-scroll">
           <table class="grid path-table">
             <thead>
@@ -581,7 +661,7 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
                   index={i}
                   count={rows.length}
                   roles={roles}
-                  errors={rowErrors(pathFields, i)}
+                  errors={rowErrors(rowFields, i)}
                   selected={selectedRow === i}
                   active={activeEntry === i}
                   onSelect={() => setSelectedRow(i)}
@@ -617,6 +697,23 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
       </Panel>
     </>
   );
+}
+
+/** The charts of the plan (groups/chart.ts): made once per group, fed the plan and the live run. */
+function PlanCharts({ plan, roles, unit, live: run }: { plan: PathAnalysisResource | null; roles: GroupRole[]; unit: string; live: LiveRun }) {
+  const ref = useRef<HTMLDivElement>(null);
+  const chart = useRef<PlanChart | null>(null);
+  useEffect(() => {
+    if (!ref.current) return;
+    chart.current = new PlanChart(ref.current, roles, unit);
+    return () => {
+      chart.current?.destroy();
+      chart.current = null;
+    };
+  }, [roles.join(','), unit]);
+  useEffect(() => chart.current?.setPlan(plan), [plan, roles.join(','), unit]);
+  useEffect(() => chart.current?.setLive(run.t, run.v), [run.t.length, run.running]);
+  return <div ref={ref} class="plan-chart" data-testid="plan-chart" />;
 }
 
 function Readout({ name, label, value, unit }: { name: string; label: string; value: string; unit?: string }) {
@@ -659,7 +756,7 @@ function PathCanvas({ data, plane }: { data: ViewData; plane: Plane }) {
   }, []);
   return (
     <figure class="path-plane">
-      <canvas ref={ref} class="path-canvas" data-plane={plane.name} data-trace={data.trace.length} data-segments={data.preview?.segments.length ?? 0} />
+      <canvas ref={ref} class="path-canvas" data-plane={plane.name} data-trace={data.trace.length} data-segments={data.preview?.segments.length ?? 0} data-plan={data.plan?.points.length ?? 0} />
       <figcaption class="small muted">{plane.hLabel}{plane.vLabel} plane</figcaption>
     </figure>
   );
