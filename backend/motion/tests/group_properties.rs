@@ -38,7 +38,8 @@ enum Interruption {
     Stop,
     Override(f64),
     Fault(u16),
-    Aborting([f64; 3]),
+    /// An aborting MovePath to the point, blending (§7.3) with this corner distance.
+    Aborting([f64; 3], Option<f64>),
 }
 
 fn point() -> impl Strategy<Value = [f64; 3]> {
@@ -82,7 +83,8 @@ fn interruption() -> impl Strategy<Value = (usize, Interruption)> {
             Just(Interruption::Stop),
             (0.0..1.2f64).prop_map(Interruption::Override),
             (0u16..3).prop_map(Interruption::Fault),
-            point().prop_map(Interruption::Aborting),
+            (point(), prop::option::of(0.5..30.0f64))
+                .prop_map(|(p, r)| Interruption::Aborting(p, r)),
         ],
     )
 }
@@ -263,11 +265,14 @@ proptest! {
                         r.gok(G, CommandKind::GroupSetOverride { factor: f });
                     }
                     Interruption::Fault(a) => r.plants[a as usize].fault = true,
-                    Interruption::Aborting(p) => {
+                    Interruption::Aborting(p, radius) => {
                         let e = PathEntry::Linear {
                             position: pt(p),
                             count: 3,
-                            motion: EntryMotion { buffer_mode: BufferMode::Aborting, ..motion_of(300.0, None) },
+                            motion: EntryMotion {
+                                buffer_mode: BufferMode::Aborting,
+                                ..motion_of(300.0, radius.map(|r| (r, r)))
+                            },
                             invoke_id: 99,
                         };
                         let (_, v) = r.path(G, vec![e]);

@@ -6810,7 +6810,7 @@ export interface components {
             /** @description TransitionParameter[1..]: 1 for corner_distance, 2 for corner_distance_advanced. */
             transition_parameters?: number[];
             /**
-             * Format: int32
+             * Format: int64
              * @description Echoed in the group status while the entry runs.
              * @default 0
              */
@@ -6837,7 +6837,7 @@ export interface components {
             transition_mode?: null | components["schemas"]["TransitionModeDto"];
             transition_parameters?: number[];
             /**
-             * Format: int32
+             * Format: int64
              * @default 0
              */
             invoke_id: number;
@@ -6845,13 +6845,13 @@ export interface components {
             type: "circular";
         } | {
             /**
-             * Format: int32
+             * Format: int64
              * @description > 0.
              */
             blocker_id: number;
             buffer_mode?: null | components["schemas"]["BufferMode"];
             /**
-             * Format: int32
+             * Format: int64
              * @default 0
              */
             invoke_id: number;
@@ -6865,7 +6865,7 @@ export interface components {
             time: number;
             buffer_mode?: null | components["schemas"]["BufferMode"];
             /**
-             * Format: int32
+             * Format: int64
              * @default 0
              */
             invoke_id: number;
@@ -7403,7 +7403,7 @@ export interface components {
          */
         ReleaseBlockerBody: {
             /**
-             * Format: int32
+             * Format: int64
              * @description The blocker's id (> 0).
              */
             blocker_id: number;

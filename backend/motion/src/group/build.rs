@@ -333,7 +333,7 @@ pub(super) fn join(
     back: &Item,
     radii: (f64, f64),
     items: &mut Vec<Item>,
-    reachable: impl Fn(f64) -> bool,
+    mut reachable: impl FnMut(f64, f64) -> bool,
 ) -> Result<BackTrim, ErrorId> {
     let (ItemKind::Motion(pseg), Some(first)) = (back.kind, items.first().copied()) else {
         return Ok(None);
@@ -350,7 +350,7 @@ pub(super) fn join(
         worth_blending(&blim, &back.limits, &first.limits).then_some((b, bseg, blim))
     });
     if let Some(((cut_prev, _, cut_next), bseg, blim)) = blended {
-        if reachable(cut_prev) {
+        if reachable(cut_prev, blim.velocity.min(first.limits.velocity)) {
             check_soft_limits(&bseg, limits)?;
             trim = Some((
                 pseg.trimmed(0.0, cut_prev),

@@ -127,6 +127,9 @@ struct StopCommand {
     released: bool,
 }
 
+/// Virtual corners an aborting blend tries (§7.3, decision 154).
+const ABORT_CORNER_TRIES: usize = 8;
+
 /// MovePaths a group keeps in flight at most.
 const MAX_PATH_COMMANDS: usize = 64;
 
@@ -941,10 +944,16 @@ impl Group {
         // A path during a stop's ramp starts where the stop ends, whatever its BufferMode.
         let aborting =
             (first == BufferMode::Aborting && !self.run.is_idle()) || self.run.is_braking();
+        if aborting && first == BufferMode::Aborting {
+            if let Some(radii) = table.first_job().and_then(PathEntry::corner_distance) {
+                if self.abort_blending(id, table, radii, axes, cycle, events)? {
+                    return Ok(());
+                }
+            }
+        }
         if aborting {
             // Velocity 0 at the transition (§7.3): the running path stops on itself first,
-            // and the new one is built from where it stands (an aborting CornerDistance
-            // blend from the virtual corner is decision 129).
+            // and the new one is built from where it stands (decision 129).
             let (dec, jerk) = self.front_dynamics();
             self.run.brake(dec, jerk);
             self.end_all_paths(cycle, events, aborted());
@@ -984,7 +993,7 @@ impl Group {
                     .first_job()
                     .and_then(PathEntry::corner_distance)
                     .unwrap_or((0.0, 0.0));
-                build::join(&ctx, &back, radii, &mut scratch, |cut| {
+                build::join(&ctx, &back, radii, &mut scratch, |cut, _| {
                     self.blend_reachable(&back, cut)
                 })
                 .map(|t| (t, frame))
@@ -1025,6 +1034,130 @@ impl Group {
         self.scratch = scratch;
         self.update_status(axes);
         Ok(())
+    }
+
+    /// §7.3 Aborting × CornerDistance: the new path blends from the running one at the
+    /// virtual corner — where the running path would come to rest if it stopped now — and
+    /// what is queued behind that point is dropped. A jerk-limited path cannot enter a blend
+    /// that starts just before its rest point at the blend's velocity, so when it cannot, the
+    /// corner moves on along the running path (by the corner distance, a few times) to the
+    /// first point from which it can (decision 154). False (nothing changed) when there is no
+    /// such corner on the motion items ahead: the caller stops first, as for None.
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the cycle's context, one call site"
+    )]
+    fn abort_blending(
+        &mut self,
+        id: CommandId,
+        table: &PathTable,
+        radii: (f64, f64),
+        axes: &mut [Option<Box<Axis>>],
+        cycle: u64,
+        events: &mut impl EventSink,
+    ) -> Result<bool, ErrorId> {
+        let (dec, jerk) = self.front_dynamics();
+        let Some(rest) = self.run.rest_s(dec, jerk) else {
+            return Ok(false);
+        };
+        let ctx = self.context(axes);
+        // The entries up to the first job decide the blend: tried first on their own.
+        let first = table
+            .entries
+            .iter()
+            .position(|e| !matches!(e, PathEntry::CoordinateTransform { .. }))
+            .unwrap_or(0);
+        let mut scratch = core::mem::take(&mut self.scratch);
+        let mut planner = self.spare.pop();
+        let step = radii.0.max(radii.1).max(1e-3);
+        let mut found = None;
+        let mut rest_item = None;
+        for k in 0..ABORT_CORNER_TRIES {
+            let Some((i, back)) = self.run.cut_point(rest + k as f64 * step) else {
+                break;
+            };
+            // The corner stays in the item the rest point lies in, and no corner blend lies
+            // between the path and it (the items up to it keep the plan they were
+            // checked with).
+            if *rest_item.get_or_insert(i) != i
+                || self.run.items.iter().take(i + 1).any(|it| it.blend)
+            {
+                break;
+            }
+            let ItemKind::Motion(back_seg) = back.kind else {
+                break;
+            };
+            scratch.clear();
+            let head = &table.entries[..=first];
+            if build::build(&ctx, id, head, back_seg.end(), back.end_s(), &mut scratch).is_err() {
+                break;
+            }
+            let run = &self.run;
+            let joined = build::join(&ctx, &back, radii, &mut scratch, |cut, v| {
+                planner
+                    .as_mut()
+                    .is_some_and(|p| run.can_pass(p, back.s0 + cut, v, &back.limits))
+            });
+            if let Ok(Some(t)) = joined {
+                found = Some((i, back, back_seg, t));
+                break;
+            }
+            if i + 1 == self.run.items.len() && back.end_s() <= rest + k as f64 * step {
+                break;
+            }
+        }
+        if let Some(p) = planner {
+            self.spare.push(p);
+        }
+        let Some((i, back, back_seg, _)) = found else {
+            self.scratch = scratch;
+            return Ok(false);
+        };
+        // The whole table from that corner, and its blend.
+        scratch.clear();
+        let built = build::build(
+            &ctx,
+            id,
+            &table.entries,
+            back_seg.end(),
+            back.end_s(),
+            &mut scratch,
+        )
+        .map_err(|(_, e)| e)
+        .and_then(|frame| {
+            build::join(&ctx, &back, radii, &mut scratch, |_, _| true).map(|t| (t, frame))
+        });
+        let (back_trim, frame_after) = match built {
+            Ok((Some(t), frame)) => (t, frame),
+            Ok((None, _)) => {
+                self.scratch = scratch;
+                return Ok(false);
+            }
+            Err(e) => {
+                self.scratch = scratch;
+                return Err(e);
+            }
+        };
+        // Accepted: the running path is cut at the corner, the new one blends on from there.
+        self.end_all_paths(cycle, events, aborted());
+        if let Some(s) = self.stop.take() {
+            self.event(events, cycle, s.id, aborted());
+        }
+        let (seg, len, corner) = back_trim;
+        let mut cut = back;
+        cut.kind = ItemKind::Motion(seg);
+        cut.len = len;
+        cut.corner = corner;
+        self.run.cut_at(i, cut);
+        if self.shift == [0.0; 3] {
+            self.frame = frame_after;
+        }
+        self.paths[0] = Some(PathCommand { id, out: busy() });
+        self.event(events, cycle, id, busy());
+        self.run.append(scratch.drain(..));
+        self.scratch = scratch;
+        self.update_status(axes);
+        Ok(true)
     }
 
     /// The deceleration and jerk the running item plans with (an aborting path's stop).

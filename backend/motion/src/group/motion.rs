@@ -256,6 +256,87 @@ impl PathRun {
         self.s = Kinematics::default();
     }
 
+    /// Where (global s) the path would come to rest if it braked now with `dec`/`jerk` (§7.3:
+    /// the virtual corner of an aborting MovePath that blends). None when it is not moving
+    /// along motion items (it stands, waits or already brakes).
+    pub(super) fn rest_s(&self, dec: f64, jerk: f64) -> Option<f64> {
+        if !matches!(self.exec, Exec::Follow { .. }) || self.braking.is_some() {
+            return None;
+        }
+        // In plan time, as the items are planned (the override scales time, not distance).
+        let reach = crate::planner::stop_distance(self.s.velocity, self.s.acceleration, dec, jerk);
+        Some(self.s.position + reach)
+    }
+
+    /// The motion item global `s` lies in (the last one when `s` is beyond the queue) and
+    /// that item cut there (a point inside a corner blend is moved to the blend's end). None
+    /// when a dwell or a blocker comes first.
+    pub(super) fn cut_point(&self, s: f64) -> Option<(usize, Item)> {
+        let mut found = None;
+        for (i, it) in self.items.iter().enumerate() {
+            if !matches!(it.kind, ItemKind::Motion(_)) {
+                return None;
+            }
+            found = Some(i);
+            if s <= it.end_s() {
+                break;
+            }
+        }
+        let i = found?;
+        let mut it = self.items[i];
+        let ItemKind::Motion(seg) = it.kind else {
+            return None;
+        };
+        let local = (s - it.s0).clamp(0.0, it.len);
+        if !it.blend && local < it.len {
+            let cut = seg.trimmed(0.0, local);
+            it.kind = ItemKind::Motion(cut);
+            it.len = cut.length();
+        }
+        Some((i, it))
+    }
+
+    /// Cuts the queue after item `i`, which becomes `cut` (from [`PathRun::cut_point`]);
+    /// what is left belongs to no command (the caller ends them) and is planned again.
+    pub(super) fn cut_at(&mut self, i: usize, cut: Item) {
+        self.items.truncate(i + 1);
+        if let Some(it) = self.items.get_mut(i) {
+            *it = cut;
+        }
+        for it in self.items.iter_mut() {
+            it.command = 0;
+            it.last = false;
+        }
+        self.last_started = 0;
+        self.entries = self.items.iter().filter(|i| !i.blend).count() as u32;
+        self.look_ahead();
+        self.exec = Exec::Follow { planned: false };
+    }
+
+    /// Whether the path, from where it is now, can pass global `s` no faster than
+    /// `velocity` within `limits` (a trial plan on `planner`).
+    pub(super) fn can_pass(
+        &self,
+        planner: &mut Planner,
+        s: f64,
+        velocity: f64,
+        limits: &Limits,
+    ) -> bool {
+        // In plan time, as the item will be planned again.
+        let from = self.s;
+        if s <= from.position + 1e-9 {
+            return false;
+        }
+        let lim = Limits {
+            velocity: limits.velocity.max(from.velocity),
+            ..*limits
+        };
+        matches!(
+            planner.plan_position_towards(from, s, velocity, &lim),
+            Ok(v) if v <= velocity * (1.0 + 1e-9) + 1e-9
+        )
+    }
+
     /// Appends items (already built and checked) and runs the look-ahead.
     pub(super) fn append(&mut self, new: impl Iterator<Item = Item>) {
         for it in new {
@@ -386,11 +467,17 @@ impl PathRun {
         let step = if q.is_finite() { q * dt } else { f64::INFINITY };
         self.k_rate += (desired - self.k_rate).clamp(-step, step);
         let next = self.k + self.k_rate * dt;
-        if (target - next) * diff <= 0.0 {
+        // Arriving: the rate ends there only when one step of its change can end it (a
+        // target changed in the middle of a ramp may be passed and come back to: a step of
+        // the rate is a step of the path acceleration, k'·v).
+        if (target - next) * diff <= 0.0 && self.k_rate.abs() <= step {
             self.k = target;
             self.k_rate = 0.0;
         } else {
             self.k = next.clamp(0.0, 1.0);
+            if self.k != next {
+                self.k_rate = 0.0;
+            }
         }
     }
 

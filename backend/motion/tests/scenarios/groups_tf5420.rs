@@ -1558,3 +1558,104 @@ fn s4_2_a_halt_at_a_low_override_brakes_in_real_time_with_its_own_deceleration()
     assert!(r.gst(G).path_velocity <= 20.0 + 1e-9);
     run_done(&mut r, p, 60.0);
 }
+
+/// §7.3 Aborting × CornerDistance: the new path blends from the running one at the virtual
+/// corner — where the running path would come to rest if it stopped now, or (a jerk-limited
+/// path cannot enter a blend just before its rest point at the blend's velocity) the first
+/// point a corner distance on from which it can (decision 154) — without stopping; the
+/// blend stays within the tolerance sphere around that corner; what was queued behind it is
+/// dropped.
+#[test]
+fn s7_3_an_aborting_move_path_with_corner_distance_blends_at_the_virtual_corner() {
+    let mut r = rig_xy();
+    enable(&mut r);
+    let a = r.path_ok(
+        G,
+        vec![lin(&[300.0, 0.0], 200.0), lin(&[300.0, 300.0], 200.0)],
+    );
+    r.until(2.0, |r| at(r, 0) > 100.0);
+    let s = r.gst(G);
+    assert!((s.path_velocity - 200.0).abs() < 1e-9, "cruising: {s:?}");
+    // At 200 mm/s, a deceleration of 1000 and a jerk of 5000 (the group's defaults) the
+    // path comes to rest 40 mm on.
+    let rest = at(&r, 0) + 200.0 * 0.4 / 2.0;
+    let target = [rest + 150.0, 30.0];
+    let b = r.path_ok(
+        G,
+        vec![lin_with(
+            &target,
+            200.0,
+            BufferMode::Aborting,
+            TransitionMode::CornerDistance,
+            &[10.0],
+        )],
+    );
+    assert!(r.out(a).command_aborted && r.out(b).busy);
+    let (mut min_v, mut blended, mut trace) = (f64::INFINITY, false, Vec::new());
+    for _ in 0..5000 {
+        if r.out(b).done {
+            break;
+        }
+        r.step();
+        let g = r.gst(G);
+        let (x, y) = (at(&r, 0), at(&r, 1));
+        if ((x - target[0]).powi(2) + (y - target[1]).powi(2)).sqrt() > 1.0 {
+            min_v = min_v.min(g.path_velocity);
+        }
+        blended |= g.in_blending_segment;
+        trace.push((x, y));
+    }
+    assert!(r.out(b).done && blended);
+    assert!(min_v > 1.0, "no stop at the corner: {min_v}");
+    // The corner: the blend left the first line 10 mm before it, at rest + k · 10 mm.
+    let leave = trace.iter().take_while(|p| p.1 == 0.0).last().unwrap().0;
+    let k = ((leave + 10.0 - rest) / 10.0).round();
+    let corner = rest + 10.0 * k;
+    assert!((0.0..8.0).contains(&k), "{k}");
+    assert!((leave + 10.0 - corner).abs() < 0.5, "{leave} {corner}");
+    let slope = target[1] / (target[0] - corner);
+    for &(x, y) in &trace {
+        let on_first = y == 0.0 && x <= corner;
+        let on_second = (y - (x - corner) * slope).abs() < 1e-6 && x >= corner - 1e-9;
+        let from_corner = ((x - corner).powi(2) + y.powi(2)).sqrt();
+        assert!(
+            on_first || on_second || from_corner <= 10.0 + 1e-6,
+            "({x}, {y})"
+        );
+    }
+    assert_eq!((at(&r, 0), at(&r, 1)), (target[0], target[1]));
+    // The second entry of the aborted path was dropped.
+    r.run(0.2);
+    assert_eq!((at(&r, 0), at(&r, 1)), (target[0], target[1]));
+}
+
+/// A corner distance larger than the way to the rest point cannot be blended from where the
+/// path is: the aborting path stops on the running one first (as with None).
+#[test]
+fn s7_3_an_aborting_corner_distance_that_cannot_be_reached_stops_first() {
+    let mut r = rig_xy();
+    enable(&mut r);
+    let a = r.path_ok(G, vec![lin(&[300.0, 0.0], 200.0)]);
+    r.until(2.0, |r| at(r, 0) > 100.0);
+    let b = r.path_ok(
+        G,
+        vec![lin_with(
+            &[200.0, 100.0],
+            200.0,
+            BufferMode::Aborting,
+            TransitionMode::CornerDistance,
+            &[60.0],
+        )],
+    );
+    assert!(r.out(a).command_aborted);
+    let mut stood = false;
+    for _ in 0..5000 {
+        if r.out(b).done {
+            break;
+        }
+        r.step();
+        stood |= r.gst(G).path_velocity == 0.0;
+    }
+    assert!(r.out(b).done && stood);
+    assert_eq!((at(&r, 0), at(&r, 1)), (200.0, 100.0));
+}

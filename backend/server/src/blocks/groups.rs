@@ -206,7 +206,7 @@ impl GroupStopBody {
 #[schema(example = json!({"blocker_id": 7}))]
 pub struct ReleaseBlockerBody {
     /// The blocker's id (> 0).
-    #[schema(minimum = 1)]
+    #[schema(value_type = i64, minimum = 1, maximum = 4294967295_u64)]
     pub blocker_id: u32,
 }
 
@@ -292,7 +292,7 @@ pub enum PathEntryDto {
         transition_parameters: Vec<f64>,
         /// Echoed in the group status while the entry runs.
         #[serde(default)]
-        #[schema(default = 0)]
+        #[schema(default = 0, value_type = i64, minimum = 0, maximum = 4294967295_u64)]
         invoke_id: u32,
     },
     /// MC_MoveCircularAbsolutePreparation.
@@ -326,18 +326,19 @@ pub enum PathEntryDto {
         #[schema(max_items = 2)]
         transition_parameters: Vec<f64>,
         #[serde(default)]
-        #[schema(default = 0)]
+        #[schema(default = 0, value_type = i64, minimum = 0, maximum = 4294967295_u64)]
         invoke_id: u32,
     },
     /// MC_BlockerPreparation.
     Blocker {
         /// > 0.
+        #[schema(value_type = i64, minimum = 1, maximum = 4294967295_u64)]
         blocker_id: u32,
         /// `buffered` (default) or, as the first entry, `aborting`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         buffer_mode: Option<BufferMode>,
         #[serde(default)]
-        #[schema(default = 0)]
+        #[schema(default = 0, value_type = i64, minimum = 0, maximum = 4294967295_u64)]
         invoke_id: u32,
     },
     /// MC_DwellTimePreparation: the path stands still for `time`.
@@ -348,7 +349,7 @@ pub enum PathEntryDto {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         buffer_mode: Option<BufferMode>,
         #[serde(default)]
-        #[schema(default = 0)]
+        #[schema(default = 0, value_type = i64, minimum = 0, maximum = 4294967295_u64)]
         invoke_id: u32,
     },
     /// MC_SetCoordinateTransformPreparation: the entries after it are read in this frame.
