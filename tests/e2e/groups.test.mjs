@@ -239,4 +239,44 @@ describe('groups page', () => {
     assert.equal(s.position.y, 20);
     await page.close();
   });
+  test("the scope records the group's path velocity beside an axis: picked as a group channel, drawn, named in the legend", async () => {
+    const st = await groupStatus();
+    if (st.state !== 'standby') {
+      await powerOn(stack.api, ['x', 'y']);
+      await rest(stack.api, 'POST', '/groups/xy/enable?wait=true', {});
+      await until(async () => (await groupStatus()).state === 'standby', { what: 'group standby' });
+    }
+    const page = await openPage(browser, `${stack.url}/#/scope`);
+    await page.waitForSelector('[data-channel="0"]');
+    while ((await page.locator('[data-channel]').count()) < 2) await page.click('button[name="add-channel"]');
+    while ((await page.locator('[data-channel]').count()) > 2) await page.locator('[data-channel="2"] button').click();
+    // The group is among the sources; its signals are the path's.
+    await select(page, 'channel-0-axis', 'group:xy');
+    const signals = await page.locator('select[name="channel-0-signal"] option').evaluateAll((os) => os.map((o) => o.value));
+    assert.deepEqual(signals, ['path_position', 'path_velocity', 'path_acceleration', 'entry_index']);
+    await select(page, 'channel-0-signal', 'path_velocity');
+    await select(page, 'channel-1-axis', 'x');
+    await select(page, 'channel-1-signal', 'set_position');
+    await page.fill('input[name="duration_s"]', '3');
+    await page.click('button[name="record"]');
+    await page.waitForSelector('[data-testid="recording-state"]', { timeout: 10000 });
+    const rec = (await rest(stack.api, 'GET', '/scope/recordings')).body[0];
+    assert.deepEqual(
+      rec.channels.map((c) => [c.group ?? c.axis, c.signal]),
+      [['xy', 'path_velocity'], ['x', 'set_position']],
+    );
+    const x0 = (await groupStatus()).position.x;
+    const r = await rest(stack.api, 'POST', '/groups/xy/move-path', {
+      entries: [{ type: 'linear', position: [x0 + 50, 20], velocity: 100 }],
+    });
+    assert.equal(r.status, 202, JSON.stringify(r.body));
+    await until(async () => (await rest(stack.api, 'GET', `/scope/recordings/${rec.id}`)).body.state === 'done', { what: 'recording done', timeout: 20000 });
+    const done = (await rest(stack.api, 'GET', `/scope/recordings/${rec.id}`)).body;
+    const v = done.data[0];
+    assert.ok(Math.max(...v) > 99 && Math.max(...v) <= 100 + 1e-9, `the path velocity reached 100: ${Math.max(...v)}`);
+    assert.equal(done.channels[0].unit, 'mm/s');
+    await page.waitForSelector('[data-testid="scope-chart"] canvas', { timeout: 20000 });
+    assert.match(await page.locator('[data-testid="scope-chart"]').textContent(), /xy\.path_velocity/);
+    await page.close();
+  });
 });

@@ -31,6 +31,16 @@ export const getRecording = (id: Recording['id']) => api.GET(recording, { params
 export const cancelRecording = (id: Recording['id']) => api.DELETE(recording, { params: { path: { id } } });
 export const csvUrl = (id: Recording['id']) => `/api/v1/scope/recordings/${encodeURIComponent(String(id))}?format=csv`;
 
+/** The names of the axis groups (their path signals can be recorded); [] when there are none. */
+export async function listGroupNames(): Promise<string[]> {
+  try {
+    const l = await api.GET('/api/v1/groups');
+    return Array.isArray(l) ? l.map((g) => g.name) : [];
+  } catch {
+    return [];
+  }
+}
+
 // Saved scope setups (GET /scope/setups, GET/PUT/DELETE /scope/setups/{name}).
 type Setup = components['schemas']['ScopeSetup'];
 const setup = '/api/v1/scope/setups/{name}';

@@ -6,6 +6,7 @@ import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { useStore } from '../../store';
 import { axes, scope, scopeLive, system } from '../../services';
 import {
+  GROUP_SIGNALS,
   MAX_CHANNELS,
   SIGNALS,
   SIGNAL_LABEL,
@@ -24,7 +25,7 @@ import {
   type ScopeForm,
   type Signal,
 } from '../../scope/data';
-import { csvUrl, deleteSetup, getRecording, listSetups, putSetup, scopeAvailable } from '../../scope/api';
+import { csvUrl, deleteSetup, getRecording, listGroupNames, listSetups, putSetup, scopeAvailable } from '../../scope/api';
 import { ScopeStack, type ChartSeries, type StackPane } from '../../scope/chart';
 import { Rolling, donePolling } from '../../scope/rolling';
 import {
@@ -76,6 +77,11 @@ export function ScopePage() {
   const online = useOnline();
   const unitOf = (axis: string | null | undefined) => list.find((a) => a.config.name === axis)?.config.unit ?? '';
   const [available, setAvailable] = useState<boolean | null>(null);
+  // Axis groups: a channel may record a group's path signals.
+  const [groupNames, setGroupNames] = useState<string[]>([]);
+  useEffect(() => {
+    void listGroupNames().then(setGroupNames);
+  }, []);
   const defaultChannels = (): ScopeForm['channels'] =>
     list.length
       ? [
@@ -423,14 +429,34 @@ export function ScopePage() {
                     />
                     {i}
                   </span>
-                  <select name={`channel-${i}-axis`} value={c.axis} title="axis" onChange={(e) => setChannel(i, { axis: (e.target as HTMLSelectElement).value })}>
+                  <select
+                    name={`channel-${i}-axis`}
+                    value={c.group ? `group:${c.group}` : c.axis}
+                    title="axis or group"
+                    onChange={(e) => {
+                      const v = (e.target as HTMLSelectElement).value;
+                      if (v.startsWith('group:')) {
+                        setChannel(i, { axis: '', group: v.slice('group:'.length), signal: GROUP_SIGNALS.includes(c.signal) ? c.signal : 'path_velocity' });
+                      } else {
+                        setChannel(i, { axis: v, group: undefined, signal: SIGNALS.includes(c.signal) ? c.signal : 'set_position' });
+                      }
+                    }}
+                  >
                     {list.map((a) => (
                       <option value={a.config.name}>{a.config.name}</option>
                     ))}
                     {c.axis && !list.some((a) => a.config.name === c.axis) && <option value={c.axis}>{c.axis} (missing)</option>}
+                    {(groupNames.length > 0 || c.group) && (
+                      <optgroup label="groups (path)">
+                        {groupNames.map((g) => (
+                          <option value={`group:${g}`}>{g}</option>
+                        ))}
+                        {c.group && !groupNames.includes(c.group) && <option value={`group:${c.group}`}>{c.group}</option>}
+                      </optgroup>
+                    )}
                   </select>
                   <select name={`channel-${i}-signal`} value={c.signal} title="signal" onChange={(e) => setChannel(i, { signal: (e.target as HTMLSelectElement).value as Signal })}>
-                    {SIGNALS.map((s) => (
+                    {(c.group ? GROUP_SIGNALS : SIGNALS).map((s) => (
                       <option value={s}>{SIGNAL_LABEL[s]}</option>
                     ))}
                   </select>
@@ -456,9 +482,9 @@ export function ScopePage() {
                   >
                     ×
                   </button>
-                  {(errors[`channels[${i}].axis`] || errors[`channels[${i}].signal`]) && (
+                  {(errors[`channels[${i}].axis`] || errors[`channels[${i}].group`] || errors[`channels[${i}].signal`]) && (
                     <div class="field-error channel-error" role="alert">
-                      {errors[`channels[${i}].axis`] ?? errors[`channels[${i}].signal`]}
+                      {errors[`channels[${i}].axis`] ?? errors[`channels[${i}].group`] ?? errors[`channels[${i}].signal`]}
                     </div>
                   )}
                 </div>
