@@ -612,6 +612,14 @@ async fn a_group_tracks_a_conveyor_until_a_frame_detaches_it() {
     let st = until_group(&s, "standby after detaching", |st| st["state"] == "standby").await;
     assert!(st.get("tracking").is_none(), "{st}");
     assert_eq!(st["tracking_velocity"], 0.0, "{st}");
+    // The members' actual positions beside the set point (the drives' feedback, same cycle).
+    for role in ["x", "y"] {
+        let (set, actual) = (&st["position"][role], &st["actual_position"][role]);
+        assert!(
+            (set.as_f64().unwrap() - actual.as_f64().unwrap()).abs() < 0.05,
+            "{role}: {st}"
+        );
+    }
 
     // The group's commands, by group: each names its group and no axis.
     let r = get(&s, "/api/v1/commands?group=xy").await;

@@ -5214,6 +5214,10 @@ export interface components {
          *       "override_ramp_time": 0.1,
          *       "status": {
          *         "actual_override": 1,
+         *         "actual_position": {
+         *           "x": 0,
+         *           "y": 0
+         *         },
          *         "all_axes_standing": true,
          *         "axes_count": 2,
          *         "blocked": false,
@@ -5301,6 +5305,10 @@ export interface components {
          *     MC_GroupReadBlockerStatus), as of `cycle`.
          * @example {
          *       "actual_override": 1,
+         *       "actual_position": {
+         *         "x": 0,
+         *         "y": 0
+         *       },
          *       "all_axes_standing": true,
          *       "axes_count": 2,
          *       "blocked": false,
@@ -5419,6 +5427,10 @@ export interface components {
             queued_entries: number;
             /** @description The group's set point of each role of its configuration. */
             position: {
+                [key: string]: number;
+            };
+            /** @description The member axes' actual positions (their drives' feedback) by role, of the same cycle. */
+            actual_position: {
                 [key: string]: number;
             };
             /**

@@ -1,7 +1,7 @@
 // The live XY (XZ, YZ) view of a group's path on a canvas: the path as the server plans it
 // (plan.ts: the sampled trace, corner blends in their own colour), the programmed geometry
 // faintly beneath it (points, lines, arcs, corner tolerance circles: geometry.ts), and the live
-// trace of the group's set positions drawn over the plan while it runs, on one scale for both
+// trace of the members' actual positions drawn over the plan while it runs, on one scale for both
 // axes (a circle stays round, which uPlot's independent scales would not keep), with a grid of
 // round numbers. Drawing only: the data come from geometry.ts, plan.ts and the trace buffer
 // below. No UI framework, no global state.

@@ -161,9 +161,32 @@ impl AppState {
         &self,
         slot: motion::group::GroupId,
     ) -> (u64, Option<motion::group::GroupStatus>) {
+        let (cycle, st, _) = self.group_status_and_actuals(slot);
+        (cycle, st)
+    }
+
+    /// A group's status with its members' actual positions (by role dimension; NaN where a
+    /// role has no axis), both of the same cycle.
+    pub fn group_status_and_actuals(
+        &self,
+        slot: motion::group::GroupId,
+    ) -> (
+        u64,
+        Option<motion::group::GroupStatus>,
+        [f64; motion::path::MAX_PATH_DIMS],
+    ) {
         let mut out = self.snapshot.lock().unwrap();
         let s = out.read();
-        (s.cycle, s.groups.get(slot as usize).copied().flatten())
+        let st = s.groups.get(slot as usize).copied().flatten();
+        let mut actual = [f64::NAN; motion::path::MAX_PATH_DIMS];
+        if let Some(g) = &st {
+            for (a, m) in actual.iter_mut().zip(g.members) {
+                if let Some(Some(axis)) = m.and_then(|m| s.axes.get(m as usize)) {
+                    *a = axis.actual_position;
+                }
+            }
+        }
+        (s.cycle, st, actual)
     }
 
     /// A MovePath's items built here, off the cycle thread, from the group's queue end in the

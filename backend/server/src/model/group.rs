@@ -104,7 +104,7 @@ pub struct GroupMemberResource {
         "actual_override": 1.0, "path_velocity": 0.0, "path_acceleration": 0.0, "path_position": 0.0,
         "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
         "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
-        "position": {"x": 0.0, "y": 0.0},
+        "position": {"x": 0.0, "y": 0.0}, "actual_position": {"x": 0.0, "y": 0.0},
         "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0,
         "tracking_velocity": 0.0}}))]
 pub struct GroupResource {
@@ -129,7 +129,7 @@ pub struct GroupResource {
     "actual_override": 1.0, "path_velocity": 0.0, "path_acceleration": 0.0, "path_position": 0.0,
     "entry_index": 0, "invoke_id": 0, "in_blending_segment": false, "remaining_distance": 0.0,
     "remaining_time": 0.0, "blocked": false, "blocker_id": 0, "queued_entries": 0,
-    "position": {"x": 0.0, "y": 0.0},
+    "position": {"x": 0.0, "y": 0.0}, "actual_position": {"x": 0.0, "y": 0.0},
         "frame": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0]}, "prepared_paths": 0,
         "tracking_velocity": 0.0}))]
 pub struct GroupStatusDto {
@@ -175,6 +175,8 @@ pub struct GroupStatusDto {
     pub queued_entries: u32,
     /// The group's set point of each role of its configuration.
     pub position: BTreeMap<String, f64>,
+    /// The member axes' actual positions (their drives' feedback) by role, of the same cycle.
+    pub actual_position: BTreeMap<String, f64>,
     /// The coordinate frame later MovePaths are read in (MC_SetCoordinateTransform or a
     /// table's frame entry; a halt or stop clears it).
     pub frame: FrameDto,

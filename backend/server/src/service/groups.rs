@@ -51,6 +51,7 @@ pub fn status_dto(
     cycle: u64,
     config: &GroupConfig,
     st: &GroupStatus,
+    actual: &[f64; motion::path::MAX_PATH_DIMS],
 ) -> GroupStatusDto {
     let members = GroupRole::ALL
         .iter()
@@ -87,6 +88,11 @@ pub fn status_dto(
             .roles()
             .map(|r| (role_name(r), st.position[r.dim()]))
             .collect(),
+        actual_position: config
+            .roles()
+            .filter(|r| actual[r.dim()].is_finite())
+            .map(|r| (role_name(r), actual[r.dim()]))
+            .collect(),
         frame: crate::model::FrameDto {
             translation: st.frame.translation,
             rotation: st.frame.rotation,
@@ -108,7 +114,7 @@ pub fn status_dto(
 }
 
 fn resource(s: &AppState, e: &GroupEntry) -> GroupResource {
-    let (cycle, st) = s.group_status(e.slot);
+    let (cycle, st, actual) = s.group_status_and_actuals(e.slot);
     let reg = s.registry.read().unwrap();
     GroupResource {
         id: e.id,
@@ -132,7 +138,7 @@ fn resource(s: &AppState, e: &GroupEntry) -> GroupResource {
         maximum_dynamics: e.config.maximum_dynamics,
         override_ramp_time: e.config.override_ramp_time,
         updated_at: e.updated_at.clone(),
-        status: st.map(|st| status_dto(&reg, cycle, &e.config, &st)),
+        status: st.map(|st| status_dto(&reg, cycle, &e.config, &st, &actual)),
     }
 }
 
@@ -148,12 +154,12 @@ pub fn get(s: &AppState, key: &str) -> AppResult<GroupResource> {
 /// The live status (MC_GroupReadStatus); 503 while the group is not in the cycle.
 pub fn status(s: &AppState, key: &str) -> AppResult<GroupStatusDto> {
     let e = entry(s, key)?;
-    let (cycle, st) = s.group_status(e.slot);
+    let (cycle, st, actual) = s.group_status_and_actuals(e.slot);
     let st = st.ok_or_else(|| {
         AppError::unavailable("group_not_in_cycle", "the group is not in the cycle yet")
     })?;
     let reg = s.registry.read().unwrap();
-    Ok(status_dto(&reg, cycle, &e.config, &st))
+    Ok(status_dto(&reg, cycle, &e.config, &st, &actual))
 }
 
 /// MC_GroupReadError.

@@ -7,7 +7,7 @@
 // /path-analysis`, debounced; its refusals land at their row and field too) and drawn — the
 // planned trace with its blends over the programmed geometry (groups/geometry.ts), the path
 // velocity and every axis's velocity and acceleration over time — and while the path runs, the
-// live trace and path velocity over the plan, from the group's websocket topic
+// live trace (the members' actual positions) and path velocity over the plan, from the group's websocket topic
 // `groups/{group}/status`.
 import { useEffect, useMemo, useRef, useState } from 'preact/hooks';
 import { api } from '../../api/client';
@@ -365,7 +365,8 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
   const [, setLiveTick] = useState(0);
   const { status, stale } = useGroupStatus(group.name, (s) => {
     if (s.state === 'moving' || s.state === 'stopping') {
-      trace.current.push(pointOf(s.position));
+      // The members' actual positions (their drives' feedback), of the status's cycle.
+      trace.current.push(pointOf({ ...s.position, ...s.actual_position }));
       liveRun.current.push(s.cycle, s.path_velocity);
       setLiveTick((n) => n + 1);
     }
@@ -558,7 +559,7 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
             )}
           </div>
           <div class="dro group-dro">
-            <Readout name="path_velocity" label="Path velocity" value={num(s?.path_velocity, 2)} unit="/s" />
+            <Readout name="path_velocity" label="Path velocity" value={num(s?.path_velocity, 2)} unit={`${axisUnit}/s`} />
             <Readout name="entry" label="Entry / invoke id" value={s && s.queued_entries > 0 ? `${s.entry_index + 1} / ${s.invoke_id}` : '—'} />
             <Readout name="remaining_distance" label="Remaining distance" value={num(s?.remaining_distance, 3)} />
             <Readout name="path_position" label="Path position" value={num(s?.path_position, 3)} />
@@ -575,7 +576,7 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
               <span class="key key-plan">planned</span>
               <span class="key key-blend">blend</span>
               <span class="key key-programmed">programmed</span>
-              <span class="key key-trace">live trace</span>
+              <span class="key key-trace" title="the member axes' actual positions while the path runs">live trace (actual)</span>
             </span>
           }
         >
