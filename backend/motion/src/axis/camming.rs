@@ -322,9 +322,20 @@ pub(super) struct CamState {
     last_master: Kinematics,
     /// MC_CamInfo of the last cam coupling, kept after an error ended it (until MC_CamOut).
     last_info: CamInfo,
+    /// The status's cam info is what it stays while no cam couples and nothing is queued
+    /// (it is not built again every cycle: it is large).
+    pub(super) idle_info: bool,
 }
 
 impl CamState {
+    /// No scaling, switch, V2 operation or table data waits to take effect.
+    pub(super) fn nothing_queued(&self) -> bool {
+        self.scaling.is_none()
+            && self.switch.is_none()
+            && self.v2_op.is_none()
+            && self.data.is_none()
+    }
+
     /// A coupling waits for its activation (the axis executes a job, §4.1.1).
     pub(super) fn waits_for_coupling(&self) -> bool {
         self.cam_in.is_some()
@@ -958,6 +969,7 @@ impl Axis {
             self.continue_at_current_velocity(cx);
         }
         self.cam.last_info = CamInfo::default();
+        self.cam.idle_info = false;
         cx.report(id, DONE);
         Ok(())
     }

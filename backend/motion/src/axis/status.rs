@@ -98,8 +98,16 @@ impl Axis {
         };
         s.set_position_offset = self.set_position_offset;
         s.active_command = job.map(|j| j.id).unwrap_or(0);
-        let (cam, queued, scaling) = self.cam_status();
-        let cam = self.cam.kept_info(cam);
+        // The cam info changes only while a cam couples or something is queued; idle, it is
+        // what it was when it became idle (the kept info or none).
+        let cam_idle = self.cam_set().is_none() && self.cam.nothing_queued();
+        let cam = if cam_idle && self.cam.idle_info {
+            None
+        } else {
+            let (cam, queued, scaling) = self.cam_status();
+            self.cam.idle_info = cam_idle;
+            Some((self.cam.kept_info(cam), queued, scaling))
+        };
         let op_modes = crate::status::AxisOpModes {
             position_area_monitoring: p.axis_en_position_range_monitoring,
             target_position_monitoring: p.axis_en_target_position_monitoring,
@@ -152,9 +160,11 @@ impl Axis {
         s.ptp_mode = !s.coupled;
         s.io_data_invalid = self.io_data_invalid;
         s.nc_cycle_counter = self.cycle;
-        s.cam = cam;
-        s.cam_table_queued = queued;
-        s.cam_scaling_pending = scaling;
-        s.cam_data_queued = cam.cam_data_queued;
+        if let Some((cam, queued, scaling)) = cam {
+            s.cam = cam;
+            s.cam_table_queued = queued;
+            s.cam_scaling_pending = scaling;
+            s.cam_data_queued = cam.cam_data_queued;
+        }
     }
 }
