@@ -279,4 +279,27 @@ describe('groups page', () => {
     assert.match(await page.locator('[data-testid="scope-chart"]').textContent(), /xy\.path_velocity/);
     await page.close();
   });
+  test('a conveyor tracking started over REST shows on the group panel: the conveyor, in sync; a static frame ends it', async () => {
+    if ((await groupStatus()).state !== 'standby') {
+      await powerOn(stack.api, ['x', 'y']);
+      await rest(stack.api, 'POST', '/groups/xy/enable?wait=true', {});
+      await until(async () => (await groupStatus()).state === 'standby', { what: 'group standby' });
+    }
+    await powerOn(stack.api, ['spindle']);
+    const mv = await rest(stack.api, 'POST', '/axes/spindle/move-velocity?wait=true', { velocity: 20 });
+    assert.equal(mv.body.outputs.in_velocity, true, JSON.stringify(mv.body));
+    const page = await openPage(browser, `${stack.url}/#/groups/xy`);
+    await page.waitForSelector('[data-testid="group-state"]');
+    const t = await rest(stack.api, 'POST', '/groups/xy/track-conveyor-belt?wait=true', {
+      conveyor: 'spindle', translation: [0, 50, 0], initial_object_position: [10], master_ref_position: 0, velocity: 100,
+    });
+    assert.equal(t.body.outputs.in_sync, true, JSON.stringify(t.body));
+    await page.waitForSelector('[data-testid="group-tracking"][data-in-sync="1"]');
+    assert.match(await page.textContent('[data-testid="group-tracking"]'), /tracking conveyor spindle · in sync/);
+    const f = await rest(stack.api, 'POST', '/groups/xy/set-coordinate-transform?wait=true', { translation: [0, 0, 0], rotation: [0, 0, 0] });
+    assert.equal(f.body.state, 'done', JSON.stringify(f.body));
+    await page.waitForSelector('[data-testid="group-tracking"]', { state: 'detached' });
+    await rest(stack.api, 'POST', '/axes/spindle/halt?wait=true', {});
+    await page.close();
+  });
 });

@@ -124,7 +124,8 @@ pub struct UpdateParams {
     pub topic: String,
     pub cycle: u64,
     /// `true`: `data` is the whole object (the first update of a subscription, and after the
-    /// axis was replaced); `false`: only the fields that changed since the previous update.
+    /// axis was replaced); `false`: only the fields that changed since the previous update (a
+    /// field that is no longer there is `null`, as in a JSON merge patch).
     pub full: bool,
     /// `axes/{axis}/status`: a `LiveStatus`; `system`: a `SystemResource` (whole or in part).
     #[schema(value_type = Object)]

@@ -250,10 +250,19 @@ impl AxisFeed {
 
 /// The members of `now` that differ from `before` (the system topic's delta).
 pub fn delta(before: &Map<String, Value>, now: &Map<String, Value>) -> Map<String, Value> {
-    now.iter()
+    let mut d: Map<String, Value> = now
+        .iter()
         .filter(|(k, v)| before.get(*k) != Some(v))
         .map(|(k, v)| (k.clone(), v.clone()))
-        .collect()
+        .collect();
+    // A field that is no longer there (an optional one left out) is sent as null, as a JSON
+    // merge patch says "removed": a client merging the changes would keep it otherwise.
+    for k in before.keys() {
+        if !now.contains_key(k) {
+            d.insert(k.clone(), Value::Null);
+        }
+    }
+    d
 }
 
 #[cfg(test)]
@@ -263,6 +272,14 @@ mod tests {
 
     fn version(cycle: u64, v: Value) -> Version {
         Version::of(cycle, &v).unwrap()
+    }
+
+    #[test]
+    fn a_field_that_is_gone_is_a_null_in_the_delta() {
+        let before = json!({"a": 1, "gone": {"x": 1}, "same": 2});
+        let now = json!({"a": 3, "same": 2, "new": true});
+        let d = delta(before.as_object().unwrap(), now.as_object().unwrap());
+        assert_eq!(Value::Object(d), json!({"a": 3, "gone": null, "new": true}));
     }
 
     #[test]

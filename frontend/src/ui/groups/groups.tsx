@@ -567,6 +567,14 @@ function GroupView({ group, onChanged }: { group: GroupResource; onChanged: () =
               <Readout key={r} name={`pos-${r}`} label={`${r.toUpperCase()} (${s?.members?.[r] ?? '—'})`} value={num(s?.position?.[r], 3)} />
             ))}
           </div>
+          {s?.tracking && (
+            // MC_TrackConveyorBelt (REST / websocket): which conveyor, whether in sync.
+            <div class="group-tracking small" data-testid="group-tracking" data-in-sync={s.tracking.in_sync ? '1' : '0'}>
+              tracking conveyor <b>{s.tracking.conveyor}</b> ·{' '}
+              {s.tracking.in_sync ? 'in sync' : `synchronising (${num(s.tracking.remaining_distance_to_sync, 3)} to go)`}
+              {s.tracking.conveyor_error && <span class="field-error"> · conveyor in error</span>}
+            </div>
+          )}
         </Panel>
         <Panel
           title="Path view"
