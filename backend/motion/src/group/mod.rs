@@ -428,11 +428,6 @@ impl Group {
                 transform
                     .check(self.config.convention.planar())
                     .map_err(|_| ErrorId::PARAMETER_NOT_CORRECT)?;
-                if !matches!(self.state, GroupState::Standby | GroupState::Moving)
-                    && self.track.is_some()
-                {
-                    return Err(ErrorId::GROUP_STATE_INVALID);
-                }
                 // For the MovePaths that follow (those already accepted keep theirs).
                 self.frame = transform;
                 if self.track.is_some() {
@@ -530,6 +525,15 @@ impl Group {
         f
     }
 
+    /// The frame a table left in effect becomes the group's. With trackings' displacements
+    /// between the path and the machine the table had no frame entry (they are refused
+    /// then): what it returns is the build frame, and the group's frame stays.
+    fn take_frame(&mut self, frame: CoordTransform) {
+        if self.shift == [0.0; 3] {
+            self.frame = frame;
+        }
+    }
+
     /// The active tracking ends with `out` and brakes to rest (with `braking`, else its own
     /// deceleration and jerk).
     fn detach(
@@ -592,15 +596,16 @@ impl Group {
                     if first || changed {
                         report = Some((t.id, t.out));
                     }
+                    add(&mut off, t.dir, t.d);
                 }
                 Err(e) => failed_with = Some(e),
             }
-            add(&mut off, t.dir, t.d);
         }
         if let Some((id, out)) = report {
             self.event(events, cycle, id, out);
         }
         if let Some(e) = failed_with {
+            // It brakes from where it was (its displacement is added below, once).
             self.detach(None, failed(e), cycle, events);
         }
         for slot in self.leaving.iter_mut() {
@@ -1007,11 +1012,8 @@ impl Group {
                 return Err(e);
             }
         };
-        // Accepted: nothing below fails. (With a shift there is no frame entry: the frame
-        // stays.)
-        if self.shift == [0.0; 3] {
-            self.frame = frame_after;
-        }
+        // Accepted: nothing below fails.
+        self.take_frame(frame_after);
         if let Some(s) = self.stop.take() {
             // A MovePath during a halt's ramp takes over (§4.2: CommandAborted).
             self.event(events, cycle, s.id, aborted());
@@ -1149,9 +1151,7 @@ impl Group {
         cut.len = len;
         cut.corner = corner;
         self.run.cut_at(i, cut);
-        if self.shift == [0.0; 3] {
-            self.frame = frame_after;
-        }
+        self.take_frame(frame_after);
         self.paths[0] = Some(PathCommand { id, out: busy() });
         self.event(events, cycle, id, busy());
         self.run.append(scratch.drain(..));
@@ -1380,9 +1380,7 @@ impl Group {
         let (start, s0) = (self.run.point, self.run.s.position);
         match build::build(&ctx, id, &self.pending_entries, start, s0, &mut scratch) {
             Ok(frame) => {
-                if self.shift == [0.0; 3] {
-                    self.frame = frame;
-                }
+                self.take_frame(frame);
                 self.run.append(scratch.drain(..));
             }
             Err((_, e)) => self.end_path(id, cycle, events, failed(e)),

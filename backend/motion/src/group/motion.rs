@@ -269,8 +269,7 @@ impl PathRun {
     }
 
     /// The motion item global `s` lies in (the last one when `s` is beyond the queue) and
-    /// that item cut there (a point inside a corner blend is moved to the blend's end). None
-    /// when a dwell or a blocker comes first.
+    /// that item cut there. None when a dwell or a blocker comes first.
     pub(super) fn cut_point(&self, s: f64) -> Option<(usize, Item)> {
         let mut found = None;
         for (i, it) in self.items.iter().enumerate() {
@@ -288,7 +287,7 @@ impl PathRun {
             return None;
         };
         let local = (s - it.s0).clamp(0.0, it.len);
-        if !it.blend && local < it.len {
+        if local < it.len {
             let cut = seg.trimmed(0.0, local);
             it.kind = ItemKind::Motion(cut);
             it.len = cut.length();

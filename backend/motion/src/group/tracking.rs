@@ -152,7 +152,7 @@ impl Tracking {
     /// second MC_TrackConveyorBelt switches directly, §4.1): the displacement's velocity and
     /// acceleration carry on, its position goes into `shift`. Returns the position folded.
     pub(super) fn take_over(&mut self, old: &Tracking) -> Option<f64> {
-        let parallel = dot(self.dir, old.dir) > 1.0 - 1e-12;
+        let parallel = crate::path::vector::dot(&self.dir, &old.dir) > 1.0 - 1e-12;
         parallel.then(|| {
             self.d = Kinematics {
                 position: 0.0,
@@ -347,8 +347,4 @@ fn conveyor_now(a: &Axis, dt: f64) -> Kinematics {
         velocity: k.velocity + k.acceleration * dt,
         ..k
     }
-}
-
-pub(super) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

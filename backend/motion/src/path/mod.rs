@@ -39,7 +39,7 @@
 mod arc;
 mod blend;
 mod line;
-mod vector;
+pub(crate) mod vector;
 
 #[cfg(test)]
 mod tests;
