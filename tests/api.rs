@@ -1033,7 +1033,7 @@ async fn openapi_json_is_current() {
         assert!(paths.contains_key(p), "{p} not documented");
     }
     // 93 before the groups: 5 resource paths and 12 blocks.
-    assert_eq!(paths.len(), 112, "{:?}", paths.keys().collect::<Vec<_>>());
+    assert_eq!(paths.len(), 114, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

@@ -186,6 +186,12 @@ pub struct ServeArgs {
     /// directory, else the one of the source tree motiond was built from].
     #[arg(long, global = true, value_name = "PATH")]
     pub ui_dir: Option<std::path::PathBuf>,
+    /// The clock the cycle runs on: `real` (the default: one cycle per cycle time), `virtual`
+    /// (cycles advance only when a client asks: `POST /api/v1/clock/advance`) or `fast` /
+    /// `fast=FACTOR` (continuously, as fast as the machine can or at FACTOR × real time).
+    /// Virtual time needs the simulated bus.
+    #[arg(long, global = true, value_name = "MODE", default_value = "real", value_parser = crate::clock::parse_mode)]
+    pub clock: crate::clock::Mode,
 }
 
 /// `--listen`: `IP:PORT`, `[IPv6]:PORT` or `localhost:PORT` (resolved, its loopback address

@@ -191,6 +191,51 @@ pub struct Shared {
     /// Written by the cycle thread when it produced verdicts or events: the pump drains at
     /// once.
     pub wake: Wake,
+    /// Virtual time (`--clock virtual|fast`): when the cycle thread may step.
+    pub clock: ClockLink,
+}
+
+/// What the cycle thread runs on in virtual time (issue 26): it steps while its cycle is below
+/// `limit` and no watched command has stopped it; between steps it takes requests as they come
+/// (they apply at the next cycle) and parks. The async side (`crate::clock::Clock`) sets the
+/// limit and unparks it. In real time none of this is read.
+pub struct ClockLink {
+    pub virtual_time: bool,
+    /// `--clock fast=FACTOR`: wall nanoseconds per cycle (0: as fast as the machine can).
+    pub pace_ns: u64,
+    /// The cycle thread steps while its cycle is below this.
+    pub limit: AtomicU64,
+    /// A command whose events stop the clock after the cycle that produced them (0: none) …
+    pub watch: AtomicU64,
+    /// … and the cycle it stopped after (0: not stopped); cleared by the async side.
+    pub watch_stop: AtomicU64,
+    /// The cycle thread is deciding on or running a cycle (an advance that ends waits for it:
+    /// the clock then stands where the answer says).
+    pub stepping: AtomicBool,
+    thread: std::sync::OnceLock<std::thread::Thread>,
+}
+
+impl ClockLink {
+    fn new(virtual_time: bool, pace_ns: u64) -> Self {
+        ClockLink {
+            virtual_time,
+            pace_ns,
+            limit: AtomicU64::new(if virtual_time { 0 } else { u64::MAX }),
+            watch: AtomicU64::new(0),
+            watch_stop: AtomicU64::new(0),
+            stepping: AtomicBool::new(false),
+            thread: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// Wakes a parked cycle thread (virtual time; nothing in real time).
+    pub fn nudge(&self) {
+        if self.virtual_time {
+            if let Some(t) = self.thread.get() {
+                t.unpark();
+            }
+        }
+    }
 }
 
 /// The cycle thread's wake-up of the pump: an eventfd. Signalling is one `write(2)` — no lock,
@@ -233,7 +278,14 @@ impl Wake {
 
 impl Shared {
     pub fn new(period_ns: u64) -> Self {
+        Self::with_clock(period_ns, false, 0)
+    }
+
+    /// `virtual_time`: cycles only when the async side lets them (`ClockLink`), each `pace_ns`
+    /// of wall time apart at least.
+    pub fn with_clock(period_ns: u64, virtual_time: bool, pace_ns: u64) -> Self {
         Shared {
+            clock: ClockLink::new(virtual_time, pace_ns),
             requests: ArrayQueue::new(COMMAND_QUEUE),
             replies: ArrayQueue::new(REPLY_QUEUE),
             events: ArrayQueue::new(EVENT_RING),
@@ -275,7 +327,10 @@ impl Shared {
                 request,
                 expires_ns,
             })
-            .map_err(|q| q.request)
+            .map_err(|q| q.request)?;
+        // A stopped virtual clock takes requests as they come.
+        self.clock.nudge();
+        Ok(())
     }
 }
 
@@ -296,10 +351,14 @@ struct RingSink<'a> {
     q: &'a ArrayQueue<CommandEvent>,
     dropped: u64,
     pushed: u64,
+    /// The command watched by a virtual clock's advance (0: none), and whether it had events.
+    watch: u64,
+    watched: bool,
 }
 
 impl EventSink for RingSink<'_> {
     fn push(&mut self, event: CommandEvent) {
+        self.watched |= self.watch != 0 && event.command == self.watch;
         if self.q.push(event).is_err() {
             self.dropped += 1;
         } else {
@@ -513,19 +572,84 @@ impl CycleThread {
         }
     }
 
+    /// Runs in virtual time until `shared.shutdown` is set: a cycle whenever the clock allows
+    /// one (`ClockLink`), as fast as the machine can or `pace_ns` apart; requests taken as they
+    /// come while it is stopped. The rings to the async side are never overrun: the thread
+    /// waits for the pump instead (time does not pass meanwhile).
+    pub fn run_virtual(mut self) {
+        let shared = self.shared.clone();
+        let link = &shared.clock;
+        let _ = link.thread.set(std::thread::current());
+        let mut feedback = vec![DriveFeedback::default(); MAX_AXES];
+        let mut setpoints = vec![DriveSetpoint::default(); MAX_AXES];
+        let mut next = now_ns();
+        let idle = std::time::Duration::from_millis(50);
+        use std::sync::atomic::Ordering::SeqCst;
+        while !shared.shutdown.load(Relaxed) {
+            // Announced before the limit is read (both SeqCst): a limit lowered by the async
+            // side is either seen here or waited for there (`Clock::stand`).
+            link.stepping.store(true, SeqCst);
+            let may_step = self.kernel.cycle() < link.limit.load(SeqCst)
+                && link.watch_stop.load(std::sync::atomic::Ordering::Acquire) == 0;
+            let backlog = shared.events.len() > EVENT_RING / 2
+                || shared.scope_frames.len() > SCOPE_RING / 2
+                || shared.replies.len() > REPLY_QUEUE / 2;
+            if !may_step || backlog {
+                link.stepping.store(false, SeqCst);
+                self.requests_and_cycle(&mut feedback, &mut setpoints, false);
+                if backlog {
+                    shared.wake.signal();
+                    std::thread::park_timeout(std::time::Duration::from_micros(200));
+                } else if shared.requests.is_empty() {
+                    std::thread::park_timeout(idle);
+                }
+                continue;
+            }
+            if link.pace_ns > 0 {
+                sleep_until(next);
+                next = next.max(now_ns().saturating_sub(link.pace_ns)) + link.pace_ns;
+            }
+            let start = now_ns();
+            self.one_cycle(&mut feedback, &mut setpoints);
+            link.stepping.store(false, SeqCst);
+            shared.stats.compute.record(now_ns() - start);
+            shared.stats.cycles.fetch_add(1, Relaxed);
+            let cycle = self.kernel.cycle();
+            if link.watch_stop.load(Relaxed) != 0 || cycle >= link.limit.load(Relaxed) {
+                // Stopped: the async side looks at this cycle now.
+                shared.wake.signal();
+            }
+        }
+    }
+
     /// One cycle without the timing: commands, kernel step on the feedback of the last
     /// exchange, bus exchange (setpoints out, feedback in for the next cycle), publish.
     pub fn one_cycle(&mut self, feedback: &mut [DriveFeedback], setpoints: &mut [DriveSetpoint]) {
+        self.requests_and_cycle(feedback, setpoints, true);
+    }
+
+    /// The requests waiting (at most [`DRAIN_PER_CYCLE`] when `step`, else all of them), then
+    /// with `step` the cycle: kernel step, bus exchange, publish. Without `step` (a stopped
+    /// virtual clock) the requests apply at the next cycle, as they would in real time.
+    fn requests_and_cycle(
+        &mut self,
+        feedback: &mut [DriveFeedback],
+        setpoints: &mut [DriveSetpoint],
+        step: bool,
+    ) {
         let shared = &*self.shared;
         let mut sink = RingSink {
             q: &shared.events,
             dropped: 0,
             pushed: 0,
+            watch: shared.clock.watch.load(Relaxed),
+            watched: false,
         };
         let mut drained = 0;
+        let most = if step { DRAIN_PER_CYCLE } else { usize::MAX };
         // Read once per cycle, and only when something waits (a vDSO call, no syscall).
         let mut now = 0;
-        while drained < DRAIN_PER_CYCLE {
+        while drained < most {
             let Some(Queued {
                 request: req,
                 expires_ns,
@@ -870,6 +994,15 @@ impl CycleThread {
             .stats
             .commands_drained
             .fetch_add(drained as u64, Relaxed);
+        if !step {
+            if sink.dropped > 0 {
+                shared.stats.events_dropped.fetch_add(sink.dropped, Relaxed);
+            }
+            if drained > 0 || sink.pushed > 0 {
+                shared.wake.signal();
+            }
+            return;
+        }
 
         self.kernel.step(feedback, setpoints, &mut sink);
         while let Some(cam) = self.kernel.take_retired_cam() {
@@ -907,7 +1040,17 @@ impl CycleThread {
             }
         }
         self.snapshot.publish();
-        shared.cycle.store(cycle, Relaxed);
+        if sink.watched {
+            // Before the cycle is stored: whoever reads this cycle sees that it stopped there.
+            shared
+                .clock
+                .watch_stop
+                .store(cycle, std::sync::atomic::Ordering::Release);
+        }
+        // Release: whoever reads this cycle finds its events in the ring (the pump, the clock).
+        shared
+            .cycle
+            .store(cycle, std::sync::atomic::Ordering::Release);
         // A verdict or an output change waits on the async side: wake the pump now rather
         // than at its next millisecond (one wake-up; nothing when the cycle produced nothing).
         if drained > 0 || sink.pushed > 0 {

@@ -13,7 +13,7 @@
 //! ```
 //! use server::api::blocks::{self, Role};
 //!
-//! let block = blocks::find("move-absolute").expect("MC_MoveAbsolute is in the catalogue");
+//! let block = blocks::find(blocks::At::Axes, "move-absolute").expect("MC_MoveAbsolute is in the catalogue");
 //! assert_eq!(block.path, "/api/v1/axes/{axis}/move-absolute");
 //! assert_eq!(block.role, Role::Operator);
 //!
@@ -30,6 +30,7 @@ pub mod auth;
 pub mod blocks;
 pub mod bus;
 pub mod cli;
+pub mod clock;
 pub mod cycle;
 pub mod error;
 pub mod metrics;
@@ -236,6 +237,13 @@ fn serve(args: ServeArgs) -> Result<(), String> {
 }
 
 async fn serve_async(args: ServeArgs) -> Result<(), String> {
+    if args.clock.is_virtual() && args.bus != bus::BusKind::Simulated {
+        // Real drives (and the emulated segment's frames) run on their own time.
+        return Err(format!(
+            "--clock {} needs the simulated bus: drives on EtherCAT run in real time (use --bus simulated)",
+            args.clock.name()
+        ));
+    }
     let db = store::open(&args.db).await?;
     if args.db == ":memory:" {
         tracing::info!("database :memory: (in memory: nothing is kept after exit)");
@@ -272,16 +280,36 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         .map_err(|e| format!("the bus start-up failed: {e}"))?
         .map_err(|e| format!("the {} bus did not come up: {e}", args.bus.name()))?
     };
-    let shared = Arc::new(cycle::Shared::new(args.cycle_us as u64 * 1000));
+    let period_ns = args.cycle_us as u64 * 1000;
+    let pace_ns = match args.clock {
+        clock::Mode::Fast(Some(factor)) => (period_ns as f64 / factor) as u64,
+        _ => 0,
+    };
+    let shared = Arc::new(cycle::Shared::with_clock(
+        period_ns,
+        args.clock.is_virtual(),
+        pace_ns,
+    ));
     let (input, output) = triple_buffer::triple_buffer(&cycle::Snapshot::default());
     let (grant_tx, grant_rx) = std::sync::mpsc::channel();
     let thread_shared = shared.clone();
+    let virtual_time = args.clock.is_virtual();
     let cycle_thread = std::thread::Builder::new()
         .name("motiond-cycle".into())
         .spawn(move || {
             let ct = cycle::CycleThread::new(cycle_time, bus, thread_shared, input);
-            let _ = grant_tx.send(cycle::request_realtime(80));
-            ct.run();
+            if virtual_time {
+                // Nothing waits for a deadline: no real-time priority (a thread running
+                // cycles back to back at SCHED_FIFO would starve the API).
+                let _ = grant_tx.send(cycle::RealtimeGrant {
+                    notes: vec!["virtual time: no real-time scheduling asked for".into()],
+                    ..Default::default()
+                });
+                ct.run_virtual();
+            } else {
+                let _ = grant_tx.send(cycle::request_realtime(80));
+                ct.run();
+            }
         })
         .map_err(|e| format!("cannot start the cycle thread: {e}"))?;
     let realtime = grant_rx
@@ -384,7 +412,19 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         info,
         auth,
         args.control_lease,
+        clock::Clock::new(args.clock, shared.clone()),
     );
+    if args.clock.is_virtual() {
+        tracing::info!(
+            "clock: {} (virtual time: {}; timestamps count from 1970-01-01T00:00:00Z)",
+            args.clock.name(),
+            match args.clock {
+                clock::Mode::Fast(Some(f)) => format!("{f} × real time"),
+                clock::Mode::Fast(None) => "as fast as the machine can".into(),
+                _ => "cycles advance on POST /api/v1/clock/advance".into(),
+            }
+        );
+    }
     tokio::spawn(app::pump(state.clone()));
     let audit_task = tokio::spawn(app::audit_writer(
         db.clone(),

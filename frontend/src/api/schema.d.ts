@@ -1356,6 +1356,43 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/clock": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The clock: real or virtual time, cycle count, time */
+        get: operations["get_clock"];
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/v1/clock/advance": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * Run the virtual clock: some cycles, some seconds, or until a command's milestone
+         * @description Only with `motiond --clock virtual`. The answer comes when the clock has run: the cycles asked for, or up to the exact cycle where the command of `until` reaches its milestone (or ends), at most `max_cycles`/`max_seconds`. Requests sent while the clock stands apply at the next cycle, the advance's first; a request sent while it runs applies at whatever cycle it arrives in. One advance at a time (409 `clock_busy`); a client that goes away mid-advance stops the clock where it is. Everything that is time follows: commands' timestamps, `?wait=true`'s `timeout_ms`, the jog's dead-man, the control lease, the websocket's subscription rates.
+         */
+        post: operations["advance"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/commands": {
         parameters: {
             query?: never;
@@ -2023,6 +2060,68 @@ export interface paths {
 export type webhooks = Record<string, never>;
 export interface components {
     schemas: {
+        /**
+         * @description How far to run the clock: exactly one of `cycles`, `seconds` or `until` (with a bound).
+         * @example {
+         *       "max_seconds": 30,
+         *       "until": {
+         *         "command": 12,
+         *         "milestone": "done"
+         *       }
+         *     }
+         */
+        AdvanceBody: {
+            /**
+             * Format: int64
+             * @description Cycles to run (1 to 100 000 000).
+             */
+            cycles?: number | null;
+            /**
+             * Format: double
+             * @description Virtual seconds to run (more than 0, at most 86 400), rounded up to whole cycles.
+             */
+            seconds?: number | null;
+            until?: null | components["schemas"]["UntilBody"];
+            /**
+             * Format: int64
+             * @description `until`'s bound in cycles (1 to 100 000 000).
+             */
+            max_cycles?: number | null;
+            /**
+             * Format: double
+             * @description `until`'s bound in virtual seconds (more than 0, at most 86 400).
+             */
+            max_seconds?: number | null;
+        };
+        /**
+         * @description The answer of an advance.
+         * @example {
+         *       "clock": {
+         *         "advancing": false,
+         *         "cycle": 2500,
+         *         "cycle_time_s": 0.001,
+         *         "mode": "virtual",
+         *         "time_s": 2.5
+         *       },
+         *       "cycles": 1000,
+         *       "from_cycle": 1500
+         *     }
+         */
+        Advanced: {
+            /** @description The clock after the advance. */
+            clock: components["schemas"]["ClockState"];
+            /**
+             * Format: int64
+             * @description Where the advance began.
+             */
+            from_cycle: number;
+            /**
+             * Format: int64
+             * @description Cycles run.
+             */
+            cycles: number;
+            until?: null | components["schemas"]["UntilOutcome"];
+        };
         /**
          * @description An EtherCAT state machine state (AL status).
          * @enum {string}
@@ -3923,6 +4022,43 @@ export interface components {
             via: string;
             /** @description `user:NAME` or `token:NAME`, when authentication is enabled. */
             principal?: string | null;
+        };
+        /**
+         * @description The clock as a client sees it.
+         * @example {
+         *       "advancing": false,
+         *       "cycle": 1500,
+         *       "cycle_time_s": 0.001,
+         *       "mode": "virtual",
+         *       "time_s": 1.5
+         *     }
+         */
+        ClockState: {
+            /**
+             * @description `real` (wall-clock time), `virtual` (cycles advance on `POST /clock/advance`) or `fast`
+             *     (continuously, faster than real time).
+             */
+            mode: string;
+            /**
+             * Format: int64
+             * @description Cycles run since motiond started.
+             */
+            cycle: number;
+            /**
+             * Format: double
+             * @description The clock's time in seconds: cycles × cycle time in virtual time (timestamps are the
+             *     Unix epoch plus this), the time since start in real time.
+             */
+            time_s: number;
+            /** Format: double */
+            cycle_time_s: number;
+            /**
+             * Format: double
+             * @description `fast=FACTOR`: the factor of real time (absent: as fast as the machine can).
+             */
+            factor?: number | null;
+            /** @description An advance is running. */
+            advancing: boolean;
         };
         /**
          * @description A change of a command's outputs.
@@ -8770,6 +8906,74 @@ export interface components {
          */
         Unit: "none" | "position" | "velocity" | "acceleration" | "jerk" | "seconds" | "factor" | "percent" | "per_second" | "position_per_increment" | "increments" | "count" | "code";
         /**
+         * @example {
+         *       "command": 12,
+         *       "milestone": "in_velocity"
+         *     }
+         */
+        UntilBody: {
+            /**
+             * Format: int64
+             * @description The command's id.
+             */
+            command: number;
+            milestone?: null | components["schemas"]["Milestone"];
+        };
+        /**
+         * @description How an advance until a milestone ended.
+         * @example {
+         *       "command": {
+         *         "accepted_cycle": 7,
+         *         "axis": "x",
+         *         "axis_id": 1,
+         *         "client": {
+         *           "addr": "127.0.0.1:50312",
+         *           "via": "rest"
+         *         },
+         *         "command": "move-absolute",
+         *         "events": [],
+         *         "final": true,
+         *         "finished_at": "1970-01-01T00:00:02.226Z",
+         *         "id": 12,
+         *         "last_cycle": 2226,
+         *         "outputs": {
+         *           "active": false,
+         *           "busy": false,
+         *           "command_aborted": false,
+         *           "done": true,
+         *           "error": false,
+         *           "error_id": 0,
+         *           "in_end_velocity": false,
+         *           "in_gear": false,
+         *           "in_sync": false,
+         *           "in_torque": false,
+         *           "in_velocity": false,
+         *           "status": false,
+         *           "warning": false,
+         *           "warning_id": 0
+         *         },
+         *         "parameters": {
+         *           "position": 100
+         *         },
+         *         "state": "done",
+         *         "submitted_at": "1970-01-01T00:00:00.006Z"
+         *       },
+         *       "milestone": "done",
+         *       "reached": true
+         *     }
+         */
+        UntilOutcome: {
+            /** @description The milestone waited for (`done`: the command's end only). */
+            milestone: components["schemas"]["Milestone"];
+            /**
+             * @description The command reached it (or its end: done, error or aborted, see the command's `state`);
+             *     false: the advance's bound came first.
+             */
+            reached: boolean;
+            /** @description The command as it stands at the clock's new cycle. */
+            command: components["schemas"]["CommandResource"];
+        };
+        /**
          * @description `PUT /users/{name}`: what to change.
          * @example {
          *       "role": "engineer"
@@ -9193,6 +9397,45 @@ export interface components {
         };
         /** @description No such cam table or point. */
         CamTableOrPointNotFound: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description The advance asked for is not one of cycles, seconds or until with a bound, or out of
+         *     range.
+         */
+        ClockAdvanceInvalid: {
+            headers: {
+                [name: string]: unknown;
+            };
+            content: {
+                /**
+                 * @example {
+                 *       "code": "validation_failed",
+                 *       "detail": "body: give exactly one of cycles, seconds or until",
+                 *       "errors": [
+                 *         {
+                 *           "field": "body",
+                 *           "message": "give exactly one of cycles, seconds or until"
+                 *         }
+                 *       ],
+                 *       "status": 422,
+                 *       "title": "Invalid request",
+                 *       "type": "urn:motiond:problem:validation_failed"
+                 *     }
+                 */
+                "application/problem+json": components["schemas"]["Problem"];
+            };
+        };
+        /**
+         * @description motiond does not run on the virtual clock (`clock_not_virtual`), or another advance is
+         *     running (`clock_busy`).
+         */
+        ClockConflict: {
             headers: {
                 [name: string]: unknown;
             };
@@ -14243,6 +14486,62 @@ export interface operations {
             404: components["responses"]["CamTableNotFound"];
             421: components["responses"]["MisdirectedRequest"];
             422: components["responses"]["CamQueryInvalid"];
+        };
+    };
+    get_clock: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: never;
+        responses: {
+            /** @description The clock now */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["ClockState"];
+                };
+            };
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["RoleInsufficient"];
+            421: components["responses"]["MisdirectedRequest"];
+        };
+    };
+    advance: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        requestBody?: {
+            content: {
+                "application/json": components["schemas"]["AdvanceBody"];
+            };
+        };
+        responses: {
+            /** @description The clock has run */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["Advanced"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["CommandNotFound"];
+            409: components["responses"]["ClockConflict"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["ClockAdvanceInvalid"];
         };
     };
     list_commands: {

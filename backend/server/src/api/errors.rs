@@ -363,6 +363,16 @@ problem_responses! {
     /// motiond runs the simulated bus.
     BusNotEthercat(example = json!(p(AppError::conflict("bus_not_ethercat",
         "motiond runs the simulated bus: there is no EtherCAT segment to reset"))));
+    /// motiond does not run on the virtual clock (`clock_not_virtual`), or another advance is
+    /// running (`clock_busy`).
+    ClockConflict(examples(
+        ("clock_not_virtual" = (value = json!(p(AppError::conflict("clock_not_virtual",
+            "motiond runs on the real clock: only --clock virtual advances when asked"))))),
+        ("clock_busy" = (value = json!(p(AppError::conflict("clock_busy",
+            "another advance of the clock is running; wait for its answer")))))));
+    /// The advance asked for is not one of cycles, seconds or until with a bound, or out of
+    /// range.
+    ClockAdvanceInvalid(example = json!(p(AppError::field("body", "give exactly one of cycles, seconds or until"))));
     /// The mailbox did not answer in time or the frame was lost.
     SdoUnavailable(example = json!(p(AppError::unavailable("sdo_failed",
         "SDO transfer of 0x1018:1 with SubDevice 0 failed: timeout"))));
@@ -678,6 +688,11 @@ error_sets! {
     }
     /// `POST /bus/reset`.
     BusResetErrors { 409: BusNotEthercat, 503: BusResetFailed }
+    /// `POST /clock/advance`.
+    ClockAdvanceErrors {
+        400: MalformedJson, 404: CommandNotFound, 409: ClockConflict, 413: PayloadTooLarge,
+        422: ClockAdvanceInvalid,
+    }
     /// `POST /path-analysis`.
     PathAnalysisErrors { 400: MalformedJson, 413: PayloadTooLarge, 422: PathAnalysisInvalid }
     /// `POST /cam-analysis`.

@@ -7,6 +7,7 @@ pub mod axes;
 pub mod blocks;
 pub mod bus;
 pub mod cams;
+pub mod clock;
 pub mod commands;
 pub mod errors;
 pub mod functions;
@@ -372,6 +373,8 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(functions::calc_dynamics_by_ramp_time_fb),
         )
         .route("/system", get(system::system))
+        .route("/clock", get(clock::get_clock))
+        .route("/clock/advance", post(clock::advance))
         .route("/bus", get(bus::bus))
         .route(
             "/bus/subdevices/{position}/sdo/{index}/{sub}",
@@ -587,7 +590,7 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
         cams::list_cam_tables, cams::create_cam_table, cams::get_cam_table, cams::replace_cam_table,
         cams::delete_cam_table, cams::analyse, cams::characteristics, cams::slave_dynamics, cams::master_position, cams::values,
         cams::cam_info, cams::get_online_change_mode, cams::set_online_change_mode, cams::get_point, cams::write_point, cams::write_points,
-        axes::export_config, axes::import_config, system::system, bus::bus, bus::sdo_read, bus::sdo_write, bus::inject_bus_fault, bus::reset_bus, audit::audit_log, system::metrics, ws::upgrade,
+        axes::export_config, axes::import_config, system::system, clock::get_clock, clock::advance, bus::bus, bus::sdo_read, bus::sdo_write, bus::inject_bus_fault, bus::reset_bus, audit::audit_log, system::metrics, ws::upgrade,
         auth::session, auth::login, auth::logout, auth::change_password,
         auth::list_users, auth::create_user, auth::get_user, auth::update_user, auth::delete_user,
         auth::list_tokens, auth::create_token, auth::revoke_token,
@@ -604,6 +607,7 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
         (name = "simulation", description = "Fault injection into the simulated drives"),
         (name = "scope", description = "Recordings of axis signals at the cycle rate, optionally triggered"),
         (name = "system", description = "Version, cycle timing, metrics, configuration export/import, audit log"),
+        (name = "clock", description = "Real or virtual time (`motiond --clock virtual|fast`): the cycle count, the time, advancing a virtual clock"),
         (name = "auth", description = "Login, users (passwords hashed with argon2id) and API tokens for machines; roles viewer < operator < engineer < admin"),
         (name = "control", description = "Who commands motion: one holder at a time, with a renewed lease; stop, halt and disabling always pass"),
     )

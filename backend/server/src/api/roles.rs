@@ -25,6 +25,8 @@ pub fn required(method: &Method, path: &str) -> Option<Role> {
         "/cam-analysis" | "/path-analysis" => Viewer,
         _ if read => Viewer,
         "/control" => Operator,
+        // Running the virtual clock moves what was commanded, as a command would.
+        "/clock/advance" => Operator,
         "/commands/{id}" | "/commands/{id}/keepalive" => Operator,
         "/axes/{axis}/status/following-error-peak/reset" => Operator,
         // The external setpoint generator's samples, fed like a jog's keepalives.

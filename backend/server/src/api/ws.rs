@@ -32,6 +32,9 @@ use crate::service::commands;
 pub const MAX_RATE_HZ: f64 = 100.0;
 /// Lowest subscription rate (one update every 10 s).
 pub const MIN_RATE_HZ: f64 = 0.1;
+/// A send that takes longer than this (the client does not read) stops the socket's ticks from
+/// holding a virtual clock.
+const SLOW_SEND: std::time::Duration = std::time::Duration::from_millis(100);
 /// Commands, keepalives and releases of one socket whose responses are still outstanding: a
 /// client that sends faster than it reads is refused instead of queued without bound.
 pub const MAX_IN_FLIGHT: usize = 32;
@@ -345,6 +348,9 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
     let mut seen_writes = u64::MAX;
     // The size of the last tick's message (the next one is usually alike).
     let mut last_len = 256;
+    let mut due_hold: Option<(u64, crate::clock::Hold)> = None;
+    // Its last send went out within `SLOW_SEND` (only then are its ticks held).
+    let mut keeping_up = true;
     loop {
         let idle_deadline = match pinged {
             None => heard + settings.ping_after,
@@ -356,9 +362,14 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
             .filter(|x| !matches!(x.topic, Topic::Commands))
             .map(|x| x.due)
             .min();
+        // The hold on the next tick is kept across wake-ups for other reasons (in virtual time
+        // the clock waits at it until this socket has taken the tick's statuses).
+        if due_hold.as_ref().map(|(t, _)| *t) != next_due {
+            due_hold = next_due.map(|t| (t, s.feed.at(t, keeping_up)));
+        }
         let due = async {
-            match next_due {
-                Some(t) => tokio::time::sleep_until(s.feed.at(t)).await,
+            match &due_hold {
+                Some((_, h)) => h.wait().await,
                 None => std::future::pending().await,
             }
         };
@@ -441,15 +452,36 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                 let mut out = Batch::with_capacity(last_len);
                 let tick = s.feed.tick_now().max(next_due.unwrap_or(0));
                 updates(&s, &mut subs, &mut seen_writes, tick, &mut out);
+                // The next tick is held before this one is let go (the clock never slips
+                // past it while this socket sends).
+                let next = subs
+                    .iter()
+                    .filter(|x| !matches!(x.topic, Topic::Commands))
+                    .map(|x| x.due)
+                    .min();
+                due_hold = next.map(|t| (t, s.feed.at(t, keeping_up)));
                 let m = out.finish();
                 last_len = m.as_ref().map_or(last_len, |m| m.len() + 64);
                 m.into_iter().collect()
             }
         };
         for m in outgoing {
-            if socket.send(Message::Text(m.into())).await.is_err() {
+            let send = socket.send(Message::Text(m.into()));
+            tokio::pin!(send);
+            let sent = tokio::select! {
+                r = &mut send => r,
+                _ = tokio::time::sleep(SLOW_SEND) => {
+                    // A client that does not read holds no virtual clock: its ticks are no
+                    // longer held (it gets the newest state when it reads again).
+                    keeping_up = false;
+                    due_hold = None;
+                    send.await
+                }
+            };
+            if sent.is_err() {
                 break;
             }
+            keeping_up = true;
         }
     }
     // The socket is gone: release its jogs (a jog held on a socket stops when it closes).

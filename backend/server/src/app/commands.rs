@@ -130,7 +130,7 @@ pub struct CommandNotice {
 /// The audit entry of a command that has ended, naming the client as its submission does.
 pub(super) fn final_audit(n: &CommandNotice, client: &ClientInfo) -> AuditEntry {
     AuditEntry {
-        at: store::now_rfc3339(),
+        at: store::cycle_rfc3339(n.cycle),
         client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
         client_id: client.id.clone(),
         principal: client.principal.clone(),
@@ -164,7 +164,7 @@ pub(super) fn apply_event(store: &mut CommandStore, ev: &CommandEvent) -> Option
         outputs: ev.outputs,
     });
     if r.is_final() && r.finished_at.is_none() {
-        r.finished_at = Some(store::now_rfc3339());
+        r.finished_at = Some(store::cycle_rfc3339(ev.cycle));
     }
     Some(CommandNotice {
         command: r.id,

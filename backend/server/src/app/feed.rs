@@ -15,9 +15,9 @@ use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use serde_json::{Map, Value};
-use tokio::time::Instant;
 
 use super::AppState;
+use crate::clock::{Clock, Hold};
 use motion::AxisSlot;
 
 /// The websocket tick: the finest subscription grid (200 Hz; the highest rate is 100 Hz).
@@ -151,29 +151,35 @@ pub struct Piece {
 }
 
 pub struct Feed {
-    epoch: Instant,
+    /// Ticks are clock time (virtual time in virtual time: a 50 Hz subscription is sent once
+    /// per 20 ms of it).
+    clock: Arc<Clock>,
     axes: Vec<RwLock<AxisFeed>>,
 }
 
 impl Feed {
-    pub fn new(slots: usize) -> Self {
+    pub fn new(slots: usize, clock: Arc<Clock>) -> Self {
         Feed {
-            epoch: Instant::now(),
+            clock,
             axes: (0..slots).map(|_| RwLock::default()).collect(),
         }
     }
 
-    /// When tick `tick` is.
-    pub fn at(&self, tick: u64) -> Instant {
-        self.epoch + Duration::from_nanos(tick.saturating_mul(TICK.as_nanos() as u64))
+    /// Tick `tick`, held (in virtual time the clock stops there until the hold is dropped, so
+    /// that the tick sends the machine as it was at that time) …
+    /// `hold`: the clock waits there (else this only wakes its holder then).
+    pub fn at(&self, tick: u64, hold: bool) -> Hold {
+        let t = Duration::from_nanos(tick.saturating_mul(TICK.as_nanos() as u64));
+        if hold {
+            self.clock.hold_until(t)
+        } else {
+            self.clock.wake_at(t)
+        }
     }
 
     /// The tick now (the last one that has begun).
     pub fn tick_now(&self) -> u64 {
-        (Instant::now()
-            .saturating_duration_since(self.epoch)
-            .as_nanos()
-            / TICK.as_nanos()) as u64
+        (self.clock.now().as_nanos() / TICK.as_nanos()) as u64
     }
 
     /// The update of axis `slot` at `tick` for a subscriber that was last sent version `seen`

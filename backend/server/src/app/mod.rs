@@ -83,12 +83,18 @@ pub struct AppState {
     pub auth: Arc<crate::auth::Auth>,
     /// Who holds control of the machine.
     pub control: control::Control,
+    /// Real or virtual time (`--clock`): what every timer on this side reads.
+    pub clock: Arc<crate::clock::Clock>,
     /// Passes of `drain` completed: a pass that begins after a snapshot was read has applied
     /// every command event of that snapshot's cycle (the cycle thread pushes them first).
     pub drains: AtomicU64,
 }
 
 impl AppState {
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "each is a separate part made at start-up; a struct of them would only rename them"
+    )]
     pub fn new(
         shared: Arc<Shared>,
         snapshot: triple_buffer::Output<Snapshot>,
@@ -97,6 +103,7 @@ impl AppState {
         info: SystemInfo,
         auth: Arc<crate::auth::Auth>,
         control_lease: bool,
+        clock: Arc<crate::clock::Clock>,
     ) -> (Arc<AppState>, mpsc::Receiver<crate::store::AuditOp>) {
         let (audit_tx, audit_rx) = mpsc::channel(8192);
         let scope = Mutex::new(Recordings::new(info.cycle_time_s, shared.period_ns));
@@ -104,7 +111,7 @@ impl AppState {
             scope,
             shared,
             snapshot: Mutex::new(snapshot),
-            feed: feed::Feed::new(MAX_AXES),
+            feed: feed::Feed::new(MAX_AXES, clock.clone()),
             metrics: Default::default(),
             registry_writes: AtomicU64::new(0),
             idempotency: Default::default(),
@@ -122,7 +129,8 @@ impl AppState {
             audit_dropped: Arc::new(AtomicU64::new(0)),
             info,
             auth,
-            control: control::Control::new(control_lease),
+            control: control::Control::new(control_lease, clock.clone()),
+            clock,
         };
         (Arc::new(state), audit_rx)
     }
@@ -268,6 +276,23 @@ impl AppState {
     /// Queues the outcome of a command whose row was stored as `submitted`.
     pub fn audit_outcome(&self, command_id: u64, outcome: String) {
         self.audit_op(crate::store::AuditOp::Outcome(command_id, outcome));
+    }
+
+    /// In virtual time: waits until the audit rows queued so far are written, so that a row
+    /// written directly after this (a command's, a configuration's) comes after them in the
+    /// log, as in the order of the requests (decision 161). Nothing in real time.
+    pub async fn audit_barrier(&self) {
+        if !self.clock.mode.is_virtual() {
+            return;
+        }
+        let (tx, rx) = oneshot::channel();
+        if self
+            .audit_tx
+            .try_send(crate::store::AuditOp::Flush(tx))
+            .is_ok()
+        {
+            let _ = rx.await;
+        }
     }
 
     fn audit_op(&self, op: crate::store::AuditOp) {

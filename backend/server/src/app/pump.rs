@@ -17,6 +17,9 @@ use crate::store::{self, AuditOp};
 impl AppState {
     /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
     pub fn drain(&self) {
+        // Every event of this cycle and before is in the ring now (stored with Release after
+        // them): once they are applied below, the clock may say the cycle is reached.
+        let cycle = self.shared.cycle.load(std::sync::atomic::Ordering::Acquire);
         // Replies are taken first but completed only after the events: the cycle thread pushes
         // a submit's events before its reply, so a handler woken by its reply sees them.
         let mut replies = Vec::new();
@@ -73,6 +76,9 @@ impl AppState {
         }
         self.drains
             .fetch_add(1, std::sync::atomic::Ordering::AcqRel);
+        self.clock.reached(cycle);
+        // A virtual clock waiting for room in the rings goes on now.
+        self.shared.clock.nudge();
     }
 }
 
@@ -125,6 +131,7 @@ pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost:
                     match op {
                         AuditOp::Row(e) => store::audit(&mut *tx, e).await?,
                         AuditOp::Outcome(id, o) => store::audit_outcome(&mut *tx, *id, o).await?,
+                        AuditOp::Flush(_) => {}
                     }
                 }
                 tx.commit().await
@@ -139,6 +146,10 @@ pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost:
                 Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
             }
         }
-        batch.clear();
+        for op in batch.drain(..) {
+            if let AuditOp::Flush(done) = op {
+                let _ = done.send(());
+            }
+        }
     }
 }

@@ -155,7 +155,7 @@ pub struct CommandResource {
 /// Where a `?wait=true` request answers for a command that stays busy (besides its end:
 /// Done, Error or CommandAborted): the output that says the block has arrived (PLCopen's
 /// InVelocity, InGear, InEndVelocity; a power's Status). Each catalogue entry names its own.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, utoipa::ToSchema)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, utoipa::ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Milestone {
     /// Only its end (Done, Error, CommandAborted).

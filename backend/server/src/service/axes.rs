@@ -94,6 +94,7 @@ pub async fn create(
         .free_slot()
         .ok_or_else(|| AppError::conflict("no_free_slot", "all axis slots are used"))?;
     let json = serde_json::to_string(&config).expect("config serialises");
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     let now = store::now_rfc3339();
     let id = store::axes::insert_axis(&mut tx, id, &config.name, &json, &now).await?;
@@ -284,6 +285,7 @@ pub async fn replace(
         });
     }
     let json = serde_json::to_string(&config).expect("config serialises");
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     store::axes::update_axis(&mut tx, id, &config.name, &json, &store::now_rfc3339()).await?;
     for c in &change.persistent_discarded {
@@ -380,6 +382,7 @@ pub async fn delete(s: &AppState, axis: &str, client: &ClientInfo) -> AppResult<
             e.persistent.clone(),
         )
     };
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     // The axis leaves its group (only while the group is disabled), in the same transaction.
     let groups = super::groups::axis_leaves(s, &mut tx, id, slot).await?;
@@ -551,6 +554,7 @@ pub async fn write_parameter(
         )
     };
     if w.persistent {
+        s.audit_barrier().await;
         let mut tx = s.db.begin().await?;
         let value = serde_json::to_string(&w.value).expect("value");
         store::axes::upsert_persistent(&mut tx, id, info.storage, &value, &store::now_rfc3339())
@@ -816,6 +820,7 @@ pub async fn import(
             return Err(not_disabled(name));
         }
     }
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     store::axes::delete_all_axes(&mut tx).await?;
     let now = store::now_rfc3339();

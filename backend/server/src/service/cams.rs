@@ -248,6 +248,7 @@ async fn store_and_register(
     } else {
         "cam_table.create"
     };
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     store::cams::upsert_cam_table(&mut tx, id, name, version, &data, &now).await?;
     store::audit(
@@ -425,6 +426,7 @@ pub async fn write_points(
 pub async fn delete(s: &AppState, key: &str, client: &ClientInfo) -> AppResult<()> {
     let _guard = s.config_lock.lock().await;
     let e = entry(s, key)?;
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     store::cams::delete_cam_table(&mut tx, e.id).await?;
     store::audit(

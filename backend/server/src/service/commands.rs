@@ -9,6 +9,7 @@ use std::time::Duration;
 use motion::{AxisSlot, CommandId, CommandKind, ErrorId, FbOutputs, Target};
 
 use crate::app::{AppState, AxisEntry, CommandRecord, GroupEntry, HISTORY, Registry};
+use crate::clock::Hold;
 use crate::error::{AppError, AppResult};
 use crate::metrics::Verdict;
 use crate::model::*;
@@ -98,10 +99,15 @@ pub async fn run<B>(
     )
     .await?;
     let view = match wait {
-        Some(t) => wait_for(s, id, t).await.map(|mut v| {
-            v.wait = Some(wait_outcome(s, &v, block.milestone));
-            v
-        }),
+        Some(t) => {
+            // In virtual time the clock stops at the timeout until the answer is made (it says
+            // how the machine was then).
+            let deadline = s.clock.hold_after(t);
+            wait_for(s, id, &deadline).await.map(|mut v| {
+                v.wait = Some(wait_outcome(s, &v, block.milestone));
+                v
+            })
+        }
         None => get(s, id),
     };
     view.ok_or_else(|| {
@@ -246,6 +252,7 @@ async fn submit(
             },
         }
     };
+    s.audit_barrier().await;
     let (stored, reply) = tokio::join!(store::audit(&s.db, &row), request);
     let stored = match stored {
         Ok(()) => true,
@@ -651,11 +658,10 @@ fn wait_outcome(s: &AppState, v: &CommandResource, milestone: Milestone) -> Wait
     }
 }
 
-/// Waits until the command is final or reaches its milestone, or the timeout — or until its
+/// Waits until the command is final or reaches its milestone, or the `deadline` — or until its
 /// axis is in error_stop, where nothing reaches a milestone before a reset (the answer then
 /// says so: `wait.reason`).
-pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<CommandResource> {
-    let deadline = tokio::time::Instant::now() + timeout;
+pub async fn wait_for(s: &AppState, id: CommandId, deadline: &Hold) -> Option<CommandResource> {
     let mut rx = s.notices.subscribe();
     // The axis's state changes without an event of this command (a power waiting for Status
     // while the axis stays in error_stop): looked at between notices too.
@@ -694,10 +700,9 @@ pub async fn wait_for(s: &AppState, id: CommandId, timeout: Duration) -> Option<
             }
         }
         tokio::select! {
-            r = tokio::time::timeout_at(deadline, rx.recv()) => match r {
-                Err(_) => return get(s, id),
-                Ok(Err(tokio::sync::broadcast::error::RecvError::Closed)) => return get(s, id),
-                Ok(_) => {}
+            _ = deadline.wait() => return get(s, id),
+            r = rx.recv() => if let Err(tokio::sync::broadcast::error::RecvError::Closed) = r {
+                return get(s, id);
             },
             _ = look.tick() => {}
         }

@@ -12,7 +12,7 @@
 //! A client is known by its principal (`user:NAME`, `token:NAME`) and its `X-Client-Id`
 //! ([`ClientInfo::control_key`]): two browser tabs of one user send different client ids.
 
-use std::time::{Duration, Instant, SystemTime};
+use std::time::Duration;
 
 use motion::CommandKind;
 use serde::{Deserialize, Serialize};
@@ -70,17 +70,14 @@ pub struct ControlState {
     pub yours: bool,
 }
 
-fn holder_view(h: &Holder) -> ControlHolder {
+fn holder_view(h: &Holder, now: Duration) -> ControlHolder {
     ControlHolder {
         client_id: h.client_id.clone(),
         principal: h.principal.clone(),
         client_addr: h.addr.clone(),
         since: humantime::format_rfc3339_millis(h.since).to_string(),
         lease_ms: h.lease.as_millis() as u64,
-        expires_in_ms: h
-            .until
-            .saturating_duration_since(Instant::now())
-            .as_millis() as u64,
+        expires_in_ms: h.until.saturating_sub(now).as_millis() as u64,
     }
 }
 
@@ -95,16 +92,14 @@ fn describe(h: &Holder) -> String {
 }
 
 /// 409: someone else holds control.
-fn held(h: &Holder) -> AppError {
+fn held(h: &Holder, now: Duration) -> AppError {
     AppError::conflict(
         "control_held",
         format!(
             "control of the machine is held by {}: motion commands from other clients are refused \
              (stop, halt and disabling are always accepted); its lease ends in {} ms unless renewed",
             describe(h),
-            h.until
-                .saturating_duration_since(Instant::now())
-                .as_millis()
+            h.until.saturating_sub(now).as_millis()
         ),
     )
 }
@@ -139,7 +134,7 @@ impl Control {
     /// The live holder (an expired lease is dropped here).
     fn live(&self) -> std::sync::MutexGuard<'_, Option<Holder>> {
         let mut h = self.holder.lock().unwrap();
-        if h.as_ref().is_some_and(|h| h.until <= Instant::now()) {
+        if h.as_ref().is_some_and(|h| h.until <= self.clock.now()) {
             *h = None;
         }
         h
@@ -150,7 +145,7 @@ impl Control {
         let key = client.control_key();
         ControlState {
             lease_enabled: self.enabled,
-            holder: h.as_ref().map(holder_view),
+            holder: h.as_ref().map(|h| holder_view(h, self.clock.now())),
             yours: h.as_ref().is_some_and(|h| Some(&h.key) == key.as_ref()),
         }
     }
@@ -186,7 +181,7 @@ impl Control {
                     .as_ref()
                     .is_none_or(|p| p.role >= Role::Admin);
                 if !req.take_over {
-                    return Err(held(cur));
+                    return Err(held(cur, self.clock.now()));
                 }
                 if !may_take_over {
                     return Err(AppError::new(
@@ -203,7 +198,7 @@ impl Control {
         let lease = Duration::from_millis(lease_ms);
         let since = match h.as_ref() {
             Some(cur) if !changed => cur.since,
-            _ => SystemTime::now(),
+            _ => self.clock.wall(),
         };
         *h = Some(Holder {
             key,
@@ -211,12 +206,12 @@ impl Control {
             principal: client.principal.clone(),
             addr: client.addr.clone(),
             since,
-            until: Instant::now() + lease,
+            until: self.clock.now() + lease,
             lease,
         });
         let state = ControlState {
             lease_enabled: true,
-            holder: h.as_ref().map(holder_view),
+            holder: h.as_ref().map(|h| holder_view(h, self.clock.now())),
             yours: true,
         };
         Ok((state, changed))
@@ -235,7 +230,7 @@ impl Control {
             .as_ref()
             .is_none_or(|p| p.role >= Role::Admin);
         if !mine && !admin {
-            return Err(held(cur));
+            return Err(held(cur, self.clock.now()));
         }
         *h = None;
         Ok(true)
@@ -262,7 +257,9 @@ impl Control {
         }
         let h = self.live();
         match h.as_ref() {
-            Some(cur) if client.control_key().as_ref() != Some(&cur.key) => Err(held(cur)),
+            Some(cur) if client.control_key().as_ref() != Some(&cur.key) => {
+                Err(held(cur, self.clock.now()))
+            }
             _ => Ok(()),
         }
     }
@@ -283,7 +280,13 @@ mod tests {
 
     #[test]
     fn a_holder_refuses_others_motion_but_never_their_stop() {
-        let c = Control::new(true);
+        let c = Control::new(
+            true,
+            crate::clock::Clock::new(
+                crate::clock::Mode::Real,
+                std::sync::Arc::new(crate::cycle::Shared::new(1_000_000)),
+            ),
+        );
         let (a, b) = (client("a"), client("b"));
         let go = CommandKind::Reset;
         c.admit(&b, &go).unwrap();
@@ -321,7 +324,13 @@ mod tests {
 
     #[test]
     fn a_lease_not_renewed_ends() {
-        let c = Control::new(true);
+        let c = Control::new(
+            true,
+            crate::clock::Clock::new(
+                crate::clock::Mode::Real,
+                std::sync::Arc::new(crate::cycle::Shared::new(1_000_000)),
+            ),
+        );
         c.take(
             &client("a"),
             &TakeControl {
@@ -331,7 +340,7 @@ mod tests {
         )
         .unwrap();
         // Forced into the past instead of sleeping.
-        c.holder.lock().unwrap().as_mut().unwrap().until = Instant::now();
+        c.holder.lock().unwrap().as_mut().unwrap().until = c.clock.now();
         assert!(c.state(&client("b")).holder.is_none());
         c.admit(&client("b"), &CommandKind::Reset).unwrap();
     }

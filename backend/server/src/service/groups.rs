@@ -406,6 +406,7 @@ async fn store_and_register(
             None => drop(s.uninstall_group(e.slot, false).await),
         }
     };
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     let stored = stored_json(&e.config, &e.members);
     store::groups::upsert_group(&mut tx, e.id, &e.name, &stored, &e.updated_at).await?;
@@ -491,6 +492,7 @@ pub async fn delete(s: &AppState, key: &str, client: &ClientInfo) -> AppResult<(
     let _guard = s.config_lock.lock().await;
     let e = entry(s, key)?;
     refuse_unless_disabled(s, &e)?;
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     store::groups::delete_group(&mut tx, e.id).await?;
     store::audit(

@@ -154,7 +154,12 @@ pub async fn run_once<B>(
                 return Err(AppError::storage(e));
             }
         };
-    let cutoff = humantime::format_rfc3339_millis(SystemTime::now() - TTL).to_string();
+    let cutoff = humantime::format_rfc3339_millis(
+        crate::store::wall_now()
+            .checked_sub(TTL)
+            .unwrap_or(SystemTime::UNIX_EPOCH),
+    )
+    .to_string();
     if let Some((id, action, target, detail, outcome, at)) = stored.filter(|r| r.5 >= cutoff) {
         s.idempotency.finish(&scoped, None);
         let axis = s

@@ -4,6 +4,7 @@
 
 pub mod axes;
 pub mod cams;
+pub mod clock;
 pub mod commands;
 pub mod control;
 pub mod groups;

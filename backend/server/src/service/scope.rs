@@ -234,6 +234,7 @@ pub async fn put_setup(
         return Err(AppError::field("view", "at most 64 KiB of JSON"));
     }
     let at = crate::store::now_rfc3339();
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     let replaced = crate::store::scope_setups::put(&mut tx, name, &body, &at).await?;
     crate::store::audit(
@@ -254,6 +255,7 @@ pub async fn put_setup(
 }
 
 pub async fn delete_setup(s: &AppState, name: &str, client: &ClientInfo) -> AppResult<()> {
+    s.audit_barrier().await;
     let mut tx = s.db.begin().await?;
     if !crate::store::scope_setups::delete(&mut tx, name).await? {
         return Err(AppError::not_found("scope_setup", name));

@@ -59,6 +59,8 @@ pub async fn audit_outcome<'e, E: sqlx::SqliteExecutor<'e>>(
 pub enum AuditOp {
     Row(AuditEntry),
     Outcome(u64, String),
+    /// Answered once everything queued before it is written (or given up).
+    Flush(tokio::sync::oneshot::Sender<()>),
 }
 
 /// The newest submission of a motion command sent with `key`: (command id, action, target,

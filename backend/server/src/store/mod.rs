@@ -163,6 +163,40 @@ pub async fn mark_initialised(pool: &SqlitePool) -> Result<(), sqlx::Error> {
         .map(|_| ())
 }
 
+/// The cycle count and the cycle time of a virtual clock (`crate::clock`), once one runs.
+type VirtualTime = (Box<dyn Fn() -> u64 + Send + Sync>, u64);
+static VIRTUAL_TIME: std::sync::OnceLock<VirtualTime> = std::sync::OnceLock::new();
+
+/// Stamps follow a virtual clock from now on: `cycle` reads its cycle count.
+pub fn use_virtual_time(cycle: Box<dyn Fn() -> u64 + Send + Sync>, period_ns: u64) {
+    let _ = VIRTUAL_TIME.set((cycle, period_ns));
+}
+
+/// The time to stamp things with: the wall clock, or in virtual time the Unix epoch plus the
+/// virtual time (two runs stamp alike; decision 158).
+pub fn wall_now() -> std::time::SystemTime {
+    match VIRTUAL_TIME.get() {
+        Some((cycle, _)) => wall_at_cycle(cycle()),
+        None => std::time::SystemTime::now(),
+    }
+}
+
+/// The time of something that happened in `cycle` (a command's end): in virtual time that
+/// cycle's time (not when the async side got to it), in real time now.
+pub fn wall_at_cycle(cycle: u64) -> std::time::SystemTime {
+    match VIRTUAL_TIME.get() {
+        Some((_, period)) => {
+            std::time::UNIX_EPOCH + std::time::Duration::from_nanos(cycle * period)
+        }
+        None => std::time::SystemTime::now(),
+    }
+}
+
+/// The time of something that happened in `cycle`, as RFC 3339 (see [`wall_at_cycle`]).
+pub fn cycle_rfc3339(cycle: u64) -> String {
+    humantime::format_rfc3339_millis(wall_at_cycle(cycle)).to_string()
+}
+
 pub fn now_rfc3339() -> String {
-    humantime::format_rfc3339_millis(std::time::SystemTime::now()).to_string()
+    humantime::format_rfc3339_millis(wall_now()).to_string()
 }
