@@ -27,6 +27,11 @@ pub enum Cmd {
     Openapi,
     /// Print the websocket's AsyncAPI document (what `openapi/asyncapi.json` must contain).
     Asyncapi,
+    /// Acceptance tests of machine sequences as data, run in virtual time.
+    Scenario {
+        #[command(subcommand)]
+        action: ScenarioCmd,
+    },
     /// Manage users in the database given with `--db` (while no motiond runs on it; use the
     /// API's `/api/v1/users` otherwise). The first user turns authentication on.
     User {
@@ -58,6 +63,23 @@ pub enum Cmd {
         #[arg(long, value_name = "MS", value_parser = clap::value_parser!(u32).range(1..=1000))]
         late_reply_ms: Option<u32>,
     },
+}
+
+#[derive(Subcommand, Debug)]
+pub enum ScenarioCmd {
+    /// Run scenario files, each on a fresh machine in virtual time (an in-memory database);
+    /// exits 1 at the first failed expectation, with what, where, expected and got.
+    Run {
+        /// Scenario files (JSON, `motiond scenario schema`).
+        #[arg(required = true)]
+        files: Vec<std::path::PathBuf>,
+        /// Write each scenario's scope recording as CSV: to this file (one scenario) or into
+        /// this directory (several: FILE.csv each).
+        #[arg(long, value_name = "PATH")]
+        csv: Option<std::path::PathBuf>,
+    },
+    /// Print the JSON Schema of a scenario file.
+    Schema,
 }
 
 #[derive(Subcommand, Debug)]

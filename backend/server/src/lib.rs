@@ -36,23 +36,20 @@ pub mod error;
 pub mod metrics;
 pub mod model;
 pub mod params;
+pub mod scenario;
 pub mod scope;
 pub mod service;
 pub mod sim;
+pub mod startup;
 pub mod stats;
 pub mod store;
 pub mod tls;
 
 pub use cli::{Cli, Cmd, ServeArgs, TokenCmd, UserCmd};
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
-use std::time::Instant;
 
 use clap::Parser;
-
-use crate::app::{AppState, AxisEntry, SystemInfo};
-use crate::params::ParamValue;
 
 /// Entry point of the `motiond` binary.
 pub fn run() {
@@ -65,6 +62,19 @@ pub fn run() {
         Some(Cmd::Asyncapi) => {
             print!("{}", api::asyncapi::asyncapi_json());
             return;
+        }
+        Some(Cmd::Scenario { action }) => {
+            return match action {
+                cli::ScenarioCmd::Schema => print!("{}", scenario::schema_json()),
+                cli::ScenarioCmd::Run { files, csv } => {
+                    // Only what goes wrong: the report is the scenario's.
+                    tracing_subscriber::fmt()
+                        .with_target(false)
+                        .with_max_level(tracing::Level::ERROR)
+                        .init();
+                    exit_with(scenario::run_files(&files, csv.as_deref()))
+                }
+            };
         }
         Some(Cmd::User { action }) => {
             return exit_with(admin_command(&cli.serve, Admin::User(action)));
@@ -237,214 +247,13 @@ fn serve(args: ServeArgs) -> Result<(), String> {
 }
 
 async fn serve_async(args: ServeArgs) -> Result<(), String> {
-    if args.clock.is_virtual() && args.bus != bus::BusKind::Simulated {
-        // Real drives (and the emulated segment's frames) run on their own time.
-        return Err(format!(
-            "--clock {} needs the simulated bus: drives on EtherCAT run in real time (use --bus simulated)",
-            args.clock.name()
-        ));
-    }
-    let db = store::open(&args.db).await?;
-    if args.db == ":memory:" {
-        tracing::info!("database :memory: (in memory: nothing is kept after exit)");
-    } else {
-        tracing::info!("database {} (WAL, synchronous=FULL)", args.db);
-    }
-
-    let cycle_time = args.cycle_us as f64 * 1e-6;
-    // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
-    let (bus, bus_handle) = {
-        let (kind, iface, strict) = (
-            args.bus,
-            args.interface.clone(),
-            args.emulated_strict_drives,
-        );
-        let (cycle, max, timeout) = (
-            std::time::Duration::from_micros(args.cycle_us as u64),
-            args.bus_max_errors,
-            args.bus_timeout_ms
-                .map(|ms| std::time::Duration::from_millis(ms as u64)),
-        );
-        tokio::task::spawn_blocking(move || {
-            bus::start(
-                kind,
-                iface.as_deref(),
-                strict,
-                cycle,
-                max,
-                timeout,
-                cycle::MAX_AXES,
-            )
-        })
-        .await
-        .map_err(|e| format!("the bus start-up failed: {e}"))?
-        .map_err(|e| format!("the {} bus did not come up: {e}", args.bus.name()))?
-    };
-    let period_ns = args.cycle_us as u64 * 1000;
-    let pace_ns = match args.clock {
-        clock::Mode::Fast(Some(factor)) => (period_ns as f64 / factor) as u64,
-        _ => 0,
-    };
-    let shared = Arc::new(cycle::Shared::with_clock(
-        period_ns,
-        args.clock.is_virtual(),
-        pace_ns,
-    ));
-    let (input, output) = triple_buffer::triple_buffer(&cycle::Snapshot::default());
-    let (grant_tx, grant_rx) = std::sync::mpsc::channel();
-    let thread_shared = shared.clone();
-    let virtual_time = args.clock.is_virtual();
-    let cycle_thread = std::thread::Builder::new()
-        .name("motiond-cycle".into())
-        .spawn(move || {
-            let ct = cycle::CycleThread::new(cycle_time, bus, thread_shared, input);
-            if virtual_time {
-                // Nothing waits for a deadline: no real-time priority (a thread running
-                // cycles back to back at SCHED_FIFO would starve the API).
-                let _ = grant_tx.send(cycle::RealtimeGrant {
-                    notes: vec!["virtual time: no real-time scheduling asked for".into()],
-                    ..Default::default()
-                });
-                ct.run_virtual();
-            } else {
-                let _ = grant_tx.send(cycle::request_realtime(80));
-                ct.run();
-            }
-        })
-        .map_err(|e| format!("cannot start the cycle thread: {e}"))?;
-    let realtime = grant_rx
-        .recv()
-        .map_err(|_| "the cycle thread died at start-up".to_string())?;
-    tracing::info!(
-        "cycle thread: {} µs cycle; SCHED_FIFO {}, mlockall {}, pinned to {}",
-        args.cycle_us,
-        if realtime.sched_fifo {
-            "granted"
-        } else {
-            "NOT granted"
-        },
-        if realtime.mlockall {
-            "granted"
-        } else {
-            "NOT granted"
-        },
-        realtime
-            .pinned_cpu
-            .map_or("no CPU (not granted)".to_string(), |c| format!("CPU {c}"))
-    );
-    for n in &realtime.notes {
-        tracing::warn!("real-time: {n} (running without it)");
-    }
-
-    // Above every id an earlier run may have acknowledged: those in the audit log and the
-    // reserved mark (an acknowledged command whose audit row died with the process is below it).
-    let first_id = store::max_command_id(&db)
-        .await
-        .map_err(|e| format!("cannot read the audit log: {e}"))?
-        .max(
-            store::command_ids_reserved(&db)
-                .await
-                .map_err(|e| format!("cannot read the database: {e}"))?,
-        )
-        + 1;
-    let info = SystemInfo {
-        version: env!("CARGO_PKG_VERSION"),
-        cycle_time_s: cycle_time,
-        listen: args.listen.to_string(),
-        db: args.db.clone(),
-        realtime,
-        started: Instant::now(),
-        ui_dir: api::ui::resolve_dir(args.ui_dir.as_deref()),
-        bus: bus_handle,
-    };
-    if api::ui::is_built(&info.ui_dir) {
-        let dir = info.ui_dir.canonicalize();
-        tracing::info!(
-            "commissioning UI: {}",
-            dir.as_deref().unwrap_or(&info.ui_dir).display()
-        );
-    } else {
-        tracing::warn!(
-            "commissioning UI not built (no index.html in {}): / shows how to build it \
-             (`{}`, or start motiond with ./scripts/run.sh)",
-            info.ui_dir.display(),
-            api::ui::BUILD_COMMAND
-        );
-    }
-    let remote = !args.listen.ip().is_loopback();
-    let tls_on = remote || args.tls || args.tls_cert.is_some();
-    let auth = Arc::new(
-        auth::Auth::load(
-            db.clone(),
-            std::time::Duration::from_secs(args.session_hours as u64 * 3600),
-            tls_on,
-        )
-        .await?,
-    );
-    first_admin_from_env(&auth).await?;
-    if remote && !auth.enabled() {
-        return Err(format!(
-            "refusing to listen on {}: a non-loopback address needs authentication, and no user exists; \
-             create an admin first (`motiond --db {} user add --admin NAME`, password on stdin, or \
-             MOTIOND_ADMIN_USER and MOTIOND_ADMIN_PASSWORD on first start)",
-            args.listen, args.db
-        ));
-    }
-    if auth.enabled() {
-        tracing::info!(
-            "authentication on: {} users; browser sessions last {} h",
-            auth.users().len(),
-            args.session_hours
-        );
-    } else {
-        tracing::info!("authentication off (no user exists): every local client may act");
-    }
-    let tls = if tls_on {
+    let machine = startup::start_machine(&args).await?;
+    let (state, remote) = (machine.state.clone(), machine.remote);
+    let tls = if machine.tls_on {
         Some(tls::acceptor(&args)?)
     } else {
         None
     };
-    let (state, audit_rx) = AppState::new(
-        shared.clone(),
-        output,
-        db.clone(),
-        first_id,
-        info,
-        auth,
-        args.control_lease,
-        clock::Clock::new(args.clock, shared.clone()),
-    );
-    if args.clock.is_virtual() {
-        tracing::info!(
-            "clock: {} (virtual time: {}; timestamps count from 1970-01-01T00:00:00Z)",
-            args.clock.name(),
-            match args.clock {
-                clock::Mode::Fast(Some(f)) => format!("{f} × real time"),
-                clock::Mode::Fast(None) => "as fast as the machine can".into(),
-                _ => "cycles advance on POST /api/v1/clock/advance".into(),
-            }
-        );
-    }
-    tokio::spawn(app::pump(state.clone()));
-    let audit_task = tokio::spawn(app::audit_writer(
-        db.clone(),
-        audit_rx,
-        state.audit_dropped.clone(),
-    ));
-
-    load_axes(&state, args.no_demo).await?;
-    if let Some(notice) = api::bus::idle_drives_notice(&state) {
-        tracing::warn!("{notice}");
-    }
-    let cams = service::cams::load(&state).await?;
-    if cams > 0 {
-        tracing::info!("{cams} cam tables loaded");
-    }
-    let groups = service::groups::load(&state).await?;
-    if groups > 0 {
-        tracing::info!("{groups} axis groups loaded (disabled)");
-    }
-
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
         .map_err(|e| format!("cannot listen on {}: {e}", args.listen))?;
@@ -506,13 +315,8 @@ async fn serve_async(args: ServeArgs) -> Result<(), String> {
         tracing::warn!("closing the connections still open");
     }
     tracing::info!("shutting down");
-    shared
-        .shutdown
-        .store(true, std::sync::atomic::Ordering::Relaxed);
-    let _ = cycle_thread.join();
     drop(state);
-    audit_task.abort();
-    db.close().await;
+    machine.shut_down().await;
     Ok(())
 }
 
@@ -730,33 +534,6 @@ async fn serve_connection<I, S>(
     }
 }
 
-/// The first admin, on a database without users, from `MOTIOND_ADMIN_USER` and
-/// `MOTIOND_ADMIN_PASSWORD` (for images and unattended installs; ignored once a user exists).
-async fn first_admin_from_env(auth: &auth::Auth) -> Result<(), String> {
-    let (Ok(name), Ok(password)) = (
-        std::env::var("MOTIOND_ADMIN_USER"),
-        std::env::var("MOTIOND_ADMIN_PASSWORD"),
-    ) else {
-        return Ok(());
-    };
-    if auth.enabled() {
-        return Ok(());
-    }
-    let audit = store::AuditEntry {
-        at: store::now_rfc3339(),
-        client_id: Some("environment".into()),
-        action: "user.create".into(),
-        target: Some(name.clone()),
-        outcome: Some("committed".into()),
-        ..Default::default()
-    };
-    auth.add_user(&name, auth::Role::Admin, &password, audit)
-        .await
-        .map_err(|e| format!("MOTIOND_ADMIN_USER: {}", e.problem().detail))?;
-    tracing::info!("created the admin {name} from MOTIOND_ADMIN_USER; authentication is on");
-    Ok(())
-}
-
 async fn shutdown_signal() {
     let ctrl_c = tokio::signal::ctrl_c();
     let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
@@ -765,89 +542,4 @@ async fn shutdown_signal() {
         _ = ctrl_c => {},
         _ = term.recv() => {},
     }
-}
-
-/// Loads the stored axes into the kernel, or creates the demo on a new database.
-async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
-    let db = &state.db;
-    let stored = store::load_axes(db)
-        .await
-        .map_err(|e| format!("cannot read axes: {e}"))?;
-    let initialised = store::meta(db, "initialised")
-        .await
-        .map_err(|e| e.to_string())?
-        .is_some();
-    if !initialised {
-        store::mark_initialised(db)
-            .await
-            .map_err(|e| format!("cannot write the database: {e}"))?;
-        if stored.is_empty() && !no_demo {
-            let mut demo = model::demo::axes();
-            if state.info.bus.kind == bus::BusKind::Emulated {
-                model::demo::on_emulated_drives(&mut demo);
-            }
-            for config in demo {
-                let name = config.name.clone();
-                let audit = store::AuditEntry {
-                    at: store::now_rfc3339(),
-                    action: "axis.create".into(),
-                    target: Some(name.clone()),
-                    client_id: Some("demo".into()),
-                    ..Default::default()
-                };
-                service::axes::create(state, config, None, audit)
-                    .await
-                    .map_err(|e| format!("cannot create demo axis {name}: {}", e))?;
-            }
-            service::groups::create_demo(state)
-                .await
-                .map_err(|e| format!("cannot create the demo group xy: {e}"))?;
-            tracing::info!(
-                "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°), \
-                 and the group xy of x and y (disabled)"
-            );
-            return Ok(());
-        }
-    }
-    let mut persistent: BTreeMap<i64, BTreeMap<u16, ParamValue>> = BTreeMap::new();
-    for (axis, number, value) in store::load_persistent(db)
-        .await
-        .map_err(|e| e.to_string())?
-    {
-        match serde_json::from_str(&value) {
-            Ok(v) => {
-                persistent.entry(axis).or_default().insert(number, v);
-            }
-            Err(e) => tracing::warn!(
-                "axis {axis}: persistent parameter {number} unreadable ({e}); ignored"
-            ),
-        }
-    }
-    for (slot, a) in stored.into_iter().enumerate() {
-        let config: model::AxisConfigDto = serde_json::from_str(&a.config)
-            .map_err(|e| format!("axis {} in the database is unreadable: {e}", a.name))?;
-        let overlay = persistent.remove(&a.id).unwrap_or_default();
-        let (p, axis, drive) = state
-            .build_axis(a.id, &config, &overlay)
-            .map_err(|e| format!("axis {} in the database is invalid: {e:?}", a.name))?;
-        let slot = slot as u16;
-        state
-            .install_axis(slot, axis, drive, false)
-            .await
-            .map_err(|e| format!("cannot install axis {}: {e}", a.name))?;
-        state.registry_write().axes.insert(
-            a.id,
-            AxisEntry {
-                id: a.id,
-                name: a.name,
-                slot,
-                config,
-                params: p,
-                persistent: overlay,
-            },
-        );
-    }
-    let n = state.registry.read().unwrap().axes.len();
-    tracing::info!("{n} axes loaded from the database");
-    Ok(())
 }

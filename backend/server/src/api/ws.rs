@@ -1012,6 +1012,77 @@ fn too_many_in_flight(id: &Value) -> String {
     )
 }
 
+/// A websocket session without a socket, for `motiond scenario run`: the same methods, with the
+/// same rules (jogs held by it, released when it ends), called one at a time.
+pub struct LocalSession {
+    s: Arc<AppState>,
+    subs: Vec<Sub>,
+    notices: Option<broadcast::Receiver<Arc<crate::app::CommandNotice>>>,
+    client: ClientInfo,
+    out_tx: mpsc::Sender<String>,
+    out_rx: mpsc::Receiver<String>,
+    jogs: Arc<Mutex<Vec<u64>>>,
+    in_flight: Arc<tokio::sync::Semaphore>,
+    next_id: u64,
+}
+
+impl LocalSession {
+    pub fn new(s: Arc<AppState>, client: ClientInfo) -> Self {
+        let (out_tx, out_rx) = mpsc::channel(64);
+        LocalSession {
+            s,
+            subs: Vec::new(),
+            notices: None,
+            client,
+            out_tx,
+            out_rx,
+            jogs: Arc::default(),
+            in_flight: Arc::new(tokio::sync::Semaphore::new(MAX_IN_FLIGHT)),
+            next_id: 1,
+        }
+    }
+
+    /// Calls `method` and waits for its answer (the JSON-RPC response object).
+    pub async fn call(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next_id;
+        self.next_id += 1;
+        let text =
+            json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}).to_string();
+        let mut answer = handle(
+            &self.s,
+            &mut self.subs,
+            &mut self.notices,
+            &self.client,
+            &self.out_tx,
+            &self.jogs,
+            &self.in_flight,
+            &text,
+        );
+        loop {
+            if let Some(a) = answer.take() {
+                let v: Value = serde_json::from_str(&a).unwrap_or(Value::Null);
+                if v["id"] == id {
+                    return v;
+                }
+            }
+            match self.out_rx.recv().await {
+                Some(a) => answer = Some(a),
+                None => return Value::Null,
+            }
+        }
+    }
+
+    /// Ends the session as a closed socket does: its jogs are released.
+    pub async fn close(self) {
+        let held: Vec<u64> = std::mem::take(&mut *self.jogs.lock().unwrap());
+        for id in held {
+            if commands::get(&self.s, id).is_some_and(|c| !c.is_final) {
+                let _ = commands::release(&self.s, id, &self.client).await;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -147,22 +147,28 @@ pub async fn advance(s: &AppState, by: Advance, client: &ClientInfo) -> AppResul
     };
     let mut outcome = None;
     let run = match milestone {
-        // Already there: nothing to run.
-        Some(m) if at_milestone(watch, m)?.0 => None,
-        _ => Some(s.clock.begin_advance(cycles, watch).ok_or_else(busy)?),
-    };
-    let from = run.as_ref().map_or(s.clock.cycle(), |a| a.from);
-    if let Some(run) = &run {
-        loop {
-            match run.run().await {
-                Stopped::Target => break,
-                Stopped::Watched(_) => {
-                    let m = milestone.unwrap_or(Milestone::Done);
-                    if at_milestone(watch, m)?.0 {
-                        break;
-                    }
-                    run.resume();
+        // Already there: on at most to the cycle its events are stamped with (a submission's
+        // outputs are those of the cycle after it, the one the command first acts in).
+        Some(m) => match at_milestone(watch, m)? {
+            (true, v) => {
+                let behind = v.last_cycle.saturating_sub(s.clock.cycle()).min(cycles);
+                s.clock.begin_advance(behind, 0)
+            }
+            _ => s.clock.begin_advance(cycles, watch),
+        },
+        None => s.clock.begin_advance(cycles, 0),
+    }
+    .ok_or_else(busy)?;
+    let from = run.from;
+    loop {
+        match run.run().await {
+            Stopped::Target => break,
+            Stopped::Watched(_) => {
+                let m = milestone.unwrap_or(Milestone::Done);
+                if at_milestone(watch, m)?.0 {
+                    break;
                 }
+                run.resume();
             }
         }
     }

@@ -165,18 +165,21 @@ pub async fn mark_initialised(pool: &SqlitePool) -> Result<(), sqlx::Error> {
 
 /// The cycle count and the cycle time of a virtual clock (`crate::clock`), once one runs.
 type VirtualTime = (Box<dyn Fn() -> u64 + Send + Sync>, u64);
-static VIRTUAL_TIME: std::sync::OnceLock<VirtualTime> = std::sync::OnceLock::new();
+/// Replaced by each machine started in this process (`motiond scenario run` runs one after
+/// the other).
+static VIRTUAL_TIME: std::sync::RwLock<Option<VirtualTime>> = std::sync::RwLock::new(None);
 
 /// Stamps follow a virtual clock from now on: `cycle` reads its cycle count.
 pub fn use_virtual_time(cycle: Box<dyn Fn() -> u64 + Send + Sync>, period_ns: u64) {
-    let _ = VIRTUAL_TIME.set((cycle, period_ns));
+    *VIRTUAL_TIME.write().unwrap() = Some((cycle, period_ns));
 }
 
 /// The time to stamp things with: the wall clock, or in virtual time the Unix epoch plus the
 /// virtual time (two runs stamp alike; decision 158).
 pub fn wall_now() -> std::time::SystemTime {
-    match VIRTUAL_TIME.get() {
-        Some((cycle, _)) => wall_at_cycle(cycle()),
+    let cycle = VIRTUAL_TIME.read().unwrap().as_ref().map(|(c, _)| c());
+    match cycle {
+        Some(c) => wall_at_cycle(c),
         None => std::time::SystemTime::now(),
     }
 }
@@ -184,7 +187,7 @@ pub fn wall_now() -> std::time::SystemTime {
 /// The time of something that happened in `cycle` (a command's end): in virtual time that
 /// cycle's time (not when the async side got to it), in real time now.
 pub fn wall_at_cycle(cycle: u64) -> std::time::SystemTime {
-    match VIRTUAL_TIME.get() {
+    match VIRTUAL_TIME.read().unwrap().as_ref() {
         Some((_, period)) => {
             std::time::UNIX_EPOCH + std::time::Duration::from_nanos(cycle * period)
         }
