@@ -115,13 +115,14 @@ fn a_failed_expectation_ends_the_run_with_what_where_expected_and_got() {
 fn the_committed_scenario_schema_is_current() {
     let out = bin().args(["scenario", "schema"]).output().unwrap();
     let committed = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/scenario.schema.json"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/schema/scenario.schema.json"),
     )
     .unwrap();
     assert_eq!(
         String::from_utf8_lossy(&out.stdout),
         committed,
-        "regenerate: motiond scenario schema > scenarios/scenario.schema.json"
+        "regenerate: motiond scenario schema > scenarios/schema/scenario.schema.json"
     );
     let schema: serde_json::Value = serde_json::from_str(&committed).unwrap();
     assert_eq!(schema["$ref"], "#/$defs/Scenario");

@@ -125,6 +125,17 @@ def mes_example() -> None:
                 p.kill()
 
 
+def mes_test_suite() -> None:
+    """The example pytest suite of an MES team (tests/client/test_virtual_time.py): motiond in
+    virtual time through the generated client."""
+    motiond = Path(os.environ.get("MOTIOND_BIN", ROOT / "target" / "debug" / "motiond"))
+    env = dict(os.environ, PYTHONPATH=str(PACKAGE.parent), MOTIOND_BIN=str(motiond))
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-s", "-p", "no:cacheprovider",
+                        str(ROOT / "tests" / "client" / "test_virtual_time.py")], env=env, timeout=300)
+    if r.returncode != 0:
+        fail("the MES test suite (pytest, virtual time) failed")
+
+
 def main() -> None:
     ids = operation_ids()
     n_py = python_client(ids)
@@ -132,8 +143,9 @@ def main() -> None:
     print(f"client-generation: {len(ids)} operations, 0 warnings "
           f"(openapi-python-client: {n_py}, openapi-typescript: {n_ts})")
     mes_example()
-    # Python client, TypeScript types, MES script (a failure has exited above).
-    print("client-generation: 3 passed, 0 failed")
+    mes_test_suite()
+    # Python client, TypeScript types, MES script, MES test suite (a failure has exited above).
+    print("client-generation: 4 passed, 0 failed")
 
 
 if __name__ == "__main__":

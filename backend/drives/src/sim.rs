@@ -481,6 +481,16 @@ pub struct SimDrive {
     // Constants derived at construction.
     dynamics: Dynamics,
     substeps: u32,
+    /// One cycle of the plant in position mode as the linear map it is (the plant is linear
+    /// and moves with its reference, its inputs linear over the cycle): the position relative
+    /// to the cycle's starting reference and the velocity at the cycle's end from
+    /// [q − r0, v, r1 − r0, w0, w1, a0, a1] at its start (reference r, velocity and
+    /// acceleration feed-forward w and a, at the cycle's start and end). Made once from the
+    /// substep integration itself, so it gives what the substeps give (to rounding, in
+    /// coordinates relative to the reference so that rounding stays at the lag's scale) at a
+    /// fraction of their cost; the substeps still run while a probe latch is armed (it needs
+    /// the load's path within the cycle).
+    cycle_map: [[f64; 7]; 2],
     /// Dead time in cycles = `delay_cycles + delay_frac`.
     delay_cycles: usize,
     delay_frac: f64,
@@ -589,10 +599,29 @@ impl SimDrive {
             0.0
         };
 
+        let mut cycle_map = [[0.0; 7]; 2];
+        for j in 0..7 {
+            let mut e = [0.0; 7];
+            e[j] = 1.0;
+            // r0 = 0: positions relative to the starting reference.
+            let inputs = [0.0, e[2], e[3], e[4], e[5], e[6]];
+            let (q, v) = integrate(
+                dynamics,
+                substeps,
+                cycle_time,
+                e[0],
+                e[1],
+                inputs,
+                |_, _| {},
+            );
+            cycle_map[0][j] = q;
+            cycle_map[1][j] = v;
+        }
         let mut drive = SimDrive {
             cycle_time,
             dynamics,
             substeps,
+            cycle_map,
             delay_cycles,
             delay_frac,
             compensation_time,
@@ -866,55 +895,35 @@ impl SimDrive {
         let offset = self.load_force / self.config.load_stiffness;
         let kv = self.config.velocity_feed_forward;
         let ka = self.config.acceleration_feed_forward;
-        let n = self.substeps;
-        let h = self.cycle_time / n as f64;
-        // Reference, feed-forward velocity and acceleration at fraction `s` of the cycle.
-        let input = |s: f64| {
-            let x = start.lerp(end, s);
-            (x.position - offset, kv * x.velocity, ka * x.acceleration)
-        };
-
-        for i in 0..n {
-            let s0 = i as f64 / n as f64;
-            let s1 = (i + 1) as f64 / n as f64;
-            let sm = 0.5 * (s0 + s1);
-            let before = self.position;
-            match self.dynamics {
-                Dynamics::Ideal => {
-                    self.position = input(s1).0;
-                    self.velocity = (end.position - start.position) / self.cycle_time;
-                }
-                Dynamics::Pt1 { inv_t } => {
-                    let f = |s: f64, q: f64| {
-                        let (r, vff, _) = input(s);
-                        (r - q) * inv_t + vff
-                    };
-                    let q = self.position;
-                    let k1 = f(s0, q);
-                    let k2 = f(sm, q + 0.5 * h * k1);
-                    let k3 = f(sm, q + 0.5 * h * k2);
-                    let k4 = f(s1, q + h * k3);
-                    self.position = q + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                    self.velocity = f(s1, self.position);
-                }
-                Dynamics::Pt2 {
-                    omega2,
-                    two_zeta_omega,
-                } => {
-                    let f = |s: f64, q: f64, v: f64| {
-                        let (r, vff, aff) = input(s);
-                        omega2 * (r - q) + two_zeta_omega * (vff - v) + aff
-                    };
-                    let (q, v) = (self.position, self.velocity);
-                    let (q1, v1) = (v, f(s0, q, v));
-                    let (q2, v2) = (v + 0.5 * h * v1, f(sm, q + 0.5 * h * q1, v + 0.5 * h * v1));
-                    let (q3, v3) = (v + 0.5 * h * v2, f(sm, q + 0.5 * h * q2, v + 0.5 * h * v2));
-                    let (q4, v4) = (v + h * v3, f(s1, q + h * q3, v + h * v3));
-                    self.position = q + h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4);
-                    self.velocity = v + h / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
-                }
-            }
-            self.probe(&mut latch, before, self.position);
+        let inputs = [
+            start.position - offset,
+            end.position - offset,
+            kv * start.velocity,
+            kv * end.velocity,
+            ka * start.acceleration,
+            ka * end.acceleration,
+        ];
+        let (q, v) = (self.position, self.velocity);
+        if latch.is_none() && !matches!(self.dynamics, Dynamics::Ideal) {
+            let r0 = inputs[0];
+            let x = [
+                q - r0,
+                v,
+                inputs[1] - r0,
+                inputs[2],
+                inputs[3],
+                inputs[4],
+                inputs[5],
+            ];
+            let row = |r: &[f64; 7]| r.iter().zip(&x).map(|(m, x)| m * x).sum::<f64>();
+            self.position = r0 + row(&self.cycle_map[0]);
+            self.velocity = row(&self.cycle_map[1]);
+        } else {
+            let (dynamics, n, t) = (self.dynamics, self.substeps, self.cycle_time);
+            let mut path = |a: f64, b: f64| self.probe(&mut latch, a, b);
+            let (q1, v1) = integrate(dynamics, n, t, q, v, inputs, &mut path);
+            self.position = q1;
+            self.velocity = v1;
         }
     }
 
@@ -1035,6 +1044,68 @@ impl SimDrive {
             *latch = None;
         }
     }
+}
+
+/// One cycle of the plant in position mode from (`q`, `v`), integrated in `n` RK4 substeps;
+/// `inputs` are the reference, the velocity and the acceleration feed-forward at the cycle's
+/// start and end (`[r0, r1, w0, w1, a0, a1]`, linear in between). `on_substep(before, after)`
+/// sees the load's path. Returns the position and velocity at the cycle's end.
+fn integrate(
+    dynamics: Dynamics,
+    n: u32,
+    cycle_time: f64,
+    q: f64,
+    v: f64,
+    inputs: [f64; 6],
+    mut on_substep: impl FnMut(f64, f64),
+) -> (f64, f64) {
+    let [r0, r1, w0, w1, a0, a1] = inputs;
+    let h = cycle_time / n as f64;
+    let input = |s: f64| (r0 + (r1 - r0) * s, w0 + (w1 - w0) * s, a0 + (a1 - a0) * s);
+    let (mut position, mut velocity) = (q, v);
+    for i in 0..n {
+        let s0 = i as f64 / n as f64;
+        let s1 = (i + 1) as f64 / n as f64;
+        let sm = 0.5 * (s0 + s1);
+        let before = position;
+        match dynamics {
+            Dynamics::Ideal => {
+                position = input(s1).0;
+                velocity = (r1 - r0) / cycle_time;
+            }
+            Dynamics::Pt1 { inv_t } => {
+                let f = |s: f64, q: f64| {
+                    let (r, vff, _) = input(s);
+                    (r - q) * inv_t + vff
+                };
+                let q = position;
+                let k1 = f(s0, q);
+                let k2 = f(sm, q + 0.5 * h * k1);
+                let k3 = f(sm, q + 0.5 * h * k2);
+                let k4 = f(s1, q + h * k3);
+                position = q + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                velocity = f(s1, position);
+            }
+            Dynamics::Pt2 {
+                omega2,
+                two_zeta_omega,
+            } => {
+                let f = |s: f64, q: f64, v: f64| {
+                    let (r, vff, aff) = input(s);
+                    omega2 * (r - q) + two_zeta_omega * (vff - v) + aff
+                };
+                let (q, v) = (position, velocity);
+                let (q1, v1) = (v, f(s0, q, v));
+                let (q2, v2) = (v + 0.5 * h * v1, f(sm, q + 0.5 * h * q1, v + 0.5 * h * v1));
+                let (q3, v3) = (v + 0.5 * h * v2, f(sm, q + 0.5 * h * q2, v + 0.5 * h * v2));
+                let (q4, v4) = (v + h * v3, f(s1, q + h * q3, v + h * v3));
+                position = q + h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4);
+                velocity = v + h / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
+            }
+        }
+        on_substep(before, position);
+    }
+    (position, velocity)
 }
 
 /// The first index pulse passed on the way from `a` to `b` (reaching it counts; leaving it

@@ -186,6 +186,9 @@ pub struct Shared {
     pub scope_frames: ArrayQueue<ScopeFrame>,
     pub stats: CycleStats,
     pub cycle: AtomicU64,
+    /// The newest cycle whose snapshot is published (every cycle in real time; in virtual
+    /// time at least every cycle the clock stops at). Stored after `cycle`.
+    pub published_cycle: AtomicU64,
     pub shutdown: AtomicBool,
     pub period_ns: u64,
     /// Written by the cycle thread when it produced verdicts or events: the pump drains at
@@ -294,6 +297,7 @@ impl Shared {
             stats: CycleStats::default(),
             wake: Wake::new(),
             cycle: AtomicU64::new(0),
+            published_cycle: AtomicU64::new(0),
             shutdown: AtomicBool::new(false),
             period_ns,
         }
@@ -513,6 +517,15 @@ pub struct CycleThread {
     published: usize,
     /// The same for the group slots.
     groups_published: usize,
+    /// Virtual time: the snapshot is published only at a stop, for a watched event, while
+    /// the scope samples, and at least every millisecond of wall time (copying 64 statuses
+    /// every cycle was a quarter of a 64-axis cycle).
+    lazy_publish: bool,
+    /// This cycle is published (virtual time: the last before a stop, or a millisecond
+    /// since the last).
+    publish_next: bool,
+    /// The last cycle was not published.
+    unpublished: bool,
 }
 
 impl CycleThread {
@@ -532,6 +545,9 @@ impl CycleThread {
             scope: ScopeConfig::default(),
             published: 0,
             groups_published: 0,
+            lazy_publish: false,
+            publish_next: false,
+            unpublished: false,
         }
     }
 
@@ -584,6 +600,8 @@ impl CycleThread {
         let mut setpoints = vec![DriveSetpoint::default(); MAX_AXES];
         let mut next = now_ns();
         let idle = std::time::Duration::from_millis(50);
+        self.lazy_publish = true;
+        let mut last_publish = 0u64;
         use std::sync::atomic::Ordering::SeqCst;
         while !shared.shutdown.load(Relaxed) {
             // Announced before the limit is read (both SeqCst): a limit lowered by the async
@@ -596,6 +614,14 @@ impl CycleThread {
                 || shared.replies.len() > REPLY_QUEUE / 2;
             if !may_step || backlog {
                 link.stepping.store(false, SeqCst);
+                if self.unpublished {
+                    // Stopped where it was not published (the limit came nearer meanwhile):
+                    // whoever looks at this cycle sees it.
+                    let cycle = self.kernel.cycle();
+                    self.publish_snapshot(cycle);
+                    shared.published_cycle.store(cycle, SeqCst);
+                    shared.wake.signal();
+                }
                 self.requests_and_cycle(&mut feedback, &mut setpoints, false);
                 if backlog {
                     shared.wake.signal();
@@ -610,6 +636,11 @@ impl CycleThread {
                 next = next.max(now_ns().saturating_sub(link.pace_ns)) + link.pace_ns;
             }
             let start = now_ns();
+            self.publish_next = self.kernel.cycle() + 1 >= link.limit.load(SeqCst)
+                || start.saturating_sub(last_publish) >= 1_000_000;
+            if self.publish_next {
+                last_publish = start;
+            }
             self.one_cycle(&mut feedback, &mut setpoints);
             link.stepping.store(false, SeqCst);
             shared.stats.compute.record(now_ns() - start);
@@ -637,7 +668,10 @@ impl CycleThread {
         setpoints: &mut [DriveSetpoint],
         step: bool,
     ) {
-        let shared = &*self.shared;
+        // Its own handle (an uncontended count): the sink holds the event ring through the
+        // cycle while the cycle publishes through `&mut self`.
+        let handle = self.shared.clone();
+        let shared = &*handle;
         let mut sink = RingSink {
             q: &shared.events,
             dropped: 0,
@@ -1015,6 +1049,40 @@ impl CycleThread {
         }
 
         let cycle = self.kernel.cycle();
+        // Virtual time publishes only where someone looks (see `run_virtual`); a scope samples
+        // from the snapshot, so it has one every cycle.
+        let publish =
+            !self.lazy_publish || self.publish_next || sink.watched || self.scope.is_active();
+        if publish {
+            self.publish_snapshot(cycle);
+        } else {
+            self.unpublished = true;
+        }
+        if sink.watched {
+            // Before the cycle is stored: whoever reads this cycle sees that it stopped there.
+            shared
+                .clock
+                .watch_stop
+                .store(cycle, std::sync::atomic::Ordering::Release);
+        }
+        // Release: whoever reads this cycle finds its events in the ring (the pump, the clock).
+        shared
+            .cycle
+            .store(cycle, std::sync::atomic::Ordering::Release);
+        if publish {
+            shared
+                .published_cycle
+                .store(cycle, std::sync::atomic::Ordering::Release);
+        }
+        // A verdict or an output change waits on the async side: wake the pump now rather
+        // than at its next millisecond (one wake-up; nothing when the cycle produced nothing).
+        if drained > 0 || sink.pushed > 0 {
+            shared.wake.signal();
+        }
+    }
+
+    /// Writes every slot's status into the snapshot, samples the scope from it, publishes it.
+    fn publish_snapshot(&mut self, cycle: u64) {
         let snap = self.snapshot.input_buffer_mut();
         snap.cycle = cycle;
         // Only the slots in use, each status copied once into its place (not the whole array
@@ -1035,27 +1103,12 @@ impl CycleThread {
         }
         if self.scope.is_active() {
             let frame = ScopeFrame::sample(cycle, &self.scope, &snap.axes, &snap.groups);
-            if shared.scope_frames.push(frame).is_err() {
-                shared.stats.scope_frames_dropped.fetch_add(1, Relaxed);
+            if self.shared.scope_frames.push(frame).is_err() {
+                self.shared.stats.scope_frames_dropped.fetch_add(1, Relaxed);
             }
         }
         self.snapshot.publish();
-        if sink.watched {
-            // Before the cycle is stored: whoever reads this cycle sees that it stopped there.
-            shared
-                .clock
-                .watch_stop
-                .store(cycle, std::sync::atomic::Ordering::Release);
-        }
-        // Release: whoever reads this cycle finds its events in the ring (the pump, the clock).
-        shared
-            .cycle
-            .store(cycle, std::sync::atomic::Ordering::Release);
-        // A verdict or an output change waits on the async side: wake the pump now rather
-        // than at its next millisecond (one wake-up; nothing when the cycle produced nothing).
-        if drained > 0 || sink.pushed > 0 {
-            shared.wake.signal();
-        }
+        self.unpublished = false;
     }
 
     fn discard(&self, g: Garbage) {

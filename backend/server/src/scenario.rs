@@ -4,7 +4,7 @@
 //! the same router and websocket methods a client uses (in-process: no network), its
 //! expectations checked at their cycles. The first failed expectation ends the run with a
 //! report of what, where, expected and got. The format is JSON; its JSON Schema is
-//! `motiond scenario schema` (`scenarios/scenario.schema.json`).
+//! `motiond scenario schema` (`scenarios/schema/scenario.schema.json`).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;

@@ -307,13 +307,20 @@ impl Axis {
     /// slave that crosses one is an axis error.
     pub(super) fn step_soft_limits(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         let p = self.p();
-        let Some(job) = self.job else { return };
+        // The job's fields by value, not the job (a copy of it every cycle was an eighth of a
+        // 64-axis cycle).
+        let Some(job) = self.job.as_ref() else {
+            return;
+        };
+        let (kind, id, endless, positioning) =
+            (job.kind, job.id, job.is_endless(), job.is_positioning());
+        let (acc, dec, jerk) = (job.acc, job.dec.max(1e-9), job.jerk.max(1e-9));
         let v = self.set.velocity;
-        if job.kind == JobKind::External {
+        if kind == JobKind::External {
             // Checked against the samples themselves (`step_external`).
             return;
         }
-        if job.kind == JobKind::Gear || job.kind == JobKind::Group {
+        if kind == JobKind::Gear || kind == JobKind::Group {
             // A slave follows its master and cannot brake for a limit of its own while
             // coupled. Crossing one (moving outwards beyond it) decouples it and stops it on
             // the fast-stop ramp in ErrorStop (TwinCAT raises an axis error for a slave
@@ -330,8 +337,8 @@ impl Axis {
             }
             return;
         }
-        let endless = job.is_endless() || (job.id == 0 && job.kind == JobKind::Velocity);
-        if v.abs() <= EPS_V || job.kind == JobKind::Home {
+        let endless = endless || (id == 0 && kind == JobKind::Velocity);
+        if v.abs() <= EPS_V || kind == JobKind::Home {
             // A homing run searches for the reference of the coordinates the limits are
             // given in; the limit switches end it.
             return;
@@ -343,7 +350,6 @@ impl Axis {
         } else {
             return;
         };
-        let (dec, jerk) = (job.dec.max(1e-9), job.jerk.max(1e-9));
         let sd = stop_distance(v, self.set.acceleration, dec, jerk);
         let margin = 2.0 * v.abs() * dt;
         if (limit - self.set.position) * v.signum() > sd + margin {
@@ -355,19 +361,19 @@ impl Axis {
         if !endless && !self.planner.overshoots(limit, v.signum()) {
             return;
         }
-        if !endless && !job.is_positioning() {
+        if !endless && !positioning {
             // A stop whose own ramp would cross the limit: stop harder, as an axis error.
             self.enter_error(cx, ErrorId::SOFT_LIMIT_REACHED);
             return;
         }
-        let mut j = job;
+        let mut j = self.job.expect("a job runs");
         j.finish_error(cx, ErrorId::SOFT_LIMIT_REACHED);
         if let Some(mut n) = self.next.take() {
             n.finish_aborted(cx);
         }
         let mut h = Job::new(0, JobKind::Positioning { continuous: false });
         h.velocity = v.abs();
-        h.acc = job.acc;
+        h.acc = acc;
         h.dec = dec;
         h.jerk = jerk;
         h.target = limit;

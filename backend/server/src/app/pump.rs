@@ -17,9 +17,13 @@ use crate::store::{self, AuditOp};
 impl AppState {
     /// Moves whatever the cycle thread produced to where it is awaited. Runs every ms.
     pub fn drain(&self) {
-        // Every event of this cycle and before is in the ring now (stored with Release after
-        // them): once they are applied below, the clock may say the cycle is reached.
-        let cycle = self.shared.cycle.load(std::sync::atomic::Ordering::Acquire);
+        // Every event of this cycle and before is in the ring now, and its snapshot published
+        // (stored with Release after both): once they are applied below, the clock may say the
+        // cycle is reached.
+        let cycle = self
+            .shared
+            .published_cycle
+            .load(std::sync::atomic::Ordering::Acquire);
         // Replies are taken first but completed only after the events: the cycle thread pushes
         // a submit's events before its reply, so a handler woken by its reply sees them.
         let mut replies = Vec::new();
