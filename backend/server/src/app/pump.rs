@@ -98,7 +98,12 @@ pub async fn pump(state: Arc<AppState>) {
     }
     .map_err(|e| e.to_string())
     .expect("the pump's eventfd registered");
-    loop {
+    // Ends with its machine (`motiond scenario run` starts one machine after the other).
+    while !state
+        .shared
+        .shutdown
+        .load(std::sync::atomic::Ordering::Relaxed)
+    {
         tokio::select! {
             _ = tick.tick() => {}
             r = wake.readable() => {
