@@ -205,7 +205,8 @@ parameters = { "path.id" = { dictionary = "decoy_tokens", probability = 1.0 } }
 # role the convention lacks, a default above the group's maximum, an arc that is no arc, a
 # frame out of an XY group's plane, a conveyor that is a member or slower than the tracking,
 # "ignore" or a value below 1 for a halt's deceleration, a path analysed for a group that is
-# not there …
+# not there, a clock advance that gives none or several of cycles/seconds/until (or a bound
+# without until) …
 [[operations]]
 include-operation-id = ["create_axis", "replace_axis", "import_config", "write_parameter",
     "create_cam_table", "replace_cam_table", "write_points", "write_point", "values",
@@ -217,7 +218,7 @@ include-operation-id = ["create_axis", "replace_axis", "import_config", "write_p
     "torque_control", "convert_pos_to_inc_pos", "ext_setpoint_gen_feed", "gear_in_multi_master",
     "create_group", "replace_group", "group_add_axis", "group_halt", "group_stop",
     "group_move_path", "group_set_coordinate_transform", "group_track_conveyor_belt",
-    "analyse_path"]
+    "analyse_path", "advance"]
 checks.positive_data_acceptance.expected-statuses = ["2XX", "3XX", 401, 403, 404, 409, 422, 429, "5XX"]
 
 [[operations]]
