@@ -316,8 +316,11 @@ impl Advance {
         let link = &self.clock.shared.clock;
         let mut rx = self.clock.reached.subscribe();
         loop {
-            let stop = link.watch_stop.load(Acquire);
+            // `reached` first: the cycle thread stores `watch_stop` before the cycle it stopped
+            // after is published (and so before the pump can report it), so a stop is never
+            // missed between the two reads.
             let reached = *rx.borrow_and_update();
+            let stop = link.watch_stop.load(Acquire);
             if stop != 0 && reached >= stop {
                 return Stopped::Watched(stop);
             }

@@ -526,6 +526,8 @@ pub struct CycleThread {
     publish_next: bool,
     /// The last cycle was not published.
     unpublished: bool,
+    /// The watched command had events from a request taken while the clock stood.
+    watched_pending: bool,
 }
 
 impl CycleThread {
@@ -548,6 +550,7 @@ impl CycleThread {
             lazy_publish: false,
             publish_next: false,
             unpublished: false,
+            watched_pending: false,
         }
     }
 
@@ -622,7 +625,11 @@ impl CycleThread {
                     shared.published_cycle.store(cycle, SeqCst);
                     shared.wake.signal();
                 }
-                self.requests_and_cycle(&mut feedback, &mut setpoints, false);
+                // With the rings to the async side half full, not even the replies are made
+                // until the pump has taken what waits (a reply beyond the queue would be lost).
+                if !backlog {
+                    self.requests_and_cycle(&mut feedback, &mut setpoints, false);
+                }
                 if backlog {
                     shared.wake.signal();
                     std::thread::park_timeout(std::time::Duration::from_micros(200));
@@ -1029,6 +1036,9 @@ impl CycleThread {
             .commands_drained
             .fetch_add(drained as u64, Relaxed);
         if !step {
+            // A request that ends the watched command (a move aborting it) while the clock
+            // stands: its events are the next cycle's, so the clock stops after that one.
+            self.watched_pending |= sink.watched;
             if sink.dropped > 0 {
                 shared.stats.events_dropped.fetch_add(sink.dropped, Relaxed);
             }
@@ -1051,14 +1061,14 @@ impl CycleThread {
         let cycle = self.kernel.cycle();
         // Virtual time publishes only where someone looks (see `run_virtual`); a scope samples
         // from the snapshot, so it has one every cycle.
-        let publish =
-            !self.lazy_publish || self.publish_next || sink.watched || self.scope.is_active();
+        let watched = sink.watched || std::mem::take(&mut self.watched_pending);
+        let publish = !self.lazy_publish || self.publish_next || watched || self.scope.is_active();
         if publish {
             self.publish_snapshot(cycle);
         } else {
             self.unpublished = true;
         }
-        if sink.watched {
+        if watched {
             // Before the cycle is stored: whoever reads this cycle sees that it stopped there.
             shared
                 .clock

@@ -377,6 +377,12 @@ impl Run {
                 let method = Method::from_bytes(method.as_bytes())
                     .map_err(|_| format!("request {r:?}: not a method"))?;
                 let path = self.path(path.trim())?;
+                if path.contains("wait=true") {
+                    // Nothing advances the clock while it would wait: it would never answer.
+                    return Err(format!(
+                        "{r}: ?wait=true waits for a clock nobody advances in a scenario; use \"when\" on the command instead"
+                    ));
+                }
                 let body = step.body.as_ref().map(|b| self.with_ids(b)).transpose()?;
                 let (status, v) = self.request(method, &path, body.as_ref()).await;
                 Some((status, v, r.clone()))

@@ -426,6 +426,9 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                 }
             },
             _ = tokio::time::sleep_until(idle_deadline) => {
+                // A client that does not read can block these sends: no tick of it is held
+                // meanwhile (held again from the next turn).
+                due_hold = None;
                 if pinged.is_some() {
                     let close = axum::extract::ws::CloseFrame {
                         code: PING_TIMEOUT_CLOSE,
