@@ -16,7 +16,7 @@
 use std::collections::BTreeMap;
 use std::sync::atomic::Ordering::{Acquire, Release};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, SystemTime};
+use std::time::Duration;
 
 use crate::cycle::Shared;
 
@@ -119,15 +119,6 @@ impl Clock {
             Duration::from_nanos(self.cycle() * self.period_ns)
         } else {
             self.start.elapsed()
-        }
-    }
-
-    /// The time to stamp things with (see `store::wall_now`).
-    pub fn wall(&self) -> SystemTime {
-        if self.mode.is_virtual() {
-            SystemTime::UNIX_EPOCH + self.now()
-        } else {
-            SystemTime::now()
         }
     }
 

@@ -198,7 +198,7 @@ impl Control {
         let lease = Duration::from_millis(lease_ms);
         let since = match h.as_ref() {
             Some(cur) if !changed => cur.since,
-            _ => self.clock.wall(),
+            _ => crate::store::wall_now(),
         };
         *h = Some(Holder {
             key,
