@@ -954,3 +954,51 @@ fn discontinuities_name_the_point_and_the_quantity() {
     .unwrap();
     assert_eq!(discontinuities(&table), vec![]);
 }
+
+proptest::proptest! {
+    /// The slave's interval hint (issue 27: O(1) lookups in large tables) changes nothing but
+    /// the time: from any hint, at any master position, the values are bit for bit those of
+    /// the plain search — rows with uneven spacing, inside and outside the range, and a
+    /// motion function's segments.
+    #[test]
+    fn a_hinted_lookup_is_the_plain_lookup(
+        gaps in proptest::collection::vec(1u8..5, 2..60),
+        xs in proptest::collection::vec(-20.0f64..200.0, 1..40),
+        hint in 0usize..100,
+        periodic: bool,
+        spline: bool,
+    ) {
+        let mut x = 0.0;
+        let rows: Vec<[f64; 2]> = gaps
+            .iter()
+            .enumerate()
+            .map(|(i, &g)| {
+                if i > 0 {
+                    x += f64::from(g) * 0.75;
+                }
+                [x, (i as f64 * 0.7).sin() * 10.0]
+            })
+            .collect();
+        let mut t = CamTableData::positions(rows, false);
+        t.periodic = periodic;
+        t.interpolation = if spline { InterpolationType::Spline } else { InterpolationType::Linear };
+        let mut function = CamTableData::motion_function(
+            (0..8)
+                .map(|i| pt(i + 1, MotionFunctionType::Polynom5, MotionPointType::Rest, i as f64 * 20.0, (i % 2) as f64 * 5.0))
+                .collect(),
+        );
+        function.periodic = periodic;
+        for cam in [Cam::build(&t).unwrap(), Cam::build(&function).unwrap()] {
+            let mut h = hint;
+            for &x in &xs {
+                let plain = cam.eval_with(x, cam.interpolation);
+                let hinted = cam.eval_hinted(x, cam.interpolation, &mut h);
+                proptest::prop_assert_eq!(format!("{plain:?}"), format!("{hinted:?}"), "x = {}", x);
+                let (_, xl) = cam.cycle_of(x);
+                let plain = cam.eval_in_range(xl);
+                let hinted = cam.eval_in_range_hinted(xl, cam.interpolation, &mut h);
+                proptest::prop_assert_eq!(format!("{plain:?}"), format!("{hinted:?}"), "xl = {}", xl);
+            }
+        }
+    }
+}

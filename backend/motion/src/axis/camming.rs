@@ -48,6 +48,10 @@ pub(super) struct CamLaw {
     y_local: f64,
     strokes: f64,
     master_pos: f64,
+    /// The interval of the cam found last: the next cycle's search starts there (O(1) in a
+    /// non-equidistant table while the master moves a few rows per cycle). Any value is
+    /// correct, only slower.
+    hint: usize,
 }
 
 impl CamLaw {
@@ -62,9 +66,9 @@ impl CamLaw {
         let (k, xl) = cam.cycle_of(x);
         let interpolation = self.interpolation.unwrap_or(cam.interpolation);
         let f = if cam.periodic {
-            cam.eval_in_range_with(xl, interpolation)
+            cam.eval_in_range_hinted(xl, interpolation, &mut self.hint)
         } else {
-            cam.eval_with(x, interpolation)
+            cam.eval_hinted(x, interpolation, &mut self.hint)
         };
         let strokes = if cam.periodic {
             (k - self.k_base) as f64 * cam.stroke()
@@ -509,6 +513,7 @@ impl Axis {
             y_local: 0.0,
             strokes: 0.0,
             master_pos: m,
+            hint: 0,
         };
         if ci.slave_scaling_mode == CamScalingMode::AutoOffset {
             // The slave stays where it is (spec §1.8: no jump in position).

@@ -358,4 +358,9 @@ impl MotionFunction {
     pub fn eval(&self, x: f64) -> CamValues {
         self.segment(x).eval(x)
     }
+
+    /// The index of [`MotionFunction::segment`], searched outward from `hint`.
+    pub fn segment_near(&self, x: f64, hint: usize) -> usize {
+        super::count_le_near(&self.segments, |s| s.x0, x, hint).saturating_sub(1)
+    }
 }

@@ -1,6 +1,7 @@
 //! Position tables (`MC_TABLETYPE_EQUIDISTANT`, `_NONEQUIDISTANT`): rows of master and slave
 //! positions, interpolated linearly, by a cubic spline through all rows, or by a sliding
-//! (local) cubic. Built off the cycle in O(n); evaluated in O(1) (equidistant) or O(log n).
+//! (local) cubic. Built off the cycle in O(n); evaluated in O(1) (equidistant, or
+//! non-equidistant near the slave's last interval) or O(log n).
 
 use super::spline::{self, End};
 use super::{CamError, CamValues, InterpolationType};
@@ -131,6 +132,18 @@ impl PositionTable {
                 .saturating_sub(1)
                 .min(n - 1),
         }
+    }
+
+    /// [`PositionTable::interval`], searched outward from `hint`: O(1) while `x` stays in or
+    /// next to the hinted interval, O(log d) for a jump of d rows.
+    pub fn interval_near(&self, x: f64, hint: usize) -> usize {
+        if self.equidistant.is_some() {
+            return self.interval(x);
+        }
+        let n = self.master.len() - 1;
+        super::count_le_near(&self.master, |&m| m, x, hint)
+            .saturating_sub(1)
+            .min(n - 1)
     }
 
     pub fn eval(&self, x: f64) -> CamValues {
