@@ -4,6 +4,10 @@
 //! (alternating targets, aborting), prints p50/p99/max of POST → 202 in µs.
 //! `bench ws ADDR CLIENTS RATE SECONDS AXIS...`: CLIENTS websocket clients, each subscribed to
 //! every AXIS status at RATE Hz, for SECONDS; prints messages received and gaps.
+//! `bench reference`: the machine-speed reference every script records with its figures —
+//! the planner's cycle sample (`cargo bench -p motion --bench planner`'s `step`: one sample
+//! of a 100 mm jerk-limited move), median ns per call over 21 batches of 0.1 s. Figures
+//! divided by it travel between machines of one kind better than absolute ones.
 
 use std::time::{Duration, Instant};
 
@@ -16,6 +20,41 @@ fn pct(sorted: &[u64], q: f64) -> u64 {
         return 0;
     }
     sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1]
+}
+
+/// The planner bench's `step` (same move, limits and cycle), timed without criterion.
+fn reference_ns() -> f64 {
+    use motion::planner::{Kinematics, Limits, Planner};
+    use std::hint::black_box;
+    const CYCLE: f64 = 0.001;
+    let limits = Limits {
+        velocity: 100.0,
+        acceleration: 1000.0,
+        deceleration: 500.0,
+        jerk: 10_000.0,
+    };
+    let mut p = Planner::new(CYCLE);
+    let mut target = 100.0;
+    p.plan_position(Kinematics::default(), target, 0.0, &limits)
+        .unwrap();
+    let mut batches = Vec::new();
+    for _ in 0..21 {
+        let (t, mut n) = (Instant::now(), 0u64);
+        while t.elapsed() < Duration::from_millis(100) {
+            for _ in 0..1000 {
+                if p.finished() {
+                    let from = p.end_state();
+                    target = -target;
+                    p.plan_position(from, target, 0.0, &limits).unwrap();
+                }
+                black_box(p.step(black_box(CYCLE)));
+            }
+            n += 1000;
+        }
+        batches.push(t.elapsed().as_nanos() as f64 / n as f64);
+    }
+    batches.sort_by(f64::total_cmp);
+    batches[batches.len() / 2]
 }
 
 async fn rtt(base: &str, n: usize) {
@@ -79,6 +118,7 @@ async fn main() {
     let args: Vec<String> = std::env::args().collect();
     match args.get(1).map(String::as_str) {
         Some("rtt") => rtt(&args[2], args[3].parse().unwrap()).await,
+        Some("reference") => println!("{:.2}", reference_ns()),
         Some("ws") => {
             let addr = args[2].clone();
             let clients: usize = args[3].parse().unwrap();
@@ -109,6 +149,8 @@ async fn main() {
                 per_client[per_client.len() - 1]
             );
         }
-        _ => eprintln!("usage: bench rtt BASE N | bench ws ADDR CLIENTS RATE SECONDS AXIS..."),
+        _ => eprintln!(
+            "usage: bench rtt BASE N | bench ws ADDR CLIENTS RATE SECONDS AXIS... | bench reference"
+        ),
     }
 }

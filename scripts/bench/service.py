@@ -13,6 +13,9 @@ Usage: service.py MOTIOND BENCH OUTDIR [--quick]
 """
 import json, os, re, resource, subprocess, sys, time, urllib.request
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import machine_info  # noqa: E402
+
 MOTIOND, BENCH, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
 QUICK = "--quick" in sys.argv
 WINDOW = 10 if QUICK else 30
@@ -67,10 +70,13 @@ def window_quantiles(before, after, name):
     return res
 
 
-def machine():
-    """What the figures were measured on (machines of one size differ 2-3x)."""
-    model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    return {"cpu": model, "cpus": os.cpu_count(), "kernel": os.uname().release}
+def machine(bench=None):
+    """What the figures were measured on, with the machine-speed reference (machine.py)."""
+    bench = bench or BENCH
+    if not os.path.exists(bench) or bench == "/bin/true":
+        # The load generator beside the binary (target/release/examples/bench).
+        bench = os.path.join(os.path.dirname(MOTIOND), "examples", "bench")
+    return machine_info.describe(bench)
 
 
 def cpu_ticks(pid):

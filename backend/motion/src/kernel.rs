@@ -565,10 +565,9 @@ impl Kernel {
             if let Some(all) = samples {
                 axis.offer_masters(all);
             }
-            let sp = axis.step(dt, &fb, master, &self.cams, cycle, events);
-            if let Some(out) = setpoints.get_mut(i) {
-                *out = sp;
-            }
+            let mut spare = DriveSetpoint::default();
+            let out = setpoints.get_mut(i).unwrap_or(&mut spare);
+            axis.step_into(dt, &fb, master, &self.cams, cycle, events, out);
             if axis.coupled_masters() != all_masters {
                 // It left its coupling (master lost, an error, a limit): next cycle it is
                 // stepped where an uncoupled axis is.

@@ -81,8 +81,12 @@ enum Plan {
 
 /// One axis's setpoint generator. Allocation-free after construction.
 pub struct Planner {
-    otg: Ruckig<1, RejectErrors>,
-    input: InputParameter<1>,
+    /// The solver and its input (13.5 KB, touched only when planning) live outside: inline
+    /// they made an axis 19 KB, and sampling a plan every cycle then walked a machine's
+    /// axes through far more cache than the few hundred bytes it reads (issue 27: the
+    /// per-axis step cost grew by half from 64 to 256 axes).
+    otg: Box<Ruckig<1, RejectErrors>>,
+    input: Box<InputParameter<1>>,
     traj: Trajectory<1>,
     /// A braking segment sampled before `traj` for `split` seconds (0 = none): a position
     /// plan that starts above its velocity limit first brakes to it on the velocity
@@ -111,8 +115,8 @@ impl core::fmt::Debug for Planner {
 impl Planner {
     pub fn new(cycle_time: f64) -> Self {
         Planner {
-            otg: Ruckig::new(None, cycle_time),
-            input: InputParameter::new(None),
+            otg: Box::new(Ruckig::new(None, cycle_time)),
+            input: Box::new(InputParameter::new(None)),
             traj: Trajectory::new(None),
             brake: Trajectory::new(None),
             split: 0.0,

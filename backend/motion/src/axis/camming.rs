@@ -932,6 +932,10 @@ impl Axis {
         if self.cam_law().is_some() {
             return;
         }
+        if self.cam.nothing_queued() && !self.cam.waits_for_coupling() {
+            // Nothing to settle: an axis that never cams writes none of this every cycle.
+            return;
+        }
         self.cam.data = None;
         let end = if self.mode == Mode::ErrorStop {
             End::Error(self.error)

@@ -22,6 +22,24 @@ impl Axis {
         cycle: u64,
         events: &mut impl EventSink,
     ) -> DriveSetpoint {
+        let mut out = DriveSetpoint::default();
+        self.step_into(dt, fb, master, cams, cycle, events, &mut out);
+        out
+    }
+
+    /// [`Axis::step`] writing the setpoint in place (the kernel's: a 56-byte setpoint
+    /// returned through the stack and copied again cost more than building it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn step_into(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        master: Master,
+        cams: &crate::cam::CamStore,
+        cycle: u64,
+        events: &mut impl EventSink,
+        out: &mut DriveSetpoint,
+    ) {
         if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
             // A drive that reports no number is a faulty drive; keep the last good values.
             let fb = DriveFeedback {
@@ -30,7 +48,7 @@ impl Axis {
                 actual_velocity: 0.0,
                 ..*fb
             };
-            return self.step(dt, &fb, master, cams, cycle, events);
+            return self.step_into(dt, &fb, master, cams, cycle, events, out);
         }
         let cx = &mut Ctx {
             slot: self.slot,
@@ -122,7 +140,7 @@ impl Axis {
         s.following_error_max = s.following_error_max.max(s.following_error);
         self.sent_position = self.set.position;
         self.prev_cam = fb.reference_cam;
-        DriveSetpoint {
+        *out = DriveSetpoint {
             enable: self.enable
                 && !(self.mode == Mode::ErrorStop && self.error == ErrorId::DRIVE_FAULT),
             fault_reset,
@@ -141,7 +159,7 @@ impl Axis {
                 (None, Some(p)) if probe_armed => p.source(),
                 _ => LatchSource::default(),
             },
-        }
+        };
     }
 
     /// The running job's step: the setpoint it gives in this cycle, its milestones, and its

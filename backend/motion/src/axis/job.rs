@@ -199,10 +199,14 @@ impl Job {
     }
 
     pub(super) fn emit(&mut self, cx: &mut Ctx<'_, impl EventSink>, out: FbOutputs) {
-        if self.id != 0 && out != self.out {
-            cx.report(self.id, out);
+        // Written only when it changes: most cycles it does not, and copying the outputs back
+        // every cycle stalled on the stores that had just built them (issue 27).
+        if out != self.out {
+            if self.id != 0 {
+                cx.report(self.id, out);
+            }
+            self.out = out;
         }
-        self.out = out;
     }
 
     pub(super) fn activate(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
@@ -277,8 +281,8 @@ impl Held {
     pub(super) fn emit(&mut self, cx: &mut Ctx<'_, impl EventSink>, out: FbOutputs) {
         if out != self.out {
             cx.report(self.id, out);
+            self.out = out;
         }
-        self.out = out;
     }
 }
 

@@ -230,7 +230,8 @@ impl Axis {
             self.enter_error(cx, ErrorId::DRIVE_NOT_READY);
         }
         self.status.power_status = status;
-        if let Some(mut p) = self.power {
+        // In place: a copy out and back every cycle stalled on its own stores (issue 27).
+        if let Some(p) = self.power.as_mut() {
             p.emit(
                 cx,
                 FbOutputs {
@@ -240,7 +241,6 @@ impl Axis {
                     ..FbOutputs::default()
                 },
             );
-            self.power = Some(p);
         }
     }
 

@@ -29,6 +29,9 @@ pub(super) struct PhasingState {
     /// A new phasing is planned here first and swapped in when it succeeds.
     scratch: Box<Planner>,
     job: Option<PhasingJob>,
+    /// `planner` may hold a plan (set where one is swapped in): an axis that never phases
+    /// does not reach into the boxed planner every cycle (a cache miss per axis, issue 27).
+    engaged: bool,
 }
 
 impl PhasingState {
@@ -39,6 +42,7 @@ impl PhasingState {
             planner: Box::new(Planner::new(cycle_time)),
             scratch: Box::new(Planner::new(cycle_time)),
             job: None,
+            engaged: false,
         }
     }
 
@@ -124,6 +128,7 @@ impl Axis {
             return Err(ErrorId::PLANNING_FAILED);
         }
         core::mem::swap(&mut self.phasing.planner, &mut self.phasing.scratch);
+        self.phasing.engaged = true;
         if let Some(mut old) = self.phasing.job.take() {
             old.cmd.end(cx, End::Aborted);
         }
@@ -146,12 +151,19 @@ impl Axis {
     /// (§5.6.1). Ends aborted when the coupling it shifts is gone.
     pub(super) fn step_phasing(&mut self, cx: &mut Ctx<'_, impl EventSink>, dt: f64) {
         if self.coupling.is_none() || self.mode != Mode::Enabled {
-            if self.phasing.job.is_some() || self.phasing.planner.is_planned() {
+            if self.phasing.job.is_some()
+                || (self.phasing.engaged && self.phasing.planner.is_planned())
+            {
                 self.end_phasing(cx, End::Aborted);
             }
-            if self.coupling.is_none() {
+            // No plan is left on the planner now.
+            self.phasing.engaged = false;
+            if self.coupling.is_none() && self.phasing.shift != Kinematics::default() {
                 self.phasing.shift = Kinematics::default();
             }
+            return;
+        }
+        if !self.phasing.engaged {
             return;
         }
         let Some(k) = self.phasing.planner.step(dt) else {
@@ -196,6 +208,7 @@ impl Axis {
                 p.cmd.end(cx, End::Done);
             }
             self.phasing.planner.clear();
+            self.phasing.engaged = false;
         }
     }
 
@@ -205,6 +218,7 @@ impl Axis {
             ph.cmd.end(cx, end);
         }
         self.phasing.planner.clear();
+        self.phasing.engaged = false;
         self.phasing.shift.velocity = 0.0;
         self.phasing.shift.acceleration = 0.0;
         self.phasing.shift.jerk = 0.0;
