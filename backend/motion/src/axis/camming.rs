@@ -1515,7 +1515,7 @@ impl Axis {
         op: &CamInV2,
         m: &Kinematics,
     ) -> Result<CamSet, ErrorId> {
-        let mut set = self.cam_set().ok_or(ErrorId::CAM_NOT_COUPLED)?;
+        let mut set = *self.cam_set().ok_or(ErrorId::CAM_NOT_COUPLED)?;
         let term = self.v2_term(&set, op)?;
         let cam = cx
             .cams

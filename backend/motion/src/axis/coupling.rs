@@ -218,8 +218,10 @@ impl From<MultiGear> for CouplingLaw {
 /// dependency points one way: the coupling knows its laws, a law does not know the coupling).
 impl Axis {
     /// The cams of a cam slave.
-    pub(super) fn cam_set(&self) -> Option<CamSet> {
-        match self.coupling {
+    /// By reference: a cam set is 616 bytes, and this is asked several times per cycle of a
+    /// cam slave (issue 27).
+    pub(super) fn cam_set(&self) -> Option<&CamSet> {
+        match &self.coupling {
             Some(Coupling {
                 law: CouplingLaw::Cam(set),
                 ..
