@@ -1437,7 +1437,7 @@ impl Axis {
             return Ok(());
         }
         // Checked now, so that a queued operation can only fail for a jump at its activation.
-        self.v2_term(&set, &op)?;
+        self.v2_term(set, &op)?;
         let base = set.base();
         let act = Activation::new(
             op.activation_mode,
