@@ -658,6 +658,34 @@ mod tests {
         }
     }
 
+    /// A reading that overflows in the axis's units (encoder scaling × a huge count), then a
+    /// drive that reports no number: the cycle goes on with a number in place of the reading
+    /// (the stand-in was the overflowed reading, and the step recursed until the stack ran
+    /// out: a stack overflow of the cycle thread, found by a review).
+    #[test]
+    fn an_overflowed_reading_then_no_number_does_not_recurse() {
+        let mut k = kernel(1);
+        let mut e = Vec::new();
+        let scale = CommandKind::SetEncoderScalingFactor {
+            factor: 1e12,
+            relative: false,
+        };
+        accept(&mut k, 1, 0, scale, &mut e);
+        let mut sp = vec![DriveSetpoint::default()];
+        let mut fb = vec![DriveFeedback {
+            ready: true,
+            actual_position: 1e300,
+            ..DriveFeedback::default()
+        }];
+        k.step(&fb, &mut sp, &mut e);
+        fb[0].actual_position = f64::NAN;
+        k.step(&fb, &mut sp, &mut e);
+        let st = k.status(0).unwrap();
+        // No last good reading to keep: the stand-in is 0, a number.
+        assert_eq!(st.actual_position, 0.0, "{st:?}");
+        assert!(sp[0].position.is_finite(), "{:?}", sp[0]);
+    }
+
     #[test]
     fn masters_are_stepped_before_their_slaves_whatever_their_slots() {
         let mut k = kernel(4);

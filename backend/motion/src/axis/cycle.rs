@@ -42,9 +42,12 @@ impl Axis {
     ) {
         if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
             // A drive that reports no number is a faulty drive; keep the last good values.
+            // Where there is none (a reading that overflowed in the axis's units), 0: the
+            // stand-in must be a number, or this would recurse without end.
+            let kept = (self.act_pos - self.offset - self.corrections.read) / self.enc_k;
             let fb = DriveFeedback {
                 fault: true,
-                actual_position: (self.act_pos - self.offset - self.corrections.read) / self.enc_k,
+                actual_position: if kept.is_finite() { kept } else { 0.0 },
                 actual_velocity: 0.0,
                 ..*fb
             };

@@ -158,7 +158,7 @@ impl Axis {
             }
             // No plan is left on the planner now.
             self.phasing.engaged = false;
-            if self.coupling.is_none() && self.phasing.shift != Kinematics::default() {
+            if self.coupling.is_none() {
                 self.phasing.shift = Kinematics::default();
             }
             return;
