@@ -567,7 +567,7 @@ impl Kernel {
             }
             let mut spare = DriveSetpoint::default();
             let out = setpoints.get_mut(i).unwrap_or(&mut spare);
-            axis.step_into(dt, &fb, master, &self.cams, cycle, events, out);
+            axis.step(dt, &fb, master, &self.cams, cycle, events, out);
             if axis.coupled_masters() != all_masters {
                 // It left its coupling (master lost, an error, a limit): next cycle it is
                 // stepped where an uncoupled axis is.

@@ -12,25 +12,11 @@ use super::*;
 
 impl Axis {
     /// One cycle, from the drive's feedback to its setpoint. `master`: what the kernel saw of
-    /// this axis's master after stepping it in this cycle.
-    pub fn step(
-        &mut self,
-        dt: f64,
-        fb: &DriveFeedback,
-        master: Master,
-        cams: &crate::cam::CamStore,
-        cycle: u64,
-        events: &mut impl EventSink,
-    ) -> DriveSetpoint {
-        let mut out = DriveSetpoint::default();
-        self.step_into(dt, fb, master, cams, cycle, events, &mut out);
-        out
-    }
-
-    /// [`Axis::step`] writing the setpoint in place (the kernel's: a 56-byte setpoint
-    /// returned through the stack and copied again cost more than building it).
+    /// this axis's master after stepping it in this cycle. The setpoint is written into `out`
+    /// in place (a 56-byte setpoint returned through the stack and copied again cost more
+    /// than building it).
     #[allow(clippy::too_many_arguments)]
-    pub fn step_into(
+    pub fn step(
         &mut self,
         dt: f64,
         fb: &DriveFeedback,
@@ -51,7 +37,7 @@ impl Axis {
                 actual_velocity: 0.0,
                 ..*fb
             };
-            return self.step_into(dt, &fb, master, cams, cycle, events, out);
+            return self.step(dt, &fb, master, cams, cycle, events, out);
         }
         let cx = &mut Ctx {
             slot: self.slot,

@@ -387,16 +387,7 @@ impl Cam {
         interpolation: InterpolationType,
         hint: &mut usize,
     ) -> CamValues {
-        if !self.periodic {
-            if x < self.x0 || x > self.xn {
-                return self.eval_with(x, interpolation);
-            }
-            return self.eval_in_range_hinted(x, interpolation, hint);
-        }
-        let (k, xl) = self.cycle_of(x);
-        let mut v = self.eval_in_range_hinted(xl, interpolation, hint);
-        v.position += k as f64 * self.stroke();
-        v
+        self.eval_by(x, |x| self.eval_in_range_hinted(x, interpolation, hint))
     }
 
     /// The cycle of a raw master position (0 for the table's own range; always 0 for a
@@ -425,6 +416,12 @@ impl Cam {
 
     /// As [`Cam::eval`] with a coupling's interpolation (see [`Cam::eval_in_range_with`]).
     pub fn eval_with(&self, x: f64, interpolation: InterpolationType) -> CamValues {
+        self.eval_by(x, |x| self.eval_in_range_with(x, interpolation))
+    }
+
+    /// [`Cam::eval`]'s rule outside the table's range (held or repeated), with `in_range`
+    /// evaluating within it.
+    fn eval_by(&self, x: f64, in_range: impl FnOnce(f64) -> CamValues) -> CamValues {
         if !self.periodic {
             if x < self.x0 || x > self.xn {
                 let y = if x < self.x0 { self.y0 } else { self.yn };
@@ -433,10 +430,10 @@ impl Cam {
                     ..CamValues::default()
                 };
             }
-            return self.eval_in_range_with(x, interpolation);
+            return in_range(x);
         }
         let (k, xl) = self.cycle_of(x);
-        let mut v = self.eval_in_range_with(xl, interpolation);
+        let mut v = in_range(xl);
         v.position += k as f64 * self.stroke();
         v
     }
