@@ -171,7 +171,15 @@ describe('cam editor', () => {
     await valueIs(page, 'master_pos-2', String(m));
 
     // the master stays strictly between its neighbours' (point 3 at 200): dragged far right
-    const b2 = await handle.boundingBox();
+    // The plot draws the redone point a frame or two after the row: wait until the handle
+    // stands still, or the drag could start where the point was (and move nothing).
+    let b2 = null;
+    await until(async () => {
+      const before = await handle.boundingBox();
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      b2 = await handle.boundingBox();
+      return before && b2 && before.x === b2.x && before.y === b2.y;
+    }, { what: 'the handle drawn where the redone point is' });
     const over = await page.locator('[data-pane="position"] .u-over').boundingBox();
     await page.mouse.move(b2.x + b2.width / 2, b2.y + b2.height / 2);
     await page.mouse.down();
