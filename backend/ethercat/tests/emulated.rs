@@ -214,9 +214,20 @@ fn sdo_errors_are_cia301_aborts_and_a_mapping_must_be_valid() {
             "read only"
         );
         assert_eq!(
-            abort_of(sd.sdo_write(0x6060, 0, 3i8).await),
+            abort_of(sd.sdo_write(0x6060, 0, 4i8).await),
             0x0609_0030,
-            "profile position is not offered"
+            "profile torque is not offered"
+        );
+        sd.sdo_write(0x6060, 0, 1i8)
+            .await
+            .expect("profile position is");
+        sd.sdo_write(0x6098, 0, 34i8)
+            .await
+            .expect("homing method 34 is");
+        assert_eq!(
+            abort_of(sd.sdo_write(0x6098, 0, 19i8).await),
+            0x0609_0030,
+            "homing method 19 is not offered"
         );
         assert_eq!(
             abort_of(sd.sdo_write(0x1600, 1, 0x6041_0010u32).await),

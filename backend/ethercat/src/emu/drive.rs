@@ -1,9 +1,14 @@
 //! An emulated CiA-402 servo drive behind an emulated ESC: the object dictionary with PDO
 //! mapping and assignment (changeable in PRE-OP), the device state machine driven by the
 //! controlword, the cyclic synchronous modes CSP, CSV and CST on a plant with lag, inertia and
-//! friction, one setpoint taken per SYNC0 pulse, the touch probe (0x60B8–0x60BB) on probe
-//! input 1 or the index pulse, digital inputs (limit and home switches), and injected faults
-//! (a drive fault with its 0x603F error code).
+//! friction, one setpoint taken per SYNC0 pulse, the profile modes PP, PV and homing in which
+//! the drive runs the motion itself ([`profile`]), the touch probe (0x60B8–0x60BB) on probe
+//! input 1 or the index pulse, digital inputs (limit switches on the plant or forced from
+//! outside), and injected faults (a drive fault with its 0x603F error code).
+
+mod profile;
+
+pub use profile::{HOMING_METHODS, Homing, Ramp};
 
 use super::Application;
 use super::coe::{self, Access, Od, WriteRules, abort};
@@ -23,8 +28,13 @@ pub struct Plant {
     pub damping: f64,
     /// Increments per index pulse (one motor turn).
     pub increments_per_turn: u32,
-    /// 0x6080 max motor speed (increments/s): velocity limit in CSV and CST.
+    /// 0x6080 max motor speed (increments/s): velocity limit in CSV, CST and the profile modes.
     pub max_speed: u32,
+    /// Hardware limit switches on the plant (0x60FD bits 0 and 1): active at motor positions
+    /// ≤ `limit_negative` / ≥ `limit_positive` (increments, where the motor is before any
+    /// homing shifted what the drive reports).
+    pub limit_negative: Option<f64>,
+    pub limit_positive: Option<f64>,
 }
 
 impl Default for Plant {
@@ -36,6 +46,8 @@ impl Default for Plant {
             damping: 5.0,
             increments_per_turn: 10_000,
             max_speed: 50_000_000,
+            limit_negative: None,
+            limit_positive: None,
         }
     }
 }
@@ -79,6 +91,15 @@ pub struct Cia402Emu {
     /// Entries one PDO may map, checked at PRE-OP → SAFE-OP (a drive with fewer mappable
     /// entries than motiond's full mapping that says so only then).
     pub max_entries_at_safe_op: Option<u8>,
+    /// The profile modes' state (PP, PV, HM).
+    profile: profile::Profile,
+    /// What the drive reports minus where the motor is on the plant (increments): set by
+    /// homing so that the home position reads as the home offset 0x607C.
+    shift: f64,
+    /// 0x60FD bits forced from outside (the emulator's door), on top of the plant's switches.
+    forced_inputs: u32,
+    /// How long the position lag has been beyond 0x6065 (s).
+    following_error_time: f64,
 }
 
 /// What a [`Cia402Emu::strict`] drive lacks: touch probe function, status and edges,
@@ -90,6 +111,9 @@ const MAPPABLE_RX: &[(u16, usize)] = &[
     (0x6060, 1),
     (0x6071, 2),
     (0x607A, 4),
+    (0x6081, 4),
+    (0x6083, 4),
+    (0x6084, 4),
     (0x60B8, 2),
     (0x60FF, 4),
 ];
@@ -97,6 +121,7 @@ const MAPPABLE_TX: &[(u16, usize)] = &[
     (0x603F, 2),
     (0x6041, 2),
     (0x6061, 1),
+    (0x6062, 4),
     (0x6064, 4),
     (0x606C, 4),
     (0x6077, 2),
@@ -111,6 +136,9 @@ const MAPPABLE_TX: &[(u16, usize)] = &[
 const MAX_ENTRIES: u8 = 16;
 
 /// CiA-402 modes of operation (0x6060).
+pub const MODE_PP: i8 = 1;
+pub const MODE_PV: i8 = 3;
+pub const MODE_HM: i8 = 6;
 pub const MODE_CSP: i8 = 8;
 pub const MODE_CSV: i8 = 9;
 pub const MODE_CST: i8 = 10;
@@ -196,11 +224,31 @@ impl Cia402Emu {
         od.add(0x60C2, 0, &[2], Access::Ro, false);
         od.add(0x60C2, 1, &[1], Access::Rw, false);
         od.add(0x60C2, 2, &[(-3i8) as u8], Access::Rw, false);
-        // Supported modes: CSP, CSV, CST.
+        // The profile modes' objects (increments, increments/s, increments/s², ms).
+        od.add(0x6066, 0, &0u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x6067, 0, &10u32.to_le_bytes(), Access::Rw, false);
+        od.add(0x6068, 0, &0u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x606D, 0, &1_000u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x606E, 0, &0u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x606F, 0, &1_000u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x6070, 0, &0u16.to_le_bytes(), Access::Rw, false);
+        od.add(0x607C, 0, &0i32.to_le_bytes(), Access::Rw, false);
+        od.add(0x607F, 0, &plant.max_speed.to_le_bytes(), Access::Rw, false);
+        od.set(0x6081, 0, &100_000u32.to_le_bytes());
+        od.set(0x6083, 0, &1_000_000u32.to_le_bytes());
+        od.set(0x6084, 0, &1_000_000u32.to_le_bytes());
+        od.add(0x6086, 0, &0i16.to_le_bytes(), Access::Rw, false);
+        od.add(0x6098, 0, &[37], Access::Rw, false);
+        od.add(0x6099, 0, &[2], Access::Ro, false);
+        od.add(0x6099, 1, &50_000u32.to_le_bytes(), Access::Rw, false);
+        od.add(0x6099, 2, &10_000u32.to_le_bytes(), Access::Rw, false);
+        od.add(0x609A, 0, &1_000_000u32.to_le_bytes(), Access::Rw, false);
+        od.add(0x60F2, 0, &0u16.to_le_bytes(), Access::Rw, false);
+        // Supported modes (0x6502 bit = mode − 1): PP, PV, HM, CSP, CSV, CST.
         od.add(
             0x6502,
             0,
-            &((1u32 << 7) | (1 << 8) | (1 << 9)).to_le_bytes(),
+            &((1u32 << 0) | (1 << 2) | (1 << 5) | (1 << 7) | (1 << 8) | (1 << 9)).to_le_bytes(),
             Access::Ro,
             false,
         );
@@ -221,6 +269,10 @@ impl Cia402Emu {
             pending_fault: None,
             strict: false,
             max_entries_at_safe_op: None,
+            profile: profile::Profile::default(),
+            shift: 0.0,
+            forced_inputs: 0,
+            following_error_time: 0.0,
         }
     }
 
@@ -267,7 +319,7 @@ impl Cia402Emu {
             Input::ProbeInput { active } => self.set_probe_input(active),
             Input::LimitSwitch { positive, active } => {
                 let bit = if positive { 0b010 } else { 0b001 };
-                let now = self.od.u32(0x60FD, 0);
+                let now = self.forced_inputs;
                 self.set_digital_inputs(if active { now | bit } else { now & !bit });
             }
             Input::Clear => {
@@ -281,9 +333,30 @@ impl Cia402Emu {
         self.pending_fault = Some(error_code);
     }
 
-    /// 0x60FD: bit 0 negative limit switch, bit 1 positive limit switch, bit 2 home switch.
+    /// 0x60FD forced from outside: bit 0 negative limit switch, bit 1 positive limit switch,
+    /// bit 2 home switch (on top of the plant's switches).
     pub fn set_digital_inputs(&mut self, bits: u32) {
-        self.od.set(0x60FD, 0, &bits.to_le_bytes());
+        self.forced_inputs = bits;
+        self.update_digital_inputs();
+    }
+
+    fn update_digital_inputs(&mut self) {
+        let (neg, pos) = self.limit_switches();
+        let bits = (self.forced_inputs & !0b11) | u32::from(neg) | (u32::from(pos) << 1);
+        if self.od.get(0x60FD, 0).is_some() {
+            self.od.set(0x60FD, 0, &bits.to_le_bytes());
+        }
+    }
+
+    /// Where the motor is on the plant (increments): what the drive reports less the shift a
+    /// homing run made.
+    pub fn plant_position(&self) -> f64 {
+        self.position - self.shift
+    }
+
+    /// The homing run's state (mode 6).
+    pub fn homing(&self) -> Homing {
+        self.profile.homing
     }
 
     /// The touch probe's input 1 (a mark passing the sensor).
@@ -317,15 +390,19 @@ impl Cia402Emu {
         };
         let mut sw = base | (1 << 9);
         if self.state == State::OperationEnabled {
-            let fe = (self.target - self.position).abs();
             let mode = self.od.i8(0x6060, 0);
-            if mode == MODE_CSP {
+            if matches!(mode, MODE_PP | MODE_PV | MODE_HM) {
+                sw |= self.profile.bits;
+                if mode == MODE_PP && self.following_error() {
+                    sw |= 1 << 13;
+                }
+            } else if mode == MODE_CSP {
                 // Bit 12: the drive follows the target; bit 10: target reached.
                 sw |= 1 << 12;
-                if fe < 10.0 {
+                if (self.target - self.position).abs() < 10.0 {
                     sw |= 1 << 10;
                 }
-                if fe > self.od.u32(0x6065, 0) as f64 {
+                if self.following_error() {
                     sw |= 1 << 13;
                 }
             } else {
@@ -370,6 +447,12 @@ impl Cia402Emu {
         };
     }
 
+    /// Following error: beyond the window 0x6065 for at least the timeout 0x6066 (ms).
+    fn following_error(&self) -> bool {
+        self.following_error_time > 0.0
+            && self.following_error_time + 1e-9 >= f64::from(self.od.u16(0x6066, 0)) * 1e-3
+    }
+
     /// Unwraps a 32-bit target against the current one.
     fn unwrap_target(&self, raw: i32) -> f64 {
         let now = self.target.round() as i64;
@@ -388,16 +471,21 @@ impl Cia402Emu {
         self.command(cw);
         let mode = self.od.i8(0x6060, 0);
         self.od.set(0x6061, 0, &[mode as u8]);
-        let before = self.position;
+        // Plant coordinates: a homing run may shift the reported ones within the period.
+        let before = self.position - self.shift;
+        if self.state != State::OperationEnabled || !matches!(mode, MODE_PP | MODE_PV | MODE_HM) {
+            self.profile_disabled();
+        }
         match self.state {
             State::OperationEnabled => {
                 self.setpoints_taken += u64::from(op);
                 match mode {
+                    MODE_PP | MODE_PV | MODE_HM => self.step_profile(mode, dt, cw),
                     MODE_CSP => {
                         self.target = self.unwrap_target(self.od.i32(0x607A, 0));
                         let k = 1.0 - (-dt / self.plant.position_lag).exp();
                         self.position += (self.target - self.position) * k;
-                        self.velocity = (self.position - before) / dt;
+                        self.velocity = (self.position - self.shift - before) / dt;
                     }
                     MODE_CSV => {
                         let v = (self.od.i32(0x60FF, 0) as f64)
@@ -440,6 +528,15 @@ impl Cia402Emu {
             }
         }
         self.probe(before);
+        self.update_digital_inputs();
+        let lag = (self.target - self.position).abs();
+        self.following_error_time = if lag > f64::from(self.od.u32(0x6065, 0)) {
+            self.following_error_time + dt
+        } else {
+            0.0
+        };
+        let demand = self.target.round() as i64 as i32;
+        self.od.set(0x6062, 0, &demand.to_le_bytes());
         let pos = self.position.round() as i64 as i32;
         self.od.set(0x6064, 0, &pos.to_le_bytes());
         self.od
@@ -463,14 +560,16 @@ impl Cia402Emu {
         status |= 1;
         let index_source = (f >> 2) & 0b11 == 1;
         let (rising, falling, at) = if index_source {
+            // The index pulse is where the motor is on the plant.
             let turn = self.plant.increments_per_turn.max(1) as f64;
-            let crossed = (before / turn).floor() != (self.position / turn).floor();
-            let at = if self.position > before {
-                (self.position / turn).floor() * turn
+            let now = self.position - self.shift;
+            let crossed = (before / turn).floor() != (now / turn).floor();
+            let at = if now > before {
+                (now / turn).floor() * turn
             } else {
                 (before / turn).floor() * turn
             };
-            (crossed, false, at)
+            (crossed, false, at + self.shift)
         } else {
             (
                 self.probe_input && !self.last_probe_input,
@@ -558,7 +657,19 @@ impl WriteRules for Rules {
         if assign && sub > 0 && v != 0 && od.get(v as u16, 0).is_none() {
             return Err(abort::VALUE_RANGE);
         }
-        if index == 0x6060 && !matches!(v as u8 as i8, MODE_CSP | MODE_CSV | MODE_CST) {
+        if index == 0x6060
+            && !matches!(
+                v as u8 as i8,
+                MODE_PP | MODE_PV | MODE_HM | MODE_CSP | MODE_CSV | MODE_CST
+            )
+        {
+            return Err(abort::VALUE_RANGE);
+        }
+        if index == 0x6098 && !HOMING_METHODS.contains(&(v as u8 as i8)) {
+            return Err(abort::VALUE_RANGE);
+        }
+        if index == 0x6086 && v as u16 != 0 {
+            // Only the linear ramp.
             return Err(abort::VALUE_RANGE);
         }
         Ok(())
