@@ -6,7 +6,7 @@
 //! probe 0x60B8–0x60BB. Pure logic on the process data: no I/O, so it is tested without a
 //! network; an EtherCAT bus maps [`RxPdo`] / [`TxPdo`] onto a SubDevice's process image.
 
-use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
+use motion::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource, ProfileFeedback, ProfileMode};
 use serde::{Deserialize, Serialize};
 
 use crate::error::ConfigError;
@@ -38,6 +38,20 @@ impl Cia402Mode {
     }
 }
 
+/// Who runs an axis's motion profile.
+#[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProfileSide {
+    /// motiond computes a setpoint every cycle and sends it in `mode` (CSP/CSV/CST): the
+    /// whole Tc2_MC2 set of blocks.
+    #[default]
+    Host,
+    /// The drive runs the profile itself (profile position 1, profile velocity 3, homing 6)
+    /// and motiond sends targets: the Drive Motion Control blocks only.
+    Drive,
+}
+
 /// How a CiA-402 drive is configured for one axis.
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -67,6 +81,14 @@ pub struct Cia402Config {
     /// CST: the torque sent is limited to ± this, per mille of rated torque (1–32767).
     #[serde(default = "default_max_torque")]
     pub max_torque: f64,
+    /// Who runs the motion profile: motiond (`host`, the cyclic synchronous `mode`) or the
+    /// drive (`drive`: its profile modes).
+    #[serde(default)]
+    pub profile: ProfileSide,
+    /// The drive's homing method (0x6098, CiA-402 methods 1–37) for homing in the drive:
+    /// written to the drive when the axis is configured; `null` leaves the drive's own.
+    #[serde(default)]
+    pub homing_method: Option<i8>,
 }
 
 fn default_max_torque() -> f64 {
@@ -90,6 +112,8 @@ impl Cia402Config {
             velocity_gain: 0.0,
             acceleration_feed_forward: 0.0,
             max_torque: default_max_torque(),
+            profile: ProfileSide::Host,
+            homing_method: None,
         }
     }
 
@@ -116,6 +140,21 @@ impl Cia402Config {
             errors.push(ConfigError {
                 field: "max_torque".into(),
                 message: "1..32767 per mille of rated torque".into(),
+            });
+        }
+        if self.profile == ProfileSide::Drive {
+            // The layers below the kernel run drive-executed profiles; until the kernel's
+            // axis runs its blocks that way, an axis must not be taken as drive-executed and
+            // then run host-side.
+            errors.push(ConfigError {
+                field: "profile".into(),
+                message: "drive-executed profiles are not available yet".into(),
+            });
+        }
+        if self.homing_method.is_some_and(|m| !(1..=37).contains(&m)) {
+            errors.push(ConfigError {
+                field: "homing_method".into(),
+                message: "a CiA-402 homing method 1..37".into(),
             });
         }
         if !(self.acceleration_feed_forward.is_finite() && self.acceleration_feed_forward >= 0.0) {
@@ -173,6 +212,32 @@ pub struct RxPdo {
     /// 0x60B8: bit 0 enable probe 1, bit 2 source (0 probe input, 1 index pulse), bit 4
     /// latch the positive edge, bit 5 latch the negative edge.
     pub touch_probe_function: u16,
+    /// 0x6081 profile velocity, 0x6083 profile acceleration, 0x6084 profile deceleration
+    /// (velocity increments per second, per second²).
+    pub profile_velocity: u32,
+    pub profile_acceleration: u32,
+    pub profile_deceleration: u32,
+}
+
+/// CiA-402 modes of operation the drive runs a profile in.
+pub const MODE_PROFILE_POSITION: i8 = 1;
+pub const MODE_PROFILE_VELOCITY: i8 = 3;
+pub const MODE_HOMING: i8 = 6;
+
+/// Controlword bits of the profile modes (CiA-402 §6.2): new set point / homing start,
+/// change set immediately, halt.
+const CW_START: u16 = 1 << 4;
+const CW_IMMEDIATE: u16 = 1 << 5;
+const CW_HALT: u16 = 1 << 8;
+
+/// The 0x6060 code of a profile mode.
+pub fn profile_mode_code(mode: ProfileMode) -> Option<i8> {
+    match mode {
+        ProfileMode::Off => None,
+        ProfileMode::Position => Some(MODE_PROFILE_POSITION),
+        ProfileMode::Velocity => Some(MODE_PROFILE_VELOCITY),
+        ProfileMode::Homing => Some(MODE_HOMING),
+    }
 }
 
 /// The CiA-402 device states (statusword bits 0–3, 5, 6).
@@ -312,9 +377,16 @@ impl Cia402Drive {
         let fault = matches!(state, Cia402State::Fault | Cia402State::FaultReactionActive);
         let (latch_valid, latch_raw) = self.latched(tx);
         let latch_position = self.position + latch_raw.wrapping_sub(tx.position_actual) as i64;
-        // A cyclic synchronous mode we run the drive in (a switch between them, asked by the
-        // kernel, is on the fly: the drive stays enabled through it).
-        let known = [8, 9, 10].contains(&tx.mode_display);
+        // A mode we run the drive in (a switch between them, asked by the kernel, is on the
+        // fly: the drive stays enabled through it).
+        let known = [1, 3, 6, 8, 9, 10].contains(&tx.mode_display);
+        let bit = |n: u16| tx.statusword & (1 << n) != 0;
+        let profile = match tx.mode_display {
+            MODE_PROFILE_POSITION => ProfileMode::Position,
+            MODE_PROFILE_VELOCITY => ProfileMode::Velocity,
+            MODE_HOMING => ProfileMode::Homing,
+            _ => ProfileMode::Off,
+        };
         DriveFeedback {
             ready: !fault && state != Cia402State::NotReadyToSwitchOn,
             enabled: state == Cia402State::OperationEnabled && known,
@@ -330,6 +402,13 @@ impl Cia402Drive {
             },
             actual_torque: tx.torque_actual as f64 / 10.0,
             velocity_limited: self.limited.get(),
+            profile: ProfileFeedback {
+                mode: profile,
+                target_reached: bit(10),
+                acknowledge: bit(12),
+                // Bit 13 in CSP is the following error too.
+                error: bit(13) && (profile != ProfileMode::Off || tx.mode_display == 8),
+            },
             fault,
             bus_error: false,
             fault_code: if fault { tx.error_code as u32 } else { 0 },
@@ -415,6 +494,21 @@ impl Cia402Drive {
             // new enable starts the sequence again from there.
             QuickStopActive => DISABLE_VOLTAGE,
         };
+        let touch_probe_function = if sp.latch_enable {
+            TP_ENABLE
+                | match sp.latch_source {
+                    LatchSource::IndexPulse => TP_SOURCE_INDEX | TP_POS_EDGE,
+                    // The drive's probe input 1 (0x60B8 bits 2-3 = 00) is where a reference
+                    // switch or a measuring probe is wired.
+                    LatchSource::CamRising | LatchSource::Input1Rising => TP_POS_EDGE,
+                    LatchSource::CamFalling | LatchSource::Input1Falling => TP_NEG_EDGE,
+                }
+        } else {
+            0
+        };
+        if let Some(code) = profile_mode_code(sp.profile.mode) {
+            return self.profile_outputs(sp, code, controlword, touch_probe_function);
+        }
         let run = Run::of(&self.config, sp.mode);
         self.torque_control.set(run == Run::Torque);
         let following = state == OperationEnabled && tx.mode_display == run.code();
@@ -457,18 +551,6 @@ impl Cia402Drive {
         } else {
             (self.position, 0.0, 0.0)
         };
-        let touch_probe_function = if sp.latch_enable {
-            TP_ENABLE
-                | match sp.latch_source {
-                    LatchSource::IndexPulse => TP_SOURCE_INDEX | TP_POS_EDGE,
-                    // The drive's probe input 1 (0x60B8 bits 2-3 = 00) is where a reference
-                    // switch or a measuring probe is wired.
-                    LatchSource::CamRising | LatchSource::Input1Rising => TP_POS_EDGE,
-                    LatchSource::CamFalling | LatchSource::Input1Falling => TP_NEG_EDGE,
-                }
-        } else {
-            0
-        };
         RxPdo {
             controlword,
             // The drive's counter wraps like ours: the low 32 bits are its target.
@@ -479,6 +561,62 @@ impl Cia402Drive {
             target_torque: torque.round() as i16,
             mode: run.code(),
             touch_probe_function,
+            ..RxPdo::default()
+        }
+    }
+
+    /// The outputs of a profile the drive runs (mode `code`): the target and the profile's
+    /// dynamics scaled to increments, and the profile bits of the controlword once the
+    /// drive runs in that mode (until then it is asked to switch, and holds where it is).
+    fn profile_outputs(
+        &self,
+        sp: &DriveSetpoint,
+        code: i8,
+        controlword: u16,
+        touch_probe_function: u16,
+    ) -> RxPdo {
+        self.torque_control.set(false);
+        self.limited.set(false);
+        let p = &sp.profile;
+        let tx = &self.last;
+        let running = controlword == controlword::ENABLE_OPERATION
+            && Cia402State::from_statusword(tx.statusword) == Cia402State::OperationEnabled
+            && tx.mode_display == code;
+        let vs = self.velocity_scale();
+        let rate = |v: f64| (v.abs() * vs).round().min(u32::MAX as f64) as u32;
+        let mut cw = controlword;
+        if running {
+            cw |= if p.start { CW_START } else { 0 }
+                | if p.immediate { CW_IMMEDIATE } else { 0 }
+                | if p.halt { CW_HALT } else { 0 };
+        } else if controlword == controlword::ENABLE_OPERATION {
+            // Switching modes: hold (a drive that is already in the new mode must not start
+            // anything on a target left from before).
+            cw |= CW_HALT;
+        }
+        // Until the drive runs in the mode, 0x607A is still the old mode's target (CSP):
+        // where the motor is.
+        let target_position = if running && p.mode == ProfileMode::Position {
+            (p.target * self.config.increments_per_unit).round() as i64
+        } else {
+            self.position
+        };
+        RxPdo {
+            controlword: cw,
+            target_position: target_position as i32,
+            target_velocity: if running && p.mode == ProfileMode::Velocity {
+                (p.target * vs)
+                    .round()
+                    .clamp(i32::MIN as f64, i32::MAX as f64) as i32
+            } else {
+                0
+            },
+            target_torque: 0,
+            mode: code,
+            touch_probe_function,
+            profile_velocity: rate(p.velocity),
+            profile_acceleration: rate(p.acceleration),
+            profile_deceleration: rate(p.deceleration),
         }
     }
 }

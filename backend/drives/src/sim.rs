@@ -682,6 +682,9 @@ impl SimDrive {
             mode: self.mode,
             actual_torque: self.torque,
             velocity_limited: self.velocity_limited,
+            // The simulated drive runs no profile of its own (a drive-executed axis needs a
+            // CiA-402 drive).
+            profile: motion::ProfileFeedback::default(),
         }
     }
 

@@ -336,8 +336,8 @@ fn a_drive_in_another_mode_is_not_taken_as_following() {
     assert_eq!(rx.target_position, 1_000, "held where it is");
     assert_eq!(rx.target_torque, 0);
     assert_eq!(rx.mode, 8, "CSP asked for again");
-    // A mode the drive is never run in (profile position, 1) is not taken as enabled.
-    device.mode_display = 1;
+    // A mode the drive is never run in (velocity mode, 2) is not taken as enabled.
+    device.mode_display = 2;
     assert!(!drive.feedback(&device.tx()).enabled);
 }
 

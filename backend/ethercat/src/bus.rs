@@ -143,21 +143,27 @@ impl BusOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Layout {
     pub name: &'static str,
-    rx: [Option<usize>; 6],
+    rx: [Option<usize>; 9],
     tx: [Option<usize>; 10],
     pub out_len: usize,
     pub in_len: usize,
 }
 
 // RxPDO objects in `Layout::rx` order.
-const RX_OBJ: [u32; 6] = [
+const RX_OBJ: [u32; 9] = [
     0x6040_0010,
     0x607A_0020,
     0x60FF_0020,
     0x6071_0010,
     0x6060_0008,
     0x60B8_0010,
+    0x6081_0020,
+    0x6083_0020,
+    0x6084_0020,
 ];
+/// The profile modes' dynamics (profile velocity, acceleration, deceleration): what a
+/// drive-executed axis needs beyond the cyclic modes.
+const RX_PROFILE: [usize; 3] = [6, 7, 8];
 // TxPDO objects in `Layout::tx` order.
 const TX_OBJ: [u32; 10] = [
     0x6041_0010,
@@ -199,21 +205,51 @@ impl Layout {
         }
         l
     }
-    /// Everything motiond uses: CSP/CSV/CST targets, touch probe, digital inputs.
+    /// Everything motiond uses: CSP/CSV/CST targets, the profile modes' dynamics, touch
+    /// probe, digital inputs.
     pub fn full() -> Layout {
-        Layout::of("full", &[0, 1, 2, 3, 4, 5], &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9])
+        Layout::of(
+            "full",
+            &[0, 1, 2, 3, 4, 5, 6, 7, 8],
+            &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9],
+        )
+    }
+    /// The full mapping without the profile modes' dynamics: everything the cyclic modes
+    /// use (a drive that cannot map 0x6081/0x6083/0x6084 runs host-side profiles only).
+    pub fn cyclic() -> Layout {
+        Layout::of(
+            "cyclic",
+            &[0, 1, 2, 3, 4, 5],
+            &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9],
+        )
+    }
+    /// Whether a drive-executed profile can run on this mapping: the mode, the targets and
+    /// the profile's dynamics are in it.
+    pub fn runs_profiles(&self) -> bool {
+        [1, 2, 4]
+            .iter()
+            .chain(&RX_PROFILE)
+            .all(|&i| self.rx[i].is_some())
     }
     /// What every CSP drive can map: controlword, target, mode; statusword, position, mode
     /// display, error code.
     pub fn minimal() -> Layout {
         Layout::of("minimal", &[0, 1, 4], &[0, 1, 4, 5])
     }
-    /// What the drive has of the full mapping (`missing`: object indices it does not have).
-    fn available(missing: &[u16]) -> Layout {
+    /// What the drive has of the full mapping (`missing`: object indices it does not have),
+    /// with or without the profile modes' dynamics.
+    fn available(missing: &[u16], profiles: bool) -> Layout {
         let has = |obj: u32| !missing.contains(&((obj >> 16) as u16));
-        let rx: Vec<usize> = (0..RX_OBJ.len()).filter(|&i| has(RX_OBJ[i])).collect();
+        let rx: Vec<usize> = (0..RX_OBJ.len())
+            .filter(|&i| has(RX_OBJ[i]) && (profiles || !RX_PROFILE.contains(&i)))
+            .collect();
         let tx: Vec<usize> = (0..TX_OBJ.len()).filter(|&i| has(TX_OBJ[i])).collect();
-        Layout::of("available", &rx, &tx)
+        let name = if profiles {
+            "available"
+        } else {
+            "available_cyclic"
+        };
+        Layout::of(name, &rx, &tx)
     }
     /// Whether the object (by index) is in this mapping.
     pub fn maps(&self, index: u16) -> bool {
@@ -225,12 +261,15 @@ impl Layout {
         };
         hit(&self.rx, &RX_OBJ) || hit(&self.tx, &TX_OBJ)
     }
-    /// The mappings to try, largest first: full; what the drive has of it; minimal.
+    /// The mappings to try, largest first: full; full for the cyclic modes only; what the
+    /// drive has of each; minimal.
     fn candidates(missing: &[u16]) -> Vec<Layout> {
         let mut v: Vec<Layout> = Vec::new();
         for l in [
             Layout::full(),
-            Layout::available(missing),
+            Layout::cyclic(),
+            Layout::available(missing, true),
+            Layout::available(missing, false),
             Layout::minimal(),
         ] {
             let has_all = l
@@ -263,6 +302,9 @@ impl Layout {
         put(out, self.rx[3], &rx.target_torque.to_le_bytes());
         put(out, self.rx[4], &rx.mode.to_le_bytes());
         put(out, self.rx[5], &rx.touch_probe_function.to_le_bytes());
+        put(out, self.rx[6], &rx.profile_velocity.to_le_bytes());
+        put(out, self.rx[7], &rx.profile_acceleration.to_le_bytes());
+        put(out, self.rx[8], &rx.profile_deceleration.to_le_bytes());
     }
 
     fn decode(&self, inp: &[u8]) -> TxPdo {
@@ -312,7 +354,7 @@ pub struct SubDeviceInfo {
 /// A mapping a drive refused at bring-up.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Refusal {
-    /// `full`, `available` or `minimal`.
+    /// `full`, `cyclic`, `available`, `available_cyclic` or `minimal`.
     pub mapping: &'static str,
     /// `PDO mapping write` (an SDO abort) or `PRE-OP to SAFE-OP` (the AL status code).
     pub at: &'static str,
@@ -686,7 +728,8 @@ async fn bring_up(
     opts: &BusOptions,
 ) -> Result<(Group, Vec<SubDeviceInfo>), String> {
     let mut refused: Vec<Vec<Refusal>> = vec![Vec::new(); MAX_SUBDEVICES];
-    for _ in 0..4 {
+    // At most one attempt per mapping motiond has.
+    for _ in 0..5 {
         match bring_up_once(md, opts, &refused).await {
             Ok(r) => return Ok(r),
             Err(Attempt::Refused(position, r)) => refused[position] = r,

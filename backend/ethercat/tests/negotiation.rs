@@ -51,9 +51,13 @@ fn a_drive_refusing_safe_op_gets_the_next_smaller_mapping() {
     let st = bus.status();
     let sd = &st.subdevices[0];
     assert_eq!(sd.drive.map(|l| l.name), Some("minimal"));
-    assert_eq!(sd.refused.len(), 1, "{:?}", sd.refused);
+    assert_eq!(sd.refused.len(), 2, "{:?}", sd.refused);
+    // Its outputs with the profile modes' dynamics (8 entries), then its inputs (6).
     let r = &sd.refused[0];
     assert_eq!((r.mapping, r.at), ("available", "PRE-OP to SAFE-OP"));
+    assert_eq!(r.al_status_code, Some(0x001D));
+    let r = &sd.refused[1];
+    assert_eq!((r.mapping, r.at), ("available_cyclic", "PRE-OP to SAFE-OP"));
     assert_eq!(r.al_status_code, Some(0x001E));
     assert!(
         r.reason.contains("Invalid Input Configuration"),

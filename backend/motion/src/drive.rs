@@ -28,6 +28,55 @@ pub struct DriveSetpoint {
     /// low), by reducing the torque.
     pub velocity_limit_high: f64,
     pub velocity_limit_low: f64,
+    /// A motion the drive executes itself (its profile modes); `ProfileMode::Off`: the
+    /// cyclic setpoint above.
+    pub profile: ProfileCommand,
+}
+
+/// Which profile the drive runs itself (CiA-402 §6.2 profile position 1, profile velocity 3,
+/// homing 6; TwinCAT Drive Motion Control).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProfileMode {
+    /// The drive follows the cyclic setpoint (CSP/CSV/CST).
+    #[default]
+    Off,
+    Position,
+    Velocity,
+    Homing,
+}
+
+/// A motion the drive executes: what is sent for it every cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProfileCommand {
+    pub mode: ProfileMode,
+    /// Position: the absolute target; Velocity: the signed target velocity.
+    pub target: f64,
+    /// Position: the profile velocity (> 0).
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub deceleration: f64,
+    /// Position: a new set point, held until the drive acknowledges it; Homing: start,
+    /// held while homing runs (dropping it interrupts homing).
+    pub start: bool,
+    /// Position: the new set point replaces the running one at once (change set immediately).
+    pub immediate: bool,
+    /// Halt: the drive brakes at `deceleration` and holds (releasing resumes).
+    pub halt: bool,
+}
+
+/// What a drive reports of the profile it executes (statusword bits 10, 12, 13 as its mode
+/// of operation display gives them meaning).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProfileFeedback {
+    /// The profile mode the drive runs in (0x6061); `Off` in a cyclic mode.
+    pub mode: ProfileMode,
+    /// Bit 10: target reached (Position: on the target, or standing while halted; Velocity:
+    /// at the target velocity, or standing while halted; Homing: with `acknowledge`, done).
+    pub target_reached: bool,
+    /// Bit 12: Position: set-point acknowledge; Velocity: speed zero; Homing: attained.
+    pub acknowledge: bool,
+    /// Bit 13: Position: following error; Homing: homing error.
+    pub error: bool,
 }
 
 /// A drive's operation mode (`E_DriveOperationMode`, §6.2; CiA-402 0x6060/0x6061).
@@ -106,4 +155,6 @@ pub struct DriveFeedback {
     /// In torque mode: the drive is holding the velocity at a limit (the torque asked for
     /// is not what it applies).
     pub velocity_limited: bool,
+    /// The profile the drive executes, as it reports it.
+    pub profile: ProfileFeedback,
 }

@@ -78,7 +78,10 @@ pub mod status;
 pub use axis::{Axis, AxisConfig};
 pub use command::*;
 pub use compensation::{CompensationTable, WorkDirection};
-pub use drive::{DriveFeedback, DriveMode, DriveSetpoint, LatchSource};
+pub use drive::{
+    DriveFeedback, DriveMode, DriveSetpoint, LatchSource, ProfileCommand, ProfileFeedback,
+    ProfileMode,
+};
 pub use error::ErrorId;
 pub use kernel::Kernel;
 

@@ -2983,7 +2983,7 @@ export interface components {
          *             "input_bytes": 29,
          *             "mapping": "full",
          *             "missing_objects": [],
-         *             "output_bytes": 15,
+         *             "output_bytes": 27,
          *             "refused": []
          *           },
          *           "name": "motiond emulated servo 1",
@@ -4834,6 +4834,17 @@ export interface components {
              * @description CST: the torque sent is limited to ± this, per mille of rated torque (1–32767).
              */
             max_torque?: number;
+            /**
+             * @description Who runs the motion profile: motiond (`host`, the cyclic synchronous `mode`) or the
+             *     drive (`drive`: its profile modes).
+             */
+            profile?: components["schemas"]["ProfileSide"];
+            /**
+             * Format: int32
+             * @description The drive's homing method (0x6098, CiA-402 methods 1–37) for homing in the drive:
+             *     written to the drive when the axis is configured; `null` leaves the drive's own.
+             */
+            homing_method?: number | null;
         };
         /**
          * @description A CiA-402 drive's process data as motiond mapped it.
@@ -7387,6 +7398,11 @@ export interface components {
             errors?: components["schemas"]["FieldError"][];
         };
         /**
+         * @description Who runs an axis's motion profile.
+         * @enum {string}
+         */
+        ProfileSide: "host" | "drive";
+        /**
          * @description Which value of the slave jumps where two pieces of a table meet.
          * @enum {string}
          */
@@ -8314,7 +8330,7 @@ export interface components {
          *         "input_bytes": 29,
          *         "mapping": "full",
          *         "missing_objects": [],
-         *         "output_bytes": 15,
+         *         "output_bytes": 27,
          *         "refused": []
          *       },
          *       "name": "motiond emulated servo 2",

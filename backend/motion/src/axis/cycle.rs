@@ -148,6 +148,7 @@ impl Axis {
                 (None, Some(p)) if probe_armed => p.source(),
                 _ => LatchSource::default(),
             },
+            profile: crate::drive::ProfileCommand::default(),
         };
     }
 

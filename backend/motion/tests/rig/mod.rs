@@ -112,6 +112,7 @@ impl Plant {
             },
             actual_torque: self.torque,
             velocity_limited: self.velocity_limited,
+            profile: Default::default(),
         }
     }
 

@@ -81,7 +81,7 @@ pub struct RefusedMapping {
 #[derive(Clone, Debug, Serialize, ToSchema)]
 #[schema(example = json!({"position": 1, "configured_address": 4097, "name": "motiond emulated servo 2",
     "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264129,
-    "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29, "missing_objects": [], "refused": []},
+    "al_state": "op", "drive": {"mapping": "full", "output_bytes": 27, "input_bytes": 29, "missing_objects": [], "refused": []},
     "dc": true, "axis": "y"}))]
 pub struct SubDeviceResource {
     /// Position on the segment (0 = next to motiond); a CiA-402 drive's `subdevice`.
@@ -113,7 +113,7 @@ pub struct SubDeviceResource {
     "dc_system_time_ns": 123456789000u64, "dc_cycle_offset_ns": 12000,
     "subdevices": [{"position": 0, "configured_address": 4096, "name": "motiond emulated servo 1",
         "vendor_id": 16714446, "product_code": 67239937, "revision": 65536, "serial": 537264128,
-        "al_state": "op", "drive": {"mapping": "full", "output_bytes": 15, "input_bytes": 29, "missing_objects": [], "refused": []},
+        "al_state": "op", "drive": {"mapping": "full", "output_bytes": 27, "input_bytes": 29, "missing_objects": [], "refused": []},
         "dc": true, "axis": "x"}]
 }))]
 pub struct BusResource {
