@@ -46,8 +46,8 @@ async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
     assert_eq!(bus.json["kind"], "emulated");
     assert_eq!(bus.json["state"], "op", "{}", bus.text);
     let subs = bus.json["subdevices"].as_array().unwrap();
-    assert_eq!(subs.len(), 3);
-    for (i, (sd, axis)) in subs.iter().zip(["x", "y", "spindle"]).enumerate() {
+    assert_eq!(subs.len(), 4);
+    for (i, (sd, axis)) in subs.iter().zip(["x", "y", "spindle", "feeder"]).enumerate() {
         assert_eq!(sd["position"], i);
         assert_eq!(sd["al_state"], "op");
         assert_eq!(sd["vendor_id"], 0x00FF_0ACE);
@@ -55,7 +55,7 @@ async fn the_demo_machine_runs_on_emulated_ethercat_drives() {
         assert_eq!(sd["drive"]["mapping"], "full");
         assert_eq!(sd["axis"], axis);
     }
-    assert_eq!(bus.json["expected_working_counter"], 9);
+    assert_eq!(bus.json["expected_working_counter"], 12);
     let sys = get(&s, "/api/v1/system").await;
     assert_eq!(sys.json["drive_bus"], "emulated");
     let x = get(&s, "/api/v1/axes/x").await;
@@ -529,7 +529,7 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
     let bus = get(&s, "/api/v1/bus").await;
     let notice = bus.json["notice"].as_str().unwrap_or_default().to_owned();
     assert!(
-        notice.contains("position 0, 1, 2 drive no axis"),
+        notice.contains("position 0, 1, 2, 3 drive no axis"),
         "{}",
         bus.text
     );
@@ -553,7 +553,7 @@ async fn an_existing_database_on_the_emulated_bus_is_told_how_to_use_the_drives(
     let bus = get(&s, "/api/v1/bus").await;
     let notice = bus.json["notice"].as_str().unwrap_or_default();
     assert!(
-        notice.contains("position 1, 2 drive no axis"),
+        notice.contains("position 1, 2, 3 drive no axis"),
         "{}",
         bus.text
     );
@@ -722,4 +722,93 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
             drop(emulator);
         },
     );
+}
+
+/// The demo's `feeder` on the emulated segment: its drive runs the profile. The status says
+/// so; homing runs in the drive (method 1 on its negative limit switch and index pulse); a
+/// move is done when the drive reports its target reached; a jog runs in profile velocity; a
+/// block Drive Motion Control does not have is refused with 409 and changes nothing.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_drive_executed_axis_homes_moves_and_jogs_in_its_drive() {
+    let s = Server::start_with(
+        ":memory:",
+        &[
+            "--bus",
+            "emulated",
+            "--bus-max-errors",
+            "5",
+            "--bus-timeout-ms",
+            "50",
+        ],
+    );
+    let st = status(&s, "feeder").await;
+    assert_eq!(st["status"]["drive_executed"], true, "{st}");
+    assert_eq!(status(&s, "x").await["status"]["drive_executed"], false);
+    power_on(&s, "feeder").await;
+    let r = post(
+        &s,
+        "/api/v1/axes/feeder/gear-in",
+        json!({"master": "x", "ratio_numerator": 1.0, "ratio_denominator": 1}),
+    )
+    .await;
+    assert_problem(&r, 409, "not_on_drive_executed_axis");
+    let r = post(
+        &s,
+        "/api/v1/axes/feeder/move-absolute",
+        json!({"position": 10.0, "velocity": 50.0, "jerk": 100.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "input_not_on_drive_executed_axis");
+    let h = post(
+        &s,
+        "/api/v1/axes/feeder/home?wait=true&timeout_ms=20000",
+        json!({"position": 0.0}),
+    )
+    .await;
+    assert_eq!(h.json["state"], "done", "{}", h.text);
+    let st = status(&s, "feeder").await;
+    assert_eq!(st["status"]["homed"], true);
+    assert!(
+        st["status"]["actual_position"].as_f64().unwrap().abs() < 0.002,
+        "{st}"
+    );
+    // The drive homed with the configured method (written to 0x6098 before the start).
+    let m = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6098/0").await;
+    assert_eq!(m.json["signed"], 1, "{}", m.text);
+    let mv = post(
+        &s,
+        "/api/v1/axes/feeder/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 120.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(mv.json["state"], "done", "{}", mv.text);
+    let st = status(&s, "feeder").await;
+    assert!(
+        (st["status"]["actual_position"].as_f64().unwrap() - 120.0).abs() <= 0.011,
+        "done only on the target: {st}"
+    );
+    let mode = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6061/0").await;
+    assert_eq!(mode.json["signed"], 1, "profile position: {}", mode.text);
+    // A jog forward runs in profile velocity; releasing it stops the axis.
+    let jog = post(
+        &s,
+        "/api/v1/axes/feeder/jog",
+        json!({"direction": "forward", "mode": "standard_fast", "deadman_timeout": 5.0}),
+    )
+    .await;
+    assert_eq!(jog.status, 202, "{}", jog.text);
+    let id = jog.json["id"].as_u64().unwrap();
+    until_status(&s, "feeder", "jogging", |st| {
+        st["actual_velocity"].as_f64().unwrap() > 40.0
+    })
+    .await;
+    let mode = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6061/0").await;
+    assert_eq!(mode.json["signed"], 3, "profile velocity: {}", mode.text);
+    let r = delete(&s, &format!("/api/v1/commands/{id}")).await;
+    assert!(r.status < 300, "{}", r.text);
+    let fin = until_final(&s, id, 20).await;
+    assert_eq!(fin["state"], "done", "{fin}");
+    let st = until_status(&s, "feeder", "standing", |st| st["state"] == "standstill").await;
+    assert!(st["actual_position"].as_f64().unwrap() > 120.0, "{st}");
+    s.stop();
 }

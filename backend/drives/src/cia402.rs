@@ -142,15 +142,6 @@ impl Cia402Config {
                 message: "1..32767 per mille of rated torque".into(),
             });
         }
-        if self.profile == ProfileSide::Drive {
-            // The layers below the kernel run drive-executed profiles; until the kernel's
-            // axis runs its blocks that way, an axis must not be taken as drive-executed and
-            // then run host-side.
-            errors.push(ConfigError {
-                field: "profile".into(),
-                message: "drive-executed profiles are not available yet".into(),
-            });
-        }
         if self.homing_method.is_some_and(|m| !(1..=37).contains(&m)) {
             errors.push(ConfigError {
                 field: "homing_method".into(),

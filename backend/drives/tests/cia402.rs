@@ -487,6 +487,7 @@ fn the_kernel_powers_and_moves_an_axis_through_the_cia402_drive() {
                 modulo: false,
                 parameters: AxisParameters::default(),
                 compensation_table: None,
+                drive_executed: false,
             },
             DT,
         ),

@@ -31,6 +31,7 @@ impl Machine {
                     modulo: false,
                     parameters: p,
                     compensation_table: None,
+                    drive_executed: false,
                 },
                 DT,
             ),

@@ -93,6 +93,7 @@ impl Machine {
                 modulo: false,
                 parameters,
                 compensation_table: None,
+                drive_executed: false,
             };
             k.insert_axis(i as u16, Axis::new(config, DT)).unwrap();
         }

@@ -262,6 +262,10 @@ pub enum HomingMode {
     ForceCalibration,
     /// Clear the homed flag without motion; position unchanged.
     ResetCalibration,
+    /// Homing in the drive (CiA-402 homing mode 6, the drive's method 0x6098), then back to
+    /// the axis's cyclic mode with the set position taken over (MC2's DriveBasedHoming).
+    /// On an axis whose drive runs the profile, `default` homes in the drive as well.
+    DriveBased,
 }
 
 /// `E_EncoderReferenceMode` (#1076): how the referencing sequence finds its reference.

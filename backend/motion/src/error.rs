@@ -135,9 +135,18 @@ error_table! {
     CAM_NOT_COUPLED = 0x7087, "cam_not_coupled", "the axis is not coupled through a cam";
     /// MC_CamIn and MC_CamIn_V2 exclude each other on a slave (spec §1.9).
     CAM_FAMILY_MIXED = 0x7088, "cam_family_mixed", "MC_CamIn and MC_CamIn_V2 cannot be mixed on one slave";
+    /// The block is not one of Drive Motion Control's: an axis whose drive runs the profile
+    /// does not take it (it is never run host-side instead).
+    NOT_ON_DRIVE_EXECUTED_AXIS = 0x70C0, "not_on_drive_executed_axis", "the drive runs this axis's profile: this block is not offered (Drive Motion Control has it not)";
+    /// An input the drive's profile does not have: jerk, a buffer mode other than aborting,
+    /// an override.
+    INPUT_NOT_ON_DRIVE_EXECUTED_AXIS = 0x70C1, "input_not_on_drive_executed_axis", "the drive runs this axis's profile: jerk, buffer modes other than aborting and the override are not its inputs";
+    /// The drive reported a homing error (statusword bit 13 in homing mode).
+    DRIVE_HOMING_ERROR = 0x70C2, "drive_homing_error", "the drive reported a homing error";
+    /// The bus lost the drive (bus_error feedback).
+    BUS_ERROR = 0x70A0, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)";
     /// MC_TouchProbe while a probe cycle runs (end it first: MC_AbortTrigger) or while homing
     /// uses the drive's latch.
-    BUS_ERROR = 0x70A0, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)";
     TOUCH_PROBE_BUSY = 0x7090, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)";
     /// MC_PhasingAbsolute/Relative and MC_HaltPhasing need the axis enabled and coupled to the given master by MC_GearIn or a cam (not MC_GearInDyn, §5.6).
     PHASING_NOT_COUPLED = 0x70B0, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam";

@@ -597,6 +597,7 @@ mod tests {
                 modulo: false,
                 parameters: AxisParameters::default(),
                 compensation_table: None,
+                drive_executed: false,
             };
             k.insert_axis(i as AxisSlot, Axis::new(config, DT)).unwrap();
         }

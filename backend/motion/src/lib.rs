@@ -16,7 +16,7 @@
 //!
 //! let dt = 0.001;
 //! let mut kernel = Kernel::new(dt, 1);
-//! let config = AxisConfig { modulo: false, parameters: AxisParameters::default(), compensation_table: None };
+//! let config = AxisConfig { modulo: false, parameters: AxisParameters::default(), compensation_table: None, drive_executed: false };
 //! kernel.insert_axis(0, Axis::new(config, dt)).unwrap();
 //!
 //! let mut events: Vec<CommandEvent> = Vec::new();

@@ -181,6 +181,10 @@ pub struct AxisStatus {
     pub ptp_mode: bool,
     /// Bit 30: the drive's process data are not valid (a lost or refused bus exchange).
     pub io_data_invalid: bool,
+    /// Which side executes the motion profile: `false` motiond (a setpoint every cycle),
+    /// `true` the drive (its profile modes; only the Drive Motion Control blocks are offered).
+    #[serde(default)]
+    pub drive_executed: bool,
     /// The kernel's cycle counter when this status was made (`NcCycleCounter`).
     pub nc_cycle_counter: u64,
     /// `ST_AxisOpModes`: the operating modes the parameters switch on (OpModeDWord).

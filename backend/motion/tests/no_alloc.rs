@@ -59,6 +59,7 @@ fn step_and_replanning_allocate_nothing() {
                     modulo: i % 2 == 1,
                     parameters: p,
                     compensation_table: None,
+                    drive_executed: false,
                 },
                 0.001,
             ),
@@ -316,6 +317,7 @@ fn group_kernel(n: usize, convention: motion::group::AxesConvention) -> Kernel {
                 ..AxisParameters::default()
             },
             compensation_table: None,
+            drive_executed: false,
         };
         k.insert_axis(i as u16, Axis::new(config, 0.001)).unwrap();
     }

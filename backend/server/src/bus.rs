@@ -38,8 +38,23 @@ impl BusKind {
     }
 }
 
-/// The drives of the emulated segment: one per demo axis.
-pub const EMULATED_DRIVES: u32 = 3;
+/// The drives of the emulated segment: one per demo axis (x, y, spindle, and the feeder
+/// whose drive runs the profile).
+pub const EMULATED_DRIVES: u32 = 4;
+
+/// The plant of emulated drive `i`: the fourth (the demo's feeder) has limit switches 5 mm
+/// outside its 0–500 mm travel at 1 µm per increment, for homing in the drive.
+pub fn emulated_plant(i: u32) -> Plant {
+    if i == 3 {
+        Plant {
+            limit_negative: Some(-5_000.0),
+            limit_positive: Some(505_000.0),
+            ..Plant::default()
+        }
+    } else {
+        Plant::default()
+    }
+}
 
 /// What the API sees of the bus.
 #[derive(Clone)]
@@ -145,7 +160,7 @@ fn emulated_segment(drives: u32, strict: bool) -> Arc<Mutex<Segment>> {
     };
     Segment::new(
         (0..drives)
-            .map(|i| make(emulated_identity(i), Plant::default()))
+            .map(|i| make(emulated_identity(i), emulated_plant(i)))
             .collect(),
         Box::new(move || start.elapsed().as_nanos() as u64),
     )

@@ -317,7 +317,12 @@ async fn load_axes(state: &Arc<AppState>, no_demo: bool) -> Result<(), String> {
                 .map_err(|e| format!("cannot create the demo group xy: {e}"))?;
             tracing::info!(
                 "new database: created the demo axes x, y (linear, mm) and spindle (modulo 360°), \
-                 and the group xy of x and y (disabled)"
+                 and the group xy of x and y (disabled){}",
+                if state.info.bus.kind == bus::BusKind::Emulated {
+                    "; on the emulated segment also feeder, whose drive runs the profile"
+                } else {
+                    ""
+                }
             );
             return Ok(());
         }

@@ -66,6 +66,7 @@ fn a_cycle_allocates_nothing() {
                 modulo: false,
                 parameters: AxisParameters::default(),
                 compensation_table: None,
+                drive_executed: false,
             },
             ct,
         )

@@ -27,6 +27,7 @@ fn an_expired_request_is_dropped_undone_and_a_live_one_acts() {
                 modulo: false,
                 parameters: AxisParameters::default(),
                 compensation_table: None,
+                drive_executed: false,
             },
             ct,
         ),

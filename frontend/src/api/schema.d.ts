@@ -2553,6 +2553,7 @@ export interface components {
          *       "covered_phase_shift": 0,
          *       "decelerating": false,
          *       "drive_error_code": 0,
+         *       "drive_executed": false,
          *       "drive_fault": false,
          *       "drive_operation_mode": "configured",
          *       "enable_negative": true,
@@ -2816,6 +2817,11 @@ export interface components {
             ptp_mode: boolean;
             /** @description Bit 30: the drive's process data are not valid (a lost or refused bus exchange). */
             io_data_invalid: boolean;
+            /**
+             * @description Which side executes the motion profile: `false` motiond (a setpoint every cycle),
+             *     `true` the drive (its profile modes; only the Drive Motion Control blocks are offered).
+             */
+            drive_executed?: boolean;
             /**
              * Format: int64
              * @description The kernel's cycle counter when this status was made (`NcCycleCounter`).
@@ -5669,7 +5675,7 @@ export interface components {
             options?: components["schemas"]["HomingOptions"];
         };
         /** @enum {string} */
-        HomingMode: "default" | "direct" | "force_calibration" | "reset_calibration";
+        HomingMode: "default" | "direct" | "force_calibration" | "reset_calibration" | "drive_based";
         /**
          * @description `ST_HomingOptions`.
          * @example {
@@ -5918,6 +5924,7 @@ export interface components {
          *       "covered_phase_shift": 0,
          *       "decelerating": false,
          *       "drive_error_code": 0,
+         *       "drive_executed": false,
          *       "drive_fault": false,
          *       "drive_operation_mode": "configured",
          *       "enable_negative": true,
@@ -8189,6 +8196,7 @@ export interface components {
          *         "covered_phase_shift": 0,
          *         "decelerating": false,
          *         "drive_error_code": 0,
+         *         "drive_executed": false,
          *         "drive_fault": false,
          *         "drive_operation_mode": "configured",
          *         "enable_negative": true,

@@ -359,6 +359,56 @@ impl Cia402Emu {
         self.profile.homing
     }
 
+    /// One setpoint period without a segment: the outputs written as an RxPDO would write
+    /// them, the drive stepped in OP, its inputs read as a TxPDO (for tests of the kernel and
+    /// the CiA-402 layer against this drive in virtual time, cycle by cycle).
+    pub fn exchange_direct(
+        &mut self,
+        rx: &drives::cia402::RxPdo,
+        dt: f64,
+    ) -> drives::cia402::TxPdo {
+        self.od.set(0x6040, 0, &rx.controlword.to_le_bytes());
+        self.od.set(0x607A, 0, &rx.target_position.to_le_bytes());
+        self.od.set(0x60FF, 0, &rx.target_velocity.to_le_bytes());
+        self.od.set(0x6071, 0, &rx.target_torque.to_le_bytes());
+        if matches!(
+            rx.mode,
+            MODE_PP | MODE_PV | MODE_HM | MODE_CSP | MODE_CSV | MODE_CST
+        ) {
+            self.od.set(0x6060, 0, &[rx.mode as u8]);
+        }
+        if self.od.get(0x60B8, 0).is_some() {
+            self.od
+                .set(0x60B8, 0, &rx.touch_probe_function.to_le_bytes());
+        }
+        self.od.set(0x6081, 0, &rx.profile_velocity.to_le_bytes());
+        self.od
+            .set(0x6083, 0, &rx.profile_acceleration.to_le_bytes());
+        self.od
+            .set(0x6084, 0, &rx.profile_deceleration.to_le_bytes());
+        self.step_drive(dt, true);
+        let get = |index: u16| {
+            self.od
+                .get(index, 0)
+                .map(<[u8]>::to_vec)
+                .unwrap_or_default()
+        };
+        let i32_of = |b: Vec<u8>| b.try_into().map(i32::from_le_bytes).unwrap_or(0);
+        let u16_of = |b: Vec<u8>| b.try_into().map(u16::from_le_bytes).unwrap_or(0);
+        drives::cia402::TxPdo {
+            statusword: u16_of(get(0x6041)),
+            position_actual: i32_of(get(0x6064)),
+            velocity_actual: i32_of(get(0x606C)),
+            mode_display: self.od.i8(0x6061, 0),
+            torque_actual: u16_of(get(0x6077)) as i16,
+            error_code: u16_of(get(0x603F)),
+            digital_inputs: i32_of(get(0x60FD)) as u32,
+            touch_probe_status: u16_of(get(0x60B9)),
+            touch_probe_pos_edge: i32_of(get(0x60BA)),
+            touch_probe_neg_edge: i32_of(get(0x60BB)),
+        }
+    }
+
     /// The touch probe's input 1 (a mark passing the sensor).
     pub fn set_probe_input(&mut self, on: bool) {
         self.probe_input = on;

@@ -44,6 +44,7 @@ impl Axis {
         cmd: Command,
         master: Option<MasterSample>,
     ) -> Result<(), ErrorId> {
+        self.admit_on_drive(&cmd.kind)?;
         match cmd.kind {
             CommandKind::Power {
                 enable,

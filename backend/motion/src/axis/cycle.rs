@@ -98,8 +98,12 @@ impl Axis {
             self.step_job(cx, dt, fb, master);
             self.step_phasing(cx, dt);
             self.step_superposition(cx, dt);
-            self.step_soft_limits(cx, dt);
-            self.step_following_error(cx, dt);
+            if !self.drive_executed() {
+                // A drive that runs the profile watches its own lag (statusword bit 13) and
+                // the soft limits are its jobs' (`drive_profile.rs`).
+                self.step_soft_limits(cx, dt);
+                self.step_following_error(cx, dt);
+            }
         }
         if self.mode == Mode::ErrorStop && self.job.is_none() {
             if let Some(mut r) = self.pending_reset.take() {
@@ -148,7 +152,7 @@ impl Axis {
                 (None, Some(p)) if probe_armed => p.source(),
                 _ => LatchSource::default(),
             },
-            profile: crate::drive::ProfileCommand::default(),
+            profile: self.profile_command(),
         };
     }
 
@@ -163,6 +167,10 @@ impl Axis {
     ) {
         let ovr = self.override_ratio();
         let Some(mut job) = self.job else {
+            if self.drive_executed() {
+                self.step_drive_job(cx, fb);
+                return;
+            }
             self.set.velocity = 0.0;
             self.set.acceleration = 0.0;
             self.set.jerk = 0.0;
@@ -189,6 +197,12 @@ impl Axis {
             }
         }
 
+        if self.drive_executed() || job.kind == JobKind::DriveHome {
+            // The drive runs the profile: no planner, no override re-plan.
+            self.job = Some(job);
+            self.step_drive_job(cx, fb);
+            return;
+        }
         if job.kind == JobKind::Gear {
             self.follow_master(cx, &mut job, master, dt);
             self.job = Some(job);
@@ -371,23 +385,7 @@ impl Axis {
                         self.set.velocity = 0.0;
                         self.set.acceleration = 0.0;
                         self.set.jerk = 0.0;
-                        if self.mode == Mode::Stopping {
-                            if let Some(mut s) = self.stop {
-                                s.emit(
-                                    cx,
-                                    FbOutputs {
-                                        busy: true,
-                                        active: true,
-                                        done: true,
-                                        ..FbOutputs::default()
-                                    },
-                                );
-                                self.stop = Some(s);
-                            } else {
-                                // The lock was removed by MC_Reset during the ramp.
-                                self.mode = Mode::Enabled;
-                            }
-                        }
+                        self.stop_ramp_ended(cx);
                         self.start_next(cx);
                     }
                     Some(Err(e)) => {
@@ -412,7 +410,30 @@ impl Axis {
             | JobKind::Gear
             | JobKind::Torque
             | JobKind::External
-            | JobKind::Group => unreachable!(),
+            | JobKind::Group
+            | JobKind::DriveHome => unreachable!(),
+        }
+    }
+
+    /// A stop's ramp came to rest: MC_Stop reports Done and keeps the lock (note 6), or the
+    /// axis is enabled again when MC_Reset removed the lock during the ramp.
+    pub(super) fn stop_ramp_ended(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
+        if self.mode != Mode::Stopping {
+            return;
+        }
+        if let Some(mut s) = self.stop {
+            s.emit(
+                cx,
+                FbOutputs {
+                    busy: true,
+                    active: true,
+                    done: true,
+                    ..FbOutputs::default()
+                },
+            );
+            self.stop = Some(s);
+        } else {
+            self.mode = Mode::Enabled;
         }
     }
 

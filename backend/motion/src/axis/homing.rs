@@ -58,6 +58,14 @@ impl Axis {
                 cx.report(id, DONE);
                 Ok(())
             }
+            HomingMode::DriveBased => {
+                self.start_drive_home(cx, id, reference);
+                Ok(())
+            }
+            HomingMode::Default if self.drive_executed() => {
+                self.start_drive_home(cx, id, reference);
+                Ok(())
+            }
             HomingMode::Default => {
                 let p = self.p();
                 let dir_of =

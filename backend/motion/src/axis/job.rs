@@ -66,6 +66,8 @@ pub(super) enum JobKind {
     External,
     /// A coordinated-motion group moves the axis along its path (`group.rs`).
     Group,
+    /// MC_Home run by the drive's homing mode (`drive_profile.rs`).
+    DriveHome,
 }
 
 /// Where a job is in its life.

@@ -21,6 +21,7 @@
 //! | `superposition.rs` | `SuperpositionState` (`superposition`) | MC_MoveSuperImposed |
 //! | `homing.rs` | `HomeSeq` (in the homing job), the drive's `latch`, `prev_cam` (core: read every cycle) | MC_Home (§5.3) |
 //! | `probe.rs` | `Probe` (`probe`) | MC_TouchProbe, MC_AbortTrigger |
+//! | `drive_profile.rs` | `DriveProfile` (`drive`) | an axis whose drive runs the profile (DMC), homing in the drive |
 //! | `correction.rs` | `Corrections` (`corrections`) | limiter, backlash, table compensation (§7.2) |
 //! | `encoder.rs` | `EncoderScaling` (`encoder`; `enc_k` core) | MC_SetEncoderScalingFactor, the encoder count |
 //! | `torque.rs` | `TorqueState` (`torque`) | MC_TorqueControl, the drive's operation mode |
@@ -54,6 +55,7 @@ mod commands;
 mod correction;
 mod coupling;
 mod cycle;
+mod drive_profile;
 mod encoder;
 mod external;
 mod group;
@@ -83,6 +85,9 @@ pub struct AxisConfig {
     pub parameters: AxisParameters,
     /// The table MC_TableBasedPositionCompensation uses (validated by the builder).
     pub compensation_table: Option<crate::CompensationTable>,
+    /// The drive runs the motion profile (CiA-402 profile modes; the Drive Motion Control
+    /// blocks only, `drive_profile.rs`).
+    pub drive_executed: bool,
 }
 
 /// Velocities below this are "at rest" (units/s); far below any real resolution.
@@ -199,6 +204,8 @@ pub struct Axis {
     group: group::GroupLink,
     /// What the kernel saw of this axis's masters (`offer_masters`).
     offered: [Option<MasterSample>; 4],
+    /// What a drive that runs the profile is sent (`drive_profile.rs`).
+    drive: drive_profile::DriveProfile,
 }
 
 impl Axis {
@@ -213,6 +220,7 @@ impl Axis {
                 modulo: config.modulo,
                 parameters,
                 compensation_table: config.compensation_table,
+                drive_executed: config.drive_executed,
             },
             slot: 0,
             cycle_time,
@@ -220,6 +228,7 @@ impl Axis {
             status: AxisStatus {
                 override_percent: 100.0,
                 gear_ratio: 0.0,
+                drive_executed: config.drive_executed,
                 ..AxisStatus::default()
             },
             planner: Planner::new(cycle_time),
@@ -278,6 +287,7 @@ impl Axis {
             ext: external::ExtGen::default(),
             group: group::GroupLink::default(),
             offered: [None; 4],
+            drive: drive_profile::DriveProfile::default(),
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();
@@ -342,7 +352,7 @@ impl Axis {
                     | JobKind::JogHeld { .. }
                     | JobKind::Torque
                     | JobKind::External => AxisState::ContinuousMotion,
-                    JobKind::Home => AxisState::Homing,
+                    JobKind::Home | JobKind::DriveHome => AxisState::Homing,
                     JobKind::Gear | JobKind::Group => AxisState::SynchronizedMotion,
                 },
             },
@@ -376,6 +386,9 @@ impl Axis {
         }
         if let Some(t) = self.last_target.as_mut() {
             *t += shift;
+        }
+        if self.drive.cmd.mode == crate::drive::ProfileMode::Position {
+            self.drive.cmd.target += shift;
         }
         // A coordinate shift is no travel (backlash direction, FULLLENGTH).
         self.corrections.last_set += shift;

@@ -251,10 +251,10 @@ impl Axis {
         }
         let v = self.set.velocity;
         // A stop of our own is already under way; homing handles limit switches itself.
-        let stoppable = self
-            .job
-            .as_ref()
-            .is_some_and(|j| (j.id != 0 || j.kind != JobKind::Halt) && j.kind != JobKind::Home);
+        let stoppable = self.job.as_ref().is_some_and(|j| {
+            (j.id != 0 || j.kind != JobKind::Halt)
+                && !matches!(j.kind, JobKind::Home | JobKind::DriveHome)
+        });
         if !stoppable {
             return;
         }

@@ -377,6 +377,9 @@ impl Axis {
 
     pub(super) fn start_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, mut job: Job) {
         job.activate(cx);
+        if self.drive_executed() || job.kind == JobKind::DriveHome {
+            self.drive_job_started();
+        }
         if job.kind != JobKind::Halt && job.id != 0 {
             // A motion command clears it; an internal job (a monitoring stop's) does not.
             self.has_been_stopped = false;

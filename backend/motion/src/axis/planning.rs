@@ -15,6 +15,10 @@ impl Axis {
         let Some(j) = self.job.as_mut() else {
             return true;
         };
+        if self.config.drive_executed || j.kind == JobKind::DriveHome {
+            // The drive plans it.
+            return true;
+        }
         j.planned_override = ovr;
         // Taking over an accelerating axis with a weak jerk would let the velocity run on
         // past the axis maximum while the acceleration is ramped down: use at least the jerk
@@ -92,7 +96,11 @@ impl Axis {
                     },
                 )
             }
-            JobKind::Gear | JobKind::Torque | JobKind::External | JobKind::Group => return true,
+            JobKind::Gear
+            | JobKind::Torque
+            | JobKind::External
+            | JobKind::Group
+            | JobKind::DriveHome => return true,
         };
         match res {
             Ok(_) => {

@@ -73,6 +73,7 @@ pub fn analyse_path(
             modulo: false,
             parameters: p,
             compensation_table: None,
+            drive_executed: false,
         };
         let _ = kernel.insert_axis(slot as u16, Axis::new(config, cycle_time));
         let power = CommandKind::Power {

@@ -314,6 +314,7 @@ impl Rig {
                     modulo,
                     parameters,
                     compensation_table: None,
+                    drive_executed: false,
                 })
                 .collect(),
         )

@@ -240,6 +240,7 @@ fn s4_5_12_table_compensation_follows_the_table_along_the_travel() {
         modulo: false,
         parameters: params(),
         compensation_table: Some(t),
+        drive_executed: false,
     };
     let mut r = Rig::with_configs(vec![config(table.clone())]);
     power(&mut r);

@@ -23,6 +23,9 @@ const VERDICT_TIMEOUT: Duration = Duration::from_secs(2);
 /// than `VERDICT_TIMEOUT` by far more than the pump's period, so that a verdict the cycle thread
 /// gives always reaches its waiting requester.
 const REQUEST_TTL: Duration = Duration::from_millis(1500);
+/// What a drive-executed axis needs in its drive's process image: mode, mode display, the
+/// position and velocity targets and the profile's dynamics.
+const PROFILE_OBJECTS: [u16; 7] = [0x6060, 0x6061, 0x607A, 0x60FF, 0x6081, 0x6083, 0x6084];
 
 impl AppState {
     pub(crate) async fn request(&self, ticket: u64, req: Request) -> AppResult<Reply> {
@@ -329,6 +332,23 @@ impl AppState {
                 ),
             );
         }
+        // The profile modes' mode, targets and dynamics travel in the process data (decision
+        // 166): a drive that could not map them runs host-side profiles only.
+        if c.profile == drives::cia402::ProfileSide::Drive {
+            let missing = bus.unmapped(c.subdevice, &PROFILE_OBJECTS);
+            if !missing.is_empty() {
+                let list: Vec<String> = missing.iter().map(|i| format!("0x{i:04X}")).collect();
+                return err(
+                    "drive.profile",
+                    format!(
+                        "the drive at position {} cannot run the profile: its process image lacks {} \
+                         (it refused to map them); use profile host",
+                        c.subdevice,
+                        list.join(", ")
+                    ),
+                );
+            }
+        }
         let taken =
             self.registry
                 .read()
@@ -373,6 +393,10 @@ impl AppState {
                 modulo: config.modulo.is_some(),
                 parameters: p.clone(),
                 compensation_table: config.position_compensation_table.clone(),
+                drive_executed: matches!(
+                    &config.drive,
+                    drives::DriveConfig::Cia402(c) if c.profile == drives::cia402::ProfileSide::Drive
+                ),
             },
             ct,
         );

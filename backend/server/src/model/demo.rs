@@ -75,14 +75,39 @@ pub fn axes() -> Vec<AxisConfigDto> {
 }
 
 /// The demo machine on the emulated EtherCAT segment: each axis's drive is the emulated
-/// CiA-402 servo at its position (1 µm per increment on the linear axes, 0.01° on the spindle).
-pub fn on_emulated_drives(axes: &mut [AxisConfigDto]) {
+/// CiA-402 servo at its position (1 µm per increment on the linear axes, 0.01° on the spindle),
+/// motiond running the profile (CSP); and a fourth axis, `feeder` (0–500 mm), whose drive runs
+/// the profile itself (profile position, profile velocity, homing method 1 on its negative
+/// limit switch and index pulse).
+pub fn on_emulated_drives(axes: &mut Vec<AxisConfigDto>) {
     for (i, a) in axes.iter_mut().enumerate() {
         a.drive = DriveConfig::Cia402(drives::cia402::Cia402Config::csp(
             i as u16,
             if a.modulo.is_some() { 100.0 } else { 1000.0 },
         ));
     }
+    let mut feeder = axes[0].clone();
+    feeder.name = "feeder".into();
+    feeder.soft_limits = Some(SoftLimits {
+        min: 0.0,
+        max: 500.0,
+    });
+    feeder.dynamics = AxisDynamics {
+        max_velocity: 200.0,
+        acceleration: 1000.0,
+        deceleration: 1000.0,
+        jerk: 10_000.0,
+        jog_velocity_slow: 10.0,
+        jog_velocity_fast: 50.0,
+        // Room for a client on a slow link to renew a jog (its own deadman_timeout decides).
+        jog_deadman_max: 5.0,
+    };
+    feeder.drive = DriveConfig::Cia402(drives::cia402::Cia402Config {
+        profile: drives::cia402::ProfileSide::Drive,
+        homing_method: Some(1),
+        ..drives::cia402::Cia402Config::csp(3, 1000.0)
+    });
+    axes.push(feeder);
 }
 
 /// The demo machine's group `xy`: axes `x` (role x) and `y` (role y) in the XY convention,

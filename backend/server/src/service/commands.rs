@@ -169,6 +169,12 @@ async fn submit(
             s.metrics.command(name, Verdict::rejected);
         })?;
     }
+    if let (Target::Axis(_), GroupOrder::Command(kind)) = (target, &order) {
+        if let Err(e) = homing_in_the_drive(s, target_key, kind).await {
+            s.metrics.command(name, Verdict::rejected);
+            return Err(e);
+        }
+    }
     let id = s.next_id();
     if let Err(e) = s.reserve_id(id).await {
         // A stop is never refused (docs/decisions.md 116): its id comes from memory, unique in
@@ -402,13 +408,15 @@ fn group_refusal(
 /// (0x60B8 function, 0x60B9 status, 0x60BA position) for MC_TouchProbe and for homing that
 /// latches the reference in the drive, the digital inputs (0x60FD: the reference cam) for
 /// homing on the cam, the target torque (0x6071) for MC_TorqueControl.
-fn objects_needed(kind: &CommandKind, reference_mode: u32) -> &'static [u16] {
+fn objects_needed(kind: &CommandKind, reference_mode: u32, drive_executed: bool) -> &'static [u16] {
     use motion::{HomingMode, ReferenceMode as R};
     const PROBE: &[u16] = &[0x60B8, 0x60B9, 0x60BA];
     const CAM_AND_PROBE: &[u16] = &[0x60FD, 0x60B8, 0x60B9, 0x60BA];
     match kind {
         CommandKind::TouchProbe(_) => PROBE,
         CommandKind::TorqueControl(_) => &[0x6071],
+        // Homing in the drive uses the drive's own inputs.
+        CommandKind::Home { .. } if drive_executed => &[],
         CommandKind::Home {
             mode: HomingMode::Default,
             ..
@@ -427,7 +435,7 @@ fn objects_needed(kind: &CommandKind, reference_mode: u32) -> &'static [u16] {
 /// in its process image (the drive's dictionary has no such object, or the mapping it took
 /// left it out): never run half-broken (issue 22).
 fn drive_lacks(s: &AppState, axis_key: &str, kind: &CommandKind) -> Option<AppError> {
-    let (subdevice, reference_mode, axis) = {
+    let (subdevice, reference_mode, axis, executed) = {
         let reg = s.registry.read().unwrap();
         let e = reg.find(axis_key)?;
         let drives::DriveConfig::Cia402(c) = &e.config.drive else {
@@ -437,9 +445,10 @@ fn drive_lacks(s: &AppState, axis_key: &str, kind: &CommandKind) -> Option<AppEr
             c.subdevice,
             e.params.axis_encoder_reference_mode,
             e.name.clone(),
+            c.profile == drives::cia402::ProfileSide::Drive,
         )
     };
-    let needed = objects_needed(kind, reference_mode);
+    let needed = objects_needed(kind, reference_mode, executed);
     if needed.is_empty() {
         return None;
     }
@@ -459,6 +468,49 @@ fn drive_lacks(s: &AppState, axis_key: &str, kind: &CommandKind) -> Option<AppEr
              (GET /api/v1/bus shows its mapping and missing objects): this block needs it"
         ),
     ))
+}
+
+/// MC_Home in the drive (an axis whose drive runs the profile, or `drive_based` on any
+/// CiA-402 axis): the configured homing method is written to the drive's 0x6098 by SDO first,
+/// so that the drive homes the way the configuration says even after it was power-cycled. A
+/// drive that is not a CiA-402 one cannot home itself: 409 `drive_based_homing_unavailable`.
+async fn homing_in_the_drive(s: &AppState, axis_key: &str, kind: &CommandKind) -> AppResult<()> {
+    use motion::HomingMode;
+    let CommandKind::Home { mode, .. } = kind else {
+        return Ok(());
+    };
+    let (cia402, name) = {
+        let reg = s.registry.read().unwrap();
+        let Some(e) = reg.find(axis_key) else {
+            return Ok(());
+        };
+        let c = match &e.config.drive {
+            drives::DriveConfig::Cia402(c) => Some((c.subdevice, c.homing_method, c.profile)),
+            _ => None,
+        };
+        (c, e.name.clone())
+    };
+    let executed = cia402.is_some_and(|c| c.2 == drives::cia402::ProfileSide::Drive);
+    let in_drive = *mode == HomingMode::DriveBased || (*mode == HomingMode::Default && executed);
+    if !in_drive {
+        return Ok(());
+    }
+    let Some((subdevice, method, _)) = cia402 else {
+        return Err(AppError::conflict(
+            "drive_based_homing_unavailable",
+            format!(
+                "axis {name}'s drive is simulated: homing in the drive needs a CiA-402 drive \
+                 (its homing mode 6); use mode default"
+            ),
+        ));
+    };
+    let (Some(method), Some((_, sdo))) = (method, &s.info.bus.ethercat) else {
+        // No method configured: the drive homes with the method it has.
+        return Ok(());
+    };
+    sdo.write(subdevice, 0x6098, 0, &[method as u8])
+        .await
+        .map_err(|e| crate::service::sdo::sdo_failed(e, subdevice, 0x6098, 0))
 }
 
 /// What stood in the way of a refused command, and what to do: the axis's state as the latest

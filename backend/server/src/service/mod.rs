@@ -12,6 +12,7 @@ pub mod idempotency;
 pub mod metrics;
 pub mod reads;
 pub mod scope;
+pub mod sdo;
 pub mod simulation;
 
 use crate::model::ClientInfo;

@@ -1,0 +1,458 @@
+//! An axis whose drive runs the profile, cycle by cycle in virtual time: the kernel, the
+//! CiA-402 layer and the emulated drive wired directly (one cycle of bus latency, no segment).
+//! Done only when the drive reports the target reached; the set-point handshake; halt and stop
+//! through the halt bit; MoveVelocity's InVelocity from the drive; homing in the drive; the
+//! blocks Drive Motion Control does not have refused; MC2's drive-based homing on a host-side
+//! axis, then a CSP move without a jump.
+
+use drives::cia402::{Cia402Config, Cia402Drive, ProfileSide, TxPdo};
+use ethercat::emu::drive::{Cia402Emu, Plant};
+use ethercat::emu::sii::Identity;
+use motion::*;
+
+const DT: f64 = 0.001;
+
+struct Machine {
+    k: Kernel,
+    cia: Cia402Drive,
+    emu: Cia402Emu,
+    tx: TxPdo,
+    sp: [DriveSetpoint; 1],
+    fb: DriveFeedback,
+    events: Vec<CommandEvent>,
+    next_id: CommandId,
+    cycle: u64,
+}
+
+impl Machine {
+    /// `soft_max`: the enabled positive software limit.
+    fn new(drive_executed: bool, soft_max: f64) -> Machine {
+        let mut k = Kernel::new(DT, 1);
+        let p = AxisParameters {
+            axis_en_max_soft_pos_limit: true,
+            axis_max_soft_pos_limit: soft_max,
+            ..Default::default()
+        };
+        k.insert_axis(
+            0,
+            Axis::new(
+                AxisConfig {
+                    parameters: p,
+                    drive_executed,
+                    ..AxisConfig::default()
+                },
+                DT,
+            ),
+        )
+        .unwrap();
+        let id = Identity {
+            vendor_id: 1,
+            product_code: 2,
+            revision: 3,
+            serial: 4,
+            name: "drive".into(),
+        };
+        let plant = Plant {
+            limit_negative: Some(-45_000.0),
+            limit_positive: Some(450_000.0),
+            ..Plant::default()
+        };
+        let profile = if drive_executed {
+            ProfileSide::Drive
+        } else {
+            ProfileSide::Host
+        };
+        Machine {
+            k,
+            cia: Cia402Drive::new(Cia402Config {
+                profile,
+                ..Cia402Config::csp(0, 1000.0)
+            }),
+            emu: Cia402Emu::new(&id, plant),
+            tx: TxPdo::default(),
+            sp: [DriveSetpoint::default()],
+            fb: DriveFeedback::default(),
+            events: Vec::new(),
+            next_id: 1,
+            cycle: 0,
+        }
+    }
+
+    fn cmd(&mut self, kind: CommandKind) -> (CommandId, Verdict) {
+        let id = self.next_id;
+        self.next_id += 1;
+        let v = self.k.submit(
+            Command {
+                id,
+                target: Target::Axis(0),
+                kind,
+            },
+            &mut self.events,
+        );
+        (id, v)
+    }
+
+    fn ok(&mut self, kind: CommandKind) -> CommandId {
+        let (id, v) = self.cmd(kind);
+        assert_eq!(v, Verdict::Accepted, "{kind:?}");
+        id
+    }
+
+    fn refused(&mut self, kind: CommandKind) -> ErrorId {
+        match self.cmd(kind).1 {
+            Verdict::Rejected(e) => e,
+            v => panic!("{kind:?} accepted: {v:?}"),
+        }
+    }
+
+    /// One cycle: the drive's last answer → the kernel → the drive.
+    fn step(&mut self) {
+        self.fb = self.cia.feedback(&self.tx);
+        self.k.step(&[self.fb], &mut self.sp, &mut self.events);
+        let rx = self.cia.outputs(&self.sp[0]);
+        self.tx = self.emu.exchange_direct(&rx, DT);
+        self.cycle += 1;
+    }
+
+    fn out(&self, id: CommandId) -> FbOutputs {
+        self.events
+            .iter()
+            .rev()
+            .find(|e| e.command == id)
+            .map(|e| e.outputs)
+            .unwrap_or_default()
+    }
+
+    fn st(&self) -> AxisStatus {
+        self.k.status(0).unwrap()
+    }
+
+    /// Steps until `f` holds; the number of cycles it took.
+    fn until(&mut self, seconds: f64, f: impl Fn(&Machine) -> bool) -> usize {
+        for n in 0..(seconds / DT) as usize {
+            if f(self) {
+                return n;
+            }
+            self.step();
+        }
+        panic!("not reached within {seconds} s: {:?}", self.st());
+    }
+
+    fn power(&mut self) {
+        self.ok(CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
+        });
+        self.until(1.0, |m| m.st().state == AxisState::Standstill);
+    }
+}
+
+fn mv(position: f64, velocity: f64) -> Positioning {
+    Positioning {
+        position,
+        velocity,
+        dynamics: Dynamics {
+            acceleration: 1000.0,
+            deceleration: 1000.0,
+            jerk: 0.0,
+        },
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
+}
+
+#[test]
+fn a_move_is_done_when_the_drive_reports_its_target_reached() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    // The drive is switched to profile position at rest.
+    m.until(0.1, |m| m.fb.profile.mode == ProfileMode::Position);
+    let id = m.ok(CommandKind::MoveAbsolute(mv(50.0, 100.0)));
+    assert_eq!(m.st().state, AxisState::DiscreteMotion);
+    let cycles = m.until(3.0, |m| m.out(id).done);
+    assert!(cycles > 500, "0.55 s of motion at least: {cycles}");
+    let st = m.st();
+    assert!((st.actual_position - 50.0).abs() <= 0.011, "{st:?}");
+    assert_eq!(st.state, AxisState::Standstill);
+    assert!(m.fb.profile.target_reached);
+    assert_eq!(m.emu.od.i32(0x607A, 0), 50_000, "the target in increments");
+    assert_eq!(m.emu.od.u32(0x6081, 0), 100_000, "the profile velocity");
+    assert_eq!(m.emu.od.u32(0x6083, 0), 1_000_000);
+}
+
+#[test]
+fn the_set_point_handshake_and_done_cycle_by_cycle() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    m.until(0.1, |m| m.fb.profile.mode == ProfileMode::Position);
+    let id = m.ok(CommandKind::MoveRelative(mv(20.0, 50.0)));
+    let mut sent = false;
+    let mut acked = false;
+    let mut done_cycle = None;
+    for _ in 0..3000 {
+        m.step();
+        let cw = m.emu.od.u16(0x6040, 0);
+        let bit4 = cw & (1 << 4) != 0;
+        if bit4 {
+            sent = true;
+            assert!(!acked, "bit 4 again after the acknowledge");
+        }
+        if sent && m.fb.profile.acknowledge {
+            acked = true;
+        }
+        let out = m.out(id);
+        assert!(!(out.done && out.busy), "exclusive outputs");
+        if out.done {
+            assert!(acked, "done only after the acknowledge");
+            assert!(m.fb.profile.target_reached, "done with the drive's bit 10");
+            done_cycle = Some(m.cycle);
+            break;
+        }
+        assert!(out.busy && out.active, "{out:?}");
+    }
+    assert!(done_cycle.is_some());
+    assert!((m.st().actual_position - 20.0).abs() <= 0.011);
+}
+
+#[test]
+fn halt_brakes_in_the_drive_and_a_new_move_runs_after_it() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    m.until(0.1, |m| m.fb.profile.mode == ProfileMode::Position);
+    let id = m.ok(CommandKind::MoveAbsolute(mv(200.0, 100.0)));
+    m.until(1.0, |m| m.st().actual_position > 50.0);
+    let halt = m.ok(CommandKind::Halt {
+        deceleration: 500.0,
+        jerk: 0.0,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    });
+    assert!(m.out(id).command_aborted);
+    m.step();
+    assert_ne!(m.emu.od.u16(0x6040, 0) & (1 << 8), 0, "halt bit");
+    let cycles = m.until(1.0, |m| m.out(halt).done);
+    // 100 mm/s at 500 mm/s² (the halt's deceleration, never weaker than the move's 1000:
+    // 1000 is taken) — at most 0.2 s plus the answer.
+    assert!(cycles < 250, "{cycles}");
+    let stood = m.st().actual_position;
+    assert!(stood < 200.0 && stood > 50.0, "{stood}");
+    let id = m.ok(CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    m.until(3.0, |m| m.out(id).done);
+    assert!((m.st().actual_position - 100.0).abs() <= 0.011);
+}
+
+#[test]
+fn move_velocity_is_in_velocity_when_the_drive_says_so_and_stop_locks() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    let id = m.ok(CommandKind::MoveVelocity {
+        velocity: 20.0,
+        dynamics: Dynamics {
+            acceleration: 200.0,
+            deceleration: 200.0,
+            jerk: 0.0,
+        },
+        direction: Direction::Negative,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    });
+    m.until(2.0, |m| m.out(id).in_velocity);
+    assert_eq!(m.fb.profile.mode, ProfileMode::Velocity);
+    assert!((m.st().actual_velocity + 20.0).abs() <= 0.2, "{:?}", m.st());
+    assert_eq!(m.st().state, AxisState::ContinuousMotion);
+    let stop = m.ok(CommandKind::Stop {
+        deceleration: 0.0,
+        jerk: 0.0,
+        options: MoveOptions::default(),
+    });
+    assert!(m.out(id).command_aborted);
+    m.until(1.0, |m| m.out(stop).done);
+    assert_eq!(m.st().state, AxisState::Stopping, "locked until released");
+    assert!(m.st().actual_velocity.abs() < 0.01);
+    let e = m.refused(CommandKind::MoveAbsolute(mv(0.0, 10.0)));
+    assert_eq!(e, ErrorId::AXIS_CANNOT_BE_STARTED);
+    m.ok(CommandKind::Release { target: stop });
+    m.until(0.1, |m| m.st().state == AxisState::Standstill);
+    // A positioning move after velocity: the drive switches back to profile position at rest.
+    let id = m.ok(CommandKind::MoveAbsolute(mv(0.0, 50.0)));
+    m.until(3.0, |m| m.out(id).done);
+    assert!(m.st().actual_position.abs() <= 0.011);
+}
+
+#[test]
+fn velocity_stops_before_an_enabled_soft_limit() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    let id = m.ok(CommandKind::MoveVelocity {
+        velocity: 100.0,
+        dynamics: Dynamics {
+            acceleration: 1000.0,
+            deceleration: 1000.0,
+            jerk: 0.0,
+        },
+        direction: Direction::Positive,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    });
+    m.until(6.0, |m| m.out(id).error);
+    assert_eq!(ErrorId(m.out(id).error_id), ErrorId::SOFT_LIMIT_REACHED);
+    m.until(1.0, |m| m.st().state == AxisState::Standstill);
+    for _ in 0..100 {
+        m.step();
+    }
+    assert!(m.st().actual_position <= 400.0, "{:?}", m.st());
+    assert!(m.st().actual_position > 390.0, "{:?}", m.st());
+}
+
+#[test]
+fn the_blocks_and_inputs_drive_motion_control_lacks_are_refused() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    for kind in [
+        CommandKind::MoveAdditive(mv(1.0, 1.0)),
+        CommandKind::MoveContinuousAbsolute {
+            move_: mv(1.0, 1.0),
+            end_velocity: 1.0,
+        },
+        CommandKind::GearOut,
+        CommandKind::ExtSetPointGenDisable,
+        CommandKind::SetOverride {
+            velocity_factor: 0.5,
+            acceleration_factor: 1.0,
+            jerk_factor: 1.0,
+        },
+        CommandKind::Jog {
+            mode: JogMode::Inching,
+            forward: true,
+            position: 1.0,
+            velocity: 1.0,
+            dynamics: Dynamics::default(),
+            deadman: 0.0,
+        },
+    ] {
+        assert_eq!(
+            m.refused(kind),
+            ErrorId::NOT_ON_DRIVE_EXECUTED_AXIS,
+            "{kind:?}"
+        );
+    }
+    let jerk = Positioning {
+        dynamics: Dynamics {
+            jerk: 1000.0,
+            ..Dynamics::default()
+        },
+        ..mv(1.0, 1.0)
+    };
+    let buffered = Positioning {
+        buffer_mode: BufferMode::Buffered,
+        ..mv(1.0, 1.0)
+    };
+    for kind in [
+        CommandKind::MoveAbsolute(jerk),
+        CommandKind::MoveRelative(buffered),
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 50.0,
+            buffer_mode: BufferMode::Aborting,
+        },
+    ] {
+        assert_eq!(
+            m.refused(kind),
+            ErrorId::INPUT_NOT_ON_DRIVE_EXECUTED_AXIS,
+            "{kind:?}"
+        );
+    }
+    // Nothing moved.
+    for _ in 0..50 {
+        m.step();
+    }
+    assert_eq!(m.st().state, AxisState::Standstill);
+    assert!(m.st().actual_position.abs() < 1e-9);
+}
+
+#[test]
+fn homing_runs_in_the_drive_and_the_axis_reads_the_reference_there() {
+    let mut m = Machine::new(true, 1000.0);
+    m.emu.od.set(0x6098, 0, &[1]);
+    m.power();
+    let id = m.ok(CommandKind::Home {
+        position: Some(-5.0),
+        mode: HomingMode::Default,
+        options: HomingOptions::default(),
+    });
+    assert_eq!(m.st().state, AxisState::Homing);
+    m.until(1.0, |m| m.fb.profile.mode == ProfileMode::Homing);
+    m.until(10.0, |m| m.out(id).done || m.out(id).error);
+    assert!(m.out(id).done, "{:?}", m.out(id));
+    let st = m.st();
+    assert!(st.homed);
+    assert_eq!(st.state, AxisState::Standstill);
+    assert!((st.actual_position + 5.0).abs() < 1e-3, "{st:?}");
+    // On the plant: method 1 found the index pulse at −40 000 increments.
+    assert!((m.emu.plant_position() + 40_000.0).abs() <= 1.0);
+    // A homing error in the drive (method 34 runs into the positive switch at 450 mm on the
+    // plant from 445 mm, 480 mm in the axis's coordinates now) ends the command with it.
+    let id = m.ok(CommandKind::MoveAbsolute(mv(480.0, 100.0)));
+    m.until(10.0, |m| m.out(id).done);
+    m.emu.od.set(0x6098, 0, &[34]);
+    let id = m.ok(CommandKind::Home {
+        position: None,
+        mode: HomingMode::Default,
+        options: HomingOptions::default(),
+    });
+    m.until(10.0, |m| m.out(id).error || m.out(id).done);
+    assert_eq!(ErrorId(m.out(id).error_id), ErrorId::DRIVE_HOMING_ERROR);
+    assert!(!m.st().homed);
+}
+
+#[test]
+fn drive_based_homing_on_a_host_axis_returns_to_csp_without_a_jump() {
+    let mut m = Machine::new(false, 400.0);
+    m.emu.od.set(0x6098, 0, &[34]);
+    m.power();
+    let id = m.ok(CommandKind::MoveAbsolute(mv(3.0, 50.0)));
+    m.until(2.0, |m| m.out(id).done);
+    let id = m.ok(CommandKind::Home {
+        position: Some(100.0),
+        mode: HomingMode::DriveBased,
+        options: HomingOptions::default(),
+    });
+    m.until(1.0, |m| m.fb.profile.mode == ProfileMode::Homing);
+    m.until(10.0, |m| m.out(id).done || m.out(id).error);
+    assert!(m.out(id).done, "{:?}", m.out(id));
+    assert!(
+        (m.emu.plant_position() - 10_000.0).abs() <= 1.0,
+        "index at 10 mm"
+    );
+    assert!((m.st().actual_position - 100.0).abs() < 1e-3);
+    // Back in CSP: the set position is the actual one, no jump while the mode changes.
+    let mut last = m.st().actual_position;
+    for _ in 0..100 {
+        m.step();
+        let p = m.st().actual_position;
+        assert!((p - last).abs() < 1e-3, "{last} → {p}");
+        last = p;
+    }
+    assert_eq!(m.emu.od.i8(0x6061, 0), 8);
+    let id = m.ok(CommandKind::MoveRelative(mv(5.0, 50.0)));
+    let mut last_set = m.st().set_position;
+    for _ in 0..2000 {
+        m.step();
+        let s = m.st().set_position;
+        assert!(
+            (s - last_set).abs() <= 50.0 * DT * 1.01,
+            "set jumped {last_set} → {s}"
+        );
+        last_set = s;
+        if m.out(id).done {
+            break;
+        }
+    }
+    assert!(m.out(id).done);
+    assert!((m.st().actual_position - 105.0).abs() < 0.01);
+}

@@ -1,0 +1,478 @@
+//! Motion the drive executes (TwinCAT Drive Motion Control on the CiA-402 profile modes):
+//! the axis keeps the PLCopen state machine and the FB output protocol, the drive runs the
+//! ramp. A drive-executed axis (`AxisConfig::drive_executed`) takes the DMC blocks only —
+//! Power, Reset, SetPosition, Home, Jog, Halt, MoveAbsolute, MoveRelative, MoveModulo,
+//! MoveVelocity, Stop, TouchProbe, AbortTrigger — with DMC's inputs (no jerk, no buffer mode
+//! but Aborting, no override); every other block is refused, never run host-side. A host-side
+//! axis runs MC_Home with `HomingMode::DriveBased` here too (homing in the drive, then back to
+//! its cyclic mode with the set position taken over).
+//!
+//! Each cycle the running job becomes a [`ProfileCommand`]: profile position for moves,
+//! profile velocity for MoveVelocity and jog, homing for MC_Home; MC_Halt, MC_Stop and an
+//! error stop set the drive's halt bit in the mode it runs in. The drive's mode changes only
+//! at rest (a move of another mode first brakes the running one) and is taken as changed once
+//! the drive reports it (0x6061). Done comes from the drive: a move after the set-point
+//! handshake (acknowledge, then target reached), a velocity when the drive reports it,
+//! homing when attained; the drive's following error and homing error are axis errors.
+
+use super::*;
+use crate::drive::{ProfileCommand, ProfileMode};
+
+/// How long a drive may take to show the profile mode asked for (0x6061) before the axis
+/// stops with DRIVE_MODE_NOT_REACHED (a drive that does not have the mode never shows it).
+const MODE_TIMEOUT: f64 = 1.0;
+
+/// Cycles a drive needs to answer a changed command in its statusword: the setpoint leaves at
+/// the end of cycle k, the drive takes it at its next SYNC0 and its status arrives one or two
+/// exchanges later. Until then the status still answers the command before.
+const ANSWER_CYCLES: u32 = 3;
+
+/// The set-point handshake of a profile-position move (statusword bit 12, controlword bit 4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) enum Handshake {
+    /// Waiting until the drive takes a new set point (bit 12 low).
+    #[default]
+    WaitFree,
+    /// New set point sent (bit 4 high) until the drive acknowledges it.
+    Sent,
+    /// Acknowledged: bit 4 low again; the drive runs the set point.
+    Acked,
+}
+
+/// What is sent to a drive that runs the profile, and the handshake of the running job.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct DriveProfile {
+    pub(super) cmd: ProfileCommand,
+    /// Cycles since the command last changed in what the drive answers (mode, target,
+    /// halt, start).
+    pub(super) since_change: u32,
+    pub(super) handshake: Handshake,
+    /// Homing: the drive reported "in progress" (or an error) since the start, so an
+    /// "attained" read now is this run's.
+    pub(super) homing_seen_running: bool,
+    /// How long the drive has not shown the mode asked for (s).
+    pub(super) mode_wait: f64,
+}
+
+impl DriveProfile {
+    fn set(&mut self, cmd: ProfileCommand) {
+        let changed = cmd.mode != self.cmd.mode
+            || cmd.target != self.cmd.target
+            || cmd.halt != self.cmd.halt
+            || cmd.start != self.cmd.start
+            || cmd.velocity != self.cmd.velocity;
+        self.cmd = cmd;
+        if changed {
+            self.since_change = 0;
+        }
+    }
+}
+
+impl Axis {
+    /// The axis's drive runs the profile.
+    pub(super) fn drive_executed(&self) -> bool {
+        self.config.drive_executed
+    }
+
+    /// The blocks and inputs a drive-executed axis takes (DMC's set, §9 of its manual): a
+    /// block Drive Motion Control does not have is refused with
+    /// [`ErrorId::NOT_ON_DRIVE_EXECUTED_AXIS`], an input it does not have (jerk, a buffer mode
+    /// other than Aborting, an override) with [`ErrorId::INPUT_NOT_ON_DRIVE_EXECUTED_AXIS`].
+    pub(super) fn admit_on_drive(&self, kind: &CommandKind) -> Result<(), ErrorId> {
+        if !self.drive_executed() {
+            return Ok(());
+        }
+        let no_input = Err(ErrorId::INPUT_NOT_ON_DRIVE_EXECUTED_AXIS);
+        let plain = |d: &Dynamics, b: BufferMode| d.jerk == 0.0 && b == BufferMode::Aborting;
+        match kind {
+            CommandKind::Power {
+                override_percent, ..
+            } if *override_percent != 100.0 => no_input,
+            CommandKind::Power { .. }
+            | CommandKind::Reset
+            | CommandKind::SetPosition { .. }
+            | CommandKind::WriteParameter { .. }
+            | CommandKind::TouchProbe(_)
+            | CommandKind::AbortTrigger
+            | CommandKind::Release { .. }
+            | CommandKind::Keepalive { .. } => Ok(()),
+            CommandKind::MoveAbsolute(m)
+            | CommandKind::MoveRelative(m)
+            | CommandKind::MoveModulo { move_: m, .. } => {
+                if plain(&m.dynamics, m.buffer_mode) {
+                    Ok(())
+                } else {
+                    no_input
+                }
+            }
+            CommandKind::MoveVelocity {
+                dynamics,
+                buffer_mode,
+                ..
+            } => {
+                if plain(dynamics, *buffer_mode) {
+                    Ok(())
+                } else {
+                    no_input
+                }
+            }
+            CommandKind::Halt {
+                jerk, buffer_mode, ..
+            } => {
+                if *jerk == 0.0 && *buffer_mode == BufferMode::Aborting {
+                    Ok(())
+                } else {
+                    no_input
+                }
+            }
+            CommandKind::Stop { jerk, .. } => {
+                if *jerk == 0.0 {
+                    Ok(())
+                } else {
+                    no_input
+                }
+            }
+            // DMC's jog runs while the key is held; inching is MC2's.
+            CommandKind::Jog { mode, dynamics, .. } => match mode {
+                JogMode::Inching | JogMode::InchingModulo => {
+                    Err(ErrorId::NOT_ON_DRIVE_EXECUTED_AXIS)
+                }
+                _ if dynamics.jerk != 0.0 => no_input,
+                _ => Ok(()),
+            },
+            CommandKind::Home { mode, .. } => match mode {
+                HomingMode::Default
+                | HomingMode::DriveBased
+                | HomingMode::Direct
+                | HomingMode::ForceCalibration
+                | HomingMode::ResetCalibration => Ok(()),
+            },
+            _ => Err(ErrorId::NOT_ON_DRIVE_EXECUTED_AXIS),
+        }
+    }
+
+    /// MC_Home in the drive: a job that switches the drive to homing, starts its method and
+    /// ends when the drive reports homing attained; the axis then reads `reference` there.
+    pub(super) fn start_drive_home(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        id: CommandId,
+        reference: f64,
+    ) {
+        let p = self.p();
+        let mut j = Job::new(id, JobKind::DriveHome);
+        j.acc = p.axis_acc;
+        j.dec = p.axis_dec;
+        j.velocity = p.axis_calibration_velocity_forward;
+        j.target = reference;
+        self.homed = false;
+        self.start_job(cx, j);
+    }
+
+    /// A job starts on a drive that runs the profile: its handshake starts over.
+    pub(super) fn drive_job_started(&mut self) {
+        self.drive.handshake = Handshake::WaitFree;
+        self.drive.homing_seen_running = false;
+        self.drive.since_change = 0;
+    }
+
+    /// The profile mode a job runs in (`None`: it keeps the drive's, e.g. a halt).
+    fn job_profile_mode(kind: JobKind) -> Option<ProfileMode> {
+        match kind {
+            JobKind::Positioning { .. } => Some(ProfileMode::Position),
+            JobKind::Velocity | JobKind::JogHeld { released: false } => Some(ProfileMode::Velocity),
+            JobKind::DriveHome => Some(ProfileMode::Homing),
+            _ => None,
+        }
+    }
+
+    /// The drive stands (its reported velocity within what it resolves).
+    fn drive_standing(&self) -> bool {
+        self.act_vel.abs() <= self.p().axis_velo_max * 1e-5
+    }
+
+    /// One cycle of a job the drive runs (instead of the planner), and of a drive-executed
+    /// axis without a job. The set values are the drive's actual ones.
+    pub(super) fn step_drive_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, fb: &DriveFeedback) {
+        self.set = Kinematics {
+            position: self.act_pos,
+            velocity: self.act_vel,
+            acceleration: self.act_acc,
+            jerk: 0.0,
+        };
+        self.drive.since_change = self.drive.since_change.saturating_add(1);
+        let pf = fb.profile;
+        if fb.enabled && self.drive.cmd.mode != ProfileMode::Off && pf.mode != self.drive.cmd.mode {
+            self.drive.mode_wait += self.cycle_time;
+            if self.drive.mode_wait > MODE_TIMEOUT && self.mode != Mode::ErrorStop {
+                self.drive.mode_wait = 0.0;
+                self.enter_error(cx, ErrorId::DRIVE_MODE_NOT_REACHED);
+                return;
+            }
+        } else {
+            self.drive.mode_wait = 0.0;
+        }
+        let Some(mut job) = self.job else {
+            // At rest in the mode it is in (profile position by default): nothing started.
+            let mode = match self.drive.cmd.mode {
+                ProfileMode::Off | ProfileMode::Homing => ProfileMode::Position,
+                m => m,
+            };
+            let hold = ProfileCommand {
+                mode,
+                target: if mode == ProfileMode::Position {
+                    self.drive.cmd.target
+                } else {
+                    0.0
+                },
+                ..self.drive.cmd
+            };
+            self.drive.set(ProfileCommand {
+                start: false,
+                halt: mode == ProfileMode::Velocity,
+                ..hold
+            });
+            return;
+        };
+        let dec = job.dec.max(1e-9);
+        let wanted = Self::job_profile_mode(job.kind);
+        let current = self.drive.cmd.mode;
+        if let Some(mode) = wanted.filter(|&m| m != current) {
+            // Modes change at rest only: brake in the mode the drive runs in, then switch.
+            if self.drive_standing() || current == ProfileMode::Off {
+                self.drive.set(ProfileCommand {
+                    mode,
+                    target: self.act_pos,
+                    velocity: job.velocity,
+                    acceleration: job.acc,
+                    deceleration: dec,
+                    start: false,
+                    immediate: true,
+                    halt: true,
+                });
+                self.drive.handshake = Handshake::WaitFree;
+            } else {
+                self.drive.set(ProfileCommand {
+                    halt: true,
+                    deceleration: dec,
+                    start: false,
+                    ..self.drive.cmd
+                });
+            }
+            return;
+        }
+        // The drive runs in the job's mode once it reports it (0x6061).
+        let in_mode = pf.mode == self.drive.cmd.mode;
+        let answered = in_mode && self.drive.since_change >= ANSWER_CYCLES;
+        match job.kind {
+            JobKind::Positioning { .. } => {
+                if pf.error && in_mode {
+                    self.enter_error(cx, ErrorId::FOLLOWING_ERROR);
+                    return;
+                }
+                let hs = self.drive.handshake;
+                let start = match hs {
+                    Handshake::WaitFree => {
+                        if in_mode && !pf.acknowledge && self.drive.since_change >= 1 {
+                            self.drive.handshake = Handshake::Sent;
+                            true
+                        } else {
+                            false
+                        }
+                    }
+                    Handshake::Sent => {
+                        if in_mode && pf.acknowledge {
+                            self.drive.handshake = Handshake::Acked;
+                            false
+                        } else {
+                            true
+                        }
+                    }
+                    Handshake::Acked => false,
+                };
+                self.drive.set(ProfileCommand {
+                    mode: ProfileMode::Position,
+                    target: job.target,
+                    velocity: job.velocity,
+                    acceleration: job.acc,
+                    deceleration: dec,
+                    start,
+                    immediate: true,
+                    halt: false,
+                });
+                if hs == Handshake::Acked && in_mode && pf.target_reached {
+                    self.end_drive_job(cx, job, Ok(()));
+                }
+            }
+            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+                if self.drive_soft_limit(cx, &job) {
+                    return;
+                }
+                let target = job.direction * job.velocity;
+                self.drive.set(ProfileCommand {
+                    mode: ProfileMode::Velocity,
+                    target,
+                    velocity: job.velocity,
+                    acceleration: job.acc,
+                    deceleration: dec,
+                    start: false,
+                    immediate: true,
+                    halt: false,
+                });
+                // The drive's bit 10, and its velocity there (a status from before the new
+                // target could still say reached).
+                let reached = answered
+                    && pf.target_reached
+                    && (self.act_vel - target).abs() <= 0.01 * job.velocity.max(EPS_V);
+                if reached != job.out.in_velocity {
+                    let out = FbOutputs {
+                        in_velocity: reached,
+                        ..job.out
+                    };
+                    job.emit(cx, out);
+                }
+                job.phase = if reached {
+                    Phase::Holding
+                } else {
+                    Phase::Moving
+                };
+                self.job = Some(job);
+            }
+            JobKind::Halt | JobKind::JogHeld { released: true } => {
+                let mode = match current {
+                    ProfileMode::Off => ProfileMode::Position,
+                    m => m,
+                };
+                self.drive.set(ProfileCommand {
+                    mode,
+                    halt: true,
+                    start: false,
+                    deceleration: dec,
+                    ..self.drive.cmd
+                });
+                // A drive that does not run the mode asked for (it never switched) ends the
+                // halt once it stands.
+                let stood = if in_mode {
+                    answered && pf.target_reached
+                } else {
+                    self.drive.since_change >= ANSWER_CYCLES
+                };
+                if stood && self.drive_standing() {
+                    // What the drive stands on is the target now (PP holds there after the
+                    // halt is released).
+                    self.drive.cmd.target = self.act_pos;
+                    self.end_drive_job(cx, job, Ok(()));
+                }
+            }
+            JobKind::DriveHome => {
+                self.drive.set(ProfileCommand {
+                    mode: ProfileMode::Homing,
+                    target: 0.0,
+                    velocity: job.velocity,
+                    acceleration: job.acc,
+                    deceleration: dec,
+                    start: in_mode,
+                    immediate: false,
+                    halt: false,
+                });
+                if !in_mode {
+                    return;
+                }
+                let attained = pf.acknowledge && pf.target_reached && !pf.error;
+                if !attained && self.drive.since_change >= 1 {
+                    self.drive.homing_seen_running = true;
+                }
+                if pf.error && answered {
+                    self.end_drive_job(cx, job, Err(ErrorId::DRIVE_HOMING_ERROR));
+                } else if attained && (self.drive.homing_seen_running || answered) {
+                    // The drive stands on its home position: the axis reads the reference
+                    // there (the drive's home offset 0x607C is left at 0, decision 167).
+                    let shift = job.target - self.act_pos;
+                    self.shift_coordinates(shift);
+                    self.set_position_offset = 0.0;
+                    self.homed = true;
+                    self.set.position = self.act_pos;
+                    self.drive.cmd.target = self.act_pos;
+                    self.end_drive_job(cx, job, Ok(()));
+                }
+            }
+            _ => {
+                // Kinds a drive-executed axis is never given (refused at submit).
+                self.job = Some(job);
+            }
+        }
+    }
+
+    /// Endless motion stops before an enabled software limit: the drive brakes at the job's
+    /// deceleration, started where its braking distance plus what it travels before it
+    /// answers still ends inside. True when it stopped the job.
+    fn drive_soft_limit(&mut self, cx: &mut Ctx<'_, impl EventSink>, job: &Job) -> bool {
+        let p = self.p();
+        let v = self.act_vel;
+        let limit = if job.direction > 0.0 && p.axis_en_max_soft_pos_limit {
+            p.axis_max_soft_pos_limit
+        } else if job.direction < 0.0 && p.axis_en_min_soft_pos_limit {
+            p.axis_min_soft_pos_limit
+        } else {
+            return false;
+        };
+        let reach = v * v / (2.0 * job.dec.max(1e-9))
+            + v.abs() * self.cycle_time * f64::from(ANSWER_CYCLES + 1);
+        if (limit - self.act_pos) * job.direction > reach {
+            return false;
+        }
+        self.stop_internally(cx, ErrorId::SOFT_LIMIT_REACHED, false);
+        true
+    }
+
+    /// A drive job ends: Done (a halt's end also reports MC_Stop's Done) or an error.
+    fn end_drive_job(
+        &mut self,
+        cx: &mut Ctx<'_, impl EventSink>,
+        mut job: Job,
+        result: Result<(), ErrorId>,
+    ) {
+        self.job = None;
+        match result {
+            Ok(()) => {
+                if let Some(e) = job.pending_error {
+                    job.finish_error(cx, e);
+                } else {
+                    job.finish_done(cx);
+                }
+                self.stop_ramp_ended(cx);
+            }
+            Err(e) => job.finish_error(cx, e),
+        }
+        if !self.drive_executed() {
+            // Back to the cyclic mode, from where the drive stands.
+            self.drive.set(ProfileCommand::default());
+            self.set = Kinematics {
+                position: self.act_pos,
+                ..Kinematics::default()
+            };
+            self.sent_position = self.act_pos;
+        }
+    }
+
+    /// What the drive is sent this cycle for the profile it runs, in the drive's coordinates
+    /// (without the axis's offset, through the encoder scaling) as the cyclic setpoint is.
+    pub(super) fn profile_command(&self) -> ProfileCommand {
+        if !(self.drive_executed() || self.job.is_some_and(|j| j.kind == JobKind::DriveHome)) {
+            return ProfileCommand::default();
+        }
+        let c = self.drive.cmd;
+        let k = self.enc_k;
+        ProfileCommand {
+            target: match c.mode {
+                ProfileMode::Position => (c.target - self.offset) / k,
+                ProfileMode::Velocity => c.target / k,
+                _ => 0.0,
+            },
+            velocity: (c.velocity / k).abs(),
+            acceleration: (c.acceleration / k).abs(),
+            deceleration: (c.deceleration / k).abs(),
+            ..c
+        }
+    }
+}
