@@ -724,10 +724,7 @@ fn a_strict_drive_with_late_replies_over_a_veth_pair_reaches_op_and_survives() {
     );
 }
 
-/// The demo's `feeder` on the emulated segment: its drive runs the profile. The status says
-/// so; homing runs in the drive (method 1 on its negative limit switch and index pulse); a
-/// move is done when the drive reports its target reached; a jog runs in profile velocity; a
-/// block Drive Motion Control does not have is refused with 409 and changes nothing.
+/// The demo's `feeder` on the emulated segment: its drive runs the profile.
 #[tokio::test(flavor = "multi_thread")]
 async fn a_drive_executed_axis_homes_moves_and_jogs_in_its_drive() {
     let s = Server::start_with(
@@ -741,74 +738,122 @@ async fn a_drive_executed_axis_homes_moves_and_jogs_in_its_drive() {
             "50",
         ],
     );
-    let st = status(&s, "feeder").await;
-    assert_eq!(st["status"]["drive_executed"], true, "{st}");
     assert_eq!(status(&s, "x").await["status"]["drive_executed"], false);
-    power_on(&s, "feeder").await;
+    drive_executed_axis_works(&s, "feeder", 3).await;
+    s.stop();
+}
+
+/// The same over a veth pair against `motiond emulate-segment` (its fourth drive has the
+/// feeder's limit switches), with the axis created on it by the API.
+#[test]
+fn a_drive_executed_axis_over_a_veth_pair() {
+    in_private_veth("ethercat::a_drive_executed_axis_over_a_veth_pair", || {
+        let emulator = emulate_segment_on_ecb(&["--drives", "4"]);
+        let s = Server::start_with(
+            ":memory:",
+            &[
+                "--bus",
+                "ethercat",
+                "--interface",
+                "ecA",
+                "--bus-max-errors",
+                "50",
+            ],
+        );
+        let rt = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        rt.block_on(async {
+            let mut cfg = get(&s, "/api/v1/axes/x").await.json["config"].clone();
+            cfg["name"] = json!("feeder");
+            cfg["soft_limits"] = json!({"min": 0.0, "max": 500.0});
+            cfg["dynamics"]["jog_deadman_max"] = json!(5.0);
+            cfg["drive"] = json!({"kind": "cia402", "subdevice": 3,
+                    "increments_per_unit": 1000.0, "profile": "drive", "homing_method": 1});
+            let r = post(&s, "/api/v1/axes", cfg).await;
+            assert_eq!(r.status, 201, "{}", r.text);
+            drive_executed_axis_works(&s, "feeder", 3).await;
+        });
+        s.stop();
+        drop(emulator);
+    });
+}
+
+/// An axis whose drive runs the profile (on SubDevice `subdevice`, with limit switches 5 mm
+/// outside 0–500 mm and homing method 1 configured): the status says so; a block Drive
+/// Motion Control does not have, and an input it lacks, are refused with 409; homing runs in
+/// the drive with the configured method; a move is done when the drive reports its target
+/// reached, in profile position; a jog runs in profile velocity and stops when released.
+async fn drive_executed_axis_works(s: &Server, axis: &str, subdevice: u16) {
+    let a = |path: &str| format!("/api/v1/axes/{axis}/{path}");
+    let sdo = |index: &str| format!("/api/v1/bus/subdevices/{subdevice}/sdo/{index}/0");
+    let st = status(s, axis).await;
+    assert_eq!(st["status"]["drive_executed"], true, "{st}");
+    power_on_retrying(s, axis).await;
     let r = post(
-        &s,
-        "/api/v1/axes/feeder/gear-in",
+        s,
+        &a("gear-in"),
         json!({"master": "x", "ratio_numerator": 1.0, "ratio_denominator": 1}),
     )
     .await;
     assert_problem(&r, 409, "not_on_drive_executed_axis");
     let r = post(
-        &s,
-        "/api/v1/axes/feeder/move-absolute",
+        s,
+        &a("move-absolute"),
         json!({"position": 10.0, "velocity": 50.0, "jerk": 100.0}),
     )
     .await;
     assert_problem(&r, 409, "input_not_on_drive_executed_axis");
     let h = post(
-        &s,
-        "/api/v1/axes/feeder/home?wait=true&timeout_ms=20000",
+        s,
+        &a("home?wait=true&timeout_ms=20000"),
         json!({"position": 0.0}),
     )
     .await;
     assert_eq!(h.json["state"], "done", "{}", h.text);
-    let st = status(&s, "feeder").await;
+    let st = status(s, axis).await;
     assert_eq!(st["status"]["homed"], true);
     assert!(
         st["status"]["actual_position"].as_f64().unwrap().abs() < 0.002,
         "{st}"
     );
     // The drive homed with the configured method (written to 0x6098 before the start).
-    let m = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6098/0").await;
+    let m = get(s, &sdo("0x6098")).await;
     assert_eq!(m.json["signed"], 1, "{}", m.text);
     let mv = post(
-        &s,
-        "/api/v1/axes/feeder/move-absolute?wait=true&timeout_ms=20000",
+        s,
+        &a("move-absolute?wait=true&timeout_ms=20000"),
         json!({"position": 120.0, "velocity": 100.0}),
     )
     .await;
     assert_eq!(mv.json["state"], "done", "{}", mv.text);
-    let st = status(&s, "feeder").await;
+    let st = status(s, axis).await;
     assert!(
         (st["status"]["actual_position"].as_f64().unwrap() - 120.0).abs() <= 0.011,
         "done only on the target: {st}"
     );
-    let mode = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6061/0").await;
+    let mode = get(s, &sdo("0x6061")).await;
     assert_eq!(mode.json["signed"], 1, "profile position: {}", mode.text);
     // A jog forward runs in profile velocity; releasing it stops the axis.
     let jog = post(
-        &s,
-        "/api/v1/axes/feeder/jog",
+        s,
+        &a("jog"),
         json!({"direction": "forward", "mode": "standard_fast", "deadman_timeout": 5.0}),
     )
     .await;
     assert_eq!(jog.status, 202, "{}", jog.text);
     let id = jog.json["id"].as_u64().unwrap();
-    until_status(&s, "feeder", "jogging", |st| {
+    until_status(s, axis, "jogging", |st| {
         st["actual_velocity"].as_f64().unwrap() > 40.0
     })
     .await;
-    let mode = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6061/0").await;
+    let mode = get(s, &sdo("0x6061")).await;
     assert_eq!(mode.json["signed"], 3, "profile velocity: {}", mode.text);
-    let r = delete(&s, &format!("/api/v1/commands/{id}")).await;
+    let r = delete(s, &format!("/api/v1/commands/{id}")).await;
     assert!(r.status < 300, "{}", r.text);
-    let fin = until_final(&s, id, 20).await;
+    let fin = until_final(s, id, 20).await;
     assert_eq!(fin["state"], "done", "{fin}");
-    let st = until_status(&s, "feeder", "standing", |st| st["state"] == "standstill").await;
+    let st = until_status(s, axis, "standing", |st| st["state"] == "standstill").await;
     assert!(st["actual_position"].as_f64().unwrap() > 120.0, "{st}");
-    s.stop();
 }
