@@ -1029,11 +1029,12 @@ async fn openapi_json_is_current() {
         "/api/v1/groups/{group}/read-blocker-status",
         "/api/v1/groups/{group}/move-path",
         "/api/v1/groups/{group}/set-coordinate-transform",
+        "/api/v1/commands/{id}/inputs",
     ] {
         assert!(paths.contains_key(p), "{p} not documented");
     }
-    // 93 before the groups: 5 resource paths and 12 blocks.
-    assert_eq!(paths.len(), 114, "{:?}", paths.keys().collect::<Vec<_>>());
+    // 93 before the groups: 5 resource paths and 12 blocks; 1 for ContinuousUpdate.
+    assert_eq!(paths.len(), 115, "{:?}", paths.keys().collect::<Vec<_>>());
     let s = Server::start();
     assert_eq!(get(&s, "/openapi.json").await.json, doc);
 }

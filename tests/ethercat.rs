@@ -856,4 +856,27 @@ async fn drive_executed_axis_works(s: &Server, axis: &str, subdevice: u16) {
     assert_eq!(fin["state"], "done", "{fin}");
     let st = until_status(s, axis, "standing", |st| st["state"] == "standstill").await;
     assert!(st["actual_position"].as_f64().unwrap() > 120.0, "{st}");
+    // MoveVelocity with ContinuousUpdate: new inputs while it runs.
+    let mv = post(
+        s,
+        &a("move-velocity?wait=true&timeout_ms=20000"),
+        json!({"velocity": 10.0, "direction": "negative",
+               "options": {"continuous_update": true}}),
+    )
+    .await;
+    assert_eq!(mv.json["outputs"]["in_velocity"], true, "{}", mv.text);
+    let id = mv.json["id"].as_u64().unwrap();
+    let r = post(
+        s,
+        &format!("/api/v1/commands/{id}/inputs"),
+        json!({"velocity": 30.0}),
+    )
+    .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    until_status(s, axis, "at the new velocity", |st| {
+        (st["actual_velocity"].as_f64().unwrap() + 30.0).abs() < 0.5
+    })
+    .await;
+    let r = post(s, &a("halt?wait=true&timeout_ms=20000"), json!({})).await;
+    assert_eq!(r.json["state"], "done", "{}", r.text);
 }

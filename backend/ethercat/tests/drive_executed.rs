@@ -456,3 +456,133 @@ fn drive_based_homing_on_a_host_axis_returns_to_csp_without_a_jump() {
     assert!(m.out(id).done);
     assert!((m.st().actual_position - 105.0).abs() < 0.01);
 }
+
+#[test]
+fn the_drives_following_error_is_an_axis_error_and_reset_recovers() {
+    let mut m = Machine::new(true, 1000.0);
+    // A lag window of 10 increments (10 µm): the drive's position loop lags more at speed.
+    m.emu.od.set(0x6065, 0, &10u32.to_le_bytes());
+    m.power();
+    let id = m.ok(CommandKind::MoveAbsolute(mv(100.0, 100.0)));
+    m.until(2.0, |m| m.out(id).error);
+    assert_eq!(ErrorId(m.out(id).error_id), ErrorId::FOLLOWING_ERROR);
+    assert_eq!(m.st().state, AxisState::ErrorStop);
+    // The error stop brakes in the drive (halt bit) to a standstill.
+    m.until(1.0, |m| {
+        m.st().actual_velocity.abs() < 1e-3 && m.fb.profile.target_reached
+    });
+    assert_ne!(m.emu.od.u16(0x6040, 0) & (1 << 8), 0, "halt bit");
+    // It stays halted: the drive's set point (100 mm) must not resume.
+    let stood = m.st().actual_position;
+    for _ in 0..300 {
+        m.step();
+        assert!(
+            (m.st().actual_position - stood).abs() < 1e-3,
+            "moved after the stop"
+        );
+    }
+    m.emu.od.set(0x6065, 0, &100_000u32.to_le_bytes());
+    let r = m.ok(CommandKind::Reset);
+    m.until(1.0, |m| m.out(r).done);
+    m.until(0.5, |m| m.st().state == AxisState::Standstill);
+    let id = m.ok(CommandKind::MoveAbsolute(mv(10.0, 50.0)));
+    m.until(3.0, |m| m.out(id).done);
+    assert!((m.st().actual_position - 10.0).abs() <= 0.011);
+}
+
+#[test]
+fn move_modulo_takes_its_start_types_on_a_drive_executed_axis() {
+    let mut m = Machine::new(true, 1000.0);
+    m.power();
+    let id = m.ok(CommandKind::MoveAbsolute(mv(90.0, 200.0)));
+    m.until(3.0, |m| m.out(id).done);
+    // From 90 positive to 0: 360; there negative to 0: no motion; negative to 270: 270;
+    // shortest way to 0: 360; negative to 360 (≥ one period: a full turn back): 0.
+    for (target, direction, end) in [
+        (0.0, Direction::Positive, 360.0),
+        (0.0, Direction::Negative, 360.0),
+        (270.0, Direction::Negative, 270.0),
+        (0.0, Direction::ShortestWay, 360.0),
+        (360.0, Direction::Negative, 0.0),
+    ] {
+        let id = m.ok(CommandKind::MoveModulo {
+            move_: mv(target, 200.0),
+            direction,
+        });
+        m.until(10.0, |m| m.out(id).done || m.out(id).error);
+        assert!(m.out(id).done, "{:?}", m.out(id));
+        assert!(
+            (m.st().actual_position - end).abs() <= 0.011,
+            "{target} {direction:?}: {} ≠ {end}",
+            m.st().actual_position
+        );
+    }
+}
+
+/// DMC's MoveVelocity with ContinuousUpdate: new inputs while it runs, taken at once, on an
+/// axis whose drive runs the profile and on a host-side one alike; without it, or on another
+/// block, an update is refused.
+#[test]
+fn move_velocity_with_continuous_update_takes_new_inputs_while_it_runs() {
+    for drive_executed in [true, false] {
+        let mut m = Machine::new(drive_executed, 1e6);
+        m.power();
+        let velocity = |v: f64, update: bool| CommandKind::MoveVelocity {
+            velocity: v,
+            dynamics: Dynamics {
+                acceleration: 200.0,
+                deceleration: 200.0,
+                jerk: 0.0,
+            },
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions {
+                continuous_update: update,
+                ..MoveOptions::default()
+            },
+        };
+        let id = m.ok(velocity(20.0, true));
+        m.until(2.0, |m| m.out(id).in_velocity);
+        let update = |v: f64| CommandKind::UpdateInputs {
+            target: id,
+            velocity: v,
+            dynamics: Dynamics {
+                acceleration: 400.0,
+                deceleration: 400.0,
+                jerk: 0.0,
+            },
+        };
+        let u = m.ok(update(40.0));
+        assert!(m.out(u).done);
+        m.step();
+        m.until(0.2, |m| !m.out(id).in_velocity);
+        m.until(2.0, |m| m.out(id).in_velocity);
+        assert!(
+            (m.st().actual_velocity - 40.0).abs() <= 0.4,
+            "{drive_executed}: {:?}",
+            m.st().actual_velocity
+        );
+        assert!(
+            m.out(id).busy && m.out(id).active,
+            "the same command runs on"
+        );
+        assert_eq!(m.refused(update(-1.0)), ErrorId::PARAMETER_NOT_CORRECT);
+        // Without ContinuousUpdate the inputs are the ones of the rising edge.
+        let plain = m.ok(velocity(10.0, false));
+        assert!(m.out(id).command_aborted);
+        let e = m.refused(CommandKind::UpdateInputs {
+            target: plain,
+            velocity: 30.0,
+            dynamics: Dynamics::default(),
+        });
+        assert_eq!(e, ErrorId::COMMAND_NOT_PERMITTED);
+        let e = m.refused(CommandKind::MoveAbsolute(Positioning {
+            options: MoveOptions {
+                continuous_update: true,
+                ..MoveOptions::default()
+            },
+            ..mv(0.0, 10.0)
+        }));
+        assert_eq!(e, ErrorId::COMMAND_NOT_PERMITTED);
+    }
+}

@@ -220,6 +220,10 @@ pub struct MoveOptions {
     pub ignore_position_monitoring: bool,
     /// Halt/Stop: wait for the target window at the stop position before Done.
     pub enable_stop_position_monitoring: bool,
+    /// MC_MoveVelocity's ContinuousUpdate (Drive Motion Control): the velocity, acceleration
+    /// and deceleration may be changed while the command runs (`UpdateInputs`; REST
+    /// `POST /commands/{id}/inputs`). MoveVelocity only.
+    pub continuous_update: bool,
 }
 
 /// Dynamics of a motion command; 0 means "the axis default" (#1004–#1006).
@@ -654,6 +658,13 @@ pub enum CommandKind {
     Keepalive {
         target: CommandId,
     },
+    /// New inputs for a running MC_MoveVelocity started with `continuous_update`: taken as
+    /// quickly as possible (0 = the axis default, as at the start).
+    UpdateInputs {
+        target: CommandId,
+        velocity: f64,
+        dynamics: Dynamics,
+    },
 }
 
 impl CommandKind {
@@ -726,6 +737,7 @@ impl CommandKind {
             CommandKind::TrackConveyorBelt(_) => "track-conveyor-belt",
             CommandKind::Release { .. } => "release",
             CommandKind::Keepalive { .. } => "keepalive",
+            CommandKind::UpdateInputs { .. } => "inputs",
         }
     }
 }

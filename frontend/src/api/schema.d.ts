@@ -1428,6 +1428,26 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/v1/commands/{id}/inputs": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /**
+         * New velocity and dynamics for a running move-velocity started with options.continuous_update
+         * @description Taken as quickly as possible (in_velocity drops until the new velocity is reached); the command runs on. 409 `command_not_permitted` for a command without continuous_update or that is no move-velocity, `command_unknown` for one that no longer runs.
+         */
+        post: operations["update_inputs"];
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/v1/commands/{id}/keepalive": {
         parameters: {
             query?: never;
@@ -5737,6 +5757,31 @@ export interface components {
             offset?: number;
         };
         /**
+         * @description New inputs for a running MC_MoveVelocity started with `options.continuous_update`
+         *     (Drive Motion Control's ContinuousUpdate).
+         * @example {
+         *       "acceleration": 500,
+         *       "velocity": 40
+         *     }
+         */
+        InputsBody: {
+            /**
+             * Format: double
+             * @description > 0, at most the axis's maximum velocity.
+             */
+            velocity: number;
+            /**
+             * Format: double
+             * @description 0 = the axis default.
+             */
+            acceleration?: number;
+            /**
+             * Format: double
+             * @description 0 = the axis default.
+             */
+            deceleration?: number;
+        };
+        /**
          * @description `MC_InterpolationType` of a position table (ignored for motion functions).
          * @enum {string}
          */
@@ -6267,6 +6312,7 @@ export interface components {
          * @description `ST_MoveOptions`.
          * @example {
          *       "blending_position": null,
+         *       "continuous_update": false,
          *       "enable_stop_position_monitoring": false,
          *       "ignore_position_monitoring": false
          *     }
@@ -6288,6 +6334,13 @@ export interface components {
              * @default false
              */
             enable_stop_position_monitoring?: boolean;
+            /**
+             * @description MC_MoveVelocity's ContinuousUpdate (Drive Motion Control): the velocity, acceleration
+             *     and deceleration may be changed while the command runs (`UpdateInputs`; REST
+             *     `POST /commands/{id}/inputs`). MoveVelocity only.
+             * @default false
+             */
+            continuous_update?: boolean;
         };
         /**
          * @description MC_MovePath with its table.
@@ -14647,6 +14700,43 @@ export interface operations {
         };
         responses: {
             /** @description Released; the command as it stands */
+            200: {
+                headers: {
+                    [name: string]: unknown;
+                };
+                content: {
+                    "application/json": components["schemas"]["CommandResource"];
+                };
+            };
+            400: components["responses"]["MalformedJson"];
+            401: components["responses"]["Unauthenticated"];
+            403: components["responses"]["Forbidden"];
+            404: components["responses"]["CommandNotFound"];
+            409: components["responses"]["CommandUnknown"];
+            413: components["responses"]["PayloadTooLarge"];
+            415: components["responses"]["UnsupportedMediaType"];
+            421: components["responses"]["MisdirectedRequest"];
+            422: components["responses"]["EmptyBodyInvalid"];
+            503: components["responses"]["CycleUnavailable"];
+        };
+    };
+    update_inputs: {
+        parameters: {
+            query?: never;
+            header?: never;
+            path: {
+                /** @description command id */
+                id: number;
+            };
+            cookie?: never;
+        };
+        requestBody: {
+            content: {
+                "application/json": components["schemas"]["InputsBody"];
+            };
+        };
+        responses: {
+            /** @description Taken; the command as it stands */
             200: {
                 headers: {
                     [name: string]: unknown;

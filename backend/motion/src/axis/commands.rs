@@ -272,6 +272,15 @@ impl Axis {
                 Ok(())
             }
             CommandKind::Release { target } => self.release(cx, target),
+            CommandKind::UpdateInputs {
+                target,
+                velocity,
+                dynamics,
+            } => {
+                self.update_inputs(target, velocity, dynamics)?;
+                cx.report(cmd.id, DONE);
+                Ok(())
+            }
             CommandKind::Keepalive { target } => {
                 for j in [self.job.as_mut(), self.next.as_mut()]
                     .into_iter()

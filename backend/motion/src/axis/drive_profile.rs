@@ -95,7 +95,8 @@ impl Axis {
             | CommandKind::TouchProbe(_)
             | CommandKind::AbortTrigger
             | CommandKind::Release { .. }
-            | CommandKind::Keepalive { .. } => Ok(()),
+            | CommandKind::Keepalive { .. }
+            | CommandKind::UpdateInputs { .. } => Ok(()),
             CommandKind::MoveAbsolute(m)
             | CommandKind::MoveRelative(m)
             | CommandKind::MoveModulo { move_: m, .. } => {
@@ -227,9 +228,11 @@ impl Axis {
                 },
                 ..self.drive.cmd
             };
+            // A halt stays set until the next job: releasing it would resume the set point
+            // the drive was halted on (CiA-402 profile position resumes after a halt).
             self.drive.set(ProfileCommand {
                 start: false,
-                halt: mode == ProfileMode::Velocity,
+                halt: mode == ProfileMode::Velocity || self.drive.cmd.halt,
                 ..hold
             });
             return;
@@ -290,6 +293,9 @@ impl Axis {
                     }
                     Handshake::Acked => false,
                 };
+                // Halted before (a stop, an error stop, a mode switch): the halt is released
+                // with the new set point, not before (the drive would resume the old one).
+                let halt = hs == Handshake::WaitFree && !start && self.drive.cmd.halt;
                 self.drive.set(ProfileCommand {
                     mode: ProfileMode::Position,
                     target: job.target,
@@ -298,7 +304,7 @@ impl Axis {
                     deceleration: dec,
                     start,
                     immediate: true,
-                    halt: false,
+                    halt,
                 });
                 if hs == Handshake::Acked && in_mode && pf.target_reached {
                     self.end_drive_job(cx, job, Ok(()));

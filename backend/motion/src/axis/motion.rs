@@ -101,6 +101,20 @@ impl Axis {
             self.admit_to_external()?;
         }
         let mut job;
+        let continuous_update = match cmd.kind {
+            CommandKind::MoveAbsolute(m)
+            | CommandKind::MoveRelative(m)
+            | CommandKind::MoveAdditive(m)
+            | CommandKind::MoveModulo { move_: m, .. }
+            | CommandKind::MoveContinuousAbsolute { move_: m, .. }
+            | CommandKind::MoveContinuousRelative { move_: m, .. } => m.options.continuous_update,
+            CommandKind::Halt { options, .. } => options.continuous_update,
+            _ => false,
+        };
+        if continuous_update {
+            // ContinuousUpdate is MoveVelocity's input only.
+            return Err(ErrorId::COMMAND_NOT_PERMITTED);
+        }
         match cmd.kind {
             CommandKind::MoveAbsolute(m)
             | CommandKind::MoveRelative(m)
@@ -323,6 +337,38 @@ impl Axis {
             _ => return Err(ErrorId::COMMAND_NOT_PERMITTED),
         }
         self.enqueue(cx, job)
+    }
+
+    /// ContinuousUpdate: a running MoveVelocity started with it takes new inputs (checked as
+    /// at its start) as quickly as possible — re-planned here, sent to the drive there.
+    pub(super) fn update_inputs(
+        &mut self,
+        target: CommandId,
+        velocity: f64,
+        dynamics: Dynamics,
+    ) -> Result<(), ErrorId> {
+        let job = self
+            .job
+            .filter(|j| j.id == target && target != 0)
+            .ok_or(ErrorId::COMMAND_UNKNOWN)?;
+        if job.kind != JobKind::Velocity || !job.options.continuous_update {
+            return Err(ErrorId::COMMAND_NOT_PERMITTED);
+        }
+        let v = self.check_velocity(velocity)?;
+        let (acc, dec, jerk) = self.dynamics(dynamics)?;
+        if self.drive_executed() && dynamics.jerk != 0.0 {
+            return Err(ErrorId::INPUT_NOT_ON_DRIVE_EXECUTED_AXIS);
+        }
+        let j = self.job.as_mut().expect("checked");
+        j.velocity = v;
+        j.acc = acc;
+        j.dec = dec;
+        j.jerk = jerk;
+        j.phase = Phase::Moving;
+        self.last_dec = dec;
+        self.last_jerk = jerk;
+        self.plan_job_now();
+        Ok(())
     }
 
     /// MC_Jog INCHING_MODULO: the next multiple of `step` after `s` in the direction of

@@ -1,5 +1,5 @@
 //! The command resources: a command's life, the recent ones, the release (falling edge of
-//! Execute/Enable) and a jog's keepalive. The blocks' own endpoints are the catalogue's
+//! Execute/Enable), a jog's keepalive and MoveVelocity's ContinuousUpdate inputs. The blocks' own endpoints are the catalogue's
 //! (`super::blocks`).
 
 use std::sync::Arc;
@@ -8,7 +8,7 @@ use axum::Json;
 use axum::extract::{Path, State};
 use axum::http::StatusCode;
 use serde::Deserialize;
-use utoipa::IntoParams;
+use utoipa::{IntoParams, ToSchema};
 
 use super::errors::{CommandControlErrors, CommandListErrors, CommandReadErrors};
 use super::{Client, Q};
@@ -83,6 +83,70 @@ pub async fn release_command(
     commands::release(&s, id, &client.0).await?;
     // The release's immediate effects (a jog dropping in_velocity, a gear-in-dyn ending) are
     // events of its submit: the pump applies them before it answers, so they show here.
+    Ok(Json(commands::find(&s, id)?))
+}
+
+/// New inputs for a running MC_MoveVelocity started with `options.continuous_update`
+/// (Drive Motion Control's ContinuousUpdate).
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({"velocity": 40.0, "acceleration": 500.0}))]
+pub struct InputsBody {
+    /// > 0, at most the axis's maximum velocity.
+    #[schema(exclusive_minimum = 0, maximum = 1e12)]
+    pub velocity: f64,
+    /// 0 = the axis default.
+    #[serde(default)]
+    #[schema(minimum = 0, maximum = 1e12)]
+    pub acceleration: f64,
+    /// 0 = the axis default.
+    #[serde(default)]
+    #[schema(minimum = 0, maximum = 1e12)]
+    pub deceleration: f64,
+}
+
+#[utoipa::path(post, path = "/api/v1/commands/{id}/inputs", tag = "commands",
+    summary = "New velocity and dynamics for a running move-velocity started with options.continuous_update",
+    description = "Taken as quickly as possible (in_velocity drops until the new velocity is reached); the \
+        command runs on. 409 `command_not_permitted` for a command without continuous_update or that is no \
+        move-velocity, `command_unknown` for one that no longer runs.",
+    params(("id" = u64, Path, description = "command id")),
+    request_body = InputsBody,
+    responses((status = 200, description = "Taken; the command as it stands", body = CommandResource), CommandControlErrors))]
+pub async fn update_inputs(
+    State(s): State<Arc<AppState>>,
+    Path(id): Path<String>,
+    client: Client,
+    super::JsonBody(body, _): super::JsonBody<InputsBody>,
+) -> AppResult<Json<CommandResource>> {
+    let id = parse_id(&id)?;
+    let mut errors = Vec::new();
+    if !(body.velocity.is_finite() && body.velocity > 0.0) {
+        errors.push(crate::error::FieldError {
+            field: "velocity".into(),
+            message: "must be a finite number > 0".into(),
+        });
+    }
+    for (field, v) in [
+        ("acceleration", body.acceleration),
+        ("deceleration", body.deceleration),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            errors.push(crate::error::FieldError {
+                field: field.into(),
+                message: "must be a finite number >= 0 (0: the axis default)".into(),
+            });
+        }
+    }
+    if !errors.is_empty() {
+        return Err(AppError::Invalid(errors));
+    }
+    let dynamics = motion::Dynamics {
+        acceleration: body.acceleration,
+        deceleration: body.deceleration,
+        jerk: 0.0,
+    };
+    commands::update_inputs(&s, id, body.velocity, dynamics, &client.0).await?;
     Ok(Json(commands::find(&s, id)?))
 }
 

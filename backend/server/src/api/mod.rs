@@ -274,6 +274,7 @@ pub fn router(state: Arc<AppState>, guard: Arc<guard::Guard>, ws: ws::Settings) 
             get(commands::get_command).delete(commands::release_command),
         )
         .route("/commands/{id}/keepalive", post(commands::keepalive))
+        .route("/commands/{id}/inputs", post(commands::update_inputs))
         .route(
             "/scope/recordings",
             get(scope::list_recordings).post(scope::create_recording),
@@ -578,7 +579,7 @@ motion from other clients is refused with 409 `control_held`; a stop, a halt and
     paths(
         axes::list_axes, axes::create_axis, axes::get_axis, axes::replace_axis, axes::delete_axis,
         axes::axis_status, axes::reset_following_error_peak, axes::list_parameters, axes::get_parameter, axes::write_parameter,
-        commands::list_commands, commands::get_command, commands::release_command, commands::keepalive,
+        commands::list_commands, commands::get_command, commands::release_command, commands::keepalive, commands::update_inputs,
         simulation::inject_fault,
         scope::create_recording, scope::list_recordings, scope::get_recording, scope::delete_recording,
         scope::list_setups, scope::get_setup, scope::put_setup, scope::delete_setup,

@@ -27,7 +27,7 @@ pub fn required(method: &Method, path: &str) -> Option<Role> {
         "/control" => Operator,
         // Running the virtual clock moves what was commanded, as a command would.
         "/clock/advance" => Operator,
-        "/commands/{id}" | "/commands/{id}/keepalive" => Operator,
+        "/commands/{id}" | "/commands/{id}/keepalive" | "/commands/{id}/inputs" => Operator,
         "/axes/{axis}/status/following-error-peak/reset" => Operator,
         // The external setpoint generator's samples, fed like a jog's keepalives.
         "/axes/{axis}/ext-setpoint-gen-feed" => Operator,

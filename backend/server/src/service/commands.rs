@@ -848,6 +848,45 @@ pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppRes
     result
 }
 
+/// New inputs for a running MoveVelocity with ContinuousUpdate: admitted like motion (the
+/// control lease), audited; the cycle they took effect in.
+pub async fn update_inputs(
+    s: &AppState,
+    id: CommandId,
+    velocity: f64,
+    dynamics: motion::Dynamics,
+    client: &ClientInfo,
+) -> AppResult<u64> {
+    let target = target_of(s, id)?;
+    let kind = CommandKind::UpdateInputs {
+        target: id,
+        velocity,
+        dynamics,
+    };
+    s.control.admit(client, &kind)?;
+    let result = s.kernel_command(target, kind).await;
+    let outcome = match &result {
+        Ok(_) => "accepted".to_owned(),
+        Err(AppError::Rejected(e)) => format!("rejected:{}", e.code()),
+        Err(_) => return result,
+    };
+    s.audit(AuditEntry {
+        at: store::now_rfc3339(),
+        client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
+        client_id: client.id.clone(),
+        principal: client.principal.clone(),
+        action: "command.inputs".into(),
+        target: Some(id.to_string()),
+        command_id: Some(id),
+        detail: serde_json::json!({"via": client.via, "velocity": velocity,
+            "acceleration": dynamics.acceleration, "deceleration": dynamics.deceleration})
+        .to_string(),
+        outcome: Some(outcome),
+        idempotency_key: None,
+    });
+    result
+}
+
 /// Renews a jog's dead-man; the cycle it took effect in.
 pub async fn keepalive(s: &AppState, id: CommandId) -> AppResult<u64> {
     let target = target_of(s, id)?;
