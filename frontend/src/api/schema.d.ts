@@ -14749,12 +14749,12 @@ export interface operations {
             401: components["responses"]["Unauthenticated"];
             403: components["responses"]["Forbidden"];
             404: components["responses"]["CommandNotFound"];
-            409: components["responses"]["CommandUnknown"];
+            409: components["responses"]["CommandRejected"];
             413: components["responses"]["PayloadTooLarge"];
             415: components["responses"]["UnsupportedMediaType"];
             421: components["responses"]["MisdirectedRequest"];
-            422: components["responses"]["EmptyBodyInvalid"];
-            503: components["responses"]["CycleUnavailable"];
+            422: components["responses"]["CommandInvalid"];
+            503: components["responses"]["CommandUnavailable"];
         };
     };
     keepalive: {

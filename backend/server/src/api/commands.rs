@@ -10,7 +10,9 @@ use axum::http::StatusCode;
 use serde::Deserialize;
 use utoipa::{IntoParams, ToSchema};
 
-use super::errors::{CommandControlErrors, CommandListErrors, CommandReadErrors};
+use super::errors::{
+    CommandControlErrors, CommandInputsErrors, CommandListErrors, CommandReadErrors,
+};
 use super::{Client, Q};
 use crate::app::AppState;
 use crate::error::{AppError, AppResult};
@@ -112,7 +114,7 @@ pub struct InputsBody {
         move-velocity, `command_unknown` for one that no longer runs.",
     params(("id" = u64, Path, description = "command id")),
     request_body = InputsBody,
-    responses((status = 200, description = "Taken; the command as it stands", body = CommandResource), CommandControlErrors))]
+    responses((status = 200, description = "Taken; the command as it stands", body = CommandResource), CommandInputsErrors))]
 pub async fn update_inputs(
     State(s): State<Arc<AppState>>,
     Path(id): Path<String>,

@@ -626,6 +626,11 @@ error_sets! {
         400: MalformedJson, 404: CommandNotFound, 409: CommandUnknown, 413: PayloadTooLarge,
         422: EmptyBodyInvalid, 503: CycleUnavailable,
     }
+    /// `POST /commands/{id}/inputs`.
+    CommandInputsErrors {
+        400: MalformedJson, 404: CommandNotFound, 409: CommandRejected, 413: PayloadTooLarge,
+        422: CommandInvalid, 503: CommandUnavailable,
+    }
     /// `GET /axes/{axis}`, its status and its parameter list.
     ReadErrors { 404: AxisNotFound }
     /// `POST /axes/{axis}/status/following-error-peak/reset`.
