@@ -740,6 +740,95 @@ async fn a_drive_executed_axis_homes_moves_and_jogs_in_its_drive() {
     );
     assert_eq!(status(&s, "x").await["status"]["drive_executed"], false);
     drive_executed_axis_works(&s, "feeder", 3).await;
+    // MC_Stop in the drive: the halt bit, locked until released.
+    let stop = post(
+        &s,
+        "/api/v1/axes/feeder/stop?wait=true&timeout_ms=20000",
+        json!({}),
+    )
+    .await;
+    assert_eq!(stop.json["outputs"]["done"], true, "{}", stop.text);
+    let cw = get(&s, "/api/v1/bus/subdevices/3/sdo/0x6040/0").await;
+    assert_ne!(
+        cw.json["unsigned"].as_u64().unwrap() & (1 << 8),
+        0,
+        "{}",
+        cw.text
+    );
+    let r = post(
+        &s,
+        "/api/v1/axes/feeder/move-absolute",
+        json!({"position": 10.0, "velocity": 50.0}),
+    )
+    .await;
+    assert_problem(&r, 409, "axis_cannot_be_started");
+    let id = stop.json["id"].as_u64().unwrap();
+    let r = delete(&s, &format!("/api/v1/commands/{id}")).await;
+    assert!(r.status < 300, "{}", r.text);
+    until_status(&s, "feeder", "unlocked", |st| st["state"] == "standstill").await;
+
+    // MC2's drive-based homing on a host-side (CSP) axis: homing mode in the drive (its
+    // default method, 37: here), then CSP again from where it stands, without a jump.
+    for (p, v) in [
+        ("AxisMaxPosLagValue", 100.0),
+        ("AxisMaxPosLagFilterTime", 2.0),
+    ] {
+        let r = put(
+            &s,
+            &format!("/api/v1/axes/x/parameters/{p}"),
+            json!({"value": v}),
+        )
+        .await;
+        assert_eq!(r.status, 200, "{}", r.text);
+    }
+    power_on(&s, "x").await;
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-absolute?wait=true&timeout_ms=20000",
+        json!({"position": 30.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let h = post(
+        &s,
+        "/api/v1/axes/x/home?wait=true&timeout_ms=20000",
+        json!({"mode": "drive_based", "position": 100.0}),
+    )
+    .await;
+    assert_eq!(h.json["state"], "done", "{}", h.text);
+    let st = until_status(&s, "x", "back in CSP", |st| st["state"] == "standstill").await;
+    assert_eq!(st["homed"], true);
+    assert!(
+        (st["actual_position"].as_f64().unwrap() - 100.0).abs() < 0.002,
+        "{st}"
+    );
+    assert!(
+        (st["set_position"].as_f64().unwrap() - 100.0).abs() < 0.002,
+        "{st}"
+    );
+    let mode = get(&s, "/api/v1/bus/subdevices/0/sdo/0x6061/0").await;
+    assert_eq!(mode.json["signed"], 8, "CSP again: {}", mode.text);
+    let m = post(
+        &s,
+        "/api/v1/axes/x/move-relative?wait=true&timeout_ms=20000",
+        json!({"distance": 5.0, "velocity": 100.0}),
+    )
+    .await;
+    assert_eq!(m.json["state"], "done", "{}", m.text);
+    let st = until_status(&s, "x", "at 105", |st| {
+        (st["actual_position"].as_f64().unwrap() - 105.0).abs() < 0.002
+    })
+    .await;
+    assert!(
+        st["following_error_max"].as_f64().unwrap() < 1.0,
+        "no jump: {st}"
+    );
+    // A simulated drive cannot home itself.
+    let s2 = Server::start();
+    power_on(&s2, "y").await;
+    let r = post(&s2, "/api/v1/axes/y/home", json!({"mode": "drive_based"})).await;
+    assert_problem(&r, 409, "drive_based_homing_unavailable");
+    s2.stop();
     s.stop();
 }
 
