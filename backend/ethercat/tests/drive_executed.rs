@@ -586,3 +586,28 @@ fn move_velocity_with_continuous_update_takes_new_inputs_while_it_runs() {
         assert_eq!(e, ErrorId::COMMAND_NOT_PERMITTED);
     }
 }
+
+/// MC_TouchProbe on an axis whose drive runs the profile: the drive's latch (0x60B8 on the
+/// index pulse) records where a profile-position move passes the pulse.
+#[test]
+fn touch_probe_latches_in_the_drive_during_a_profile_move() {
+    let mut m = Machine::new(true, 1000.0);
+    m.power();
+    let probe = m.ok(CommandKind::TouchProbe(TouchProbe {
+        source: LatchSource::IndexPulse,
+        window_only: false,
+        first_position: 0.0,
+        last_position: 0.0,
+        modulo_positions: false,
+    }));
+    let id = m.ok(CommandKind::MoveAbsolute(mv(15.0, 50.0)));
+    m.until(3.0, |m| m.out(probe).done || m.out(probe).error);
+    assert!(m.out(probe).done, "{:?}", m.out(probe));
+    // The index pulse every 10 mm: the first one passed is at 10 mm.
+    assert!(
+        (m.st().probe.recorded_position - 10.0).abs() < 1e-3,
+        "{:?}",
+        m.st().probe
+    );
+    m.until(3.0, |m| m.out(id).done);
+}
