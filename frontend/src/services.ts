@@ -2,7 +2,7 @@
 import { LiveClient } from './live/client';
 import { JogController } from './live/jog';
 import { Store } from './store';
-import { ApiError, NotSentError } from './api/problem';
+import { ApiError, NotOfferedError, NotSentError } from './api/problem';
 import { api } from './api/client';
 import { postBlock, type BlockBody, type BlockName, type BlockOptions } from './api/blocks';
 import { errorInfo } from './api/errors';
@@ -12,6 +12,7 @@ import { ScopeSession } from './scope/session';
 import { cancelRecording, createRecording, getRecording, listRecordings } from './scope/api';
 import { TrendBuffer } from './live/trend';
 import { releaseWhenDone } from './axis/stop';
+import { driveRefusal, isDriveExecuted } from './axis/drive-executed';
 import { LiveTrace } from './scope/live';
 import { clientId } from './auth/client-id';
 import { postGroupBlock, type GroupBlockBody, type GroupBlockName } from './groups/api';
@@ -228,8 +229,8 @@ export function logCommand(r: CommandResource): void {
 
 /** A command the server refused (no command resource exists for it). */
 export function logRejected(axis: string, command: string, parameters: unknown, e: unknown): void {
-  // Never sent (a number field's text is not a number): nothing the server refused.
-  if (e instanceof NotSentError) return;
+  // Never sent (a number field's text is not a number, a block the axis does not offer): nothing the server refused.
+  if (e instanceof NotSentError || e instanceof NotOfferedError) return;
   const p = e instanceof ApiError || e instanceof RpcError ? e.problem : null;
   const errorId = p?.error_id ?? 0;
   const text = p ? `${p.title}: ${p.detail}` : (e as Error).message;
@@ -286,6 +287,10 @@ export async function refreshCommands(): Promise<void> {
  * logging the outcome; rethrows the error for the form. `options.query`: `wait`, `timeout_ms`.
  */
 export async function command<N extends BlockName>(axis: string, name: N, body: BlockBody<N>, options?: BlockOptions<N>): Promise<CommandResource> {
+  // An axis whose drive runs the profile: a block or input it does not take is never sent
+  // (the pages do not offer them; this holds for every way of sending).
+  const refusal = driveExecutedAxis(axis) ? driveRefusal(name, body) : null;
+  if (refusal) throw new NotOfferedError(refusal.code, refusal.detail, refusal.fields);
   try {
     const r = await postBlock(axis, name, body, options);
     logCommand(r);
@@ -294,6 +299,12 @@ export async function command<N extends BlockName>(axis: string, name: N, body: 
     logRejected(axis, name, body, e);
     throw e;
   }
+}
+
+/** Whether the drive runs axis `axis`'s profile, as its live status (else its configuration) says. */
+export function driveExecutedAxis(axis: string): boolean {
+  const a = axes.get().find((x) => x.config.name === axis);
+  return isDriveExecuted(a?.config, statuses.get().get(axis)?.status);
 }
 
 /** Releases a command (DELETE /commands/{id}): unlocks a stop, ends a power or jog. */

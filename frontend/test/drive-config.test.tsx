@@ -34,10 +34,10 @@ const xConfig: AxisConfig = {
   unit: 'mm',
   dynamics,
   parameters: { AxisTargetPositionWindow: 0.01 } as unknown as AxisConfig['parameters'],
-  drive: { kind: 'cia402', subdevice: 0, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 },
+  drive: { kind: 'cia402', subdevice: 0, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'host', homing_method: null },
 };
 /** The CiA-402 fields a CSP drive is sent with besides subdevice and scaling (the server's defaults). */
-const gains = { position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 };
+const gains = { position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'host', homing_method: null };
 const x = { id: 1, slot: 0, state: 'disabled', config: xConfig } as AxisResource;
 const invalid = (field: string, message: string) => problem(422, 'validation_failed', 'Invalid request', `${field}: ${message}`, [{ field, message }]);
 
@@ -137,6 +137,8 @@ describe('the drive kind', () => {
       velocity_gain: 2.5,
       acceleration_feed_forward: 0.1,
       max_torque: 1500,
+      profile: 'host',
+      homing_method: null,
     });
   });
 
@@ -175,6 +177,50 @@ describe('the drive kind', () => {
     expect(dry.url).toBe('/api/v1/axes/x?dry_run=true');
     expect(dry.body).toEqual(xConfig);
     expect(q('[data-testid="save-panel"]')).not.toBeNull();
+  });
+
+  it('the profile side (host or drive) and the homing method (the named common ones, the others by number, blank = the drive\'s own): shown as configured, sent in `drive`', async () => {
+    const feeder = { ...x, id: 4, config: { ...xConfig, name: 'feeder', drive: { ...xConfig.drive, subdevice: 2, profile: 'drive', homing_method: 1 } } } as AxisResource;
+    await act(async () => render(<AxisConfigPage axis={feeder} />, root));
+    await settle();
+    expect(q<HTMLSelectElement>('select[name="drive.profile"]')!.value).toBe('drive');
+    expect(options('select[name="drive.profile"]').map((o) => o[0])).toEqual(['host', 'drive']);
+    expect(text('[data-field="drive.profile"] .field-hint')).toMatch(/^the drive runs profile position, velocity and homing/);
+    expect(q<HTMLSelectElement>('select[name="drive.homing_method"]')!.value).toBe('1');
+    const methods = options('select[name="drive.homing_method"]');
+    expect(methods.slice(0, 9).map((o) => o[1])).toEqual([
+      'the drive’s own (not written)',
+      '1 · negative limit switch + index pulse',
+      '2 · positive limit switch + index pulse',
+      '17 · negative limit switch',
+      '18 · positive limit switch',
+      '33 · index pulse, negative',
+      '34 · index pulse, positive',
+      '35 · current position',
+      '37 · current position',
+    ]);
+    // every CiA-402 method 1..37 can be chosen, each once
+    expect(methods.slice(1).map((o) => Number(o[0])).sort((a, b) => a - b)).toEqual(Array.from({ length: 37 }, (_, i) => i + 1));
+    choose('select[name="drive.profile"]', 'host');
+    expect(text('[data-field="drive.profile"] .field-hint')).toMatch(/^motiond plans the motion/);
+    choose('select[name="drive.homing_method"]', '34');
+    await save();
+    expect((calls.find((c) => c.method === 'PUT')!.body as AxisConfig).drive).toEqual({ ...xConfig.drive, subdevice: 2, profile: 'host', homing_method: 34 });
+    choose('select[name="drive.homing_method"]', '');
+    choose('select[name="drive.profile"]', 'drive');
+    await act(async () => q<HTMLButtonElement>('[data-testid="save-panel"] button[name="cancel-save"]')!.click());
+    calls.length = 0;
+    await save();
+    expect((calls.find((c) => c.method === 'PUT')!.body as AxisConfig).drive).toMatchObject({ profile: 'drive', homing_method: null });
+  });
+
+  it("the server's 422 at drive.profile (a drive that cannot run the profile) is shown at the profile select", async () => {
+    answer = [422, invalid('drive.profile', 'the drive at position 2 cannot run the profile: its process image lacks 0x607A; use profile host')];
+    await newCiaAxis();
+    choose('select[name="drive.profile"]', 'drive');
+    await save();
+    expect(text('[data-field="drive.profile"] .field-error')).toBe('the drive at position 2 cannot run the profile: its process image lacks 0x607A; use profile host');
+    expect(text('.banner-error > span')).toBe('The server refused the configuration: see the fields marked red.');
   });
 
   it("the server's 422 at drive.kind (no EtherCAT bus) is shown at the kind select", async () => {

@@ -119,7 +119,7 @@ describe('axis configuration form', () => {
       unit: 'mm',
       dynamics,
       parameters: { AxisTargetPositionWindow: 0.01 },
-      drive: { kind: 'cia402', subdevice: 0, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 },
+      drive: { kind: 'cia402', subdevice: 0, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'host', homing_method: null },
     };
     const f = formOf(cfg as never);
     expect(f.driveKind).toBe('cia402');
@@ -130,11 +130,11 @@ describe('axis configuration form', () => {
     expect(config).toEqual(cfg);
     // CSV with its own velocity scaling and gain
     const csv = configOf({ ...f, ciaMode: 'csv', cia: { ...f.cia, subdevice: '2', increments_per_unit: '131072', velocity_increments_per_unit: '10', position_gain: '80' } });
-    expect(csv.config!.drive).toEqual({ kind: 'cia402', subdevice: 2, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'csv', position_gain: 80, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 });
+    expect(csv.config!.drive).toEqual({ kind: 'cia402', subdevice: 2, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'csv', position_gain: 80, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'host', homing_method: null });
   });
 
   it('round-trips a CST drive with its torque loop; a drive read without the CST fields gets the server defaults; a save keeps the gains of the other modes', () => {
-    const cst = { kind: 'cia402', subdevice: 1, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'cst', position_gain: 40, velocity_gain: 2.5, acceleration_feed_forward: 0.1, max_torque: 1500 };
+    const cst = { kind: 'cia402', subdevice: 1, increments_per_unit: 131072, velocity_increments_per_unit: 10, mode: 'cst', position_gain: 40, velocity_gain: 2.5, acceleration_feed_forward: 0.1, max_torque: 1500, profile: 'host', homing_method: null };
     const cfg = { name: 'y', unit: 'mm', dynamics, parameters: {}, drive: cst };
     const f = formOf(cfg as never);
     expect(f.ciaMode).toBe('cst');
@@ -152,7 +152,7 @@ describe('axis configuration form', () => {
   it('a CiA-402 drive: no simulated field is sent; the simulated one keeps what was typed while the kind is switched', () => {
     const typed = { ...DEFAULT_FORM, name: 'z', plant: 'pt1' as const, time_constant: '0.02', cia: { ...DEFAULT_FORM.cia, subdevice: '1' } };
     const cia = configOf({ ...typed, driveKind: 'cia402' }).config!;
-    expect(cia.drive).toEqual({ kind: 'cia402', subdevice: 1, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000 });
+    expect(cia.drive).toEqual({ kind: 'cia402', subdevice: 1, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'host', homing_method: null });
     const sim = configOf({ ...typed, driveKind: 'simulated' }).config!;
     expect(sim.drive).toMatchObject({ kind: 'simulated', plant: { kind: 'pt1', time_constant: 0.02 }, dead_time: 0.001 });
     // a simulated drive read from a configuration starts the CiA-402 fields at their defaults
@@ -160,6 +160,24 @@ describe('axis configuration form', () => {
     expect(formOf(sim).driveKind).toBe('simulated');
     // a configuration without a kind is a simulated drive
     expect(formOf({ ...sim, drive: undefined }).driveKind).toBe('simulated');
+  });
+
+  it('the profile side and the homing method: read, sent in `drive`; blank method = null (the drive\'s own); an older configuration is host-side', () => {
+    const feeder = { kind: 'cia402', subdevice: 3, increments_per_unit: 1000, velocity_increments_per_unit: null, mode: 'csp', position_gain: 50, velocity_gain: 0, acceleration_feed_forward: 0, max_torque: 1000, profile: 'drive', homing_method: 1 };
+    const cfg = { name: 'feeder', unit: 'mm', dynamics, parameters: {}, drive: feeder };
+    const f = formOf(cfg as never);
+    expect([f.ciaProfile, f.homingMethod]).toEqual(['drive', '1']);
+    expect(configOf(f)).toEqual({ config: cfg, errors: {} });
+    expect(configOf({ ...f, ciaProfile: 'host', homingMethod: '' }).config!.drive).toEqual({ ...feeder, profile: 'host', homing_method: null });
+    expect(configOf({ ...f, homingMethod: '34' }).config!.drive).toMatchObject({ profile: 'drive', homing_method: 34 });
+    // range checks are the server's (1..37); a fraction is no method number
+    expect(configOf({ ...f, homingMethod: '40' }).config!.drive).toMatchObject({ homing_method: 40 });
+    expect(configOf({ ...f, homingMethod: '1.5' }).errors).toEqual({ 'drive.homing_method': 'a whole number' });
+    const old = formOf({ ...cfg, drive: { kind: 'cia402', subdevice: 1, increments_per_unit: 1000, mode: 'csp' } } as never);
+    expect([old.ciaProfile, old.homingMethod]).toEqual(['host', '']);
+    // the fields the form shows for a CiA-402 drive (a 422 there lands at the field)
+    expect(shownFields(f).has('drive.profile')).toBe(true);
+    expect(shownFields(f).has('drive.homing_method')).toBe(true);
   });
 
   it('CiA-402 fields that are not numbers are named by their JSON path; the position must be whole', () => {

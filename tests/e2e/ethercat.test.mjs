@@ -1,5 +1,6 @@
 // Browser tests of motiond on an emulated EtherCAT segment (`--bus emulated`): the demo axes x,
-// y and spindle have CiA-402 drives on SubDevices 0, 1 and 2. The System page's bus (SubDevices
+// y, spindle and feeder have CiA-402 drives on SubDevices 0, 1, 2 and 3 (feeder's drive runs its
+// profile: drive-executed.test.mjs). The System page's bus (SubDevices
 // in OP with identity and axis, SDO read/abort/write; lost frames fault the bus, which clears by
 // itself while x stays stopped until reset; a SubDevice in SAFE-OP asked back by a power-on; a
 // stopped TX/RX loop with its reason in the banner, back to OP with Reset bus; late and duplicate
@@ -84,23 +85,24 @@ async function sdo(page, position, { index, sub, value, size }) {
 }
 
 describe('motiond on an emulated EtherCAT segment', () => {
-  test('the System page shows the bus in OP and its 3 SubDevices with names, identity and axes, read again every second', async () => {
+  test('the System page shows the bus in OP and its 4 SubDevices with names, identity and axes, read again every second', async () => {
     const bus = (await rest(stack.api, 'GET', '/bus')).body;
     assert.equal(bus.kind, 'emulated');
     const page = await open('/system');
-    await page.waitForSelector('[data-testid="subdevices"] tr[data-subdevice="2"]');
+    await page.waitForSelector('[data-testid="subdevices"] tr[data-subdevice="3"]');
     assert.equal(await text(page, '[data-testid="bus-title"]'), 'EtherCAT (emulated segment)');
     await page.waitForSelector('[data-testid="bus-state"][data-state="op"]');
     assert.equal(await text(page, '[data-testid="bus-state"] [data-led]'), 'OP');
     assert.equal(await page.locator('[data-testid="bus-banner"]').count(), 0);
     const rows = [];
-    for (const p of [0, 1, 2]) rows.push(await cells(page, p));
+    for (const p of [0, 1, 2, 3]) rows.push(await cells(page, p));
     assert.deepEqual(
       rows.map((r) => [r.position, r.name, r.al, r.axis, r.address, r.vendor]),
       [
         ['0', 'motiond emulated servo 1', 'OP', 'x', '0x1000', '0x00FF0ACE'],
         ['1', 'motiond emulated servo 2', 'OP', 'y', '0x1001', '0x00FF0ACE'],
         ['2', 'motiond emulated servo 3', 'OP', 'spindle', '0x1002', '0x00FF0ACE'],
+        ['3', 'motiond emulated servo 4', 'OP', 'feeder', '0x1003', '0x00FF0ACE'],
       ],
     );
     assert.equal(rows[0].mapping, `${bus.subdevices[0].drive.mapping} · ${bus.subdevices[0].drive.output_bytes} B out, ${bus.subdevices[0].drive.input_bytes} B in`);
@@ -127,7 +129,7 @@ describe('motiond on an emulated EtherCAT segment', () => {
     assert.equal(await text(page, '[data-testid="bus-txrx"] [data-led]'), 'running');
     assert.equal(await text(page, '[data-testid="bus-txrx-thread"] b'), bus.txrx.thread);
     // the emulated drives take the full mapping: nothing missing, nothing refused, no row under them
-    assert.deepEqual(bus.subdevices.map((d) => [d.drive.mapping, d.drive.missing_objects.length, d.drive.refused.length]), [['full', 0, 0], ['full', 0, 0], ['full', 0, 0]]);
+    assert.deepEqual(bus.subdevices.map((d) => [d.drive.mapping, d.drive.missing_objects.length, d.drive.refused.length]), [['full', 0, 0], ['full', 0, 0], ['full', 0, 0], ['full', 0, 0]]);
     assert.equal(await page.locator('tr[data-mapping-for]').count(), 0);
     assert.equal(await page.locator('[data-testid="bus-notice"]').count(), bus.notice ? 1 : 0);
     assert.equal(await page.isDisabled('button[name="bus-reset"]'), false);

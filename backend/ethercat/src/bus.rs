@@ -147,6 +147,10 @@ pub struct Layout {
     tx: [Option<usize>; 10],
     pub out_len: usize,
     pub in_len: usize,
+    /// The drive's own 0x6081/0x6083/0x6084 as read at bring-up: sent while it runs a
+    /// cyclic mode, so that a host-side axis leaves the ramps the drive uses for its halt,
+    /// quick-stop and fault reactions as commissioned (a mapped object must carry a value).
+    pub profile_defaults: [u32; 3],
 }
 
 // RxPDO objects in `Layout::rx` order.
@@ -302,9 +306,19 @@ impl Layout {
         put(out, self.rx[3], &rx.target_torque.to_le_bytes());
         put(out, self.rx[4], &rx.mode.to_le_bytes());
         put(out, self.rx[5], &rx.touch_probe_function.to_le_bytes());
-        put(out, self.rx[6], &rx.profile_velocity.to_le_bytes());
-        put(out, self.rx[7], &rx.profile_acceleration.to_le_bytes());
-        put(out, self.rx[8], &rx.profile_deceleration.to_le_bytes());
+        let profile = [1, 3, 6].contains(&rx.mode);
+        let [v, a, d] = if profile {
+            [
+                rx.profile_velocity,
+                rx.profile_acceleration,
+                rx.profile_deceleration,
+            ]
+        } else {
+            self.profile_defaults
+        };
+        put(out, self.rx[6], &v.to_le_bytes());
+        put(out, self.rx[7], &a.to_le_bytes());
+        put(out, self.rx[8], &d.to_le_bytes());
     }
 
     fn decode(&self, inp: &[u8]) -> TxPdo {
@@ -848,18 +862,30 @@ async fn bring_up_once(
         };
         let device_type = sd.sdo_read::<u32>(0x1000, 0).await.unwrap_or(0);
         if device_type & 0xFFFF == 402 {
-            // What the drive has of the full mapping (SDO upload; 0x06020000: no such object).
+            // What the drive has of the full mapping (SDO upload; 0x06020000: no such object),
+            // and the values of the profile dynamics it has (sent while it runs cyclically).
             let mut missing = Vec::new();
+            let mut defaults = [0u32; 3];
             for obj in RX_OBJ.iter().chain(&TX_OBJ) {
                 let index = (obj >> 16) as u16;
                 let r = sd.sdo_read::<heapless::Vec<u8, 64>>(index, 0).await;
-                if let Err(ethercrab::error::Error::Mailbox(
-                    ethercrab::error::MailboxError::Aborted { code, .. },
-                )) = r
-                {
-                    if u32::from(code) == 0x0602_0000 && !missing.contains(&index) {
-                        missing.push(index);
+                match r {
+                    Err(ethercrab::error::Error::Mailbox(
+                        ethercrab::error::MailboxError::Aborted { code, .. },
+                    )) => {
+                        if u32::from(code) == 0x0602_0000 && !missing.contains(&index) {
+                            missing.push(index);
+                        }
                     }
+                    Ok(v) => {
+                        if let Some(k) = [0x6081, 0x6083, 0x6084].iter().position(|&i| i == index) {
+                            let mut b = [0u8; 4];
+                            let n = v.len().min(4);
+                            b[..n].copy_from_slice(&v[..n]);
+                            defaults[k] = u32::from_le_bytes(b);
+                        }
+                    }
+                    Err(_) => {}
                 }
             }
             missing.sort_unstable();
@@ -922,6 +948,10 @@ async fn bring_up_once(
                 )));
             };
             let _ = last_err;
+            let layout = Layout {
+                profile_defaults: defaults,
+                ..layout
+            };
             // Optional objects: a drive without them keeps its own settings.
             let (value, index) = interpolation_period(opts.cycle);
             let _ = sd.sdo_write(0x60C2, 1, value).await;

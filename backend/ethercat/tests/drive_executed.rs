@@ -22,6 +22,9 @@ struct Machine {
     events: Vec<CommandEvent>,
     next_id: CommandId,
     cycle: u64,
+    /// The drive's answers still on their way (a bus that answers `latency` cycles late).
+    in_flight: std::collections::VecDeque<TxPdo>,
+    latency: usize,
 }
 
 impl Machine {
@@ -75,6 +78,8 @@ impl Machine {
             events: Vec::new(),
             next_id: 1,
             cycle: 0,
+            in_flight: std::collections::VecDeque::new(),
+            latency: 0,
         }
     }
 
@@ -110,7 +115,11 @@ impl Machine {
         self.fb = self.cia.feedback(&self.tx);
         self.k.step(&[self.fb], &mut self.sp, &mut self.events);
         let rx = self.cia.outputs(&self.sp[0]);
-        self.tx = self.emu.exchange_direct(&rx, DT);
+        let answer = self.emu.exchange_direct(&rx, DT);
+        self.in_flight.push_back(answer);
+        while self.in_flight.len() > self.latency {
+            self.tx = self.in_flight.pop_front().expect("one at least");
+        }
         self.cycle += 1;
     }
 
@@ -271,7 +280,13 @@ fn move_velocity_is_in_velocity_when_the_drive_says_so_and_stop_locks() {
     assert!(m.out(id).command_aborted);
     m.until(1.0, |m| m.out(stop).done);
     assert_eq!(m.st().state, AxisState::Stopping, "locked until released");
-    assert!(m.st().actual_velocity.abs() < 0.01);
+    // Done when the drive says it stands (within its velocity window 0x606D, 1 mm/s here).
+    assert!(
+        m.st().actual_velocity.abs() <= 1.0,
+        "{:?}",
+        m.st().actual_velocity
+    );
+    m.until(0.1, |m| m.st().actual_velocity.abs() < 0.01);
     let e = m.refused(CommandKind::MoveAbsolute(mv(0.0, 10.0)));
     assert_eq!(e, ErrorId::AXIS_CANNOT_BE_STARTED);
     m.ok(CommandKind::Release { target: stop });
@@ -610,4 +625,116 @@ fn touch_probe_latches_in_the_drive_during_a_profile_move() {
         m.st().probe
     );
     m.until(3.0, |m| m.out(id).done);
+}
+
+/// The set-point handshake on a bus that answers late (2 more cycles): a move replacing one
+/// whose acknowledge is still on its way is not lost (the drive must see bit 4 low before a
+/// new rising edge), and the axis ends on the new target.
+#[test]
+fn a_move_replacing_an_unacknowledged_one_is_not_lost_on_a_late_bus() {
+    let mut m = Machine::new(true, 1000.0);
+    m.latency = 2;
+    m.power();
+    m.until(0.1, |m| m.fb.profile.mode == ProfileMode::Position);
+    for _ in 0..10 {
+        m.step();
+    }
+    let a = m.ok(CommandKind::MoveAbsolute(mv(50.0, 100.0)));
+    // Until A's set point is sent (bit 4 high), then B at once.
+    m.until(0.1, |m| m.emu.od.u16(0x6040, 0) & (1 << 4) != 0);
+    let b = m.ok(CommandKind::MoveAbsolute(mv(-20.0, 100.0)));
+    assert!(m.out(a).command_aborted);
+    m.until(5.0, |m| m.out(b).done || m.out(b).error);
+    assert!(m.out(b).done, "{:?}", m.out(b));
+    assert!(
+        (m.st().actual_position + 20.0).abs() <= 0.011,
+        "{:?}",
+        m.st().actual_position
+    );
+    assert_eq!(m.emu.od.i32(0x607A, 0), -20_000);
+}
+
+/// A move that reverses an endless motion heading for a software limit, with a deceleration
+/// too weak to stop before it: the drive first brakes the motion it runs (never weaker than
+/// that motion's deceleration), and the axis never passes the limit.
+#[test]
+fn reversing_a_velocity_with_a_weak_deceleration_stays_within_the_soft_limit() {
+    let mut m = Machine::new(true, 400.0);
+    m.power();
+    let v = m.ok(CommandKind::MoveVelocity {
+        velocity: 100.0,
+        dynamics: Dynamics {
+            acceleration: 1000.0,
+            deceleration: 1000.0,
+            jerk: 0.0,
+        },
+        direction: Direction::Positive,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    });
+    m.until(5.0, |m| m.st().actual_position > 380.0);
+    let weak = Positioning {
+        dynamics: Dynamics {
+            acceleration: 10.0,
+            deceleration: 10.0,
+            jerk: 0.0,
+        },
+        ..mv(0.0, 100.0)
+    };
+    let id = m.ok(CommandKind::MoveAbsolute(weak));
+    assert!(m.out(v).command_aborted);
+    let mut highest: f64 = 0.0;
+    for _ in 0..3000 {
+        m.step();
+        highest = highest.max(m.st().actual_position);
+        if m.st().actual_velocity < -1.0 || m.out(id).error {
+            break;
+        }
+    }
+    assert!(highest <= 400.0, "passed the limit: {highest}");
+}
+
+/// A stop during drive-based homing on a host-side axis: the drive brakes by itself in its
+/// homing mode, and the axis goes back to CSP only once it stands — no hard stop, no lurch.
+#[test]
+fn a_stop_during_drive_based_homing_brakes_in_the_drive_then_returns_to_csp() {
+    let mut m = Machine::new(false, 1000.0);
+    m.emu.od.set(0x6098, 0, &[34]);
+    m.emu.od.set(0x6099, 2, &100_000u32.to_le_bytes());
+    m.power();
+    let home = m.ok(CommandKind::Home {
+        position: None,
+        mode: HomingMode::DriveBased,
+        options: HomingOptions::default(),
+    });
+    m.until(1.0, |m| m.st().actual_velocity > 50.0);
+    let stop = m.ok(CommandKind::Stop {
+        deceleration: 500.0,
+        jerk: 0.0,
+        options: MoveOptions::default(),
+    });
+    assert!(m.out(home).command_aborted);
+    let mut last_v = m.st().actual_velocity;
+    for _ in 0..2000 {
+        m.step();
+        let v = m.st().actual_velocity;
+        // The homing acceleration 0x609A (1 000 mm/s² by default) per cycle at most.
+        assert!(
+            (v - last_v).abs() <= 1000.0 * DT * 1.5 + 0.2,
+            "{last_v} → {v}"
+        );
+        last_v = v;
+        if m.out(stop).done {
+            break;
+        }
+    }
+    assert!(m.out(stop).done, "{:?}", m.out(stop));
+    m.ok(CommandKind::Release { target: stop });
+    m.until(0.1, |m| m.st().state == AxisState::Standstill);
+    assert_eq!(m.emu.od.i8(0x6061, 0), 8, "CSP again");
+    assert!(!m.st().homed);
+    let at = m.st().actual_position;
+    let id = m.ok(CommandKind::MoveRelative(mv(1.0, 20.0)));
+    m.until(2.0, |m| m.out(id).done);
+    assert!((m.st().actual_position - at - 1.0).abs() < 0.01);
 }

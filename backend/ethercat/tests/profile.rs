@@ -65,6 +65,13 @@ fn profile_position_velocity_and_homing_run_in_the_drive() {
     assert!(rig.bus.attach(0, cfg.build(0.001)).unwrap().is_none());
     rig.sp[0].enable = true;
     rig.until("enabled", |f| f.enabled);
+    // In CSP the mapped profile dynamics carry the drive's own values (read at bring-up): its
+    // halt and quick-stop ramps stay as commissioned.
+    for _ in 0..5 {
+        rig.cycle();
+    }
+    assert_eq!(rig.emu(|d| d.od.u32(0x6081, 0)), 100_000);
+    assert_eq!(rig.emu(|d| d.od.u32(0x6084, 0)), 1_000_000);
 
     // Profile position: 20 mm at 50 mm/s, 500 mm/s².
     rig.sp[0].profile = ProfileCommand {

@@ -143,6 +143,8 @@ error_table! {
     INPUT_NOT_ON_DRIVE_EXECUTED_AXIS = 0x70C1, "input_not_on_drive_executed_axis", "the drive runs this axis's profile: jerk, buffer modes other than aborting and the override are not its inputs";
     /// The drive reported a homing error (statusword bit 13 in homing mode).
     DRIVE_HOMING_ERROR = 0x70C2, "drive_homing_error", "the drive reported a homing error";
+    /// The drive did not acknowledge a new set point (statusword bit 12) within 1 s.
+    DRIVE_SET_POINT_NOT_ACKNOWLEDGED = 0x70C3, "drive_set_point_not_acknowledged", "the drive did not acknowledge the new set point";
     /// The bus lost the drive (bus_error feedback).
     BUS_ERROR = 0x70A0, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)";
     /// MC_TouchProbe while a probe cycle runs (end it first: MC_AbortTrigger) or while homing

@@ -50,6 +50,7 @@ export const ERROR_TABLE: ReadonlyArray<readonly [id: number, code: string, text
   [28864, "not_on_drive_executed_axis", "the drive runs this axis's profile: this block is not offered (Drive Motion Control has it not)"],
   [28865, "input_not_on_drive_executed_axis", "the drive runs this axis's profile: jerk, buffer modes other than aborting and the override are not its inputs"],
   [28866, "drive_homing_error", "the drive reported a homing error"],
+  [28867, "drive_set_point_not_acknowledged", "the drive did not acknowledge the new set point"],
   [28832, "bus_error", "the drive bus lost the drive (frames lost, working counter wrong, or the SubDevice left OP)"],
   [28816, "touch_probe_busy", "the touch probe is in use (a probe cycle or homing)"],
   [28848, "phasing_not_coupled", "phasing needs the slave coupled to this master by MC_GearIn or a cam"],

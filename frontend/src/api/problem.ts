@@ -71,6 +71,24 @@ export class NotSentError extends ApiError {
   }
 }
 
+/**
+ * A command not sent because the axis is known to refuse it (a block an axis whose drive runs
+ * the profile does not offer, or an input it lacks): a 409 made here with the code and field
+ * errors the server's refusal would have, so forms show it where they show the server's.
+ */
+export class NotOfferedError extends ApiError {
+  constructor(code: string, detail: string, fields: Record<string, string> = {}) {
+    super(409, {
+      type: 'about:blank',
+      title: 'Not sent',
+      status: 409,
+      code,
+      detail,
+      errors: Object.entries(fields).map(([field, message]) => ({ field, message })),
+    });
+  }
+}
+
 export function isProblem(x: unknown): x is Problem {
   return !!x && typeof x === 'object' && typeof (x as Problem).status === 'number' &&
     typeof (x as Problem).code === 'string';

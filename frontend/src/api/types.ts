@@ -32,6 +32,8 @@ export type SimDriveConfig = Extract<DriveConfig, { kind: 'simulated' }>;
 /** A CiA-402 servo drive on the EtherCAT bus (`kind: "cia402"`). */
 export type Cia402DriveConfig = Extract<DriveConfig, { kind: 'cia402' }>;
 export type Cia402Mode = S['Cia402Mode'];
+/** Who runs a CiA-402 axis's motion profile: motiond (`host`) or the drive (`drive`, Drive Motion Control). */
+export type ProfileSide = S['ProfileSide'];
 /** `GET /bus`: the drive bus (simulated, emulated or real EtherCAT) and its SubDevices. */
 export type BusResource = S['BusResource'];
 export type SubDeviceResource = S['SubDeviceResource'];

@@ -215,9 +215,13 @@ export const HOME_DEFAULTS: Form = {
   clear_position_lag: '',
 };
 
-/** MC_Home: blank options are left out (the axis's parameters #1073/#1074/#1012/#1013/#1076 apply). */
-export function homeBody(f: Form): Built<HomeBody> {
-  const options = clean({
+/**
+ * MC_Home: blank options are left out (the axis's parameters #1073/#1074/#1012/#1013/#1076 apply).
+ * `inDrive`: the drive homes with its own method (axis/drive-executed.ts), so motiond's
+ * referencing options are not sent.
+ */
+export function homeBody(f: Form, inDrive = false): Built<HomeBody> {
+  const options = inDrive ? {} : clean({
     reference_mode: (f.reference_mode || undefined) as ReferenceMode | undefined,
     search_direction: (f.search_direction || undefined) as Direction | undefined,
     search_velocity: optNum(f.search_velocity),

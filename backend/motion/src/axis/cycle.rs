@@ -166,6 +166,17 @@ impl Axis {
         master: Master,
     ) {
         let ovr = self.override_ratio();
+        let returning = !self.drive_executed()
+            && self.drive.cmd.mode != crate::drive::ProfileMode::Off
+            && !self.job.is_some_and(|j| j.kind == JobKind::DriveHome);
+        if returning {
+            // A host-side axis whose drive still runs its homing mode: the drive stops by
+            // itself first; the job (if any) takes over in the cyclic mode from rest.
+            if self.step_drive_return(fb) {
+                return;
+            }
+            self.plan_job_now();
+        }
         let Some(mut job) = self.job else {
             if self.drive_executed() {
                 self.step_drive_job(cx, fb);

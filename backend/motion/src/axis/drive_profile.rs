@@ -16,7 +16,7 @@
 //! homing when attained; the drive's following error and homing error are axis errors.
 
 use super::*;
-use crate::drive::{ProfileCommand, ProfileMode};
+use crate::drive::{ProfileCommand, ProfileFeedback, ProfileMode};
 
 /// How long a drive may take to show the profile mode asked for (0x6061) before the axis
 /// stops with DRIVE_MODE_NOT_REACHED (a drive that does not have the mode never shows it).
@@ -52,6 +52,9 @@ pub(super) struct DriveProfile {
     pub(super) homing_seen_running: bool,
     /// How long the drive has not shown the mode asked for (s).
     pub(super) mode_wait: f64,
+    /// Cycles bit 4 has been sent low, and cycles a set point has waited for its acknowledge.
+    pub(super) start_low: u32,
+    pub(super) sent_for: u32,
 }
 
 impl DriveProfile {
@@ -187,9 +190,45 @@ impl Axis {
         }
     }
 
-    /// The drive stands (its reported velocity within what it resolves).
-    fn drive_standing(&self) -> bool {
-        self.act_vel.abs() <= self.p().axis_velo_max * 1e-5
+    /// The drive stands: it says so under a halt (bit 10: velocity 0) or at the end of a
+    /// profile-position or homing run, or its reported velocity is below a ten-thousandth of
+    /// the axis's maximum.
+    fn drive_at_rest(&self, pf: ProfileFeedback, answered: bool) -> bool {
+        let says = answered
+            && pf.target_reached
+            && (self.drive.cmd.halt || pf.mode != ProfileMode::Velocity);
+        says || self.act_vel.abs() <= self.p().axis_velo_max * 1e-4
+    }
+
+    /// A host-side axis whose drive still runs its homing mode (the homing ended by a stop,
+    /// an error or a homing error): the drive brakes by itself with the halt bit, and the
+    /// axis goes back to its cyclic mode once it stands, the set position taken over there.
+    /// True while it is still returning.
+    pub(super) fn step_drive_return(&mut self, fb: &DriveFeedback) -> bool {
+        self.set = Kinematics {
+            position: self.act_pos,
+            velocity: self.act_vel,
+            acceleration: self.act_acc,
+            jerk: 0.0,
+        };
+        self.drive.since_change = self.drive.since_change.saturating_add(1);
+        let pf = fb.profile;
+        let answered = pf.mode == self.drive.cmd.mode && self.drive.since_change >= ANSWER_CYCLES;
+        if !self.drive_at_rest(pf, answered) && fb.enabled {
+            self.drive.set(ProfileCommand {
+                halt: true,
+                start: false,
+                ..self.drive.cmd
+            });
+            return true;
+        }
+        self.drive.set(ProfileCommand::default());
+        self.set = Kinematics {
+            position: self.act_pos,
+            ..Kinematics::default()
+        };
+        self.sent_position = self.act_pos;
+        false
     }
 
     /// One cycle of a job the drive runs (instead of the planner), and of a drive-executed
@@ -202,38 +241,61 @@ impl Axis {
             jerk: 0.0,
         };
         self.drive.since_change = self.drive.since_change.saturating_add(1);
+        // How long the drive has seen bit 4 low: a new set point needs a rising edge it sees.
+        self.drive.start_low = if self.drive.cmd.start {
+            0
+        } else {
+            self.drive.start_low.saturating_add(1)
+        };
         let pf = fb.profile;
-        if fb.enabled && self.drive.cmd.mode != ProfileMode::Off && pf.mode != self.drive.cmd.mode {
+        let in_mode = pf.mode == self.drive.cmd.mode;
+        let answered = in_mode && self.drive.since_change >= ANSWER_CYCLES;
+        let commanding = matches!(self.mode, Mode::Enabled | Mode::Stopping);
+        if fb.enabled && self.drive.cmd.mode != ProfileMode::Off && !in_mode && commanding {
             self.drive.mode_wait += self.cycle_time;
-            if self.drive.mode_wait > MODE_TIMEOUT && self.mode != Mode::ErrorStop {
+            if self.drive.mode_wait > MODE_TIMEOUT {
+                // Ask for the mode the drive is in (or profile position), so that a reset
+                // does not run into the same timeout at once.
                 self.drive.mode_wait = 0.0;
+                self.drive.cmd.mode = match pf.mode {
+                    ProfileMode::Off if self.drive_executed() => ProfileMode::Position,
+                    m => m,
+                };
                 self.enter_error(cx, ErrorId::DRIVE_MODE_NOT_REACHED);
                 return;
             }
         } else {
             self.drive.mode_wait = 0.0;
         }
+        // The drive's following error (bit 13 in profile position), whenever it shows.
+        if pf.error && pf.mode == ProfileMode::Position && in_mode && commanding {
+            self.enter_error(cx, ErrorId::FOLLOWING_ERROR);
+            return;
+        }
+        if self.drive_executed() && commanding && self.drive_soft_limit(cx) {
+            return;
+        }
+        let at_rest = self.drive_at_rest(pf, answered);
         let Some(mut job) = self.job else {
-            // At rest in the mode it is in (profile position by default): nothing started.
+            // At rest in the mode it is in (profile position by default; homing once it
+            // stands): nothing started. A halt stays set until the next job: releasing it
+            // would resume the set point the drive was halted on (CiA-402 profile position
+            // resumes after a halt).
             let mode = match self.drive.cmd.mode {
-                ProfileMode::Off | ProfileMode::Homing => ProfileMode::Position,
+                ProfileMode::Off => ProfileMode::Position,
+                ProfileMode::Homing if at_rest => ProfileMode::Position,
                 m => m,
             };
-            let hold = ProfileCommand {
+            self.drive.set(ProfileCommand {
                 mode,
                 target: if mode == ProfileMode::Position {
                     self.drive.cmd.target
                 } else {
                     0.0
                 },
-                ..self.drive.cmd
-            };
-            // A halt stays set until the next job: releasing it would resume the set point
-            // the drive was halted on (CiA-402 profile position resumes after a halt).
-            self.drive.set(ProfileCommand {
                 start: false,
-                halt: mode == ProfileMode::Velocity || self.drive.cmd.halt,
-                ..hold
+                halt: mode != ProfileMode::Position || self.drive.cmd.halt,
+                ..self.drive.cmd
             });
             return;
         };
@@ -241,11 +303,16 @@ impl Axis {
         let wanted = Self::job_profile_mode(job.kind);
         let current = self.drive.cmd.mode;
         if let Some(mode) = wanted.filter(|&m| m != current) {
-            // Modes change at rest only: brake in the mode the drive runs in, then switch.
-            if self.drive_standing() || current == ProfileMode::Off {
+            // Modes change at rest only: brake in the mode the drive runs in (never weaker
+            // than the motion it brakes), then switch.
+            if at_rest || current == ProfileMode::Off {
                 self.drive.set(ProfileCommand {
                     mode,
-                    target: self.act_pos,
+                    target: if mode == ProfileMode::Position {
+                        self.act_pos
+                    } else {
+                        0.0
+                    },
                     velocity: job.velocity,
                     acceleration: job.acc,
                     deceleration: dec,
@@ -257,36 +324,36 @@ impl Axis {
             } else {
                 self.drive.set(ProfileCommand {
                     halt: true,
-                    deceleration: dec,
+                    deceleration: dec.max(self.drive.cmd.deceleration),
                     start: false,
                     ..self.drive.cmd
                 });
             }
             return;
         }
-        // The drive runs in the job's mode once it reports it (0x6061).
-        let in_mode = pf.mode == self.drive.cmd.mode;
-        let answered = in_mode && self.drive.since_change >= ANSWER_CYCLES;
         match job.kind {
             JobKind::Positioning { .. } => {
-                if pf.error && in_mode {
-                    self.enter_error(cx, ErrorId::FOLLOWING_ERROR);
-                    return;
-                }
                 let hs = self.drive.handshake;
                 let start = match hs {
                     Handshake::WaitFree => {
-                        if in_mode && !pf.acknowledge && self.drive.since_change >= 1 {
+                        // The drive saw bit 4 low long enough, and its bit 12 (read after
+                        // that) says it takes a new set point.
+                        if in_mode && !pf.acknowledge && self.drive.start_low >= ANSWER_CYCLES {
                             self.drive.handshake = Handshake::Sent;
+                            self.drive.sent_for = 0;
                             true
                         } else {
                             false
                         }
                     }
                     Handshake::Sent => {
+                        self.drive.sent_for = self.drive.sent_for.saturating_add(1);
                         if in_mode && pf.acknowledge {
                             self.drive.handshake = Handshake::Acked;
                             false
+                        } else if f64::from(self.drive.sent_for) * self.cycle_time > MODE_TIMEOUT {
+                            self.enter_error(cx, ErrorId::DRIVE_SET_POINT_NOT_ACKNOWLEDGED);
+                            return;
                         } else {
                             true
                         }
@@ -311,9 +378,6 @@ impl Axis {
                 }
             }
             JobKind::Velocity | JobKind::JogHeld { released: false } => {
-                if self.drive_soft_limit(cx, &job) {
-                    return;
-                }
                 let target = job.direction * job.velocity;
                 self.drive.set(ProfileCommand {
                     mode: ProfileMode::Velocity,
@@ -362,8 +426,9 @@ impl Axis {
                     answered && pf.target_reached
                 } else {
                     self.drive.since_change >= ANSWER_CYCLES
+                        && self.act_vel.abs() <= self.p().axis_velo_max * 1e-4
                 };
-                if stood && self.drive_standing() {
+                if stood {
                     // What the drive stands on is the target now (PP holds there after the
                     // halt is released).
                     self.drive.cmd.target = self.act_pos;
@@ -392,7 +457,7 @@ impl Axis {
                     self.end_drive_job(cx, job, Err(ErrorId::DRIVE_HOMING_ERROR));
                 } else if attained && (self.drive.homing_seen_running || answered) {
                     // The drive stands on its home position: the axis reads the reference
-                    // there (the drive's home offset 0x607C is left at 0, decision 167).
+                    // there (the drive's home offset 0x607C is left at 0, decision 168).
                     let shift = job.target - self.act_pos;
                     self.shift_coordinates(shift);
                     self.set_position_offset = 0.0;
@@ -403,35 +468,59 @@ impl Axis {
                 }
             }
             _ => {
-                // Kinds a drive-executed axis is never given (refused at submit).
+                // Kinds a drive-executed axis is never given (refused at submit, and groups
+                // do not take it).
                 self.job = Some(job);
             }
         }
     }
 
-    /// Endless motion stops before an enabled software limit: the drive brakes at the job's
-    /// deceleration, started where its braking distance plus what it travels before it
-    /// answers still ends inside. True when it stopped the job.
-    fn drive_soft_limit(&mut self, cx: &mut Ctx<'_, impl EventSink>, job: &Job) -> bool {
+    /// The software limits of an axis whose drive runs the profile (its set position is the
+    /// drive's actual one, so motiond's own monitor cannot see what the drive plans): where
+    /// the drive would stand if it braked now — at the deceleration it was given, after the
+    /// cycles it takes to answer — lies beyond an enabled limit in the direction of travel.
+    /// Endless motion (velocity, a held jog) stops there with its deceleration, ending with
+    /// `soft_limit_reached`; anything else heading out (a move reversing a faster one, a
+    /// weak halt) is an axis error, stopped with the fast ramp. True when it stopped.
+    fn drive_soft_limit(&mut self, cx: &mut Ctx<'_, impl EventSink>) -> bool {
         let p = self.p();
         let v = self.act_vel;
-        let limit = if job.direction > 0.0 && p.axis_en_max_soft_pos_limit {
+        if v.abs() <= EPS_V {
+            return false;
+        }
+        let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {
             p.axis_max_soft_pos_limit
-        } else if job.direction < 0.0 && p.axis_en_min_soft_pos_limit {
+        } else if v < 0.0 && p.axis_en_min_soft_pos_limit {
             p.axis_min_soft_pos_limit
         } else {
             return false;
         };
-        let reach = v * v / (2.0 * job.dec.max(1e-9))
-            + v.abs() * self.cycle_time * f64::from(ANSWER_CYCLES + 1);
-        if (limit - self.act_pos) * job.direction > reach {
+        let Some(job) = self.job else {
+            return false;
+        };
+        let dec = self.drive.cmd.deceleration.max(job.dec).max(1e-9);
+        let reach = v * v / (2.0 * dec) + v.abs() * self.cycle_time * f64::from(ANSWER_CYCLES + 1);
+        if (limit - self.act_pos) * v.signum() > reach {
             return false;
         }
-        self.stop_internally(cx, ErrorId::SOFT_LIMIT_REACHED, false);
-        true
+        match job.kind {
+            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+                self.stop_internally(cx, ErrorId::SOFT_LIMIT_REACHED, false);
+                true
+            }
+            // A move towards a target inside the limits brakes to it by itself.
+            JobKind::Positioning { .. } if (job.target - self.act_pos) * v > 0.0 => false,
+            JobKind::DriveHome => false,
+            _ => {
+                self.enter_error(cx, ErrorId::SOFT_LIMIT_REACHED);
+                true
+            }
+        }
     }
 
-    /// A drive job ends: Done (a halt's end also reports MC_Stop's Done) or an error.
+    /// A drive job ends: Done (a halt's end also reports MC_Stop's Done) or an error. A
+    /// host-side axis goes back to its cyclic mode once its drive stands
+    /// (`step_drive_return`).
     fn end_drive_job(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
@@ -450,21 +539,12 @@ impl Axis {
             }
             Err(e) => job.finish_error(cx, e),
         }
-        if !self.drive_executed() {
-            // Back to the cyclic mode, from where the drive stands.
-            self.drive.set(ProfileCommand::default());
-            self.set = Kinematics {
-                position: self.act_pos,
-                ..Kinematics::default()
-            };
-            self.sent_position = self.act_pos;
-        }
     }
 
     /// What the drive is sent this cycle for the profile it runs, in the drive's coordinates
     /// (without the axis's offset, through the encoder scaling) as the cyclic setpoint is.
     pub(super) fn profile_command(&self) -> ProfileCommand {
-        if !(self.drive_executed() || self.job.is_some_and(|j| j.kind == JobKind::DriveHome)) {
+        if !self.drive_executed() && self.drive.cmd.mode == ProfileMode::Off {
             return ProfileCommand::default();
         }
         let c = self.drive.cmd;

@@ -38,7 +38,9 @@ impl Axis {
 
     /// Closed loop and standing, or already following the group (note 8).
     pub(crate) fn group_axis_ready(&self) -> bool {
-        self.mode == Mode::Enabled
+        // An axis whose drive runs the profile cannot follow a path's set points.
+        !self.config.drive_executed
+            && self.mode == Mode::Enabled
             && (self.job.is_none() || self.group_axis_following())
             && self.status.power_status
     }
@@ -53,7 +55,7 @@ impl Axis {
         if self.group_axis_following() {
             return true;
         }
-        if self.mode != Mode::Enabled || self.job.is_some() {
+        if self.mode != Mode::Enabled || self.job.is_some() || self.config.drive_executed {
             return false;
         }
         let mut job = Job::new(0, JobKind::Group);

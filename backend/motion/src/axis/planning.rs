@@ -15,8 +15,12 @@ impl Axis {
         let Some(j) = self.job.as_mut() else {
             return true;
         };
-        if self.config.drive_executed || j.kind == JobKind::DriveHome {
-            // The drive plans it.
+        if self.config.drive_executed
+            || j.kind == JobKind::DriveHome
+            || self.drive.cmd.mode != crate::drive::ProfileMode::Off
+        {
+            // The drive plans it (a host-side axis's drive still in its homing mode: the job
+            // is planned once it is back in the cyclic mode).
             return true;
         }
         j.planned_override = ovr;

@@ -345,6 +345,10 @@ impl Group {
                 let Some(a) = axes.get(axis as usize).and_then(|a| a.as_deref()) else {
                     return Err(ErrorId::AXIS_UNKNOWN);
                 };
+                if a.config().drive_executed {
+                    // Its drive runs the profile: it cannot follow a path's set points.
+                    return Err(ErrorId::NOT_ON_DRIVE_EXECUTED_AXIS);
+                }
                 match a.group_link().0 {
                     Some(g) if g == self.id && self.members[d] == Some(axis) => {}
                     Some(_) => return Err(ErrorId::GROUP_CONFIG_INVALID),

@@ -9,6 +9,7 @@ import { ParametersTab } from '../config/parameters';
 import { AxisConfigPage } from '../config/axis-config';
 import { CouplingTab } from './coupling';
 import { FunctionsTab } from './functions';
+import { DRIVE_EXECUTED_TEXT, isDriveExecuted } from '../../axis/drive-executed';
 
 export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
   const list = useStore(axes);
@@ -57,6 +58,15 @@ export function AxisPage({ axis, tab }: { axis: string; tab: AxisTab }) {
         <span class="axis-state" data-testid="axis-state">
           {STATE_LABEL[s?.state ?? a.state]}
         </span>
+        {isDriveExecuted(a.config, s) && (
+          <span
+            class="tag tag-blue drive-executed"
+            data-testid="drive-executed"
+            title="TwinCAT Drive Motion Control: the CiA-402 drive runs profile position, velocity and homing itself from the targets motiond sends (no setpoint every cycle). Only its blocks are offered: power, reset, set position, home, jog, halt, stop, the moves (absolute, relative, modulo, velocity), touch probe; no jerk, no override, no coupling."
+          >
+            {DRIVE_EXECUTED_TEXT}
+          </span>
+        )}
         <span class="muted small">
           id {a.id} · {a.config.unit}
           {a.config.modulo ? ` · modulo ${a.config.modulo.period}` : ''}

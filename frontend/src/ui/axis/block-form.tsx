@@ -7,6 +7,7 @@ import type { AxisLiveStatus, AxisResource, ParameterResource } from '../../api/
 import type { BlockBody, BlockName, BlockOptions } from '../../api/blocks';
 import { Field, NumberInput, errorText, fieldsOf } from '../shared/common';
 import { label, type Built, type Form } from '../../axis/bodies';
+import { NOT_OFFERED } from '../../axis/drive-executed';
 
 /** A text input of a form record with its field error. */
 export function NumField({ f, set, k, label: l, errors, hint, name, placeholder, disabled }: { f: Form; set: (k: string, v: string) => void; k: string; label: ComponentChildren; errors: Record<string, string>; hint?: string; name?: string; placeholder?: string; disabled?: boolean }) {
@@ -25,7 +26,8 @@ export function SelectField({ f, set, k, label: l, errors, options, name, blank,
   k: string;
   label: ComponentChildren;
   errors: Record<string, string>;
-  options: (string | [string, string])[];
+  /** A value, or value and text, or value, text and why it cannot be chosen (null: it can). */
+  options: (string | [string, string] | [string, string, string | null])[];
   name?: string;
   blank?: string;
   disabled?: boolean;
@@ -37,8 +39,12 @@ export function SelectField({ f, set, k, label: l, errors, options, name, blank,
       <select name={n} value={f[k] ?? ''} disabled={disabled} title={title} onChange={(e) => set(k, (e.target as HTMLSelectElement).value)}>
         {blank !== undefined && <option value="">{blank}</option>}
         {options.map((o) => {
-          const [v, t] = Array.isArray(o) ? o : [o, label(o)];
-          return <option value={v}>{t}</option>;
+          const [v, t, why]: [string, string, (string | null)?] = Array.isArray(o) ? o : [o, label(o)];
+          return (
+            <option value={v} disabled={!!why} title={why ?? undefined}>
+              {t}
+            </option>
+          );
         })}
       </select>
     </Field>
@@ -77,6 +83,20 @@ export interface BlockProps {
   setBanner: (s: string | null) => void;
   /** The axis's parameters (what a blank field stands for), null while they load. */
   params: Map<number, ParameterResource> | null;
+  /** The drive runs the axis's profile (Drive Motion Control): only its blocks are offered. */
+  driveExecuted: boolean;
+}
+
+/**
+ * The note of a panel whose blocks an axis whose drive runs the profile does not offer (they are
+ * shown disabled beside it); `what` names them.
+ */
+export function NotOffered({ what }: { what: string }) {
+  return (
+    <p class="small panel-note not-offered" data-testid="not-offered">
+      {what}: {NOT_OFFERED}.
+    </p>
+  );
 }
 
 /** A live value: label, value, unit (the online tab's readout row). */

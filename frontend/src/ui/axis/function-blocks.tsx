@@ -34,7 +34,7 @@ import {
   type PositionConversion,
 } from '../../axis/bodies';
 import { useCommand, useForm, useRunning } from '../../axis/hooks';
-import { NumField, Readout, SelectField, release, type BlockProps } from './block-form';
+import { NotOffered, NumField, Readout, SelectField, release, type BlockProps } from './block-form';
 import { P_BACKLASH, paramDefault } from './axis-params';
 
 const DRIVE_MODE_LABEL: Record<string, string> = {
@@ -45,7 +45,7 @@ const DRIVE_MODE_LABEL: Record<string, string> = {
 };
 
 /** MC_TorqueControl, back to position control (MC_Halt), and the drive's operation mode. */
-export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
+export function TorquePanel({ axis: a, s, online, send, driveExecuted }: BlockProps) {
   const axis = a.config.name;
   const u = a.config.unit;
   const offline = !online;
@@ -91,44 +91,47 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
         <Led on={s?.torque_velocity_limited} label="Velocity limited" tone="amber" title="The drive holds the velocity at a limit" />
         <Led on={s?.control_loop_closed} label="Loop closed" title="Operational with the position loop closed (open in torque mode)" />
       </div>
-      <h4 class="sub">MC_TorqueControl · MC_Halt</h4>
-      <form
-        class="row"
-        data-form="torque-control"
-        onSubmit={(e) => {
-          e.preventDefault();
-          if (online) void send('torque-control', torqueControlBody(f), setErr);
-        }}
-      >
-        <NumField f={f} set={set} k="torque" label={f.relative === '1' ? 'Torque change (%)' : 'Torque (%)'} errors={err} name="torque-torque" hint="of rated torque; positive drives the positive way" />
-        <NumField f={f} set={set} k="torque_ramp" label="Torque ramp (%/s)" errors={err} name="torque-ramp" hint="> 0" />
-        <NumField f={f} set={set} k="velocity_limit_high" label={`Limit high (${u}/s)`} errors={err} name="torque-limit-high" hint="velocity limit high: within ±AxisVeloMax" />
-        <NumField f={f} set={set} k="velocity_limit_low" label={`Limit low (${u}/s)`} errors={err} name="torque-limit-low" hint="velocity limit low: ≤ the high limit" />
-        <NumField f={f} set={set} k="manual_start_torque" label="Start torque (%)" errors={err} name="torque-start-torque" placeholder="actual" hint="blank = the drive's actual torque" />
-        <label class="check" title="The torque is a change of the running torque control's target">
-          <input type="checkbox" name="torque-relative" checked={f.relative === '1'} onChange={(e) => set('relative', (e.target as HTMLInputElement).checked ? '1' : '')} /> relative
-        </label>
-        <div class="row-buttons">
-          <button type="submit" class="btn btn-primary" name="torque-start" disabled={offline} title="MC_TorqueControl: the drive in torque mode, the torque ramped, the velocity kept within the limits">
-            Start
-          </button>
-          <ActionButton name="torque-halt" kind="warn" disabled={offline} title="MC_Halt: back to position control, from where the load is and how fast it goes" onClick={() => send('halt', { body: {}, errors: {} }, setHaltErr)}>
-            Back to position control
-          </ActionButton>
-        </div>
-      </form>
-      {haltErr.body && <div class="field-error">{haltErr.body}</div>}
-      <p class="small muted panel-note">
-        {running ? `#${running.id} ${running.state}. ` : ''}Halt, Stop or any move takes the axis back to position control. On the simulated drive the torque moves a model (acceleration per
-        percent, friction).
-      </p>
+      {driveExecuted && <NotOffered what="MC_TorqueControl and MC_WriteDriveOperationMode" />}
+      <fieldset class="plain-fieldset" disabled={driveExecuted} data-blocks="torque-control">
+        <h4 class="sub">MC_TorqueControl · MC_Halt</h4>
+        <form
+          class="row"
+          data-form="torque-control"
+          onSubmit={(e) => {
+            e.preventDefault();
+            if (online) void send('torque-control', torqueControlBody(f), setErr);
+          }}
+        >
+          <NumField f={f} set={set} k="torque" label={f.relative === '1' ? 'Torque change (%)' : 'Torque (%)'} errors={err} name="torque-torque" hint="of rated torque; positive drives the positive way" />
+          <NumField f={f} set={set} k="torque_ramp" label="Torque ramp (%/s)" errors={err} name="torque-ramp" hint="> 0" />
+          <NumField f={f} set={set} k="velocity_limit_high" label={`Limit high (${u}/s)`} errors={err} name="torque-limit-high" hint="velocity limit high: within ±AxisVeloMax" />
+          <NumField f={f} set={set} k="velocity_limit_low" label={`Limit low (${u}/s)`} errors={err} name="torque-limit-low" hint="velocity limit low: ≤ the high limit" />
+          <NumField f={f} set={set} k="manual_start_torque" label="Start torque (%)" errors={err} name="torque-start-torque" placeholder="actual" hint="blank = the drive's actual torque" />
+          <label class="check" title="The torque is a change of the running torque control's target">
+            <input type="checkbox" name="torque-relative" checked={f.relative === '1'} onChange={(e) => set('relative', (e.target as HTMLInputElement).checked ? '1' : '')} /> relative
+          </label>
+          <div class="row-buttons">
+            <button type="submit" class="btn btn-primary" name="torque-start" disabled={offline} title="MC_TorqueControl: the drive in torque mode, the torque ramped, the velocity kept within the limits">
+              Start
+            </button>
+            <ActionButton name="torque-halt" kind="warn" disabled={offline} title="MC_Halt: back to position control, from where the load is and how fast it goes" onClick={() => send('halt', { body: {}, errors: {} }, setHaltErr)}>
+              Back to position control
+            </ActionButton>
+          </div>
+        </form>
+        {haltErr.body && <div class="field-error">{haltErr.body}</div>}
+        <p class="small muted panel-note">
+          {running ? `#${running.id} ${running.state}. ` : ''}Halt, Stop or any move takes the axis back to position control. On the simulated drive the torque moves a model (acceleration per
+          percent, friction).
+        </p>
+      </fieldset>
       <h4 class="sub">MC_ReadDriveOperationMode · MC_WriteDriveOperationMode</h4>
       <form
         class="row drive-mode"
         data-form="drive-mode"
         onSubmit={(e) => {
           e.preventDefault();
-          if (online) void writeMode();
+          if (online && !driveExecuted) void writeMode();
         }}
       >
         <div class="field drive-mode-read" data-field="drive-mode-read">
@@ -155,9 +158,10 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
           options={WRITABLE_DRIVE_MODES.map((m) => [m, DRIVE_MODE_LABEL[m] ?? m])}
           name="drive-mode"
           title="Position-based modes only, at rest (torque is MC_TorqueControl's)"
+          disabled={driveExecuted}
         />
         <div class="row-buttons">
-          <button type="submit" class="btn" name="drive-mode-write" disabled={offline} title="MC_WriteDriveOperationMode (at rest); Done once the drive reports the mode">
+          <button type="submit" class="btn" name="drive-mode-write" disabled={offline || driveExecuted} title="MC_WriteDriveOperationMode (at rest); Done once the drive reports the mode">
             Write
           </button>
         </div>
@@ -167,7 +171,7 @@ export function TorquePanel({ axis: a, s, online, send }: BlockProps) {
 }
 
 /** AxisEnablePosCorrection (#1046) and the three correction sources. */
-export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, params }: BlockProps) {
+export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, params, driveExecuted }: BlockProps) {
   const axis = a.config.name;
   const u = a.config.unit;
   const backlash = paramDefault(params, P_BACKLASH);
@@ -268,74 +272,77 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, p
         </tbody>
       </table>
 
-      <h4 class="sub">MC_PositionCorrectionLimiter</h4>
-      <form
-        class="row"
-        data-form="limiter"
-        onSubmit={(e) => {
-          e.preventDefault();
-          if (online) void start('position-correction-limiter', limiterBody(lim), setLimErr);
-        }}
-      >
-        <NumField f={lim} set={setLim} k="value" label={`Correction (${u})`} errors={limErr} name="limiter-value" />
-        <SelectField f={lim} set={setLim} k="mode" label="Mode" errors={limErr} options={CORRECTION_MODES} name="limiter-mode" />
-        {lim.mode === 'fast' && <NumField f={lim} set={setLim} k="acceleration" label={`Acc (${u}/s²)`} errors={limErr} name="limiter-acceleration" placeholder="0" hint="blank or 0 = no limitation" />}
-        {lim.mode === 'full_length' && <NumField f={lim} set={setLim} k="correction_length" label={`Correction length (${u})`} errors={limErr} name="limiter-length" hint="the travel a change is spread over (> 0)" />}
-        <div class="row-buttons">
-          <button type="submit" class="btn btn-primary" name="limiter-start" disabled={offline} title="MC_PositionCorrectionLimiter (a running one is taken over from where it is)">
-            Start
-          </button>
-          {releaseButton('limiter-release', limCmd, 'the correction stays where it is')}
-        </div>
-      </form>
+      {driveExecuted && <NotOffered what="The limiter, backlash and table compensation" />}
+      <fieldset class="plain-fieldset" disabled={driveExecuted} data-blocks="position-correction">
+        <h4 class="sub">MC_PositionCorrectionLimiter</h4>
+        <form
+          class="row"
+          data-form="limiter"
+          onSubmit={(e) => {
+            e.preventDefault();
+            if (online) void start('position-correction-limiter', limiterBody(lim), setLimErr);
+          }}
+        >
+          <NumField f={lim} set={setLim} k="value" label={`Correction (${u})`} errors={limErr} name="limiter-value" />
+          <SelectField f={lim} set={setLim} k="mode" label="Mode" errors={limErr} options={CORRECTION_MODES} name="limiter-mode" />
+          {lim.mode === 'fast' && <NumField f={lim} set={setLim} k="acceleration" label={`Acc (${u}/s²)`} errors={limErr} name="limiter-acceleration" placeholder="0" hint="blank or 0 = no limitation" />}
+          {lim.mode === 'full_length' && <NumField f={lim} set={setLim} k="correction_length" label={`Correction length (${u})`} errors={limErr} name="limiter-length" hint="the travel a change is spread over (> 0)" />}
+          <div class="row-buttons">
+            <button type="submit" class="btn btn-primary" name="limiter-start" disabled={offline} title="MC_PositionCorrectionLimiter (a running one is taken over from where it is)">
+              Start
+            </button>
+            {releaseButton('limiter-release', limCmd, 'the correction stays where it is')}
+          </div>
+        </form>
 
-      <h4 class="sub">MC_BacklashCompensation</h4>
-      <form
-        class="row"
-        data-form="backlash"
-        onSubmit={(e) => {
-          e.preventDefault();
-          if (online) void start('backlash-compensation', backlashBody(bl), setBlErr);
-        }}
-      >
-        <NumField f={bl} set={setBl} k="backlash" label={`Backlash (${u})`} errors={blErr} name="backlash-value" placeholder={backlash.placeholder} hint={backlash.title} />
-        <NumField f={bl} set={setBl} k="ramp" label={`Ramp (${u}/s)`} errors={blErr} name="backlash-ramp" hint="> 0" />
-        <SelectField f={bl} set={setBl} k="disable_mode" label="On release" errors={blErr} options={DISABLE_MODES} name="backlash-disable-mode" title="hold: the correction stays; reset: back to 0 at once" />
-        <label class="check" title="false: compensated while travelling negative (left flank); true: while positive">
-          <input
-            type="checkbox"
-            name="backlash-positive"
-            checked={bl.compensate_in_positive_direction === '1'}
-            onChange={(e) => setBl('compensate_in_positive_direction', (e.target as HTMLInputElement).checked ? '1' : '')}
-          />{' '}
-          positive direction
-        </label>
-        <div class="row-buttons">
-          <button type="submit" class="btn btn-primary" name="backlash-start" disabled={offline} title="MC_BacklashCompensation">
-            Start
-          </button>
-          {releaseButton('backlash-release', blCmd, `${bl.disable_mode || 'hold'} as started`)}
-        </div>
-      </form>
+        <h4 class="sub">MC_BacklashCompensation</h4>
+        <form
+          class="row"
+          data-form="backlash"
+          onSubmit={(e) => {
+            e.preventDefault();
+            if (online) void start('backlash-compensation', backlashBody(bl), setBlErr);
+          }}
+        >
+          <NumField f={bl} set={setBl} k="backlash" label={`Backlash (${u})`} errors={blErr} name="backlash-value" placeholder={backlash.placeholder} hint={backlash.title} />
+          <NumField f={bl} set={setBl} k="ramp" label={`Ramp (${u}/s)`} errors={blErr} name="backlash-ramp" hint="> 0" />
+          <SelectField f={bl} set={setBl} k="disable_mode" label="On release" errors={blErr} options={DISABLE_MODES} name="backlash-disable-mode" title="hold: the correction stays; reset: back to 0 at once" />
+          <label class="check" title="false: compensated while travelling negative (left flank); true: while positive">
+            <input
+              type="checkbox"
+              name="backlash-positive"
+              checked={bl.compensate_in_positive_direction === '1'}
+              onChange={(e) => setBl('compensate_in_positive_direction', (e.target as HTMLInputElement).checked ? '1' : '')}
+            />{' '}
+            positive direction
+          </label>
+          <div class="row-buttons">
+            <button type="submit" class="btn btn-primary" name="backlash-start" disabled={offline} title="MC_BacklashCompensation">
+              Start
+            </button>
+            {releaseButton('backlash-release', blCmd, `${bl.disable_mode || 'hold'} as started`)}
+          </div>
+        </form>
 
-      <h4 class="sub">MC_TableBasedPositionCompensation</h4>
-      <form
-        class="row"
-        data-form="table-compensation"
-        onSubmit={(e) => {
-          e.preventDefault();
-          if (online) void start('table-based-position-compensation', tableCompensationBody(tab), setTabErr);
-        }}
-      >
-        <NumField f={tab} set={setTab} k="ramp" label={`Ramp (${u}/s)`} errors={tabErr} name="table-ramp" hint="> 0" />
-        <SelectField f={tab} set={setTab} k="disable_mode" label="On release" errors={tabErr} options={DISABLE_MODES} name="table-disable-mode" title="hold: the correction stays; reset: back to 0 at once" />
-        <div class="row-buttons">
-          <button type="submit" class="btn btn-primary" name="table-start" disabled={offline} title="MC_TableBasedPositionCompensation">
-            Start
-          </button>
-          {releaseButton('table-release', tabCmd, 'as its disable mode says')}
-        </div>
-      </form>
+        <h4 class="sub">MC_TableBasedPositionCompensation</h4>
+        <form
+          class="row"
+          data-form="table-compensation"
+          onSubmit={(e) => {
+            e.preventDefault();
+            if (online) void start('table-based-position-compensation', tableCompensationBody(tab), setTabErr);
+          }}
+        >
+          <NumField f={tab} set={setTab} k="ramp" label={`Ramp (${u}/s)`} errors={tabErr} name="table-ramp" hint="> 0" />
+          <SelectField f={tab} set={setTab} k="disable_mode" label="On release" errors={tabErr} options={DISABLE_MODES} name="table-disable-mode" title="hold: the correction stays; reset: back to 0 at once" />
+          <div class="row-buttons">
+            <button type="submit" class="btn btn-primary" name="table-start" disabled={offline} title="MC_TableBasedPositionCompensation">
+              Start
+            </button>
+            {releaseButton('table-release', tabCmd, 'as its disable mode says')}
+          </div>
+        </form>
+      </fieldset>
       <p class="small muted panel-note" data-testid="compensation-table">
         The table is <code>position_compensation_table</code> of the axis configuration (set with the configuration, not on this page):{' '}
         {table ? (
@@ -355,7 +362,7 @@ export function PositionCorrectionPanel({ axis: a, s, online, send, setBanner, p
 type Conversion = { ok: PositionConversion } | null;
 
 /** The encoder: its scaling and count, MC_SetEncoderScalingFactor, and the conversions. */
-export function EncoderPanel({ axis: a, s, online, send }: BlockProps) {
+export function EncoderPanel({ axis: a, s, online, send, driveExecuted }: BlockProps) {
   const axis = a.config.name;
   const u = a.config.unit;
   const offline = !online;
@@ -386,23 +393,26 @@ export function EncoderPanel({ axis: a, s, online, send }: BlockProps) {
     <Panel title="Encoder" class="encoder">
       <Readout label="Scaling factor" value={sig(s?.encoder_scaling_factor, 9)} unit={`${u}/inc`} name="encoder_scaling_factor" title="AxisEncoderScalingFactor (#1040) now" />
       <Readout label="Encoder count" value={s ? String(s.encoder_count) : '—'} unit="inc" name="encoder_count" title="The raw count (drive position ÷ the build-time scaling, masked by #1043)" />
-      <h4 class="sub">MC_SetEncoderScalingFactor</h4>
-      <form
-        class="row"
-        data-form="encoder-scaling"
-        onSubmit={(e) => {
-          e.preventDefault();
-          if (online) void send('set-encoder-scaling-factor', encoderScalingBody(f), setErr);
-        }}
-      >
-        <NumField f={f} set={set} k="scaling_factor" label={`Scaling factor (${u}/inc)`} errors={err} name="encoder-scaling-factor" placeholder={s ? sig(s.encoder_scaling_factor, 9) : ''} hint="> 0" />
-        <SelectField f={f} set={set} k="mode" label="Mode" errors={err} options={ENCODER_SCALING_MODES} name="encoder-scaling-mode" title="absolute: the position jumps (at rest only); relative: no jump, also in motion" />
-        <div class="row-buttons">
-          <button type="submit" class="btn btn-primary" name="encoder-scaling-set" disabled={offline} title="MC_SetEncoderScalingFactor">
-            Set
-          </button>
-        </div>
-      </form>
+      {driveExecuted && <NotOffered what="MC_SetEncoderScalingFactor" />}
+      <fieldset class="plain-fieldset" disabled={driveExecuted} data-blocks="encoder-scaling">
+        <h4 class="sub">MC_SetEncoderScalingFactor</h4>
+        <form
+          class="row"
+          data-form="encoder-scaling"
+          onSubmit={(e) => {
+            e.preventDefault();
+            if (online) void send('set-encoder-scaling-factor', encoderScalingBody(f), setErr);
+          }}
+        >
+          <NumField f={f} set={set} k="scaling_factor" label={`Scaling factor (${u}/inc)`} errors={err} name="encoder-scaling-factor" placeholder={s ? sig(s.encoder_scaling_factor, 9) : ''} hint="> 0" />
+          <SelectField f={f} set={set} k="mode" label="Mode" errors={err} options={ENCODER_SCALING_MODES} name="encoder-scaling-mode" title="absolute: the position jumps (at rest only); relative: no jump, also in motion" />
+          <div class="row-buttons">
+            <button type="submit" class="btn btn-primary" name="encoder-scaling-set" disabled={offline} title="MC_SetEncoderScalingFactor">
+              Set
+            </button>
+          </div>
+        </form>
+      </fieldset>
       <h4 class="sub">MC_ConvertIncPosToPos · MC_ConvertPosToIncPos</h4>
       <form
         class="row conv"

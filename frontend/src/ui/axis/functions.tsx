@@ -19,6 +19,7 @@ import { useCommand, useForm } from '../../axis/hooks';
 import { NumField, SelectField, useSender } from './block-form';
 import { P_HOME_POSITION, P_HOME_SEARCH_INVERSE, P_HOME_SEARCH_VELOCITY, P_HOME_SYNC_INVERSE, P_HOME_SYNC_VELOCITY, P_REFERENCE_MODE, paramDefault, useLiveParameters } from './axis-params';
 import { EncoderPanel, PositionCorrectionPanel, TorquePanel } from './function-blocks';
+import { driveHomingText, homeModeOptions, homesInDrive, isDriveExecuted } from '../../axis/drive-executed';
 
 /** Longest wait for one move of the sequence (the server's limit). */
 const MOVE_TIMEOUT_MS = 600000;
@@ -33,6 +34,8 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
   const offline = !online;
   const liveStatus = st.get(axis);
   const s = liveStatus?.status ?? null;
+  // The drive runs the profile (Drive Motion Control): its blocks only.
+  const de = isDriveExecuted(a.config, s);
   const [banner, setBanner] = useState<string | null>(null);
   const send = useSender(axis, setBanner);
 
@@ -122,8 +125,10 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
   const [homeErr, setHomeErr] = useState<Record<string, string>>({});
   const [homeId, setHomeId] = useState<number | null>(null);
   const homeCmd = useCommand(homeId);
+  // Homing in the drive: its method, not motiond's referencing options.
+  const inDrive = homesInDrive(home.mode, de);
   const startHome = async () => {
-    const r = await send('home', homeBody(home), setHomeErr);
+    const r = await send('home', homeBody(home, inDrive), setHomeErr);
     if (r) setHomeId(r.id);
   };
   const homeFailed = homeCmd && homeCmd.final && (homeCmd.state === 'error' || homeCmd.outputs.error_id !== 0) ? homeCmd : null;
@@ -148,7 +153,8 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
   const syncDir = paramDefault(params, P_HOME_SYNC_INVERSE, dirOf(P_HOME_SYNC_INVERSE));
   const refModeDefault = paramDefault(params, P_REFERENCE_MODE, refMode);
   const stale = liveStatus?.stale || offline;
-  const blocks = { axis: a, s, online, send, setBanner, params };
+  const blocks = { axis: a, s, online, send, setBanner, params, driveExecuted: de };
+  const optionTitle = (t: string) => (inDrive ? `not with homing in the drive (${driveHomingText(a.config)})` : t);
 
   return (
     <div class={`functions ${stale ? 'stale' : ''}`}>
@@ -220,22 +226,17 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
                 label="Mode"
                 errors={homeErr}
                 name="home-mode"
-                title="default: the referencing sequence of the reference mode (#1076)"
-                options={[
-                  ['default', 'default: referencing'],
-                  ['direct', 'direct'],
-                  ['force_calibration', 'force calibration'],
-                  ['reset_calibration', 'reset calibration'],
-                ]}
+                title={inDrive ? driveHomingText(a.config) : 'default: the referencing sequence of the reference mode (#1076)'}
+                options={homeModeOptions(a.config, de, true)}
               />
               <Field label={`Home position (${u})`} error={homeErr.position} name="home-position">
                 <NumberInput name="home-position" value={home.position} onValue={(v) => setHome('position', v)} placeholder={homePos.placeholder} title={homePos.title} />
               </Field>
-              <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank={`axis: ${refMode || '…'}`} title={refModeDefault.title} />
-              <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank={`axis: ${searchDir.placeholder || '…'}`} title={searchDir.title} />
-              <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder={searchVelocity.placeholder} hint={searchVelocity.title} />
-              <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank={`axis: ${syncDir.placeholder || '…'}`} title={syncDir.title} />
-              <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder={syncVelocity.placeholder} hint={syncVelocity.title} />
+              <SelectField f={home} set={setHome} k="reference_mode" label="Reference mode" errors={{ reference_mode: homeErr['options.reference_mode'] }} options={REFERENCE_MODES} name="home-reference-mode" blank={`axis: ${refMode || '…'}`} title={optionTitle(refModeDefault.title)} disabled={inDrive} />
+              <SelectField f={home} set={setHome} k="search_direction" label="Search direction" errors={{ search_direction: homeErr['options.search_direction'] }} options={dirs} name="home-search-direction" blank={`axis: ${searchDir.placeholder || '…'}`} title={optionTitle(searchDir.title)} disabled={inDrive} />
+              <NumField f={home} set={setHome} k="search_velocity" label={`Search velocity (${u}/s)`} errors={{ search_velocity: homeErr['options.search_velocity'] }} name="home-search-velocity" placeholder={searchVelocity.placeholder} hint={optionTitle(searchVelocity.title)} disabled={inDrive} />
+              <SelectField f={home} set={setHome} k="sync_direction" label="Sync direction" errors={{ sync_direction: homeErr['options.sync_direction'] }} options={dirs} name="home-sync-direction" blank={`axis: ${syncDir.placeholder || '…'}`} title={optionTitle(syncDir.title)} disabled={inDrive} />
+              <NumField f={home} set={setHome} k="sync_velocity" label={`Sync velocity (${u}/s)`} errors={{ sync_velocity: homeErr['options.sync_velocity'] }} name="home-sync-velocity" placeholder={syncVelocity.placeholder} hint={optionTitle(syncVelocity.title)} disabled={inDrive} />
               <div class="form-actions">
                 <label class="check" title="MC_Direct only: set position = actual position afterwards">
                   <input type="checkbox" name="home-clear-lag" checked={home.clear_position_lag === '1'} onChange={(e) => setHome('clear_position_lag', (e.target as HTMLInputElement).checked ? '1' : '')} /> clear lag
@@ -245,6 +246,11 @@ export function FunctionsTab({ axis: a }: { axis: AxisResource }) {
                 </button>
               </div>
             </form>
+            {inDrive && (
+              <p class="small muted panel-note" data-testid="drive-homing">
+                Homing in the drive: {driveHomingText(a.config)}. The reference mode, directions and velocities above are motiond’s referencing and are not sent.
+              </p>
+            )}
             <div class="led-grid">
               <Led on={s?.homed} label="Homed" />
               <Led on={!!s && s.homing_phase !== 'idle'} label="Homing" tone="blue" />

@@ -8,12 +8,14 @@ import { ActionButton, Field, NumberInput, errorText, fieldsOf, parseNum } from 
 import { inputNum } from '../../format';
 import { P_INC_BACKWARD, P_INC_FORWARD, P_JOG_SLOW, numParam } from './axis-params';
 
-export function Inching({ axis, unit, params, online, onError }: {
+export function Inching({ axis, unit, params, online, onError, notOffered }: {
   axis: string;
   unit: string;
   params: Map<number, ParameterResource> | null;
   online: boolean;
   onError: (text: string) => void;
+  /** Why inching is not offered on this axis (its drive runs the profile: DMC jogs while held only), or null. */
+  notOffered?: string | null;
 }) {
   const [back, setBack] = useState('');
   const [fwd, setFwd] = useState('');
@@ -26,7 +28,7 @@ export function Inching({ axis, unit, params, online, onError }: {
   }, [params]);
   const velocity = numParam(params, P_JOG_SLOW);
   const inch = async (forward: boolean) => {
-    if (velocity === null) return;
+    if (velocity === null || notOffered) return;
     const key = forward ? 'forward' : 'backward';
     setErrors({});
     try {
@@ -43,8 +45,15 @@ export function Inching({ axis, unit, params, online, onError }: {
       onError(errorText(e));
     }
   };
-  const ready = online && velocity !== null;
+  const ready = online && velocity !== null && !notOffered;
   const why = velocity === null ? ' (waiting for the parameters)' : '';
+  if (notOffered) {
+    return (
+      <div class="row inching" data-testid="inching-not-offered">
+        <span class="small muted">Inching (one step per click) is {notOffered}: hold a jog button.</span>
+      </div>
+    );
+  }
   return (
     <div class="row inching">
       <Field label={`Step − (${unit})`} error={errors.backward} name="inch-step-backward">

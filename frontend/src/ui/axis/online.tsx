@@ -17,6 +17,7 @@ import { href } from '../../router';
 import { hexId } from '../../api/errors';
 import { P_HOME_POSITION, P_JOG_FAST, P_JOG_SLOW, numParam, paramDefault, useLiveParameters } from './axis-params';
 import { installFunctionKeys, keyOf, type FunctionAction, type FunctionKeyHandlers } from './fkeys';
+import { NOT_OFFERED, driveHomingText, homeModeOptions, homesInDrive, isDriveExecuted } from '../../axis/drive-executed';
 
 function Readout({ label, value, unit, name, extra }: { label: string; value: string; unit: string; name: string; extra?: preact.ComponentChildren }) {
   return (
@@ -66,6 +67,8 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const params = useLiveParameters(axis, a.id);
   const homeDefault = paramDefault(params, P_HOME_POSITION);
   const [error, setError] = useState<string | null>(null);
+  // The drive runs the profile (Drive Motion Control): no jerk, no override, no inching.
+  const de = isDriveExecuted(a.config, s);
 
   // --- enable -------------------------------------------------------------------------
   const [ctrl, setCtrl] = useState(true);
@@ -119,7 +122,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
       velocity: parseNum(velocity),
       acceleration: parseNum(accel, 0),
       deceleration: parseNum(decel, 0),
-      jerk: parseNum(jerk, 0),
+      jerk: de ? 0 : parseNum(jerk, 0),
     };
     // A relative move's input is its distance (PLCopen's name), the others' a target position.
     const position = { 'move-absolute': target, 'move-modulo': moduloTarget, 'move-relative': null, 'move-velocity': null }[moveKind];
@@ -142,7 +145,7 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
   const [stopDec, setStopDec] = useState('');
   const [stopJerk, setStopJerk] = useState('');
   const [stopErrors, setStopErrors] = useState<Record<string, string>>({});
-  const stopBody = () => ({ deceleration: parseNum(stopDec, 0), jerk: parseNum(stopJerk, 0) });
+  const stopBody = () => ({ deceleration: parseNum(stopDec, 0), jerk: de ? 0 : parseNum(stopJerk, 0) });
   const halt = async () => {
     setStopErrors({});
     try {
@@ -336,12 +339,12 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
                 Reset
               </ActionButton>
             </div>
-            <OverrideControl axis={axis} status={s} online={online} onError={setError} />
+            <OverrideControl axis={axis} status={s} online={online} onError={setError} notOffered={de ? NOT_OFFERED : null} />
           </Panel>
 
           <Panel title="Jog" class="jog-panel">
             <JogButtons axis={axis} unit={u} buttons={jogButtons} disabled={offline} />
-            <Inching axis={axis} unit={u} params={params} online={online} onError={setError} />
+            <Inching axis={axis} unit={u} params={params} online={online} onError={setError} notOffered={de ? NOT_OFFERED : null} />
           </Panel>
 
           <Panel
@@ -406,8 +409,8 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               <Field label={`Dec (${u}/s²)`} error={moveErrors.deceleration} hint="0 = axis default" name="deceleration">
                 <NumberInput name="deceleration" value={decel} onValue={setDecel} />
               </Field>
-              <Field label={`Jerk (${u}/s³)`} error={moveErrors.jerk} hint="0 = axis default" name="jerk">
-                <NumberInput name="jerk" value={jerk} onValue={setJerk} />
+              <Field label={`Jerk (${u}/s³)`} error={moveErrors.jerk} hint={de ? 'none: the drive’s profile' : '0 = axis default'} name="jerk">
+                <NumberInput name="jerk" value={de ? '' : jerk} onValue={setJerk} disabled={de} placeholder={de ? '—' : undefined} title={de ? `jerk is ${NOT_OFFERED}` : undefined} />
               </Field>
             </form>
             <div class="row stop-row">
@@ -418,7 +421,14 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
                 <NumberInput name="stop-deceleration" value={stopDec} onValue={setStopDec} placeholder="default" title="MC_Halt / MC_Stop deceleration; blank or 0 = default" />
               </Field>
               <Field label={`Stop jerk (${u}/s³)`} error={stopErrors.jerk} name="stop-jerk">
-                <NumberInput name="stop-jerk" value={stopJerk} onValue={setStopJerk} placeholder="default" title="MC_Halt / MC_Stop jerk; blank or 0 = default" />
+                <NumberInput
+                  name="stop-jerk"
+                  value={de ? '' : stopJerk}
+                  onValue={setStopJerk}
+                  disabled={de}
+                  placeholder={de ? '—' : 'default'}
+                  title={de ? `jerk is ${NOT_OFFERED}` : 'MC_Halt / MC_Stop jerk; blank or 0 = default'}
+                />
               </Field>
               <ActionButton name="halt" disabled={offline} title="MC_Halt: decelerate to standstill" onClick={halt}>
                 Halt
@@ -469,11 +479,17 @@ export function OnlineTab({ axis: a }: { axis: AxisResource }) {
               }}
             >
               <Field label="Homing mode" name="home-mode" error={homeErrors.mode} class="wide">
-                <select name="home-mode" title="default: the referencing sequence of the reference mode (#1076)" value={homeMode} onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}>
-                  <option value="default">default: referencing</option>
-                  <option value="direct">direct: set the position here</option>
-                  <option value="force_calibration">force calibration: mark as homed</option>
-                  <option value="reset_calibration">reset calibration: mark as not homed</option>
+                <select
+                  name="home-mode"
+                  title={homesInDrive(homeMode, de) ? driveHomingText(a.config) : 'default: the referencing sequence of the reference mode (#1076)'}
+                  value={homeMode}
+                  onChange={(e) => setHomeMode((e.target as HTMLSelectElement).value as HomingMode)}
+                >
+                  {homeModeOptions(a.config, de).map(([m, label, why]) => (
+                    <option value={m} disabled={!!why} title={why ?? undefined}>
+                      {label}
+                    </option>
+                  ))}
                 </select>
               </Field>
               <Field label={`Home position (${u})`} name="home-position" error={homeErrors.position}>

@@ -22,12 +22,14 @@ export function factorPercent(factor: number | null | undefined): number | null 
   return Math.min(100, Math.max(0, Math.round(factor * 100)));
 }
 
-export function OverrideControl({ axis, status, online, onError }: {
+export function OverrideControl({ axis, status, online, onError, notOffered }: {
   axis: string;
   /** The axis status (null before the first one). */
   status: OverrideStatus | null;
   online: boolean;
   onError: (text: string) => void;
+  /** Why MC_SetOverride is not offered on this axis (its drive runs the profile), or null. */
+  notOffered?: string | null;
 }) {
   const power = status ? status.power_override_percent : null;
   const effective = status?.override_percent;
@@ -61,6 +63,7 @@ export function OverrideControl({ axis, status, online, onError }: {
   );
 
   const send = (v: number) => {
+    if (notOffered) return;
     setValue(v);
     wanted.current = v;
     lastInput.current = Date.now();
@@ -96,7 +99,7 @@ export function OverrideControl({ axis, status, online, onError }: {
 
   return (
     <div class="row override">
-      <span class="field-label" title="MC_SetOverride: velocity factor of this axis">
+      <span class="field-label" title={notOffered ? `MC_SetOverride is ${notOffered}` : 'MC_SetOverride: velocity factor of this axis'}>
         Override
       </span>
       <input
@@ -106,7 +109,8 @@ export function OverrideControl({ axis, status, online, onError }: {
         max={100}
         step={1}
         value={value ?? 100}
-        disabled={!online}
+        disabled={!online || !!notOffered}
+        title={notOffered ? `MC_SetOverride is ${notOffered}` : undefined}
         onPointerDown={grab}
         onInput={(e) => send(Number((e.target as HTMLInputElement).value))}
       />
@@ -114,10 +118,15 @@ export function OverrideControl({ axis, status, online, onError }: {
         {value ?? '—'} %
       </span>
       {[0, 25, 50, 100].map((v) => (
-        <button type="button" class="btn btn-small" name={`override-${v}`} disabled={!online} onClick={() => send(v)}>
+        <button type="button" class="btn btn-small" name={`override-${v}`} disabled={!online || !!notOffered} title={notOffered ? `MC_SetOverride is ${notOffered}` : undefined} onClick={() => send(v)}>
           {v}
         </button>
       ))}
+      {notOffered && (
+        <div class="small muted override-power" data-testid="override-not-offered">
+          The override is {notOffered}.
+        </div>
+      )}
       {power !== null && power !== 100 && (
         <div class="small muted override-power" data-testid="override-power">
           × MC_Power override {Number(power.toFixed(1))} % = {num(effective, 1)} % effective

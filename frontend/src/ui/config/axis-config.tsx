@@ -4,7 +4,9 @@
 //
 // The drive is a simulated one (plant model, homing cam, switches) or a CiA-402 servo drive on
 // the EtherCAT bus (its SubDevice chosen from `GET /bus`); on the simulated bus CiA-402 is
-// offered disabled, with how to start motiond for it.
+// offered disabled, with how to start motiond for it. A CiA-402 drive has its profile side
+// (`host`: motiond's setpoints every cycle; `drive`: the drive runs the profile, Drive Motion
+// Control) and the homing method written to it before it homes (0x6098, blank: its own).
 //
 // Saving an existing axis first asks the server what the save would do (`?dry_run=true`) and
 // shows it (save-panel.tsx beside this file): parameters written online on the running axis, or the axis
@@ -12,7 +14,7 @@
 // online and persistent values where these differ from the configured (start-up) value.
 import { useEffect, useState } from 'preact/hooks';
 import type { JSX } from 'preact';
-import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, SimDriveConfig } from '../../api/types';
+import type { AxisConfig, AxisLiveStatus, AxisResource, BusResource, Cia402Mode, ParamValue, ProfileSide, SimDriveConfig } from '../../api/types';
 import { ApiError, NOT_A_NUMBER } from '../../api/problem';
 import { api } from '../../api/client';
 import { command, refreshAxes, statuses } from '../../services';
@@ -25,6 +27,7 @@ import { type ConfigChange, type SideValues, differingFields, rebuildBlockedText
 import { SavePanel, SaveResult } from './save-panel';
 import { cia402Unavailable, driveOptions, firstFreeDrive } from '../../system/bus';
 import { useBus } from '../system/bus';
+import { HOMING_METHODS, OTHER_HOMING_METHODS } from '../../axis/drive-executed';
 
 export const UNITS = ['mm', 'm', 'um', 'deg', 'rad', 'rev', 'in', 'inc'];
 
@@ -40,6 +43,12 @@ const CIA_MODES: [Cia402Mode, string, string][] = [
   ['csp', 'CSP (position)', 'cyclic synchronous position: the drive closes the position loop'],
   ['csv', 'CSV (velocity)', 'cyclic synchronous velocity: motiond closes the position loop'],
   ['cst', 'CST (torque)', 'cyclic synchronous torque: motiond closes the position and velocity loops'],
+];
+
+/** Who runs the profile: value, label, what it means. */
+const PROFILES: [ProfileSide, string, string][] = [
+  ['host', 'motiond (host)', 'motiond plans the motion and sends a setpoint every cycle in the mode below: every block'],
+  ['drive', 'the drive (Drive Motion Control)', 'the drive runs profile position, velocity and homing from the targets motiond sends: power, reset, set position, home, jog, halt, stop, the moves and the touch probe only (no coupling, cams, superposition, torque control, jerk or override)'],
 ];
 
 const PLANTS: [PlantKind, string][] = [
@@ -96,6 +105,10 @@ export interface ConfigForm {
    */
   cia: Record<CiaField, string>;
   ciaMode: Cia402Mode;
+  /** `drive.profile`: who runs the motion profile. */
+  ciaProfile: ProfileSide;
+  /** `drive.homing_method` (0x6098, 1..37); blank: null, the drive's own. */
+  homingMethod: string;
   parameters: { key: string; value: string }[];
   /** `dynamics.jog_deadman_max` (s); blank: not sent, the server's default (1 s). */
   jogDeadmanMax: string;
@@ -135,6 +148,8 @@ export const DEFAULT_FORM: ConfigForm = {
   // the server's defaults (a CST drive needs a velocity gain > 0: the server says so at the field)
   cia: { subdevice: '', increments_per_unit: '1000', velocity_increments_per_unit: '', position_gain: '50', velocity_gain: '0', acceleration_feed_forward: '0', max_torque: '1000' },
   ciaMode: 'csp',
+  ciaProfile: 'host',
+  homingMethod: '',
   parameters: [],
 };
 
@@ -201,6 +216,8 @@ export function formOf(c: AxisConfig): ConfigForm {
         }
       : { ...DEFAULT_FORM.cia },
     ciaMode: cia?.mode ?? 'csp',
+    ciaProfile: cia?.profile ?? 'host',
+    homingMethod: typeof cia?.homing_method === 'number' ? String(cia.homing_method) : '',
     parameters: Object.entries(c.parameters ?? {}).map(([key, value]) => ({ key, value: String(value) })),
   };
 }
@@ -258,6 +275,8 @@ export function configOf(f: ConfigForm): { config: AxisConfig | null; errors: Re
       velocity_gain: num('drive.velocity_gain', f.cia.velocity_gain),
       acceleration_feed_forward: num('drive.acceleration_feed_forward', f.cia.acceleration_feed_forward),
       max_torque: num('drive.max_torque', f.cia.max_torque),
+      profile: f.ciaProfile,
+      homing_method: f.homingMethod.trim() === '' ? null : whole('drive.homing_method', f.homingMethod),
     } : {
       kind: 'simulated',
       plant: plant(),
@@ -289,6 +308,8 @@ function ciaFields(mode: Cia402Mode): string[] {
     'drive.increments_per_unit',
     'drive.velocity_increments_per_unit',
     'drive.mode',
+    'drive.profile',
+    'drive.homing_method',
     ...(mode !== 'csp' ? ['drive.position_gain'] : []),
     ...(mode === 'cst' ? ['drive.velocity_gain', 'drive.acceleration_feed_forward', 'drive.max_torque'] : []),
   ];
@@ -764,6 +785,36 @@ function DriveFields({ form, setForm, bus, axis, err, num }: {
                   {label}
                 </option>
               ))}
+            </select>
+          </Field>
+          <Field label="Motion profile" name="drive.profile" class="field-row" error={err('drive.profile')} hint={PROFILES.find(([k]) => k === form.ciaProfile)?.[2]}>
+            <select name="drive.profile" class="select-fit" value={form.ciaProfile} onChange={(e) => set('ciaProfile', (e.target as HTMLSelectElement).value as ProfileSide)}>
+              {PROFILES.map(([k, label, title]) => (
+                <option value={k} title={title}>
+                  {label}
+                </option>
+              ))}
+            </select>
+          </Field>
+          <Field
+            label="Homing method (0x6098)"
+            name="drive.homing_method"
+            class="field-row"
+            error={err('drive.homing_method')}
+            hint="for homing in the drive (MC_Home drive-based; default too when the drive runs the profile): written to the drive before it homes"
+          >
+            <select name="drive.homing_method" class="select-fit" value={form.homingMethod} onChange={(e) => set('homingMethod', (e.target as HTMLSelectElement).value)}>
+              <option value="">the drive’s own (not written)</option>
+              {HOMING_METHODS.map(([n, label]) => (
+                <option value={String(n)}>
+                  {n} · {label}
+                </option>
+              ))}
+              <optgroup label="other CiA-402 methods">
+                {OTHER_HOMING_METHODS.map((n) => (
+                  <option value={String(n)}>{n}</option>
+                ))}
+              </optgroup>
             </select>
           </Field>
           {form.ciaMode !== 'csp' && num('drive.position_gain', form.cia.position_gain, (v) => setCia('position_gain', v), 'Position gain (1/s)', 'the position loop motiond closes, > 0')}

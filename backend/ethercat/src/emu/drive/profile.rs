@@ -11,7 +11,8 @@
 //! target. Statusword bit 12 (set-point acknowledge) rises with the accepted set point and
 //! falls once bit 4 is low and the buffer is free again; bit 10 (target reached) is set when
 //! no set point is left and the actual position stayed within 0x6067 for 0x6068 ms, or, while
-//! halted (bit 8), when the drive stands. Releasing the halt resumes the set point.
+//! halted (bit 8, braking at 0x6084 as it is then), when the drive stands. Releasing the halt
+//! resumes the set point.
 //!
 //! HM runs the homing method of 0x6098 on the plant's limit switches and index pulse (methods
 //! 1, 2, 17, 18, 33, 34, 35 and 37), at 0x6099:1 while searching a switch and 0x6099:2 while
@@ -268,9 +269,9 @@ impl Cia402Emu {
         let halt = cw & CW_HALT != 0;
         let p = &mut self.profile;
         if halt {
-            let dec = p
-                .active
-                .map_or(f64::from(self.od.u32(0x6084, 0)), |s| s.deceleration);
+            // The profile deceleration as it is now (a controller brakes harder by writing
+            // it with the halt).
+            let dec = f64::from(self.od.u32(0x6084, 0));
             p.ramp.to_velocity(0.0, dec, dec, dt);
         } else if let Some(sp) = p.active {
             if p.ramp
