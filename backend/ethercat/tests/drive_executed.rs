@@ -445,6 +445,15 @@ fn drive_based_homing_on_a_host_axis_returns_to_csp_without_a_jump() {
         "index at 10 mm"
     );
     assert!((m.st().actual_position - 100.0).abs() < 1e-3);
+    // The drive's position jumped where it homed: no following error for it (the lag is the
+    // drive's own while it runs the profile).
+    let st = m.st();
+    assert!(
+        st.following_error_max < 0.1 && st.following_error_min > -0.1,
+        "{} {}",
+        st.following_error_min,
+        st.following_error_max
+    );
     // Back in CSP: the set position is the actual one, no jump while the mode changes.
     let mut last = m.st().actual_position;
     for _ in 0..100 {

@@ -211,6 +211,9 @@ impl Axis {
             acceleration: self.act_acc,
             jerk: 0.0,
         };
+        // The lag is the drive's own while it runs the profile (it reports it, bit 13): what
+        // the drive answers is its own position, also where homing moved it.
+        self.sent_position = self.act_pos;
         self.drive.since_change = self.drive.since_change.saturating_add(1);
         let pf = fb.profile;
         let answered = pf.mode == self.drive.cmd.mode && self.drive.since_change >= ANSWER_CYCLES;
@@ -240,6 +243,9 @@ impl Axis {
             acceleration: self.act_acc,
             jerk: 0.0,
         };
+        // The lag is the drive's own while it runs the profile (it reports it, bit 13): what
+        // the drive answers is its own position, also where homing moved it.
+        self.sent_position = self.act_pos;
         self.drive.since_change = self.drive.since_change.saturating_add(1);
         // How long the drive has seen bit 4 low: a new set point needs a rising edge it sees.
         self.drive.start_low = if self.drive.cmd.start {
