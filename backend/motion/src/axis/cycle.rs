@@ -313,18 +313,7 @@ impl Axis {
         match job.kind {
             JobKind::Velocity | JobKind::JogHeld { released: false } => {
                 let reached = finished && ovr > 0.0 && job.planned_override == ovr;
-                if reached != job.out.in_velocity {
-                    let out = FbOutputs {
-                        in_velocity: reached,
-                        ..job.out
-                    };
-                    job.emit(cx, out);
-                }
-                job.phase = if reached {
-                    Phase::Holding
-                } else {
-                    Phase::Moving
-                };
+                job.hold_velocity(cx, reached);
                 self.job = Some(job);
             }
             JobKind::Positioning { continuous: true } => {

@@ -400,18 +400,7 @@ impl Axis {
                 let reached = answered
                     && pf.target_reached
                     && (self.act_vel - target).abs() <= 0.01 * job.velocity.max(EPS_V);
-                if reached != job.out.in_velocity {
-                    let out = FbOutputs {
-                        in_velocity: reached,
-                        ..job.out
-                    };
-                    job.emit(cx, out);
-                }
-                job.phase = if reached {
-                    Phase::Holding
-                } else {
-                    Phase::Moving
-                };
+                job.hold_velocity(cx, reached);
                 self.job = Some(job);
             }
             JobKind::Halt | JobKind::JogHeld { released: true } => {

@@ -221,6 +221,22 @@ impl Job {
         self.emit(cx, out);
     }
 
+    /// A velocity job at its velocity (InVelocity, Holding) or not (Moving).
+    pub(super) fn hold_velocity(&mut self, cx: &mut Ctx<'_, impl EventSink>, reached: bool) {
+        if reached != self.out.in_velocity {
+            let out = FbOutputs {
+                in_velocity: reached,
+                ..self.out
+            };
+            self.emit(cx, out);
+        }
+        self.phase = if reached {
+            Phase::Holding
+        } else {
+            Phase::Moving
+        };
+    }
+
     pub(super) fn finish_done(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
         self.emit(cx, ended(self.out, End::Done));
     }

@@ -823,29 +823,16 @@ pub fn target_of(s: &AppState, id: CommandId) -> AppResult<Target> {
 /// Releases a command (the falling edge of Execute/Enable) and audits it; the cycle it took
 /// effect in.
 pub async fn release(s: &AppState, id: CommandId, client: &ClientInfo) -> AppResult<u64> {
-    let target = target_of(s, id)?;
-    let result = s
-        .kernel_command(target, CommandKind::Release { target: id })
-        .await;
-    let outcome = match &result {
-        Ok(_) => "accepted".to_owned(),
-        Err(AppError::Rejected(e)) => format!("rejected:{}", e.code()),
-        // The cycle thread did not answer: nothing was released, nothing to audit.
-        Err(_) => return result,
-    };
-    s.audit(AuditEntry {
-        at: store::now_rfc3339(),
-        client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
-        client_id: client.id.clone(),
-        principal: client.principal.clone(),
-        action: "command.release".into(),
-        target: Some(id.to_string()),
-        command_id: Some(id),
-        detail: serde_json::json!({"via": client.via}).to_string(),
-        outcome: Some(outcome),
-        idempotency_key: None,
-    });
-    result
+    let detail = serde_json::json!({"via": client.via});
+    control_audited(
+        s,
+        id,
+        CommandKind::Release { target: id },
+        "release",
+        detail,
+        client,
+    )
+    .await
 }
 
 /// New inputs for a running MoveVelocity with ContinuousUpdate: admitted like motion (the
@@ -857,13 +844,31 @@ pub async fn update_inputs(
     dynamics: motion::Dynamics,
     client: &ClientInfo,
 ) -> AppResult<u64> {
-    let target = target_of(s, id)?;
     let kind = CommandKind::UpdateInputs {
         target: id,
         velocity,
         dynamics,
     };
+    // An unknown command is a 404 before the control lease is asked.
+    target_of(s, id)?;
     s.control.admit(client, &kind)?;
+    let detail = serde_json::json!({"via": client.via, "velocity": velocity,
+        "acceleration": dynamics.acceleration, "deceleration": dynamics.deceleration});
+    control_audited(s, id, kind, "inputs", detail, client).await
+}
+
+/// A change to the running command `id` (`kind` names it as its target), audited as
+/// `command.<action>` with its outcome; the cycle it took effect in. A cycle thread that did
+/// not answer changed nothing: nothing to audit.
+async fn control_audited(
+    s: &AppState,
+    id: CommandId,
+    kind: CommandKind,
+    action: &str,
+    detail: serde_json::Value,
+    client: &ClientInfo,
+) -> AppResult<u64> {
+    let target = target_of(s, id)?;
     let result = s.kernel_command(target, kind).await;
     let outcome = match &result {
         Ok(_) => "accepted".to_owned(),
@@ -875,12 +880,10 @@ pub async fn update_inputs(
         client_addr: (!client.addr.is_empty()).then(|| client.addr.clone()),
         client_id: client.id.clone(),
         principal: client.principal.clone(),
-        action: "command.inputs".into(),
+        action: format!("command.{action}"),
         target: Some(id.to_string()),
         command_id: Some(id),
-        detail: serde_json::json!({"via": client.via, "velocity": velocity,
-            "acceleration": dynamics.acceleration, "deceleration": dynamics.deceleration})
-        .to_string(),
+        detail: detail.to_string(),
         outcome: Some(outcome),
         idempotency_key: None,
     });
