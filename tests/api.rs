@@ -1087,7 +1087,13 @@ async fn asyncapi_json_is_current() {
         .values()
         .map(|o| (o["title"].as_str().unwrap(), o))
         .collect();
-    for m in ["subscribe", "unsubscribe", "keepalive", "release"] {
+    for m in [
+        "subscribe",
+        "unsubscribe",
+        "keepalive",
+        "release",
+        "update-inputs",
+    ] {
         assert_eq!(ops[m]["action"], "receive", "{m}");
         assert_eq!(
             ops[m]["reply"]["messages"].as_array().unwrap().len(),

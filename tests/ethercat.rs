@@ -966,6 +966,28 @@ async fn drive_executed_axis_works(s: &Server, axis: &str, subdevice: u16) {
         (st["actual_velocity"].as_f64().unwrap() + 30.0).abs() < 0.5
     })
     .await;
+    // The same over the websocket (`update-inputs`): the command as it stands comes back.
+    let mut ws = ws_connect(s).await;
+    let r = call(
+        &mut ws,
+        1,
+        "update-inputs",
+        json!({"command": id, "velocity": 20.0, "acceleration": 400.0}),
+    )
+    .await;
+    assert_eq!(r["result"]["id"], id, "{r}");
+    until_status(s, axis, "at the velocity sent over the websocket", |st| {
+        (st["actual_velocity"].as_f64().unwrap() + 20.0).abs() < 0.5
+    })
+    .await;
+    let r = call(
+        &mut ws,
+        2,
+        "update-inputs",
+        json!({"command": id, "velocity": -1.0}),
+    )
+    .await;
+    assert_eq!(r["error"]["data"]["code"], "validation_failed", "{r}");
     let r = post(s, &a("halt?wait=true&timeout_ms=20000"), json!({})).await;
     assert_eq!(r.json["state"], "done", "{}", r.text);
 }

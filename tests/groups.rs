@@ -8,7 +8,7 @@ mod common;
 use std::time::Duration;
 
 use common::*;
-use futures_util::{SinkExt, StreamExt};
+use futures_util::StreamExt;
 use serde_json::{Value, json};
 use tokio_tungstenite::tungstenite::Message;
 
@@ -418,34 +418,11 @@ async fn a_group_runs_a_path_refuses_what_is_wrong_and_keeps_its_configuration_a
     let _ = std::fs::remove_dir_all(dir);
 }
 
-type Stream =
-    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
-
-async fn call(ws: &mut Stream, id: u64, method: &str, params: Value) -> Value {
-    let m = json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params});
-    ws.send(Message::Text(m.to_string().into())).await.unwrap();
-    loop {
-        let msg = tokio::time::timeout(Duration::from_secs(20), ws.next())
-            .await
-            .expect("an answer within 20 s")
-            .expect("the socket stays open")
-            .unwrap();
-        if let Message::Text(t) = msg {
-            let v: Value = serde_json::from_str(&t).unwrap();
-            if v["id"] == id {
-                return v;
-            }
-        }
-    }
-}
-
 #[tokio::test(flavor = "multi_thread")]
 async fn a_blocker_is_released_and_a_stop_held_over_the_websocket() {
     let s = Server::start();
     enable_xy(&s).await;
-    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
-        .await
-        .expect("websocket connects");
+    let mut ws = ws_connect(&s).await;
 
     // The group's status as a subscription: the full object first.
     let r = call(

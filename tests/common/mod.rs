@@ -254,3 +254,36 @@ pub fn cannot_run(test: &str, why: &str) {
         }
     }
 }
+
+pub type WsStream =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+/// A websocket session on `/api/v1/ws` (no Origin: a tool, not a page).
+pub async fn ws_connect(s: &Server) -> WsStream {
+    tokio_tungstenite::connect_async(format!("ws://{}/api/v1/ws", s.addr))
+        .await
+        .expect("websocket connects")
+        .0
+}
+
+/// A JSON-RPC request and its answer (the message with its id; notifications in between are
+/// skipped).
+pub async fn call(ws: &mut WsStream, id: u64, method: &str, params: Value) -> Value {
+    use futures_util::{SinkExt, StreamExt};
+    use tokio_tungstenite::tungstenite::Message;
+    let m = json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params});
+    ws.send(Message::Text(m.to_string().into())).await.unwrap();
+    loop {
+        let msg = tokio::time::timeout(Duration::from_secs(20), ws.next())
+            .await
+            .expect("an answer within 20 s")
+            .expect("the socket stays open")
+            .unwrap();
+        if let Message::Text(t) = msg {
+            let v: Value = serde_json::from_str(&t).unwrap();
+            if v["id"] == id {
+                return v;
+            }
+        }
+    }
+}

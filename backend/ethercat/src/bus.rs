@@ -26,12 +26,54 @@ use motion::{DriveFeedback, DriveSetpoint};
 use crate::emu::Segment;
 use crate::txrx::{self, LinkState, Opener, RawWire, SegmentWire, Wire};
 
-/// SubDevices on one segment (a power of two, as ethercrab wants).
-pub const MAX_SUBDEVICES: usize = 16;
-/// Bytes of process image of the whole group.
-pub const MAX_PDI: usize = 1024;
+/// SubDevices on one segment (a power of two, as ethercrab wants): 64 servos, or fewer with
+/// their I/O terminals.
+pub const MAX_SUBDEVICES: usize = 64;
+/// Bytes of process image of the whole group: 64 drives with the full mapping (56 bytes
+/// each) and room for terminals. ethercrab sends it in as many frames as it needs.
+pub const MAX_PDI: usize = 4096;
 const MAX_FRAMES: usize = 16;
-const MAX_PDU_DATA: usize = PduStorage::element_size(1100);
+/// Data of one frame's single PDU (an Ethernet frame carries up to 1498 bytes of PDUs):
+/// ethercrab's storage adds the headers and the working counter of one PDU to it.
+const PDU_PAYLOAD: usize = 1100;
+const MAX_PDU_DATA: usize = PduStorage::element_size(PDU_PAYLOAD);
+/// The FRMW of the reference clock's system time that ethercrab puts before the first chunk
+/// of a DC group's process image: a PDU's header and working counter (12) and 8 bytes.
+const DC_TIME_PDU: usize = 12 + 8;
+
+/// The working counter of one whole exchange. ethercrab lays the process image out as all
+/// SubDevices' inputs, then all their outputs, in bus order, and sends it in LRWs of at most
+/// `PDU_PAYLOAD` bytes (the first one shorter by the DC time's PDU): each LRW
+/// counts 1 for every SubDevice whose inputs it touches and 2 for every SubDevice whose
+/// outputs it writes, so a SubDevice whose image straddles two frames counts in both.
+/// `io`: (input, output) bytes of each SubDevice, in bus order.
+fn expected_working_counter(io: &[(usize, usize)], dc: bool) -> u16 {
+    // (start, end, weight) of every SubDevice's inputs, then outputs, in the image.
+    let mut ranges = Vec::with_capacity(2 * io.len());
+    let mut at = 0;
+    for &(inputs, _) in io {
+        ranges.push((at, at + inputs, 1u16));
+        at += inputs;
+    }
+    for &(_, outputs) in io {
+        ranges.push((at, at + outputs, 2u16));
+        at += outputs;
+    }
+    let total = at;
+    let mut wkc = 0;
+    let (mut start, mut first) = (0, true);
+    while start < total {
+        let room = PDU_PAYLOAD - if dc && first { DC_TIME_PDU } else { 0 };
+        let end = (start + room).min(total);
+        wkc += ranges
+            .iter()
+            .filter(|&&(a, b, _)| a < b && a < end && b > start)
+            .map(|r| r.2)
+            .sum::<u16>();
+        (start, first) = (end, false);
+    }
+    wkc
+}
 
 type DcGroup = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op, HasDc>;
 type FreeGroup = SubDeviceGroup<MAX_SUBDEVICES, MAX_PDI, ethercrab::DefaultLock, Op>;
@@ -580,6 +622,9 @@ fn leak<T>(t: T) -> &'static T {
     Box::leak(Box::new(t))
 }
 
+/// Stack of the bring-up thread (only what it touches is ever committed).
+const BRING_UP_STACK: usize = 64 << 20;
+
 /// The 0x60C2 interpolation period (value, index) of a cycle.
 fn interpolation_period(cycle: Duration) -> (u8, i8) {
     let us = cycle.as_micros() as u64;
@@ -640,17 +685,25 @@ impl EthercatBus {
                 retry_behaviour: RetryBehaviour::Count(opts.retries),
             },
         ));
-        let (group, infos) = block_on(bring_up(md, opts))?;
-        let group: &'static Group = leak(group);
-        let expected = infos
-            .iter()
-            .enumerate()
-            .map(|(i, _)| {
+        // On its own thread: ethercrab's group of 64 SubDevices moves by value through the
+        // bring-up's typestates, more than a test or tokio thread's 2 MB of stack.
+        let bring_up_opts = opts.clone();
+        let (group, infos) = std::thread::Builder::new()
+            .name("ethercat-bring-up".into())
+            .stack_size(BRING_UP_STACK)
+            .spawn(move || block_on(bring_up(md, &bring_up_opts)).map(|(g, i)| (leak(g), i)))
+            .map_err(|e| format!("cannot start the bring-up: {e}"))?
+            .join()
+            .map_err(|_| "the EtherCAT bring-up panicked".to_string())??;
+        let group: &'static Group = group;
+        let io: Vec<(usize, usize)> = (0..infos.len())
+            .map(|i| {
                 let sd = group.subdevice(md, i).expect("found at bring-up");
                 let io = sd.io_raw();
-                2 * u16::from(!io.outputs().is_empty()) + u16::from(!io.inputs().is_empty())
+                (io.inputs().len(), io.outputs().len())
             })
-            .sum();
+            .collect();
+        let expected = expected_working_counter(&io, matches!(group, Group::Dc(_)));
         let status = Arc::new(BusStatus {
             al_states: infos.iter().map(|_| AtomicU8::new(8)).collect(),
             subdevices: infos,
@@ -1117,7 +1170,7 @@ impl DriveBus for EthercatBus {
             st.frames.fetch_add(1, Relaxed);
         }
         let good = link_up
-            && match block_on(self.group.exchange(self.md)) {
+            && match txrx::block_on_spinning(self.group.exchange(self.md)) {
                 Ok(r) => {
                     st.last_working_counter.store(r.working_counter, Relaxed);
                     if let Some((time, offset)) = r.dc {
@@ -1237,5 +1290,34 @@ impl DriveBus for EthercatBus {
     /// emulated segment takes its faults through the emulator's door, `emu::drive::Input`).
     fn simulated(&mut self) -> Option<&mut SimBus> {
         Some(&mut self.sim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::expected_working_counter;
+
+    #[test]
+    fn a_subdevice_whose_image_straddles_two_frames_counts_in_both() {
+        // Two drives of the full mapping (29 bytes in, 27 out): one frame, 3 each.
+        assert_eq!(expected_working_counter(&[(29, 27); 2], true), 6);
+        // 64 of them: 1856 bytes of inputs, then 1728 of outputs, in LRWs of 1100 bytes.
+        // Inputs of drive 37 ([1073, 1102)) straddle the first frame's end, outputs of
+        // drives 12 ([2180, 2207)) and 53 ([3287, 3314)) the second's and the third's.
+        assert_eq!(
+            expected_working_counter(&[(29, 27); 64], false),
+            64 + 1 + 2 * (64 + 2)
+        );
+        // With DC the first LRW is 20 bytes shorter (1080): drive 37's inputs still straddle,
+        // the second frame ends exactly between drives 11 and 12, drive 52 straddles the third.
+        assert_eq!(
+            expected_working_counter(&[(29, 27); 64], true),
+            64 + 1 + 2 * (64 + 1)
+        );
+        // A coupler without process data counts nowhere.
+        assert_eq!(
+            expected_working_counter(&[(0, 0), (2, 0), (0, 1)], false),
+            3
+        );
     }
 }

@@ -276,3 +276,73 @@ fn a_segment_without_dc_runs_free() {
         0
     );
 }
+
+/// A segment of 64 servos (the full mapping, 3584 bytes of process image): ethercrab sends
+/// the image in four frames, a drive whose image straddles two frames counts in both
+/// working counters, and every drive follows its own set point — with and without DC.
+#[test]
+fn sixty_four_drives_share_a_process_image_of_four_frames() {
+    for dc in [true, false] {
+        let seg = servos(64, dc);
+        let mut bus = EthercatBus::start(Link::Emulated(seg.clone()), &BusOptions::new(CYCLE), 64)
+            .expect("bring-up");
+        let status = bus.status();
+        assert_eq!(status.subdevices.len(), 64);
+        assert!(
+            status
+                .subdevices
+                .iter()
+                .all(|s| s.drive.map(|l| l.name) == Some("full"))
+        );
+        // 64 × 3, and the straddling drives once more (see the unit test of the count).
+        assert_eq!(status.expected_working_counter, if dc { 195 } else { 197 });
+        for i in 0..64u16 {
+            let cfg = DriveConfig::Cia402(Cia402Config::csp(i, 1000.0));
+            assert!(bus.attach(i as usize, cfg.build(0.001)).unwrap().is_none());
+        }
+        let mut sp = vec![
+            DriveSetpoint {
+                enable: true,
+                ..DriveSetpoint::default()
+            };
+            64
+        ];
+        let mut fb = vec![DriveFeedback::default(); 64];
+        // Drive i goes to i/64 mm, 0.01 mm per cycle once enabled.
+        let target = |i: usize| i as f64 / 64.0;
+        let mut reached = false;
+        for _ in 0..5000 {
+            bus.exchange(&sp, &mut fb);
+            std::thread::sleep(CYCLE);
+            for (i, (s, f)) in sp.iter_mut().zip(&fb).enumerate() {
+                if f.enabled {
+                    s.position = (s.position + 0.01).min(target(i));
+                }
+            }
+            if fb
+                .iter()
+                .enumerate()
+                .all(|(i, f)| f.enabled && (f.actual_position - target(i)).abs() < 0.002)
+            {
+                reached = true;
+                break;
+            }
+        }
+        assert!(reached, "dc {dc}: {fb:?}");
+        let wkc_errors = status
+            .working_counter_errors
+            .load(std::sync::atomic::Ordering::Relaxed);
+        assert_eq!(wkc_errors, 0, "dc {dc}");
+        assert_eq!(
+            status
+                .last_working_counter
+                .load(std::sync::atomic::Ordering::Relaxed),
+            status.expected_working_counter
+        );
+        let mut s = seg.lock().unwrap();
+        for i in [0, 37, 52, 53, 63] {
+            let p = s.app::<Cia402Emu>(i).unwrap().position;
+            assert!((p - 1000.0 * target(i)).abs() < 2.0, "drive {i} at {p}");
+        }
+    }
+}

@@ -50,8 +50,8 @@ pub enum Cmd {
         /// The interface to answer frames on.
         #[arg(long = "on", value_name = "IFACE")]
         on: String,
-        /// Drives on the segment (1–16).
-        #[arg(long, default_value_t = bus::EMULATED_DRIVES, value_parser = clap::value_parser!(u32).range(1..=16))]
+        /// Drives on the segment (1–64).
+        #[arg(long, default_value_t = bus::EMULATED_DRIVES, value_parser = clap::value_parser!(u32).range(1..=64))]
         drives: u32,
         /// Drives like many not written by motiond's authors: no touch probe (0x60B8–0x60BB)
         /// and no digital inputs (0x60FD) in the dictionary; any mapping write is taken and

@@ -1,5 +1,5 @@
 //! The AsyncAPI 3 document of the websocket `/api/v1/ws` (`GET /asyncapi.json`, committed as
-//! `openapi/asyncapi.json`): every JSON-RPC request (subscribe, unsubscribe, keepalive, release
+//! `openapi/asyncapi.json`): every JSON-RPC request (subscribe, unsubscribe, keepalive, release, update-inputs
 //! and each command method) with its reply, and every notification. Built from the types the
 //! session reads and writes: the command params are the REST bodies' schemas (plus `axis`,
 //! `wait`, `timeout_ms`), the other messages the types of `ws.rs`, results and errors the
@@ -287,6 +287,25 @@ pub fn document() -> Value {
         schema_ref("ControlResult"),
         "Release a command (falling edge of Execute/Enable)",
         "Unlocks an MC_Stop, ends a jog, a power or a gear-in-dyn (as `DELETE /api/v1/commands/{id}`).",
+    );
+    d.rpc(
+        "update-inputs",
+        {
+            let mut p = schemas
+                .get("InputsBody")
+                .cloned()
+                .expect("InputsBody is in the components");
+            p["properties"]["command"] = json!({"type": "integer", "minimum": 1, "description": "The running move-velocity's command id.", "example": 7});
+            let required = p["required"].as_array().cloned().unwrap_or_default();
+            p["required"] = Value::Array([json!("command")].into_iter().chain(required).collect());
+            p.as_object_mut().unwrap().remove("example");
+            p
+        },
+        schema_ref("CommandResource"),
+        "New velocity and dynamics for a move-velocity with continuous_update",
+        "As `POST /api/v1/commands/{id}/inputs` (MC_MoveVelocity's ContinuousUpdate, also on a drive-executed \
+         axis, where the drive takes the new target at once): the result is the command as it stands; a refusal \
+         is an error whose `data` is the REST API's problem.",
     );
     for block in super::blocks::BLOCKS {
         let key = match block.at {

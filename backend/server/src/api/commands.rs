@@ -122,6 +122,17 @@ pub async fn update_inputs(
     super::JsonBody(body, _): super::JsonBody<InputsBody>,
 ) -> AppResult<Json<CommandResource>> {
     let id = parse_id(&id)?;
+    Ok(Json(take_inputs(&s, id, &body, &client.0).await?))
+}
+
+/// New inputs for a running MoveVelocity with ContinuousUpdate, checked, given and audited;
+/// the command as it stands (REST and the websocket's `update-inputs`).
+pub async fn take_inputs(
+    s: &AppState,
+    id: motion::CommandId,
+    body: &InputsBody,
+    client: &crate::model::ClientInfo,
+) -> AppResult<CommandResource> {
     let mut errors = Vec::new();
     if !(body.velocity.is_finite() && body.velocity > 0.0) {
         errors.push(crate::error::FieldError {
@@ -148,8 +159,8 @@ pub async fn update_inputs(
         deceleration: body.deceleration,
         jerk: 0.0,
     };
-    commands::update_inputs(&s, id, body.velocity, dynamics, &client.0).await?;
-    Ok(Json(commands::find(&s, id)?))
+    commands::update_inputs(s, id, body.velocity, dynamics, client).await?;
+    commands::find(s, id)
 }
 
 #[utoipa::path(post, path = "/api/v1/commands/{id}/keepalive", tag = "commands", summary = "Renew a jog's dead-man",

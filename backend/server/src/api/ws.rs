@@ -735,7 +735,7 @@ fn handle(
     )]
     let need = match method.as_str() {
         "subscribe" | "unsubscribe" => Role::Viewer,
-        "keepalive" | "release" | "ext-setpoint-gen-feed" => Role::Operator,
+        "keepalive" | "release" | "update-inputs" | "ext-setpoint-gen-feed" => Role::Operator,
         name => blocks::find(target_kind(&params), name).map_or(Role::Viewer, |b| b.role),
     };
     if let Err(e) = may(s, client, need) {
@@ -842,35 +842,34 @@ fn handle(
             let Some(cmd) = params.get("command").and_then(|c| c.as_u64()) else {
                 return Some(rpc_error(&id, -32602, "command (id) is required", None));
             };
-            let permit = match in_flight.clone().try_acquire_owned() {
-                Ok(p) => p,
-                Err(_) => return Some(too_many_in_flight(&id)),
-            };
             let s = s.clone();
-            let out = out_tx.clone();
             let client = client.clone();
-            tokio::spawn(async move {
-                let r = if method == "keepalive" {
+            answer_later(in_flight, out_tx, &id, notification, async move {
+                let cycle = if method == "keepalive" {
                     commands::keepalive(&s, cmd).await
                 } else {
                     commands::release(&s, cmd, &client).await
-                };
-                let msg = match r {
-                    Ok(cycle) => rpc_result(
-                        &id,
-                        json!(ControlResult {
-                            command: cmd,
-                            cycle
-                        }),
-                    ),
-                    Err(e) => api_error(&id, e),
-                };
-                if !notification {
-                    let _ = out.send(msg).await;
-                }
-                drop(permit);
-            });
-            None
+                }?;
+                Ok(json!(ControlResult {
+                    command: cmd,
+                    cycle
+                }))
+            })
+        }
+        "update-inputs" => {
+            let Some(cmd) = params.remove("command").and_then(|c| c.as_u64()) else {
+                return Some(rpc_error(&id, -32602, "command (id) is required", None));
+            };
+            let body: super::commands::InputsBody = match super::from_value(Value::Object(params)) {
+                Ok((b, _)) => b,
+                Err(e) => return Some(api_error(&id, e)),
+            };
+            let s = s.clone();
+            let client = client.clone();
+            answer_later(in_flight, out_tx, &id, notification, async move {
+                let c = super::commands::take_inputs(&s, cmd, &body, &client).await?;
+                Ok(json!(c))
+            })
         }
         "ext-setpoint-gen-feed" => {
             let Some(axis) = take_axis(&mut params) else {
@@ -880,26 +879,14 @@ fn handle(
                 Ok((b, _)) => b,
                 Err(e) => return Some(api_error(&id, e)),
             };
-            let permit = match in_flight.clone().try_acquire_owned() {
-                Ok(p) => p,
-                Err(_) => return Some(too_many_in_flight(&id)),
-            };
             let s = s.clone();
-            let out = out_tx.clone();
             let client = client.clone();
-            tokio::spawn(async move {
-                let r = commands::ext_feed(&s, &axis, &body, ExtSetPointFeedBody::to_kind, &client)
-                    .await;
-                if !notification {
-                    let msg = match r {
-                        Ok(cycle) => rpc_result(&id, json!(FeedResult { cycle })),
-                        Err(e) => api_error(&id, e),
-                    };
-                    let _ = out.send(msg).await;
-                }
-                drop(permit);
-            });
-            None
+            answer_later(in_flight, out_tx, &id, notification, async move {
+                let cycle =
+                    commands::ext_feed(&s, &axis, &body, ExtSetPointFeedBody::to_kind, &client)
+                        .await?;
+                Ok(json!(FeedResult { cycle }))
+            })
         }
         name if super::reads::READS.iter().any(|r| r.name == name) => {
             let Some(axis) = take_axis(&mut params) else {
@@ -1004,6 +991,33 @@ fn may(s: &AppState, client: &ClientInfo, need: Role) -> Result<(), AppError> {
         )),
         None => Ok(()),
     }
+}
+
+/// Runs a request's work off the session's loop (at most `MAX_IN_FLIGHT` at once) and
+/// answers with its result or its problem, unless the request was a notification.
+fn answer_later(
+    in_flight: &Arc<tokio::sync::Semaphore>,
+    out_tx: &mpsc::Sender<String>,
+    id: &Value,
+    notification: bool,
+    work: impl std::future::Future<Output = Result<Value, AppError>> + Send + 'static,
+) -> Option<String> {
+    let Ok(permit) = in_flight.clone().try_acquire_owned() else {
+        return Some(too_many_in_flight(id));
+    };
+    let (out, id) = (out_tx.clone(), id.clone());
+    tokio::spawn(async move {
+        let r = work.await;
+        if !notification {
+            let msg = match r {
+                Ok(v) => rpc_result(&id, v),
+                Err(e) => api_error(&id, e),
+            };
+            let _ = out.send(msg).await;
+        }
+        drop(permit);
+    });
+    None
 }
 
 fn too_many_in_flight(id: &Value) -> String {
