@@ -10,7 +10,7 @@
 //! holding), `*_standing` (enabled, no job). One step of 64 axes; ÷ 64 per axis.
 //!
 //! Group `cycle_64_axes_segment`: the same cases on an emulated EtherCAT segment of 64
-//! drives (DC, SYNC0, the full mapping: four frames per cycle), through `EthercatBus` as
+//! drives (DC, SYNC0, the full mapping: four LRWs and a frame of state checks per cycle), through `EthercatBus` as
 //! the cycle thread runs it, paced at 1 ms. Timed: the kernel's step and the bus exchange,
 //! which includes the frames' round trips through the TX/RX thread and the emulated
 //! segment's answer (the emulator's work is in it, the same for every case).
@@ -322,7 +322,8 @@ fn cases(c: &mut Criterion, group: &str, segment: bool) {
                 format!(", cycle median {:.0} µs, p99 {:.0} µs", at(0.5), at(0.99))
             }
         );
-        if load == Load::Positioning {
+        // (`cargo test` runs each case once: too short for a move to end.)
+        if load == Load::Positioning && cycles >= 1000 {
             assert!(
                 m.moves - moves > AXES as u64,
                 "the axes move back and forth"

@@ -694,7 +694,14 @@ impl EthercatBus {
             .spawn(move || block_on(bring_up(md, &bring_up_opts)).map(|(g, i)| (leak(g), i)))
             .map_err(|e| format!("cannot start the bring-up: {e}"))?
             .join()
-            .map_err(|_| "the EtherCAT bring-up panicked".to_string())??;
+            .map_err(|p| {
+                let why = p
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| p.downcast_ref::<String>().cloned())
+                    .unwrap_or_default();
+                format!("the EtherCAT bring-up panicked: {why}")
+            })??;
         let group: &'static Group = group;
         let io: Vec<(usize, usize)> = (0..infos.len())
             .map(|i| {
@@ -1170,7 +1177,10 @@ impl DriveBus for EthercatBus {
             st.frames.fetch_add(1, Relaxed);
         }
         let good = link_up
-            && match txrx::block_on_spinning(self.group.exchange(self.md)) {
+            && match txrx::block_on_spinning(
+                self.group.exchange(self.md),
+                st.link.runs_apart_from_caller(),
+            ) {
                 Ok(r) => {
                     st.last_working_counter.store(r.working_counter, Relaxed);
                     if let Some((time, offset)) = r.dc {

@@ -139,7 +139,9 @@ pub fn wait(
             revents: 0,
         },
     ];
-    let ms = timeout.as_millis().min(i32::MAX as u128) as i32;
+    // Rounded up: a wait of 0.3 ms must not become a poll that returns at once (a busy loop
+    // until the time has passed).
+    let ms = timeout.as_nanos().div_ceil(1_000_000).min(i32::MAX as u128) as i32;
     // SAFETY: two pollfds of ours.
     let n = unsafe { libc::poll(fds.as_mut_ptr(), 2, ms) };
     if n < 0 {

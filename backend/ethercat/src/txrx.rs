@@ -36,14 +36,16 @@ use crate::raw::{self, EventFd};
 pub const SPIN: Duration = Duration::from_micros(100);
 
 /// `block_on` for the cycle thread's exchange: while the future waits for a reply it polls
-/// again as soon as it is woken, spinning for up to [`SPIN`] before it parks. A parked thread
-/// is woken from the TX/RX thread's CPU by an interrupt that costs tens of microseconds per
-/// frame on a virtual machine — five frames a cycle for 64 drives (decision 170).
-pub fn block_on_spinning<F: std::future::Future>(f: F) -> F::Output {
+/// again as soon as it is woken, spinning (yielding) for up to [`SPIN`] before it parks. A
+/// parked thread is woken from the TX/RX thread's CPU by an interrupt that costs tens of
+/// microseconds per frame on a virtual machine — five frames a cycle for 64 drives (decision
+/// 170). `spin`: whether spinning can help, i.e. the TX/RX thread runs on another CPU (see
+/// [`LinkState::runs_apart_from_caller`]); on the same CPU a spinning real-time thread would
+/// only keep the reply from being made.
+pub fn block_on_spinning<F: std::future::Future>(f: F, spin: bool) -> F::Output {
     use std::sync::atomic::Ordering::{Acquire, Release};
     use std::task::{Context, Poll};
     thread_local! {
-        static BUDGET: std::cell::RefCell<SpinBudget> = std::cell::RefCell::new(SpinBudget::new());
         // Made once per thread: the cycle's exchange allocates nothing.
         static WAKER: (Arc<SpinFlag>, Waker) = {
             let flag = Arc::new(SpinFlag {
@@ -56,23 +58,27 @@ pub fn block_on_spinning<F: std::future::Future>(f: F) -> F::Output {
     WAKER.with(|(flag, waker)| {
         let mut cx = Context::from_waker(waker);
         let mut f = std::pin::pin!(f);
+        let mut spin = spin;
         loop {
             if let Poll::Ready(v) = f.as_mut().poll(&mut cx) {
                 return v;
             }
             let since = Instant::now();
-            let spin = BUDGET.with_borrow_mut(|b| b.allows());
+            let spinning = spin && CYCLE_SPIN.allows();
             while !flag.woken.swap(false, Acquire) {
-                if !spin || since.elapsed() >= SPIN {
+                if !spinning || since.elapsed() >= SPIN {
                     // A wake between the check and the park leaves its token: park returns.
                     std::thread::park();
                     flag.woken.store(false, Release);
+                    // A wake that came while spinning left a token too, and this park may
+                    // have returned on it: no second spin in this exchange.
+                    spin = false;
                     break;
                 }
                 std::thread::yield_now();
             }
-            if spin {
-                BUDGET.with_borrow_mut(|b| b.spend(since.elapsed().min(SPIN)));
+            if spinning {
+                CYCLE_SPIN.spend(since.elapsed().min(SPIN));
             }
         }
     })
@@ -116,6 +122,8 @@ pub struct LinkState {
     fault: Mutex<Option<String>>,
     /// What the thread got: SCHED_FIFO and the CPU, or why not.
     realtime: Mutex<String>,
+    /// The CPU the thread runs on when it got both SCHED_FIFO and its CPU, else -1.
+    pinned_cpu: std::sync::atomic::AtomicI32,
     wake: EventFd,
 }
 
@@ -133,6 +141,7 @@ impl LinkState {
             kill: AtomicBool::new(false),
             fault: Mutex::new(None),
             realtime: Mutex::new(String::new()),
+            pinned_cpu: std::sync::atomic::AtomicI32::new(-1),
             wake: EventFd::new()?,
         })
     }
@@ -144,6 +153,32 @@ impl LinkState {
     pub fn fault(&self) -> Option<String> {
         self.fault.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
+    /// Whether this thread never runs on the TX/RX thread's CPU (its affinity excludes it),
+    /// and that thread has its CPU at real-time priority: then waiting for a frame by
+    /// spinning saves the cross-CPU wake-up. Checked once per thread and CPU.
+    pub fn runs_apart_from_caller(&self) -> bool {
+        thread_local! {
+            static APART: std::cell::Cell<Option<(i32, bool)>> = const { std::cell::Cell::new(None) };
+        }
+        let cpu = self.pinned_cpu.load(Relaxed);
+        if cpu < 0 {
+            return false;
+        }
+        if let Some((c, apart)) = APART.get()
+            && c == cpu
+        {
+            return apart;
+        }
+        // SAFETY: reads this thread's affinity into a zeroed set of the right size.
+        let apart = unsafe {
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) == 0
+                && !libc::CPU_ISSET(cpu as usize, &set)
+        };
+        APART.set(Some((cpu, apart)));
+        apart
+    }
+
     pub fn realtime(&self) -> String {
         self.realtime
             .lock()
@@ -289,33 +324,49 @@ fn carries_process_data(frame: &[u8]) -> bool {
     matches!(frame.get(16), Some(0x0A..=0x0C | 0x0E))
 }
 
-/// How much a real-time thread may spin: a quarter of every 10 ms at most. Linux stops
-/// real-time threads that ran 95 % of a second for the rest of it (50 ms, longer than a frame
-/// may take), and the other threads on the CPU need it too: a cycle whose exchange fills it
-/// (a short cycle, many drives) sleeps between frames again.
+/// How much real-time threads may spin: a quarter of every 10 ms at most, for all threads
+/// that share the budget together (the cycle thread has one, every segment's TX/RX thread
+/// shares another: they would share a CPU). Linux stops real-time threads that ran 95 % of a
+/// second for the rest of it (50 ms, longer than a frame may take), and the other threads on
+/// the CPU need it too: a cycle whose exchange fills it (a short cycle, many drives) sleeps
+/// between frames again.
 struct SpinBudget {
-    window: Instant,
-    spent: Duration,
+    /// Start of the current window and time spun in it, in ns since the first use.
+    window: AtomicU64,
+    spent: AtomicU64,
 }
 
+static CYCLE_SPIN: SpinBudget = SpinBudget::new();
+static TXRX_SPIN: SpinBudget = SpinBudget::new();
+
 impl SpinBudget {
-    const WINDOW: Duration = Duration::from_millis(10);
-    const SHARE: Duration = Duration::from_micros(2500);
-    fn new() -> SpinBudget {
+    const WINDOW_NS: u64 = 10_000_000;
+    const SHARE_NS: u64 = 2_500_000;
+    const fn new() -> SpinBudget {
         SpinBudget {
-            window: Instant::now(),
-            spent: Duration::ZERO,
+            window: AtomicU64::new(0),
+            spent: AtomicU64::new(0),
         }
     }
-    fn allows(&mut self) -> bool {
-        if self.window.elapsed() >= Self::WINDOW {
-            self.window = Instant::now();
-            self.spent = Duration::ZERO;
-        }
-        self.spent < Self::SHARE
+    fn now_ns() -> u64 {
+        static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+        EPOCH.get_or_init(Instant::now).elapsed().as_nanos() as u64
     }
-    fn spend(&mut self, d: Duration) {
-        self.spent += d;
+    fn allows(&self) -> bool {
+        let now = Self::now_ns();
+        let w = self.window.load(Relaxed);
+        if now.saturating_sub(w) >= Self::WINDOW_NS
+            && self
+                .window
+                .compare_exchange(w, now, Relaxed, Relaxed)
+                .is_ok()
+        {
+            self.spent.store(0, Relaxed);
+        }
+        self.spent.load(Relaxed) < Self::SHARE_NS
+    }
+    fn spend(&self, d: Duration) {
+        self.spent.fetch_add(d.as_nanos() as u64, Relaxed);
     }
 }
 
@@ -339,8 +390,11 @@ fn run(
     let mut sent_at = [None::<Instant>; 256];
     let mut answered = [false; 256];
     // The last process-data frame sent or received: the cycle's exchange is under way.
-    let mut last_traffic = Instant::now() - SPIN;
-    let mut budget = SpinBudget::new();
+    let mut last_traffic = Instant::now()
+        .checked_sub(SPIN)
+        .unwrap_or_else(Instant::now);
+    // Spinning helps only a TX/RX thread that has its own CPU at real-time priority.
+    let may_spin = st.pinned_cpu.load(Relaxed) >= 0;
     loop {
         if st.kill.swap(false, Relaxed) {
             return Err("the TX/RX loop was stopped (injected fault)".into());
@@ -385,7 +439,7 @@ fn run(
         // microseconds (the cycle's next chunk of process image, its reply): look for it
         // without sleeping for a while, as a sleeping thread is woken by another CPU only
         // after tens of microseconds on a virtual machine.
-        let wait = if last_traffic.elapsed() < SPIN && budget.allows() {
+        let wait = if may_spin && last_traffic.elapsed() < SPIN && TXRX_SPIN.allows() {
             Duration::ZERO
         } else {
             Duration::from_millis(50)
@@ -398,7 +452,7 @@ fn run(
                     // Yield, not spin: another thread of the same SCHED_FIFO priority on this
                     // CPU (another segment's loop) must not wait for this one's window to end.
                     std::thread::yield_now();
-                    budget.spend(looked.elapsed());
+                    TXRX_SPIN.spend(looked.elapsed());
                 }
                 continue;
             }
@@ -437,9 +491,12 @@ fn run(
 }
 
 /// Tries SCHED_FIFO and pinning for the calling thread; what it got, in words.
-fn request_realtime() -> (String, bool) {
+/// What it got, in words; whether it got all it asked for; the CPU it is pinned to when it
+/// also runs at real-time priority.
+fn request_realtime() -> (String, bool, Option<usize>) {
     let mut notes = Vec::new();
     let mut granted = true;
+    let mut pinned = None;
     // SAFETY: plain libc calls on the current thread with valid arguments.
     unsafe {
         let param = libc::sched_param {
@@ -462,6 +519,7 @@ fn request_realtime() -> (String, bool) {
             libc::CPU_SET(cpu, &mut set);
             if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) == 0 {
                 notes.push(format!("pinned to CPU {cpu}"));
+                pinned = Some(cpu);
             } else {
                 granted = false;
                 notes.push(format!(
@@ -473,7 +531,7 @@ fn request_realtime() -> (String, bool) {
             notes.push("not pinned (one CPU)".into());
         }
     }
-    (notes.join(", "), granted)
+    (notes.join(", "), granted, pinned.filter(|_| granted))
 }
 
 /// Opens the link again after it failed.
@@ -495,7 +553,9 @@ pub fn spawn(
         .name("ecat-txrx".into())
         .spawn(move || {
             let st = state;
-            let (rt, granted) = request_realtime();
+            let (rt, granted, pinned) = request_realtime();
+            st.pinned_cpu
+                .store(pinned.map_or(-1, |c| c as i32), Relaxed);
             if !granted {
                 tracing::warn!("EtherCAT TX/RX thread: {rt}; it runs at normal priority");
             }
@@ -567,7 +627,16 @@ mod tests {
     fn the_exchange_sees_its_reply_whether_it_spins_or_has_parked() {
         // Within the spin, well after it (parked), and several in a row on one thread (the
         // thread's waker is reused: a stale wake of one exchange must not lose the next).
-        for delay in [0, 20, 500, 20_000, 0, 300] {
+        for (delay, spin) in [
+            (0, true),
+            (20, true),
+            (500, true),
+            (20_000, true),
+            (0, true),
+            (300, false),
+            (0, false),
+            (20_000, false),
+        ] {
             let shared = Arc::new(Mutex::new((None, None::<Waker>)));
             let replier = shared.clone();
             let t = std::thread::spawn(move || {
@@ -578,7 +647,7 @@ mod tests {
                     w.wake();
                 }
             });
-            assert_eq!(block_on_spinning(Reply(shared)), delay as u32);
+            assert_eq!(block_on_spinning(Reply(shared), spin), delay as u32);
             t.join().unwrap();
         }
     }

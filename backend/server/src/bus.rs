@@ -197,11 +197,20 @@ pub fn serve_emulated_segment(
         .map_err(|_| "the emulated segment stopped".to_string())
 }
 
+/// What `--bus emulated` puts on its segment.
+#[derive(Clone, Copy, Debug)]
+pub struct Emulation {
+    /// Emulated drives (the demo's axes use the first [`EMULATED_DRIVES`]).
+    pub drives: u32,
+    /// Drives like many not written by motiond's authors (`--emulated-strict-drives`).
+    pub strict: bool,
+}
+
 /// Builds the bus (blocking: an EtherCAT segment is brought up to OP here).
 pub fn start(
     kind: BusKind,
     interface: Option<&str>,
-    strict_drives: bool,
+    emulation: Emulation,
     cycle: Duration,
     max_errors_in_row: u32,
     timeout: Option<Duration>,
@@ -216,7 +225,7 @@ pub fn start(
                 .ok_or("--bus ethercat needs --interface (the network interface of the segment)")?
                 .to_string(),
         ),
-        BusKind::Emulated => Link::Emulated(emulated_segment(EMULATED_DRIVES, strict_drives)),
+        BusKind::Emulated => Link::Emulated(emulated_segment(emulation.drives, emulation.strict)),
     };
     let segment = match &link {
         Link::Emulated(s) => Some(s.clone()),

@@ -196,6 +196,10 @@ pub struct ServeArgs {
     /// (as `emulate-segment --strict-drives`).
     #[arg(long = "emulated-strict-drives", global = true)]
     pub emulated_strict_drives: bool,
+    /// The number of drives on `--bus emulated`'s segment (4–64): the demo's axes use the
+    /// first four, the others wait for axes configured on them (`drive.subdevice`).
+    #[arg(long = "emulated-drives", global = true, value_name = "N", default_value_t = bus::EMULATED_DRIVES, value_parser = clap::value_parser!(u32).range(4..=64))]
+    pub emulated_drives: u32,
     /// Lost frames or wrong working counters in a row after which every axis of the EtherCAT
     /// bus stops into ErrorStop (1–1000).
     #[arg(long = "bus-max-errors", global = true, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]

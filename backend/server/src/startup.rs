@@ -56,10 +56,13 @@ pub async fn start_machine(args: &ServeArgs) -> Result<Machine, String> {
     let cycle_time = args.cycle_us as f64 * 1e-6;
     // The bus first: an EtherCAT segment is brought up to OP before the cycle starts.
     let (bus, bus_handle) = {
-        let (kind, iface, strict) = (
+        let (kind, iface, emulation) = (
             args.bus,
             args.interface.clone(),
-            args.emulated_strict_drives,
+            bus::Emulation {
+                drives: args.emulated_drives,
+                strict: args.emulated_strict_drives,
+            },
         );
         let (cycle, max, timeout) = (
             std::time::Duration::from_micros(args.cycle_us as u64),
@@ -71,7 +74,7 @@ pub async fn start_machine(args: &ServeArgs) -> Result<Machine, String> {
             bus::start(
                 kind,
                 iface.as_deref(),
-                strict,
+                emulation,
                 cycle,
                 max,
                 timeout,
