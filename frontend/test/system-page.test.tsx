@@ -15,7 +15,7 @@ vi.mock('../src/services', async () => {
   };
 });
 
-import { AuditPanel, ConfigPanel } from '../src/ui/system/system';
+import { AuditPanel, ConfigPanel, clockText } from '../src/ui/system/system';
 import { parseRoute, href } from '../src/router';
 import { ms, plantText, simulatedAxes } from '../src/system/bus';
 
@@ -239,5 +239,15 @@ describe('the route and the bus', () => {
     expect(ms(0.001)).toBe('1 ms');
     expect(ms(0.005)).toBe('5 ms');
     expect(ms(undefined)).toBe('—');
+  });
+});
+
+describe('the clock KPI', () => {
+  it('says real time plainly and names what is not', () => {
+    const c = { cycle: 1500, cycle_time_s: 0.001, time_s: 1.5, advancing: false };
+    expect(clockText({ ...c, mode: 'real' })).toBe('real');
+    expect(clockText({ ...c, mode: 'virtual' })).toBe('virtual');
+    expect(clockText({ ...c, mode: 'fast', factor: 10 })).toBe('fast ×10');
+    expect(clockText({ ...c, mode: 'fast', factor: null })).toBe('fast (max)');
   });
 });

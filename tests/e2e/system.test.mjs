@@ -63,6 +63,11 @@ describe('the System page', () => {
     const period = num(await text('tr[data-metric="period"] td[data-q="p50_us"]'));
     assert.ok(period > sys.cycle_time * 1e6 * 0.5 && period < sys.cycle_time * 1e6 * 2, `period p50 ${period} µs`);
     assert.equal(await text('[data-kpi="cycle_time"] .kpi-value'), `${sys.cycle_time * 1000} ms`);
+    // The clock it runs on: the default, real time (not flagged).
+    const clk = (await rest(stack.api, 'GET', '/clock')).body;
+    assert.equal(clk.mode, 'real');
+    assert.equal(await text('[data-kpi="clock"] .kpi-value'), 'real');
+    assert.ok(!(await page.getAttribute('[data-kpi="clock"]', 'class')).includes('kpi-warn'));
     // polled: the cycle count goes up
     const cycles = num(await text('[data-kpi="cycles"] .kpi-value'));
     assert.ok(cycles > 0);

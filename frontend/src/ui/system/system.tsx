@@ -1,5 +1,6 @@
 // System: what a commissioning engineer checks before trusting the machine. The cycle's timing
-// (`GET /system` every 2 s: wake-up latency, compute time and period in µs, overruns), its
+// (`GET /system` every 2 s: wake-up latency, compute time and period in µs, overruns) and the
+// clock it runs on (`GET /clock`: real, virtual or fast — a machine that is not in real time), its
 // distributions (`GET /metrics?buckets=fine`), overruns over the last minutes (kept here), the
 // real-time grants, the drive bus (bus.tsx beside this file), the audit log, and the configuration as one document:
 // download it, or import a file after seeing what it would change.
@@ -7,6 +8,7 @@ import { useEffect, useRef, useState } from 'preact/hooks';
 import { ApiError } from '../../api/problem';
 import { api } from '../../api/client';
 import type { Problem } from '../../api/types';
+import type { components } from '../../api/schema';
 import { useStore } from '../../store';
 import { refreshAxes, statuses } from '../../services';
 import { auth, may } from '../../auth/session';
@@ -39,6 +41,8 @@ import {
 import { diffConfig, diffCounts, exportName, importErrors, notADocument, valueText, type ConfigDiff, type ConfigDocument, type ItemDiff } from '../../system/config-diff';
 import { BusPanel } from './bus';
 
+type ClockState = components['schemas']['ClockState'];
+
 /** Polls of this page, kept while the page is away (the gap is drawn as one). */
 const history = new TimingHistory(HISTORY_S);
 
@@ -54,13 +58,15 @@ export function SystemPage() {
   const [sysError, setSysError] = useState<string | null>(null);
   const [histError, setHistError] = useState<string | null>(null);
   const [version, setVersion] = useState(0);
+  const [clockState, setClockState] = useState<ClockState | null>(null);
   useEffect(() => {
     let stopped = false;
     let timer: ReturnType<typeof setTimeout> | undefined;
     const tick = async () => {
       if (typeof document === 'undefined' || !document.hidden) {
-        const [s, m] = await Promise.allSettled([api.GET('/api/v1/system'), getCycleHistograms()]);
+        const [s, m, c] = await Promise.allSettled([api.GET('/api/v1/system'), getCycleHistograms(), api.GET('/api/v1/clock')]);
         if (stopped) return;
+        setClockState(c.status === 'fulfilled' ? c.value : null);
         const h = m.status === 'fulfilled' ? m.value : null;
         if (s.status === 'fulfilled') {
           setSys(s.value);
@@ -102,7 +108,7 @@ export function SystemPage() {
         </div>
       )}
       <div class={`sys-grid ${sysError ? 'stale' : ''}`}>
-        <TimingPanel sys={sys} />
+        <TimingPanel sys={sys} clock={clockState} />
         <RealtimePanel sys={sys} />
       </div>
       <HistogramPanel hist={hist} error={histError} version={version} />
@@ -116,7 +122,19 @@ export function SystemPage() {
   );
 }
 
-function TimingPanel({ sys }: { sys: SystemResource | null }) {
+/** The clock as a KPI (short: it fits the tile): `real`, or what makes this machine's time not the wall clock's. */
+export function clockText(c: ClockState): string {
+  if (c.mode === 'fast') return c.factor ? `fast ×${c.factor}` : 'fast (max)';
+  return c.mode;
+}
+
+const CLOCK_HELP: Record<string, string> = {
+  real: 'one cycle per cycle time',
+  virtual: 'cycles advance only when a client asks (POST /api/v1/clock/advance): nothing moves on its own',
+  fast: 'cycles run continuously, faster than real time',
+};
+
+function TimingPanel({ sys, clock }: { sys: SystemResource | null; clock: ClockState | null }) {
   const t = sys?.timing;
   const ct = sys?.cycle_time ?? 0;
   return (
@@ -127,6 +145,7 @@ function TimingPanel({ sys }: { sys: SystemResource | null }) {
         <>
           <div class="sys-kpis">
             <Kpi label="Cycle time" value={`${(ct * 1000).toPrecision(4).replace(/\.?0+$/, '')} ms`} name="cycle_time" />
+            {clock && <Kpi label="Clock" value={clockText(clock)} name="clock" tone={clock.mode === 'real' ? undefined : 'warn'} title={`${CLOCK_HELP[clock.mode] ?? clock.mode}; clock time ${clock.time_s.toFixed(3)} s`} />}
             <Kpi label="Cycles" value={t!.cycles.toLocaleString('en-US')} name="cycles" />
             <Kpi label="Overruns" value={t!.overruns.toLocaleString('en-US')} name="overruns" tone={t!.overruns ? 'bad' : 'ok'} />
             <Kpi label="Overrun rate" value={t!.cycles ? `${((t!.overruns / t!.cycles) * 100).toPrecision(2)} %` : '—'} name="overrun_rate" tone={t!.overruns ? 'bad' : 'ok'} />
