@@ -8,6 +8,8 @@
 //! that leaves OP, flag the axes' feedback with `bus_error` (the kernel stops them on their
 //! ramp into ErrorStop, 0x70A0, latched there until MC_Reset); as many good frames in a row
 //! clear the bus, and a power-on or reset edge of an axis asks its SubDevice back to OP.
+//! Up to 64 SubDevices and 4 KB of process image: ethercrab sends it in as many frames as it
+//! takes, and the expected working counter follows its split (`expected_working_counter`).
 
 use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU16, AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex};

@@ -253,21 +253,26 @@ fn halt_brakes_in_the_drive_and_a_new_move_runs_after_it() {
     assert!((m.st().actual_position - 100.0).abs() <= 0.011);
 }
 
+/// MC_MoveVelocity, aborting, with the same acceleration and deceleration.
+fn velocity(velocity: f64, ramp: f64, direction: Direction) -> CommandKind {
+    CommandKind::MoveVelocity {
+        velocity,
+        dynamics: Dynamics {
+            acceleration: ramp,
+            deceleration: ramp,
+            jerk: 0.0,
+        },
+        direction,
+        buffer_mode: BufferMode::Aborting,
+        options: MoveOptions::default(),
+    }
+}
+
 #[test]
 fn move_velocity_is_in_velocity_when_the_drive_says_so_and_stop_locks() {
     let mut m = Machine::new(true, 400.0);
     m.power();
-    let id = m.ok(CommandKind::MoveVelocity {
-        velocity: 20.0,
-        dynamics: Dynamics {
-            acceleration: 200.0,
-            deceleration: 200.0,
-            jerk: 0.0,
-        },
-        direction: Direction::Negative,
-        buffer_mode: BufferMode::Aborting,
-        options: MoveOptions::default(),
-    });
+    let id = m.ok(velocity(20.0, 200.0, Direction::Negative));
     m.until(2.0, |m| m.out(id).in_velocity);
     assert_eq!(m.fb.profile.mode, ProfileMode::Velocity);
     assert!((m.st().actual_velocity + 20.0).abs() <= 0.2, "{:?}", m.st());
@@ -301,17 +306,7 @@ fn move_velocity_is_in_velocity_when_the_drive_says_so_and_stop_locks() {
 fn velocity_stops_before_an_enabled_soft_limit() {
     let mut m = Machine::new(true, 400.0);
     m.power();
-    let id = m.ok(CommandKind::MoveVelocity {
-        velocity: 100.0,
-        dynamics: Dynamics {
-            acceleration: 1000.0,
-            deceleration: 1000.0,
-            jerk: 0.0,
-        },
-        direction: Direction::Positive,
-        buffer_mode: BufferMode::Aborting,
-        options: MoveOptions::default(),
-    });
+    let id = m.ok(velocity(100.0, 1000.0, Direction::Positive));
     m.until(6.0, |m| m.out(id).error);
     assert_eq!(ErrorId(m.out(id).error_id), ErrorId::SOFT_LIMIT_REACHED);
     m.until(1.0, |m| m.st().state == AxisState::Standstill);
@@ -670,17 +665,7 @@ fn a_move_replacing_an_unacknowledged_one_is_not_lost_on_a_late_bus() {
 fn reversing_a_velocity_with_a_weak_deceleration_stays_within_the_soft_limit() {
     let mut m = Machine::new(true, 400.0);
     m.power();
-    let v = m.ok(CommandKind::MoveVelocity {
-        velocity: 100.0,
-        dynamics: Dynamics {
-            acceleration: 1000.0,
-            deceleration: 1000.0,
-            jerk: 0.0,
-        },
-        direction: Direction::Positive,
-        buffer_mode: BufferMode::Aborting,
-        options: MoveOptions::default(),
-    });
+    let v = m.ok(velocity(100.0, 1000.0, Direction::Positive));
     m.until(5.0, |m| m.st().actual_position > 380.0);
     let weak = Positioning {
         dynamics: Dynamics {

@@ -200,21 +200,26 @@ impl Axis {
         says || self.act_vel.abs() <= self.p().axis_velo_max * 1e-4
     }
 
-    /// A host-side axis whose drive still runs its homing mode (the homing ended by a stop,
-    /// an error or a homing error): the drive brakes by itself with the halt bit, and the
-    /// axis goes back to its cyclic mode once it stands, the set position taken over there.
-    /// True while it is still returning.
-    pub(super) fn step_drive_return(&mut self, fb: &DriveFeedback) -> bool {
+    /// While the drive runs the profile the set values are its actual ones, and the lag is the
+    /// drive's own (it reports it, bit 13): what the drive answers is its own position, also
+    /// where homing moved it. Counts the cycles since the last profile command changed.
+    fn follow_the_drive(&mut self) {
         self.set = Kinematics {
             position: self.act_pos,
             velocity: self.act_vel,
             acceleration: self.act_acc,
             jerk: 0.0,
         };
-        // The lag is the drive's own while it runs the profile (it reports it, bit 13): what
-        // the drive answers is its own position, also where homing moved it.
         self.sent_position = self.act_pos;
         self.drive.since_change = self.drive.since_change.saturating_add(1);
+    }
+
+    /// A host-side axis whose drive still runs its homing mode (the homing ended by a stop,
+    /// an error or a homing error): the drive brakes by itself with the halt bit, and the
+    /// axis goes back to its cyclic mode once it stands, the set position taken over there.
+    /// True while it is still returning.
+    pub(super) fn step_drive_return(&mut self, fb: &DriveFeedback) -> bool {
+        self.follow_the_drive();
         let pf = fb.profile;
         let answered = pf.mode == self.drive.cmd.mode && self.drive.since_change >= ANSWER_CYCLES;
         if !self.drive_at_rest(pf, answered) && fb.enabled {
@@ -237,16 +242,7 @@ impl Axis {
     /// One cycle of a job the drive runs (instead of the planner), and of a drive-executed
     /// axis without a job. The set values are the drive's actual ones.
     pub(super) fn step_drive_job(&mut self, cx: &mut Ctx<'_, impl EventSink>, fb: &DriveFeedback) {
-        self.set = Kinematics {
-            position: self.act_pos,
-            velocity: self.act_vel,
-            acceleration: self.act_acc,
-            jerk: 0.0,
-        };
-        // The lag is the drive's own while it runs the profile (it reports it, bit 13): what
-        // the drive answers is its own position, also where homing moved it.
-        self.sent_position = self.act_pos;
-        self.drive.since_change = self.drive.since_change.saturating_add(1);
+        self.follow_the_drive();
         // How long the drive has seen bit 4 low: a new set point needs a rising edge it sees.
         self.drive.start_low = if self.drive.cmd.start {
             0
