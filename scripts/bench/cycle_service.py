@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The service's cycle compute time (docs/benchmarks.md): the demo machine idle (3 axes) and
-with 64 axes moving, from /metrics over a window, for one or more motiond binaries measured
+"""The service's cycle compute time (docs/benchmarks.md): the demo machine idle (3 axes), 64
+axes powered and standing, and 64 axes moving, from /metrics over a window, for one or more motiond binaries measured
 alternately in one run.
 
 Usage: cycle_service.py OUTDIR [--window S] NAME=MOTIOND [NAME=MOTIOND …]
@@ -32,8 +32,13 @@ def measure(name, binary):
         for i in range(61):
             st, body = service.http("POST", "/api/v1/axes", dict(cfg, name=f"a{i}"))
             assert st == 201, body
-        for a in ["x", "y", "spindle"] + [f"a{i}" for i in range(61)]:
+        names = ["x", "y", "spindle"] + [f"a{i}" for i in range(61)]
+        for a in names:
             service.http("POST", f"/api/v1/axes/{a}/power?wait=true", {})
+        time.sleep(1)
+        m0 = service.metrics(); time.sleep(window); m1 = service.metrics()
+        rows["standing_64_axes"] = service.window_quantiles(m0, m1, "motiond_cycle_compute_seconds")
+        for a in names:
             service.http("POST", f"/api/v1/axes/{a}/move-velocity", {"velocity": 8.0 if a != "spindle" else 360.0})
         time.sleep(1)
         m0 = service.metrics(); time.sleep(window); m1 = service.metrics()

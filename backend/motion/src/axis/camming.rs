@@ -594,43 +594,6 @@ impl Axis {
         Ok(true)
     }
 
-    /// A ramp-in's cycle: its deviation laid over the cams' setpoint `set`; InSync (and the
-    /// MC_CamIn ends) when it has run down to 0.
-    pub(super) fn step_ramp_in(
-        &mut self,
-        cx: &mut Ctx<'_, impl EventSink>,
-        job: &mut Job,
-        cams: &mut CamSet,
-        dt: f64,
-    ) {
-        if !cams.ramp {
-            return;
-        }
-        if let Some(e) = self.planner.step(dt) {
-            self.set.position += e.position;
-            self.set.velocity += e.velocity;
-            self.set.acceleration += e.acceleration;
-            self.set.jerk += e.jerk;
-        }
-        if self.planner.finished() {
-            cams.ramp = false;
-            self.planner.clear();
-            let out = FbOutputs {
-                busy: false,
-                active: false,
-                in_sync: true,
-                ..job.out
-            };
-            job.emit(cx, out);
-            // The coupling goes on without an owning command, as after an immediate one.
-            job.id = 0;
-            job.out = FbOutputs {
-                busy: true,
-                ..FbOutputs::default()
-            };
-        }
-    }
-
     /// 0x7084 when following `law` from now on would step the slave's position or velocity
     /// away from `from` (where the slave is, or where the law in force puts it in this cycle).
     fn check_no_jump(
@@ -1685,6 +1648,44 @@ impl Axis {
         }
         self.cam.scaling_term = term;
         self.queue_cam_scaling(cx, id, scaling)
+    }
+}
+
+/// A ramp-in's cycle: its deviation laid over the cams' setpoint `set`; InSync (and the
+/// MC_CamIn ends) when it has run down to 0.
+pub(super) fn step_ramp_in(
+    cx: &mut Ctx<'_, impl EventSink>,
+    job: &mut Job,
+    cams: &mut CamSet,
+    planner: &mut Planner,
+    set: &mut Kinematics,
+    dt: f64,
+) {
+    if !cams.ramp {
+        return;
+    }
+    if let Some(e) = planner.step(dt) {
+        set.position += e.position;
+        set.velocity += e.velocity;
+        set.acceleration += e.acceleration;
+        set.jerk += e.jerk;
+    }
+    if planner.finished() {
+        cams.ramp = false;
+        planner.clear();
+        let out = FbOutputs {
+            busy: false,
+            active: false,
+            in_sync: true,
+            ..job.out
+        };
+        job.emit(cx, out);
+        // The coupling goes on without an owning command, as after an immediate one.
+        job.id = 0;
+        job.out = FbOutputs {
+            busy: true,
+            ..FbOutputs::default()
+        };
     }
 }
 

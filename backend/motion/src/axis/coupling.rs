@@ -7,7 +7,7 @@
 //! and its `submit_*`, while what every coupling shares — admission, aborting what runs,
 //! InGear, losing the master, soft limits — stays as it is.
 
-use super::camming::CamSet;
+use super::camming::{CamSet, step_ramp_in};
 use super::multimaster::MultiGear;
 use super::*;
 
@@ -520,7 +520,6 @@ impl Axis {
     pub(super) fn follow_master(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
-        job: &mut Job,
         master: Master,
         dt: f64,
     ) {
@@ -529,22 +528,26 @@ impl Axis {
             .as_ref()
             .is_some_and(|c| matches!(c.law, CouplingLaw::Multi(_)))
         {
-            self.follow_multi(cx, job, master, dt);
+            self.follow_multi(cx, master, dt);
             return;
         }
-        let (Some(mut c), Master::Sample(m)) = (self.coupling, master) else {
+        // In place, field by field: a coupling carries a cam set's size, and copying it out
+        // and back every cycle cost more than the gear's arithmetic (issue 27).
+        let (Some(c), Master::Sample(m)) = (self.coupling.as_mut(), master) else {
             return;
         };
         // Gears and cams follow the master's set values, or its actual ones with #1064.
-        let followed = m.followed(self.p().axis_couple_slave_to_actual_values);
+        let followed = m.followed(self.config.parameters.axis_couple_slave_to_actual_values);
         let ramping = c.law.ramping();
         if let Some(set) = c.law.slave_setpoint(&followed, dt, cx.cams) {
             self.set = set;
         }
         if let CouplingLaw::Cam(cams) = &mut c.law {
-            self.step_ramp_in(cx, job, cams, dt);
+            let job = self.job.as_mut().expect("a gear job runs");
+            step_ramp_in(cx, job, cams, &mut self.planner, &mut self.set, dt);
         }
         self.superposition.main_motion_sampled();
+        let job = self.job.as_mut().expect("a gear job runs");
         if ramping && !c.law.ramping() && job.id != 0 && !job.out.in_gear {
             let out = FbOutputs {
                 in_gear: true,
@@ -552,6 +555,5 @@ impl Axis {
             };
             job.emit(cx, out);
         }
-        self.coupling = Some(c);
     }
 }

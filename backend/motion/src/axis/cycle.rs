@@ -142,7 +142,7 @@ impl Axis {
             acceleration: self.set.acceleration / self.enc_k,
             mode: self
                 .torque
-                .drive_mode(self.job.is_some_and(|j| j.kind == JobKind::Torque)),
+                .drive_mode(self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque)),
             torque: self.torque.set,
             velocity_limit_high: self.torque.limit_high,
             velocity_limit_low: self.torque.limit_low,
@@ -168,7 +168,10 @@ impl Axis {
         let ovr = self.override_ratio();
         let returning = !self.drive_executed()
             && self.drive.cmd.mode != crate::drive::ProfileMode::Off
-            && !self.job.is_some_and(|j| j.kind == JobKind::DriveHome);
+            && !self
+                .job
+                .as_ref()
+                .is_some_and(|j| j.kind == JobKind::DriveHome);
         if returning {
             // A host-side axis whose drive still runs its homing mode: the drive stops by
             // itself first; the job (if any) takes over in the cyclic mode from rest.
@@ -177,7 +180,10 @@ impl Axis {
             }
             self.plan_job_now();
         }
-        let Some(mut job) = self.job else {
+        // The job is worked on in place (`self.job`), borrowed anew after each call that needs
+        // the whole axis: a copy of the 300-byte job out and back every cycle was a sixth of a
+        // moving axis's step (issue 27).
+        let Some(job) = self.job.as_mut() else {
             if self.drive_executed() {
                 self.step_drive_job(cx, fb);
                 return;
@@ -202,40 +208,26 @@ impl Axis {
                     ..job.out
                 };
                 job.emit(cx, out);
-                self.job = Some(job);
                 self.plan_job_now();
-                job = self.job.expect("set above");
             }
         }
 
-        if self.drive_executed() || job.kind == JobKind::DriveHome {
+        let kind = self.running().kind;
+        if self.drive_executed() || kind == JobKind::DriveHome {
             // The drive runs the profile: no planner, no override re-plan.
-            self.job = Some(job);
             self.step_drive_job(cx, fb);
             return;
         }
-        if job.kind == JobKind::Gear {
-            self.follow_master(cx, &mut job, master, dt);
-            self.job = Some(job);
-            return;
-        }
-        if job.kind == JobKind::Torque {
-            self.job = Some(job);
-            self.step_torque(cx, dt, fb);
-            return;
-        }
-        if job.kind == JobKind::External {
-            self.job = Some(job);
-            self.step_external(cx, dt);
-            return;
-        }
-        if job.kind == JobKind::Group {
-            self.job = Some(job);
-            self.step_group(cx, dt);
-            return;
+        match kind {
+            JobKind::Gear => return self.follow_master(cx, master, dt),
+            JobKind::Torque => return self.step_torque(cx, dt, fb),
+            JobKind::External => return self.step_external(cx, dt),
+            JobKind::Group => return self.step_group(cx, dt),
+            _ => {}
         }
 
         // Override changes re-plan (never a velocity jump).
+        let job = self.running();
         let endless_holding =
             job.phase == Phase::Holding && job.kind == JobKind::Positioning { continuous: true };
         if job.planned_override != ovr
@@ -246,10 +238,9 @@ impl Axis {
             )
             && !matches!(job.phase, Phase::Settling { .. })
         {
-            self.job = Some(job);
             if endless_holding {
                 // Continue at end velocity × override.
-                let j = self.job.as_mut().expect("set");
+                let j = self.job.as_mut().expect("running");
                 j.planned_override = ovr;
                 let v = j.end_velocity * ovr;
                 let _ = self
@@ -258,12 +249,12 @@ impl Axis {
             } else {
                 self.plan_job_now();
                 // Re-planning restarts the milestone.
-                let j = self.job.as_mut().expect("set");
+                let j = self.job.as_mut().expect("running");
                 if j.phase == Phase::Holding {
                     j.phase = Phase::Moving;
                 }
             }
-            job = self.job.expect("set above");
+            let job = self.job.as_mut().expect("running");
             if job.out.in_velocity {
                 let out = FbOutputs {
                     in_velocity: false,
@@ -273,8 +264,7 @@ impl Axis {
             }
         }
 
-        if job.kind == JobKind::Home {
-            self.job = Some(job);
+        if kind == JobKind::Home {
             self.step_home(cx, dt, fb);
             return;
         }
@@ -283,6 +273,7 @@ impl Axis {
             self.set = k;
             self.superposition.main_motion_sampled();
         }
+        let job = self.job.as_mut().expect("running");
         // An end or blending velocity that could not be reached moving only towards the
         // target was adjusted to the best reachable one: say so.
         if let Some(w) = job.warn.take() {
@@ -314,7 +305,6 @@ impl Axis {
             JobKind::Velocity | JobKind::JogHeld { released: false } => {
                 let reached = finished && ovr > 0.0 && job.planned_override == ovr;
                 job.hold_velocity(cx, reached);
-                self.job = Some(job);
             }
             JobKind::Positioning { continuous: true } => {
                 let short = (job.planned_end - job.end_velocity).abs()
@@ -327,7 +317,6 @@ impl Axis {
                 {
                     // Passed the target slower than the end velocity: now run up to it.
                     job.past_target = true;
-                    self.job = Some(job);
                     self.plan_job_now();
                     return;
                 }
@@ -340,7 +329,6 @@ impl Axis {
                     };
                     job.emit(cx, out);
                 }
-                self.job = Some(job);
             }
             JobKind::Positioning { continuous: false }
             | JobKind::Halt
@@ -349,7 +337,6 @@ impl Axis {
                     || (job.kind == JobKind::Positioning { continuous: false }
                         && job.planned_override <= 0.0)
                 {
-                    self.job = Some(job);
                     return;
                 }
                 // Logical end of positioning: the setpoint stands exactly on the target.
@@ -369,18 +356,18 @@ impl Axis {
                     self.start_next(cx);
                     return;
                 }
-                let done = self.done_criterion(&mut job, dt);
+                let Some(done) = self.done_criterion(dt) else {
+                    return;
+                };
+                // The job ends: taken out of the axis (this happens once).
+                let mut job = self.job.take().expect("running");
                 match done {
-                    None => {
-                        self.job = Some(job);
-                    }
-                    Some(Ok(())) => {
+                    Ok(()) => {
                         if let Some(e) = job.pending_error {
                             job.finish_error(cx, e);
                         } else {
                             job.finish_done(cx);
                         }
-                        self.job = None;
                         self.planner.clear();
                         self.set.velocity = 0.0;
                         self.set.acceleration = 0.0;
@@ -388,9 +375,8 @@ impl Axis {
                         self.stop_ramp_ended(cx);
                         self.start_next(cx);
                     }
-                    Some(Err(e)) => {
+                    Err(e) => {
                         job.finish_error(cx, e);
-                        self.job = None;
                         self.planner.clear();
                         if let Some(mut n) = self.next.take() {
                             n.finish_aborted(cx);
@@ -413,6 +399,11 @@ impl Axis {
             | JobKind::Group
             | JobKind::DriveHome => unreachable!(),
         }
+    }
+
+    /// The running job (callers have checked that there is one).
+    fn running(&self) -> &Job {
+        self.job.as_ref().expect("a job runs")
     }
 
     /// A stop's ramp came to rest: MC_Stop reports Done and keeps the lock (note 6), or the
@@ -438,8 +429,9 @@ impl Axis {
     }
 
     /// §3.11: None = still waiting; Some(Ok) = done; Some(Err) = in-target timeout.
-    pub(super) fn done_criterion(&mut self, job: &mut Job, dt: f64) -> Option<Result<(), ErrorId>> {
-        let p = self.p();
+    pub(super) fn done_criterion(&mut self, dt: f64) -> Option<Result<(), ErrorId>> {
+        let p = &self.config.parameters;
+        let job = self.job.as_mut().expect("a job runs");
         let stop_like = job.kind != (JobKind::Positioning { continuous: false });
         let monitor = if stop_like {
             job.options.enable_stop_position_monitoring

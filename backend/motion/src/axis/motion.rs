@@ -448,7 +448,11 @@ impl Axis {
         self.job = Some(job);
         if job.modulo.is_some() {
             self.resolve_modulo_from_motion();
-            let target = self.job.map(|j| j.target).unwrap_or(self.set.position);
+            let target = self
+                .job
+                .as_ref()
+                .map(|j| j.target)
+                .unwrap_or(self.set.position);
             if let Err(e) = self.check_soft_limits(target) {
                 // The oriented stop would cross a software limit: stop safely, with the
                 // error, not at the position (spec §5.1.4).

@@ -238,7 +238,6 @@ impl Axis {
     pub(super) fn follow_multi(
         &mut self,
         cx: &mut Ctx<'_, impl EventSink>,
-        job: &mut Job,
         master: Master,
         dt: f64,
     ) {
@@ -332,6 +331,7 @@ impl Axis {
             };
         }
         self.superposition.main_motion_sampled();
+        let job = self.job.as_mut().expect("a gear job runs");
         if job.id != 0 && job.out.in_gear != law.in_gear {
             let out = FbOutputs {
                 in_gear: law.in_gear,

@@ -156,9 +156,16 @@ impl Axis {
             {
                 self.end_phasing(cx, End::Aborted);
             }
-            // No plan is left on the planner now.
-            self.phasing.engaged = false;
-            if self.coupling.is_none() {
+            // No plan is left on the planner now. Written only when it changes: an axis that
+            // never phases dirties none of this every cycle (issue 27).
+            if self.phasing.engaged {
+                self.phasing.engaged = false;
+            }
+            let s = self.phasing.shift;
+            let zero = [s.position, s.velocity, s.acceleration, s.jerk]
+                .iter()
+                .all(|v| v.to_bits() == 0);
+            if self.coupling.is_none() && !zero {
                 self.phasing.shift = Kinematics::default();
             }
             return;

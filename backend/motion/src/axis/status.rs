@@ -126,7 +126,7 @@ impl Axis {
         let position_correction = self.correction_status();
         let encoder_count = self.encoder_count();
         let (drive_mode, actual_torque, set_torque, velocity_limited) = self.torque_status();
-        let torque_job = self.job.is_some_and(|j| j.kind == JobKind::Torque);
+        let torque_job = self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
         let ext_enabled = self.ext.enabled;
         let ext_target = self.ext.target.filter(|_| self.ext.enabled);
         let s = &mut self.status;
@@ -156,7 +156,8 @@ impl Axis {
         s.not_moving = !s.moving;
         s.has_been_stopped = self.has_been_stopped;
         s.homing_busy = state == AxisState::Homing;
-        s.new_target_position = self.new_target && self.job.is_some_and(|j| j.is_positioning());
+        s.new_target_position =
+            self.new_target && self.job.as_ref().is_some_and(|j| j.is_positioning());
         s.ptp_mode = !s.coupled;
         s.io_data_invalid = self.io_data_invalid;
         s.nc_cycle_counter = self.cycle;

@@ -201,7 +201,12 @@ impl Axis {
     /// one is an axis error), so there the distance is not limited.
     pub(super) fn superposition_room(&self, distance: f64) -> f64 {
         let p = self.p();
-        let Some(target) = self.job.filter(|j| j.is_positioning()).map(|j| j.target) else {
+        let Some(target) = self
+            .job
+            .as_ref()
+            .filter(|j| j.is_positioning())
+            .map(|j| j.target)
+        else {
             return distance;
         };
         if distance > 0.0 && p.axis_en_max_soft_pos_limit {
