@@ -264,7 +264,8 @@ impl Axis {
             }
         }
 
-        if kind == JobKind::Home {
+        // Read again: a re-plan that failed above made the homing run a stop (`Halt`).
+        if self.running().kind == JobKind::Home {
             self.step_home(cx, dt, fb);
             return;
         }
