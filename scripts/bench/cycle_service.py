@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The service's cycle compute time (docs/benchmarks.md): the demo machine idle (3 axes), 64
-axes powered and standing, and 64 axes moving, from /metrics over a window, for one or more motiond binaries measured
-alternately in one run.
+axes powered and standing, and 64 axes moving, from /metrics over a window, for one or more
+motiond binaries measured alternately in one run.
 
 Usage: cycle_service.py OUTDIR [--window S] NAME=MOTIOND [NAME=MOTIOND …]
 """

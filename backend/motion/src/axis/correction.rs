@@ -248,8 +248,7 @@ impl Axis {
         let set = self.set.position;
         // While the set position follows the actual one (disabled, torque control) the
         // reading moves with the correction itself: no travel of the axis's own.
-        let follows_actual = self.mode == Mode::Disabled
-            || self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
+        let follows_actual = self.mode == Mode::Disabled || self.runs(JobKind::Torque);
         let c = &mut self.corrections;
         let travel = if c.started && !follows_actual {
             set - c.last_set

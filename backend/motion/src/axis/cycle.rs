@@ -54,7 +54,7 @@ impl Axis {
         self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.read;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
-        if !self.job.as_ref().is_some_and(|j| j.kind == JobKind::Home) {
+        if !self.runs(JobKind::Home) {
             // Whatever ended a homing run (stop, power off, error, reset) disarms its latch.
             self.latch = None;
         }
@@ -140,9 +140,7 @@ impl Axis {
             position: (self.set.position - self.offset - correction) / self.enc_k,
             velocity: (self.set.velocity - correction_rate) / self.enc_k,
             acceleration: self.set.acceleration / self.enc_k,
-            mode: self
-                .torque
-                .drive_mode(self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque)),
+            mode: self.torque.drive_mode(self.runs(JobKind::Torque)),
             torque: self.torque.set,
             velocity_limit_high: self.torque.limit_high,
             velocity_limit_low: self.torque.limit_low,
@@ -168,10 +166,7 @@ impl Axis {
         let ovr = self.override_ratio();
         let returning = !self.drive_executed()
             && self.drive.cmd.mode != crate::drive::ProfileMode::Off
-            && !self
-                .job
-                .as_ref()
-                .is_some_and(|j| j.kind == JobKind::DriveHome);
+            && !self.runs(JobKind::DriveHome);
         if returning {
             // A host-side axis whose drive still runs its homing mode: the drive stops by
             // itself first; the job (if any) takes over in the cyclic mode from rest.

@@ -50,11 +50,7 @@ impl Axis {
     /// MC_ExtSetPointGenDisable: the axis no longer takes samples; one that is moving by them
     /// stops on its ramp (the client's motion ends with it).
     pub(super) fn submit_ext_disable(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
-        if self
-            .job
-            .as_ref()
-            .is_some_and(|j| j.kind == JobKind::External)
-        {
+        if self.runs(JobKind::External) {
             self.stop_external(cx, None);
         }
         self.ext = ExtGen::default();
@@ -91,10 +87,7 @@ impl Axis {
         {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
-        let running = self
-            .job
-            .as_ref()
-            .is_some_and(|j| j.kind == JobKind::External);
+        let running = self.runs(JobKind::External);
         if !running {
             // The first sample: from standstill, continuing the set position without a jump.
             if self.state() != AxisState::Standstill {
@@ -208,12 +201,7 @@ impl Axis {
     /// A motion command to an axis the generator moves needs #1066 (§4.4.1); a halt or a stop
     /// never does.
     pub(super) fn admit_to_external(&self) -> Result<(), ErrorId> {
-        if self
-            .job
-            .as_ref()
-            .is_some_and(|j| j.kind == JobKind::External)
-            && !self.p().axis_allow_motion_cmd_to_ext_set_axis
-        {
+        if self.runs(JobKind::External) && !self.p().axis_allow_motion_cmd_to_ext_set_axis {
             return Err(ErrorId::EXT_SETPOINT_AXIS_COMMAND_NOT_ALLOWED);
         }
         Ok(())

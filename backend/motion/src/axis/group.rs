@@ -46,7 +46,7 @@ impl Axis {
     }
 
     pub(crate) fn group_axis_following(&self) -> bool {
-        self.job.as_ref().is_some_and(|j| j.kind == JobKind::Group)
+        self.runs(JobKind::Group)
     }
 
     /// The group starts moving: the axis takes the path as its setpoint source. False when

@@ -363,6 +363,11 @@ impl Axis {
         &self.config.parameters
     }
 
+    /// The running job is of this kind (asked by reference: a job is 300 bytes to copy).
+    fn runs(&self, kind: JobKind) -> bool {
+        self.job.as_ref().is_some_and(|j| j.kind == kind)
+    }
+
     fn override_ratio(&self) -> f64 {
         (self.power_override / 100.0 * self.override_factor).clamp(0.0, 1.0)
     }

@@ -126,7 +126,7 @@ impl Axis {
         let position_correction = self.correction_status();
         let encoder_count = self.encoder_count();
         let (drive_mode, actual_torque, set_torque, velocity_limited) = self.torque_status();
-        let torque_job = self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
+        let torque_job = self.runs(JobKind::Torque);
         let ext_enabled = self.ext.enabled;
         let ext_target = self.ext.target.filter(|_| self.ext.enabled);
         let s = &mut self.status;

@@ -86,7 +86,7 @@ impl Axis {
             return Err(ErrorId::PARAMETER_NOT_CORRECT);
         }
         self.admit_motion(BufferMode::Aborting)?;
-        let running = self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
+        let running = self.runs(JobKind::Torque);
         let start = match (running, tc.manual_start) {
             (true, _) => self.torque.set,
             (false, Some(t)) => t,
@@ -206,7 +206,7 @@ impl Axis {
         // The manual's danger note (§5.7.1): a drive left in torque mode after torque control
         // moves unplanned. Asked back to its position mode, it must show it within the
         // timeout, or the axis goes to ErrorStop.
-        let torque_job = self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
+        let torque_job = self.runs(JobKind::Torque);
         if !torque_job
             && self.torque.reported == DriveMode::Torque
             && matches!(self.mode, Mode::Enabled | Mode::Stopping)
@@ -233,7 +233,7 @@ impl Axis {
 
     /// The torque part of the status: the mode the drive reports, its torque, the setpoint.
     pub(super) fn torque_status(&self) -> (DriveMode, f64, f64, bool) {
-        let torque_job = self.job.as_ref().is_some_and(|j| j.kind == JobKind::Torque);
+        let torque_job = self.runs(JobKind::Torque);
         (
             self.torque.reported,
             self.torque.actual,
