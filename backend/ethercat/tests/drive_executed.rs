@@ -317,6 +317,71 @@ fn velocity_stops_before_an_enabled_soft_limit() {
     assert!(m.st().actual_position > 390.0, "{:?}", m.st());
 }
 
+/// A drive that still creeps out of the limits after homing onto a limit (what a drive
+/// reports while it settles) heads nowhere: a move back into the limits starts. It was an
+/// axis error (soft_limit_reached) whenever the move came within the creep, so a move after
+/// homing onto the limit failed at random over the emulated segment (decision 172).
+#[test]
+fn a_move_off_a_limit_starts_while_the_drive_settles_onto_it() {
+    let mut k = Kernel::new(DT, 1);
+    let p = AxisParameters {
+        axis_en_min_soft_pos_limit: true,
+        axis_min_soft_pos_limit: 0.0,
+        ..Default::default()
+    };
+    let config = AxisConfig {
+        parameters: p,
+        drive_executed: true,
+        ..AxisConfig::default()
+    };
+    k.insert_axis(0, Axis::new(config, DT)).unwrap();
+    // A thousandth of a unit per second outwards, a ten-thousandth of a micrometre away.
+    let fb = [DriveFeedback {
+        ready: true,
+        enabled: true,
+        actual_position: 1e-7,
+        actual_velocity: -1e-3,
+        ..DriveFeedback::default()
+    }];
+    let (mut sp, mut events) = ([DriveSetpoint::default()], Vec::new());
+    let submit = |k: &mut Kernel, id, kind, events: &mut Vec<CommandEvent>| {
+        let c = Command {
+            id,
+            target: Target::Axis(0),
+            kind,
+        };
+        assert_eq!(k.submit(c, events), Verdict::Accepted);
+    };
+    let power = CommandKind::Power {
+        enable: true,
+        enable_positive: true,
+        enable_negative: true,
+        override_percent: 100.0,
+        buffer_mode: BufferMode::Aborting,
+    };
+    submit(&mut k, 1, power, &mut events);
+    for _ in 0..5 {
+        k.step(&fb, &mut sp, &mut events);
+    }
+    assert_eq!(k.status(0).unwrap().state, AxisState::Standstill);
+    submit(
+        &mut k,
+        2,
+        CommandKind::MoveAbsolute(mv(120.0, 100.0)),
+        &mut events,
+    );
+    for _ in 0..5 {
+        k.step(&fb, &mut sp, &mut events);
+    }
+    let st = k.status(0).unwrap();
+    assert_eq!(st.state, AxisState::DiscreteMotion, "{st:?}");
+    assert!(
+        events.iter().all(|e| !e.outputs.error),
+        "{:?}",
+        events.iter().find(|e| e.outputs.error)
+    );
+}
+
 #[test]
 fn the_blocks_and_inputs_drive_motion_control_lacks_are_refused() {
     let mut m = Machine::new(true, 400.0);

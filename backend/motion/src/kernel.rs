@@ -585,7 +585,7 @@ impl Kernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::command::{BufferMode, Direction, Dynamics, MoveOptions};
+    use crate::command::{BufferMode, Direction, Dynamics, MoveOptions, Positioning};
     use crate::{AxisConfig, AxisParameters, AxisState, CommandEvent};
 
     const DT: f64 = 0.001;
@@ -733,5 +733,84 @@ mod tests {
         assert_eq!(&k.order.slots[..k.order.len], &[0, 2, 3]);
         step(&mut k, &mut sp, &mut e);
         assert_eq!(&k.order.slots[..k.order.len], &[0, 2, 3]);
+    }
+
+    /// Issue 27: a standing axis with the same feedback cycle after cycle is stepped at rest
+    /// (`axis/rest.rs`) — its status changes in its cycle counter only, its status count not
+    /// at all — and leaves rest in the cycle a command or a new reading arrives. In debug
+    /// builds every cycle at rest also runs the full step and asserts it gave the same.
+    #[test]
+    fn rest_step_is_the_full_step() {
+        let mut k = kernel(2);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 2], Vec::new());
+        let power = CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
+        };
+        accept(&mut k, 1, 0, power, &mut e);
+        let rests = |k: &Kernel, a| k.axis(a).unwrap().is_at_rest();
+        // Powering up takes cycles, each different: no rest yet.
+        step(&mut k, &mut sp, &mut e);
+        assert!(!rests(&k, 0));
+        for _ in 0..100 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        // Powered and standing in its window past the dwell; the disabled axis too.
+        assert!(rests(&k, 0) && rests(&k, 1));
+        let st = k.status(0).unwrap();
+        assert!(st.power_status && st.in_target_position && st.state == AxisState::Standstill);
+        let seq = k.axis(0).unwrap().status_seq();
+        let out = sp[0];
+        for _ in 0..10 {
+            step(&mut k, &mut sp, &mut e);
+            assert_eq!(k.status(0).unwrap().nc_cycle_counter, k.cycle);
+            assert_eq!(sp[0], out);
+        }
+        assert_eq!(k.axis(0).unwrap().status_seq(), seq);
+        assert_eq!(
+            k.status(0).unwrap(),
+            AxisStatus {
+                nc_cycle_counter: k.cycle,
+                ..st
+            }
+        );
+        // A command wakes it: the axis moves in the next cycle.
+        let relative = CommandKind::MoveRelative(Positioning {
+            position: 5.0,
+            velocity: 50.0,
+            dynamics: Dynamics::default(),
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        });
+        accept(&mut k, 2, 0, relative, &mut e);
+        assert!(!rests(&k, 0));
+        assert_ne!(k.axis(0).unwrap().status_seq(), seq);
+        step(&mut k, &mut sp, &mut e);
+        assert!(k.status(0).unwrap().set_position > 0.0 && !rests(&k, 0));
+        while k.status(0).unwrap().state != AxisState::Standstill {
+            step(&mut k, &mut sp, &mut e);
+        }
+        for _ in 0..100 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        assert!(rests(&k, 0));
+        assert_eq!(k.status(0).unwrap().set_position, 5.0);
+        // A new reading (the drive moved by itself, as a real encoder's count can) is read in
+        // its cycle.
+        let fb = [
+            DriveFeedback {
+                ready: true,
+                enabled: true,
+                actual_position: 5.001,
+                ..DriveFeedback::default()
+            },
+            DriveFeedback::default(),
+        ];
+        k.step(&fb, &mut sp, &mut e);
+        assert!(!rests(&k, 0));
+        assert_eq!(k.status(0).unwrap().actual_position, 5.001);
     }
 }

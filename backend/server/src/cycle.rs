@@ -155,6 +155,10 @@ pub struct Snapshot {
     pub axes: [Option<AxisStatus>; MAX_AXES],
     /// The groups' status (TF5420 `NcToPlc` of each group), by group slot.
     pub groups: [Option<GroupStatus>; MAX_GROUPS],
+    /// The `Axis::status_seq` each slot's status was copied at: a slot whose axis has the
+    /// same count now gets only its cycle counter written (this buffer is reused every
+    /// third publication, so it keeps its own record).
+    copied_at: [u64; MAX_AXES],
 }
 
 impl Default for Snapshot {
@@ -163,6 +167,7 @@ impl Default for Snapshot {
             cycle: 0,
             axes: [None; MAX_AXES],
             groups: [None; MAX_GROUPS],
+            copied_at: [u64::MAX; MAX_AXES],
         }
     }
 }
@@ -1096,12 +1101,23 @@ impl CycleThread {
         let snap = self.snapshot.input_buffer_mut();
         snap.cycle = cycle;
         // Only the slots in use, each status copied once into its place (not the whole array
-        // of 64 through a temporary every cycle: that copy was a quarter of an idle cycle).
-        for (i, s) in snap.axes[..self.published].iter_mut().enumerate() {
+        // of 64 through a temporary every cycle: that copy was a quarter of an idle cycle),
+        // and only when it changed since this buffer last held it: an axis at rest changes
+        // its cycle counter only.
+        let slots = snap.axes[..self.published].iter_mut();
+        for ((i, s), at) in slots.enumerate().zip(snap.copied_at.iter_mut()) {
             match (self.kernel.axis(i as AxisSlot), s.as_mut()) {
-                (Some(a), Some(dst)) => *dst = *a.status(),
-                (Some(a), None) => *s = Some(*a.status()),
-                (None, _) => *s = None,
+                (Some(a), Some(dst)) if *at == a.status_seq() => {
+                    dst.nc_cycle_counter = a.status().nc_cycle_counter;
+                }
+                (Some(a), _) => {
+                    *s = Some(*a.status());
+                    *at = a.status_seq();
+                }
+                (None, _) => {
+                    *s = None;
+                    *at = u64::MAX;
+                }
             }
         }
         for (i, s) in snap.groups[..self.groups_published].iter_mut().enumerate() {

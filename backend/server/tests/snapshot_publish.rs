@@ -1,5 +1,5 @@
 //! The published snapshot copies an axis's status only when it changed since that buffer held
-//! it (issue 27). What a reader sees must still be the axis's status of the published cycle,
+//! it (issue 27; an axis at rest changes only its cycle counter). What a reader sees must still be the axis's status of the published cycle,
 //! in every one of the three buffers: a standing axis's cycle counter advances, a move shows
 //! cycle by cycle, a slot taken by another axis shows the new one.
 
@@ -100,9 +100,12 @@ fn every_published_buffer_shows_the_status_of_its_cycle() {
         rig.step();
     }
 
-    // Standing: nothing but the cycle counter changes, and that shows in every buffer.
+    // Standing: nothing but the cycle counter changes, and that shows in every buffer. The
+    // simulated drive's feedback is constant at standstill: the axis steps at rest, its
+    // status is not copied again.
     for _ in 0..10 {
         let snap = rig.step();
+        assert!(rig.cycle.kernel.axis(0).expect("axis").is_at_rest());
         let s = snap.axes[0].expect("slot 0 holds an axis");
         assert_eq!(s.state, AxisState::Standstill);
         assert_eq!(s.nc_cycle_counter, snap.cycle, "a stale cycle counter");

@@ -397,6 +397,7 @@ impl Axis {
     /// An online change of table `id` (new data in generation `generation`) is to reach this slave
     /// as `change` says (OFF: it keeps the data it runs).
     pub fn queue_cam_data(&mut self, id: u32, generation: u32, change: crate::cam::OnlineChange) {
+        self.wake();
         let Some(set) = self.cam_set() else {
             return;
         };
@@ -428,6 +429,7 @@ impl Axis {
     /// MC_CamActivation DELETEQUEUEDDATA for table `id`: written data not yet in effect on
     /// this slave stays out of it.
     pub fn drop_cam_data(&mut self, id: u32) {
+        self.wake();
         if self.cam_set().is_some_and(|set| set.find(id).is_some())
             && self.cam.data.take().is_some()
         {

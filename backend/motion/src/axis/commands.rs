@@ -22,6 +22,7 @@ impl Axis {
         cycle: u64,
         events: &mut impl EventSink,
     ) -> Verdict {
+        self.wake();
         let cx = &mut Ctx {
             slot: self.slot,
             cycle,

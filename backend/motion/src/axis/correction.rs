@@ -78,6 +78,11 @@ pub(super) struct Corrections {
 }
 
 impl Corrections {
+    /// No source is commanded: nothing approaches a target.
+    pub(super) fn settled(&self) -> bool {
+        self.limiter.cmd.is_none() && self.backlash.cmd.is_none() && self.table.cmd.is_none()
+    }
+
     pub(super) fn total(&self) -> f64 {
         self.limiter.value + self.backlash.value + self.table.value
     }

@@ -26,6 +26,31 @@ impl Axis {
         events: &mut impl EventSink,
         out: &mut DriveSetpoint,
     ) {
+        // An axis at rest repeats its last cycle (`rest.rs`); debug builds check it against
+        // the full step.
+        if self.at_rest(fb, &master) {
+            #[cfg(debug_assertions)]
+            self.step_at_rest_checked(dt, fb, master, cams, cycle, events, out);
+            #[cfg(not(debug_assertions))]
+            self.step_at_rest(dt, cycle, out);
+            return;
+        }
+        self.step_full(dt, fb, master, cams, cycle, events, out);
+        self.settle_rest(fb, out);
+    }
+
+    /// [`Axis::step`] with everything in it.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn step_full(
+        &mut self,
+        dt: f64,
+        fb: &DriveFeedback,
+        master: Master,
+        cams: &crate::cam::CamStore,
+        cycle: u64,
+        events: &mut impl EventSink,
+        out: &mut DriveSetpoint,
+    ) {
         if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
             // A drive that reports no number is a faulty drive; keep the last good values.
             // Where there is none (a reading that overflowed in the axis's units), 0: the
@@ -37,7 +62,7 @@ impl Axis {
                 actual_velocity: 0.0,
                 ..*fb
             };
-            return self.step(dt, &fb, master, cams, cycle, events, out);
+            return self.step_full(dt, &fb, master, cams, cycle, events, out);
         }
         let cx = &mut Ctx {
             slot: self.slot,

@@ -476,7 +476,10 @@ impl Axis {
     fn drive_soft_limit(&mut self, cx: &mut Ctx<'_, impl EventSink>) -> bool {
         let p = self.p();
         let v = self.act_vel;
-        if v.abs() <= EPS_V {
+        // A drive within its standstill band (as `drive_at_rest` takes it) heads nowhere:
+        // the creep a drive reports while it settles after homing onto a limit is no motion
+        // out of the limits (a move off that limit was an axis error at random, decision 172).
+        if v.abs() <= p.axis_velo_max * 1e-4 {
             return false;
         }
         let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {

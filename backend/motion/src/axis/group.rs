@@ -27,6 +27,7 @@ impl Axis {
     }
 
     pub(crate) fn set_group_link(&mut self, group: Option<GroupId>, engaged: bool) {
+        self.wake();
         self.group.group = group;
         self.group.engaged = engaged && group.is_some();
     }
@@ -52,6 +53,7 @@ impl Axis {
     /// The group starts moving: the axis takes the path as its setpoint source. False when
     /// it cannot (not standing in Enabled).
     pub(crate) fn group_start(&mut self) -> bool {
+        self.wake();
         if self.group_axis_following() {
             return true;
         }
@@ -65,6 +67,7 @@ impl Axis {
     }
 
     pub(crate) fn group_follow(&mut self, k: Kinematics) {
+        self.wake();
         if self.group_axis_following() {
             self.group.set = Some(k);
         }
@@ -72,6 +75,7 @@ impl Axis {
 
     /// The path stands with nothing left: the axis stands, without a job.
     pub(crate) fn group_finish(&mut self) {
+        self.wake();
         if self.group_axis_following() {
             self.job = None;
             // The path's last point, given this cycle, is where the axis stands.
@@ -85,12 +89,14 @@ impl Axis {
     }
 
     pub(crate) fn group_abandon(&mut self) {
+        self.wake();
         if self.group_axis_following() {
             self.group.abandon = true;
         }
     }
 
     pub(crate) fn group_reset_axis(&mut self) {
+        self.wake();
         self.group.reset = true;
     }
 

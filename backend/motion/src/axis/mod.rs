@@ -28,6 +28,7 @@
 //! | `external.rs` | `ExtGen` (`ext`) | the external setpoint generator (§4.4) |
 //! | `monitoring.rs` | `OverrideFilterState` (`override_filter`) | MC_Power's enable, MC_OverrideFilter, errors, feed enables, soft limits, following error |
 //! | `status.rs` | — | the status snapshot |
+//! | `rest.rs` | `Rest` (`rest`) | the step of an axis at rest |
 //!
 //! Type dependencies point one way: `coupling.rs` names the cam and multi-master laws,
 //! `camming.rs` and `multimaster.rs` reach the coupling only through the axis's methods
@@ -68,6 +69,7 @@ mod multimaster;
 mod phasing;
 mod planning;
 mod probe;
+mod rest;
 mod status;
 mod superposition;
 mod torque;
@@ -104,6 +106,9 @@ enum Mode {
     Stopping,
     ErrorStop,
 }
+
+/// Seeds each axis's `status_seq`.
+static NEXT_AXIS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// One axis. Built off the cycle thread with [`Axis::new`]; stepped by the kernel.
 #[derive(Debug)]
@@ -206,6 +211,12 @@ pub struct Axis {
     offered: [Option<MasterSample>; 4],
     /// What a drive that runs the profile is sent (`drive_profile.rs`).
     drive: drive_profile::DriveProfile,
+    /// At rest: what the next steps repeat (`rest.rs`).
+    rest: Option<rest::Rest>,
+    /// Counts the status's changes (every full step and every accepted submit): a reader
+    /// that copied the status at one count need not copy it again at the same count, except
+    /// its cycle counter.
+    status_seq: u64,
 }
 
 impl Axis {
@@ -288,6 +299,10 @@ impl Axis {
             group: group::GroupLink::default(),
             offered: [None; 4],
             drive: drive_profile::DriveProfile::default(),
+            rest: None,
+            // Unique between axes, so that a reader never takes one axis's count for
+            // another's in a reused slot (2^40 changes each: 35 years at 1 kHz).
+            status_seq: NEXT_AXIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) << 40,
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();
@@ -296,11 +311,17 @@ impl Axis {
 
     /// The slot the kernel keeps this axis in: the `axis` of every event it reports.
     pub(crate) fn place(&mut self, slot: AxisSlot) {
+        self.wake();
         self.slot = slot;
     }
 
     pub fn status(&self) -> &AxisStatus {
         &self.status
+    }
+
+    /// Changes whenever the status may have changed other than in its `nc_cycle_counter`.
+    pub fn status_seq(&self) -> u64 {
+        self.status_seq
     }
 
     pub fn parameters(&self) -> &AxisParameters {

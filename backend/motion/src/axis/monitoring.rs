@@ -27,8 +27,18 @@ impl OverrideFilterState {
 
     /// `dt` has passed: the value to apply as MC_Power's override, once the quiet time after
     /// the last change has passed (0 % and 100 % at once).
-    fn step(&mut self, dt: f64) -> Option<f64> {
+    /// Nothing waits to be applied.
+    pub(super) fn settled(&self) -> bool {
+        self.pending.is_none()
+    }
+
+    /// The quiet time counts on (at rest nothing else happens here).
+    pub(super) fn count(&mut self, dt: f64) {
         self.since_change += dt;
+    }
+
+    fn step(&mut self, dt: f64) -> Option<f64> {
+        self.count(dt);
         let v = self.pending?;
         if self.applied == Some(v) {
             self.pending = None;

@@ -121,6 +121,7 @@ impl Axis {
     /// The kernel hands over what it saw of every master before a submit or a step (in the
     /// order of [`Axis::coupled_masters`], or of a GearInMultiMaster's masters).
     pub fn offer_masters(&mut self, masters: [Option<MasterSample>; 4]) {
+        self.wake();
         self.offered = masters;
     }
 

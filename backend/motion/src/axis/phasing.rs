@@ -35,6 +35,11 @@ pub(super) struct PhasingState {
 }
 
 impl PhasingState {
+    /// No phasing runs or holds a plan.
+    pub(super) fn settled(&self) -> bool {
+        self.job.is_none() && !self.engaged
+    }
+
     /// Built with the axis (the only allocation: the two planners).
     pub(super) fn new(cycle_time: f64) -> Self {
         PhasingState {

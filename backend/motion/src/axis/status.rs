@@ -7,12 +7,15 @@ use super::*;
 impl Axis {
     /// Starts a new following-error peak hold from the present following error.
     pub fn reset_following_error_peak(&mut self) {
+        self.wake();
+        self.status_seq = self.status_seq.wrapping_add(1);
         let s = &mut self.status;
         s.following_error_min = s.following_error;
         s.following_error_max = s.following_error;
     }
 
     pub(super) fn update_status(&mut self) {
+        self.status_seq = self.status_seq.wrapping_add(1);
         let p = &self.config.parameters;
         let state = self.state();
         let s = &mut self.status;

@@ -35,6 +35,11 @@ pub(super) struct TorqueState {
 }
 
 impl TorqueState {
+    /// No mode change is awaited or timed.
+    pub(super) fn settled(&self) -> bool {
+        self.pending.is_none() && self.leaving == 0.0
+    }
+
     /// The drive's feedback of this cycle.
     pub(super) fn read(&mut self, fb: &DriveFeedback) {
         self.reported = fb.mode;
