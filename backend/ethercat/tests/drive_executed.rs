@@ -382,6 +382,23 @@ fn a_move_off_a_limit_starts_while_the_drive_settles_onto_it() {
     );
 }
 
+/// Endless motion commanded within the standstill band is still watched: a crawl stops at
+/// the soft limit (the band is only for jobs that end by themselves, decision 172).
+#[test]
+fn a_crawl_stops_at_an_enabled_soft_limit() {
+    let mut m = Machine::new(true, 0.05);
+    m.power();
+    let id = m.ok(velocity(0.04, 1000.0, Direction::Positive));
+    m.until(3.0, |m| m.out(id).error);
+    assert_eq!(ErrorId(m.out(id).error_id), ErrorId::SOFT_LIMIT_REACHED);
+    m.until(1.0, |m| m.st().state == AxisState::Standstill);
+    for _ in 0..100 {
+        m.step();
+    }
+    assert!(m.st().actual_position <= 0.05, "{:?}", m.st());
+    assert!(m.st().actual_position > 0.04, "{:?}", m.st());
+}
+
 #[test]
 fn the_blocks_and_inputs_drive_motion_control_lacks_are_refused() {
     let mut m = Machine::new(true, 400.0);

@@ -476,10 +476,7 @@ impl Axis {
     fn drive_soft_limit(&mut self, cx: &mut Ctx<'_, impl EventSink>) -> bool {
         let p = self.p();
         let v = self.act_vel;
-        // A drive within its standstill band (as `drive_at_rest` takes it) heads nowhere:
-        // the creep a drive reports while it settles after homing onto a limit is no motion
-        // out of the limits (a move off that limit was an axis error at random, decision 172).
-        if v.abs() <= p.axis_velo_max * 1e-4 {
+        if v.abs() <= EPS_V {
             return false;
         }
         let limit = if v > 0.0 && p.axis_en_max_soft_pos_limit {
@@ -492,13 +489,25 @@ impl Axis {
         let Some(job) = self.job else {
             return false;
         };
+        let endless = matches!(
+            job.kind,
+            JobKind::Velocity | JobKind::JogHeld { released: false }
+        );
+        // A drive within its standstill band (as `drive_at_rest` takes it) under a job that
+        // ends by itself heads nowhere: the creep a drive reports while it settles after
+        // homing onto a limit is no motion out of the limits (a move off that limit was an
+        // axis error at random, decision 172). Endless motion may be commanded that slowly:
+        // it is watched at any speed.
+        if !endless && v.abs() <= p.axis_velo_max * 1e-4 {
+            return false;
+        }
         let dec = self.drive.cmd.deceleration.max(job.dec).max(1e-9);
         let reach = v * v / (2.0 * dec) + v.abs() * self.cycle_time * f64::from(ANSWER_CYCLES + 1);
         if (limit - self.act_pos) * v.signum() > reach {
             return false;
         }
         match job.kind {
-            JobKind::Velocity | JobKind::JogHeld { released: false } => {
+            _ if endless => {
                 self.stop_internally(cx, ErrorId::SOFT_LIMIT_REACHED, false);
                 true
             }

@@ -88,16 +88,21 @@ impl Axis {
     pub(super) fn at_rest(&self, fb: &DriveFeedback, master: &Master) -> bool {
         self.rest
             .as_ref()
-            .is_some_and(|r| r.confirmed && r.fb == *fb && *master == Master::Uncoupled)
+            .is_some_and(|r| r.confirmed && same_reading(&r.fb, fb) && *master == Master::Uncoupled)
     }
 
     /// After a full step: at rest from the next cycle on, or a step closer to it.
     pub(super) fn settle_rest(&mut self, fb: &DriveFeedback, out: &DriveSetpoint) {
         if !self.quiet() {
-            self.rest = None;
+            // Written only when it changes: a moving axis dirties nothing here.
+            if self.rest.is_some() {
+                self.rest = None;
+            }
             return;
         }
-        let confirmed = self.rest.is_some_and(|r| r.fb == *fb && r.out == *out);
+        let confirmed = self
+            .rest
+            .is_some_and(|r| same_reading(&r.fb, fb) && r.out == *out);
         self.rest = Some(Rest {
             fb: *fb,
             out: *out,
@@ -205,4 +210,13 @@ impl Axis {
         let _ = core::fmt::Write::write_fmt(&mut h, format_args!("{self:?}"));
         h.0
     }
+}
+
+/// The same feedback, down to the sign of a zero in the readings the status shows (`==` takes
+/// −0.0 for 0.0, the status would not).
+fn same_reading(a: &DriveFeedback, b: &DriveFeedback) -> bool {
+    a == b
+        && a.actual_position.to_bits() == b.actual_position.to_bits()
+        && a.actual_velocity.to_bits() == b.actual_velocity.to_bits()
+        && a.actual_torque.to_bits() == b.actual_torque.to_bits()
 }
