@@ -11,9 +11,10 @@
 //! `pub` `&mut self` method calls [`Axis::wake`]).
 //!
 //! Debug builds hold the claim: every cycle at rest runs the full step too and asserts that
-//! it gave what the rest step gives — the whole axis (its `Debug` form), the setpoint, no
-//! event (`rest_step_is_the_full_step` in `kernel.rs`' tests, and every other test that lets
-//! an axis stand).
+//! it gave what the rest step gives — the setpoint, the status, no event, and in the first
+//! cycles at rest and every 64th the whole axis (its `Debug` form, hashed)
+//! (`rest_step_is_the_full_step` in `kernel.rs`' tests, and every other test that lets an
+//! axis stand).
 
 use super::*;
 
