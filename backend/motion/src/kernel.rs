@@ -585,7 +585,9 @@ impl Kernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::command::{BufferMode, Direction, Dynamics, MoveOptions, Positioning};
+    use crate::command::{
+        BufferMode, Direction, DisableMode, Dynamics, MoveOptions, Positioning, Superposition,
+    };
     use crate::{AxisConfig, AxisParameters, AxisState, CommandEvent};
 
     const DT: f64 = 0.001;
@@ -692,14 +694,7 @@ mod tests {
         let mut k = kernel(4);
         let (mut sp, mut e) = (vec![DriveSetpoint::default(); 4], Vec::new());
         for a in 0..4 {
-            let power = CommandKind::Power {
-                enable: true,
-                enable_positive: true,
-                enable_negative: true,
-                override_percent: 100.0,
-                buffer_mode: BufferMode::Aborting,
-            };
-            accept(&mut k, 1 + a as u64, a, power, &mut e);
+            accept(&mut k, 1 + a as u64, a, power(), &mut e);
         }
         for _ in 0..10 {
             step(&mut k, &mut sp, &mut e);
@@ -708,13 +703,7 @@ mod tests {
         // A chain against the slot order: 0 follows 1, which follows 3.
         accept(&mut k, 5, 1, gear_in(3), &mut e);
         accept(&mut k, 6, 0, gear_in(1), &mut e);
-        let velocity = CommandKind::MoveVelocity {
-            velocity: 10.0,
-            dynamics: Dynamics::default(),
-            direction: Direction::Positive,
-            buffer_mode: BufferMode::Aborting,
-            options: MoveOptions::default(),
-        };
+        let velocity = velocity(10.0);
         accept(&mut k, 7, 3, velocity, &mut e);
         for _ in 0..50 {
             step(&mut k, &mut sp, &mut e);
@@ -743,14 +732,7 @@ mod tests {
     fn rest_step_is_the_full_step() {
         let mut k = kernel(2);
         let (mut sp, mut e) = (vec![DriveSetpoint::default(); 2], Vec::new());
-        let power = CommandKind::Power {
-            enable: true,
-            enable_positive: true,
-            enable_negative: true,
-            override_percent: 100.0,
-            buffer_mode: BufferMode::Aborting,
-        };
-        accept(&mut k, 1, 0, power, &mut e);
+        accept(&mut k, 1, 0, power(), &mut e);
         let rests = |k: &Kernel, a| k.axis(a).unwrap().is_at_rest();
         // Powering up takes cycles, each different: no rest yet.
         step(&mut k, &mut sp, &mut e);
@@ -812,5 +794,102 @@ mod tests {
         k.step(&fb, &mut sp, &mut e);
         assert!(!rests(&k, 0));
         assert_eq!(k.status(0).unwrap().actual_position, 5.001);
+    }
+
+    fn velocity(velocity: f64) -> CommandKind {
+        CommandKind::MoveVelocity {
+            velocity,
+            dynamics: Dynamics::default(),
+            direction: Direction::Positive,
+            buffer_mode: BufferMode::Aborting,
+            options: MoveOptions::default(),
+        }
+    }
+
+    fn power() -> CommandKind {
+        CommandKind::Power {
+            enable: true,
+            enable_positive: true,
+            enable_negative: true,
+            override_percent: 100.0,
+            buffer_mode: BufferMode::Aborting,
+        }
+    }
+
+    /// Issue 27: a moving axis marks the blocks it does not use as idle and skips their
+    /// checks and status parts (`axis/idle.rs`); a command for one of them wakes it, and the
+    /// block acts from the next cycle as it did before. In debug builds every status update
+    /// with a mark also asserts that the block is idle and its status part what the full
+    /// update writes.
+    #[test]
+    fn idle_blocks_wake_with_their_command() {
+        let mut k = kernel(1);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 1], Vec::new());
+        accept(&mut k, 1, 0, power(), &mut e);
+        let allow_correction = CommandKind::WriteParameter {
+            number: 1046,
+            value: 1.0,
+        };
+        accept(&mut k, 2, 0, allow_correction, &mut e);
+        for _ in 0..5 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let velocity = velocity(10.0);
+        accept(&mut k, 3, 0, velocity, &mut e);
+        let marks = |k: &Kernel| k.axis(0).unwrap().idle_marks();
+        for _ in 0..200 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let st = k.status(0).unwrap();
+        assert!(st.constant_velocity && st.set_velocity == 10.0);
+        assert_eq!(marks(&k), 0x7f, "every block idle while only moving");
+        // Backlash compensation on the right flank while travelling positive: −0.5 on the
+        // actual position, +0.5 on the drive's setpoint, ramped at 100 units/s.
+        let backlash = CommandKind::BacklashCompensation {
+            backlash: Some(0.5),
+            compensate_in_positive_direction: true,
+            ramp: 100.0,
+            disable_mode: DisableMode::default(),
+        };
+        accept(&mut k, 4, 0, backlash, &mut e);
+        assert_eq!(marks(&k), 0, "a command wakes every block");
+        step(&mut k, &mut sp, &mut e);
+        let st = k.status(0).unwrap();
+        assert!(st.position_correction.backlash_enabled);
+        assert!((st.position_correction.backlash + 0.1).abs() < 1e-9);
+        for _ in 0..10 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let st = k.status(0).unwrap();
+        assert_eq!(st.position_correction.backlash, -0.5);
+        assert!((sp[0].position - (st.set_position + 0.5)).abs() < 1e-9);
+        assert_eq!(marks(&k) & 1, 0, "a commanded correction is not idle");
+        // MC_MoveSuperImposed on the moving axis: under way in the next cycle.
+        let before = k.status(0).unwrap().set_position;
+        let superimposed = CommandKind::MoveSuperImposed(Superposition {
+            distance: 2.0,
+            velocity_diff: 5.0,
+            velocity_process: 10.0,
+            length: 10.0,
+            ..Superposition::default()
+        });
+        accept(&mut k, 5, 0, superimposed, &mut e);
+        step(&mut k, &mut sp, &mut e);
+        let st = k.status(0).unwrap();
+        assert!(st.compensating);
+        for _ in 0..2000 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let st = k.status(0).unwrap();
+        assert!(
+            !st.compensating && st.superimposed_distance == 0.0,
+            "{} {}",
+            st.compensating,
+            st.superimposed_distance
+        );
+        // Ten units a second for 2001 cycles, and the two units laid on top.
+        let laid_on = st.set_position - before - 10.0 * 2001.0 * DT;
+        assert!((laid_on - 2.0).abs() < 1e-6, "{laid_on}");
+        assert_eq!(marks(&k) & 0b1000, 0b1000, "idle again once done");
     }
 }

@@ -372,7 +372,11 @@ fn finite_scaling(v: f64) -> bool {
 impl Axis {
     /// The slave's master while coupled through a cam, or waiting to be.
     pub(super) fn cam_master(&self) -> Option<AxisSlot> {
-        self.cam.cam_in.map(|p| p.master)
+        if self.idle(Idle::CAM) {
+            // Nothing waits for its activation (`idle.rs`).
+            return None;
+        }
+        self.cam.cam_in.as_ref().map(|p| p.master)
     }
 
     /// Runs generation `generation` of cam table `id` (the kernel retires data no slave runs).
@@ -894,7 +898,8 @@ impl Axis {
 
     /// Ends the queued switch and scaling of a coupling that is gone.
     pub(super) fn settle_cam(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
-        if self.cam_law().is_some() {
+        // Marked idle: nothing queued or waiting (`idle.rs`).
+        if self.idle(Idle::CAM) || self.cam_law().is_some() {
             return;
         }
         if self.cam.nothing_queued() && !self.cam.waits_for_coupling() {
@@ -1090,7 +1095,8 @@ impl Axis {
         master: Master,
     ) {
         let Master::Sample(m) = master else {
-            if let (Some(_), Master::Lost) = (self.cam.cam_in, master) {
+            // (Asked without copying the pending coupling.)
+            if master == Master::Lost && self.cam.cam_in.is_some() {
                 self.cancel_cam_in(cx, End::Error(ErrorId::MASTER_LOST));
             }
             return;

@@ -52,14 +52,22 @@ impl Source {
     }
 }
 
-/// The position correction of an axis.
+/// The position correction of an axis. In declaration order, what every cycle reads first
+/// (one cache line), the sources after it (read only while one is commanded, `idle.rs`).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C)]
 pub(super) struct Corrections {
     /// The total sent with the last setpoint: the actual position read now answers it.
     pub(super) sent: f64,
     /// The total the latest actual position was read with (`sent` before this cycle's step):
     /// what turns the reading back into the drive's position.
     pub(super) read: f64,
+    /// The set position's last travel direction (+1, −1; 0 before the first travel), kept
+    /// at standstill: backlash and directional tables depend on it.
+    direction: f64,
+    pub(super) last_set: f64,
+    /// `last_set` holds a set position (false before the first cycle: no travel yet).
+    started: bool,
     pub(super) limiter: Source,
     limiter_mode: PositionCorrectionMode,
     limiter_acceleration: f64,
@@ -69,12 +77,6 @@ pub(super) struct Corrections {
     backlash_value: f64,
     backlash_positive: bool,
     pub(super) table: Source,
-    /// The set position's last travel direction (+1, −1; 0 before the first travel), kept
-    /// at standstill: backlash and directional tables depend on it.
-    direction: f64,
-    pub(super) last_set: f64,
-    /// `last_set` holds a set position (false before the first cycle: no travel yet).
-    started: bool,
 }
 
 impl Corrections {
@@ -264,6 +266,10 @@ impl Axis {
         c.last_set = set;
         if travel.abs() > 1e-12 {
             c.direction = travel.signum();
+        }
+        if self.idle(Idle::CORRECTIONS) {
+            // No source commanded (`idle.rs`): the total stays what was sent.
+            return self.corrections.sent;
         }
         self.correction_targets();
         let c = &mut self.corrections;

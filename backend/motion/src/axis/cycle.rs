@@ -121,8 +121,13 @@ impl Axis {
             self.step_cam_activations(cx, master);
             self.step_feed_enables(cx);
             self.step_job(cx, dt, fb, master);
-            self.step_phasing(cx, dt);
-            self.step_superposition(cx, dt);
+            // Blocks marked idle are skipped (`idle.rs`).
+            if !self.idle(Idle::PHASING) {
+                self.step_phasing(cx, dt);
+            }
+            if !self.idle(Idle::SUPERPOSITION) {
+                self.step_superposition(cx, dt);
+            }
             if !self.drive_executed() {
                 // A drive that runs the profile watches its own lag (statusword bit 13) and
                 // the soft limits are its jobs' (`drive_profile.rs`).
@@ -151,6 +156,7 @@ impl Axis {
         let correction_rate = (correction - self.corrections.sent) / dt;
         self.corrections.sent = correction;
         self.update_status();
+        self.settle_idle();
         // The peak hold counts cycles only: a submit's status update sees the setpoint the
         // drive has not answered yet. NaN feedback cannot stick (f64::min/max skip NaN).
         let s = &mut self.status;
@@ -170,10 +176,11 @@ impl Axis {
             velocity_limit_high: self.torque.limit_high,
             velocity_limit_low: self.torque.limit_low,
             latch_enable: self.latch.is_some() || probe_armed,
-            latch_source: match (self.latch, &self.probe) {
-                (Some(l), _) => l,
-                (None, Some(p)) if probe_armed => p.source(),
-                _ => LatchSource::default(),
+            // The probe only when armed: an axis without one does not read it.
+            latch_source: match self.latch {
+                Some(l) => l,
+                None if probe_armed => self.probe.as_ref().map(|p| p.source()).unwrap_or_default(),
+                None => LatchSource::default(),
             },
             profile: self.profile_command(),
         };

@@ -49,6 +49,7 @@ use crate::modulo::modulo_end_position;
 use crate::params::AxisParameters;
 use crate::planner::{Kinematics, Limits, Planner, sign, stop_distance};
 use crate::status::{AxisState, AxisStatus, HomingPhase};
+use idle::Idle;
 
 mod blending;
 mod camming;
@@ -61,6 +62,7 @@ mod encoder;
 mod external;
 mod group;
 mod homing;
+mod idle;
 mod job;
 mod master;
 mod monitoring;
@@ -213,6 +215,8 @@ pub struct Axis {
     drive: drive_profile::DriveProfile,
     /// At rest: what the next steps repeat (`rest.rs`).
     rest: Option<rest::Rest>,
+    /// Blocks found idle after a full step, skipped until the axis is woken (`idle.rs`).
+    idle: idle::Idle,
     /// Counts the status's changes (every full step and every accepted submit): a reader
     /// that copied the status at one count need not copy it again at the same count, except
     /// its cycle counter.
@@ -300,6 +304,7 @@ impl Axis {
             offered: [None; 4],
             drive: drive_profile::DriveProfile::default(),
             rest: None,
+            idle: idle::Idle::default(),
             // Unique between axes, so that a reader never takes one axis's count for
             // another's in a reused slot (2^40 changes each: 35 years at 1 kHz).
             status_seq: NEXT_AXIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) << 40,
@@ -341,7 +346,7 @@ impl Axis {
         self.coupling
             .as_ref()
             .map(|c| c.master)
-            .or(self.cam_master())
+            .or_else(|| self.cam_master())
     }
 
     /// The PLCopen state, derived from the mode and the active job.

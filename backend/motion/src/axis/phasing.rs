@@ -40,6 +40,15 @@ impl PhasingState {
         self.job.is_none() && !self.engaged
     }
 
+    /// Settled, and no phase shift left (what an uncoupled axis's step leaves).
+    pub(super) fn unused(&self) -> bool {
+        let s = self.shift;
+        self.settled()
+            && [s.position, s.velocity, s.acceleration, s.jerk]
+                .iter()
+                .all(|v| v.to_bits() == 0)
+    }
+
     /// Built with the axis (the only allocation: the two planners).
     pub(super) fn new(cycle_time: f64) -> Self {
         PhasingState {

@@ -76,6 +76,10 @@ impl Axis {
         cx: &mut Ctx<'_, impl EventSink>,
         fb: &DriveFeedback,
     ) -> bool {
+        if self.latch.is_none() && self.idle(Idle::PROBE) {
+            // No probe armed (`idle.rs`): what the lines below find.
+            return false;
+        }
         // Homing takes the drive's one latch: a probe cycle gives way.
         if self.latch.is_some() {
             self.abort_trigger(cx);

@@ -38,6 +38,7 @@ impl Axis {
     /// The axis was changed from outside its step: the next step is a full one.
     pub(super) fn wake(&mut self) {
         self.rest = None;
+        self.forget_idle();
     }
 
     /// Nothing in the axis moves, waits or counts towards anything: the state its next full
@@ -87,9 +88,12 @@ impl Axis {
 
     /// The rest step applies to this cycle.
     pub(super) fn at_rest(&self, fb: &DriveFeedback, master: &Master) -> bool {
-        self.rest
-            .as_ref()
-            .is_some_and(|r| r.confirmed && same_reading(&r.fb, fb) && *master == Master::Uncoupled)
+        // The job first: it is on a line the step reads anyway, the rest record is not, and an
+        // axis with a job never rests.
+        self.job.is_none()
+            && self.rest.as_ref().is_some_and(|r| {
+                r.confirmed && same_reading(&r.fb, fb) && *master == Master::Uncoupled
+            })
     }
 
     /// After a full step: at rest from the next cycle on, or a step closer to it.

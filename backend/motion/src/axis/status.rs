@@ -86,8 +86,6 @@ impl Axis {
             Some(coupling::CouplingLaw::Multi(m)) => m.ratios(),
             _ => [s.gear_ratio, 0.0, 0.0, 0.0],
         };
-        s.compensating = self.superposition.running.is_some();
-        s.superimposed_distance = self.superposition.running.map(|x| x.applied).unwrap_or(0.0);
         s.error_id = if self.mode == Mode::ErrorStop {
             self.error.0
         } else {
@@ -103,44 +101,55 @@ impl Axis {
         s.active_command = job.map(|j| j.id).unwrap_or(0);
         // The cam info changes only while a cam couples or something is queued; idle, it is
         // what it was when it became idle (the kept info or none).
-        let cam_idle = self.cam_set().is_none() && self.cam.nothing_queued();
-        let cam = if cam_idle && self.cam.idle_info {
+        // Blocks marked idle (`idle.rs`) keep their part of the status as it is.
+        let cam_idle = self.cam_set().is_none()
+            && (self.idle(Idle::CAM) || (self.cam.nothing_queued() && self.cam.idle_info));
+        let cam = if cam_idle {
             None
         } else {
+            let cam_idle = self.cam_set().is_none() && self.cam.nothing_queued();
             let (cam, queued, scaling) = self.cam_status();
             self.cam.idle_info = cam_idle;
+            // The kept info may change from now on: looked at again after the step.
+            self.idle.forget(Idle::CAM);
             Some((self.cam.kept_info(cam), queued, scaling))
         };
-        let op_modes = crate::status::AxisOpModes {
-            position_area_monitoring: p.axis_en_position_range_monitoring,
-            target_position_monitoring: p.axis_en_target_position_monitoring,
-            loop_mode: p.axis_en_looping_distance,
-            motion_monitoring: p.axis_en_motion_monitoring,
-            peh_time_monitoring: p.axis_en_in_target_timeout,
-            modulo: self.config.modulo,
-            position_lag_monitoring: p.axis_en_position_lag_monitoring,
-            soft_limit_min_monitoring: p.axis_en_min_soft_pos_limit,
-            soft_limit_max_monitoring: p.axis_en_max_soft_pos_limit,
-            position_correction: p.axis_enable_pos_correction,
-            allow_slave_commands: p.axis_allow_motion_cmd_to_slave_axis,
-            allow_ext_set_axis_commands: p.axis_allow_motion_cmd_to_ext_set_axis,
-        };
-        let (phasing_active, absolute_phase_shift, covered_phase_shift) = self.phasing_status();
-        let position_correction = self.correction_status();
+        let phasing = (!self.idle(Idle::PHASING)).then(|| self.phasing_status());
+        let position_correction = (!self.idle(Idle::CORRECTIONS)).then(|| self.correction_status());
+        let op_modes = (!self.idle(Idle::CONFIG)).then(|| self.op_modes());
         let encoder_count = self.encoder_count();
         let (drive_mode, actual_torque, set_torque, velocity_limited) = self.torque_status();
         let torque_job = self.runs(JobKind::Torque);
-        let ext_enabled = self.ext.enabled;
-        let ext_target = self.ext.target.filter(|_| self.ext.enabled);
+        // Not `then_some`: an idle generator's line is not to be read at all.
+        let ext = if self.idle(Idle::EXT) {
+            None
+        } else {
+            Some(self.ext.enabled)
+        };
+        let ext_target = self.ext.target.filter(|_| ext == Some(true));
+        let superposition = (!self.idle(Idle::SUPERPOSITION))
+            .then(|| self.superposition.running.map(|x| x.applied));
         let s = &mut self.status;
-        s.phasing_active = phasing_active;
-        s.position_correction = position_correction;
+        if let Some((active, absolute, covered)) = phasing {
+            s.phasing_active = active;
+            s.absolute_phase_shift = absolute;
+            s.covered_phase_shift = covered;
+        }
+        if let Some(c) = position_correction {
+            s.position_correction = c;
+        }
+        if let Some(running) = superposition {
+            s.compensating = running.is_some();
+            s.superimposed_distance = running.unwrap_or(0.0);
+        }
         s.encoder_count = encoder_count;
         s.drive_operation_mode = drive_mode;
         s.actual_torque = actual_torque;
         s.set_torque = set_torque;
         s.torque_velocity_limited = velocity_limited;
-        s.ext_setpoint_gen_enabled = ext_enabled;
+        if let Some(enabled) = ext {
+            s.ext_setpoint_gen_enabled = enabled;
+        }
         if let Some(t) = ext_target {
             // §4.4.1: the position given to the enable is monitored, the axis does not go
             // there by itself.
@@ -149,10 +158,10 @@ impl Axis {
             s.in_target_position =
                 s.in_target_position && s.remaining_distance <= p.axis_target_position_window;
         }
-        s.encoder_scaling_factor = p.axis_encoder_scaling_factor;
-        s.absolute_phase_shift = absolute_phase_shift;
-        s.covered_phase_shift = covered_phase_shift;
-        s.op_modes = op_modes;
+        if let Some(op_modes) = op_modes {
+            s.encoder_scaling_factor = p.axis_encoder_scaling_factor;
+            s.op_modes = op_modes;
+        }
         s.operational = s.power_status && matches!(self.mode, Mode::Enabled | Mode::Stopping);
         // Torque control leaves the position loop open.
         s.control_loop_closed = s.operational && !torque_job;
@@ -169,6 +178,27 @@ impl Axis {
             s.cam_table_queued = queued;
             s.cam_scaling_pending = scaling;
             s.cam_data_queued = cam.cam_data_queued;
+        }
+        #[cfg(debug_assertions)]
+        self.check_idle();
+    }
+
+    /// The status's OpModes: the parameters that switch monitoring and modes on.
+    pub(super) fn op_modes(&self) -> crate::status::AxisOpModes {
+        let p = &self.config.parameters;
+        crate::status::AxisOpModes {
+            position_area_monitoring: p.axis_en_position_range_monitoring,
+            target_position_monitoring: p.axis_en_target_position_monitoring,
+            loop_mode: p.axis_en_looping_distance,
+            motion_monitoring: p.axis_en_motion_monitoring,
+            peh_time_monitoring: p.axis_en_in_target_timeout,
+            modulo: self.config.modulo,
+            position_lag_monitoring: p.axis_en_position_lag_monitoring,
+            soft_limit_min_monitoring: p.axis_en_min_soft_pos_limit,
+            soft_limit_max_monitoring: p.axis_en_max_soft_pos_limit,
+            position_correction: p.axis_enable_pos_correction,
+            allow_slave_commands: p.axis_allow_motion_cmd_to_slave_axis,
+            allow_ext_set_axis_commands: p.axis_allow_motion_cmd_to_ext_set_axis,
         }
     }
 }
