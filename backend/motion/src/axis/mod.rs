@@ -215,6 +215,8 @@ pub struct Axis {
     drive: drive_profile::DriveProfile,
     /// At rest: what the next steps repeat (`rest.rs`).
     rest: Option<rest::Rest>,
+    /// `rest` is confirmed (asked first: this flag shares the line of the other flags).
+    resting: bool,
     /// Blocks found idle after a full step, skipped until the axis is woken (`idle.rs`).
     idle: idle::Idle,
     /// Counts the status's changes (every full step and every accepted submit): a reader
@@ -304,6 +306,7 @@ impl Axis {
             offered: [None; 4],
             drive: drive_profile::DriveProfile::default(),
             rest: None,
+            resting: false,
             idle: idle::Idle::default(),
             // Unique between axes, so that a reader never takes one axis's count for
             // another's in a reused slot (2^40 changes each: 35 years at 1 kHz).

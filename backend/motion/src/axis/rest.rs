@@ -38,6 +38,7 @@ impl Axis {
     /// The axis was changed from outside its step: the next step is a full one.
     pub(super) fn wake(&mut self) {
         self.rest = None;
+        self.resting = false;
         self.forget_idle();
     }
 
@@ -88,9 +89,9 @@ impl Axis {
 
     /// The rest step applies to this cycle.
     pub(super) fn at_rest(&self, fb: &DriveFeedback, master: &Master) -> bool {
-        // The job first: it is on a line the step reads anyway, the rest record is not, and an
-        // axis with a job never rests.
-        self.job.is_none()
+        // The flag first: it shares its line with the flags every step reads, the rest
+        // record does not.
+        self.resting
             && self.rest.as_ref().is_some_and(|r| {
                 r.confirmed && same_reading(&r.fb, fb) && *master == Master::Uncoupled
             })
@@ -103,11 +104,13 @@ impl Axis {
             if self.rest.is_some() {
                 self.rest = None;
             }
+            self.resting = false;
             return;
         }
         let confirmed = self
             .rest
             .is_some_and(|r| same_reading(&r.fb, fb) && r.out == *out);
+        self.resting = confirmed;
         self.rest = Some(Rest {
             fb: *fb,
             out: *out,
