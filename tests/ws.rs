@@ -655,12 +655,7 @@ async fn updates_due_together_come_as_one_batch() {
     let s = Server::start();
     let mut a = connect(&s).await;
     let mut b = connect(&s).await;
-    for (i, axis) in ["x", "y"].iter().enumerate() {
-        let id = 10 + i as u64;
-        send(&mut a, id, "power", json!({"axis": axis, "wait": true})).await;
-        let (r, _) = response(&mut a, id).await;
-        assert_eq!(r["result"]["outputs"]["status"], true, "{r}");
-    }
+    power_x_and_y(&mut a).await;
     for (id, topic) in [(1, "axes/x/status"), (2, "axes/y/status")] {
         send(
             &mut a,
@@ -679,17 +674,7 @@ async fn updates_due_together_come_as_one_batch() {
     )
     .await;
     response(&mut b, 1).await;
-    for (id, axis) in [(20, "x"), (21, "y")] {
-        send(
-            &mut a,
-            id,
-            "move-velocity",
-            json!({"axis": axis, "velocity": 20.0}),
-        )
-        .await;
-        let (r, _) = response(&mut a, id).await;
-        assert!(r["error"].is_null(), "{r}");
-    }
+    move_x_and_y(&mut a).await;
     // Read a second of updates on both sockets.
     let (mut on_a, mut on_b) = (Vec::new(), Vec::new());
     for (ws, seen) in [(&mut a, &mut on_a), (&mut b, &mut on_b)] {
@@ -715,21 +700,10 @@ async fn updates_due_together_come_as_one_batch() {
     // read here): the same on both sockets in every cycle both were sent, member by member.
     // (The deltas themselves may differ: a socket that skipped a version gets the delta from
     // the version it has; and the full objects came before the reading began.)
-    let states = |updates: &[Value]| {
-        let mut state = serde_json::Map::new();
-        let mut by_cycle = std::collections::BTreeMap::new();
-        for u in updates.iter().filter(|u| u["topic"] == "axes/x/status") {
-            if u["full"] == true {
-                state.clear();
-            }
-            for (k, v) in u["data"].as_object().expect("an object") {
-                state.insert(k.clone(), v.clone());
-            }
-            by_cycle.insert(u["cycle"].as_u64().expect("a cycle"), state.clone());
-        }
-        by_cycle
-    };
-    let (xa, xb) = (states(&on_a), states(&on_b));
+    let (xa, xb) = (
+        states(&on_a, "axes/x/status"),
+        states(&on_b, "axes/x/status"),
+    );
     let mut same = 0;
     for (cycle, sb) in &xb {
         if let Some(sa) = xa.get(cycle) {
@@ -744,6 +718,127 @@ async fn updates_due_together_come_as_one_batch() {
     }
     assert!(same > 0, "no common cycle between the two sockets");
     for ws in [&mut a, &mut b] {
+        send(ws, 99, "stop", json!({"axis": "x"})).await;
+    }
+}
+
+/// An axis topic's status as a socket has it after each cycle it was sent: the members last
+/// sent (from `updates`, whole from a full one on).
+fn states(
+    updates: &[Value],
+    topic: &str,
+) -> std::collections::BTreeMap<u64, serde_json::Map<String, Value>> {
+    let mut state = serde_json::Map::new();
+    let mut by_cycle = std::collections::BTreeMap::new();
+    for u in updates.iter().filter(|u| u["topic"] == topic) {
+        if u["full"] == true {
+            state.clear();
+        }
+        for (k, v) in u["data"].as_object().expect("an object") {
+            state.insert(k.clone(), v.clone());
+        }
+        by_cycle.insert(u["cycle"].as_u64().expect("a cycle"), state.clone());
+    }
+    by_cycle
+}
+
+/// Powers x and y through `ws`.
+async fn power_x_and_y(ws: &mut Ws) {
+    for (i, axis) in ["x", "y"].iter().enumerate() {
+        let id = 10 + i as u64;
+        send(ws, id, "power", json!({"axis": axis, "wait": true})).await;
+        let (r, _) = response(ws, id).await;
+        assert_eq!(r["result"]["outputs"]["status"], true, "{r}");
+    }
+}
+
+/// Starts x and y at 20 units/s through `ws`.
+async fn move_x_and_y(ws: &mut Ws) {
+    for (id, axis) in [(20, "x"), (21, "y")] {
+        send(
+            ws,
+            id,
+            "move-velocity",
+            json!({"axis": axis, "velocity": 20.0}),
+        )
+        .await;
+        let (r, _) = response(ws, id).await;
+        assert!(r["error"].is_null(), "{r}");
+    }
+}
+
+/// Issue 27: sockets that subscribe alike take one message per tick, made once (`/metrics`
+/// counts the ones taken from another socket's), and what they have of an axis is what a
+/// socket that subscribed otherwise (and made its own messages) has, cycle by cycle.
+#[tokio::test(flavor = "multi_thread")]
+async fn sockets_that_subscribe_alike_share_a_tick_s_message() {
+    let s = Server::start();
+    let (mut a, mut b, mut c) = (connect(&s).await, connect(&s).await, connect(&s).await);
+    power_x_and_y(&mut a).await;
+    // a and b alike (x, then y); c the other way round.
+    for (ws, topics) in [
+        (&mut a, ["axes/x/status", "axes/y/status"]),
+        (&mut b, ["axes/x/status", "axes/y/status"]),
+        (&mut c, ["axes/y/status", "axes/x/status"]),
+    ] {
+        for (id, topic) in [1, 2].into_iter().zip(topics) {
+            send(ws, id, "subscribe", json!({"topic": topic, "rate_hz": 50})).await;
+            response(ws, id).await;
+        }
+    }
+    move_x_and_y(&mut a).await;
+    let shared = || async {
+        let m = get(&s, "/metrics").await;
+        let line = m
+            .text
+            .lines()
+            .find(|l| l.starts_with("motiond_ws_messages_shared_total "))
+            .unwrap_or_else(|| panic!("no shared count: {}", m.text));
+        line.rsplit(' ').next().unwrap().parse::<f64>().unwrap()
+    };
+    // Read the three sockets in turn until some message was shared (alike sockets that keep
+    // up share from their second tick on; a busy machine may take longer).
+    let mut got: [Vec<Value>; 3] = Default::default();
+    let deadline = tokio::time::Instant::now() + Duration::from_secs(60);
+    loop {
+        for (ws, seen) in [&mut a, &mut b, &mut c].into_iter().zip(got.iter_mut()) {
+            let end = tokio::time::Instant::now() + Duration::from_millis(300);
+            while tokio::time::Instant::now() < end {
+                match next(ws, Duration::from_secs(5)).await {
+                    Some(m) if m["method"] == "update" => seen.push(m["params"].clone()),
+                    Some(_) => {}
+                    None => break,
+                }
+            }
+        }
+        if shared().await > 0.0 && got.iter().all(|g| g.len() > 20) {
+            break;
+        }
+        assert!(
+            tokio::time::Instant::now() < deadline,
+            "nothing shared in 60 s"
+        );
+    }
+    for topic in ["axes/x/status", "axes/y/status"] {
+        // Each axis's status by cycle (members as last sent since the reading began).
+        let theirs = states(&got[2], topic);
+        for (socket, updates) in got[..2].iter().enumerate() {
+            let mine = states(updates, topic);
+            let mut common = 0;
+            for (cycle, m) in &mine {
+                if let Some(t) = theirs.get(cycle) {
+                    for (k, v) in m.iter().filter(|(k, _)| t.contains_key(*k)) {
+                        assert_eq!(v, &t[k], "{topic}'s {k} at {cycle}: {socket} and c differ");
+                    }
+                    common += usize::from(
+                        m.contains_key("set_position") && t.contains_key("set_position"),
+                    );
+                }
+            }
+            assert!(common > 0, "{topic}: socket {socket} and c share no cycle");
+        }
+    }
+    for ws in [&mut a, &mut b, &mut c] {
         send(ws, 99, "stop", json!({"axis": "x"})).await;
     }
 }

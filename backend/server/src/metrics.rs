@@ -313,6 +313,8 @@ pub struct Sources<'a> {
     pub cycle_time_s: f64,
     pub sched_fifo: bool,
     pub metrics: &'a Metrics,
+    /// Websocket tick messages made by a socket, and taken from another socket's.
+    pub ws_messages: (u64, u64),
 }
 
 /// The whole `/metrics` text; `fine`: every bucket of the cycle timing histograms (for
@@ -416,6 +418,16 @@ pub fn render(s: Sources<'_>, fine: bool) -> String {
                 "motiond_requests_expired",
                 "Requests dropped undone after their requester had answered 503",
                 st.requests_expired.load(Relaxed),
+            ),
+            (
+                "motiond_ws_messages_made",
+                "Websocket tick messages made by their socket",
+                s.ws_messages.0,
+            ),
+            (
+                "motiond_ws_messages_shared",
+                "Websocket tick messages taken from another socket that asked the same",
+                s.ws_messages.1,
             ),
         ]
         .into_iter()

@@ -10,7 +10,7 @@ use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::ws::{Message, Utf8Bytes, WebSocket, WebSocketUpgrade};
 use axum::extract::{ConnectInfo, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
@@ -64,7 +64,8 @@ impl Default for Settings {
         }
     }
 }
-use crate::app::feed::TICK;
+use crate::app::feed::{Asked, TICK};
+use motion::AxisSlot;
 
 // ---------------------------------------------------------------------------------------------
 // The messages, as types: the session serialises these, and `super::asyncapi` describes the
@@ -373,6 +374,8 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                 None => std::future::pending().await,
             }
         };
+        // A tick's message (shared with other sockets: no copy).
+        let mut tick_out: Option<Utf8Bytes> = None;
         let outgoing: Vec<String> = tokio::select! {
             msg = socket.recv() => {
                 if matches!(msg, Some(Ok(_))) {
@@ -452,9 +455,8 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
             _ = due => {
                 // Socket jogs are not renewed here: only the client's keepalives renew them,
                 // so a client whose script hangs with the socket open still stops the axis.
-                let mut out = Batch::with_capacity(last_len);
                 let tick = s.feed.tick_now().max(next_due.unwrap_or(0));
-                updates(&s, &mut subs, &mut seen_writes, tick, &mut out);
+                let m = tick_message(&s, &mut subs, &mut seen_writes, tick, last_len);
                 // The next tick is held before this one is let go (the clock never slips
                 // past it while this socket sends).
                 let next = subs
@@ -463,13 +465,17 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
                     .map(|x| x.due)
                     .min();
                 due_hold = next.map(|t| (t, s.feed.at(t, keeping_up)));
-                let m = out.finish();
                 last_len = m.as_ref().map_or(last_len, |m| m.len() + 64);
-                m.into_iter().collect()
+                tick_out = m;
+                vec![]
             }
         };
-        for m in outgoing {
-            let send = socket.send(Message::Text(m.into()));
+        for m in outgoing
+            .into_iter()
+            .map(Utf8Bytes::from)
+            .chain(tick_out.take())
+        {
+            let send = socket.send(Message::Text(m));
             tokio::pin!(send);
             let sent = tokio::select! {
                 r = &mut send => r,
@@ -567,7 +573,18 @@ impl Batch {
     }
 }
 
-fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, out: &mut Batch) {
+/// This socket's updates at `tick` as one message (`None`: nothing to send). A socket whose
+/// due subscriptions are all axis topics asks the feed first for the message another socket
+/// made for the same at this tick, and leaves its own there for the sockets after it: sockets
+/// that subscribe alike and keep up share one message per tick (issue 27).
+fn tick_message(
+    s: &AppState,
+    subs: &mut Vec<Sub>,
+    seen_writes: &mut u64,
+    tick: u64,
+    capacity: usize,
+) -> Option<Utf8Bytes> {
+    let mut out = Batch::with_capacity(capacity);
     let writes = s.registry_writes();
     if writes != *seen_writes
         && subs
@@ -576,8 +593,78 @@ fn updates(s: &AppState, subs: &mut Vec<Sub>, seen_writes: &mut u64, tick: u64, 
     {
         // Only after the registry changed: axes moved to other slots, were renamed or removed.
         *seen_writes = writes;
-        follow_axes(s, subs, out);
+        follow_axes(s, subs, &mut out);
     }
+    // A group's or the system's update is this socket's own (its delta against what this
+    // socket was sent); so is a message that tells of a subscription ended.
+    let shareable = out.n == 0
+        && subs
+            .iter()
+            .filter(|x| tick >= x.due)
+            .all(|x| matches!(x.topic, Topic::Axis { .. } | Topic::Commands));
+    // (A tick with no axis topic due has nothing to share.)
+    let shareable = shareable && asked(subs, tick).next().is_some();
+    if shareable {
+        let same = |theirs: &[Asked]| {
+            let mut mine = asked(subs, tick);
+            theirs
+                .iter()
+                .all(|t| mine.next() == Some((t.0, t.1, &*t.2)))
+                && mine.next().is_none()
+        };
+        if let Some(batch) = s.feed.shared(tick, same) {
+            let mut seen = batch.seen.iter();
+            for sub in subs.iter_mut().filter(|x| tick >= x.due) {
+                sub.due = (tick / sub.every + 1) * sub.every;
+                if let Topic::Axis { .. } = sub.topic {
+                    sub.seen = seen.next().copied().flatten();
+                }
+            }
+            return batch.message.clone().map(text);
+        }
+    }
+    let mine: Option<Vec<Asked>> = shareable.then(|| {
+        asked(subs, tick)
+            .map(|(slot, seen, key)| (slot, seen, key.into()))
+            .collect()
+    });
+    let due: Vec<bool> = subs.iter().map(|x| tick >= x.due).collect();
+    updates(s, subs, tick, &mut out);
+    s.feed.made_one();
+    let message = out.finish().map(bytes::Bytes::from);
+    if let Some(asked) = mine {
+        let seen = subs
+            .iter()
+            .zip(due)
+            .filter(|(x, due)| *due && matches!(x.topic, Topic::Axis { .. }))
+            .map(|(x, _)| x.seen)
+            .collect();
+        let batch = crate::app::feed::SharedBatch {
+            asked,
+            seen,
+            message: message.clone(),
+        };
+        s.feed.share(tick, batch);
+    }
+    message.map(text)
+}
+
+/// The axis subscriptions due at `tick`: slot, version last sent, topic as JSON.
+fn asked(subs: &[Sub], tick: u64) -> impl Iterator<Item = (AxisSlot, Option<u64>, &str)> {
+    subs.iter()
+        .filter(move |x| tick >= x.due)
+        .filter_map(|x| match x.topic {
+            Topic::Axis { slot, .. } => Some((slot, x.seen, x.key_json.as_str())),
+            _ => None,
+        })
+}
+
+/// A message made from a `String` as the websocket's text (no copy).
+fn text(b: bytes::Bytes) -> Utf8Bytes {
+    Utf8Bytes::try_from(b).expect("made from a String: UTF-8")
+}
+
+fn updates(s: &AppState, subs: &mut [Sub], tick: u64, out: &mut Batch) {
     for sub in subs.iter_mut().filter(|x| tick >= x.due) {
         // The rate's grid; a socket that fell behind skips what it missed.
         sub.due = (tick / sub.every + 1) * sub.every;

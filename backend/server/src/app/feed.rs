@@ -11,7 +11,8 @@
 //! subscriber is known here only by the version (the status's cycle) it was last sent.
 
 use std::collections::VecDeque;
-use std::sync::{Arc, RwLock};
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+use std::sync::{Arc, Mutex, RwLock};
 use std::time::Duration;
 
 use serde_json::{Map, Value};
@@ -25,6 +26,9 @@ pub const TICK: Duration = Duration::from_millis(5);
 
 /// Versions of an axis's status kept for deltas (a subscriber further behind gets it whole).
 pub const KEPT: usize = 8;
+
+/// Different messages shared per tick (sockets asking for something else make their own).
+const SHARED_PER_TICK: usize = 16;
 
 /// One axis's status at one cycle, as JSON.
 struct Version {
@@ -150,11 +154,60 @@ pub struct Piece {
     pub version: u64,
 }
 
+/// One due axis subscription of a socket: its slot, the version it was last sent, its topic
+/// as JSON.
+pub type Asked = (AxisSlot, Option<u64>, Box<str>);
+
+/// One socket's axis updates at a tick, as sent: shared with every socket that asks for the
+/// same at that tick — the same axes under the same topic names, each last sent the same
+/// version (issue 27). Sockets that subscribe alike and keep up ask alike, so a tick's
+/// message is made once, not once per socket.
+pub struct SharedBatch {
+    /// Each due axis subscription, in the socket's order.
+    pub asked: Vec<Asked>,
+    /// The version each of them has after this message (in `asked`'s order).
+    pub seen: Vec<Option<u64>>,
+    /// The message (`None`: nothing changed, nothing to send).
+    pub message: Option<bytes::Bytes>,
+}
+
+#[derive(Default)]
+struct SharedTick {
+    tick: u64,
+    batches: Vec<Arc<SharedBatch>>,
+}
+
+impl SharedTick {
+    fn find(&self, tick: u64, same: impl Fn(&[Asked]) -> bool) -> Option<Arc<SharedBatch>> {
+        if self.tick != tick {
+            return None;
+        }
+        self.batches.iter().find(|b| same(&b.asked)).cloned()
+    }
+
+    fn keep(&mut self, tick: u64, batch: SharedBatch) {
+        if tick > self.tick {
+            self.tick = tick;
+            self.batches.clear();
+        }
+        // Two sockets that asked alike at once both made it: one copy is enough.
+        let known = self.batches.iter().any(|b| b.asked == batch.asked);
+        if tick == self.tick && !known && self.batches.len() < SHARED_PER_TICK {
+            self.batches.push(Arc::new(batch));
+        }
+    }
+}
+
 pub struct Feed {
     /// Ticks are clock time (virtual time in virtual time: a 50 Hz subscription is sent once
     /// per 20 ms of it).
     clock: Arc<Clock>,
     axes: Vec<RwLock<AxisFeed>>,
+    /// The newest tick's messages, for the sockets that ask the same.
+    shared: Mutex<SharedTick>,
+    /// Tick messages made by a socket, and taken from another socket's (`/metrics`).
+    made: AtomicU64,
+    reused: AtomicU64,
 }
 
 impl Feed {
@@ -162,7 +215,35 @@ impl Feed {
         Feed {
             clock,
             axes: (0..slots).map(|_| RwLock::default()).collect(),
+            shared: Mutex::default(),
+            made: AtomicU64::new(0),
+            reused: AtomicU64::new(0),
         }
+    }
+
+    /// Tick messages made by a socket, and taken from the one another socket made.
+    pub fn messages(&self) -> (u64, u64) {
+        (self.made.load(Relaxed), self.reused.load(Relaxed))
+    }
+
+    /// A socket made its tick's message itself.
+    pub fn made_one(&self) {
+        self.made.fetch_add(1, Relaxed);
+    }
+
+    /// The message another socket made at `tick` for what `same` accepts (its `asked`), if
+    /// any. Only the newest tick's messages are kept: a socket behind makes its own.
+    pub fn shared(&self, tick: u64, same: impl Fn(&[Asked]) -> bool) -> Option<Arc<SharedBatch>> {
+        let found = self.shared.lock().unwrap().find(tick, same);
+        if found.is_some() {
+            self.reused.fetch_add(1, Relaxed);
+        }
+        found
+    }
+
+    /// Keeps what a socket made at `tick` for the sockets after it.
+    pub fn share(&self, tick: u64, batch: SharedBatch) {
+        self.shared.lock().unwrap().keep(tick, batch);
     }
 
     /// Tick `tick`, held (in virtual time the clock stops there until the hold is dropped, so
@@ -342,5 +423,41 @@ mod tests {
         let p = f.answer(Some(1)).unwrap();
         assert!(p.full);
         assert_eq!(&*p.data.unwrap(), &*f.versions.back().unwrap().json);
+    }
+
+    /// Issue 27: a tick's message is kept for the sockets that ask the same at that tick; a
+    /// newer tick drops the older ones, a socket still at an older tick makes its own, and
+    /// only so many different ones are kept per tick.
+    #[test]
+    fn a_tick_s_message_is_kept_for_the_sockets_that_ask_the_same() {
+        let batch = |slot: AxisSlot, seen: Option<u64>, text: &'static str| SharedBatch {
+            asked: vec![(slot, seen, r#""axes/x/status""#.into())],
+            seen: vec![Some(7)],
+            message: Some(bytes::Bytes::from_static(text.as_bytes())),
+        };
+        let asks = |slot: AxisSlot, seen: Option<u64>| {
+            move |a: &[Asked]| a.len() == 1 && a[0].0 == slot && a[0].1 == seen
+        };
+        let mut t = SharedTick::default();
+        t.keep(5, batch(0, Some(3), "five"));
+        let got = t.find(5, asks(0, Some(3))).expect("the same asked");
+        assert_eq!(got.message.as_deref(), Some(&b"five"[..]));
+        assert_eq!(got.seen, [Some(7)]);
+        assert!(
+            t.find(5, asks(0, Some(2))).is_none(),
+            "another version last sent"
+        );
+        assert!(t.find(5, asks(1, Some(3))).is_none(), "another axis");
+        assert!(t.find(4, asks(0, Some(3))).is_none(), "an older tick");
+        // An older tick's message is not kept over the newer one's.
+        t.keep(4, batch(0, Some(3), "four"));
+        assert!(t.find(4, asks(0, Some(3))).is_none());
+        t.keep(6, batch(0, Some(3), "six"));
+        assert!(t.find(5, asks(0, Some(3))).is_none(), "tick 5 is gone");
+        assert_eq!(t.batches.len(), 1);
+        for slot in 1..=(2 * SHARED_PER_TICK as AxisSlot) {
+            t.keep(6, batch(slot, None, "more"));
+        }
+        assert_eq!(t.batches.len(), SHARED_PER_TICK);
     }
 }

@@ -38,6 +38,7 @@ pub fn text(s: &AppState, fine: bool) -> String {
         cycle_time_s: s.info.cycle_time_s,
         sched_fifo: s.info.realtime.sched_fifo,
         metrics: &s.metrics,
+        ws_messages: s.feed.messages(),
     };
     metrics::render(sources, fine)
 }
