@@ -52,8 +52,8 @@ impl Source {
     }
 }
 
-/// The position correction of an axis. In declaration order, what every cycle reads first
-/// (one cache line), the sources after it (read only while one is commanded, `idle.rs`).
+/// The position correction of an axis. In declaration order: what every cycle reads, together
+/// (33 bytes), then the sources (read only while one is commanded, `idle.rs`).
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C)]
 pub(super) struct Corrections {

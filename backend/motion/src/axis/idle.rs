@@ -1,4 +1,5 @@
-//! Blocks an axis does not use cost a moving axis nothing per cycle (issue 27). Each block's
+//! Blocks an axis does not use cost a moving axis the test of one bit per cycle (issue 27),
+//! not the reading of their state. Each block's
 //! per-cycle check reads its own state — the correction sources, the cam queues, the phasing,
 //! the superposition, the touch probe, the external setpoint generator — and each of those
 //! lies on cache lines of its own: on a moving axis that used none of them the checks were
@@ -12,6 +13,9 @@
 //! (a buffered MC_CamIn taking over) is not covered by a mark: the cam part of the status is
 //! skipped only while the axis runs no cam. The status keeps what the last full status update
 //! wrote for an idle block, which is what it would write again.
+//!
+//! So a block that is ever to start from inside the step (say, a buffered command that
+//! arms it when the job before it ends) must clear its mark there (`Idle::forget`).
 //!
 //! Debug builds hold the claim: every status update with a mark set asserts that the block is
 //! idle and that its part of the status is what the full update would write
