@@ -421,12 +421,12 @@ pub fn render(s: Sources<'_>, fine: bool) -> String {
             ),
             (
                 "motiond_ws_messages_made",
-                "Websocket tick messages made by their socket",
+                "Websocket ticks whose axis updates a socket made itself",
                 s.ws_messages.0,
             ),
             (
                 "motiond_ws_messages_shared",
-                "Websocket tick messages taken from another socket that asked the same",
+                "Websocket ticks whose axis updates a socket took from another socket that asked the same",
                 s.ws_messages.1,
             ),
         ]

@@ -205,7 +205,8 @@ pub struct Feed {
     axes: Vec<RwLock<AxisFeed>>,
     /// The newest tick's messages, for the sockets that ask the same.
     shared: Mutex<SharedTick>,
-    /// Tick messages made by a socket, and taken from another socket's (`/metrics`).
+    /// Ticks whose axis updates a socket made itself, and took from another socket's (`/metrics`;
+    /// a tick with nothing to send counts too).
     made: AtomicU64,
     reused: AtomicU64,
 }
@@ -221,12 +222,12 @@ impl Feed {
         }
     }
 
-    /// Tick messages made by a socket, and taken from the one another socket made.
+    /// Ticks whose axis updates a socket made itself, and took from another socket's.
     pub fn messages(&self) -> (u64, u64) {
         (self.made.load(Relaxed), self.reused.load(Relaxed))
     }
 
-    /// A socket made its tick's message itself.
+    /// A socket made its tick's axis updates itself.
     pub fn made_one(&self) {
         self.made.fetch_add(1, Relaxed);
     }
