@@ -313,7 +313,7 @@ pub struct Sources<'a> {
     pub cycle_time_s: f64,
     pub sched_fifo: bool,
     pub metrics: &'a Metrics,
-    /// Websocket tick messages made by a socket, and taken from another socket's.
+    /// Websocket ticks whose axis updates a socket made itself, and took from another's.
     pub ws_messages: (u64, u64),
 }
 

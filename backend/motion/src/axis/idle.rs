@@ -1,11 +1,10 @@
 //! Blocks an axis does not use cost a moving axis the test of one bit per cycle (issue 27),
-//! not the reading of their state. Each block's
-//! per-cycle check reads its own state — the correction sources, the cam queues, the phasing,
-//! the superposition, the touch probe, the external setpoint generator — and each of those
-//! lies on cache lines of its own: on a moving axis that used none of them the checks were
-//! about a fifth of the lines its step touched. So a block found idle at the end of a full
-//! step is marked in one byte, and the next steps skip its check and its part of the status
-//! until the axis is woken.
+//! not the reading of their state. Each block's per-cycle check reads its own state — the
+//! correction sources, the cam queues, the phasing, the superposition, the touch probe, the
+//! external setpoint generator — and each of those lies on cache lines of its own: on a
+//! moving axis that used none of them the checks were about a fifth of the lines its step
+//! touched. So a block found idle at the end of a full step is marked in one byte, and the
+//! next steps skip its check and its part of the status until the axis is woken.
 //!
 //! Why that is exact: a block goes from idle to in use only through a command or a call from
 //! outside the step (every `pub` `&mut self` method calls [`Axis::wake`], which clears the

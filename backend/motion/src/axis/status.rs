@@ -107,9 +107,9 @@ impl Axis {
         let cam = if cam_idle {
             None
         } else {
-            let cam_idle = self.cam_set().is_none() && self.cam.nothing_queued();
+            let idle_now = self.cam_set().is_none() && self.cam.nothing_queued();
             let (cam, queued, scaling) = self.cam_status();
-            self.cam.idle_info = cam_idle;
+            self.cam.idle_info = idle_now;
             // The kept info may change from now on: looked at again after the step.
             self.idle.forget(Idle::CAM);
             Some((self.cam.kept_info(cam), queued, scaling))

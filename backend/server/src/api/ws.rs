@@ -277,6 +277,14 @@ struct Sub {
     seen: Option<u64>,
 }
 
+impl Sub {
+    /// Sent at `tick`: due next on its rate's grid (a socket that fell behind skips what it
+    /// missed).
+    fn sent_at(&mut self, tick: u64) {
+        self.due = (tick / self.every + 1) * self.every;
+    }
+}
+
 fn rpc_result(id: &Value, result: Value) -> String {
     json!({"jsonrpc": "2.0", "id": id, "result": result}).to_string()
 }
@@ -597,13 +605,13 @@ fn tick_message(
     }
     // A group's or the system's update is this socket's own (its delta against what this
     // socket was sent); so is a message that tells of a subscription ended.
+    // A tick with no axis topic due has nothing to share.
     let shareable = out.n == 0
         && subs
             .iter()
             .filter(|x| tick >= x.due)
-            .all(|x| matches!(x.topic, Topic::Axis { .. } | Topic::Commands));
-    // (A tick with no axis topic due has nothing to share.)
-    let shareable = shareable && asked(subs, tick).next().is_some();
+            .all(|x| matches!(x.topic, Topic::Axis { .. } | Topic::Commands))
+        && asked(subs, tick).next().is_some();
     if shareable {
         let same = |theirs: &[Asked]| {
             let mut mine = asked(subs, tick);
@@ -615,7 +623,7 @@ fn tick_message(
         if let Some(batch) = s.feed.shared(tick, same) {
             let mut seen = batch.seen.iter();
             for sub in subs.iter_mut().filter(|x| tick >= x.due) {
-                sub.due = (tick / sub.every + 1) * sub.every;
+                sub.sent_at(tick);
                 if let Topic::Axis { .. } = sub.topic {
                     sub.seen = seen.next().copied().flatten();
                 }
@@ -628,17 +636,15 @@ fn tick_message(
             .map(|(slot, seen, key)| (slot, seen, key.into()))
             .collect()
     });
-    let due: Vec<bool> = subs.iter().map(|x| tick >= x.due).collect();
+    // The subscriptions in `mine`, to read their versions after the updates.
+    let due_axes: Vec<usize> = (0..subs.len())
+        .filter(|&i| tick >= subs[i].due && matches!(subs[i].topic, Topic::Axis { .. }))
+        .collect();
     updates(s, subs, tick, &mut out);
     s.feed.made_one();
     let message = out.finish().map(bytes::Bytes::from);
     if let Some(asked) = mine {
-        let seen = subs
-            .iter()
-            .zip(due)
-            .filter(|(x, due)| *due && matches!(x.topic, Topic::Axis { .. }))
-            .map(|(x, _)| x.seen)
-            .collect();
+        let seen = due_axes.iter().map(|&i| subs[i].seen).collect();
         let batch = crate::app::feed::SharedBatch {
             asked,
             seen,
@@ -666,8 +672,7 @@ fn text(b: bytes::Bytes) -> Utf8Bytes {
 
 fn updates(s: &AppState, subs: &mut [Sub], tick: u64, out: &mut Batch) {
     for sub in subs.iter_mut().filter(|x| tick >= x.due) {
-        // The rate's grid; a socket that fell behind skips what it missed.
-        sub.due = (tick / sub.every + 1) * sub.every;
+        sub.sent_at(tick);
         match &sub.topic {
             Topic::Commands => {}
             Topic::Axis { slot, .. } => {
