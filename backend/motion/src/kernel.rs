@@ -516,13 +516,23 @@ impl Kernel {
         for g in self.groups.iter_mut().flatten() {
             g.step(&mut self.axes, cycle, events);
         }
+        // A slot beyond the feedback given reads as a drive that is not ready.
+        let no_feedback = DriveFeedback::default();
+        // … and a setpoint beyond those given goes nowhere (a step writes all of it).
+        let mut spare = DriveSetpoint::default();
         for k in 0..self.order.len {
             let i = self.order.slots[k] as usize;
             let Some(axis) = self.axes[i].as_deref() else {
                 continue;
             };
-            let coupled_to = axis.master_slot();
-            let all_masters = axis.coupled_masters();
+            // Most axes follow no master: they skip the masters' bookkeeping (issue 27).
+            let free = axis.follows_no_master();
+            debug_assert_eq!(free, axis.coupled_masters() == [None; 4]);
+            let all_masters = if free {
+                [None; 4]
+            } else {
+                axis.coupled_masters()
+            };
             // Stepped before this slave in this cycle (the order sees to it).
             let sample = |m: AxisSlot| {
                 self.axes
@@ -531,15 +541,15 @@ impl Kernel {
                     .map(MasterSample::of)
             };
             let mut samples = None;
-            let master = match coupled_to {
+            // The first of them is the one a single coupling follows.
+            let master = match all_masters[0] {
                 _ if k >= self.order.in_loop => Master::Lost,
                 None => Master::Uncoupled,
                 Some(m) => {
-                    let masters = axis.coupled_masters();
                     let mut all = [None; 4];
                     let mut vanished = false;
                     let mut failed = false;
-                    for (j, m) in masters.iter().enumerate().skip(1) {
+                    for (j, m) in all_masters.iter().enumerate().skip(1) {
                         if let Some(m) = *m {
                             all[j] = sample(m);
                             vanished |= all[j].is_none();
@@ -560,17 +570,25 @@ impl Kernel {
                     }
                 }
             };
-            let fb = feedback.get(i).copied().unwrap_or_default();
+            let fb = feedback.get(i).unwrap_or(&no_feedback);
             let axis = self.axes[i].as_deref_mut().expect("checked above");
             if let Some(all) = samples {
                 axis.offer_masters(all);
             }
-            let mut spare = DriveSetpoint::default();
             let out = setpoints.get_mut(i).unwrap_or(&mut spare);
-            axis.step(dt, &fb, master, &self.cams, cycle, events, out);
-            if axis.coupled_masters() != all_masters {
-                // It left its coupling (master lost, an error, a limit): next cycle it is
-                // stepped where an uncoupled axis is.
+            axis.step(dt, fb, master, &self.cams, cycle, events, out);
+            let masters_changed = if free {
+                debug_assert_eq!(
+                    axis.follows_no_master(),
+                    axis.coupled_masters() == [None; 4]
+                );
+                !axis.follows_no_master()
+            } else {
+                axis.coupled_masters() != all_masters
+            };
+            if masters_changed {
+                // It left its coupling (master lost, an error, a limit) or a buffered one took
+                // effect: next cycle it is stepped where its masters put it.
                 self.order.stale = true;
             }
         }

@@ -279,6 +279,11 @@ impl Axis {
         }
     }
 
+    /// [`Axis::coupled_masters`] are all `None` (asked without building them).
+    pub fn follows_no_master(&self) -> bool {
+        self.coupling.is_none() && self.cam_master().is_none()
+    }
+
     /// MC_GearInMultiMaster's Master2…Master4 of the coupling just made.
     pub(super) fn couple_more_masters(&mut self, more: [Option<AxisSlot>; 3]) {
         if let Some(c) = self.coupling.as_mut() {

@@ -118,7 +118,10 @@ impl Axis {
             if lost && self.coupling.is_some() {
                 self.enter_error(cx, ErrorId::MASTER_LOST);
             }
-            self.step_cam_activations(cx, master);
+            // Nothing waits for a master that is not there (and an uncoupled axis has none).
+            if !matches!(master, Master::Uncoupled) {
+                self.step_cam_activations(cx, master);
+            }
             self.step_feed_enables(cx);
             self.step_job(cx, dt, fb, master);
             // Blocks marked idle are skipped (`idle.rs`).
