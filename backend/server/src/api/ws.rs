@@ -628,7 +628,7 @@ fn tick_message(
                     sub.seen = seen.next().copied().flatten();
                 }
             }
-            return batch.message.clone().map(text);
+            return batch.message.clone();
         }
     }
     let mine: Option<Vec<Asked>> = shareable.then(|| {
@@ -642,7 +642,7 @@ fn tick_message(
         .collect();
     updates(s, subs, tick, &mut out);
     s.feed.made_one();
-    let message = out.finish().map(bytes::Bytes::from);
+    let message = out.finish().map(Utf8Bytes::from);
     if let Some(asked) = mine {
         let seen = due_axes.iter().map(|&i| subs[i].seen).collect();
         let batch = crate::app::feed::SharedBatch {
@@ -652,7 +652,7 @@ fn tick_message(
         };
         s.feed.share(tick, batch);
     }
-    message.map(text)
+    message
 }
 
 /// The axis subscriptions due at `tick`: slot, version last sent, topic as JSON.
@@ -663,11 +663,6 @@ fn asked(subs: &[Sub], tick: u64) -> impl Iterator<Item = (AxisSlot, Option<u64>
             Topic::Axis { slot, .. } => Some((slot, x.seen, x.key_json.as_str())),
             _ => None,
         })
-}
-
-/// A message made from a `String` as the websocket's text (no copy).
-fn text(b: bytes::Bytes) -> Utf8Bytes {
-    Utf8Bytes::try_from(b).expect("made from a String: UTF-8")
 }
 
 fn updates(s: &AppState, subs: &mut [Sub], tick: u64, out: &mut Batch) {

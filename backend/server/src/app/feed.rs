@@ -168,7 +168,8 @@ pub struct SharedBatch {
     /// The version each of them has after this message (in `asked`'s order).
     pub seen: Vec<Option<u64>>,
     /// The message (`None`: nothing changed, nothing to send).
-    pub message: Option<bytes::Bytes>,
+    /// (Text as made: a socket that takes it sends it without validating it again.)
+    pub message: Option<axum::extract::ws::Utf8Bytes>,
 }
 
 #[derive(Default)]
@@ -434,7 +435,7 @@ mod tests {
         let batch = |slot: AxisSlot, seen: Option<u64>, text: &'static str| SharedBatch {
             asked: vec![(slot, seen, r#""axes/x/status""#.into())],
             seen: vec![Some(7)],
-            message: Some(bytes::Bytes::from_static(text.as_bytes())),
+            message: Some(axum::extract::ws::Utf8Bytes::from_static(text)),
         };
         let asks = |slot: AxisSlot, seen: Option<u64>| {
             move |a: &[Asked]| a.len() == 1 && a[0].0 == slot && a[0].1 == seen
@@ -442,7 +443,7 @@ mod tests {
         let mut t = SharedTick::default();
         t.keep(5, batch(0, Some(3), "five"));
         let got = t.find(5, asks(0, Some(3))).expect("the same asked");
-        assert_eq!(got.message.as_deref(), Some(&b"five"[..]));
+        assert_eq!(got.message.as_deref(), Some("five"));
         assert_eq!(got.seen, [Some(7)]);
         assert!(
             t.find(5, asks(0, Some(2))).is_none(),
