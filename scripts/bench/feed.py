@@ -65,7 +65,8 @@ def curve(name, binary):
             asked = clients * n * 50
             row = {"clients": clients, "axes": n, "asked_per_s": asked, "delivered_per_s": ws["updates_per_s"],
                    "delivered_fraction": round(ws["updates_per_s"] / asked, 3),
-                   "motiond_cpu_percent": ws["motiond_cpu_percent"], "overruns": ws["overruns"]}
+                   "motiond_cpu_percent": ws["motiond_cpu_percent"], "overruns": ws["overruns"],
+                   "mb_per_s": ws["mb_per_s"], "motiond_cpu_percent_by_thread": ws["motiond_cpu_percent_by_thread"]}
             if before and after:
                 # Tick messages made by a socket and taken from another's (motiond from 1f46409 on).
                 made, shared = after[0] - before[0], after[1] - before[1]
