@@ -894,7 +894,7 @@ pub enum Verdict {
 
 /// The outputs of a function block (`ST_McOutputs` plus the milestone flags).
 #[cfg_attr(feature = "schema", derive(utoipa::ToSchema))]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, Eq, Serialize, Deserialize)]
 pub struct FbOutputs {
     pub busy: bool,
     pub active: bool,
@@ -921,6 +921,36 @@ pub struct FbOutputs {
     /// dead-man fired; the jog then ends with that error at rest).
     pub warning_id: u32,
 }
+
+/// Every field, as the derived comparison would, but not one by one: a held block's outputs
+/// are compared every cycle (MC_Power's on every powered axis), and twelve flags compared as
+/// one array are a few instructions instead of twelve branches (issue 27).
+impl PartialEq for FbOutputs {
+    fn eq(&self, other: &Self) -> bool {
+        let key = |o: &Self| {
+            let flags = [
+                o.busy,
+                o.active,
+                o.done,
+                o.command_aborted,
+                o.error,
+                o.in_velocity,
+                o.in_gear,
+                o.in_sync,
+                o.in_end_velocity,
+                o.in_torque,
+                o.status,
+                o.warning,
+            ];
+            (flags, o.error_id, o.warning_id)
+        };
+        key(self) == key(other)
+    }
+}
+
+// Twelve flags and two numbers: an output added later changes the size and stops the build
+// here until `eq` above compares it.
+const _: () = assert!(std::mem::size_of::<FbOutputs>() == 12 + 2 * 4);
 
 impl FbOutputs {
     /// The command has ended (Busy fell); its outputs no longer change.
@@ -960,5 +990,39 @@ pub trait EventSink {
 impl EventSink for Vec<CommandEvent> {
     fn push(&mut self, event: CommandEvent) {
         Vec::push(self, event)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FbOutputs;
+
+    /// The hand-written comparison sees every output: one changed output is a change.
+    #[test]
+    fn outputs_differ_in_any_one_output() {
+        let base = FbOutputs::default();
+        let changes: [fn(&mut FbOutputs); 14] = [
+            |o| o.busy = true,
+            |o| o.active = true,
+            |o| o.done = true,
+            |o| o.command_aborted = true,
+            |o| o.error = true,
+            |o| o.error_id = 0x4221,
+            |o| o.in_velocity = true,
+            |o| o.in_gear = true,
+            |o| o.in_sync = true,
+            |o| o.in_end_velocity = true,
+            |o| o.in_torque = true,
+            |o| o.status = true,
+            |o| o.warning = true,
+            |o| o.warning_id = 0x4243,
+        ];
+        for (i, change) in changes.iter().enumerate() {
+            let mut o = base;
+            change(&mut o);
+            assert_ne!(o, base, "output {i}");
+            assert_eq!(o, o);
+        }
+        assert_eq!(base, FbOutputs::default());
     }
 }

@@ -587,8 +587,8 @@ impl Kernel {
                 axis.coupled_masters() != all_masters
             };
             if masters_changed {
-                // It left its coupling (master lost, an error, a limit) or a buffered one took
-                // effect: next cycle it is stepped where its masters put it.
+                // It left its coupling (master lost, an error, a limit), or its masters changed
+                // otherwise: next cycle it is stepped where its masters put it.
                 self.order.stale = true;
             }
         }
