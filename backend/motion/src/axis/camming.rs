@@ -812,6 +812,16 @@ impl Axis {
             );
             self.start_cam_coupling(cx, ci.master, law, cmd, v2, ramp);
         } else {
+            // The activation is watched on the master the slave follows now (the kernel steps
+            // only its masters before it): a coupling that waits for another is refused, not
+            // run from one master's position on another's (decision 174).
+            if self
+                .coupling
+                .as_ref()
+                .is_some_and(|c| c.master != ci.master)
+            {
+                return Err(ErrorId::MASTER_INVALID);
+            }
             self.cancel_cam_in(cx, End::Aborted);
             let cmd = Held::start(
                 cx,

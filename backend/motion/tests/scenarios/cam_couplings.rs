@@ -1229,3 +1229,85 @@ fn the_electronic_cams_sample_runs_without_a_jump() {
         r.out(scale)
     );
 }
+
+/// A coupled slave waits for an activation only on the master it follows: a CamIn to another
+/// master that would couple later (at that master's position) is refused with 0x7040 and
+/// changes nothing, whether the slave follows its master through a cam or a gear; the same
+/// CamIn at once recouples without a jump (decision 174). Before, the activation was watched
+/// on the old master and the cam built from the old master's position ran on the new one.
+#[test]
+fn a_coupled_slave_waits_for_no_other_master() {
+    let mut p = params();
+    p.axis_velo_max = 2000.0;
+    let mut r = Rig::with(vec![(false, p.clone()), (false, p.clone()), (false, p)]);
+    r.bounds[1].velocity = 1e9;
+    r.bounds[1].acceleration = 1e9;
+    r.bounds[1].jerk = 1e12;
+    for a in 0..3 {
+        r.power_on(a);
+    }
+    let m = r.ok(2, CommandKind::MoveAbsolute(mv(400.0, 1000.0)));
+    r.until(10.0, |r| r.out(m).done);
+    r.cam(T_LINE, &line(false));
+    // A cam at rest up to 550 on master 2.
+    let t = CamTableData::positions(vec![[0.0, 0.0], [550.0, 0.0], [600.0, 50.0]], false);
+    r.cam(T_HALF, &t);
+    let later = CamIn {
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: 500.0,
+        ..cam_in(2, T_HALF)
+    };
+    let followed: [(&str, CommandKind, CommandKind); 2] = [
+        (
+            "cam",
+            CommandKind::CamIn(cam_in(0, T_LINE)),
+            CommandKind::CamOut,
+        ),
+        ("gear", gear_in(0, 1.0, 1), CommandKind::GearOut),
+    ];
+    for (how, couple, decouple) in followed {
+        let c = r.ok(1, couple);
+        assert!(r.out(c).in_sync || r.out(c).in_gear, "{how}: not coupled");
+        assert_eq!(r.st(1).state, AxisState::SynchronizedMotion, "{how}");
+        assert_eq!(
+            r.rejected(1, CommandKind::CamIn(later)),
+            ErrorId::MASTER_INVALID,
+            "{how}: a CamIn waiting on master 2"
+        );
+        // Nothing changed: the slave still follows master 0, nothing waits.
+        assert!(!r.out(c).error && !r.out(c).command_aborted, "{how}");
+        assert_eq!(r.k.axis(1).expect("slave").master_slot(), Some(0), "{how}");
+        let (m0, s0) = (r.st(0).set_position, r.st(1).set_position);
+        move_master(&mut r, m0 + 300.0, 500.0, |r| {
+            let (dm, ds) = (r.st(0).set_position - m0, r.st(1).set_position - s0);
+            assert!(
+                (ds - dm).abs() < 1e-9,
+                "{how}: slave moved {ds}, master 0 {dm}"
+            );
+        });
+        // Master 2 across 500 (the refused activation) moves nothing.
+        let before = r.st(1).set_position;
+        move_master_axis(&mut r, 2, 560.0);
+        assert_eq!(r.st(1).set_position, before, "{how}");
+        move_master_axis(&mut r, 2, 400.0);
+        // Decoupled and back to where master 0 is, for the next round.
+        r.ok(1, decouple);
+        let out = r.ok(1, CommandKind::MoveAbsolute(mv(0.0, 1000.0)));
+        r.until(10.0, |r| r.out(out).done);
+        let back = r.ok(0, CommandKind::MoveAbsolute(mv(0.0, 1000.0)));
+        r.until(10.0, |r| r.out(back).done);
+    }
+    // At once, to master 2 at 400 where the cam puts the slave at 0: recoupled there.
+    let c = r.ok(1, CommandKind::CamIn(cam_in(0, T_LINE)));
+    assert!(r.out(c).in_sync);
+    let now = r.ok(1, CommandKind::CamIn(cam_in(2, T_HALF)));
+    assert!(r.out(now).in_sync && !r.out(now).error);
+    assert_eq!(r.k.axis(1).expect("slave").master_slot(), Some(2));
+    move_master_axis(&mut r, 2, 600.0);
+    assert!((r.st(1).set_position - 50.0).abs() < 1e-9);
+}
+
+fn move_master_axis(r: &mut Rig, axis: u16, to: f64) {
+    let m = r.ok(axis, CommandKind::MoveAbsolute(mv(to, 500.0)));
+    r.until(30.0, |r| r.out(m).done);
+}
