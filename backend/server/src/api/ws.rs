@@ -264,8 +264,9 @@ enum Topic {
 
 struct Sub {
     key: String,
-    /// `key` as a JSON string (written into every update).
-    key_json: String,
+    /// `key` as a JSON string (written into every update); one allocation for every socket
+    /// with this topic ([`crate::app::feed::Feed::topic`]).
+    key_json: Arc<str>,
     topic: Topic,
     /// The rate, in feed ticks; due on the ticks that are multiples of it (the same ticks in
     /// every socket, so that subscribers share the feed's deltas).
@@ -486,6 +487,9 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
             let send = socket.send(Message::Text(m));
             tokio::pin!(send);
             let sent = tokio::select! {
+                // The send first: one that completes at once (the usual case) never registers
+                // its timer in the runtime's wheel (issue 27: fewer timers per tick).
+                biased;
                 r = &mut send => r,
                 _ = tokio::time::sleep(SLOW_SEND) => {
                     // A client that does not read holds no virtual clock: its ticks are no
@@ -615,10 +619,12 @@ fn tick_message(
     if shareable {
         let same = |theirs: &[Asked]| {
             let mut mine = asked(subs, tick);
-            theirs
-                .iter()
-                .all(|t| mine.next() == Some((t.0, t.1, &*t.2)))
-                && mine.next().is_none()
+            theirs.iter().all(|t| {
+                mine.next().is_some_and(|(slot, seen, key)| {
+                    // Topics are shared: the same topic is most often the same text.
+                    slot == t.0 && seen == t.1 && (Arc::ptr_eq(key, &t.2) || key == &t.2)
+                })
+            }) && mine.next().is_none()
         };
         if let Some(batch) = s.feed.shared(tick, same) {
             let mut seen = batch.seen.iter();
@@ -633,7 +639,7 @@ fn tick_message(
     }
     let mine: Option<Vec<Asked>> = shareable.then(|| {
         asked(subs, tick)
-            .map(|(slot, seen, key)| (slot, seen, key.into()))
+            .map(|(slot, seen, key)| (slot, seen, key.clone()))
             .collect()
     });
     // The subscriptions in `mine`, to read their versions after the updates.
@@ -656,11 +662,11 @@ fn tick_message(
 }
 
 /// The axis subscriptions due at `tick`: slot, version last sent, topic as JSON.
-fn asked(subs: &[Sub], tick: u64) -> impl Iterator<Item = (AxisSlot, Option<u64>, &str)> {
+fn asked(subs: &[Sub], tick: u64) -> impl Iterator<Item = (AxisSlot, Option<u64>, &Arc<str>)> {
     subs.iter()
         .filter(move |x| tick >= x.due)
         .filter_map(|x| match x.topic {
-            Topic::Axis { slot, .. } => Some((slot, x.seen, x.key_json.as_str())),
+            Topic::Axis { slot, .. } => Some((slot, x.seen, &x.key_json)),
             _ => None,
         })
 }
@@ -895,7 +901,9 @@ fn handle(
             subs.retain(|x| x.key != canonical && x.key != key);
             let every = (1.0 / (rate * TICK.as_secs_f64())).round().max(1.0) as u64;
             subs.push(Sub {
-                key_json: serde_json::to_string(&key).unwrap_or_default(),
+                key_json: s
+                    .feed
+                    .topic(&serde_json::to_string(&key).unwrap_or_default()),
                 key: key.clone(),
                 topic,
                 every,
