@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The websocket feed's CPU, two (or more) motiond binaries alternately in one run
+# (docs/benchmarks.md, "Websocket feed: shared topic text"): each run starts one binary with 64
+# moving axes, connects CLIENTS websocket clients subscribed to every axis at 50 Hz
+# (target/release/examples/bench ws), and reads motiond's task-clock with `perf stat` over 8 s
+# after 6 s of warm-up. Task-clock is what the process used on all its threads.
+# Usage: scripts/bench/feed_ab.sh ROUNDS CLIENTS MOTIOND_A MOTIOND_B [...]
+set -euo pipefail
+rounds=$1; clients=$2; shift 2
+bench=${BENCH:-target/release/examples/bench}
+command -v perf >/dev/null || { echo "needs perf (Debian: linux-perf)" >&2; exit 1; }
+port=18190
+for _ in $(seq "$rounds"); do
+    for bin in "$@"; do
+        port=$((port + 1))
+        "$bin" --db :memory: --listen "127.0.0.1:$port" --max-connections 4000 >/dev/null 2>&1 &
+        motiond=$!
+        for _ in $(seq 100); do curl -sf "127.0.0.1:$port/api/v1/axes" >/dev/null && break; sleep 0.1; done
+        axes=$(python3 - "$port" <<'PY'
+import json, sys, urllib.request
+port = sys.argv[1]
+def post(path, body):
+    r = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=json.dumps(body).encode(),
+                               method="POST", headers={"content-type": "application/json"})
+    with urllib.request.urlopen(r) as f:
+        assert f.status in (201, 202), (path, f.status)
+cfg = {"unit": "mm", "dynamics": {"max_velocity": 500.0, "acceleration": 2500.0, "deceleration": 2500.0,
+                                   "jerk": 25000.0, "jog_velocity_slow": 10.0, "jog_velocity_fast": 100.0}}
+axes = ["x", "y", "spindle"]
+while len(axes) < 64:
+    axes.append(f"a{len(axes)}")
+    post("/api/v1/axes", dict(cfg, name=axes[-1]))
+for a in axes:
+    post(f"/api/v1/axes/{a}/power?wait=true", {})
+    post(f"/api/v1/axes/{a}/move-velocity", {"velocity": 360.0 if a == "spindle" else 8.0})
+print(" ".join(axes))
+PY
+)
+        # shellcheck disable=SC2086
+        "$bench" ws "127.0.0.1:$port" "$clients" 50 18 $axes >/dev/null 2>&1 &
+        load=$!
+        sleep 6
+        ms=$(perf stat -e task-clock -p "$motiond" -- sleep 8 2>&1 | awk '/task-clock/ {print $1}')
+        echo "$bin task_clock_ms_per_8s=$ms"
+        wait "$load"
+        kill "$motiond"; wait "$motiond" 2>/dev/null || true
+    done
+done
