@@ -804,3 +804,44 @@ async fn an_unsaved_table_is_analysed_and_nothing_is_stored() {
         "nothing stored"
     );
 }
+
+/// Decision 174 over HTTP: a cam-in to another master that would wait for its activation, on
+/// a slave coupled to x, is refused (409 master_invalid) with what to do, and the slave goes
+/// on following x.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_coupled_slave_refuses_to_wait_on_another_master() {
+    let s = Server::start();
+    assert_eq!(post(&s, "/api/v1/cam-tables", polynom5()).await.status, 201);
+    for a in ["x", "y", "spindle"] {
+        power_on(&s, a).await;
+    }
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in?wait=true",
+        json!({"master": "x", "cam_table": "p5"}),
+    )
+    .await;
+    assert_eq!(r.json["outputs"]["in_sync"], true, "{}", r.text);
+    let r = post(
+        &s,
+        "/api/v1/axes/y/cam-in",
+        json!({"master": "spindle", "cam_table": "p5",
+               "activation_mode": "at_master_axis_pos", "activation_position": 100.0}),
+    )
+    .await;
+    assert_eq!(
+        (r.status, r.json["code"].as_str()),
+        (409, Some("master_invalid")),
+        "{}",
+        r.text
+    );
+    let detail = r.json["detail"].as_str().unwrap_or_default();
+    assert!(
+        detail.contains("the slave follows x") && detail.contains("instantaneous"),
+        "{detail}"
+    );
+    let y = status(&s, "y").await;
+    assert_eq!(y["status"]["state"], "synchronized_motion", "{y}");
+    assert_eq!(y["status"]["master"], "x", "{y}");
+    assert_eq!(y["status"]["cam"]["cam_table_id"], 1, "{y}");
+}

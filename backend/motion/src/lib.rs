@@ -94,6 +94,9 @@ pub enum RefusalHint {
         velocity: f64,
         window: f64,
     },
+    /// 0x7040: the slave follows `master`; a coupling that waits for its activation can wait
+    /// only on it (decision 174).
+    FollowsMaster { master: command::AxisSlot },
 }
 pub use params::AxisParameters;
 pub use status::{

@@ -815,11 +815,9 @@ impl Axis {
             // The activation is watched on the master the slave follows now (the kernel steps
             // only its masters before it): a coupling that waits for another is refused, not
             // run from one master's position on another's (decision 174).
-            if self
-                .coupling
-                .as_ref()
-                .is_some_and(|c| c.master != ci.master)
-            {
+            if let Some(c) = self.coupling.as_ref().filter(|c| c.master != ci.master) {
+                self.refusal_hint
+                    .set(Some(crate::RefusalHint::FollowsMaster { master: c.master }));
                 return Err(ErrorId::MASTER_INVALID);
             }
             self.cancel_cam_in(cx, End::Aborted);

@@ -550,6 +550,15 @@ pub fn refusal_why(
             n(window)
         ));
     }
+    if let Some(motion::RefusalHint::FollowsMaster { master }) = hint {
+        let reg = s.registry.read().unwrap();
+        let name = reg.by_slot(master).map_or("?", |e| e.name.as_str());
+        return Some(format!(
+            "the slave follows {name}: a coupling that waits for its activation can only wait \
+             on {name}; couple at once (activation_mode instantaneous) or decouple first \
+             (cam-out, gear-out)"
+        ));
+    }
     let (_, Some(st)) = s.status(slot) else {
         return Some("the axis is not in the cycle".into());
     };
