@@ -551,7 +551,20 @@ impl Axis {
         stepped: bool,
     ) -> Result<bool, ErrorId> {
         if !ci.start_mode.ramp_in() {
-            self.check_no_jump(law, cam, m, self.set)?;
+            // In the step the master has moved this cycle and the slave not yet: the cam is
+            // compared with where the slave's own motion takes it in this cycle (a slave at
+            // rest stays where it is; a geared slave goes on with its master), decision 175.
+            let from = if stepped {
+                let (s, dt) = (self.set, self.cycle_time);
+                Kinematics {
+                    position: s.position + s.velocity * dt + 0.5 * s.acceleration * dt * dt,
+                    velocity: s.velocity + s.acceleration * dt,
+                    ..s
+                }
+            } else {
+                self.set
+            };
+            self.check_no_jump(law, cam, m, from)?;
             return Ok(false);
         }
         let mut probe = *law;

@@ -1237,15 +1237,7 @@ fn the_electronic_cams_sample_runs_without_a_jump() {
 /// on the old master and the cam built from the old master's position ran on the new one.
 #[test]
 fn a_coupled_slave_waits_for_no_other_master() {
-    let mut p = params();
-    p.axis_velo_max = 2000.0;
-    let mut r = Rig::with(vec![(false, p.clone()), (false, p.clone()), (false, p)]);
-    r.bounds[1].velocity = 1e9;
-    r.bounds[1].acceleration = 1e9;
-    r.bounds[1].jerk = 1e12;
-    for a in 0..3 {
-        r.power_on(a);
-    }
+    let mut r = rig3();
     let m = r.ok(2, CommandKind::MoveAbsolute(mv(400.0, 1000.0)));
     r.until(10.0, |r| r.out(m).done);
     r.cam(T_LINE, &line(false));
@@ -1305,6 +1297,68 @@ fn a_coupled_slave_waits_for_no_other_master() {
     assert_eq!(r.k.axis(1).expect("slave").master_slot(), Some(2));
     move_master_axis(&mut r, 2, 600.0);
     assert!((r.st(1).set_position - 50.0).abs() < 1e-9);
+}
+
+/// Decision 174, the other side: a deferred CamIn to the master the slave follows still waits
+/// — from a gear to a cam at a master position, without a jump — and on a multi-master slave
+/// it may wait on Master1 (whose sample the slave is given), not on a further master. The
+/// gear to cam change on a moving master was refused with 0x7084 at the activation before
+/// decision 175 (the slave's last setpoint was compared with this cycle's cam).
+#[test]
+fn a_coupled_slave_waits_for_a_cam_on_the_master_it_follows() {
+    let mut r = rig3();
+    r.cam(T_LINE, &line(false));
+    let g = r.ok(1, gear_in(0, 1.0, 1));
+    assert!(r.out(g).in_gear);
+    let later = |master| CamIn {
+        activation_mode: CamActivationMode::AtMasterAxisPos,
+        activation_position: 300.0,
+        ..cam_in(master, T_LINE)
+    };
+    let c = r.ok(1, CommandKind::CamIn(later(0)));
+    assert!(r.out(c).busy && r.out(c).active && !r.out(c).in_sync);
+    move_master(&mut r, 350.0, 200.0, |r| {
+        let (m, s) = (r.st(0).set_position, r.st(1).set_position);
+        assert!((s - m).abs() < 1e-9, "slave {s} left master {m}");
+        assert_eq!(r.out(c).in_sync, m >= 300.0, "at {m}: {:?}", r.out(c));
+        assert!(!r.out(c).error, "at {m}: {:?}", r.out(c));
+    });
+    assert_eq!(r.st(1).cam.cam_table_id, T_LINE);
+    // A multi-master slave: Master1 is 0, a further master 2.
+    r.ok(1, CommandKind::CamOut);
+    let mm = r.ok(
+        1,
+        CommandKind::GearInMultiMaster(GearInMultiMaster {
+            masters: [Some(0), Some(2), None, None],
+            ratios: [1.0, 1.0, 0.0, 0.0],
+            acceleration: 0.0,
+            deceleration: 0.0,
+            jerk: 0.0,
+            advanced_slave_dynamics: false,
+            sync_mode: MultiMasterSyncMode::Velosync,
+        }),
+    );
+    assert!(r.out(mm).in_gear);
+    assert_eq!(
+        r.rejected(1, CommandKind::CamIn(later(2))),
+        ErrorId::MASTER_INVALID
+    );
+    let c = r.ok(1, CommandKind::CamIn(later(0)));
+    assert!(r.out(c).busy && r.out(c).active && !r.out(mm).command_aborted);
+}
+
+/// Three axes powered: masters 0 and 2, the slave 1 with its dynamics bounds opened.
+fn rig3() -> Rig {
+    let mut p = params();
+    p.axis_velo_max = 2000.0;
+    let mut r = Rig::with(vec![(false, p.clone()), (false, p.clone()), (false, p)]);
+    r.bounds[1].velocity = 1e9;
+    r.bounds[1].acceleration = 1e9;
+    r.bounds[1].jerk = 1e12;
+    for a in 0..3 {
+        r.power_on(a);
+    }
+    r
 }
 
 fn move_master_axis(r: &mut Rig, axis: u16, to: f64) {
