@@ -3,12 +3,17 @@
 # (docs/benchmarks.md, "Websocket feed: shared topic text"): each run starts one binary with 64
 # moving axes, connects CLIENTS websocket clients subscribed to every axis at 50 Hz
 # (target/release/examples/bench ws), and reads motiond's task-clock with `perf stat` over 8 s
-# after 6 s of warm-up. Task-clock is what the process used on all its threads.
+# after 6 s of warm-up, and what the load generator received. Task-clock is what the process used
+# on all its threads; it reads lower than feed.py's CPU, whose window includes connecting.
 # Usage: scripts/bench/feed_ab.sh ROUNDS CLIENTS MOTIOND_A MOTIOND_B [...]
 set -euo pipefail
 rounds=$1; clients=$2; shift 2
 bench=${BENCH:-target/release/examples/bench}
 command -v perf >/dev/null || { echo "needs perf (Debian: linux-perf)" >&2; exit 1; }
+# The machine-speed reference (the planner's sample, ns) with the figures, so that they can be
+# set against another machine's.
+echo "reference: $("$bench" reference)"
+out=$(mktemp -d)
 port=18190
 for _ in $(seq "$rounds"); do
     for bin in "$@"; do
@@ -37,12 +42,14 @@ print(" ".join(axes))
 PY
 )
         # shellcheck disable=SC2086
-        "$bench" ws "127.0.0.1:$port" "$clients" 50 18 $axes >/dev/null 2>&1 &
+        "$bench" ws "127.0.0.1:$port" "$clients" 50 18 $axes >"$out/load.json" 2>&1 &
         load=$!
         sleep 6
         ms=$(perf stat -e task-clock -p "$motiond" -- sleep 8 2>&1 | awk '/task-clock/ {print $1}')
-        echo "$bin task_clock_ms_per_8s=$ms"
         wait "$load"
+        # What was delivered over the whole 18 s (a build that delivers less must not look cheaper).
+        delivered=$(python3 -c 'import json,sys; r=json.loads(open(sys.argv[1]).read().strip().splitlines()[-1]); print(r["updates_per_s"], "of", r["clients"]*len(sys.argv[2:])*50)' "$out/load.json" $axes)
+        echo "$bin task_clock_ms_per_8s=$ms updates_per_s=$delivered"
         kill "$motiond"; wait "$motiond" 2>/dev/null || true
     done
 done

@@ -739,6 +739,13 @@ impl CycleThread {
             let cycle = self.kernel.cycle() + 1;
             let reply = match req {
                 Request::Command(cmd) => {
+                    // A hint the step left (a queued cam change's jump check) is not this
+                    // command's.
+                    if let motion::Target::Axis(slot) = cmd.target {
+                        if let Some(a) = self.kernel.axis(slot) {
+                            a.take_refusal_hint();
+                        }
+                    }
                     let result = match self.kernel.submit(cmd, &mut sink) {
                         Verdict::Accepted => Ok(()),
                         Verdict::Rejected(e) => Err(e),

@@ -274,18 +274,29 @@ impl SharedTick {
 /// Topics as shared text: sockets that ask alike are found alike by comparing pointers, not
 /// 64 topic names per socket and tick (issue 27: those comparisons were 6 % of motiond's
 /// samples at 100 clients × 64 axes, 1.4 % after). Topics no socket holds are forgotten.
+/// (Swept when it has doubled since the last sweep: subscribing stays O(1) on average.)
 #[derive(Default)]
-struct Topics(Mutex<std::collections::HashSet<Arc<str>>>);
+struct Topics(Mutex<TopicSet>);
+
+#[derive(Default)]
+struct TopicSet {
+    set: std::collections::HashSet<Arc<str>>,
+    /// The set's size after the last sweep.
+    swept: usize,
+}
 
 impl Topics {
     fn get(&self, topic_json: &str) -> Arc<str> {
         let mut topics = self.0.lock().unwrap();
-        if let Some(t) = topics.get(topic_json) {
+        if let Some(t) = topics.set.get(topic_json) {
             return t.clone();
         }
-        topics.retain(|t| Arc::strong_count(t) > 1);
+        if topics.set.len() >= 2 * topics.swept.max(8) {
+            topics.set.retain(|t| Arc::strong_count(t) > 1);
+            topics.swept = topics.set.len();
+        }
         let t: Arc<str> = topic_json.into();
-        topics.insert(t.clone());
+        topics.set.insert(t.clone());
         t
     }
 }
@@ -520,14 +531,18 @@ mod tests {
         let b = topics.get(r#""axes/x/status""#);
         assert!(Arc::ptr_eq(&a, &b));
         assert!(!Arc::ptr_eq(&a, &topics.get(r#""axes/y/status""#)));
-        drop(b);
-        // y is held by no socket: forgotten when the next new topic comes; x is held.
-        let _z = topics.get(r#""axes/z/status""#);
-        assert_eq!(topics.0.lock().unwrap().len(), 2, "x and z");
-        drop(a);
-        let _w = topics.get(r#""axes/w/status""#);
-        assert_eq!(topics.0.lock().unwrap().len(), 2, "z and w");
-        assert!(topics.0.lock().unwrap().contains(r#""axes/w/status""#));
+        // Topics no socket holds are forgotten once the set has doubled: it stays within
+        // twice what sockets hold (and at least 16).
+        let held: Vec<Arc<str>> = (0..20)
+            .map(|i| topics.get(&format!(r#""axes/h{i}/status""#)))
+            .collect();
+        for i in 0..500 {
+            topics.get(&format!(r#""axes/gone{i}/status""#));
+            let n = topics.0.lock().unwrap().set.len();
+            assert!(n <= 2 * (held.len() + 1) + 1, "{n} kept after {i}");
+        }
+        let set = &topics.0.lock().unwrap().set;
+        assert!(held.iter().all(|t| set.contains(&**t)) && set.contains(&*a));
     }
 
     #[test]

@@ -523,11 +523,12 @@ pub fn refusal_why(
     hint: Option<motion::RefusalHint>,
 ) -> Option<String> {
     use motion::AxisState as S;
+    // A hint explains only the refusal it was given for.
     if let Some(motion::RefusalHint::CamSlave {
         position,
         velocity,
         window,
-    }) = hint
+    }) = hint.filter(|_| e == ErrorId::CAM_SLAVE_WOULD_JUMP)
     {
         let (_, st) = s.status(slot);
         let at = st.map(|st| st.set_position).unwrap_or(f64::NAN);
@@ -550,13 +551,16 @@ pub fn refusal_why(
             n(window)
         ));
     }
-    if let Some(motion::RefusalHint::FollowsMaster { master }) = hint {
+    if let Some(motion::RefusalHint::FollowsMaster { master }) =
+        hint.filter(|_| e == ErrorId::MASTER_INVALID)
+    {
         let reg = s.registry.read().unwrap();
         let name = reg.by_slot(master).map_or("?", |e| e.name.as_str());
         return Some(format!(
             "the slave follows {name}: a coupling that waits for its activation can only wait \
              on {name}; couple at once (activation_mode instantaneous) or decouple first \
-             (cam-out, gear-out)"
+             (cam-out; gear-out, after a gear-in-dyn or gear-in-multi-master is ended with \
+             DELETE /api/v1/commands/{{id}})"
         ));
     }
     let (_, Some(st)) = s.status(slot) else {
