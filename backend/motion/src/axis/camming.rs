@@ -554,16 +554,7 @@ impl Axis {
             // In the step the master has moved this cycle and the slave not yet: the cam is
             // compared with where the slave's own motion takes it in this cycle (a slave at
             // rest stays where it is; a geared slave goes on with its master), decision 175.
-            let from = if stepped {
-                let (s, dt) = (self.set, self.cycle_time);
-                Kinematics {
-                    position: s.position + s.velocity * dt + 0.5 * s.acceleration * dt * dt,
-                    velocity: s.velocity + s.acceleration * dt,
-                    ..s
-                }
-            } else {
-                self.set
-            };
+            let from = if stepped { self.carried_on() } else { self.set };
             self.check_no_jump(law, cam, m, from)?;
             return Ok(false);
         }
@@ -1108,6 +1099,17 @@ impl Axis {
         }
     }
 
+    /// The slave's last setpoint carried on by its own motion for one cycle: where it is in
+    /// this cycle's step before its job has run (decision 175).
+    fn carried_on(&self) -> Kinematics {
+        let (s, dt) = (self.set, self.cycle_time);
+        Kinematics {
+            position: s.position + s.velocity * dt + 0.5 * s.acceleration * dt * dt,
+            velocity: s.velocity + s.acceleration * dt,
+            ..s
+        }
+    }
+
     /// Each cycle before the coupling's setpoint: a queued coupling, switch or scaling takes
     /// effect when its activation is reached.
     pub(super) fn step_cam_activations(
@@ -1128,22 +1130,19 @@ impl Axis {
                 p.cmd.end(cx, End::Error(ErrorId::MASTER_INVALID));
             } else if let Some(cam) = cx.cams.get(p.ci.cam_table) {
                 let generation = cx.cams.generation(p.ci.cam_table);
-                let law = self.law_for(
-                    &p.ci,
-                    (cam, generation),
-                    m.set.position,
-                    self.set.position,
-                    None,
-                );
+                // A relative slave start counts from where the slave is in this cycle (the
+                // position the no-jump check compares with); a ramp-in plans from its last
+                // setpoint.
+                let slave_at = if p.ci.start_mode.ramp_in() {
+                    self.set.position
+                } else {
+                    self.carried_on().position
+                };
+                let law = self.law_for(&p.ci, (cam, generation), m.set.position, slave_at, None);
                 if p.act.reached(m.set.position, law.raw(m.set.position), cam) {
                     // Coupled from the slave's and the master's positions at activation.
-                    let mut law = self.law_for(
-                        &p.ci,
-                        (cam, generation),
-                        m.set.position,
-                        self.set.position,
-                        None,
-                    );
+                    let mut law =
+                        self.law_for(&p.ci, (cam, generation), m.set.position, slave_at, None);
                     match self.join_cam(&p.ci, &mut law, cam, &m.set, true) {
                         Ok(ramp) => self.start_cam_coupling(cx, p.master, law, p.cmd, p.v2, ramp),
                         Err(e) => p.cmd.end(cx, End::Error(e)),

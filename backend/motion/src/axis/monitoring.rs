@@ -163,6 +163,8 @@ impl Axis {
         if let Some(mut s) = self.stop.take() {
             s.end(cx, End::Error(e));
         }
+        // A coupling that waits for its activation would take the stopping axis over.
+        self.cancel_cam_in(cx, End::Error(e));
         self.coupling = None;
         self.mode = Mode::ErrorStop;
         if group_job.is_some() {
@@ -303,6 +305,7 @@ impl Axis {
             jerk = jerk.max(j.jerk);
             j.finish_error(cx, e);
         }
+        self.cancel_cam_in(cx, End::Error(e));
         self.coupling = None;
         let mut h = Job::new(0, JobKind::Halt);
         h.dec = dec;

@@ -1324,6 +1324,26 @@ fn a_coupled_slave_waits_for_a_cam_on_the_master_it_follows() {
         assert!(!r.out(c).error, "at {m}: {:?}", r.out(c));
     });
     assert_eq!(r.st(1).cam.cam_table_id, T_LINE);
+    // The same relative (the cam's origin is where master and slave are in the cycle of the
+    // activation): geared down to 100, then the cam from 200 upwards.
+    r.ok(1, CommandKind::CamOut);
+    let g = r.ok(1, gear_in(0, 1.0, 1));
+    assert!(r.out(g).in_gear);
+    move_master(&mut r, 100.0, 200.0, |_| {});
+    let c = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            start_mode: StartMode::Relative,
+            activation_position: 200.0,
+            ..later(0)
+        }),
+    );
+    move_master(&mut r, 300.0, 200.0, |r| {
+        let (m, s) = (r.st(0).set_position, r.st(1).set_position);
+        assert!((s - m).abs() < 1e-9, "slave {s} left master {m}");
+        assert_eq!(r.out(c).in_sync, m >= 200.0, "at {m}: {:?}", r.out(c));
+        assert!(!r.out(c).error, "at {m}: {:?}", r.out(c));
+    });
     // A multi-master slave: Master1 is 0, a further master 2.
     r.ok(1, CommandKind::CamOut);
     let mm = r.ok(
@@ -1343,7 +1363,14 @@ fn a_coupled_slave_waits_for_a_cam_on_the_master_it_follows() {
         r.rejected(1, CommandKind::CamIn(later(2))),
         ErrorId::MASTER_INVALID
     );
-    let c = r.ok(1, CommandKind::CamIn(later(0)));
+    // (The master stands at 300 now: an activation further on.)
+    let c = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_position: 500.0,
+            ..later(0)
+        }),
+    );
     assert!(r.out(c).busy && r.out(c).active && !r.out(mm).command_aborted);
 }
 
@@ -1364,4 +1391,44 @@ fn rig3() -> Rig {
 fn move_master_axis(r: &mut Rig, axis: u16, to: f64) {
     let m = r.ok(axis, CommandKind::MoveAbsolute(mv(to, 500.0)));
     r.until(30.0, |r| r.out(m).done);
+}
+
+/// An axis error ends a coupling that waits for its activation (with the error), also in the
+/// cycle its master reaches the position: it never takes the stopping axis over (the
+/// activation was looked at after the error in the same step, and a coupled cam survived the
+/// ErrorStop's clean-up).
+#[test]
+fn a_waiting_coupling_ends_with_an_axis_error() {
+    let mut r = rig_at(400.0, 0.0);
+    let t = CamTableData::positions(vec![[0.0, 0.0], [550.0, 0.0], [600.0, 50.0]], false);
+    r.cam(T_HALF, &t);
+    let c = r.ok(
+        1,
+        CommandKind::CamIn(CamIn {
+            activation_mode: CamActivationMode::AtMasterAxisPos,
+            activation_position: 500.0,
+            ..cam_in(0, T_HALF)
+        }),
+    );
+    assert!(r.out(c).busy && r.out(c).active);
+    let m = r.ok(0, CommandKind::MoveAbsolute(mv(560.0, 200.0)));
+    // The slave's drive faults in the cycle the master passes 500 (its feedback is read in
+    // the next step: the fault is set one cycle before).
+    r.until(5.0, |r| r.st(0).set_position >= 499.7);
+    r.plants[1].fault = true;
+    r.until(5.0, |r| {
+        let st = r.st(1);
+        assert!(
+            !st.coupled && st.state != AxisState::SynchronizedMotion && !st.cam.active,
+            "coupled in error at master {}",
+            r.st(0).set_position
+        );
+        r.out(m).done
+    });
+    assert_eq!(r.st(1).state, AxisState::ErrorStop);
+    assert!(
+        r.out(c).error && !r.out(c).busy && r.out(c).error_id == ErrorId::DRIVE_FAULT.0,
+        "{:?}",
+        r.out(c)
+    );
 }
