@@ -1,6 +1,6 @@
 //! The websocket status feed. Each axis's status is written as JSON once per cycle that anyone
-//! asks for (straight from the status, no `serde_json::Value`), split into its top-level
-//! members, and kept with the last [`KEPT`] versions; the delta from an older version to the
+//! asks for (straight from the status, no `serde_json::Value`; the members that did not change
+//! since the version before are copied from it, `members.rs`), marked member by member, and kept with the last [`KEPT`] versions; the delta from an older version to the
 //! newest is made once and shared by every subscriber that has that older version. So the cost
 //! of streaming grows with axes × versions in flight (at most [`KEPT`]), never with axes ×
 //! subscribers — also when sockets fall out of step with each other. A subscriber whose
@@ -10,7 +10,6 @@
 //! on the same ticks in every socket (and a socket sleeps until its next one is due). A
 //! subscriber is known here only by the version (the status's cycle) it was last sent.
 
-use std::cell::Cell;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex, RwLock};
@@ -19,6 +18,7 @@ use std::time::Duration;
 use serde_json::{Map, Value};
 
 use super::AppState;
+use super::members::{self, Member};
 use crate::clock::{Clock, Hold};
 use motion::AxisSlot;
 
@@ -37,19 +37,37 @@ struct Version {
     /// The whole object (what a first update sends).
     json: Arc<str>,
     members: Vec<Member>,
+    /// For each member, the cycle at which it last changed (see [`members::Written`]).
+    since: Vec<u64>,
+    /// The cycle since which the versions have had these members.
+    shape_since: u64,
 }
 
-/// A top-level member `"key":value` of a JSON object: where it starts, where its value starts
-/// (after the colon), where it ends.
-type Member = (u32, u32, u32);
-
 impl Version {
-    fn of(cycle: u64, status: &impl serde::Serialize) -> Option<Version> {
-        let (json, members) = marked(status)?;
+    /// The status at `cycle`, its members that did not change since `before` (the newest
+    /// version, whose prints are `prints`) copied from it; its own prints go to `spare`.
+    fn of(
+        cycle: u64,
+        status: &impl serde::Serialize,
+        before: Option<&Version>,
+        prints: &members::Prints,
+        spare: &mut members::Prints,
+    ) -> Option<Version> {
+        let before = before.map(|b| members::Before {
+            cycle: b.cycle,
+            json: &b.json,
+            members: &b.members,
+            since: &b.since,
+            shape_since: b.shape_since,
+            prints,
+        });
+        let w = members::write(cycle, status, before, spare)?;
         Some(Version {
             cycle,
-            json: json.into(),
-            members,
+            json: w.json.into(),
+            members: w.members,
+            since: w.since,
+            shape_since: w.shape_since,
         })
     }
 
@@ -69,122 +87,21 @@ impl Version {
     }
 }
 
-/// `value` as compact JSON (what `serde_json::to_string` writes) and its top-level members: for
-/// each, where it starts, where its value starts (after the colon) and where it ends. Marked
-/// while it is written, not found by parsing it again (issue 27: parsing 4 KB per axis and tick
-/// byte by byte was a tenth of the feed's CPU; the UTF-8 check at the end is a fast pass that
-/// keeps this free of `unsafe`). `None` for anything that is not an object.
-fn marked(value: &impl serde::Serialize) -> Option<(String, Vec<Member>)> {
-    let len = Cell::new(0);
-    let mut members = Vec::with_capacity(96);
-    let mut out = Written {
-        buf: Vec::with_capacity(5 * 1024),
-        len: &len,
-    };
-    let marks = Marks {
-        len: &len,
-        members: &mut members,
-        depth: 0,
-        start: 0,
-        value: 0,
-    };
-    let mut ser = serde_json::Serializer::with_formatter(&mut out, marks);
-    value.serialize(&mut ser).ok()?;
-    let object = ser.into_inner().buf.first() == Some(&b'{');
-    let json = String::from_utf8(out.buf).ok()?;
-    object.then_some((json, members))
-}
-
-/// The JSON as written, its length where [`Marks`] reads it.
-struct Written<'a> {
-    buf: Vec<u8>,
-    len: &'a Cell<usize>,
-}
-
-impl std::io::Write for Written<'_> {
-    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
-        self.buf.extend_from_slice(b);
-        self.len.set(self.buf.len());
-        Ok(b.len())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
-/// serde_json's compact formatting, noting where the outermost object's members are.
-struct Marks<'a> {
-    len: &'a Cell<usize>,
-    members: &'a mut Vec<Member>,
-    /// Objects and arrays open around what is written now (a key at 1 is a member of the
-    /// outermost object; one deeper marks nothing).
-    depth: usize,
-    start: usize,
-    value: usize,
-}
-
-impl serde_json::ser::Formatter for Marks<'_> {
-    fn begin_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.depth += 1;
-        w.write_all(b"{")
-    }
-
-    fn end_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.depth -= 1;
-        w.write_all(b"}")
-    }
-
-    fn begin_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.depth += 1;
-        w.write_all(b"[")
-    }
-
-    fn end_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.depth -= 1;
-        w.write_all(b"]")
-    }
-
-    fn begin_object_key<W: ?Sized + std::io::Write>(
-        &mut self,
-        w: &mut W,
-        first: bool,
-    ) -> std::io::Result<()> {
-        if !first {
-            w.write_all(b",")?;
-        }
-        if self.depth == 1 {
-            self.start = self.len.get();
-        }
-        Ok(())
-    }
-
-    fn begin_object_value<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        w.write_all(b":")?;
-        if self.depth == 1 {
-            self.value = self.len.get();
-        }
-        Ok(())
-    }
-
-    fn end_object_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
-        if self.depth == 1 {
-            let at = |x: usize| u32::try_from(x).map_err(std::io::Error::other);
-            self.members
-                .push((at(self.start)?, at(self.value)?, at(self.len.get())?));
-        }
-        Ok(())
-    }
-}
-
 /// The members of `now` whose value differs from `before` (or that `before` lacks), as a JSON
 /// object; `None` when nothing changed.
 fn delta_json(before: &Version, now: &Version) -> Option<Arc<str>> {
-    let same_shape = before.members.len() == now.members.len()
-        && (0..now.members.len()).all(|i| before.key(i) == now.key(i));
+    // A version since which every version has had the same members: each member of `now`
+    // says when it last changed, nothing is compared (a member that changed and changed back
+    // is sent again, which a client merging the changes does not see).
+    let chained = before.cycle < now.cycle && before.cycle >= now.shape_since;
+    let same_shape = chained
+        || before.members.len() == now.members.len()
+            && (0..now.members.len()).all(|i| before.key(i) == now.key(i));
     let mut out = String::with_capacity(256);
     for i in 0..now.members.len() {
-        let changed = if same_shape {
+        let changed = if chained {
+            now.since[i] > before.cycle
+        } else if same_shape {
             before.value(i) != now.value(i)
         } else {
             let key = now.key(i);
@@ -211,6 +128,9 @@ struct AxisFeed {
     tick: u64,
     /// Oldest first.
     versions: VecDeque<Arc<Version>>,
+    /// The newest version's prints, and the buffer the next one's are made in.
+    prints: members::Prints,
+    spare: members::Prints,
     /// Deltas to the newest version from the older ones asked for (`None`: no change).
     deltas: Vec<(u64, Option<Arc<str>>)>,
 }
@@ -394,14 +314,18 @@ impl Feed {
                 }
             }
         }
-        let mut f = axis.write().unwrap();
+        let mut guard = axis.write().unwrap();
+        let f = &mut *guard;
         // A late socket uses the newer version (newer data), never takes the feed back.
         if f.versions.is_empty() || tick > f.tick {
             f.tick = f.tick.max(tick);
             let (cycle, status) = s.status(slot);
             let status = status?;
             if f.versions.back().is_none_or(|v| v.cycle != cycle) {
-                let v = Version::of(cycle, &s.status_view(status))?;
+                let before = f.versions.back().map(|v| &**v);
+                let view = s.status_view(status);
+                let v = Version::of(cycle, &view, before, &f.prints, &mut f.spare)?;
+                std::mem::swap(&mut f.prints, &mut f.spare);
                 if f.versions.len() == KEPT {
                     f.versions.pop_front();
                 }
@@ -470,7 +394,20 @@ mod tests {
     use serde_json::json;
 
     fn version(cycle: u64, v: Value) -> Version {
-        Version::of(cycle, &v).unwrap()
+        let none = members::Prints::default();
+        Version::of(cycle, &v, None, &none, &mut members::Prints::default()).unwrap()
+    }
+
+    /// Versions made one after the other, as the feed makes them.
+    fn versions(values: &[(u64, Value)]) -> Vec<Version> {
+        let (mut prints, mut spare) = <(members::Prints, members::Prints)>::default();
+        let mut out: Vec<Version> = Vec::new();
+        for (cycle, v) in values {
+            let made = Version::of(*cycle, v, out.last(), &prints, &mut spare).unwrap();
+            std::mem::swap(&mut prints, &mut spare);
+            out.push(made);
+        }
+        out
     }
 
     #[test]
@@ -492,36 +429,13 @@ mod tests {
         assert_eq!(v.value(1), r#"{"c":[1,2,{"d":"x,}]\"y"}]}"#);
         assert_eq!(v.value(2), r#""q\\\"""#);
         assert_eq!(v.value(3), "null");
-        assert!(Version::of(1, &json!([1, {"a": 2}])).is_none());
+        let none = members::Prints::default();
+        let mut spare = members::Prints::default();
+        assert!(Version::of(1, &json!([1, {"a": 2}]), None, &none, &mut spare).is_none());
         assert_eq!(version(1, json!({})).members.len(), 0);
         // Written as `serde_json::to_string` writes it.
         let status = json!({"s": "standstill", "p": [1.5, {"q": null}], "e": {}});
         assert_eq!(&*version(1, status.clone()).json, status.to_string());
-    }
-
-    /// The status as the feed sends it (`LiveStatus`: the axis status flattened, beside its
-    /// master's name) is written exactly as `serde_json::to_string` writes it, and every
-    /// top-level member is marked.
-    #[test]
-    fn a_live_status_is_marked_member_by_member() {
-        let mut status = motion::AxisStatus {
-            set_position: 12.5,
-            ..Default::default()
-        };
-        status.cam.cams[1].slave_offset = -0.25;
-        let live = crate::model::LiveStatus {
-            status,
-            master: Some("x\"y".into()),
-        };
-        let v = Version::of(7, &live).unwrap();
-        assert_eq!(&*v.json, serde_json::to_string(&live).unwrap());
-        let whole: Map<String, Value> = serde_json::from_str(&v.json).unwrap();
-        assert_eq!(v.members.len(), whole.len());
-        for i in 0..v.members.len() {
-            let key: String = serde_json::from_str(v.key(i).trim_end_matches(':')).unwrap();
-            let value: Value = serde_json::from_str(v.value(i)).unwrap();
-            assert_eq!(whole[&key], value, "member {key}");
-        }
     }
 
     #[test]
@@ -562,6 +476,43 @@ mod tests {
         let c = version(3, json!({"s": "standstill", "p": 2.5, "m": "x"}));
         let d: Value = serde_json::from_str(&delta_json(&a, &c).unwrap()).unwrap();
         assert_eq!(d, json!({"p": 2.5, "m": "x"}));
+    }
+
+    /// Versions made one after the other know when each member last changed: a delta over
+    /// several of them has every member changed in any of them; one from a version of other
+    /// members is compared by key and value.
+    #[test]
+    fn a_delta_over_several_versions_has_what_changed_in_any() {
+        let v = versions(&[
+            (10, json!({"p": 1.0, "s": "a", "n": {"x": 1}})),
+            (20, json!({"p": 2.0, "s": "a", "n": {"x": 1}})),
+            (30, json!({"p": 3.0, "s": "a", "n": {"x": 2}})),
+            (40, json!({"p": 3.0, "s": "a", "n": {"x": 2}})),
+            (50, json!({"p": 3.0, "s": "b"})),
+            (60, json!({"p": 4.0, "s": "b"})),
+        ]);
+        let delta = |from: usize, to: usize| -> Option<Value> {
+            delta_json(&v[from], &v[to]).map(|d| serde_json::from_str(&d).unwrap())
+        };
+        assert_eq!(v[3].shape_since, 10);
+        assert_eq!(delta(0, 3), Some(json!({"p": 3.0, "n": {"x": 2}})));
+        assert_eq!(delta(1, 3), Some(json!({"p": 3.0, "n": {"x": 2}})));
+        assert_eq!(delta(2, 3), None);
+        assert_eq!(delta(3, 3), None);
+        // Other members since 50: compared by value (a member gone is not in the delta).
+        assert_eq!(v[5].shape_since, 50);
+        assert_eq!(delta(3, 5), Some(json!({"p": 4.0, "s": "b"})));
+        assert_eq!(delta(4, 5), Some(json!({"p": 4.0})));
+        assert_eq!(delta(0, 4), Some(json!({"p": 3.0, "s": "b"})));
+        // A member that changed and changed back between two versions is in their delta
+        // (decision 177): the same value again.
+        let v = versions(&[
+            (10, json!({"p": 1.0, "n": 1})),
+            (20, json!({"p": 1.0, "n": 2})),
+            (30, json!({"p": 1.0, "n": 1})),
+        ]);
+        let d: Value = serde_json::from_str(&delta_json(&v[0], &v[2]).unwrap()).unwrap();
+        assert_eq!(d, json!({"n": 1}));
     }
 
     #[test]

@@ -8,6 +8,7 @@ pub mod control;
 pub mod feed;
 pub mod idempotency;
 mod link;
+pub mod members;
 mod pump;
 mod registry;
 
