@@ -314,6 +314,8 @@ impl Feed {
                 }
             }
         }
+        // The oldest version, freed after the lock is let go (not while others wait on it).
+        let mut _retired = None;
         let mut guard = axis.write().unwrap();
         let f = &mut *guard;
         // A late socket uses the newer version (newer data), never takes the feed back.
@@ -327,7 +329,7 @@ impl Feed {
                 let v = Version::of(cycle, &view, before, &f.prints, &mut f.spare)?;
                 std::mem::swap(&mut f.prints, &mut f.spare);
                 if f.versions.len() == KEPT {
-                    f.versions.pop_front();
+                    _retired = f.versions.pop_front();
                 }
                 f.versions.push_back(Arc::new(v));
                 f.deltas.clear();
