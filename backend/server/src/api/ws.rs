@@ -672,6 +672,21 @@ fn asked(subs: &[Sub], tick: u64) -> impl Iterator<Item = (AxisSlot, Option<u64>
 }
 
 fn updates(s: &AppState, subs: &mut [Sub], tick: u64, out: &mut Batch) {
+    // The axes' versions first: a second socket making its own message at this tick (on the
+    // other worker) makes them from the other end, so the two share the work instead of one
+    // waiting on the other axis by axis.
+    let slots = subs
+        .iter()
+        .filter(|x| tick >= x.due)
+        .filter_map(|x| match x.topic {
+            Topic::Axis { slot, .. } => Some(slot),
+            _ => None,
+        });
+    if s.feed.maker(tick) % 2 == 1 {
+        slots.rev().for_each(|slot| s.feed.prepare(s, slot, tick));
+    } else {
+        slots.for_each(|slot| s.feed.prepare(s, slot, tick));
+    }
     for sub in subs.iter_mut().filter(|x| tick >= x.due) {
         sub.sent_at(tick);
         match &sub.topic {

@@ -234,6 +234,8 @@ pub struct Feed {
     reused: AtomicU64,
     /// Every topic's text once, shared by the sockets that subscribe to it.
     topics: Topics,
+    /// The tick and how many sockets began to make their own message at it.
+    makers: Mutex<(u64, u32)>,
 }
 
 impl Feed {
@@ -245,6 +247,7 @@ impl Feed {
             made: AtomicU64::new(0),
             reused: AtomicU64::new(0),
             topics: Topics::default(),
+            makers: Mutex::default(),
         }
     }
 
@@ -295,6 +298,34 @@ impl Feed {
         (self.clock.now().as_nanos() / TICK.as_nanos()) as u64
     }
 
+    /// Makes axis `slot`'s version for `tick` unless it is made or being made (another socket
+    /// holds the axis). Sockets that make a tick's message at the same time make its versions
+    /// from both ends ([`Feed::maker`]) instead of waiting on each other axis by axis.
+    pub fn prepare(&self, s: &AppState, slot: AxisSlot, tick: u64) {
+        let Some(axis) = self.axes.get(slot as usize) else {
+            return;
+        };
+        match axis.try_read() {
+            Ok(f) if !f.versions.is_empty() && tick <= f.tick => return,
+            Err(std::sync::TryLockError::WouldBlock) => return,
+            _ => {}
+        }
+        let mut _retired = None;
+        if let Ok(mut f) = axis.try_write() {
+            f.make(s, slot, tick, &mut _retired);
+        }
+    }
+
+    /// How many sockets began to make their own message at `tick` before this one.
+    pub fn maker(&self, tick: u64) -> u32 {
+        let mut m = self.makers.lock().unwrap();
+        if m.0 != tick {
+            *m = (tick, 0);
+        }
+        m.1 += 1;
+        m.1 - 1
+    }
+
     /// The update of axis `slot` at `tick` for a subscriber that was last sent version `seen`
     /// (`None`: nothing yet); `None` when the axis has no status.
     pub fn piece(
@@ -318,23 +349,7 @@ impl Feed {
         let mut _retired = None;
         let mut guard = axis.write().unwrap();
         let f = &mut *guard;
-        // A late socket uses the newer version (newer data), never takes the feed back.
-        if f.versions.is_empty() || tick > f.tick {
-            f.tick = f.tick.max(tick);
-            let (cycle, status) = s.status(slot);
-            let status = status?;
-            if f.versions.back().is_none_or(|v| v.cycle != cycle) {
-                let before = f.versions.back().map(|v| &**v);
-                let view = s.status_view(status);
-                let v = Version::of(cycle, &view, before, &f.prints, &mut f.spare)?;
-                std::mem::swap(&mut f.prints, &mut f.spare);
-                if f.versions.len() == KEPT {
-                    _retired = f.versions.pop_front();
-                }
-                f.versions.push_back(Arc::new(v));
-                f.deltas.clear();
-            }
-        }
+        f.make(s, slot, tick, &mut _retired)?;
         if let Some(from) = seen {
             let newest = f.versions.back()?.clone();
             let made = from == newest.cycle || f.deltas.iter().any(|(c, _)| *c == from);
@@ -350,6 +365,34 @@ impl Feed {
 }
 
 impl AxisFeed {
+    /// The version for `tick`, unless one as new is there. A late socket uses the newer
+    /// version (newer data), never takes the feed back. `None` when the axis has no status.
+    fn make(
+        &mut self,
+        s: &AppState,
+        slot: AxisSlot,
+        tick: u64,
+        retired: &mut Option<Arc<Version>>,
+    ) -> Option<()> {
+        if self.versions.is_empty() || tick > self.tick {
+            self.tick = self.tick.max(tick);
+            let (cycle, status) = s.status(slot);
+            let status = status?;
+            if self.versions.back().is_none_or(|v| v.cycle != cycle) {
+                let before = self.versions.back().map(|v| &**v);
+                let view = s.status_view(status);
+                let v = Version::of(cycle, &view, before, &self.prints, &mut self.spare)?;
+                std::mem::swap(&mut self.prints, &mut self.spare);
+                if self.versions.len() == KEPT {
+                    *retired = self.versions.pop_front();
+                }
+                self.versions.push_back(Arc::new(v));
+                self.deltas.clear();
+            }
+        }
+        Some(())
+    }
+
     /// The update for a subscriber last sent version `seen`, if it is made (`None`: a delta
     /// still to make).
     fn answer(&self, seen: Option<u64>) -> Option<Piece> {
