@@ -1,7 +1,8 @@
 //! The websocket status feed. Each axis's status is written as JSON once per cycle that anyone
 //! asks for (straight from the status, no `serde_json::Value`; the members that did not change
-//! since the version before are copied from it, `members.rs`), marked member by member, and kept with the last [`KEPT`] versions; the delta from an older version to the
-//! newest is made once and shared by every subscriber that has that older version. So the cost
+//! since the version before are copied from it, `members.rs`), marked member by member, and
+//! kept with the last [`KEPT`] versions; the delta from an older version to the newest is made
+//! once and shared by every subscriber that has that older version. So the cost
 //! of streaming grows with axes × versions in flight (at most [`KEPT`]), never with axes ×
 //! subscribers — also when sockets fall out of step with each other. A subscriber whose
 //! version is older than what is kept gets the newest state whole (coalesced).
@@ -88,7 +89,8 @@ impl Version {
 }
 
 /// The members of `now` whose value differs from `before` (or that `before` lacks), as a JSON
-/// object; `None` when nothing changed.
+/// object; `None` when nothing changed. (From a version in `now`'s chain of the same members:
+/// every member changed since, which may include one that changed back, decision 177.)
 fn delta_json(before: &Version, now: &Version) -> Option<Arc<str>> {
     // A version since which every version has had the same members: each member of `now`
     // says when it last changed, nothing is compared (a member that changed and changed back
@@ -378,6 +380,12 @@ impl AxisFeed {
             self.tick = self.tick.max(tick);
             let (cycle, status) = s.status(slot);
             let status = status?;
+            // Versions are a chain of rising cycles (what the deltas rely on, `delta_json`);
+            // a cycle that went back (never, with one kernel) starts the chain again.
+            if self.versions.back().is_some_and(|v| cycle < v.cycle) {
+                self.versions.clear();
+                self.deltas.clear();
+            }
             if self.versions.back().is_none_or(|v| v.cycle != cycle) {
                 let before = self.versions.back().map(|v| &**v);
                 let view = s.status_view(status);

@@ -2,14 +2,15 @@
 //! each top-level member's value is first walked into a *print* — its values as bytes, with
 //! nothing formatted or escaped — and a member whose print equals the previous version's is
 //! copied from that version's text instead of being written again. A moving axis changes
-//! about six of its status's hundred members a cycle, so the floats and keys of the other
-//! ninety-odd (the cam block alone is 1.7 KB) are formatted once, not at every tick.
+//! six or seven of its status's 77 members a cycle, so the floats and keys of the other
+//! seventy (the cam block alone is 1.7 KB) are formatted once, not at every tick.
 //!
 //! Equal prints mean equal JSON: a print records every call serde makes with every argument
 //! serde_json's output depends on (a value's exact bits, a string's bytes; the name of a
-//! struct's field or an enum's variant by its address, which is the same for the same field
-//! of the same type — a different address only makes a member count as changed). The text is
-//! exactly what `serde_json::to_string` writes for the whole object (tests).
+//! struct, of its fields or of an enum's variant by its address, which is the same for the
+//! same name of the same type — a different address only makes a member count as changed;
+//! serde_json writes a struct of one special name, its `RawValue`, raw). The text is exactly
+//! what `serde_json::to_string` writes for the whole object (tests).
 
 use serde::ser::{self, Serialize};
 
@@ -21,9 +22,10 @@ pub type Member = (u32, u32, u32);
 pub struct Written {
     pub json: String,
     pub members: Vec<Member>,
-    /// For each member, the cycle of the version in which its value last differed from the
-    /// version before (as far back as versions written with the same members in the same
-    /// order go; see `shape_since`).
+    /// For each member, the cycle of the version in which its value (or key) last differed
+    /// from the version before at the same place. (Only what changed since `shape_since` is
+    /// known from it: a member copied across a change of the other members keeps its older
+    /// cycle.)
     pub since: Vec<u64>,
     /// The cycle since which every version has had these members (keys in this order).
     pub shape_since: u64,
@@ -33,6 +35,8 @@ pub struct Written {
 #[derive(Default)]
 pub struct Prints {
     bytes: Vec<u8>,
+    /// A changed member as serde_json writes it (kept here to be reused).
+    scratch: Vec<u8>,
     /// Where member i's print ends in `bytes` (it starts where member i − 1's ends).
     ends: Vec<u32>,
 }
@@ -57,8 +61,10 @@ pub struct Before<'a> {
 
 /// `value` (an object: a struct or a map with string keys) at `cycle` as JSON, its members
 /// that are unchanged since `before` copied from `before`'s text; its prints go to `prints`
-/// (cleared first; not `before`'s: the caller keeps two and swaps them). `None` for anything that is not an object. A `before` of the same or a
-/// later cycle is not used (its members' cycles would say nothing about this one).
+/// (cleared first; not `before`'s: the caller keeps two and swaps them). `None` for anything
+/// else (also for some values serde_json writes as objects: an object in `Some`, a variant,
+/// a map with keys that are not strings). A `before` of the same or a later cycle is not used
+/// (its members' cycles would say nothing about this one).
 pub fn write(
     cycle: u64,
     value: &impl Serialize,
@@ -68,6 +74,12 @@ pub fn write(
     prints.bytes.clear();
     prints.ends.clear();
     let before = before.filter(|b| b.cycle < cycle);
+    // `before`'s prints are its own (they are paired by the caller).
+    debug_assert!(
+        before.as_ref().is_none_or(
+            |b| b.prints.ends.len() == b.members.len() && b.since.len() == b.members.len()
+        )
+    );
     let mut top = Top {
         cycle,
         print: Print {
@@ -81,10 +93,11 @@ pub fn write(
         before,
         member_start: 0,
         run: None,
-        scratch: Vec::with_capacity(256),
+        scratch: std::mem::take(&mut prints.scratch),
     };
     let ok = value.serialize(&mut top).is_ok();
     prints.bytes = std::mem::take(&mut top.print.bytes);
+    prints.scratch = std::mem::take(&mut top.scratch);
     prints.ends = std::mem::take(&mut top.ends);
     if !ok {
         prints.bytes.clear();
@@ -396,7 +409,11 @@ impl<'a, 't> ser::Serializer for &'a mut Top<'t> {
         Ok(self)
     }
 
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Self, NotWritten> {
+    fn serialize_struct(self, name: &'static str, _: usize) -> Result<Self, NotWritten> {
+        // serde_json writes its `RawValue` (a struct of this name) raw, not as an object.
+        if name == RAW_VALUE {
+            return Err(NotWritten);
+        }
         self.open();
         Ok(self)
     }
@@ -411,6 +428,10 @@ impl<'a, 't> ser::Serializer for &'a mut Top<'t> {
         Err(NotWritten)
     }
 }
+
+/// The name of serde_json's `RawValue` struct (serde_json's `raw_value` feature, which axum
+/// turns on): written as the text it holds.
+const RAW_VALUE: &str = "$serde_json::private::RawValue";
 
 // The print's tags: each value begins with one; a sequence, map or struct ends with END, which
 // begins no value, so a print reads back one way only.
@@ -600,7 +621,6 @@ impl ser::Serializer for &mut Print {
         name: &'static str,
         value: &T,
     ) -> Result<(), NotWritten> {
-        // The name too: serde_json writes a `RawValue` (a newtype of a special name) raw.
         self.bytes.push(NEWTYPE);
         self.name(name);
         value.serialize(self)
@@ -648,8 +668,10 @@ impl ser::Serializer for &mut Print {
         Ok(self)
     }
 
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Self, NotWritten> {
+    fn serialize_struct(self, name: &'static str, _: usize) -> Result<Self, NotWritten> {
+        // The name too: serde_json writes a struct of one name (its `RawValue`) raw.
         self.bytes.push(STRUCT);
+        self.name(name);
         Ok(self)
     }
 
@@ -911,6 +933,45 @@ mod tests {
         assert_eq!(changed(3), ["f", "v", "e"]);
         // NaN and infinity are both null to serde_json, but not the same value.
         assert_eq!(changed(4), ["f", "v"]);
+    }
+
+    /// serde_json writes its `RawValue` raw: a struct of that name is not taken for another
+    /// struct of the same fields, nor written as an object at the top.
+    #[test]
+    fn a_raw_value_is_written_raw() {
+        use serde_json::value::RawValue;
+        struct Named(&'static str, &'static str);
+        impl Serialize for Named {
+            fn serialize<S: ser::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                use ser::SerializeStruct;
+                let mut st = s.serialize_struct(self.0, 1)?;
+                st.serialize_field(RAW_VALUE, self.1)?;
+                st.end()
+            }
+        }
+        #[derive(serde::Serialize)]
+        struct S {
+            n: Named,
+            r: Box<RawValue>,
+        }
+        let raw = |t: &str| RawValue::from_string(t.into()).unwrap();
+        let w = chain(&[
+            S {
+                n: Named("W", "1"),
+                r: raw("[1, 2]"),
+            },
+            S {
+                n: Named(RAW_VALUE, "1"),
+                r: raw("[1, 2]"),
+            },
+            S {
+                n: Named("W", "1"),
+                r: raw("[1,2]"),
+            },
+        ]);
+        assert_eq!(w[1].json, r#"{"n":1,"r":[1, 2]}"#);
+        let mut prints = Prints::default();
+        assert!(write(1, &raw(r#"{"a":1}"#), None, &mut prints).is_none());
     }
 
     #[test]
