@@ -314,7 +314,12 @@ impl Feed {
         }
         let mut _retired = None;
         if let Ok(mut f) = axis.try_write() {
-            f.make(s, slot, tick, &mut _retired);
+            f.make(
+                tick,
+                || s.status(slot),
+                |st| s.status_view(st),
+                &mut _retired,
+            );
         }
     }
 
@@ -351,34 +356,45 @@ impl Feed {
         let mut _retired = None;
         let mut guard = axis.write().unwrap();
         let f = &mut *guard;
-        f.make(s, slot, tick, &mut _retired)?;
-        if let Some(from) = seen {
-            let newest = f.versions.back()?.clone();
-            let made = from == newest.cycle || f.deltas.iter().any(|(c, _)| *c == from);
-            if !made {
-                if let Some(old) = f.versions.iter().find(|v| v.cycle == from).cloned() {
-                    let d = delta_json(&old, &newest);
-                    f.deltas.push((from, d));
-                }
-            }
-        }
-        f.answer(seen)
+        f.make(
+            tick,
+            || s.status(slot),
+            |st| s.status_view(st),
+            &mut _retired,
+        )?;
+        f.update(seen)
     }
 }
 
 impl AxisFeed {
+    /// The update for a subscriber last sent version `seen`, its delta made if it is not yet.
+    fn update(&mut self, seen: Option<u64>) -> Option<Piece> {
+        if let Some(from) = seen {
+            let newest = self.versions.back()?.clone();
+            let made = from == newest.cycle || self.deltas.iter().any(|(c, _)| *c == from);
+            if !made {
+                if let Some(old) = self.versions.iter().find(|v| v.cycle == from).cloned() {
+                    let d = delta_json(&old, &newest);
+                    self.deltas.push((from, d));
+                }
+            }
+        }
+        self.answer(seen)
+    }
+
     /// The version for `tick`, unless one as new is there. A late socket uses the newer
     /// version (newer data), never takes the feed back. `None` when the axis has no status.
-    fn make(
+    /// (`status`: the axis's cycle and status now; `view`: the status as the API shows it.)
+    fn make<S, V: serde::Serialize>(
         &mut self,
-        s: &AppState,
-        slot: AxisSlot,
         tick: u64,
+        status: impl FnOnce() -> (u64, Option<S>),
+        view: impl FnOnce(S) -> V,
         retired: &mut Option<Arc<Version>>,
     ) -> Option<()> {
         if self.versions.is_empty() || tick > self.tick {
             self.tick = self.tick.max(tick);
-            let (cycle, status) = s.status(slot);
+            let (cycle, status) = status();
             let status = status?;
             // Versions are a chain of rising cycles (what the deltas rely on, `delta_json`);
             // a cycle that went back (never, with one kernel) starts the chain again.
@@ -388,7 +404,7 @@ impl AxisFeed {
             }
             if self.versions.back().is_none_or(|v| v.cycle != cycle) {
                 let before = self.versions.back().map(|v| &**v);
-                let view = s.status_view(status);
+                let view = view(status);
                 let v = Version::of(cycle, &view, before, &self.prints, &mut self.spare)?;
                 std::mem::swap(&mut self.prints, &mut self.spare);
                 if self.versions.len() == KEPT {
@@ -566,6 +582,31 @@ mod tests {
         ]);
         let d: Value = serde_json::from_str(&delta_json(&v[0], &v[2]).unwrap()).unwrap();
         assert_eq!(d, json!({"n": 1}));
+    }
+
+    /// Versions are a chain of rising cycles: a cycle that goes back starts it again, and a
+    /// subscriber of a version from before is sent the newest whole (a delta by the members'
+    /// cycles across the break would have missed the change of `p`).
+    #[test]
+    fn a_cycle_that_goes_back_starts_the_versions_again() {
+        let mut f = AxisFeed::default();
+        let mut retired = None;
+        let mut at = |f: &mut AxisFeed, tick: u64, cycle: u64, p: f64| {
+            let status = json!({"p": p, "k": 1});
+            f.make(tick, || (cycle, Some(status)), |v| v, &mut retired)
+                .unwrap();
+        };
+        at(&mut f, 1, 100, 1.0);
+        at(&mut f, 2, 50, 2.0);
+        at(&mut f, 3, 120, 2.0);
+        let cycles: Vec<u64> = f.versions.iter().map(|v| v.cycle).collect();
+        assert_eq!(cycles, [50, 120]);
+        let p = f.update(Some(100)).unwrap();
+        let data: Value = serde_json::from_str(p.data.as_deref().unwrap()).unwrap();
+        assert!(p.full && data["p"] == 2.0, "{data}");
+        // Within the new chain, deltas as usual.
+        let p = f.update(Some(50)).unwrap();
+        assert!(!p.full && p.data.is_none(), "nothing changed since 50");
     }
 
     #[test]
