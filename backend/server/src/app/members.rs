@@ -498,6 +498,15 @@ impl Print {
     }
 }
 
+/// Serializer methods that hand a narrower integer to the method for the widest.
+macro_rules! widen {
+    ($($name:ident($ty:ty) => $wide:ident;)*) => {
+        $(fn $name(self, v: $ty) -> Result<(), NotWritten> {
+            self.$wide(v.into())
+        })*
+    };
+}
+
 impl ser::Serializer for &mut Print {
     type Ok = ();
     type Error = NotWritten;
@@ -514,16 +523,11 @@ impl ser::Serializer for &mut Print {
         Ok(())
     }
 
-    fn serialize_i8(self, v: i8) -> Result<(), NotWritten> {
-        self.serialize_i64(v.into())
-    }
-
-    fn serialize_i16(self, v: i16) -> Result<(), NotWritten> {
-        self.serialize_i64(v.into())
-    }
-
-    fn serialize_i32(self, v: i32) -> Result<(), NotWritten> {
-        self.serialize_i64(v.into())
+    // Narrower integers as the widest of their sign (serde_json writes them alike).
+    widen! {
+        serialize_i8(i8) => serialize_i64; serialize_i16(i16) => serialize_i64;
+        serialize_i32(i32) => serialize_i64; serialize_u8(u8) => serialize_u64;
+        serialize_u16(u16) => serialize_u64; serialize_u32(u32) => serialize_u64;
     }
 
     fn serialize_i64(self, v: i64) -> Result<(), NotWritten> {
@@ -534,18 +538,6 @@ impl ser::Serializer for &mut Print {
     fn serialize_i128(self, v: i128) -> Result<(), NotWritten> {
         self.tag(INT128, &v.to_le_bytes());
         Ok(())
-    }
-
-    fn serialize_u8(self, v: u8) -> Result<(), NotWritten> {
-        self.serialize_u64(v.into())
-    }
-
-    fn serialize_u16(self, v: u16) -> Result<(), NotWritten> {
-        self.serialize_u64(v.into())
-    }
-
-    fn serialize_u32(self, v: u32) -> Result<(), NotWritten> {
-        self.serialize_u64(v.into())
     }
 
     fn serialize_u64(self, v: u64) -> Result<(), NotWritten> {
