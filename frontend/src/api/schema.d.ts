@@ -9,7 +9,7 @@ export interface paths {
         };
         /**
          * The audit log, newest first
-         * @description Every change (axes, parameters, configuration import, fault injection) and every motion command (when it was submitted and when it ended), with the client's address and `X-Client-Id`. Changes are written in the same transaction as the change itself; motion commands are written in batches a few milliseconds later, so that a slow disk never delays a command.
+         * @description Every change (axes, parameters, configuration import, fault injection) and every motion command (when it was submitted and when it ended), with the client's address and `X-Client-Id`. Changes to the stored configuration are written in the same transaction as the change itself; motion commands and parameter writes that are not persistent are written in batches a few milliseconds later, so that a slow disk never delays them. A read waits for the rows queued before it: the entry of everything acknowledged before the request is in the answer.
          */
         get: operations["audit_log"];
         put?: never;

@@ -287,14 +287,14 @@ impl AppState {
         if self.clock.mode != crate::clock::Mode::Virtual {
             return;
         }
-        let (tx, rx) = oneshot::channel();
-        if self
-            .audit_tx
-            .try_send(crate::store::AuditOp::Flush(tx))
-            .is_ok()
-        {
-            let _ = rx.await;
-        }
+        self.audit_written().await;
+    }
+
+    /// Waits until the audit rows queued before this call are written (or given up as lost):
+    /// a reader of the log then finds the entry of every change and command acknowledged
+    /// before its request (decision 178).
+    pub async fn audit_written(&self) {
+        pump::audit_flushed(&self.audit_tx).await;
     }
 
     fn audit_op(&self, op: crate::store::AuditOp) {

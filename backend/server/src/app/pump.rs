@@ -126,6 +126,14 @@ pub async fn pump(state: Arc<AppState>) {
     }
 }
 
+/// Waits until the audit writer has written (or given up as lost) what was queued before.
+pub async fn audit_flushed(queue: &mpsc::Sender<AuditOp>) {
+    let (done, written) = tokio::sync::oneshot::channel();
+    if queue.send(AuditOp::Flush(done)).await.is_ok() {
+        let _ = written.await;
+    }
+}
+
 /// Writes queued audit entries in batches, one transaction per batch. A batch that cannot be
 /// written (database locked past its busy timeout, disk full) is tried again a few times; what
 /// is still not written is logged and counted in `lost` (`audit_dropped` in /system, /metrics).
@@ -160,5 +168,30 @@ pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost:
                 let _ = done.send(());
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every row queued before the flush is in the log when it returns, also when they took
+    /// more than one batch.
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_flush_returns_when_the_rows_queued_before_it_are_written() {
+        let db = store::open(":memory:").await.unwrap();
+        let (queue, rx) = mpsc::channel(1024);
+        for n in 0..300 {
+            let row = store::AuditEntry {
+                action: format!("parameter.write.{n}"),
+                ..Default::default()
+            };
+            queue.send(AuditOp::Row(row)).await.unwrap();
+        }
+        tokio::spawn(audit_writer(db.clone(), rx, Default::default()));
+        audit_flushed(&queue).await;
+        let rows = store::read_audit(&db, 1000, 0, i64::MAX).await.unwrap();
+        assert_eq!(rows.len(), 300);
+        assert_eq!(rows[0].entry.action, "parameter.write.299");
     }
 }
