@@ -464,7 +464,7 @@ async fn session(s: Arc<AppState>, mut socket: WebSocket, client: ClientInfo, se
             _ = due => {
                 // Socket jogs are not renewed here: only the client's keepalives renew them,
                 // so a client whose script hangs with the socket open still stops the axis.
-                let tick = s.feed.tick_now().max(next_due.unwrap_or(0));
+                let tick = sending_tick(s.feed.tick_now(), &subs);
                 let m = tick_message(&s, &mut subs, &mut seen_writes, tick, last_len);
                 // The next tick is held before this one is let go (the clock never slips
                 // past it while this socket sends).
@@ -582,6 +582,22 @@ impl Batch {
                 Some(self.buf)
             }
         }
+    }
+}
+
+/// The tick a socket woken for its next due subscription sends: that tick when it woke within
+/// the subscription's period (the versions and the message made for it, most often by the
+/// sockets that were on time, are taken instead of new ones made for this socket alone), else
+/// the newest tick on the subscription's grid (a socket a period or more behind gets the newest
+/// state). Decision 179.
+fn sending_tick(now: u64, subs: &[Sub]) -> u64 {
+    let next = subs
+        .iter()
+        .filter(|x| !matches!(x.topic, Topic::Commands))
+        .min_by_key(|x| (x.due, x.every));
+    match next {
+        Some(x) => x.due.max(now - now % x.every.max(1)),
+        None => now,
     }
 }
 
@@ -1213,6 +1229,41 @@ impl LocalSession {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A socket woken late within its subscription's period sends the tick it was due at (the
+    /// one the sockets on time made); a period or more late, the newest tick of its grid.
+    #[test]
+    fn a_late_socket_sends_its_due_tick_within_the_period() {
+        let sub = |every: u64, due: u64, topic: Topic| Sub {
+            key: String::new(),
+            key_json: Arc::from(""),
+            topic,
+            every,
+            due,
+            last: None,
+            seen: None,
+        };
+        let axis = || Topic::Axis {
+            id: 1,
+            slot: 0,
+            name: "x".into(),
+        };
+        // 50 Hz (every 4th tick), due at 40: woken at 40 to 43 it sends 40.
+        let subs = [sub(4, 40, axis()), sub(1, 0, Topic::Commands)];
+        for now in 40..44 {
+            assert_eq!(sending_tick(now, &subs), 40, "woken at {now}");
+        }
+        // A period or more behind: the newest tick of its grid.
+        assert_eq!(sending_tick(45, &subs), 44);
+        assert_eq!(sending_tick(51, &subs), 48);
+        // The earliest due subscription sets the grid (10 Hz every 20th, 100 Hz every 2nd).
+        let mixed = [sub(20, 60, Topic::System), sub(2, 42, axis())];
+        assert_eq!(sending_tick(43, &mixed), 42);
+        assert_eq!(sending_tick(47, &mixed), 46);
+        // A new subscription (due 0) is sent at once, on its grid.
+        assert_eq!(sending_tick(43, &[sub(4, 0, axis())]), 40);
+        assert_eq!(sending_tick(43, &[]), 43);
+    }
 
     /// The update written from the feed's ready JSON is the `UpdateParams` notification the
     /// AsyncAPI document describes (the same JSON value; members in another order).
