@@ -32,11 +32,15 @@ pub const KEPT: usize = 8;
 /// Different messages shared per tick (sockets asking for something else make their own).
 const SHARED_PER_TICK: usize = 16;
 
+/// A JSON text shared by the subscribers that send it.
+pub type Text = Arc<String>;
+
 /// One axis's status at one cycle, as JSON.
 struct Version {
     cycle: u64,
-    /// The whole object (what a first update sends).
-    json: Arc<str>,
+    /// The whole object (what a first update sends; kept as written, not copied into an
+    /// `Arc<str>`: 4 KB per axis per tick).
+    json: Text,
     members: Vec<Member>,
     /// For each member, the cycle at which it last changed (see [`members::Written`]).
     since: Vec<u64>,
@@ -65,7 +69,7 @@ impl Version {
         let w = members::write(cycle, status, before, spare)?;
         Some(Version {
             cycle,
-            json: w.json.into(),
+            json: Arc::new(w.json),
             members: w.members,
             since: w.since,
             shape_since: w.shape_since,
@@ -91,7 +95,7 @@ impl Version {
 /// The members of `now` whose value differs from `before` (or that `before` lacks), as a JSON
 /// object; `None` when nothing changed. (From a version in `now`'s chain of the same members:
 /// every member changed since, which may include one that changed back, decision 177.)
-fn delta_json(before: &Version, now: &Version) -> Option<Arc<str>> {
+fn delta_json(before: &Version, now: &Version) -> Option<Text> {
     // A version since which every version has had the same members: each member of `now`
     // says when it last changed, nothing is compared (a member that changed and changed back
     // is sent again, which a client merging the changes does not see).
@@ -120,7 +124,7 @@ fn delta_json(before: &Version, now: &Version) -> Option<Arc<str>> {
         return None;
     }
     out.push('}');
-    Some(out.into())
+    Some(Arc::new(out))
 }
 
 /// One axis: its recent versions and the deltas made to the newest.
@@ -134,7 +138,7 @@ struct AxisFeed {
     prints: members::Prints,
     spare: members::Prints,
     /// Deltas to the newest version from the older ones asked for (`None`: no change).
-    deltas: Vec<(u64, Option<Arc<str>>)>,
+    deltas: Vec<(u64, Option<Text>)>,
 }
 
 /// What a subscription sends for one axis at a tick.
@@ -143,7 +147,7 @@ pub struct Piece {
     /// `data` is the whole object (the first update, or a subscriber too far behind).
     pub full: bool,
     /// The object (or the delta) as JSON; `None`: nothing changed, nothing to send.
-    pub data: Option<Arc<str>>,
+    pub data: Option<Text>,
     /// The version the subscriber has from now on.
     pub version: u64,
 }
@@ -421,7 +425,7 @@ impl AxisFeed {
     /// still to make).
     fn answer(&self, seen: Option<u64>) -> Option<Piece> {
         let newest = self.versions.back()?;
-        let piece = |full: bool, data: Option<Arc<str>>| Piece {
+        let piece = |full: bool, data: Option<Text>| Piece {
             cycle: newest.cycle,
             full,
             data,
@@ -504,7 +508,7 @@ mod tests {
         assert_eq!(version(1, json!({})).members.len(), 0);
         // Written as `serde_json::to_string` writes it.
         let status = json!({"s": "standstill", "p": [1.5, {"q": null}], "e": {}});
-        assert_eq!(&*version(1, status.clone()).json, status.to_string());
+        assert_eq!(*version(1, status.clone()).json, status.to_string());
     }
 
     #[test]
