@@ -4,7 +4,8 @@
 # moving axes, connects CLIENTS websocket clients subscribed to every axis at 50 Hz
 # (target/release/examples/bench ws), and reads motiond's task-clock with `perf stat` over 8 s
 # after 6 s of warm-up, and what the load generator received; then again over 8 s once the
-# clients are gone (the same moving axes): the difference is the feed's own cost. Task-clock is
+# clients are gone (the same moving axes): the difference is what serving the clients costs
+# (the feed, the sends, and on loopback the clients' receive path inside `sendto`). Task-clock is
 # what the process used on all its threads; it reads lower than feed.py's CPU, whose window
 # includes connecting.
 # Usage: scripts/bench/feed_ab.sh ROUNDS CLIENTS MOTIOND_A MOTIOND_B [...]
@@ -16,6 +17,10 @@ command -v perf >/dev/null || { echo "needs perf (Debian: linux-perf)" >&2; exit
 # set against another machine's.
 echo "reference: $("$bench" reference)"
 out=$(mktemp -d)
+motiond=
+# perf's figures without a locale's digit grouping; no motiond left running on a failure.
+export LC_ALL=C
+trap '[ -n "$motiond" ] && kill "$motiond" 2>/dev/null; rm -rf "$out"' EXIT
 port=18190
 for _ in $(seq "$rounds"); do
     for bin in "$@"; do
@@ -52,10 +57,12 @@ PY
         # What was delivered over the whole 18 s (a build that delivers less must not look cheaper).
         delivered=$(python3 -c 'import json,sys; r=json.loads(open(sys.argv[1]).read().strip().splitlines()[-1]); print(r["updates_per_s"], "of", r["clients"]*len(sys.argv[2:])*50)' "$out/load.json" $axes)
         # The same machine with no client (the cycle thread with 64 moving axes, the runtime
-        # idle): what is left of the figure above when it is taken away is what the feed costs.
+        # idle): what is left of the figure above when it is taken away is what serving the
+        # clients costs.
         base=$(perf stat -e task-clock -p "$motiond" -- sleep 8 2>&1 | awk '/task-clock/ {print $1}')
-        feed=$(awk -v a="${ms//,/}" -v b="${base//,/}" 'BEGIN { printf "%.0f", a - b }')
-        echo "$bin task_clock_ms_per_8s=$ms without_clients=$base feed=$feed updates_per_s=$delivered"
+        serving=$(awk -v a="$ms" -v b="$base" 'BEGIN { printf "%.0f", a - b }')
+        echo "$bin task_clock_ms_per_8s=$ms without_clients=$base serving=$serving updates_per_s=$delivered"
         kill "$motiond"; wait "$motiond" 2>/dev/null || true
+        motiond=
     done
 done

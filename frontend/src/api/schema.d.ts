@@ -9,7 +9,7 @@ export interface paths {
         };
         /**
          * The audit log, newest first
-         * @description Every change (axes, parameters, configuration import, fault injection) and every motion command (when it was submitted and when it ended), with the client's address and `X-Client-Id`. Changes to the stored configuration are written in the same transaction as the change itself; motion commands and parameter writes that are not persistent are written in batches a few milliseconds later, so that a slow disk never delays them. A read waits for the rows queued before it: the entry of everything acknowledged before the request is in the answer.
+         * @description Every change (axes, parameters, configuration import, fault injection) and every motion command (when it was submitted and when it ended), with the client's address and `X-Client-Id`. Changes to the stored configuration and the submission of a motion command are written before the answer (a change in its own transaction); a command's outcome and end, parameter writes that are not persistent and the other events (logins, control, fault injection, clock steps) are written in batches a few milliseconds later, so that a slow disk never delays them. A read first waits (at most 2 s) for the rows queued before it, so the entry of everything acknowledged before the request is in the answer, unless the database did not take it (counted in `audit_dropped` of `/system` and `/metrics`).
          */
         get: operations["audit_log"];
         put?: never;

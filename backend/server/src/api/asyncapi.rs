@@ -261,7 +261,7 @@ pub fn document() -> Value {
         schema_ref("SubscribeParams"),
         schema_ref("SubscribeResult"),
         "Subscribe to a topic",
-        "`axes/{axis}/status` (updates at `rate_hz` from the latest cycle: the full `LiveStatus` first, then only \
+        "`axes/{axis}/status` (updates at `rate_hz` on the feed's 5 ms grid, each from the latest cycle at its tick: the full `LiveStatus` first, then only \
          the changed fields, a field no longer there as `null`; the subscription follows its axis by id and ends with `subscription_ended` when the \
          axis is removed), `groups/{group}/status` (the `GroupStatusDto`, likewise; nothing is sent while the group \
          does not exist), `system` (the `SystemResource`, likewise) or `commands` (every `command_event`). \

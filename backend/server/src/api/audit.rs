@@ -70,10 +70,12 @@ pub struct AuditQuery {
 #[utoipa::path(get, path = "/api/v1/audit", tag = "system", summary = "The audit log, newest first",
     description = "Every change (axes, parameters, configuration import, fault injection) and every motion \
 command (when it was submitted and when it ended), with the client's address and `X-Client-Id`. Changes to \
-the stored configuration are written in the same transaction as the change itself; motion commands and \
-parameter writes that are not persistent are written in batches a few milliseconds later, so that a slow \
-disk never delays them. A read waits for the rows queued before it: the entry of everything acknowledged \
-before the request is in the answer.",
+the stored configuration and the submission of a motion command are written before the answer (a change in \
+its own transaction); a command's outcome and end, parameter writes that are not persistent and the other \
+events (logins, control, fault injection, clock steps) are written in batches a few milliseconds later, so \
+that a slow disk never delays them. A read first waits (at most 2 s) for the rows queued before it, so the \
+entry of everything acknowledged before the request is in the answer, unless the database did not take it \
+(counted in `audit_dropped` of `/system` and `/metrics`).",
     params(AuditQuery),
     responses((status = 200, description = "Entries, newest first", body = Vec<AuditRecord>), AuditErrors))]
 pub async fn audit_log(
@@ -90,8 +92,8 @@ pub async fn audit_log(
     if q.before_id.is_some_and(|v| v < 1) {
         return Err(AppError::field("before_id", "must be ≥ 1"));
     }
-    // Rows queued for the batching writer (motion commands, parameter writes) are written
-    // first: an entry acknowledged before this request is in its answer.
+    // Rows queued for the batching writer (a command's end, a parameter write, a login …)
+    // are written first: an entry acknowledged before this request is in its answer.
     s.audit_written().await;
     let rows = store::read_audit(
         &s.db,

@@ -1,7 +1,8 @@
 //! Websocket `/api/v1/ws`: JSON-RPC 2.0 — subscriptions with deltas, and commands.
 //!
-//! Each connection is one task. Snapshots are taken from the latest status when a
-//! subscription is due, so a slow client simply skips intermediate snapshots; command
+//! Each connection is one task. Snapshots are taken from the latest status at the tick a
+//! subscription is due (a socket woken at most [`LATE_TICKS`] late sends that tick's), so a
+//! slow client simply skips intermediate snapshots; command
 //! notices come from a bounded broadcast channel (a lagging client is told how many it
 //! missed). Replies to commands are produced by spawned tasks through a bounded channel.
 //! Nothing here can block another client or the cycle thread.
@@ -585,19 +586,23 @@ impl Batch {
     }
 }
 
-/// The tick a socket woken for its next due subscription sends: that tick when it woke within
-/// the subscription's period (the versions and the message made for it, most often by the
+/// How many ticks late a socket may wake and still send the tick it was due at.
+const LATE_TICKS: u64 = 2;
+
+/// The tick a socket woken for its next due subscription sends: that tick when it woke at most
+/// [`LATE_TICKS`] (10 ms) late (the versions and the message made for it, most often by the
 /// sockets that were on time, are taken instead of new ones made for this socket alone), else
-/// the newest tick on the subscription's grid (a socket a period or more behind gets the newest
-/// state). Decision 179.
+/// the tick now (a socket further behind gets the newest state). Decision 179.
 fn sending_tick(now: u64, subs: &[Sub]) -> u64 {
-    let next = subs
+    let due = subs
         .iter()
         .filter(|x| !matches!(x.topic, Topic::Commands))
-        .min_by_key(|x| (x.due, x.every));
-    match next {
-        Some(x) => x.due.max(now - now % x.every.max(1)),
-        None => now,
+        .map(|x| x.due)
+        .min();
+    match due {
+        // (Woken before it, as the old rule did: the due tick.)
+        Some(due) if now <= due + LATE_TICKS => due,
+        _ => now,
     }
 }
 
@@ -1230,10 +1235,9 @@ impl LocalSession {
 mod tests {
     use super::*;
 
-    /// A socket woken late within its subscription's period sends the tick it was due at (the
-    /// one the sockets on time made); a period or more late, the newest tick of its grid.
+    /// A socket woken at most two ticks late sends the tick it was due at; later, the tick now.
     #[test]
-    fn a_late_socket_sends_its_due_tick_within_the_period() {
+    fn a_late_socket_sends_its_due_tick_when_at_most_two_ticks_late() {
         let sub = |every: u64, due: u64, topic: Topic| Sub {
             key: String::new(),
             key_json: Arc::from(""),
@@ -1248,20 +1252,20 @@ mod tests {
             slot: 0,
             name: "x".into(),
         };
-        // 50 Hz (every 4th tick), due at 40: woken at 40 to 43 it sends 40.
+        // 50 Hz (every 4th tick), due at 40: woken at 40 to 42 it sends 40.
         let subs = [sub(4, 40, axis()), sub(1, 0, Topic::Commands)];
-        for now in 40..44 {
+        for now in 40..=42 {
             assert_eq!(sending_tick(now, &subs), 40, "woken at {now}");
         }
-        // A period or more behind: the newest tick of its grid.
-        assert_eq!(sending_tick(45, &subs), 44);
-        assert_eq!(sending_tick(51, &subs), 48);
-        // The earliest due subscription sets the grid (10 Hz every 20th, 100 Hz every 2nd).
+        // Further behind: the tick now (the newest state), also at a slow rate.
+        assert_eq!(sending_tick(43, &subs), 43);
+        assert_eq!(sending_tick(1900, &[sub(2000, 0, axis())]), 1900);
+        // The earliest due subscription counts.
         let mixed = [sub(20, 60, Topic::System), sub(2, 42, axis())];
-        assert_eq!(sending_tick(43, &mixed), 42);
-        assert_eq!(sending_tick(47, &mixed), 46);
-        // A new subscription (due 0) is sent at once, on its grid.
-        assert_eq!(sending_tick(43, &[sub(4, 0, axis())]), 40);
+        assert_eq!(sending_tick(44, &mixed), 42);
+        assert_eq!(sending_tick(45, &mixed), 45);
+        // Woken before it: the due tick.
+        assert_eq!(sending_tick(39, &subs), 40);
         assert_eq!(sending_tick(43, &[]), 43);
     }
 

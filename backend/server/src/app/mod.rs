@@ -290,11 +290,11 @@ impl AppState {
         self.audit_written().await;
     }
 
-    /// Waits until the audit rows queued before this call are written (or given up as lost):
-    /// a reader of the log then finds the entry of every change and command acknowledged
-    /// before its request (decision 178).
+    /// Waits until the audit rows queued before this call are written (or given up as lost),
+    /// at most 2 s: a reader of the log then finds the entry of every change and command
+    /// acknowledged before its request (decision 178).
     pub async fn audit_written(&self) {
-        pump::audit_flushed(&self.audit_tx).await;
+        pump::audit_flushed(&self.audit_tx, std::time::Duration::from_secs(2)).await;
     }
 
     fn audit_op(&self, op: crate::store::AuditOp) {

@@ -31,7 +31,6 @@ impl AppState {
             replies.push(r);
         }
         let mut notices = Vec::new();
-        let mut audits = Vec::new();
         {
             let mut store = self.commands.lock().unwrap();
             while let Some(ev) = self.shared.events.pop() {
@@ -42,7 +41,9 @@ impl AppState {
                     if let Some(r) = store.map.get_mut(&n.command) {
                         let entry = final_audit(&n, &r.client);
                         if r.accepted {
-                            audits.push(entry);
+                            // Queued before the store shows the command final (`try_send`,
+                            // no wait): a reader of the log who saw it end finds its row.
+                            self.audit(entry);
                         } else {
                             // Ended before its verdict was handled: `submit` writes this entry
                             // after the one of the submission.
@@ -52,9 +53,6 @@ impl AppState {
                 }
                 notices.push(n);
             }
-        }
-        for e in audits {
-            self.audit(e);
         }
         {
             let mut scope = self.scope.lock().unwrap();
@@ -126,12 +124,16 @@ pub async fn pump(state: Arc<AppState>) {
     }
 }
 
-/// Waits until the audit writer has written (or given up as lost) what was queued before.
-pub async fn audit_flushed(queue: &mpsc::Sender<AuditOp>) {
+/// Waits until the audit writer has written (or given up as lost) what was queued before, at
+/// most `bound` (a database held by a long transaction must not hold the caller longer).
+pub async fn audit_flushed(queue: &mpsc::Sender<AuditOp>, bound: Duration) {
     let (done, written) = tokio::sync::oneshot::channel();
-    if queue.send(AuditOp::Flush(done)).await.is_ok() {
-        let _ = written.await;
-    }
+    let _ = tokio::time::timeout(bound, async {
+        if queue.send(AuditOp::Flush(done)).await.is_ok() {
+            let _ = written.await;
+        }
+    })
+    .await;
 }
 
 /// Writes queued audit entries in batches, one transaction per batch. A batch that cannot be
@@ -141,7 +143,15 @@ pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost:
     const TRIES: u32 = 3;
     let mut batch = Vec::with_capacity(256);
     while rx.recv_many(&mut batch, 256).await > 0 {
+        // Flushes are not entries: not written, not counted as lost.
+        let entries = batch
+            .iter()
+            .filter(|op| !matches!(op, AuditOp::Flush(_)))
+            .count();
         for attempt in 1..=TRIES {
+            if entries == 0 {
+                break;
+            }
             let result = async {
                 let mut tx = db.begin().await?;
                 for op in &batch {
@@ -157,8 +167,8 @@ pub async fn audit_writer(db: SqlitePool, mut rx: mpsc::Receiver<AuditOp>, lost:
             match result {
                 Ok(()) => break,
                 Err(e) if attempt == TRIES => {
-                    tracing::error!("audit log: {} entries not written: {e}", batch.len());
-                    lost.fetch_add(batch.len() as u64, Relaxed);
+                    tracing::error!("audit log: {entries} entries not written: {e}");
+                    lost.fetch_add(entries as u64, Relaxed);
                 }
                 Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
             }
@@ -189,7 +199,7 @@ mod tests {
             queue.send(AuditOp::Row(row)).await.unwrap();
         }
         tokio::spawn(audit_writer(db.clone(), rx, Default::default()));
-        audit_flushed(&queue).await;
+        audit_flushed(&queue, Duration::from_secs(60)).await;
         let rows = store::read_audit(&db, 1000, 0, i64::MAX).await.unwrap();
         assert_eq!(rows.len(), 300);
         assert_eq!(rows[0].entry.action, "parameter.write.299");
