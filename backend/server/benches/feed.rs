@@ -8,7 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use server::app::members::{Before, Prints, Written, write};
+use server::app::members::{Prints, Written, write};
 use server::model::LiveStatus;
 
 /// The status of a moving axis at `cycle`: what changes from one tick to the next in the
@@ -47,14 +47,7 @@ fn status(c: &mut Criterion) {
     g.bench_function("members_against_the_last_version", |b| {
         b.iter(|| {
             cycle += 20;
-            let before = Before {
-                cycle: cycle - 20,
-                json: &last.json,
-                members: &last.members,
-                since: &last.since,
-                shape_since: last.shape_since,
-                prints: &prints,
-            };
+            let before = last.before(&prints);
             let w = write(cycle, black_box(&moving(cycle)), Some(before), &mut spare).unwrap();
             std::mem::swap(&mut prints, &mut spare);
             last = w;

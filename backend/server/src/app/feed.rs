@@ -19,7 +19,7 @@ use std::time::Duration;
 use serde_json::{Map, Value};
 
 use super::AppState;
-use super::members::{self, Member};
+use super::members;
 use crate::clock::{Clock, Hold};
 use motion::AxisSlot;
 
@@ -35,61 +35,21 @@ const SHARED_PER_TICK: usize = 16;
 /// A JSON text shared by the subscribers that send it.
 pub type Text = Arc<String>;
 
-/// One axis's status at one cycle, as JSON.
-struct Version {
+/// One axis's status at one cycle, as JSON (its text kept as written, not copied into an
+/// `Arc<str>`: 4 KB per axis per tick). `since`: the cycle at which each member last changed.
+type Version = members::Written<Text>;
+
+/// The status at `cycle`, its members that did not change since `before` (the newest version,
+/// whose prints are `prints`) copied from it; its own prints go to `spare`.
+fn write_version(
     cycle: u64,
-    /// The whole object (what a first update sends; kept as written, not copied into an
-    /// `Arc<str>`: 4 KB per axis per tick).
-    json: Text,
-    members: Vec<Member>,
-    /// For each member, the cycle at which it last changed (see [`members::Written`]).
-    since: Vec<u64>,
-    /// The cycle since which the versions have had these members.
-    shape_since: u64,
-}
-
-impl Version {
-    /// The status at `cycle`, its members that did not change since `before` (the newest
-    /// version, whose prints are `prints`) copied from it; its own prints go to `spare`.
-    fn of(
-        cycle: u64,
-        status: &impl serde::Serialize,
-        before: Option<&Version>,
-        prints: &members::Prints,
-        spare: &mut members::Prints,
-    ) -> Option<Version> {
-        let before = before.map(|b| members::Before {
-            cycle: b.cycle,
-            json: &b.json,
-            members: &b.members,
-            since: &b.since,
-            shape_since: b.shape_since,
-            prints,
-        });
-        let w = members::write(cycle, status, before, spare)?;
-        Some(Version {
-            cycle,
-            json: Arc::new(w.json),
-            members: w.members,
-            since: w.since,
-            shape_since: w.shape_since,
-        })
-    }
-
-    fn key(&self, i: usize) -> &str {
-        let (start, value, _) = self.members[i];
-        &self.json[start as usize..value as usize]
-    }
-
-    fn value(&self, i: usize) -> &str {
-        let (_, value, end) = self.members[i];
-        &self.json[value as usize..end as usize]
-    }
-
-    fn member(&self, i: usize) -> &str {
-        let (start, _, end) = self.members[i];
-        &self.json[start as usize..end as usize]
-    }
+    status: &impl serde::Serialize,
+    before: Option<&Version>,
+    prints: &members::Prints,
+    spare: &mut members::Prints,
+) -> Option<Version> {
+    let before = before.map(|b| b.before(prints));
+    members::write(cycle, status, before, spare).map(members::Written::shared)
 }
 
 /// The members of `now` whose value differs from `before` (or that `before` lacks), as a JSON
@@ -409,7 +369,7 @@ impl AxisFeed {
             if self.versions.back().is_none_or(|v| v.cycle != cycle) {
                 let before = self.versions.back().map(|v| &**v);
                 let view = view(status);
-                let v = Version::of(cycle, &view, before, &self.prints, &mut self.spare)?;
+                let v = write_version(cycle, &view, before, &self.prints, &mut self.spare)?;
                 std::mem::swap(&mut self.prints, &mut self.spare);
                 if self.versions.len() == KEPT {
                     *retired = self.versions.pop_front();
@@ -468,7 +428,7 @@ mod tests {
 
     fn version(cycle: u64, v: Value) -> Version {
         let none = members::Prints::default();
-        Version::of(cycle, &v, None, &none, &mut members::Prints::default()).unwrap()
+        write_version(cycle, &v, None, &none, &mut members::Prints::default()).unwrap()
     }
 
     /// Versions made one after the other, as the feed makes them.
@@ -476,7 +436,7 @@ mod tests {
         let (mut prints, mut spare) = <(members::Prints, members::Prints)>::default();
         let mut out: Vec<Version> = Vec::new();
         for (cycle, v) in values {
-            let made = Version::of(*cycle, v, out.last(), &prints, &mut spare).unwrap();
+            let made = write_version(*cycle, v, out.last(), &prints, &mut spare).unwrap();
             std::mem::swap(&mut prints, &mut spare);
             out.push(made);
         }
@@ -504,7 +464,7 @@ mod tests {
         assert_eq!(v.value(3), "null");
         let none = members::Prints::default();
         let mut spare = members::Prints::default();
-        assert!(Version::of(1, &json!([1, {"a": 2}]), None, &none, &mut spare).is_none());
+        assert!(write_version(1, &json!([1, {"a": 2}]), None, &none, &mut spare).is_none());
         assert_eq!(version(1, json!({})).members.len(), 0);
         // Written as `serde_json::to_string` writes it.
         let status = json!({"s": "standstill", "p": [1.5, {"q": null}], "e": {}});

@@ -19,8 +19,11 @@ use serde::ser::{self, Serialize};
 pub type Member = (u32, u32, u32);
 
 /// An object's JSON text and its members, with the cycle at which each member last changed.
-pub struct Written {
-    pub json: String,
+/// `T`: the text as written (`String`), or shared (`Arc<String>`: the feed's versions).
+pub struct Written<T = String> {
+    /// The cycle it was written at.
+    pub cycle: u64,
+    pub json: T,
     pub members: Vec<Member>,
     /// For each member, the cycle of the version in which its value (or key) last differed
     /// from the version before at the same place. (Only what changed since `shape_since` is
@@ -29,6 +32,60 @@ pub struct Written {
     pub since: Vec<u64>,
     /// The cycle since which every version has had these members (keys in this order).
     pub shape_since: u64,
+}
+
+impl<T> Written<T>
+where
+    T: std::ops::Deref,
+    T::Target: AsRef<str>,
+{
+    fn text(&self) -> &str {
+        (*self.json).as_ref()
+    }
+
+    /// This object as the one the next is written against (`prints`: those `write` made with
+    /// it).
+    pub fn before<'a>(&'a self, prints: &'a Prints) -> Before<'a> {
+        Before {
+            cycle: self.cycle,
+            json: self.text(),
+            members: &self.members,
+            since: &self.since,
+            shape_since: self.shape_since,
+            prints,
+        }
+    }
+
+    /// Member `i`'s key with its colon (`"key":`).
+    pub fn key(&self, i: usize) -> &str {
+        let (start, value, _) = self.members[i];
+        &self.text()[start as usize..value as usize]
+    }
+
+    /// Member `i`'s value.
+    pub fn value(&self, i: usize) -> &str {
+        let (_, value, end) = self.members[i];
+        &self.text()[value as usize..end as usize]
+    }
+
+    /// Member `i`, key and value.
+    pub fn member(&self, i: usize) -> &str {
+        let (start, _, end) = self.members[i];
+        &self.text()[start as usize..end as usize]
+    }
+}
+
+impl Written {
+    /// The same object, its text shared as it was written (not copied).
+    pub fn shared(self) -> Written<std::sync::Arc<String>> {
+        Written {
+            cycle: self.cycle,
+            json: std::sync::Arc::new(self.json),
+            members: self.members,
+            since: self.since,
+            shape_since: self.shape_since,
+        }
+    }
 }
 
 /// The prints of the last object written (kept for the next one: only the newest is needed).
@@ -114,6 +171,7 @@ pub fn write(
         _ => cycle,
     };
     Some(Written {
+        cycle,
         json: top.out,
         members: top.members,
         since: top.since,
@@ -768,14 +826,7 @@ mod tests {
         let mut out: Vec<Written> = Vec::new();
         for (c, v) in values.iter().enumerate() {
             let cycle = 10 * (c as u64 + 1);
-            let before = out.last().map(|w| Before {
-                cycle: cycle - 10,
-                json: &w.json,
-                members: &w.members,
-                since: &w.since,
-                shape_since: w.shape_since,
-                prints: &prints,
-            });
+            let before = out.last().map(|w| w.before(&prints));
             let w = write(cycle, v, before, &mut spare).unwrap();
             std::mem::swap(&mut prints, &mut spare);
             assert_eq!(w.json, serde_json::to_string(v).unwrap(), "cycle {cycle}");
