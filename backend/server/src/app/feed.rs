@@ -278,12 +278,7 @@ impl Feed {
         }
         let mut _retired = None;
         if let Ok(mut f) = axis.try_write() {
-            f.make(
-                tick,
-                || s.status(slot),
-                |st| s.status_view(st),
-                &mut _retired,
-            );
+            f.make_now(s, slot, tick, &mut _retired);
         }
     }
 
@@ -320,12 +315,7 @@ impl Feed {
         let mut _retired = None;
         let mut guard = axis.write().unwrap();
         let f = &mut *guard;
-        f.make(
-            tick,
-            || s.status(slot),
-            |st| s.status_view(st),
-            &mut _retired,
-        )?;
+        f.make_now(s, slot, tick, &mut _retired)?;
         f.update(seen)
     }
 }
@@ -344,6 +334,17 @@ impl AxisFeed {
             }
         }
         self.answer(seen)
+    }
+
+    /// [`AxisFeed::make`] from axis `slot`'s status now, as the API shows it.
+    fn make_now(
+        &mut self,
+        s: &AppState,
+        slot: AxisSlot,
+        tick: u64,
+        retired: &mut Option<Arc<Version>>,
+    ) -> Option<()> {
+        self.make(tick, || s.status(slot), |st| s.status_view(st), retired)
     }
 
     /// The version for `tick`, unless one as new is there. A late socket uses the newer
