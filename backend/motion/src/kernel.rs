@@ -860,7 +860,7 @@ mod tests {
         }
         let st = k.status(0).unwrap();
         assert!(st.constant_velocity && st.set_velocity == 10.0);
-        assert_eq!(marks(&k), 0x7f, "every block idle while only moving");
+        assert_eq!(marks(&k), 0x1ff, "every block idle while only moving");
         // Backlash compensation on the right flank while travelling positive: −0.5 on the
         // actual position, +0.5 on the drive's setpoint, ramped at 100 units/s.
         let backlash = CommandKind::BacklashCompensation {
@@ -909,5 +909,45 @@ mod tests {
         let laid_on = st.set_position - before - 10.0 * 2001.0 * DT;
         assert!((laid_on - 2.0).abs() < 1e-6, "{laid_on}");
         assert_eq!(marks(&k) & 0b1000, 0b1000, "idle again once done");
+    }
+
+    /// The drive-mode block marked idle on a moving axis is still looked at whenever the
+    /// drive reports torque mode (§5.7.1's danger note: nothing asked for it, so after the
+    /// timeout the axis goes to ErrorStop, 0x70B4), cycle by cycle.
+    #[test]
+    fn a_drive_in_torque_mode_is_seen_with_every_block_marked_idle() {
+        let mut k = kernel(1);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 1], Vec::new());
+        accept(&mut k, 1, 0, power(), &mut e);
+        for _ in 0..5 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        accept(&mut k, 2, 0, velocity(10.0), &mut e);
+        for _ in 0..50 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        assert_eq!(k.axis(0).unwrap().idle_marks(), 0x1ff);
+        let feedback = |sp: &[DriveSetpoint], mode| {
+            vec![DriveFeedback {
+                ready: true,
+                enabled: sp[0].enable,
+                actual_position: sp[0].position,
+                mode,
+                ..DriveFeedback::default()
+            }]
+        };
+        // Timed from the first cycle in torque mode: the 500th (a sum of 500 × 1 ms just
+        // over the 0.5 s timeout) ends it.
+        for i in 0..500 {
+            let fb = feedback(&sp, crate::DriveMode::Torque);
+            k.step(&fb, &mut sp, &mut e);
+            let st = k.status(0).unwrap();
+            if i < 499 {
+                assert_eq!(st.state, AxisState::ContinuousMotion, "cycle {i}");
+            } else {
+                assert_eq!(st.state, AxisState::ErrorStop);
+                assert_eq!(st.error_id, crate::ErrorId::DRIVE_MODE_NOT_REACHED.0);
+            }
+        }
     }
 }

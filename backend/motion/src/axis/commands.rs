@@ -150,7 +150,7 @@ impl Axis {
                     return Err(ErrorId::PARAMETER_NOT_CORRECT);
                 }
                 self.override_filter.queue(recovery_time, percent);
-                self.step_override_filter(0.0);
+                self.step_override_filter();
                 cx.report(cmd.id, DONE);
                 Ok(())
             }

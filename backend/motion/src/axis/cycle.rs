@@ -72,14 +72,16 @@ impl Axis {
         };
         self.cycle = cycle;
         self.io_data_invalid = fb.bus_error;
-        self.torque.read(fb);
+        self.reported_mode = fb.mode;
+        self.actual_torque = fb.actual_torque;
+        self.velocity_limited = fb.velocity_limited;
         // The drive answers the setpoint sent last cycle, which carried that cycle's correction.
         // Read through the encoder scaling (1 unless MC_SetEncoderScalingFactor changed it).
         self.corrections.read = self.corrections.sent;
         self.act_pos = self.enc_k * fb.actual_position + self.offset + self.corrections.read;
         self.limit_positive = fb.limit_positive;
         self.limit_negative = fb.limit_negative;
-        if !self.runs(JobKind::Home) {
+        if self.latch.is_some() && !self.runs(JobKind::Home) {
             // Whatever ended a homing run (stop, power off, error, reset) disarms its latch.
             self.latch = None;
         }
@@ -92,9 +94,16 @@ impl Axis {
         self.act_vel = self.enc_k * fb.actual_velocity;
         let fault_reset = core::mem::take(&mut self.fault_reset);
 
-        self.step_override_filter(dt);
+        if !self.idle(Idle::OVERRIDE_FILTER) {
+            self.step_override_filter();
+        }
         self.step_group_reset(cx);
-        self.step_drive_mode(cx, dt);
+        // A drive that reports torque mode is looked at in every cycle, marked or not (it is
+        // timed from now on: the mark no longer holds).
+        if !self.idle(Idle::DRIVE_MODE) || self.reported_mode == crate::DriveMode::Torque {
+            self.idle.forget(Idle::DRIVE_MODE);
+            self.step_drive_mode(cx, dt);
+        }
         // Power and drive readiness (notes 1, 2, 5).
         self.step_power(cx, dt, fb);
 
@@ -174,7 +183,7 @@ impl Axis {
             position: (self.set.position - self.offset - correction) / self.enc_k,
             velocity: (self.set.velocity - correction_rate) / self.enc_k,
             acceleration: self.set.acceleration / self.enc_k,
-            mode: self.torque.drive_mode(self.runs(JobKind::Torque)),
+            mode: self.drive_mode(self.runs(JobKind::Torque)),
             torque: self.torque.set,
             velocity_limit_high: self.torque.limit_high,
             velocity_limit_low: self.torque.limit_low,

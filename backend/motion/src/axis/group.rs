@@ -16,8 +16,6 @@ pub(super) struct GroupLink {
     /// The group stopped commanding in motion (MC_GroupDisable): brake on the axis's own
     /// fast-stop ramp in this cycle's step.
     pub(super) abandon: bool,
-    /// MC_GroupReset asks the axis to clear its error in this cycle's step.
-    pub(super) reset: bool,
 }
 
 impl Axis {
@@ -97,12 +95,12 @@ impl Axis {
 
     pub(crate) fn group_reset_axis(&mut self) {
         self.wake();
-        self.group.reset = true;
+        self.group_reset = true;
     }
 
     /// MC_GroupReset has asked this axis to reset and its step has not run yet.
     pub(crate) fn group_reset_pending(&self) -> bool {
-        self.group.reset
+        self.group_reset
     }
 
     /// One cycle of the group's motion: the set point the group gave. Without one (the
@@ -132,7 +130,7 @@ impl Axis {
 
     /// MC_GroupReset's part on the axis: an axis in ErrorStop at rest is reset.
     pub(super) fn step_group_reset(&mut self, cx: &mut Ctx<'_, impl EventSink>) {
-        if core::mem::take(&mut self.group.reset)
+        if core::mem::take(&mut self.group_reset)
             && self.mode == Mode::ErrorStop
             && self.job.is_none()
         {

@@ -157,6 +157,18 @@ pub struct Axis {
     act_acc: f64,
     /// Feedback has been read once (the first cycle has no velocity to differentiate).
     fed: bool,
+    /// What the drive reported in the latest cycle besides its position: its operation mode,
+    /// its torque, and whether it holds the velocity at a limit. Read every cycle, so kept
+    /// among the other readings, not on the torque block's lines (issue 27).
+    reported_mode: crate::DriveMode,
+    actual_torque: f64,
+    velocity_limited: bool,
+    /// The position-based mode the drive is to run in (MC_WriteDriveOperationMode; sent with
+    /// every setpoint, so kept here rather than in the torque block).
+    position_mode: crate::DriveMode,
+    /// MC_GroupReset asks the axis to clear its error in this cycle's step (beside the other
+    /// flags every step reads, not on the group link's line).
+    group_reset: bool,
     /// axis position = drive position + offset (MC_SetPosition, homing).
     offset: f64,
     error: ErrorId,
@@ -202,8 +214,8 @@ pub struct Axis {
     enc_k: f64,
     /// The rest of the encoder scaling's state (`encoder.rs`).
     encoder: encoder::EncoderScaling,
-    /// MC_TorqueControl's torque setpoint and limits (while a Torque job runs), the drive's
-    /// position-based mode (MC_WriteDriveOperationMode) and what the drive reported.
+    /// MC_TorqueControl's torque setpoint and limits (while a Torque job runs) and
+    /// MC_WriteDriveOperationMode's wait for the drive.
     torque: torque::TorqueState,
     /// The external setpoint generator (§4.4).
     ext: external::ExtGen,
@@ -273,6 +285,11 @@ impl Axis {
             act_vel: 0.0,
             act_acc: 0.0,
             fed: false,
+            reported_mode: crate::DriveMode::default(),
+            actual_torque: 0.0,
+            velocity_limited: false,
+            position_mode: crate::DriveMode::default(),
+            group_reset: false,
             offset: 0.0,
             error: ErrorId(0),
             drive_error_code: 0,

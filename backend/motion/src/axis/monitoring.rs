@@ -10,8 +10,10 @@ use super::*;
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct OverrideFilterState {
     recovery_time: f64,
-    /// Seconds since the filtered override last changed.
-    since_change: f64,
+    /// The cycle (`Axis::cycle`) at which the filtered override last changed: the quiet time
+    /// is counted from it when a new value waits, not by a timer stepped every cycle (a
+    /// cache line written in every cycle of every axis, issue 27).
+    changed_at: u64,
     /// The latest filtered value (percent) not yet applied.
     pending: Option<f64>,
     /// The last value applied (percent).
@@ -25,31 +27,26 @@ impl OverrideFilterState {
         self.pending = Some(percent);
     }
 
-    /// `dt` has passed: the value to apply as MC_Power's override, once the quiet time after
-    /// the last change has passed (0 % and 100 % at once).
     /// Nothing waits to be applied.
     pub(super) fn settled(&self) -> bool {
         self.pending.is_none()
     }
 
-    /// The quiet time counts on (at rest nothing else happens here).
-    pub(super) fn count(&mut self, dt: f64) {
-        self.since_change += dt;
-    }
-
-    fn step(&mut self, dt: f64) -> Option<f64> {
-        self.count(dt);
+    /// At cycle `cycle` (cycles of `dt`): the value to apply as MC_Power's override, once the
+    /// quiet time after the last change has passed (0 % and 100 % at once).
+    fn step(&mut self, cycle: u64, dt: f64) -> Option<f64> {
         let v = self.pending?;
+        let since_change = cycle.wrapping_sub(self.changed_at) as f64 * dt;
         if self.applied == Some(v) {
             self.pending = None;
         } else if v == 0.0
             || v == 100.0
             || self.applied.is_none()
-            || self.since_change >= self.recovery_time - 1e-9
+            || since_change >= self.recovery_time - 1e-9
         {
             self.pending = None;
             self.applied = Some(v);
-            self.since_change = 0.0;
+            self.changed_at = cycle;
             return Some(v);
         }
         None
@@ -83,8 +80,10 @@ impl Axis {
 
     /// MC_OverrideFilter (§4.5.4): a filtered value waiting for the quiet time after the last
     /// change is applied as MC_Power's override once it has passed; 0 % and 100 % at once.
-    pub(super) fn step_override_filter(&mut self, dt: f64) {
-        if let Some(v) = self.override_filter.step(dt) {
+    /// MC_OverrideFilter's value waiting for its quiet time (asked in a step and right after
+    /// the call, between two steps: counted from the latest step's cycle).
+    pub(super) fn step_override_filter(&mut self) {
+        if let Some(v) = self.override_filter.step(self.cycle, self.cycle_time) {
             self.power_override = v;
         }
     }

@@ -73,7 +73,7 @@ impl Axis {
             && self.override_filter.settled()
             && self.torque.settled()
             && self.group.group.is_none()
-            && !self.group.reset
+            && !self.group_reset
             && !self.drive_executed()
             && self.drive.cmd.mode == crate::drive::ProfileMode::Off
             && self.act_acc == 0.0
@@ -130,7 +130,6 @@ impl Axis {
         if r.in_window {
             self.in_window_timer += dt;
         }
-        self.override_filter.count(dt);
         self.cycle = cycle;
         self.status.nc_cycle_counter = cycle;
     }

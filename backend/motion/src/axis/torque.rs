@@ -24,14 +24,17 @@ pub(super) struct TorqueState {
     waiting: f64,
     /// Seconds the drive has kept reporting torque mode with no torque control running.
     leaving: f64,
-    /// The position-based mode the drive is to run in (MC_WriteDriveOperationMode).
-    position_mode: DriveMode,
     /// MC_WriteDriveOperationMode waiting for the drive to report its mode.
     pending: Option<(Held, DriveMode, f64)>,
-    /// What the drive reported in the latest cycle.
-    pub(super) reported: DriveMode,
-    pub(super) actual: f64,
-    pub(super) velocity_limited: bool,
+}
+
+/// Whether a drive reporting `reported` runs `mode` (a drive that does not say is taken as
+/// running the position-based mode it was configured for).
+fn reports(reported: DriveMode, mode: DriveMode) -> bool {
+    match mode {
+        DriveMode::Configured => reported != DriveMode::Torque,
+        m => reported == m || (reported == DriveMode::Configured && m == DriveMode::Position),
+    }
 }
 
 impl TorqueState {
@@ -39,14 +42,9 @@ impl TorqueState {
     pub(super) fn settled(&self) -> bool {
         self.pending.is_none() && self.leaving == 0.0
     }
+}
 
-    /// The drive's feedback of this cycle.
-    pub(super) fn read(&mut self, fb: &DriveFeedback) {
-        self.reported = fb.mode;
-        self.actual = fb.actual_torque;
-        self.velocity_limited = fb.velocity_limited;
-    }
-
+impl Axis {
     /// The mode to ask the drive for.
     pub(super) fn drive_mode(&self, torque_job: bool) -> DriveMode {
         if torque_job {
@@ -56,20 +54,6 @@ impl TorqueState {
         }
     }
 
-    /// Whether the drive reports `mode` (a drive that does not say is taken as running the
-    /// position-based mode it was configured for).
-    fn reports(&self, mode: DriveMode) -> bool {
-        match mode {
-            DriveMode::Configured => self.reported != DriveMode::Torque,
-            m => {
-                self.reported == m
-                    || (self.reported == DriveMode::Configured && m == DriveMode::Position)
-            }
-        }
-    }
-}
-
-impl Axis {
     /// MC_TorqueControl: admission as a motion command (Aborting), the ramp from the torque
     /// the drive applies now (or the manual start value, or the running setpoint).
     pub(super) fn submit_torque_control(
@@ -95,7 +79,7 @@ impl Axis {
         let start = match (running, tc.manual_start) {
             (true, _) => self.torque.set,
             (false, Some(t)) => t,
-            (false, None) => self.torque.actual,
+            (false, None) => self.actual_torque,
         };
         let base = if running { self.torque.target } else { start };
         let target = if tc.relative {
@@ -199,7 +183,7 @@ impl Axis {
         if let Some((mut old, _, _)) = self.torque.pending.take() {
             old.end(cx, End::Aborted);
         }
-        self.torque.position_mode = mode;
+        self.position_mode = mode;
         let held = Held::start_active(cx, id);
         self.torque.pending = Some((held, mode, 0.0));
         Ok(())
@@ -213,7 +197,7 @@ impl Axis {
         // timeout, or the axis goes to ErrorStop.
         let torque_job = self.runs(JobKind::Torque);
         if !torque_job
-            && self.torque.reported == DriveMode::Torque
+            && self.reported_mode == DriveMode::Torque
             && matches!(self.mode, Mode::Enabled | Mode::Stopping)
         {
             self.torque.leaving += dt;
@@ -227,7 +211,7 @@ impl Axis {
         let Some((mut held, mode, waited)) = self.torque.pending.take() else {
             return;
         };
-        if self.torque.reports(mode) {
+        if reports(self.reported_mode, mode) {
             held.end(cx, End::Done);
         } else if waited + dt > MODE_SWITCH_TIMEOUT {
             held.end(cx, End::Error(ErrorId::DRIVE_MODE_NOT_REACHED));
@@ -236,14 +220,27 @@ impl Axis {
         }
     }
 
+    /// MC_TorqueControl's setpoint now, read only while it runs: out of line, so that the
+    /// status of an axis without torque control never loads the torque block's line (a select
+    /// would load it every cycle).
+    #[cold]
+    #[inline(never)]
+    fn torque_setpoint(&self) -> f64 {
+        self.torque.set
+    }
+
     /// The torque part of the status: the mode the drive reports, its torque, the setpoint.
     pub(super) fn torque_status(&self) -> (DriveMode, f64, f64, bool) {
         let torque_job = self.runs(JobKind::Torque);
         (
-            self.torque.reported,
-            self.torque.actual,
-            if torque_job { self.torque.set } else { 0.0 },
-            torque_job && self.torque.velocity_limited,
+            self.reported_mode,
+            self.actual_torque,
+            if torque_job {
+                self.torque_setpoint()
+            } else {
+                0.0
+            },
+            torque_job && self.velocity_limited,
         )
     }
 }
