@@ -145,7 +145,7 @@ impl Kernel {
         });
         match self.axes.get_mut(slot as usize) {
             Some(s) => {
-                axis.place(slot);
+                axis.place(slot, self.cycle);
                 if let Some((engaged, g)) = member_of {
                     axis.set_group_link(Some(g), engaged);
                 }
@@ -948,6 +948,49 @@ mod tests {
                 assert_eq!(st.state, AxisState::ErrorStop);
                 assert_eq!(st.error_id, crate::ErrorId::DRIVE_MODE_NOT_REACHED.0);
             }
+        }
+    }
+
+    /// An axis put into a kernel that has run for a while counts MC_OverrideFilter's quiet
+    /// time from the kernel's cycle, also for a call before its first step (it counted from
+    /// cycle 0, so the next value applied at once; found by a review).
+    #[test]
+    fn an_axis_put_into_a_running_kernel_keeps_the_override_filter_quiet_time() {
+        let mut k = Kernel::new(DT, 2);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 2], Vec::new());
+        for _ in 0..10_000 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let config = AxisConfig {
+            modulo: false,
+            parameters: AxisParameters::default(),
+            compensation_table: None,
+            drive_executed: false,
+        };
+        k.insert_axis(1, Axis::new(config, DT)).unwrap();
+        let filter = |raw| CommandKind::OverrideFilter {
+            raw,
+            lower_threshold: 0.0,
+            upper_threshold: 32767.0,
+            steps: 200,
+            recovery_time: 0.15,
+        };
+        // The first value applies at once (nothing to wait after), before any step.
+        accept(&mut k, 1, 1, filter(16383.5), &mut e);
+        assert_eq!(k.status(1).unwrap().power_override_percent, 50.0);
+        for _ in 0..50 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        accept(&mut k, 2, 1, filter(8191.75), &mut e);
+        // 150 ms after the first: 100 cycles more.
+        for i in 1..=100 {
+            step(&mut k, &mut sp, &mut e);
+            let want = if i < 100 { 50.0 } else { 25.0 };
+            assert_eq!(
+                k.status(1).unwrap().power_override_percent,
+                want,
+                "cycle {i}"
+            );
         }
     }
 }

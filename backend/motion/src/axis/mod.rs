@@ -197,7 +197,8 @@ pub struct Axis {
     prev_cam: bool,
     /// MC_CamIn/MC_CamScaling/… waiting for their activation, MC_CamInfo kept (`camming.rs`).
     cam: camming::CamState,
-    /// The cycle of the latest step (the status's NcCycleCounter).
+    /// The cycle of the latest step (the status's NcCycleCounter); before the first one, the
+    /// kernel's cycle when the axis was put into its slot.
     cycle: u64,
     /// The drive's process data were invalid in the latest cycle (bus error).
     io_data_invalid: bool,
@@ -335,9 +336,12 @@ impl Axis {
     }
 
     /// The slot the kernel keeps this axis in: the `axis` of every event it reports.
-    pub(crate) fn place(&mut self, slot: AxisSlot) {
+    /// `cycle`: the kernel's cycle now, the axis's until its first step (what a command
+    /// between now and then counts from, e.g. MC_OverrideFilter's quiet time).
+    pub(crate) fn place(&mut self, slot: AxisSlot, cycle: u64) {
         self.wake();
         self.slot = slot;
+        self.cycle = cycle;
     }
 
     pub fn status(&self) -> &AxisStatus {

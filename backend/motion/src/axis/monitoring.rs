@@ -36,7 +36,9 @@ impl OverrideFilterState {
     /// quiet time after the last change has passed (0 % and 100 % at once).
     fn step(&mut self, cycle: u64, dt: f64) -> Option<f64> {
         let v = self.pending?;
-        let since_change = cycle.wrapping_sub(self.changed_at) as f64 * dt;
+        // An axis never counts back; saturating, a count from another kernel's cycles (an axis
+        // moved) waits the whole quiet time rather than none.
+        let since_change = cycle.saturating_sub(self.changed_at) as f64 * dt;
         if self.applied == Some(v) {
             self.pending = None;
         } else if v == 0.0
@@ -80,8 +82,8 @@ impl Axis {
 
     /// MC_OverrideFilter (§4.5.4): a filtered value waiting for the quiet time after the last
     /// change is applied as MC_Power's override once it has passed; 0 % and 100 % at once.
-    /// MC_OverrideFilter's value waiting for its quiet time (asked in a step and right after
-    /// the call, between two steps: counted from the latest step's cycle).
+    /// Asked in a step and right after the call (between two steps: the quiet time counts
+    /// from the latest step's cycle).
     pub(super) fn step_override_filter(&mut self) {
         if let Some(v) = self.override_filter.step(self.cycle, self.cycle_time) {
             self.power_override = v;

@@ -1,9 +1,9 @@
 //! An axis at rest (issue 27): powered and standing, or disabled, with nothing running,
 //! buffered, coupled, queued or settling, and the same feedback as in the cycle before. Its
 //! full step would give the same status and setpoint again, and change nothing but the cycle
-//! counter and two timers that only count (InTargetPosition's dwell and MC_OverrideFilter's
-//! quiet time). [`Axis::step`] then does only that: a standing axis pays for reading its
-//! feedback, not for the blocks it does not use.
+//! counter and a timer that only counts (InTargetPosition's dwell; MC_OverrideFilter's quiet
+//! time counts from a cycle, decision 180). [`Axis::step`] then does only that: a standing
+//! axis pays for reading its feedback, not for the blocks it does not use.
 //!
 //! Entered after two full steps in a row that ended at rest with the same feedback and the
 //! same setpoint; left at the first cycle whose feedback differs, whose master is not
@@ -166,7 +166,6 @@ impl Axis {
             self.cycle,
             self.status.nc_cycle_counter,
             self.in_window_timer,
-            self.override_filter,
         );
         self.rest = rest;
         self.step_at_rest(dt, cycle, out);
@@ -178,7 +177,6 @@ impl Axis {
             self.cycle,
             self.status.nc_cycle_counter,
             self.in_window_timer,
-            self.override_filter,
         ) = kept;
         let mut counting = Counting(events, 0);
         let seq = self.status_seq;

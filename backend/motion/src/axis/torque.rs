@@ -220,26 +220,13 @@ impl Axis {
         }
     }
 
-    /// MC_TorqueControl's setpoint now, read only while it runs: out of line, so that the
-    /// status of an axis without torque control never loads the torque block's line (a select
-    /// would load it every cycle).
-    #[cold]
-    #[inline(never)]
-    fn torque_setpoint(&self) -> f64 {
-        self.torque.set
-    }
-
     /// The torque part of the status: the mode the drive reports, its torque, the setpoint.
     pub(super) fn torque_status(&self) -> (DriveMode, f64, f64, bool) {
         let torque_job = self.runs(JobKind::Torque);
         (
             self.reported_mode,
             self.actual_torque,
-            if torque_job {
-                self.torque_setpoint()
-            } else {
-                0.0
-            },
+            if torque_job { self.torque.set } else { 0.0 },
             torque_job && self.velocity_limited,
         )
     }
