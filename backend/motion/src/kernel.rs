@@ -961,13 +961,8 @@ mod tests {
         for _ in 0..10_000 {
             step(&mut k, &mut sp, &mut e);
         }
-        let config = AxisConfig {
-            modulo: false,
-            parameters: AxisParameters::default(),
-            compensation_table: None,
-            drive_executed: false,
-        };
-        k.insert_axis(1, Axis::new(config, DT)).unwrap();
+        k.insert_axis(1, Axis::new(AxisConfig::default(), DT))
+            .unwrap();
         let filter = |raw| CommandKind::OverrideFilter {
             raw,
             lower_threshold: 0.0,

@@ -2,9 +2,8 @@
 //!
 //! Each connection is one task. Snapshots are taken from the latest status at the tick a
 //! subscription is due (a socket woken at most [`LATE_TICKS`] late sends that tick's), so a
-//! slow client simply skips intermediate snapshots; command
-//! notices come from a bounded broadcast channel (a lagging client is told how many it
-//! missed). Replies to commands are produced by spawned tasks through a bounded channel.
+//! slow client simply skips intermediate snapshots; command notices come from a bounded
+//! broadcast channel (a lagging client is told how many it missed). Replies to commands are produced by spawned tasks through a bounded channel.
 //! Nothing here can block another client or the cycle thread.
 
 use std::net::SocketAddr;
