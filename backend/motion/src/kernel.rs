@@ -570,6 +570,12 @@ impl Kernel {
                     }
                 }
             };
+            // The next axis's lines are on their way while this one steps (`prefetch.rs`).
+            if let Some(next) = self.order.slots[..self.order.len].get(k + 1) {
+                if let Some(next) = self.axes[*next as usize].as_deref() {
+                    next.prefetch_step();
+                }
+            }
             let fb = feedback.get(i).unwrap_or(&no_feedback);
             let axis = self.axes[i].as_deref_mut().expect("checked above");
             if let Some(all) = samples {

@@ -29,6 +29,7 @@
 //! | `monitoring.rs` | `OverrideFilterState` (`override_filter`) | MC_Power's enable, MC_OverrideFilter, errors, feed enables, soft limits, following error |
 //! | `status.rs` | — | the status snapshot |
 //! | `rest.rs` | `Rest` (`rest`) | the step of an axis at rest |
+//! | `prefetch.rs` | — | the lines a moving step touches, asked for one axis ahead |
 //!
 //! Type dependencies point one way: `coupling.rs` names the cam and multi-master laws,
 //! `camming.rs` and `multimaster.rs` reach the coupling only through the axis's methods
@@ -70,6 +71,7 @@ mod motion;
 mod multimaster;
 mod phasing;
 mod planning;
+mod prefetch;
 mod probe;
 mod rest;
 mod status;
@@ -114,6 +116,9 @@ static NEXT_AXIS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::n
 
 /// One axis. Built off the cycle thread with [`Axis::new`]; stepped by the kernel.
 #[derive(Debug)]
+// On cache lines of its own, so that the lines a step touches are the same in every axis
+// (`prefetch.rs`).
+#[repr(align(64))]
 pub struct Axis {
     config: AxisConfig,
     /// Set by `Kernel::insert_axis`; the `axis` of every event this axis reports.

@@ -1,0 +1,181 @@
+//! The lines of an axis that its next step will touch, asked for while the axis before it
+//! steps (issue 27). An axis is ≈ 6 KB (95 cache lines) and a moving step touches ≈ 31–33 of
+//! them, spread over it; with 256 axes they live in L2 instead of L1, and the step waited for
+//! them (a positioning axis 1.6 × as long per axis at 256 axes as at 16). A prefetch is only a
+//! hint: a span that no longer holds what a step touches costs a little time, never a result.
+
+use super::*;
+use core::mem::{offset_of, size_of};
+
+/// A part of an axis: its offset and length in bytes.
+type Span = (usize, usize);
+
+/// `len` bytes from `at` into the field at `offset` of size `size`; `at` < 0 counts from
+/// the field's end.
+const fn span(offset: usize, size: usize, at: isize, len: usize) -> Span {
+    let start = if at < 0 {
+        offset + size - (-at) as usize
+    } else {
+        offset + at as usize
+    };
+    (start, len)
+}
+
+macro_rules! part {
+    ($field:ident) => {
+        span(
+            offset_of!(Axis, $field),
+            size_of_field!($field),
+            0,
+            size_of_field!($field),
+        )
+    };
+    ($field:ident, $at:expr, $len:expr) => {
+        span(offset_of!(Axis, $field), size_of_field!($field), $at, $len)
+    };
+}
+
+/// The size of a field of `Axis` (without a value to take it from).
+macro_rules! size_of_field {
+    ($field:ident) => {{
+        const fn size<T>(_: fn(&Axis) -> &T) -> usize {
+            size_of::<T>()
+        }
+        size(|a: &Axis| &a.$field)
+    }};
+}
+
+/// The parts a moving step reads or writes — a velocity or positioning job with nothing
+/// coupled and no other block in use — as a trace of the step's memory accesses found them
+/// (valgrind's lackey over 16 moving axes, docs/benchmarks.md "Kernel cycle"); named by field
+/// and measured from a field's start or end, so that they follow the layout when fields are
+/// added. The step's scalar fields (set and actual values, flags, the idle marks) lie together
+/// at the end of the struct, whatever their order.
+const MOVING: [Span; 19] = [
+    // The plan being sampled: its trajectory's head and the sampling state at its end.
+    part!(planner, 48, 80),
+    part!(planner, -72, 72),
+    part!(ext),
+    part!(job),
+    part!(next, 0, 8),
+    // The parameters a step reads (windows, limits, following error) and the config's flags.
+    part!(config, 144, 48),
+    part!(config, 280, 8),
+    part!(config, -72, 72),
+    // The status: its numbers at the head, its flags at the end.
+    part!(status, 0, 264),
+    part!(status, -72, 72),
+    part!(coupling, -16, 16),
+    part!(drive, 40, 8),
+    part!(superposition, -8, 8),
+    part!(corrections, 0, 40),
+    part!(power),
+    part!(stop),
+    part!(torque, 0, 32),
+    part!(rest, -8, 8),
+    (SCALARS, size_of::<Axis>() - SCALARS),
+];
+
+/// Where the step's scalar fields begin (the lowest of their offsets).
+const SCALARS: usize = {
+    let offsets = [
+        offset_of!(Axis, cycle_time),
+        offset_of!(Axis, power_override),
+        offset_of!(Axis, set),
+        offset_of!(Axis, act_pos),
+        offset_of!(Axis, enc_k),
+        offset_of!(Axis, cycle),
+        offset_of!(Axis, error),
+        offset_of!(Axis, idle),
+        offset_of!(Axis, mode),
+        offset_of!(Axis, resting),
+    ];
+    let mut low = usize::MAX;
+    let mut i = 0;
+    while i < offsets.len() {
+        if offsets[i] < low {
+            low = offsets[i];
+        }
+        i += 1;
+    }
+    low
+};
+
+/// The cache lines of `spans` (64 bytes, from the start of an axis: `Axis` is aligned to
+/// them), as a bit set.
+const fn lines(spans: &[Span]) -> u128 {
+    let mut set = 0u128;
+    let mut i = 0;
+    while i < spans.len() {
+        let (start, len) = spans[i];
+        let mut line = start / 64;
+        while line <= (start + len - 1) / 64 {
+            set |= 1 << line;
+            line += 1;
+        }
+        i += 1;
+    }
+    set
+}
+
+const MOVING_LINES: u128 = lines(&MOVING);
+const COUNT: usize = MOVING_LINES.count_ones() as usize;
+
+/// The lines' offsets in bytes, lowest first.
+const OFFSETS: [usize; COUNT] = {
+    let mut out = [0; COUNT];
+    let mut set = MOVING_LINES;
+    let mut i = 0;
+    while set != 0 {
+        out[i] = set.trailing_zeros() as usize * 64;
+        set &= set - 1;
+        i += 1;
+    }
+    out
+};
+
+// The set holds every line of an axis.
+const _: () = assert!(size_of::<Axis>() <= 128 * 64);
+const _: () = assert!(core::mem::align_of::<Axis>() == 64);
+
+impl Axis {
+    /// Asks the core to bring the lines this axis's next step touches into its L1 cache.
+    /// Called by the kernel one axis ahead, so that the lines arrive while the axis before
+    /// steps. An axis at rest reads a few lines of its own; those it would touch anyway.
+    #[inline]
+    pub fn prefetch_step(&self) {
+        if self.resting {
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        {
+            let base = (self as *const Axis).cast::<i8>();
+            for offset in OFFSETS {
+                // SAFETY: a prefetch reads nothing and cannot fault; the address lies inside
+                // this axis.
+                unsafe {
+                    core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(
+                        base.wrapping_add(offset),
+                    )
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every span lies inside the axis, and the set is the few lines a step touches, not the
+    /// whole axis (the trace found 31–33 of its 95).
+    #[test]
+    fn the_prefetched_lines_are_inside_the_axis_and_few() {
+        for (start, len) in MOVING {
+            assert!(len > 0 && start + len <= size_of::<Axis>(), "{start}+{len}");
+        }
+        let all = size_of::<Axis>().div_ceil(64);
+        assert!(COUNT >= 25 && COUNT <= all / 2, "{COUNT} of {all} lines");
+        assert!(OFFSETS.windows(2).all(|w| w[0] < w[1]));
+    }
+}
