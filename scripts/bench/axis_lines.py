@@ -2,7 +2,7 @@
 """Which parts of an axis a moving step touches (issue 27; the spans of
 backend/motion/src/axis/prefetch.rs): runs the `axis_lines` example under valgrind's lackey
 and maps every data access of ten steps of AXES moving axes to offsets in `Axis`. Prints the
-touched byte ranges (merged when less than 16 bytes apart) and the cache lines per axis step.
+touched byte ranges (merged when at most 16 bytes apart) and the cache lines per axis step.
 
     cargo build --release -p motion --example axis_lines
     python3 scripts/bench/axis_lines.py [AXES] [velocity|positioning]
@@ -46,6 +46,8 @@ with tempfile.TemporaryDirectory() as tmp:
                     touched.add((addr - base) // 8 * 8)
                     lines.add(addr // 64)
                     break
+if not bases or marks == 0:
+    sys.exit("axis_lines.py: the example printed no axes or its marker was never read")
 spans = []
 for off in sorted(touched):
     if spans and off - spans[-1][1] <= 16:

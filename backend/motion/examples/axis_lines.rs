@@ -33,7 +33,9 @@ fn main() {
     let mut submit = |k: &mut Kernel, axis: u16, kind: CommandKind, events: &mut Vec<_>| {
         id += 1;
         let target = Target::Axis(axis);
-        k.submit(Command { id, target, kind }, events);
+        let verdict = k.submit(Command { id, target, kind }, events);
+        // A refused command would leave the axis standing: the trace would be of the wrong step.
+        assert!(matches!(verdict, Verdict::Accepted), "{verdict:?}");
     };
     let step = |k: &mut Kernel,
                 fb: &mut [DriveFeedback],

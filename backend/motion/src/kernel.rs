@@ -516,6 +516,12 @@ impl Kernel {
         for g in self.groups.iter_mut().flatten() {
             g.step(&mut self.axes, cycle, events);
         }
+        // The first axis's lines; each axis then asks for the next one's (`prefetch.rs`).
+        if let Some(first) = self.order.slots[..self.order.len].first() {
+            if let Some(first) = self.axes[*first as usize].as_deref() {
+                first.prefetch_step();
+            }
+        }
         // A slot beyond the feedback given reads as a drive that is not ready.
         let no_feedback = DriveFeedback::default();
         // … and a setpoint beyond those given goes nowhere (a step writes all of it).

@@ -4,6 +4,9 @@
 //! them (a positioning axis 1.6 × as long per axis at 256 axes as at 16). A prefetch is only a
 //! hint: a span that no longer holds what a step touches costs a little time, never a result.
 
+// Elsewhere than on x86-64 the prefetch is a no-op and the lines are not used.
+#![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+
 use super::*;
 use core::mem::{offset_of, size_of};
 
@@ -11,14 +14,16 @@ use core::mem::{offset_of, size_of};
 type Span = (usize, usize);
 
 /// `len` bytes from `at` into the field at `offset` of size `size`; `at` < 0 counts from
-/// the field's end.
+/// the field's end. A span that leaves its field stops the build.
 const fn span(offset: usize, size: usize, at: isize, len: usize) -> Span {
-    let start = if at < 0 {
-        offset + size - (-at) as usize
+    let from = if at < 0 {
+        assert!(at.unsigned_abs() <= size, "a span starts before its field");
+        size - at.unsigned_abs()
     } else {
-        offset + at as usize
+        at as usize
     };
-    (start, len)
+    assert!(len > 0 && from + len <= size, "a span leaves its field");
+    (offset + from, len)
 }
 
 macro_rules! part {
@@ -47,10 +52,12 @@ macro_rules! size_of_field {
 
 /// The parts a moving step reads or writes — a velocity or positioning job with nothing
 /// coupled and no other block in use — as a trace of the step's memory accesses found them
-/// (valgrind's lackey over 16 moving axes, docs/benchmarks.md "Kernel cycle"); named by field
-/// and measured from a field's start or end, so that they follow the layout when fields are
-/// added. The step's scalar fields (set and actual values, flags, the idle marks) lie together
-/// at the end of the struct, whatever their order.
+/// (valgrind's lackey over 16 moving axes, `scripts/bench/axis_lines.py`); named by field and
+/// measured from a field's start or end, so that they follow each field's place in `Axis`
+/// when fields are added (the offsets inside a field follow that type's own layout: the trace
+/// is what tells them). The step's scalar fields (set and actual values, flags, the idle
+/// marks) lie together at the end of the struct in rustc's present layout, which puts the
+/// small fields last; the test bounds the set should that change.
 const MOVING: [Span; 19] = [
     // The plan being sampled: its trajectory's head and the sampling state at its end.
     part!(planner, 48, 80),
@@ -108,6 +115,10 @@ const fn lines(spans: &[Span]) -> u128 {
     let mut i = 0;
     while i < spans.len() {
         let (start, len) = spans[i];
+        assert!(
+            len > 0 && start + len <= size_of::<Axis>(),
+            "a span leaves the axis"
+        );
         let mut line = start / 64;
         while line <= (start + len - 1) / 64 {
             set |= 1 << line;
@@ -143,7 +154,7 @@ impl Axis {
     /// Called by the kernel one axis ahead, so that the lines arrive while the axis before
     /// steps. An axis at rest reads a few lines of its own; those it would touch anyway.
     #[inline]
-    pub fn prefetch_step(&self) {
+    pub(crate) fn prefetch_step(&self) {
         if self.resting {
             return;
         }
@@ -151,8 +162,9 @@ impl Axis {
         {
             let base = (self as *const Axis).cast::<i8>();
             for offset in OFFSETS {
-                // SAFETY: a prefetch reads nothing and cannot fault; the address lies inside
-                // this axis.
+                // SAFETY: SSE, which `_mm_prefetch` needs, is part of every x86-64 CPU; the
+                // address is made with `wrapping_add` and a prefetch never faults (it reads
+                // nothing into the program).
                 unsafe {
                     core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(
                         base.wrapping_add(offset),
@@ -167,8 +179,9 @@ impl Axis {
 mod tests {
     use super::*;
 
-    /// Every span lies inside the axis, and the set is the few lines a step touches, not the
-    /// whole axis (the trace found 31–33 of its 95).
+    /// Every span lies inside the axis (also checked while the constants are evaluated), and
+    /// the set is the few lines a step touches, not the whole axis (the trace found 31–33 of
+    /// its 95).
     #[test]
     fn the_prefetched_lines_are_inside_the_axis_and_few() {
         for (start, len) in MOVING {
