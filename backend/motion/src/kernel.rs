@@ -498,6 +498,16 @@ impl Kernel {
         target < n && reached[target / 64] & (1 << (target % 64)) != 0
     }
 
+    /// Asks for the lines of the `k`th axis in the step order (none beyond the order's end
+    /// or for an empty slot).
+    fn prefetch_step(&self, k: usize) {
+        if let Some(&slot) = self.order.slots[..self.order.len].get(k) {
+            if let Some(axis) = self.axes[slot as usize].as_deref() {
+                axis.prefetch_step();
+            }
+        }
+    }
+
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
     /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
     /// a drive that is not ready / left untouched).
@@ -517,11 +527,7 @@ impl Kernel {
             g.step(&mut self.axes, cycle, events);
         }
         // The first axis's lines; each axis then asks for the next one's (`prefetch.rs`).
-        if let Some(first) = self.order.slots[..self.order.len].first() {
-            if let Some(first) = self.axes[*first as usize].as_deref() {
-                first.prefetch_step();
-            }
-        }
+        self.prefetch_step(0);
         // A slot beyond the feedback given reads as a drive that is not ready.
         let no_feedback = DriveFeedback::default();
         // … and a setpoint beyond those given goes nowhere (a step writes all of it).
@@ -577,11 +583,7 @@ impl Kernel {
                 }
             };
             // The next axis's lines are on their way while this one steps (`prefetch.rs`).
-            if let Some(next) = self.order.slots[..self.order.len].get(k + 1) {
-                if let Some(next) = self.axes[*next as usize].as_deref() {
-                    next.prefetch_step();
-                }
-            }
+            self.prefetch_step(k + 1);
             let fb = feedback.get(i).unwrap_or(&no_feedback);
             let axis = self.axes[i].as_deref_mut().expect("checked above");
             if let Some(all) = samples {
