@@ -33,6 +33,7 @@
 #     ST_MIN_REQUESTS  fail when fewer requests were made (0: no minimum) [admin and off:
 #                      10000; none: 500]
 #     ST_REPORT_DIR    where the NDJSON event log and the JUnit report go [target/schemathesis]
+#     ST_SETUP_ONLY    1: make the virtualenv, then stop (no server, no run) [0]
 set -euo pipefail
 caller_dir=$(pwd)
 cd "$(dirname "$0")/.."
@@ -72,6 +73,9 @@ fi
 if ! cmp -s tests/schemathesis/requirements.txt "$venv/requirements.installed"; then
     "$venv/bin/pip" install --quiet --disable-pip-version-check -r tests/schemathesis/requirements.txt
     cp tests/schemathesis/requirements.txt "$venv/requirements.installed"
+fi
+if [ "${ST_SETUP_ONLY:-0}" = 1 ]; then
+    exit 0 # the virtualenv only (before runs that share it start at once)
 fi
 
 # --- The server ----------------------------------------------------------------------------

@@ -50,6 +50,16 @@ rm -f "$MOTIOND_SKIPPED_LOG"
 
 cargo test --workspace --all-targets 2>&1
 phase "Rust tests"
+# The binary the browser tests, the generated clients and schemathesis start: the one this
+# build made for the integration tests. A `cargo build -p motiond` after it would build the
+# server again (2 min: without the dev-dependencies the dependencies' features differ).
+target_dir=${CARGO_TARGET_DIR:-target}
+case $target_dir in /*) ;; *) target_dir=$root/$target_dir ;; esac
+export MOTIOND_BIN=$target_dir/debug/motiond
+if [ ! -x "$MOTIOND_BIN" ]; then
+    say "the test build left no motiond binary at $MOTIOND_BIN"
+    exit 1
+fi
 
 # Who may depend on whom (docs/ARCHITECTURE.md): no import cycle, no upward import.
 python3 scripts/check-layers.py
@@ -75,15 +85,14 @@ fi
 command -v chromium >/dev/null 2>&1 || apt_install chromium
 (cd frontend && npm ci --no-audit --no-fund && npm run check:api && npm run build && NO_COLOR=1 npm test)
 phase "UI build and Vitest"
-# The browser tests start target/debug/motiond (the workspace target/, whatever the caller's CARGO_TARGET_DIR).
-env -u CARGO_TARGET_DIR cargo build -p motiond 2>&1
-(cd tests/e2e && npm ci --no-audit --no-fund && env -u CARGO_TARGET_DIR npm test)
+# The browser tests start $MOTIOND_BIN.
+(cd tests/e2e && npm ci --no-audit --no-fund && npm test)
 phase "Chromium e2e"
 
 # --- Client generation (tests/client/) -----------------------------------------------------
 # openapi-python-client and openapi-typescript (pinned) generate clients from
 # openapi/openapi.json: no warning, no operation missing. Then an MES script drives the real
-# motiond (target/debug/motiond, built above) through the generated Python client.
+# motiond ($MOTIOND_BIN) through the generated Python client.
 if ! command -v python3 >/dev/null 2>&1; then
     apt_install python3 python3-venv
 fi
@@ -91,14 +100,26 @@ fi
 phase "generated clients"
 
 # --- Schemathesis (scripts/schemathesis.sh, tests/schemathesis/) ---------------------------
-# The real binary (target/debug/motiond, built above) against its own OpenAPI document, every
+# The real binary ($MOTIOND_BIN) against its own OpenAPI document, every
 # check, a fixed number of test cases per operation and phase, fixed seed: with an admin token
 # (≥ 10 000 requests), and without credentials while authentication is on (every operation but
 # login, logout and the session query must be 401; a handful of variants each).
+# Both runs at once, each with its own motiond and reports (one Python process each: the two
+# cores are used without schemathesis's workers); the virtualenv first, which they share.
+ST_SETUP_ONLY=1 ./scripts/schemathesis.sh
+none_log=$target_dir/schemathesis-none.log
+ST_AUTH=none ST_REPORT_DIR=$target_dir/schemathesis-none ./scripts/schemathesis.sh >"$none_log" 2>&1 &
+none_pid=$!
 ST_AUTH=admin ./scripts/schemathesis.sh
-phase "schemathesis (admin)"
-ST_AUTH=none ./scripts/schemathesis.sh
-phase "schemathesis (no credentials)"
+phase "schemathesis (admin; no credentials beside it)"
+none_rc=0
+wait "$none_pid" || none_rc=$?
+cat "$none_log"
+if [ "$none_rc" != 0 ]; then
+    say "schemathesis without credentials failed (exit $none_rc)"
+    exit "$none_rc"
+fi
+phase "schemathesis (no credentials, after admin)"
 
 echo
 echo "test-all: summary ($(( $(date +%s) - started )) s in all)"
