@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Which parts of an axis a moving step touches (issue 27; the spans of
+"""Which parts of an axis a step touches (issue 27; the spans of
 backend/motion/src/axis/prefetch.rs): runs the `axis_lines` example under valgrind's lackey
-and maps every data access of ten steps of AXES moving axes to offsets in `Axis`. Prints the
+and maps every data access of ten steps of AXES axes to offsets in `Axis`. Prints the
 touched byte ranges (merged when at most 16 bytes apart) and the cache lines per axis step.
 
     cargo build --release -p motion --example axis_lines
-    python3 scripts/bench/axis_lines.py [AXES] [velocity|positioning]
+    python3 scripts/bench/axis_lines.py [AXES] [velocity|positioning|standing]
 """
 import os
 import subprocess

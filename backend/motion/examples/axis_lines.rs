@@ -1,10 +1,11 @@
-//! Which parts of an axis a moving step touches: steps N axes (velocity or positioning
-//! jobs, ideal drives) into their constant phase, prints where each axis lies, then steps ten
+//! Which parts of an axis a step touches: steps N axes (velocity or positioning jobs, ideal
+//! drives) into their constant phase, or lets them stand (at rest), prints where each axis
+//! lies, then steps ten
 //! cycles between two reads of a marker. `scripts/bench/axis_lines.py` runs it under
 //! valgrind's lackey and maps the accesses between the markers to offsets in `Axis`
 //! (the spans of `backend/motion/src/axis/prefetch.rs` come from it).
 //!
-//!     axis_lines [AXES] [velocity|positioning]
+//!     axis_lines [AXES] [velocity|positioning|standing]
 
 use motion::*;
 
@@ -13,7 +14,7 @@ static MARKER: [u64; 8] = [0; 8];
 fn main() {
     let mut args = std::env::args().skip(1);
     let n: usize = args.next().map_or(16, |a| a.parse().expect("AXES"));
-    let positioning = args.next().as_deref() == Some("positioning");
+    let load = args.next().unwrap_or_else(|| "velocity".into());
     let mut k = Kernel::new(0.001, n);
     for i in 0..n {
         let parameters = AxisParameters {
@@ -63,8 +64,8 @@ fn main() {
     for _ in 0..10 {
         step(&mut k, &mut fb, &mut sp, &mut events);
     }
-    for a in 0..n as u16 {
-        let kind = if positioning {
+    for a in (0..n as u16).filter(|_| load != "standing") {
+        let kind = if load == "positioning" {
             CommandKind::MoveAbsolute(Positioning {
                 position: 1e7,
                 velocity: 100.0,
@@ -83,7 +84,7 @@ fn main() {
         };
         submit(&mut k, a, kind, &mut events);
     }
-    // Past the acceleration phase.
+    // Past the acceleration phase (or at rest).
     for _ in 0..2000 {
         step(&mut k, &mut fb, &mut sp, &mut events);
     }

@@ -105,6 +105,8 @@ impl Kernel {
     /// `cycle_time` in seconds; `max_axes` slots.
     pub fn new(cycle_time: f64, max_axes: usize) -> Self {
         assert!(cycle_time > 0.0 && cycle_time.is_finite());
+        // The kernel is made on the thread that steps it: its plans then allocate nothing.
+        crate::planner::prepare_solver();
         Kernel {
             cycle_time,
             cycle: 0,

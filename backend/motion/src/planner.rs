@@ -5,6 +5,8 @@
 //! trajectory cycle by cycle. When Ruckig cannot solve a problem (it never should for valid
 //! limits) the caller falls back to [`StopRamp`], a closed-form jerk-limited stop.
 
+use std::cell::RefCell;
+
 use rsruckig::prelude::*;
 
 /// A kinematic state of the setpoint.
@@ -79,14 +81,54 @@ enum Plan {
     Fallback,
 }
 
-/// One axis's setpoint generator. Allocation-free after construction.
+/// Ruckig's working memory and its input: 13.5 KB, used only while a plan is solved.
+struct Solver {
+    otg: Ruckig<1, RejectErrors>,
+    input: InputParameter<1>,
+}
+
+thread_local! {
+    /// One solver per thread, shared by every planner on it: planning runs one problem at a
+    /// time, and nothing of a solve is kept in the solver (the plan is the planner's
+    /// trajectory; Ruckig's calculator only holds scratch). Three solvers per axis (its job's
+    /// planner and phasing's two) put each axis's few hundred hot bytes 51.5 KB apart, on
+    /// pages of their own (issue 27, decision 182).
+    static SOLVER: RefCell<Option<Box<Solver>>> = const { RefCell::new(None) };
+}
+
+/// Makes this thread's solver, so that no plan on it allocates (the cycle thread's
+/// `Kernel::new` calls it). A thread that plans without it makes its solver at the first plan.
+pub fn prepare_solver() {
+    SOLVER.with(|s| {
+        s.borrow_mut().get_or_insert_with(Solver::new);
+    });
+}
+
+impl Solver {
+    fn new() -> Box<Solver> {
+        Box::new(Solver {
+            // The cycle time is set by each solve (it counts only for discrete durations,
+            // which no plan asks for).
+            otg: Ruckig::new(None, 0.001),
+            input: InputParameter::new(None),
+        })
+    }
+}
+
+/// What a plan aims at: Ruckig's control interface and target (the rest of its input is the
+/// start state and the limits, given to each solve).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Goal {
+    interface: ControlInterface,
+    position: f64,
+    velocity: f64,
+}
+
+/// One axis's setpoint generator. Allocation-free after construction (with the thread's
+/// solver prepared, [`prepare_solver`]).
 pub struct Planner {
-    /// The solver and its input (13.5 KB, touched only when planning) live outside: inline
-    /// they made an axis 19 KB, and sampling a plan every cycle then walked a machine's
-    /// axes through far more cache than the few hundred bytes it reads (issue 27: the
-    /// per-axis step cost grew by half from 64 to 256 axes).
-    otg: Box<Ruckig<1, RejectErrors>>,
-    input: Box<InputParameter<1>>,
+    cycle_time: f64,
+    goal: Goal,
     traj: Trajectory<1>,
     /// A braking segment sampled before `traj` for `split` seconds (0 = none): a position
     /// plan that starts above its velocity limit first brakes to it on the velocity
@@ -115,8 +157,12 @@ impl core::fmt::Debug for Planner {
 impl Planner {
     pub fn new(cycle_time: f64) -> Self {
         Planner {
-            otg: Box::new(Ruckig::new(None, cycle_time)),
-            input: Box::new(InputParameter::new(None)),
+            cycle_time,
+            goal: Goal {
+                interface: ControlInterface::Position,
+                position: 0.0,
+                velocity: 0.0,
+            },
             traj: Trajectory::new(None),
             brake: Trajectory::new(None),
             split: 0.0,
@@ -279,9 +325,11 @@ impl Planner {
         } else {
             direction_limits(dir, limits)
         };
-        self.input.control_interface = ControlInterface::Position;
-        self.input.target_position[0] = target;
-        self.input.target_velocity[0] = target_velocity;
+        self.goal = Goal {
+            interface: ControlInterface::Position,
+            position: target,
+            velocity: target_velocity,
+        };
         if overshoot && !away {
             // The closed-form braking distance is a hair above the distance left when the
             // axis is braking exactly for the target (a re-plan on the way): braking with the
@@ -431,9 +479,11 @@ impl Planner {
             };
             direction_limits(dir, limits)
         };
-        self.input.control_interface = ControlInterface::Velocity;
-        self.input.target_position[0] = from.position;
-        self.input.target_velocity[0] = target_velocity;
+        self.goal = Goal {
+            interface: ControlInterface::Velocity,
+            position: from.position,
+            velocity: target_velocity,
+        };
         // The velocity interface ignores the velocity limit, but Ruckig validates it.
         let limits = Limits {
             velocity: limits
@@ -469,13 +519,15 @@ impl Planner {
             jerk,
         };
         check(from, &limits)?;
-        self.input.control_interface = if velocity_interface {
-            ControlInterface::Velocity
-        } else {
-            ControlInterface::Position
+        self.goal = Goal {
+            interface: if velocity_interface {
+                ControlInterface::Velocity
+            } else {
+                ControlInterface::Position
+            },
+            position: target_position,
+            velocity: target_velocity,
         };
-        self.input.target_position[0] = target_position;
-        self.input.target_velocity[0] = target_velocity;
         self.solve_signed(from, &limits, max_acc, min_acc)
     }
 
@@ -617,38 +669,45 @@ impl Planner {
         max_acc: f64,
         min_acc: f64,
     ) -> Result<f64, PlanError> {
-        let inp = &mut self.input;
-        inp.current_position[0] = from.position;
-        inp.current_velocity[0] = from.velocity;
-        inp.current_acceleration[0] = from.acceleration;
-        inp.target_acceleration[0] = 0.0;
-        inp.max_velocity[0] = limits.velocity;
-        inp.max_acceleration[0] = max_acc;
-        inp.min_acceleration = Some(rsruckig::daov_stack![min_acc]);
-        inp.max_jerk[0] = limits.jerk;
-        let mut solved = matches!(
-            self.otg.calculate(inp, &mut self.traj),
-            Ok(RuckigResult::Working | RuckigResult::Finished)
-        );
-        // rsruckig 3.0.1 fails on about 0.2 % of valid position problems in narrow
-        // numerical bands that upstream Ruckig solves (backend/motion/tests/ruckig_golden.rs):
-        // the same problem with limits a hair tighter lies outside the band. Tighter limits
-        // never violate the commanded ones; the duration grows by about the same fraction.
-        for shrink in [1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6] {
-            if solved {
-                break;
-            }
-            let k = 1.0 - shrink;
-            let inp = &mut self.input;
-            inp.max_velocity[0] = limits.velocity * k;
-            inp.max_acceleration[0] = max_acc * k;
-            inp.min_acceleration = Some(rsruckig::daov_stack![min_acc * k]);
-            inp.max_jerk[0] = limits.jerk * k;
-            solved = matches!(
-                self.otg.calculate(inp, &mut self.traj),
+        let solved = SOLVER.with(|solver| {
+            let mut solver = solver.borrow_mut();
+            let Solver { otg, input: inp } = &mut **solver.get_or_insert_with(Solver::new);
+            otg.delta_time = self.cycle_time;
+            inp.control_interface = self.goal.interface;
+            inp.target_position[0] = self.goal.position;
+            inp.target_velocity[0] = self.goal.velocity;
+            inp.current_position[0] = from.position;
+            inp.current_velocity[0] = from.velocity;
+            inp.current_acceleration[0] = from.acceleration;
+            inp.target_acceleration[0] = 0.0;
+            inp.max_velocity[0] = limits.velocity;
+            inp.max_acceleration[0] = max_acc;
+            inp.min_acceleration = Some(rsruckig::daov_stack![min_acc]);
+            inp.max_jerk[0] = limits.jerk;
+            let mut solved = matches!(
+                otg.calculate(inp, &mut self.traj),
                 Ok(RuckigResult::Working | RuckigResult::Finished)
             );
-        }
+            // rsruckig 3.0.1 fails on about 0.2 % of valid position problems in narrow
+            // numerical bands that upstream Ruckig solves (backend/motion/tests/ruckig_golden.rs):
+            // the same problem with limits a hair tighter lies outside the band. Tighter limits
+            // never violate the commanded ones; the duration grows by about the same fraction.
+            for shrink in [1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6] {
+                if solved {
+                    break;
+                }
+                let k = 1.0 - shrink;
+                inp.max_velocity[0] = limits.velocity * k;
+                inp.max_acceleration[0] = max_acc * k;
+                inp.min_acceleration = Some(rsruckig::daov_stack![min_acc * k]);
+                inp.max_jerk[0] = limits.jerk * k;
+                solved = matches!(
+                    otg.calculate(inp, &mut self.traj),
+                    Ok(RuckigResult::Working | RuckigResult::Finished)
+                );
+            }
+            solved
+        });
         match solved {
             true => {
                 self.plan = Plan::Ruckig;
@@ -658,11 +717,11 @@ impl Planner {
                 self.duration = self.traj.get_duration();
                 // The end state is the target itself, not a float-noisy sample of it.
                 let mut end = self.sample_raw(self.duration);
-                end.velocity = self.input.target_velocity[0];
+                end.velocity = self.goal.velocity;
                 end.acceleration = 0.0;
                 end.jerk = 0.0;
-                if self.input.control_interface == ControlInterface::Position {
-                    end.position = self.input.target_position[0];
+                if self.goal.interface == ControlInterface::Position {
+                    end.position = self.goal.position;
                 }
                 self.end = end;
                 Ok(self.duration)
@@ -1012,6 +1071,84 @@ mod tests {
             assert!(out.len() < 1_000_000);
         }
         out
+    }
+
+    /// Decision 182: every planner on a thread solves with the thread's one solver. A plan
+    /// must not depend on what the solver solved before: planner `a`'s plans, made between
+    /// another planner's, equal bit for bit those of a planner alone on a fresh thread.
+    #[test]
+    fn a_plan_does_not_depend_on_what_the_shared_solver_solved_before() {
+        // (start, target, target velocity, limits): position and velocity plans, some that
+        // turn round, one started above its velocity limit.
+        let problems: Vec<(Kinematics, f64, f64, Limits)> = (0..40)
+            .map(|i| {
+                let f = i as f64;
+                let from = Kinematics {
+                    position: (f * 7.3) % 50.0 - 25.0,
+                    velocity: (f * 13.7) % 160.0 - 80.0,
+                    acceleration: (f * 31.1) % 400.0 - 200.0,
+                    jerk: 0.0,
+                };
+                let lim = Limits {
+                    velocity: 40.0 + (f * 3.1) % 60.0,
+                    acceleration: 300.0 + (f * 17.0) % 900.0,
+                    deceleration: 200.0 + (f * 23.0) % 900.0,
+                    jerk: 5000.0 + (f * 997.0) % 20000.0,
+                };
+                let target = if i % 3 == 0 {
+                    f64::NAN
+                } else {
+                    (f * 11.9) % 80.0 - 40.0
+                };
+                let v = if i % 4 == 1 {
+                    (f * 5.5) % 30.0 - 15.0
+                } else {
+                    0.0
+                };
+                (from, target, v, lim)
+            })
+            .collect();
+        // A plan's duration and its setpoints, bit for bit.
+        fn plan(
+            p: &mut Planner,
+            (from, target, v, lim): &(Kinematics, f64, f64, Limits),
+        ) -> Vec<u64> {
+            let d = if target.is_nan() {
+                p.plan_velocity(*from, *v + 20.0, lim)
+            } else {
+                p.plan_position(*from, *target, *v, lim)
+            };
+            let mut bits = vec![d.map_or(u64::MAX, f64::to_bits)];
+            if d.is_ok() {
+                for _ in 0..2000 {
+                    let k = p.step(0.001).unwrap();
+                    bits.extend([k.position, k.velocity, k.acceleration].map(f64::to_bits));
+                    if p.finished() {
+                        break;
+                    }
+                }
+            }
+            bits
+        }
+        let alone: Vec<Vec<u64>> = std::thread::spawn({
+            let problems = problems.clone();
+            move || {
+                let mut a = Planner::new(0.001);
+                problems.iter().map(|x| plan(&mut a, x)).collect()
+            }
+        })
+        .join()
+        .unwrap();
+        let (mut a, mut b) = (Planner::new(0.001), Planner::new(0.002));
+        let mut solved = 0;
+        for (i, x) in problems.iter().enumerate() {
+            // Another planner's problem (the one after) in between.
+            plan(&mut b, &problems[(i + 1) % problems.len()]);
+            let bits = plan(&mut a, x);
+            solved += usize::from(bits[0] != u64::MAX);
+            assert_eq!(bits, alone[i], "problem {i}");
+        }
+        assert!(solved >= 30, "only {solved} of the problems were solved");
     }
 
     #[test]

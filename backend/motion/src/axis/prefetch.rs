@@ -179,14 +179,11 @@ impl Axis {
 mod tests {
     use super::*;
 
-    /// Every span lies inside the axis (also checked while the constants are evaluated), and
-    /// the set is the few lines a step touches, not the whole axis (the trace found 31–33 of
-    /// its 95).
+    /// Every span lies inside the axis (checked while the constants are evaluated), and the
+    /// set is the few lines a step touches, not the whole axis (the trace found 31–33 of its
+    /// 95).
     #[test]
     fn the_prefetched_lines_are_inside_the_axis_and_few() {
-        for (start, len) in MOVING {
-            assert!(len > 0 && start + len <= size_of::<Axis>(), "{start}+{len}");
-        }
         let all = size_of::<Axis>().div_ceil(64);
         assert!(COUNT >= 25 && COUNT <= all / 2, "{COUNT} of {all} lines");
         assert!(OFFSETS.windows(2).all(|w| w[0] < w[1]));
