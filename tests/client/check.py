@@ -89,7 +89,7 @@ def typescript(ids: set[str]) -> int:
 def mes_example() -> None:
     motiond = Path(os.environ.get("MOTIOND_BIN", ROOT / "target" / "debug" / "motiond"))
     if not motiond.exists():
-        fail(f"{motiond} missing: run `cargo build -p motiond` first")
+        fail(f"{motiond} missing: run `cargo build -p motiond` first, or set MOTIOND_BIN")
     with tempfile.TemporaryDirectory(prefix="motiond-mes-") as tmp:
         p = subprocess.Popen(
             [str(motiond), "serve", "--listen", "127.0.0.1:0", "--db", str(Path(tmp) / "mes.db")],

@@ -2,8 +2,9 @@
 # Generates clients from openapi/openapi.json with pinned generators and fails on any warning or
 # dropped operation, then runs the MES script (mes_example.py) through the generated Python
 # client against the real motiond. Needs python3 (≥ 3.10, with venv), frontend/node_modules
-# (npm ci) and target/debug/motiond (cargo build -p motiond). Installs the Python side into
-# target/client-venv (from tests/client/requirements.txt, again when that file changes).
+# (npm ci) and motiond ($MOTIOND_BIN, else target/debug/motiond: cargo build -p motiond).
+# Installs the Python side into target/client-venv (from tests/client/requirements.txt, again
+# when that file changes).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 

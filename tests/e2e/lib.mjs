@@ -88,7 +88,7 @@ async function stopProcess(p) {
  * Returns { url (the UI), api (motiond), stop() }.
  */
 export async function startStack({ noDemo = true, env = {}, args: extraArgs = [] } = {}) {
-  if (!existsSync(MOTIOND)) throw new Error(`${MOTIOND} missing: cargo build -p motiond`);
+  if (!existsSync(MOTIOND)) throw new Error(`${MOTIOND} missing: cargo build -p motiond, or set MOTIOND_BIN`);
   if (!existsSync(join(DIST, 'index.html'))) throw new Error(`${DIST} missing: cd frontend && npm run build`);
   const dir = mkdtempSync(join(tmpdir(), 'motiond-e2e-'));
   const port = await freePort();

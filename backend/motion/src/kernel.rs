@@ -519,6 +519,8 @@ impl Kernel {
         setpoints: &mut [DriveSetpoint],
         events: &mut impl EventSink,
     ) {
+        // Stepped on the thread that made the kernel (`Kernel::new`): its plans allocate nothing.
+        debug_assert!(crate::planner::solver_prepared());
         self.cycle += 1;
         let cycle = self.cycle;
         let dt = self.cycle_time;

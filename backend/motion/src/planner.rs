@@ -91,8 +91,8 @@ thread_local! {
     /// One solver per thread, shared by every planner on it: planning runs one problem at a
     /// time, and nothing of a solve is kept in the solver (the plan is the planner's
     /// trajectory; Ruckig's calculator only holds scratch). Three solvers per axis (its job's
-    /// planner and phasing's two) put each axis's few hundred hot bytes 51.5 KB apart, on
-    /// pages of their own (issue 27, decision 182).
+    /// planner and phasing's two), as before, put each axis's few hundred hot bytes 51.5 KB
+    /// apart, on pages of their own (issue 27, decision 182).
     static SOLVER: RefCell<Option<Box<Solver>>> = const { RefCell::new(None) };
 }
 
@@ -102,6 +102,11 @@ pub fn prepare_solver() {
     SOLVER.with(|s| {
         s.borrow_mut().get_or_insert_with(Solver::new);
     });
+}
+
+/// This thread's solver is made: its plans allocate nothing.
+pub fn solver_prepared() -> bool {
+    SOLVER.with(|s| s.borrow().is_some())
 }
 
 impl Solver {
