@@ -1,9 +1,8 @@
 //! Which parts of an axis a step touches: steps N axes (velocity or positioning jobs, ideal
 //! drives) into their constant phase, or lets them stand (at rest), prints where each axis
-//! lies, then steps ten
-//! cycles between two reads of a marker. `scripts/bench/axis_lines.py` runs it under
-//! valgrind's lackey and maps the accesses between the markers to offsets in `Axis`
-//! (the spans of `backend/motion/src/axis/prefetch.rs` come from it).
+//! lies, then steps ten cycles between two reads of a marker. `scripts/bench/axis_lines.py`
+//! runs it under valgrind's lackey and maps the accesses between the markers to offsets in
+//! `Axis` (the spans of `backend/motion/src/axis/prefetch.rs` come from it).
 //!
 //!     axis_lines [AXES] [velocity|positioning|standing]
 

@@ -685,33 +685,24 @@ impl Planner {
             inp.current_velocity[0] = from.velocity;
             inp.current_acceleration[0] = from.acceleration;
             inp.target_acceleration[0] = 0.0;
-            inp.max_velocity[0] = limits.velocity;
-            inp.max_acceleration[0] = max_acc;
-            inp.min_acceleration = Some(rsruckig::daov_stack![min_acc]);
-            inp.max_jerk[0] = limits.jerk;
-            let mut solved = matches!(
-                otg.calculate(inp, &mut self.traj),
-                Ok(RuckigResult::Working | RuckigResult::Finished)
-            );
-            // rsruckig 3.0.1 fails on about 0.2 % of valid position problems in narrow
-            // numerical bands that upstream Ruckig solves (backend/motion/tests/ruckig_golden.rs):
-            // the same problem with limits a hair tighter lies outside the band. Tighter limits
-            // never violate the commanded ones; the duration grows by about the same fraction.
-            for shrink in [1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6] {
-                if solved {
-                    break;
-                }
-                let k = 1.0 - shrink;
-                inp.max_velocity[0] = limits.velocity * k;
-                inp.max_acceleration[0] = max_acc * k;
-                inp.min_acceleration = Some(rsruckig::daov_stack![min_acc * k]);
-                inp.max_jerk[0] = limits.jerk * k;
-                solved = matches!(
-                    otg.calculate(inp, &mut self.traj),
-                    Ok(RuckigResult::Working | RuckigResult::Finished)
-                );
-            }
-            solved
+            // The limits as given first (× 1.0 is exact). rsruckig 3.0.1 fails on about 0.2 %
+            // of valid position problems in narrow numerical bands that upstream Ruckig solves
+            // (backend/motion/tests/ruckig_golden.rs): the same problem with limits a hair
+            // tighter lies outside the band. Tighter limits never violate the commanded ones;
+            // the duration grows by about the same fraction.
+            [0.0, 1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6]
+                .into_iter()
+                .any(|shrink| {
+                    let k = 1.0 - shrink;
+                    inp.max_velocity[0] = limits.velocity * k;
+                    inp.max_acceleration[0] = max_acc * k;
+                    inp.min_acceleration = Some(rsruckig::daov_stack![min_acc * k]);
+                    inp.max_jerk[0] = limits.jerk * k;
+                    matches!(
+                        otg.calculate(inp, &mut self.traj),
+                        Ok(RuckigResult::Working | RuckigResult::Finished)
+                    )
+                })
         });
         match solved {
             true => {
