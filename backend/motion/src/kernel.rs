@@ -2,7 +2,7 @@
 //! It holds what no single axis can see — the slots, the couplings between them and the order
 //! they are stepped in; everything else is the axis's (`axis/`).
 
-use crate::axis::{Axis, Master, MasterSample};
+use crate::axis::{Axis, Master, MasterSample, Rest};
 use std::sync::Arc;
 
 use crate::cam::{Cam, CamStore};
@@ -19,6 +19,9 @@ pub struct Kernel {
     cycle_time: f64,
     cycle: u64,
     axes: Vec<Option<Box<Axis>>>,
+    /// By slot, what an axis at rest repeats (`axis/rest.rs`): side by side, so that the
+    /// standing axes of a large machine cost little more each than those of a small one.
+    rest: Box<[Rest]>,
     order: StepOrder,
     cams: CamStore,
     /// Coordinated-motion groups, stepped before the axes (they give their members' set
@@ -111,6 +114,7 @@ impl Kernel {
             cycle_time,
             cycle: 0,
             axes: (0..max_axes).map(|_| None).collect(),
+            rest: vec![Rest::default(); max_axes].into_boxed_slice(),
             order: StepOrder::new(max_axes),
             cams: CamStore::default(),
             groups: (0..MAX_GROUPS).map(|_| None).collect(),
@@ -264,7 +268,7 @@ impl Kernel {
     }
 
     pub fn status(&self, slot: AxisSlot) -> Option<AxisStatus> {
-        self.axis(slot).map(|a| *a.status())
+        self.axis(slot).map(|a| a.status())
     }
 
     /// No axis in the slot, or one that is disabled with no enable requested.
@@ -509,7 +513,6 @@ impl Kernel {
             }
         }
     }
-
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
     /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
     /// a drive that is not ready / left untouched).
@@ -541,6 +544,23 @@ impl Kernel {
             let Some(axis) = self.axes[i].as_deref() else {
                 continue;
             };
+            // The next axis's lines are on their way while this one steps (`prefetch.rs`).
+            self.prefetch_step(k + 1);
+            let fb = feedback.get(i).unwrap_or(&no_feedback);
+            // An axis at rest follows no master (it would not be at rest): it reads its rest
+            // record and its beat, nothing else (`axis/rest.rs`).
+            if axis.at_rest(fb, &self.rest[i]) {
+                debug_assert!(axis.follows_no_master() && k < self.order.in_loop);
+                let axis = self.axes[i].as_deref_mut().expect("checked above");
+                let out = setpoints.get_mut(i).unwrap_or(&mut spare);
+                let rest = &mut self.rest[i];
+                // Debug builds run the full step beside it and compare the two.
+                #[cfg(debug_assertions)]
+                axis.step_at_rest_checked(dt, fb, &self.cams, cycle, events, rest, out);
+                #[cfg(not(debug_assertions))]
+                axis.step_at_rest(dt, cycle, rest, out);
+                continue;
+            }
             // Most axes follow no master: they skip the masters' bookkeeping (issue 27).
             let free = axis.follows_no_master();
             debug_assert_eq!(free, axis.coupled_masters() == [None; 4]);
@@ -586,15 +606,13 @@ impl Kernel {
                     }
                 }
             };
-            // The next axis's lines are on their way while this one steps (`prefetch.rs`).
-            self.prefetch_step(k + 1);
-            let fb = feedback.get(i).unwrap_or(&no_feedback);
             let axis = self.axes[i].as_deref_mut().expect("checked above");
             if let Some(all) = samples {
                 axis.offer_masters(all);
             }
             let out = setpoints.get_mut(i).unwrap_or(&mut spare);
-            axis.step(dt, fb, master, &self.cams, cycle, events, out);
+            let rest = &mut self.rest[i];
+            axis.step(dt, fb, master, &self.cams, cycle, events, rest, out);
             let masters_changed = if free {
                 debug_assert_eq!(
                     axis.follows_no_master(),
@@ -830,6 +848,31 @@ mod tests {
         k.step(&fb, &mut sp, &mut e);
         assert!(!rests(&k, 0));
         assert_eq!(k.status(0).unwrap().actual_position, 5.001);
+    }
+
+    /// The kernel keeps the rest records by slot (`axis/rest.rs`): an axis put into a slot
+    /// starts with full steps, whatever rested there before and wherever it rested itself.
+    #[test]
+    fn an_axis_put_into_a_slot_does_not_repeat_the_rest_of_the_one_before() {
+        let mut k = kernel(2);
+        let (mut sp, mut e) = (vec![DriveSetpoint::default(); 2], Vec::new());
+        accept(&mut k, 1, 0, power(), &mut e);
+        for _ in 0..100 {
+            step(&mut k, &mut sp, &mut e);
+        }
+        let rests = |k: &Kernel, a| k.axis(a).unwrap().is_at_rest();
+        assert!(rests(&k, 0) && rests(&k, 1) && sp[0].enable && !sp[1].enable);
+        // The powered axis moves into the slot of the disabled one.
+        let moved = k.remove_axis(0).unwrap();
+        let old = k.insert_axis(1, moved).unwrap();
+        assert!(old.is_some_and(|a| a.is_at_rest()));
+        assert!(!rests(&k, 1));
+        // The reading the disabled axis rested on: the powered axis reads it itself, a
+        // drive that is not enabled.
+        step(&mut k, &mut sp, &mut e);
+        assert!(sp[1].enable, "the disabled axis's setpoint was repeated");
+        assert_eq!(k.status(1).unwrap().state, AxisState::ErrorStop);
+        assert!(!rests(&k, 1));
     }
 
     fn velocity(velocity: f64) -> CommandKind {

@@ -1115,10 +1115,10 @@ impl CycleThread {
         for ((i, s), at) in slots.enumerate().zip(snap.copied_at.iter_mut()) {
             match (self.kernel.axis(i as AxisSlot), s.as_mut()) {
                 (Some(a), Some(dst)) if *at == a.status_seq() => {
-                    dst.nc_cycle_counter = a.status().nc_cycle_counter;
+                    dst.nc_cycle_counter = a.nc_cycle_counter();
                 }
                 (Some(a), _) => {
-                    *s = Some(*a.status());
+                    *s = Some(a.status());
                     *at = a.status_seq();
                 }
                 (None, _) => {

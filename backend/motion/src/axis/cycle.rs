@@ -14,9 +14,10 @@ impl Axis {
     /// One cycle, from the drive's feedback to its setpoint. `master`: what the kernel saw of
     /// this axis's master after stepping it in this cycle. The setpoint is written into `out`
     /// in place (a 56-byte setpoint returned through the stack and copied again cost more
-    /// than building it).
+    /// than building it). `rest`: the kernel's rest record for this slot, kept up to date
+    /// here; an axis at rest the kernel steps with [`Axis::step_at_rest`] (`rest.rs`).
     #[allow(clippy::too_many_arguments)]
-    pub fn step(
+    pub(crate) fn step(
         &mut self,
         dt: f64,
         fb: &DriveFeedback,
@@ -24,19 +25,13 @@ impl Axis {
         cams: &crate::cam::CamStore,
         cycle: u64,
         events: &mut impl EventSink,
+        rest: &mut rest::Rest,
         out: &mut DriveSetpoint,
     ) {
-        // An axis at rest repeats its last cycle (`rest.rs`); debug builds check it against
-        // the full step.
-        if self.at_rest(fb, &master) {
-            #[cfg(debug_assertions)]
-            self.step_at_rest_checked(dt, fb, master, cams, cycle, events, out);
-            #[cfg(not(debug_assertions))]
-            self.step_at_rest(dt, cycle, out);
-            return;
-        }
+        // The kernel steps an axis at rest without coming here (`rest.rs`).
+        debug_assert!(!self.at_rest(fb, rest));
         self.step_full(dt, fb, master, cams, cycle, events, out);
-        self.settle_rest(fb, out);
+        self.settle_rest(fb, out, rest);
     }
 
     /// [`Axis::step`] with everything in it.
@@ -70,7 +65,7 @@ impl Axis {
             events,
             cams,
         };
-        self.cycle = cycle;
+        self.beat.cycle = cycle;
         self.io_data_invalid = fb.bus_error;
         self.reported_mode = fb.mode;
         self.actual_torque = fb.actual_torque;
@@ -159,9 +154,9 @@ impl Axis {
         // InTargetPosition's dwell counts cycles (not status updates: submits update too).
         let lag = (self.act_pos - self.set.position).abs();
         if self.set.velocity.abs() <= EPS_V && lag <= self.p().axis_target_position_window {
-            self.in_window_timer += dt;
+            self.beat.in_window_timer += dt;
         } else {
-            self.in_window_timer = 0.0;
+            self.beat.in_window_timer = 0.0;
         }
         let probe_armed = self.step_probe(cx, fb);
         let correction = self.step_corrections();

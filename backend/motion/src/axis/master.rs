@@ -31,7 +31,7 @@ pub enum Master {
 
 impl MasterSample {
     pub fn of(axis: &Axis) -> Self {
-        let s = axis.status();
+        let s = &axis.status;
         MasterSample {
             set: Kinematics {
                 position: s.set_position,

@@ -82,6 +82,7 @@ use coupling::Coupling;
 use homing::HomeSeq;
 use job::{Ctx, DONE, End, Held, Job, JobKind, Phase};
 pub use master::{Master, MasterSample};
+pub(crate) use rest::Rest;
 
 /// Static configuration of an axis (the base configuration the parameters start from).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -125,6 +126,7 @@ pub struct Axis {
     slot: AxisSlot,
     cycle_time: f64,
     mode: Mode,
+    /// Its `nc_cycle_counter` is not kept here (the beat's cycle is; `Axis::status`).
     status: AxisStatus,
     planner: Planner,
     job: Option<Job>,
@@ -192,7 +194,6 @@ pub struct Axis {
     last_dec: f64,
     last_jerk: f64,
     lag_timer: f64,
-    in_window_timer: f64,
     coupling: Option<Coupling>,
     /// MC_MoveSuperImposed (`superposition.rs`).
     superposition: superposition::SuperpositionState,
@@ -202,9 +203,6 @@ pub struct Axis {
     prev_cam: bool,
     /// MC_CamIn/MC_CamScaling/… waiting for their activation, MC_CamInfo kept (`camming.rs`).
     cam: camming::CamState,
-    /// The cycle of the latest step (the status's NcCycleCounter); before the first one, the
-    /// kernel's cycle when the axis was put into its slot.
-    cycle: u64,
     /// The drive's process data were invalid in the latest cycle (bus error).
     io_data_invalid: bool,
     /// The last motion was ended by a stop (HasBeenStopped).
@@ -231,16 +229,11 @@ pub struct Axis {
     offered: [Option<MasterSample>; 4],
     /// What a drive that runs the profile is sent (`drive_profile.rs`).
     drive: drive_profile::DriveProfile,
-    /// At rest: what the next steps repeat (`rest.rs`).
-    rest: Option<rest::Rest>,
-    /// `rest` is confirmed (asked first: this flag shares the line of the other flags).
-    resting: bool,
+    /// The cycle, InTargetPosition's dwell, the status's change count and the rest flags: all
+    /// of itself that a step at rest touches, on one line (`rest.rs`).
+    beat: rest::Beat,
     /// Blocks found idle after a full step, skipped until the axis is woken (`idle.rs`).
     idle: idle::Idle,
-    /// Counts the status's changes (every full step and every accepted submit): a reader
-    /// that copied the status at one count need not copy it again at the same count, except
-    /// its cycle counter.
-    status_seq: u64,
 }
 
 impl Axis {
@@ -308,14 +301,12 @@ impl Axis {
             last_dec,
             last_jerk,
             lag_timer: 0.0,
-            in_window_timer: 0.0,
             coupling: None,
             superposition: superposition::SuperpositionState::default(),
             latch: None,
             probe: None,
             prev_cam: false,
             cam: camming::CamState::default(),
-            cycle: 0,
             io_data_invalid: false,
             has_been_stopped: false,
             new_target: false,
@@ -328,12 +319,16 @@ impl Axis {
             group: group::GroupLink::default(),
             offered: [None; 4],
             drive: drive_profile::DriveProfile::default(),
-            rest: None,
-            resting: false,
             idle: idle::Idle::default(),
-            // Unique between axes, so that a reader never takes one axis's count for
-            // another's in a reused slot (2^40 changes each: 35 years at 1 kHz).
-            status_seq: NEXT_AXIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) << 40,
+            beat: rest::Beat {
+                cycle: 0,
+                in_window_timer: 0.0,
+                // Unique between axes, so that a reader never takes one axis's count for
+                // another's in a reused slot (2^40 changes each: 35 years at 1 kHz).
+                status_seq: NEXT_AXIS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) << 40,
+                kept: false,
+                resting: false,
+            },
         });
         // The status is whole from the start (flags such as NotMoving, OpModes).
         axis.update_status();
@@ -346,16 +341,26 @@ impl Axis {
     pub(crate) fn place(&mut self, slot: AxisSlot, cycle: u64) {
         self.wake();
         self.slot = slot;
-        self.cycle = cycle;
+        self.beat.cycle = cycle;
     }
 
-    pub fn status(&self) -> &AxisStatus {
-        &self.status
+    /// The status (a copy: its `nc_cycle_counter` is the axis's cycle, which a step at rest
+    /// advances without touching the status's lines; `rest.rs`).
+    pub fn status(&self) -> AxisStatus {
+        AxisStatus {
+            nc_cycle_counter: self.beat.cycle,
+            ..self.status
+        }
+    }
+
+    /// The status's `nc_cycle_counter`: the cycle of the axis's latest step.
+    pub fn nc_cycle_counter(&self) -> u64 {
+        self.beat.cycle
     }
 
     /// Changes whenever the status may have changed other than in its `nc_cycle_counter`.
     pub fn status_seq(&self) -> u64 {
-        self.status_seq
+        self.beat.status_seq
     }
 
     pub fn parameters(&self) -> &AxisParameters {

@@ -85,7 +85,7 @@ impl Axis {
     /// Asked in a step and right after the call (between two steps: the quiet time counts
     /// from the latest step's cycle).
     pub(super) fn step_override_filter(&mut self) {
-        if let Some(v) = self.override_filter.step(self.cycle, self.cycle_time) {
+        if let Some(v) = self.override_filter.step(self.beat.cycle, self.cycle_time) {
             self.power_override = v;
         }
     }

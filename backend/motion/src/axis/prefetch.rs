@@ -55,10 +55,11 @@ macro_rules! size_of_field {
 /// (valgrind's lackey over 16 moving axes, `scripts/bench/axis_lines.py`); named by field and
 /// measured from a field's start or end, so that they follow each field's place in `Axis`
 /// when fields are added (the offsets inside a field follow that type's own layout: the trace
-/// is what tells them). The step's scalar fields (set and actual values, flags, the idle
-/// marks) lie together at the end of the struct in rustc's present layout, which puts the
-/// small fields last; the test bounds the set should that change.
-const MOVING: [Span; 19] = [
+/// is what tells them). The step's scalar fields (actual values, flags, the idle marks) lie
+/// together at the end of the struct in rustc's present layout, which puts the small fields
+/// last; the set values (32 bytes, as aligned as the beat's 32) and the beat come earlier and
+/// are named on their own. The test bounds the set should the layout change.
+const MOVING: [Span; 20] = [
     // The plan being sampled: its trajectory's head and the sampling state at its end.
     part!(planner, 48, 80),
     part!(planner, -72, 72),
@@ -79,7 +80,8 @@ const MOVING: [Span; 19] = [
     part!(power),
     part!(stop),
     part!(torque, 0, 32),
-    part!(rest, -8, 8),
+    part!(beat),
+    part!(set),
     (SCALARS, size_of::<Axis>() - SCALARS),
 ];
 
@@ -88,14 +90,11 @@ const SCALARS: usize = {
     let offsets = [
         offset_of!(Axis, cycle_time),
         offset_of!(Axis, power_override),
-        offset_of!(Axis, set),
         offset_of!(Axis, act_pos),
         offset_of!(Axis, enc_k),
-        offset_of!(Axis, cycle),
         offset_of!(Axis, error),
         offset_of!(Axis, idle),
         offset_of!(Axis, mode),
-        offset_of!(Axis, resting),
     ];
     let mut low = usize::MAX;
     let mut i = 0;
@@ -155,7 +154,7 @@ impl Axis {
     /// steps. An axis at rest reads a few lines of its own; those it would touch anyway.
     #[inline]
     pub(crate) fn prefetch_step(&self) {
-        if self.resting {
+        if self.beat.resting {
             return;
         }
         #[cfg(target_arch = "x86_64")]

@@ -8,14 +8,14 @@ impl Axis {
     /// Starts a new following-error peak hold from the present following error.
     pub fn reset_following_error_peak(&mut self) {
         self.wake();
-        self.status_seq = self.status_seq.wrapping_add(1);
+        self.beat.status_seq = self.beat.status_seq.wrapping_add(1);
         let s = &mut self.status;
         s.following_error_min = s.following_error;
         s.following_error_max = s.following_error;
     }
 
     pub(super) fn update_status(&mut self) {
-        self.status_seq = self.status_seq.wrapping_add(1);
+        self.beat.status_seq = self.beat.status_seq.wrapping_add(1);
         let p = &self.config.parameters;
         let state = self.state();
         let s = &mut self.status;
@@ -70,7 +70,7 @@ impl Axis {
         s.decelerating = s.moving && set.acceleration * set.velocity < 0.0;
         s.constant_velocity = s.moving && set.acceleration == 0.0;
         s.in_target_position = !s.moving
-            && self.in_window_timer + 1e-12 >= p.axis_target_position_monitoring_time
+            && self.beat.in_window_timer + 1e-12 >= p.axis_target_position_monitoring_time
             && state != AxisState::Disabled;
         s.in_position_area =
             (self.act_pos - s.target_position).abs() <= p.axis_position_range_window;
@@ -172,7 +172,6 @@ impl Axis {
             self.new_target && self.job.as_ref().is_some_and(|j| j.is_positioning());
         s.ptp_mode = !s.coupled;
         s.io_data_invalid = self.io_data_invalid;
-        s.nc_cycle_counter = self.cycle;
         if let Some((cam, queued, scaling)) = cam {
             s.cam = cam;
             s.cam_table_queued = queued;
