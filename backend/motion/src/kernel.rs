@@ -513,6 +513,7 @@ impl Kernel {
             }
         }
     }
+
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
     /// `feedback` and `setpoints` are indexed by slot (missing entries are treated as
     /// a drive that is not ready / left untouched).

@@ -151,7 +151,7 @@ const _: () = assert!(core::mem::align_of::<Axis>() == 64);
 impl Axis {
     /// Asks the core to bring the lines this axis's next step touches into its L1 cache.
     /// Called by the kernel one axis ahead, so that the lines arrive while the axis before
-    /// steps. An axis at rest reads a few lines of its own; those it would touch anyway.
+    /// steps. An axis at rest reads only its beat, which this reads to know.
     #[inline]
     pub(crate) fn prefetch_step(&self) {
         if self.beat.resting {

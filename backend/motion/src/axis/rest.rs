@@ -8,10 +8,11 @@
 //!
 //! What it repeats (the feedback and the setpoint) the kernel keeps in a [`Rest`] record per
 //! slot, side by side; what the step changes in the axis (the cycle, the dwell) and the flags
-//! it reads lie in the axis's [`Beat`], one cache line. So a standing axis costs the same
-//! with 256 axes as with 16 (nearly: docs/benchmarks.md, "Kernel cycle"), where it read 8
-//! lines spread over its 6 KB. The status's NcCycleCounter is the beat's cycle, put in when the status is read
-//! ([`Axis::status`]), so the step does not write the status's line either.
+//! it reads lie in the axis's [`Beat`], one cache line. The status's NcCycleCounter is the
+//! beat's cycle, put in when the status is read ([`Axis::status`]), so the step does not
+//! write the status's line either. With 256 axes a standing axis then costs 1.15–1.19 × what
+//! it costs with 16, where it read 8 lines spread over its 6 KB and cost 1.3–1.4 × (docs/
+//! benchmarks.md, "Kernel cycle").
 //!
 //! Entered after two full steps in a row that ended at rest with the same feedback and the
 //! same setpoint; left at the first cycle whose feedback differs in any bit, or after any
