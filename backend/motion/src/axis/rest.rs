@@ -36,8 +36,6 @@ pub(crate) struct Rest {
     fb: DriveFeedback,
     /// The setpoint it gave.
     out: DriveSetpoint,
-    /// InTargetPosition's dwell counts (the axis stands inside its target window).
-    in_window: bool,
     /// Debug builds: cycles checked against the full step (`step_at_rest_checked`).
     #[cfg(debug_assertions)]
     checks: u32,
@@ -139,7 +137,6 @@ impl Axis {
         *rest = Rest {
             fb: *fb,
             out: *out,
-            in_window: self.beat.in_window_timer > 0.0,
             #[cfg(debug_assertions)]
             checks: 0,
         };
@@ -155,7 +152,9 @@ impl Axis {
         out: &mut DriveSetpoint,
     ) {
         *out = rest.out;
-        if rest.in_window {
+        // The dwell counts while the axis stands in its window: then it is past 0 (`quiet`
+        // takes it at 0 or past its time), and a step at rest keeps it so.
+        if self.beat.in_window_timer > 0.0 {
             self.beat.in_window_timer += dt;
         }
         self.beat.cycle = cycle;
