@@ -2,7 +2,7 @@
 //! It holds what no single axis can see — the slots, the couplings between them and the order
 //! they are stepped in; everything else is the axis's (`axis/`).
 
-use crate::axis::{Axis, Master, MasterSample, Rest};
+use crate::axis::{Ahead, Axis, Master, MasterSample, Rest};
 use std::sync::Arc;
 
 use crate::cam::{Cam, CamStore};
@@ -504,14 +504,11 @@ impl Kernel {
         target < n && reached[target / 64] & (1 << (target % 64)) != 0
     }
 
-    /// Asks for the lines of the `k`th axis in the step order (none beyond the order's end
-    /// or for an empty slot).
-    fn prefetch_step(&self, k: usize) {
-        if let Some(&slot) = self.order.slots[..self.order.len].get(k) {
-            if let Some(axis) = self.axes[slot as usize].as_deref() {
-                axis.prefetch_step();
-            }
-        }
+    /// The `k`th axis in the step order, whose lines are asked for ahead of its step (none
+    /// beyond the order's end or for an empty slot).
+    fn ahead(&self, k: usize) -> Ahead {
+        let slot = self.order.slots[..self.order.len].get(k);
+        Ahead::of(slot.and_then(|&s| self.axes[s as usize].as_deref()))
     }
 
     /// One cycle: every axis reads its feedback, advances and writes its setpoint.
@@ -535,7 +532,7 @@ impl Kernel {
             g.step(&mut self.axes, cycle, events);
         }
         // The first axis's lines; each axis then asks for the next one's (`prefetch.rs`).
-        self.prefetch_step(0);
+        self.ahead(0).rest_from(0);
         // A slot beyond the feedback given reads as a drive that is not ready.
         let no_feedback = DriveFeedback::default();
         // … and a setpoint beyond those given goes nowhere (a step writes all of it).
@@ -545,8 +542,10 @@ impl Kernel {
             let Some(axis) = self.axes[i].as_deref() else {
                 continue;
             };
-            // The next axis's lines are on their way while this one steps (`prefetch.rs`).
-            self.prefetch_step(k + 1);
+            // The next axis's lines are on their way while this one steps, asked for in parts:
+            // the first now, the others from inside the step (`prefetch.rs`).
+            let ahead = self.ahead(k + 1);
+            ahead.part(0);
             let fb = feedback.get(i).unwrap_or(&no_feedback);
             // An axis at rest follows no master (it would not be at rest): it reads its rest
             // record and its beat, nothing else (`axis/rest.rs`).
@@ -560,6 +559,7 @@ impl Kernel {
                 axis.step_at_rest_checked(dt, fb, &self.cams, cycle, events, rest, out);
                 #[cfg(not(debug_assertions))]
                 axis.step_at_rest(dt, cycle, rest, out);
+                ahead.rest_from(1);
                 continue;
             }
             // Most axes follow no master: they skip the masters' bookkeeping (issue 27).
@@ -613,7 +613,7 @@ impl Kernel {
             }
             let out = setpoints.get_mut(i).unwrap_or(&mut spare);
             let rest = &mut self.rest[i];
-            axis.step(dt, fb, master, &self.cams, cycle, events, rest, out);
+            axis.step(dt, fb, master, &self.cams, cycle, events, rest, out, ahead);
             let masters_changed = if free {
                 debug_assert_eq!(
                     axis.follows_no_master(),

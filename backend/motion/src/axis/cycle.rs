@@ -16,6 +16,8 @@ impl Axis {
     /// in place (a 56-byte setpoint returned through the stack and copied again cost more
     /// than building it). `rest`: the kernel's rest record for this slot, kept up to date
     /// here; an axis at rest the kernel steps with [`Axis::step_at_rest`] (`rest.rs`).
+    /// `ahead`: the axis stepped next, whose lines this step asks for in parts as it goes
+    /// (`prefetch.rs`; the kernel asked for the first part).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn step(
         &mut self,
@@ -27,10 +29,11 @@ impl Axis {
         events: &mut impl EventSink,
         rest: &mut rest::Rest,
         out: &mut DriveSetpoint,
+        ahead: Ahead,
     ) {
         // The kernel steps an axis at rest without coming here (`rest.rs`).
         debug_assert!(!self.at_rest(fb, rest));
-        self.step_full(dt, fb, master, cams, cycle, events, out);
+        self.step_full(dt, fb, master, cams, cycle, events, out, ahead);
         self.settle_rest(fb, out, rest);
     }
 
@@ -45,6 +48,7 @@ impl Axis {
         cycle: u64,
         events: &mut impl EventSink,
         out: &mut DriveSetpoint,
+        ahead: Ahead,
     ) {
         if !(fb.actual_position.is_finite() && fb.actual_velocity.is_finite()) {
             // A drive that reports no number is a faulty drive; keep the last good values.
@@ -57,7 +61,7 @@ impl Axis {
                 actual_velocity: 0.0,
                 ..*fb
             };
-            return self.step_full(dt, &fb, master, cams, cycle, events, out);
+            return self.step_full(dt, &fb, master, cams, cycle, events, out, ahead);
         }
         let cx = &mut Ctx {
             slot: self.slot,
@@ -101,6 +105,7 @@ impl Axis {
         }
         // Power and drive readiness (notes 1, 2, 5).
         self.step_power(cx, dt, fb);
+        ahead.part(1);
 
         // Disabled: the setpoint follows the actual position.
         if self.mode == Mode::Disabled || (self.mode == Mode::ErrorStop && !fb.enabled) {
@@ -112,6 +117,7 @@ impl Axis {
                 self.job = None;
                 self.planner.clear();
             }
+            ahead.part(2);
         } else {
             // A coupled slave whose master is gone or in ErrorStop.
             let lost = match master {
@@ -128,6 +134,9 @@ impl Axis {
             }
             self.step_feed_enables(cx);
             self.step_job(cx, dt, fb, master);
+            // The next axis's last part: the monitors and the status, still to come, cover its
+            // way (`prefetch.rs`).
+            ahead.part(2);
             // Blocks marked idle are skipped (`idle.rs`).
             if !self.idle(Idle::PHASING) {
                 self.step_phasing(cx, dt);

@@ -82,6 +82,7 @@ use coupling::Coupling;
 use homing::HomeSeq;
 use job::{Ctx, DONE, End, Held, Job, JobKind, Phase};
 pub use master::{Master, MasterSample};
+pub(crate) use prefetch::Ahead;
 pub(crate) use rest::Rest;
 
 /// Static configuration of an axis (the base configuration the parameters start from).

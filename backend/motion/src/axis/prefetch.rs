@@ -1,8 +1,10 @@
 //! The lines of an axis that its next step will touch, asked for while the axis before it
 //! steps (issue 27). An axis is ≈ 6 KB (95 cache lines) and a moving step touches ≈ 31–33 of
 //! them, spread over it; with 256 axes they live in L2 instead of L1, and the step waited for
-//! them (a positioning axis 1.6 × as long per axis at 256 axes as at 16). A prefetch is only a
-//! hint: a span that no longer holds what a step touches costs a little time, never a result.
+//! them (a positioning axis 1.6 × as long per axis at 256 axes as at 16). They are asked for
+//! in [`PARTS`] parts spread over the step before ([`Ahead`]), not all at once. A prefetch is
+//! only a hint: a span that no longer holds what a step touches costs a little time, never a
+//! result.
 
 // Elsewhere than on x86-64 the prefetch is a no-op and the lines are not used.
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
@@ -148,19 +150,59 @@ const OFFSETS: [usize; COUNT] = {
 const _: () = assert!(size_of::<Axis>() <= 128 * 64);
 const _: () = assert!(core::mem::align_of::<Axis>() == 64);
 
-impl Axis {
-    /// Asks the core to bring the lines this axis's next step touches into its L1 cache.
-    /// Called by the kernel one axis ahead, so that the lines arrive while the axis before
-    /// steps. An axis at rest reads only its beat, which this reads to know.
+/// In how many parts the next axis's lines are asked for: the first before this axis steps,
+/// the second after its MC_Power part, the third after its job (`cycle.rs`). All ≈ 33 at
+/// once, as before, waited for the core's line-fill buffers (about a dozen misses in flight)
+/// before the step went on: at 256 axes, where the lines come from L2, a moving step cost
+/// 1.13–1.23 × per axis what it cost at 16, and 1.11–1.14 × with the requests in three parts
+/// (docs/benchmarks.md, "Kernel cycle").
+pub(crate) const PARTS: usize = 3;
+const PART: usize = COUNT.div_ceil(PARTS);
+// The parts cover every line, and none is empty.
+const _: () = assert!(PART * PARTS >= COUNT && PART * (PARTS - 1) < COUNT);
+
+/// The axis the kernel steps next, whose lines are asked for while this one steps. Only its
+/// address is kept: a prefetch reads nothing into the program, so the next axis is never
+/// read through it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ahead(*const Axis);
+
+impl Ahead {
+    /// No axis follows, or it rests: nothing to ask for.
+    pub(crate) const NONE: Ahead = Ahead(core::ptr::null());
+
+    /// `next`'s step is ahead. An axis at rest reads only its beat, which this reads to know.
     #[inline]
-    pub(crate) fn prefetch_step(&self) {
-        if self.beat.resting {
+    pub(crate) fn of(next: Option<&Axis>) -> Ahead {
+        match next {
+            Some(a) if !a.beat.resting => Ahead(a),
+            _ => Ahead::NONE,
+        }
+    }
+
+    /// Asks for the `n`th part of the lines (`n` < [`PARTS`]).
+    #[inline]
+    pub(crate) fn part(self, n: usize) {
+        self.parts(n, n + 1);
+    }
+
+    /// Asks for the parts from the `n`th on, at once (a step at rest is too short to spread
+    /// them over).
+    #[inline]
+    pub(crate) fn rest_from(self, n: usize) {
+        self.parts(n, PARTS);
+    }
+
+    #[inline]
+    fn parts(self, from: usize, to: usize) {
+        if self.0.is_null() {
             return;
         }
         #[cfg(target_arch = "x86_64")]
         {
-            let base = (self as *const Axis).cast::<i8>();
-            for offset in OFFSETS {
+            let base = self.0.cast::<i8>();
+            let lines = &OFFSETS[(from * PART).min(COUNT)..(to * PART).min(COUNT)];
+            for &offset in lines {
                 // SAFETY: SSE, which `_mm_prefetch` needs, is part of every x86-64 CPU; the
                 // address is made with `wrapping_add` and a prefetch never faults (it reads
                 // nothing into the program).

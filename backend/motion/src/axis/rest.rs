@@ -193,7 +193,16 @@ impl Axis {
         (self.beat.cycle, self.beat.in_window_timer) = kept;
         let mut counting = Counting(events, 0);
         let seq = self.beat.status_seq;
-        self.step_full(dt, fb, Master::Uncoupled, cams, cycle, &mut counting, out);
+        self.step_full(
+            dt,
+            fb,
+            Master::Uncoupled,
+            cams,
+            cycle,
+            &mut counting,
+            out,
+            Ahead::NONE,
+        );
         // The full step counts a status change; the rest step does not (it changes none).
         self.beat.status_seq = seq;
         let full_axis = if deep { self.digest() } else { 0 };
