@@ -532,7 +532,7 @@ impl Kernel {
             g.step(&mut self.axes, cycle, events);
         }
         // The first axis's lines; each axis then asks for the next one's (`prefetch.rs`).
-        self.ahead(0).rest_from(0);
+        self.ahead(0).all_from(0);
         // A slot beyond the feedback given reads as a drive that is not ready.
         let no_feedback = DriveFeedback::default();
         // … and a setpoint beyond those given goes nowhere (a step writes all of it).
@@ -559,7 +559,7 @@ impl Kernel {
                 axis.step_at_rest_checked(dt, fb, &self.cams, cycle, events, rest, out);
                 #[cfg(not(debug_assertions))]
                 axis.step_at_rest(dt, cycle, rest, out);
-                ahead.rest_from(1);
+                ahead.all_from(1);
                 continue;
             }
             // Most axes follow no master: they skip the masters' bookkeeping (issue 27).

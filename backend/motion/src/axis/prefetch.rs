@@ -151,11 +151,12 @@ const _: () = assert!(size_of::<Axis>() <= 128 * 64);
 const _: () = assert!(core::mem::align_of::<Axis>() == 64);
 
 /// In how many parts the next axis's lines are asked for: the first before this axis steps,
-/// the second after its MC_Power part, the third after its job (`cycle.rs`). All ≈ 33 at
-/// once, as before, waited for the core's line-fill buffers (about a dozen misses in flight)
-/// before the step went on: at 256 axes, where the lines come from L2, a moving step cost
-/// 1.13–1.23 × per axis what it cost at 16, and 1.11–1.14 × with the requests in three parts
-/// (docs/benchmarks.md, "Kernel cycle").
+/// the second after its MC_Power part, the third after its job or, disabled, its setpoint
+/// (`cycle.rs`). The parts go by offset, not by when the next step reads them: all of them are
+/// asked for before it begins. All ≈ 33 at once, as before, waited for the core's line-fill
+/// buffers (about a dozen misses in flight) before the step went on: at 256 axes, where the
+/// lines come from L2, a moving step cost 1.13–1.27 × per axis what it cost at 16, and
+/// 1.10–1.18 × with the requests in three parts (docs/benchmarks.md, "Kernel cycle").
 pub(crate) const PARTS: usize = 3;
 const PART: usize = COUNT.div_ceil(PARTS);
 // The parts cover every line, and none is empty.
@@ -183,17 +184,19 @@ impl Ahead {
     /// Asks for the `n`th part of the lines (`n` < [`PARTS`]).
     #[inline]
     pub(crate) fn part(self, n: usize) {
+        debug_assert!(n < PARTS);
         self.parts(n, n + 1);
     }
 
-    /// Asks for the parts from the `n`th on, at once (a step at rest is too short to spread
-    /// them over).
+    /// Asks for the parts from the `n`th on, at once: for the first axis, which no step
+    /// precedes, and after a step at rest, which is too short to spread them over.
     #[inline]
-    pub(crate) fn rest_from(self, n: usize) {
+    pub(crate) fn all_from(self, n: usize) {
         self.parts(n, PARTS);
     }
 
     #[inline]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
     fn parts(self, from: usize, to: usize) {
         if self.0.is_null() {
             return;
