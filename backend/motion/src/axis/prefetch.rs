@@ -151,12 +151,13 @@ const _: () = assert!(size_of::<Axis>() <= 128 * 64);
 const _: () = assert!(core::mem::align_of::<Axis>() == 64);
 
 /// In how many parts the next axis's lines are asked for: the first before this axis steps,
-/// the second after its MC_Power part, the third after its job or, disabled, its setpoint
-/// (`cycle.rs`). The parts go by offset, not by when the next step reads them: all of them are
-/// asked for before it begins. All ≈ 33 at once, as before, waited for the core's line-fill
-/// buffers (about a dozen misses in flight) before the step went on: at 256 axes, where the
-/// lines come from L2, a moving step cost 1.13–1.27 × per axis what it cost at 16, and
-/// 1.10–1.18 × with the requests in three parts (docs/benchmarks.md, "Kernel cycle").
+/// the second after its MC_Power part, the third after its job (a disabled axis: once its set
+/// values follow the actual position; `cycle.rs`). The parts go by offset, not by when the
+/// next step reads them: all of them are asked for before it begins. All ≈ 33 at once, as
+/// before, waited for the core's line-fill buffers (about a dozen misses in flight) before the
+/// step went on: at 256 axes, where the lines come from L2, a moving step cost 1.13–1.27 × per
+/// axis what it cost at 16, and 1.10–1.18 × with the requests in three parts
+/// (docs/benchmarks.md, "Kernel cycle").
 pub(crate) const PARTS: usize = 3;
 const PART: usize = COUNT.div_ceil(PARTS);
 // The parts cover every line, and none is empty.
