@@ -639,6 +639,21 @@ fn interpolation_period(cycle: Duration) -> (u8, i8) {
     }
 }
 
+/// ethercrab's timeouts for a bus with these options. Its EEPROM wait bounds a whole loop of
+/// frames that poll the EEPROM until it is not busy (ethercrab's own default, 10 ms, is shorter
+/// than one frame with its retries), and the EEPROM is read only while the segment is brought
+/// up, never in the cycle. So the bound is generous: at least 500 ms, and more than a frame
+/// with all its retries. With (retries + 2) frames as the bound, 40 ms at a 1 ms cycle, a
+/// loaded 2-core machine ended the bring-up of 64 emulated drives with "timeout: EEPROM"
+/// (`tests/bus.rs`); a long bound only delays the report of an EEPROM that stays busy.
+fn bring_up_timeouts(opts: &BusOptions) -> Timeouts {
+    Timeouts {
+        pdu: opts.pdu_timeout,
+        eeprom: (opts.pdu_timeout * (opts.retries as u32 + 2)).max(Duration::from_millis(500)),
+        ..Timeouts::default()
+    }
+}
+
 impl EthercatBus {
     /// Brings the segment up to OP (blocking; off the cycle thread). `slots`: the number of
     /// axis slots.
@@ -674,14 +689,7 @@ impl EthercatBus {
             txrx::spawn(tx, rx, wire, reopen, opts.pdu_timeout).map_err(|e| e.to_string())?;
         let md: &'static MainDevice<'static> = leak(MainDevice::new(
             pdu_loop,
-            Timeouts {
-                pdu: opts.pdu_timeout,
-                // ethercrab's EEPROM wait (10 ms) is shorter than a frame and its retries: one
-                // late reply during discovery would end the bring-up.
-                eeprom: (opts.pdu_timeout * (opts.retries as u32 + 2))
-                    .max(Timeouts::default().eeprom),
-                ..Timeouts::default()
-            },
+            bring_up_timeouts(opts),
             MainDeviceConfig {
                 dc_static_sync_iterations: 1000,
                 retry_behaviour: RetryBehaviour::Count(opts.retries),
@@ -1307,7 +1315,24 @@ impl DriveBus for EthercatBus {
 
 #[cfg(test)]
 mod tests {
-    use super::expected_working_counter;
+    use super::{BusOptions, Duration, bring_up_timeouts, expected_working_counter};
+
+    /// The EEPROM's wait outlasts a frame with all its retries, several times over, and a
+    /// machine that holds the bring-up's threads off for tens of milliseconds.
+    #[test]
+    fn the_eeprom_wait_outlasts_a_frame_and_its_retries() {
+        for cycle_us in [250, 1000, 4000, 10_000] {
+            let opts = BusOptions::new(Duration::from_micros(cycle_us));
+            let t = bring_up_timeouts(&opts);
+            assert_eq!(t.pdu, opts.pdu_timeout);
+            let frame_with_retries = opts.pdu_timeout * (opts.retries as u32 + 1);
+            assert!(t.eeprom > frame_with_retries * 4, "{cycle_us} µs: {t:?}");
+            assert!(
+                t.eeprom >= Duration::from_millis(500),
+                "{cycle_us} µs: {t:?}"
+            );
+        }
+    }
 
     #[test]
     fn a_subdevice_whose_image_straddles_two_frames_counts_in_both() {
